@@ -1,0 +1,1 @@
+# rostest integration tests: driver_node against a pseudo-terminal.

@@ -1,0 +1,18 @@
+# GoogleTest unit tests of the ROS-free core and simulator (no roscore needed).
+catkin_add_gtest(core_tests
+  test/unit/test_base_codec.cpp
+  test/unit/test_body_codec.cpp
+  test/unit/test_servo_bus_codec.cpp
+  test/unit/test_servo_params.cpp
+  test/unit/test_stream_framer.cpp
+  test/unit/test_diff_drive.cpp
+  test/unit/test_transport.cpp
+  test/unit/test_device.cpp
+  test/unit/test_sim.cpp)
+target_link_libraries(core_tests srd_core srd_sim)
+
+# Conversions and parameter validation of the ROS layer (pure functions, no roscore needed).
+catkin_add_gtest(ros_layer_tests
+  test/unit/test_conversions.cpp
+  test/unit/test_driver_params.cpp)
+target_link_libraries(ros_layer_tests srd_ros)

@@ -1,0 +1,78 @@
+// UART bus servo protocol (PROTOCOLS.md section 3).
+//
+//   request  12 4C | CMD | N | CONTENT (N) | SUM
+//   response 05 1C | CMD | N | CONTENT (N) | SUM
+// SUM = sum of all preceding bytes mod 256; multi-byte values little-endian.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "serial_robot_driver/protocol/decode_result.h"
+#include "serial_robot_driver/protocol/servo_params.h"
+
+namespace serial_robot_driver::protocol::servo {
+
+constexpr uint8_t kRequestHeader0 = 0x12;
+constexpr uint8_t kRequestHeader1 = 0x4C;
+constexpr uint8_t kResponseHeader0 = 0x05;
+constexpr uint8_t kResponseHeader1 = 0x1C;
+constexpr std::size_t kOverhead = 5;  ///< header (2), CMD, N, SUM
+/// Longest CONTENT of any command: WRITE_BATCH_DATA / READ_BATCH_DATA reply = id + 32 bytes.
+constexpr uint8_t kMaxContent = 1 + kUserBlockSize;
+constexpr std::size_t kMaxFrameSize = kMaxContent + kOverhead;
+constexpr uint8_t kBroadcastId = 255;
+constexpr uint8_t kMaxServoId = 254;
+
+enum class Command : uint8_t {
+  kPing = 1,
+  kResetUserData = 2,
+  kReadData = 3,
+  kWriteData = 4,
+  kReadBatchData = 5,
+  kWriteBatchData = 6,
+  kSpin = 7,
+  kRotate = 8,
+  kDamping = 9,
+  kReadAngle = 10,
+};
+constexpr uint8_t kMinCommand = 1;
+constexpr uint8_t kMaxCommand = 10;
+
+uint8_t byteSum(const uint8_t* data, std::size_t size);
+
+/// SPIN method byte: bit 7 direction, bits 1..0 mode.
+enum class SpinMode : uint8_t { kStop = 0, kContinuous = 1, kTurns = 2, kDurationMs = 3 };
+uint8_t spinMethod(bool clockwise, SpinMode mode);
+
+std::vector<uint8_t> encodePing(uint8_t id);
+std::vector<uint8_t> encodeResetUserData(uint8_t id);
+std::vector<uint8_t> encodeReadData(uint8_t id, uint8_t data_id);
+/// `value` must have passed checkWrite for `param`.
+std::vector<uint8_t> encodeWriteData(uint8_t id, const ParamInfo& param, int64_t value);
+std::vector<uint8_t> encodeReadBatchData(uint8_t id);
+std::vector<uint8_t> encodeWriteBatchData(uint8_t id, const std::array<uint8_t, kUserBlockSize>& block);
+std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint16_t speed_dps, uint16_t value);
+std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms, uint16_t power_mw);
+std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw);
+std::vector<uint8_t> encodeReadAngle(uint8_t id);
+
+/// A request or response packet after header/length/sum checks.
+struct Packet {
+  uint8_t cmd = 0;
+  uint8_t content_size = 0;
+  std::array<uint8_t, kMaxContent> content{};
+  uint8_t id() const { return content_size > 0 ? content[0] : 0; }
+};
+
+/// Decodes one complete response (05 1C ...) or request (12 4C ..., for the simulator and for
+/// recognising the half-duplex echo of our own request).
+Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size);
+Decoded<Packet> decodeRequest(const uint8_t* data, std::size_t size);
+
+/// Builds a response packet (simulator side).
+std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& content);
+
+}  // namespace serial_robot_driver::protocol::servo

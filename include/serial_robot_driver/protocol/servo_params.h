@@ -1,0 +1,58 @@
+// The UART bus servo parameter table (PROTOCOLS.md section 3): data_id, name, wire type, unit and
+// safety flags in one place, so validation, encoding and the services read the same facts.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace serial_robot_driver::protocol::servo {
+
+enum class ParamType { kU8, kU16, kU32, kI16 };
+
+std::size_t typeSize(ParamType type);
+int64_t typeMin(ParamType type);
+int64_t typeMax(ParamType type);
+
+struct ParamInfo {
+  uint8_t data_id;
+  std::string_view name;
+  ParamType type;
+  std::string_view unit;  ///< "mV", "mA", "mW", "degC", "ms", "0.1deg" or "" (raw)
+  bool read_only;
+  bool dangerous;  ///< can make the servo unreachable: refused unless explicitly allowed
+  int64_t min;     ///< allowed range for writes (the type's range unless the datasheet narrows it)
+  int64_t max;
+};
+
+constexpr std::size_t kParamCount = 30;
+const std::array<ParamInfo, kParamCount>& paramTable();
+
+/// Looks a parameter up by name ("voltage"; both "temperature" and the vendor's "temprature") or
+/// by its numeric data_id written as text ("51"). nullptr when unknown.
+const ParamInfo* findParam(std::string_view name_or_id);
+const ParamInfo* findParamById(uint8_t data_id);
+
+/// The read-write user block (ids 32..53 packed in order) is 32 bytes.
+constexpr std::size_t kUserBlockSize = 32;
+constexpr uint8_t kFirstUserParamId = 32;
+constexpr uint8_t kLastUserParamId = 53;
+
+enum class WriteCheck { kOk, kReadOnly, kOutOfRange, kDangerous };
+/// Checks a write before any byte is encoded. `allow_dangerous` arms servo_id/baudrate writes.
+WriteCheck checkWrite(const ParamInfo& param, int64_t value, bool allow_dangerous);
+/// A sentence for a failed check, naming the parameter and the allowed range.
+std::string describe(WriteCheck check, const ParamInfo& param, int64_t value);
+
+/// Reads a value of `param`'s type from little-endian bytes (`size` must be typeSize).
+std::optional<int64_t> readValue(const ParamInfo& param, const uint8_t* data, std::size_t size);
+/// Writes a value already checked by checkWrite; returns the number of bytes written.
+std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out);
+
+/// Byte offset of a user-block parameter inside the 32-byte block, nullopt for read-only ones.
+std::optional<std::size_t> userBlockOffset(const ParamInfo& param);
+
+}  // namespace serial_robot_driver::protocol::servo

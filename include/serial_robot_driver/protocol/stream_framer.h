@@ -1,0 +1,87 @@
+// One stream framer per serial port: it takes byte chunks of any size, finds complete frames of the
+// families it is configured for, verifies them (length rules, checksum, tail) and hands each one to
+// a callback together with its family. Several devices can therefore share one port: their inbound
+// headers differ (PROTOCOLS.md, table at the top).
+//
+// Design (after kobuki's packet finder and novatel's multi-family extractor):
+//  - fixed-size buffer, no heap allocation after construction;
+//  - on garbage, a bad checksum/tail or an impossible LEN, drop ONE byte and rescan, so a real
+//    frame hidden inside a broken one is still found;
+//  - a frame whose length is plausible but which is not complete yet is kept until more bytes come.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+namespace serial_robot_driver::protocol {
+
+enum class FrameFamily : uint8_t {
+  kBase = 0,          ///< 55 AA, XOR (both directions share the layout)
+  kTelemetry,         ///< 12 34 ... SUM 1F 2F (board -> host)
+  kServoResponse,     ///< 05 1C, sum (servo -> host)
+  kServoRequest,      ///< 12 4C, sum (host -> servo; the half-duplex echo, or the simulator's input)
+  kSyncWrite,         ///< FF FF FD 00, CRC-16 (host -> board; the simulator's input)
+};
+constexpr std::size_t kFrameFamilyCount = 5;
+const char* toString(FrameFamily family);
+
+struct FramerConfig {
+  bool base = false;
+  bool telemetry = false;
+  bool servo_response = false;
+  bool servo_request = false;
+  bool sync_write = false;
+  /// Telemetry LEN must equal 24 + 4N or 40 + 4N for this N.
+  std::size_t telemetry_servo_count = 0;
+
+  /// What the driver listens for on a port shared by the given devices.
+  static FramerConfig forDriver(bool base, bool body, bool servo_bus, std::size_t servo_count);
+  /// What the simulator listens for.
+  static FramerConfig forSimulator();
+};
+
+struct FramerStats {
+  uint64_t bytes_in = 0;
+  uint64_t bytes_skipped = 0;     ///< bytes dropped while resynchronising
+  uint64_t checksum_errors = 0;   ///< complete candidates whose XOR/sum/CRC failed
+  uint64_t bad_tails = 0;         ///< telemetry with a wrong 1F 2F tail
+  uint64_t bad_lengths = 0;       ///< impossible LEN bytes
+  std::array<uint64_t, kFrameFamilyCount> frames{};  ///< verified frames per family
+};
+
+class StreamFramer {
+ public:
+  /// Called for every verified frame; `data` is valid only during the call.
+  using FrameHandler = std::function<void(FrameFamily family, const uint8_t* data, std::size_t size)>;
+
+  /// Large enough for several of the longest frames (telemetry: 255 bytes).
+  static constexpr std::size_t kBufferSize = 4096;
+
+  StreamFramer(const FramerConfig& config, FrameHandler handler);
+
+  /// Feeds bytes as they arrived from the port; calls the handler for each complete frame.
+  void feed(const uint8_t* data, std::size_t size);
+  /// Drops buffered bytes (after a reconnect the old partial frame is meaningless).
+  void reset();
+
+  const FramerStats& stats() const { return stats_; }
+  const FramerConfig& config() const { return config_; }
+  std::size_t buffered() const { return size_; }
+
+ private:
+  enum class Candidate { kFrame, kNeedMore, kInvalid };
+  /// Examines the bytes at buffer_[pos..size_): a complete verified frame (its size in *frame_size),
+  /// a plausible but incomplete one, or not a frame at this position.
+  Candidate examine(std::size_t pos, std::size_t* frame_size, FrameFamily* family);
+  void scan();
+
+  FramerConfig config_;
+  FrameHandler handler_;
+  FramerStats stats_;
+  std::array<uint8_t, kBufferSize> buffer_{};
+  std::size_t size_ = 0;
+};
+
+}  // namespace serial_robot_driver::protocol

@@ -1,0 +1,40 @@
+// The transport seen by the rest of the driver: a byte stream that can be opened, read with a
+// timeout, written and closed. SerialPort implements it with termios; tests use a pseudo-terminal
+// or an in-memory fake.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace serial_robot_driver::transport {
+
+/// Why a transport operation failed. kDisconnected covers EOF, EIO (a pty whose other end closed,
+/// an unplugged USB adapter) and a device node that disappeared.
+enum class TransportErrorKind { kOpenFailed, kConfigureFailed, kDisconnected, kIoError };
+
+class TransportError : public std::runtime_error {
+ public:
+  TransportError(TransportErrorKind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
+  TransportErrorKind kind() const { return kind_; }
+
+ private:
+  TransportErrorKind kind_;
+};
+
+class ByteStream {
+ public:
+  virtual ~ByteStream() = default;
+  virtual void open() = 0;
+  virtual void close() = 0;
+  virtual bool isOpen() const = 0;
+  /// Waits up to `timeout_ms` for data and returns what arrived (0 on timeout: not an error).
+  /// Throws TransportError when the device is gone.
+  virtual std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms) = 0;
+  /// Writes all bytes or throws TransportError.
+  virtual void write(const uint8_t* data, std::size_t size) = 0;
+  virtual std::string name() const = 0;
+};
+
+}  // namespace serial_robot_driver::transport
