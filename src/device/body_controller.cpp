@@ -1,1 +1,148 @@
-// placeholder: being written
+#include "serial_robot_driver/device/body_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace serial_robot_driver::device {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+double radiansPerTick(const JointCalibration& calibration) {
+  return kTwoPi / static_cast<double>(calibration.ticks_per_revolution);
+}
+
+}  // namespace
+
+double JointCalibration::toRadians(uint16_t ticks) const {
+  return direction * (static_cast<double>(ticks) - zero_ticks) * radiansPerTick(*this);
+}
+
+double JointCalibration::toRadiansPerSecond(int16_t raw_speed) const {
+  if (velocity_scale != 0.0) return direction * velocity_scale * raw_speed;
+  return direction * raw_speed * radiansPerTick(*this);
+}
+
+std::optional<uint16_t> JointCalibration::toTicks(double radians) const {
+  if (!std::isfinite(radians)) return std::nullopt;
+  // direction is +-1, so dividing by it is multiplying by it.
+  const double ticks = zero_ticks + direction * radians / radiansPerTick(*this);
+  const double clamped =
+      std::clamp(std::round(ticks), 0.0, static_cast<double>(std::numeric_limits<uint16_t>::max()));
+  return static_cast<uint16_t>(clamped);
+}
+
+std::string JointCommandResult::message() const {
+  switch (status) {
+    case JointCommandStatus::kSent:
+      return "sent";
+    case JointCommandStatus::kEmpty:
+      return "joint command names no joint";
+    case JointCommandStatus::kLengthMismatch:
+      return "joint command has different numbers of names and positions";
+    case JointCommandStatus::kUnknownJoint:
+      return "joint command names unknown joint '" + joint + "'";
+    case JointCommandStatus::kDuplicateJoint:
+      return "joint command names joint '" + joint + "' more than once";
+    case JointCommandStatus::kNotFinite:
+      return "joint command has a NaN or infinite position for joint '" + joint + "'";
+    case JointCommandStatus::kWriteFailed:
+      return "joint command not written: the body port is not connected";
+  }
+  return "unknown joint command status";
+}
+
+BodyController::BodyController(std::vector<BodyJoint> joints, WriteFunction write,
+                               TelemetryCallback on_telemetry)
+    : joints_(std::move(joints)),
+      write_(std::move(write)),
+      on_telemetry_(std::move(on_telemetry)),
+      last_commanded_ticks_(joints_.size()) {}
+
+BodyController::WriteFunction BodyController::writerFor(SerialLink& link) {
+  return [&link](const std::vector<uint8_t>& frame) { return link.write(frame); };
+}
+
+void BodyController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+                             Clock::time_point arrival) {
+  // A shared port hands every listener every frame: only telemetry is ours.
+  if (family != protocol::FrameFamily::kTelemetry) return;
+  const auto telemetry = protocol::body::decodeTelemetry(data, size, joints_.size());
+  if (!telemetry) {
+    decode_errors_.fetch_add(1);
+    last_decode_error_.store(static_cast<int>(telemetry.error()));
+    return;
+  }
+  frames_decoded_.fetch_add(1);
+  if (on_telemetry_) on_telemetry_(*telemetry, arrival);
+}
+
+JointCommandResult BodyController::sendJointCommand(const std::vector<std::string>& names,
+                                                    const std::vector<double>& positions) {
+  JointCommandResult result;
+  std::vector<std::optional<uint16_t>> requested(joints_.size());
+
+  // Validate the whole command before touching any state: a bad command must not half-apply.
+  if (names.empty()) {
+    result.status = JointCommandStatus::kEmpty;
+  } else if (names.size() != positions.size()) {
+    result.status = JointCommandStatus::kLengthMismatch;
+  } else {
+    for (std::size_t i = 0; i < names.size() && result.ok(); ++i) {
+      const auto joint = std::find_if(joints_.begin(), joints_.end(),
+                                      [&](const BodyJoint& j) { return j.name == names[i]; });
+      result.joint = names[i];
+      if (joint == joints_.end()) {
+        result.status = JointCommandStatus::kUnknownJoint;
+        break;
+      }
+      const std::size_t index = static_cast<std::size_t>(joint - joints_.begin());
+      if (requested[index]) {
+        result.status = JointCommandStatus::kDuplicateJoint;
+        break;
+      }
+      requested[index] = joint->calibration.toTicks(positions[i]);
+      if (!requested[index]) result.status = JointCommandStatus::kNotFinite;
+    }
+    if (result.ok()) result.joint.clear();
+  }
+
+  std::lock_guard<std::mutex> lock(command_mutex_);
+  if (!result.ok()) {
+    ++commands_rejected_;
+    return result;
+  }
+  std::vector<protocol::body::ServoTarget> targets;
+  targets.reserve(joints_.size());
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    if (requested[i]) last_commanded_ticks_[i] = requested[i];
+    if (last_commanded_ticks_[i])
+      targets.push_back({joints_[i].servo_id, *last_commanded_ticks_[i]});
+  }
+  // Writing under the lock keeps frames in the order their positions were stored.
+  if (!write_ || !write_(protocol::body::encodeSyncWrite(targets))) {
+    ++write_failures_;
+    result.status = JointCommandStatus::kWriteFailed;
+    return result;
+  }
+  ++commands_sent_;
+  return result;
+}
+
+BodyStats BodyController::stats() const {
+  BodyStats stats;
+  stats.frames_decoded = frames_decoded_.load();
+  stats.decode_errors = decode_errors_.load();
+  const int last_error = last_decode_error_.load();
+  if (last_error >= 0) stats.last_decode_error = static_cast<protocol::DecodeError>(last_error);
+  std::lock_guard<std::mutex> lock(command_mutex_);
+  stats.commands_sent = commands_sent_;
+  stats.commands_rejected = commands_rejected_;
+  stats.write_failures = write_failures_;
+  return stats;
+}
+
+}  // namespace serial_robot_driver::device

@@ -1,1 +1,210 @@
-// placeholder: being written
+#include "serial_robot_driver/protocol/servo_params.h"
+
+#include <limits>
+
+#include "serial_robot_driver/protocol/byte_order.h"
+
+namespace serial_robot_driver::protocol::servo {
+
+namespace {
+
+constexpr int64_t kU8Max = std::numeric_limits<uint8_t>::max();
+constexpr int64_t kU16Max = std::numeric_limits<uint16_t>::max();
+constexpr int64_t kU32Max = std::numeric_limits<uint32_t>::max();
+constexpr int64_t kI16Min = std::numeric_limits<int16_t>::min();
+constexpr int64_t kI16Max = std::numeric_limits<int16_t>::max();
+
+constexpr ParamInfo readOnly(uint8_t id, std::string_view name, ParamType type,
+                             std::string_view unit, int64_t max) {
+  return ParamInfo{id, name, type, unit, true, false, 0, max};
+}
+constexpr ParamInfo readWrite(uint8_t id, std::string_view name, ParamType type,
+                              std::string_view unit, int64_t min, int64_t max,
+                              bool dangerous = false) {
+  return ParamInfo{id, name, type, unit, false, dangerous, min, max};
+}
+
+// PROTOCOLS.md section 3. Ranges are the type's unless the datasheet narrows them.
+constexpr std::array<ParamInfo, kParamCount> kParams = {{
+    readOnly(1, "voltage", ParamType::kU16, "mV", kU16Max),
+    readOnly(2, "current", ParamType::kU16, "mA", kU16Max),
+    readOnly(3, "power", ParamType::kU16, "mW", kU16Max),
+    readOnly(4, "temperature", ParamType::kU16, "degC", kU16Max),
+    readOnly(5, "servo_status", ParamType::kU8, "", kU8Max),
+    readOnly(6, "servo_type", ParamType::kU16, "", kU16Max),
+    readOnly(7, "firmware_version", ParamType::kU16, "", kU16Max),
+    readOnly(8, "serial_number", ParamType::kU32, "", kU32Max),
+    readWrite(32, "reserved_32", ParamType::kU8, "", 0, kU8Max),
+    readWrite(33, "response_switch", ParamType::kU8, "", 0, 1),
+    // Changes the address the servo answers to: a mistake loses the servo.
+    readWrite(34, "servo_id", ParamType::kU8, "", 0, 254, true),
+    readWrite(35, "reserved_35", ParamType::kU8, "", 0, kU8Max),
+    // Takes effect at once: the servo stops understanding us at our baud rate.
+    readWrite(36, "baudrate", ParamType::kU8, "", 1, 7, true),
+    readWrite(37, "stall_protect_mode", ParamType::kU8, "", 0, kU8Max),
+    readWrite(38, "stall_power_limit", ParamType::kU16, "mW", 0, kU16Max),
+    readWrite(39, "over_volt_low", ParamType::kU16, "mV", 0, kU16Max),
+    readWrite(40, "over_volt_high", ParamType::kU16, "mV", 0, kU16Max),
+    readWrite(41, "over_temperature", ParamType::kU16, "degC", 0, kU16Max),
+    readWrite(42, "over_power", ParamType::kU16, "mW", 0, kU16Max),
+    readWrite(43, "over_current", ParamType::kU16, "mA", 0, kU16Max),
+    readWrite(44, "accel_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(45, "reserved_45", ParamType::kU8, "", 0, kU8Max),
+    readWrite(46, "po_lock_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(47, "wb_lock_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(48, "angle_limit_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(49, "soft_start_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(50, "soft_start_time", ParamType::kU16, "ms", 0, kU16Max),
+    readWrite(51, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(52, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(53, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+}};
+
+// The vendor's spellings, accepted so that names copied from its datasheet work.
+struct NameAlias {
+  std::string_view vendor;
+  std::string_view canonical;
+};
+constexpr std::array<NameAlias, 2> kAliases = {{
+    {"temprature", "temperature"},
+    {"over_temprature", "over_temperature"},
+}};
+
+// Parses a plain decimal data_id ("51"); no sign, no spaces, no trailing characters.
+std::optional<uint8_t> parseDataId(std::string_view text) {
+  constexpr std::size_t kMaxDigits = 3;
+  if (text.empty() || text.size() > kMaxDigits) return std::nullopt;
+  int value = 0;
+  for (char c : text) {
+    if (c < '0' || c > '9') return std::nullopt;
+    value = value * 10 + (c - '0');
+  }
+  if (value > std::numeric_limits<uint8_t>::max()) return std::nullopt;
+  return static_cast<uint8_t>(value);
+}
+
+std::string label(const ParamInfo& param) {
+  return "'" + std::string(param.name) + "' (id " + std::to_string(param.data_id) + ")";
+}
+
+}  // namespace
+
+std::size_t typeSize(ParamType type) {
+  switch (type) {
+    case ParamType::kU8:
+      return 1;
+    case ParamType::kU16:
+    case ParamType::kI16:
+      return 2;
+    case ParamType::kU32:
+      return 4;
+  }
+  return 0;
+}
+
+int64_t typeMin(ParamType type) { return type == ParamType::kI16 ? kI16Min : 0; }
+
+int64_t typeMax(ParamType type) {
+  switch (type) {
+    case ParamType::kU8:
+      return kU8Max;
+    case ParamType::kU16:
+      return kU16Max;
+    case ParamType::kU32:
+      return kU32Max;
+    case ParamType::kI16:
+      return kI16Max;
+  }
+  return 0;
+}
+
+const std::array<ParamInfo, kParamCount>& paramTable() { return kParams; }
+
+const ParamInfo* findParamById(uint8_t data_id) {
+  for (const ParamInfo& param : kParams) {
+    if (param.data_id == data_id) return &param;
+  }
+  return nullptr;
+}
+
+const ParamInfo* findParam(std::string_view name_or_id) {
+  for (const NameAlias& alias : kAliases) {
+    if (name_or_id == alias.vendor) {
+      name_or_id = alias.canonical;
+      break;
+    }
+  }
+  for (const ParamInfo& param : kParams) {
+    if (param.name == name_or_id) return &param;
+  }
+  if (const std::optional<uint8_t> id = parseDataId(name_or_id)) return findParamById(*id);
+  return nullptr;
+}
+
+WriteCheck checkWrite(const ParamInfo& param, int64_t value, bool allow_dangerous) {
+  if (param.read_only) return WriteCheck::kReadOnly;
+  if (value < param.min || value > param.max) return WriteCheck::kOutOfRange;
+  if (param.dangerous && !allow_dangerous) return WriteCheck::kDangerous;
+  return WriteCheck::kOk;
+}
+
+std::string describe(WriteCheck check, const ParamInfo& param, int64_t value) {
+  switch (check) {
+    case WriteCheck::kOk:
+      return "value " + std::to_string(value) + " for parameter " + label(param) + " is valid";
+    case WriteCheck::kReadOnly:
+      return "parameter " + label(param) + " is read-only";
+    case WriteCheck::kOutOfRange:
+      return "value " + std::to_string(value) + " out of range " + std::to_string(param.min) +
+             ".." + std::to_string(param.max) + " for parameter " + label(param);
+    case WriteCheck::kDangerous:
+      return "writing parameter " + label(param) +
+             " can make the servo unreachable; refused because dangerous writes are not allowed";
+  }
+  return "unknown write check result";
+}
+
+std::optional<int64_t> readValue(const ParamInfo& param, const uint8_t* data, std::size_t size) {
+  if (size != typeSize(param.type)) return std::nullopt;
+  switch (param.type) {
+    case ParamType::kU8:
+      return data[0];
+    case ParamType::kU16:
+      return readLE16(data);
+    case ParamType::kI16:
+      return readLE16Signed(data);
+    case ParamType::kU32:
+      return readLE32(data);
+  }
+  return std::nullopt;
+}
+
+std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out) {
+  switch (param.type) {
+    case ParamType::kU8:
+      out[0] = static_cast<uint8_t>(value);
+      break;
+    case ParamType::kU16:
+    case ParamType::kI16:
+      // Two's complement: the low 16 bits of a negative i16 are its wire form.
+      writeLE16(out, static_cast<uint16_t>(value));
+      break;
+    case ParamType::kU32:
+      writeLE32(out, static_cast<uint32_t>(value));
+      break;
+  }
+  return typeSize(param.type);
+}
+
+std::optional<std::size_t> userBlockOffset(const ParamInfo& param) {
+  if (param.data_id < kFirstUserParamId || param.data_id > kLastUserParamId) return std::nullopt;
+  std::size_t offset = 0;
+  for (const ParamInfo& other : kParams) {
+    if (other.data_id < kFirstUserParamId) continue;
+    if (other.data_id == param.data_id) return offset;
+    offset += typeSize(other.type);
+  }
+  return std::nullopt;
+}
+
+}  // namespace serial_robot_driver::protocol::servo

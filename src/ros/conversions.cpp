@@ -1,1 +1,136 @@
-// placeholder: being written
+#include "serial_robot_driver/ros/conversions.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+
+namespace serial_robot_driver::ros_layer {
+
+namespace body = protocol::body;
+
+ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time& ros_now,
+                    std::chrono::steady_clock::time_point steady_now) {
+  const auto age = std::chrono::duration_cast<std::chrono::nanoseconds>(steady_now - event);
+  const ros::Duration age_ros(std::chrono::duration<double>(age).count());
+  // An event "in the future" (clock read order) is now; one before the epoch is the epoch.
+  if (age_ros <= ros::Duration(0)) return ros_now;
+  if (ros_now.toSec() <= age_ros.toSec()) return ros::Time(0);
+  return ros_now - age_ros;
+}
+
+ros::Time toRosTime(std::chrono::steady_clock::time_point event) {
+  // Read both clocks back to back so the offset between them is as exact as it can be.
+  const auto steady_now = std::chrono::steady_clock::now();
+  const ros::Time ros_now = ros::Time::now();
+  return toRosTime(event, ros_now, steady_now);
+}
+
+std::vector<device::BodyJoint> makeBodyJoints(const BodyParams& params) {
+  std::vector<device::BodyJoint> joints(params.servo_ids.size());
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    device::BodyJoint& joint = joints[i];
+    joint.servo_id = static_cast<uint8_t>(params.servo_ids[i]);
+    joint.name = i < params.joint_names.size() ? params.joint_names[i] : "";
+    if (i < params.zero_ticks.size()) joint.calibration.zero_ticks = params.zero_ticks[i];
+    if (i < params.directions.size()) joint.calibration.direction = params.directions[i];
+    joint.calibration.ticks_per_revolution = params.ticks_per_revolution;
+    joint.calibration.velocity_scale = params.velocity_scale;
+  }
+  return joints;
+}
+
+geometry_msgs::Quaternion quaternionFromRollPitchYaw(double roll, double pitch, double yaw) {
+  const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
+  geometry_msgs::Quaternion msg;
+  msg.x = q.x();
+  msg.y = q.y();
+  msg.z = q.z();
+  msg.w = q.w();
+  return msg;
+}
+
+sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
+                                     const std::vector<device::BodyJoint>& joints,
+                                     const ros::Time& stamp) {
+  sensor_msgs::JointState msg;
+  msg.header.stamp = stamp;
+  const std::size_t count = std::min(joints.size(), telemetry.servo_count);
+  msg.name.reserve(count);
+  msg.position.reserve(count);
+  msg.velocity.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const device::JointCalibration& calibration = joints[i].calibration;
+    msg.name.push_back(joints[i].name);
+    msg.position.push_back(calibration.toRadians(telemetry.servos[i].position));
+    msg.velocity.push_back(calibration.toRadiansPerSecond(telemetry.servos[i].speed));
+  }
+  return msg;
+}
+
+sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params,
+                       const ros::Time& stamp) {
+  sensor_msgs::Imu msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = params.frame_id;
+  const auto& raw = telemetry.imu;
+  msg.linear_acceleration.x = raw[body::kAccelX] * params.accel_scale;
+  msg.linear_acceleration.y = raw[body::kAccelY] * params.accel_scale;
+  msg.linear_acceleration.z = raw[body::kAccelZ] * params.accel_scale;
+  msg.angular_velocity.x = raw[body::kGyroX] * params.gyro_scale;
+  msg.angular_velocity.y = raw[body::kGyroY] * params.gyro_scale;
+  msg.angular_velocity.z = raw[body::kGyroZ] * params.gyro_scale;
+  msg.orientation = quaternionFromRollPitchYaw(raw[body::kRoll] * params.angle_scale,
+                                               raw[body::kPitch] * params.angle_scale,
+                                               raw[body::kYaw] * params.angle_scale);
+  // Row-major 3x3 matrices: the diagonal is elements 0, 4, 8.
+  for (std::size_t i = 0; i < 3; ++i) {
+    msg.orientation_covariance[4 * i] = params.orientation_variance;
+    msg.angular_velocity_covariance[4 * i] = params.angular_velocity_variance;
+    msg.linear_acceleration_covariance[4 * i] = params.linear_acceleration_variance;
+  }
+  if (params.orientation_variance < 0) {
+    // REP-145: element 0 = -1 says "no orientation estimate"; the rest is ignored.
+    msg.orientation_covariance = {};
+    msg.orientation_covariance[0] = -1.0;
+  }
+  return msg;
+}
+
+std::optional<serial_robot_driver::FootPressure> toFootPressure(const body::Telemetry& telemetry,
+                                                                const ros::Time& stamp,
+                                                                const std::string& frame_id) {
+  if (!telemetry.has_foot) return std::nullopt;
+  serial_robot_driver::FootPressure msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame_id;
+  for (std::size_t j = 0; j < body::kFootSensorCount; ++j) msg.pressure[j] = telemetry.foot[j];
+  return msg;
+}
+
+serial_robot_driver::Telemetry toTelemetryMsg(const body::Telemetry& telemetry,
+                                              const std::vector<device::BodyJoint>& joints,
+                                              const ros::Time& stamp) {
+  serial_robot_driver::Telemetry msg;
+  msg.header.stamp = stamp;
+  const std::size_t count = telemetry.servo_count;
+  msg.servo_ids.resize(count);
+  msg.positions.resize(count);
+  msg.speeds.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    // Ids come from the configuration: the frame itself does not carry them.
+    msg.servo_ids[i] = i < joints.size() ? joints[i].servo_id : 0;
+    msg.positions[i] = telemetry.servos[i].position;
+    msg.speeds[i] = telemetry.servos[i].speed;
+  }
+  for (std::size_t k = 0; k < body::kImuValueCount; ++k) msg.imu[k] = telemetry.imu[k];
+  msg.has_foot = telemetry.has_foot;
+  if (telemetry.has_foot) msg.foot.assign(telemetry.foot.begin(), telemetry.foot.end());
+  return msg;
+}
+
+JointCommand fromJointState(const sensor_msgs::JointState& msg) {
+  return JointCommand{msg.name, msg.position};
+}
+
+}  // namespace serial_robot_driver::ros_layer

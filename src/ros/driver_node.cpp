@@ -1,1 +1,140 @@
-// placeholder: being written
+#include "serial_robot_driver/ros/driver_node.h"
+
+#include "serial_robot_driver/ros/base_interface.h"
+#include "serial_robot_driver/ros/body_interface.h"
+#include "serial_robot_driver/ros/servo_bus_interface.h"
+
+namespace serial_robot_driver::ros_layer {
+
+/// Logs a port's comings and goings once per event (reader thread), and the USB latency hint.
+class PortMonitor : public device::LinkListener {
+ public:
+  explicit PortMonitor(const device::SerialLink& link) : link_(link) {}
+
+  void onLinkUp() override {
+    const device::LinkStats stats = link_.stats();
+    ROS_INFO("port %s connected (low latency: %s)", link_.options().path.c_str(),
+             stats.low_latency ? "yes" : "not supported");
+    if (stats.latency_timer_ms && *stats.latency_timer_ms > 1) {
+      ROS_WARN("port %s: the USB-serial adapter's latency_timer is %d ms, which delays every frame; "
+               "set it to 1 ms with a udev rule (see config/99-serial-robot.rules)",
+               link_.options().path.c_str(), *stats.latency_timer_ms);
+    }
+  }
+  void onLinkDown() override {
+    ROS_WARN("port %s lost (%s); reopening every %.1f s", link_.options().path.c_str(),
+             link_.stats().last_error.c_str(), link_.options().reconnect_interval);
+  }
+  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t, device::Clock::time_point) override {}
+
+ private:
+  const device::SerialLink& link_;
+};
+
+DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params)
+    : nh_(nh), params_(std::move(params)), diagnostics_(nh, private_nh) {
+  diagnostics_.setHardwareID("serial_robot_driver");
+
+  // Devices naming the same path share one port, one reader thread and one framer.
+  struct Users {
+    bool base = false, body = false, servo_bus = false;
+    int baud = 0;
+  };
+  std::map<std::string, Users> users;
+  if (params_.base.enabled) {
+    users[params_.basePort()].base = true;
+    users[params_.basePort()].baud = params_.baseBaud();
+  }
+  if (params_.body.enabled) {
+    users[params_.bodyPort()].body = true;
+    users[params_.bodyPort()].baud = params_.bodyBaud();
+  }
+  if (params_.servo_bus.enabled) {
+    users[params_.servoBusPort()].servo_bus = true;
+    users[params_.servoBusPort()].baud = params_.servoBusBaud();
+  }
+  for (const auto& [path, use] : users) {
+    device::SerialLinkOptions options;
+    options.path = path;
+    options.baud = static_cast<unsigned>(use.baud);
+    options.reconnect_interval = params_.reconnect_interval;
+    options.framer = protocol::FramerConfig::forDriver(use.base, use.body, use.servo_bus,
+                                                       params_.body.servo_ids.size());
+    Port port;
+    port.link = std::make_unique<device::SerialLink>(options);
+    port.monitor = std::make_unique<PortMonitor>(*port.link);
+    port.link->addListener(port.monitor.get());
+    Port& stored = ports_[path] = std::move(port);
+    diagnostics_.add("port " + path, [this, &stored](diagnostic_updater::DiagnosticStatusWrapper& s) {
+      diagnosePort(stored, s);
+    });
+  }
+
+  if (params_.base.enabled) {
+    base_ = std::make_unique<BaseInterface>(nh_, params_, portFor(params_.basePort()), diagnostics_);
+  }
+  if (params_.body.enabled) {
+    body_ = std::make_unique<BodyInterface>(nh_, params_, portFor(params_.bodyPort()), diagnostics_);
+  }
+  if (params_.servo_bus.enabled) {
+    servo_bus_ = std::make_unique<ServoBusInterface>(nh_, params_, portFor(params_.servoBusPort()),
+                                                     diagnostics_);
+  }
+  diagnostics_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0),
+                                             [this](const ros::SteadyTimerEvent&) { diagnostics_.update(); });
+}
+
+DriverNode::~DriverNode() { shutdown(); }
+
+device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }
+
+void DriverNode::start() {
+  for (auto& [path, port] : ports_) port.link->start();
+  if (base_) base_->start();
+}
+
+void DriverNode::shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  diagnostics_timer_.stop();
+  if (base_) base_->shutdown();  // zero-speed frame while the port is still open
+  if (servo_bus_) servo_bus_->shutdown();
+  for (auto& [path, port] : ports_) port.link->stop();
+}
+
+void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const device::LinkStats s = port.link->stats();
+  using protocol::FrameFamily;
+  if (s.connected) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "connected");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                   "not connected" + (s.last_error.empty() ? std::string() : ": " + s.last_error));
+  }
+  status.add("path", port.link->options().path);
+  status.add("baud", port.link->options().baud);
+  status.add("connected", s.connected);
+  status.add("connects", s.connects);
+  status.add("disconnects", s.disconnects);
+  status.add("last error", s.last_error);
+  status.add("bytes in", s.framer.bytes_in);
+  status.add("bytes out", s.bytes_out);
+  status.add("frames out", s.frames_out);
+  status.add("write failures", s.write_failures);
+  for (std::size_t i = 0; i < protocol::kFrameFamilyCount; ++i) {
+    if (s.framer.frames[i] == 0) continue;
+    status.add(std::string("frames in: ") + protocol::toString(static_cast<FrameFamily>(i)),
+               s.framer.frames[i]);
+  }
+  status.add("checksum errors", s.framer.checksum_errors);
+  status.add("bad tails", s.framer.bad_tails);
+  status.add("bad lengths", s.framer.bad_lengths);
+  status.add("bytes skipped (resync)", s.framer.bytes_skipped);
+  status.add("low latency", s.low_latency);
+  status.add("latency_timer (ms)", s.latency_timer_ms ? std::to_string(*s.latency_timer_ms) : "n/a");
+  if (s.connected && s.latency_timer_ms && *s.latency_timer_ms > 1) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "latency_timer above 1 ms");
+  }
+}
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,1 +1,213 @@
-// placeholder: being written
+#include "serial_robot_driver/ros/driver_params.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include <ros/node_handle.h>
+#include <ros/param.h>
+
+namespace serial_robot_driver::ros_layer {
+
+namespace {
+
+void require(bool ok, const std::string& name, const std::string& problem) {
+  if (!ok) throw ParameterError(name, problem);
+}
+
+void requirePositive(double value, const std::string& name) {
+  std::ostringstream text;
+  text << "must be a finite number > 0 (got " << value << ")";
+  require(std::isfinite(value) && value > 0, name, text.str());
+}
+
+void requireNonNegative(double value, const std::string& name) {
+  std::ostringstream text;
+  text << "must be a finite number >= 0 (got " << value << ")";
+  require(std::isfinite(value) && value >= 0, name, text.str());
+}
+
+void requireBaud(int baud, const std::string& name, bool zero_means_inherit) {
+  static const std::set<int> kRates = {1200,   2400,   4800,   9600,    19200,   38400,  57600,
+                                       115200, 230400, 250000, 460800,  500000,  576000, 921600,
+                                       1000000, 1500000, 2000000, 3000000, 4000000};
+  if (zero_means_inherit && baud == 0) return;
+  require(kRates.count(baud) > 0, name,
+          "unsupported baud rate " + std::to_string(baud) + " (e.g. 9600, 115200, 1000000)");
+}
+
+void validateDevicePort(const DevicePortParams& device, const std::string& prefix) {
+  requireBaud(device.baud, prefix + "/baud", true);
+}
+
+// --- loading --------------------------------------------------------------------------------
+
+/// Reads `key` when present; a present key of the wrong type is an error, not a silent default.
+template <typename T>
+void load(const ros::NodeHandle& nh, const std::string& key, T* value, const char* type_name) {
+  if (!nh.hasParam(key)) return;
+  if (!nh.getParam(key, *value)) throw ParameterError(key, std::string("must be ") + type_name);
+}
+
+}  // namespace
+
+void DriverParams::validate() const {
+  require(!port.empty(), "port", "must name a serial device, e.g. /dev/ttyUSB0");
+  requireBaud(baud, "baud", false);
+  requirePositive(loop_rate, "loop_rate");
+  require(loop_rate <= 1000, "loop_rate", "must be at most 1000 Hz");
+  requirePositive(reconnect_interval, "reconnect_interval");
+  require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
+          "every device is disabled (base, body, servo_bus): nothing to drive");
+
+  if (base.enabled) {
+    validateDevicePort(base, "base");
+    requirePositive(base.wheel_diameter, "base/wheel_diameter");
+    requirePositive(base.encoder_resolution, "base/encoder_resolution");
+    requirePositive(base.pid_rate, "base/pid_rate");
+    requirePositive(base.wheel_separation, "base/wheel_separation");
+    requireNonNegative(base.max_wheel_speed, "base/max_wheel_speed");
+    requireNonNegative(base.max_wheel_accel, "base/max_wheel_accel");
+    requirePositive(base.cmd_vel_timeout, "base/cmd_vel_timeout");
+    requireNonNegative(base.battery_poll_rate, "base/battery_poll_rate");
+    require(base.battery_poll_rate <= loop_rate, "base/battery_poll_rate",
+            "must not exceed loop_rate (requests go out from the loop)");
+  }
+
+  if (body.enabled) {
+    validateDevicePort(body, "body");
+    const std::size_t n = body.servo_ids.size();
+    require(n > 0, "body/servo_ids", "must list at least one servo id");
+    require(n <= 57, "body/servo_ids", "at most 57 servos fit in a telemetry frame");
+    std::set<int> seen;
+    for (int id : body.servo_ids) {
+      require(id >= 0 && id <= 253, "body/servo_ids",
+              "ids must be 0..253 (254 is broadcast), got " + std::to_string(id));
+      require(seen.insert(id).second, "body/servo_ids", "id " + std::to_string(id) + " is listed twice");
+    }
+    require(body.joint_names.size() == n, "body/joint_names",
+            "has " + std::to_string(body.joint_names.size()) + " entries but body/servo_ids has " +
+                std::to_string(n));
+    std::set<std::string> names;
+    for (const auto& name : body.joint_names) {
+      require(!name.empty(), "body/joint_names", "a joint name is empty");
+      require(names.insert(name).second, "body/joint_names", "'" + name + "' is listed twice");
+    }
+    require(body.ticks_per_revolution > 0, "body/ticks_per_revolution", "must be > 0");
+    require(body.zero_ticks.size() == n, "body/zero_ticks",
+            "has " + std::to_string(body.zero_ticks.size()) + " entries but body/servo_ids has " +
+                std::to_string(n));
+    for (int zero : body.zero_ticks) {
+      require(zero >= 0 && zero <= 65535, "body/zero_ticks", "entries must be 0..65535");
+    }
+    require(body.directions.size() == n, "body/directions",
+            "has " + std::to_string(body.directions.size()) + " entries but body/servo_ids has " +
+                std::to_string(n));
+    for (int direction : body.directions) {
+      require(direction == 1 || direction == -1, "body/directions", "entries must be 1 or -1");
+    }
+    requireNonNegative(body.velocity_scale, "body/velocity_scale");
+    require(!imu.frame_id.empty(), "imu/frame_id", "must not be empty");
+    requirePositive(imu.accel_scale, "imu/accel_scale");
+    requirePositive(imu.gyro_scale, "imu/gyro_scale");
+    requirePositive(imu.angle_scale, "imu/angle_scale");
+    require(std::isfinite(imu.orientation_variance), "imu/orientation_variance", "must be finite");
+    requireNonNegative(imu.angular_velocity_variance, "imu/angular_velocity_variance");
+    requireNonNegative(imu.linear_acceleration_variance, "imu/linear_acceleration_variance");
+  }
+
+  if (servo_bus.enabled) {
+    validateDevicePort(servo_bus, "servo_bus");
+    requirePositive(servo_bus.timeout, "servo_bus/timeout");
+    require(servo_bus.timeout <= 5.0, "servo_bus/timeout", "must be at most 5 s");
+    require(servo_bus.retries >= 0 && servo_bus.retries <= 10, "servo_bus/retries", "must be 0..10");
+  }
+
+  // Devices sharing a path share one port, so they must agree on its baud rate.
+  struct Use {
+    std::string name, path;
+    int baud;
+  };
+  std::vector<Use> uses;
+  if (base.enabled) uses.push_back({"base", basePort(), baseBaud()});
+  if (body.enabled) uses.push_back({"body", bodyPort(), bodyBaud()});
+  if (servo_bus.enabled) uses.push_back({"servo_bus", servoBusPort(), servoBusBaud()});
+  for (std::size_t i = 0; i < uses.size(); ++i) {
+    for (std::size_t j = i + 1; j < uses.size(); ++j) {
+      require(uses[i].path != uses[j].path || uses[i].baud == uses[j].baud, uses[j].name + "/baud",
+              "differs from " + uses[i].name + "'s baud on the shared port " + uses[i].path);
+    }
+  }
+}
+
+DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unknown_keys) {
+  DriverParams p;
+  load(nh, "port", &p.port, "a string");
+  load(nh, "baud", &p.baud, "an integer");
+  load(nh, "loop_rate", &p.loop_rate, "a number");
+  load(nh, "reconnect_interval", &p.reconnect_interval, "a number");
+
+  auto loadDevice = [&nh](const std::string& prefix, DevicePortParams* device) {
+    load(nh, prefix + "/enabled", &device->enabled, "true or false");
+    load(nh, prefix + "/port", &device->port, "a string");
+    load(nh, prefix + "/baud", &device->baud, "an integer");
+  };
+
+  loadDevice("base", &p.base);
+  load(nh, "base/wheel_diameter", &p.base.wheel_diameter, "a number");
+  load(nh, "base/encoder_resolution", &p.base.encoder_resolution, "an integer");
+  load(nh, "base/pid_rate", &p.base.pid_rate, "a number");
+  load(nh, "base/wheel_separation", &p.base.wheel_separation, "a number");
+  load(nh, "base/max_wheel_speed", &p.base.max_wheel_speed, "a number");
+  load(nh, "base/max_wheel_accel", &p.base.max_wheel_accel, "a number");
+  load(nh, "base/cmd_vel_timeout", &p.base.cmd_vel_timeout, "a number");
+  load(nh, "base/speed_dithering", &p.base.speed_dithering, "true or false");
+  load(nh, "base/battery_poll_rate", &p.base.battery_poll_rate, "a number");
+
+  loadDevice("body", &p.body);
+  load(nh, "body/servo_ids", &p.body.servo_ids, "a list of integers");
+  load(nh, "body/joint_names", &p.body.joint_names, "a list of strings");
+  load(nh, "body/ticks_per_revolution", &p.body.ticks_per_revolution, "an integer");
+  load(nh, "body/zero_ticks", &p.body.zero_ticks, "a list of integers");
+  load(nh, "body/directions", &p.body.directions, "a list of integers");
+  load(nh, "body/velocity_scale", &p.body.velocity_scale, "a number");
+
+  load(nh, "imu/frame_id", &p.imu.frame_id, "a string");
+  load(nh, "imu/accel_scale", &p.imu.accel_scale, "a number");
+  load(nh, "imu/gyro_scale", &p.imu.gyro_scale, "a number");
+  load(nh, "imu/angle_scale", &p.imu.angle_scale, "a number");
+  load(nh, "imu/orientation_variance", &p.imu.orientation_variance, "a number");
+  load(nh, "imu/angular_velocity_variance", &p.imu.angular_velocity_variance, "a number");
+  load(nh, "imu/linear_acceleration_variance", &p.imu.linear_acceleration_variance, "a number");
+
+  loadDevice("servo_bus", &p.servo_bus);
+  load(nh, "servo_bus/timeout", &p.servo_bus.timeout, "a number");
+  load(nh, "servo_bus/retries", &p.servo_bus.retries, "an integer");
+  load(nh, "servo_bus/allow_dangerous_writes", &p.servo_bus.allow_dangerous_writes, "true or false");
+
+  if (unknown_keys) {
+    static const std::set<std::string> kKnown = {
+        "port", "baud", "loop_rate", "reconnect_interval",
+        "base/enabled", "base/port", "base/baud", "base/wheel_diameter", "base/encoder_resolution",
+        "base/pid_rate", "base/wheel_separation", "base/max_wheel_speed", "base/max_wheel_accel",
+        "base/cmd_vel_timeout", "base/speed_dithering", "base/battery_poll_rate",
+        "body/enabled", "body/port", "body/baud", "body/servo_ids", "body/joint_names",
+        "body/ticks_per_revolution", "body/zero_ticks", "body/directions", "body/velocity_scale",
+        "imu/frame_id", "imu/accel_scale", "imu/gyro_scale", "imu/angle_scale",
+        "imu/orientation_variance", "imu/angular_velocity_variance",
+        "imu/linear_acceleration_variance",
+        "servo_bus/enabled", "servo_bus/port", "servo_bus/baud", "servo_bus/timeout",
+        "servo_bus/retries", "servo_bus/allow_dangerous_writes"};
+    std::vector<std::string> all;
+    ros::param::getParamNames(all);
+    const std::string prefix = nh.getNamespace() + "/";
+    for (const auto& full : all) {
+      if (full.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string key = full.substr(prefix.size());
+      if (!kKnown.count(key)) unknown_keys->push_back(key);
+    }
+  }
+  return p;
+}
+
+}  // namespace serial_robot_driver::ros_layer

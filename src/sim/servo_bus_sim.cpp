@@ -1,1 +1,394 @@
-// placeholder: being written
+#include "serial_robot_driver/sim/servo_bus_sim.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/protocol/servo_params.h"
+
+namespace serial_robot_driver::sim {
+
+namespace servo = protocol::servo;
+using servo::Command;
+
+namespace {
+
+// data_ids of PROTOCOLS.md section 3 the simulator gives a behaviour to.
+constexpr uint8_t kVoltage = 1;
+constexpr uint8_t kCurrent = 2;
+constexpr uint8_t kPower = 3;
+constexpr uint8_t kTemperature = 4;
+constexpr uint8_t kServoStatus = 5;
+constexpr uint8_t kServoType = 6;
+constexpr uint8_t kFirmwareVersion = 7;
+constexpr uint8_t kSerialNumber = 8;
+constexpr uint8_t kResponseSwitch = 33;
+constexpr uint8_t kServoId = 34;
+constexpr uint8_t kAngleLimitSwitch = 48;
+constexpr uint8_t kAngleLimitHigh = 51;
+constexpr uint8_t kAngleLimitLow = 52;
+
+constexpr int64_t kNominalVoltage = 7400;  // mV, a 2S LiPo
+constexpr int64_t kNominalTemperature = 35;
+constexpr int64_t kIdleCurrent = 20;  // mA
+constexpr int64_t kMovingCurrent = 350;
+
+constexpr auto kDriftPeriod = std::chrono::milliseconds(100);
+
+// Factory values of the user block (assumption: datasheet-like numbers; the id stays the one the
+// servo was configured with, so a reset never collides with its neighbours on the chain).
+const std::map<uint8_t, int64_t>& userDefaults() {
+  static const std::map<uint8_t, int64_t> defaults = {
+      {32, 0},     {33, 0},  {35, 0},     {36, 5},    {37, 1},    {38, 4000},  {39, 4500},
+      {40, 14000}, {41, 65}, {42, 12000}, {43, 3000}, {44, 1},    {45, 0},     {46, 0},
+      {47, 0},     {48, 0},  {49, 0},     {50, 3000}, {51, 1800}, {52, -1800}, {53, 0}};
+  return defaults;
+}
+
+int16_t toDecidegrees(double degrees) {
+  constexpr double kMin = std::numeric_limits<int16_t>::min();
+  constexpr double kMax = std::numeric_limits<int16_t>::max();
+  return static_cast<int16_t>(std::lround(std::clamp(degrees * 10.0, kMin, kMax)));
+}
+
+// Spinning servos report an angle inside one turn.
+double wrapDegrees(double degrees) {
+  double wrapped = std::fmod(degrees + 180.0, 360.0);
+  if (wrapped < 0) wrapped += 360.0;
+  return wrapped - 180.0;
+}
+
+}  // namespace
+
+ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
+    : config_(config), rng_(config.seed), last_drift_(now) {
+  for (uint8_t id : config_.servo_ids) {
+    const bool offline = std::find(config_.offline_ids.begin(), config_.offline_ids.end(), id) !=
+                         config_.offline_ids.end();
+    if (offline || id == servo::kBroadcastId) continue;
+    Servo s;
+    s.factory_id = id;
+    s.last_step = now;
+    s.params[kVoltage] = kNominalVoltage;
+    s.params[kCurrent] = kIdleCurrent;
+    s.params[kPower] = kNominalVoltage * kIdleCurrent / 1000;
+    s.params[kTemperature] = kNominalTemperature;
+    s.params[kServoStatus] = 0;
+    s.params[kServoType] = 0x0101;
+    s.params[kFirmwareVersion] = 0x0102;
+    s.params[kSerialNumber] = 0x53520000 + id;
+    resetUserData(&s);
+    servos_.push_back(std::move(s));
+  }
+}
+
+void ServoBusSim::resetUserData(Servo* s) const {
+  for (const auto& [data_id, value] : userDefaults()) s->params[data_id] = value;
+  s->params[kServoId] = s->factory_id;
+}
+
+int64_t ServoBusSim::param(const Servo& s, uint8_t data_id) {
+  const auto it = s.params.find(data_id);
+  return it == s.params.end() ? 0 : it->second;
+}
+
+void ServoBusSim::answer(TimePoint due, Command cmd, const std::vector<uint8_t>& content) {
+  PendingAnswer pending{due, servo::encodeResponse(cmd, content)};
+  const auto position =
+      std::upper_bound(pending_.begin(), pending_.end(), due,
+                       [](TimePoint t, const PendingAnswer& other) { return t < other.due; });
+  pending_.insert(position, std::move(pending));
+}
+
+void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint now) {
+  const auto decoded = servo::decodeRequest(data, size);
+  if (!decoded || decoded->content_size == 0) {
+    ++stats_.malformed;
+    return;
+  }
+  const servo::Packet& packet = *decoded;
+  ++stats_.requests;
+  const uint8_t id = packet.id();
+  if (id == servo::kBroadcastId) {
+    ++stats_.broadcasts;
+    for (Servo& s : servos_) execute(&s, packet, true, now);
+    return;
+  }
+  // The address is the servo_id parameter, which a write may have changed.
+  for (Servo& s : servos_) {
+    if (param(s, kServoId) == id) {
+      execute(&s, packet, false, now);
+      return;
+    }
+  }
+  ++stats_.unaddressed;
+}
+
+void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast, TimePoint now) {
+  runMotions(s, now);  // the angle and the queue as of this request
+  const uint8_t id = packet.id();
+  const uint8_t* content = packet.content.data();
+  const std::size_t size = packet.content_size;
+  const TimePoint due = now + fromSeconds(config_.answer_latency_s);
+  const auto reply = [&](Command cmd, const std::vector<uint8_t>& answer_content) {
+    if (!broadcast) answer(due, cmd, answer_content);
+  };
+  const auto malformed = [&]() { ++stats_.malformed; };
+
+  switch (static_cast<Command>(packet.cmd)) {
+    case Command::kPing:
+      reply(Command::kPing, {id});
+      break;
+
+    case Command::kResetUserData:
+      resetUserData(s);
+      reply(Command::kResetUserData, {id, 1});
+      break;
+
+    case Command::kReadData: {
+      if (size != 2) return malformed();
+      const servo::ParamInfo* info = servo::findParamById(content[1]);
+      if (info == nullptr) {
+        ++stats_.unknown_data_ids;
+        return;
+      }
+      std::vector<uint8_t> answer_content = {id, info->data_id};
+      uint8_t value[8] = {};
+      const std::size_t n = servo::writeValue(*info, param(*s, info->data_id), value);
+      answer_content.insert(answer_content.end(), value, value + n);
+      reply(Command::kReadData, answer_content);
+      break;
+    }
+
+    case Command::kWriteData: {
+      if (size < 2) return malformed();
+      const servo::ParamInfo* info = servo::findParamById(content[1]);
+      if (info == nullptr) {
+        ++stats_.unknown_data_ids;
+        return;
+      }
+      const auto value = servo::readValue(*info, content + 2, size - 2);
+      if (!value) return malformed();
+      // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
+      const bool ok = servo::checkWrite(*info, *value, true) == servo::WriteCheck::kOk;
+      if (ok) {
+        s->params[info->data_id] = *value;
+      } else {
+        ++stats_.writes_rejected;
+      }
+      reply(Command::kWriteData, {id, info->data_id, static_cast<uint8_t>(ok ? 1 : 0)});
+      break;
+    }
+
+    case Command::kReadBatchData: {
+      if (size != 1) return malformed();
+      std::vector<uint8_t> answer_content(1 + servo::kUserBlockSize, 0);
+      answer_content[0] = id;
+      for (const servo::ParamInfo& info : servo::paramTable()) {
+        const auto offset = servo::userBlockOffset(info);
+        if (!offset) continue;
+        servo::writeValue(info, param(*s, info.data_id), &answer_content[1 + *offset]);
+      }
+      reply(Command::kReadBatchData, answer_content);
+      break;
+    }
+
+    case Command::kWriteBatchData: {
+      if (size != 1 + servo::kUserBlockSize) return malformed();
+      // All or nothing: one bad cell rejects the block.
+      std::map<uint8_t, int64_t> values;
+      bool ok = true;
+      for (const servo::ParamInfo& info : servo::paramTable()) {
+        const auto offset = servo::userBlockOffset(info);
+        if (!offset) continue;
+        const auto value =
+            servo::readValue(info, content + 1 + *offset, servo::typeSize(info.type));
+        if (!value || servo::checkWrite(info, *value, true) != servo::WriteCheck::kOk) {
+          ok = false;
+          break;
+        }
+        values[info.data_id] = *value;
+      }
+      if (ok) {
+        for (const auto& [data_id, value] : values) s->params[data_id] = value;
+      } else {
+        ++stats_.writes_rejected;
+      }
+      reply(Command::kWriteBatchData, {id, static_cast<uint8_t>(ok ? 1 : 0)});
+      break;
+    }
+
+    case Command::kSpin: {
+      if (size != 6) return malformed();
+      const uint8_t method = content[1];
+      const double speed = protocol::readLE16(content + 2);
+      const uint16_t value = protocol::readLE16(content + 4);
+      const double rate = (method & 0x80) ? -speed : speed;  // clockwise is negative
+      Motion motion;
+      motion.kind = Motion::Kind::kSpin;
+      motion.cmd = Command::kSpin;
+      motion.answer = !broadcast && param(*s, kResponseSwitch) == 1;
+      motion.answer_id = id;
+      motion.rate_dps = rate;
+      switch (static_cast<servo::SpinMode>(method & 0x03)) {
+        case servo::SpinMode::kStop:
+          stopAll(s);
+          if (motion.answer) answer(due, Command::kSpin, {id, 1});
+          return;
+        case servo::SpinMode::kContinuous:
+          stopAll(s);
+          s->spin_rate_dps = rate;
+          if (motion.answer) answer(due, Command::kSpin, {id, 1});
+          return;
+        case servo::SpinMode::kTurns:
+          motion.duration_s = speed > 0 ? value * 360.0 / speed : 0.0;
+          break;
+        case servo::SpinMode::kDurationMs:
+          motion.duration_s = value / 1000.0;
+          break;
+      }
+      startMotion(s, motion, now);
+      break;
+    }
+
+    case Command::kRotate: {
+      if (size != 7) return malformed();
+      double target = protocol::readLE16Signed(content + 1) / 10.0;
+      if (param(*s, kAngleLimitSwitch) == 1) {
+        target =
+            std::clamp(target, param(*s, kAngleLimitLow) / 10.0, param(*s, kAngleLimitHigh) / 10.0);
+      }
+      Motion motion;
+      motion.kind = Motion::Kind::kRotate;
+      motion.cmd = Command::kRotate;
+      motion.target_angle = target;
+      motion.duration_s = protocol::readLE16(content + 3) / 1000.0;
+      motion.answer = !broadcast && param(*s, kResponseSwitch) == 1;
+      motion.answer_id = id;
+      startMotion(s, motion, now);
+      break;
+    }
+
+    case Command::kDamping:
+      if (size != 3) return malformed();
+      stopAll(s);  // damping releases the holding torque: nothing keeps moving
+      if (!broadcast && param(*s, kResponseSwitch) == 1) answer(due, Command::kDamping, {id, 1});
+      break;
+
+    case Command::kReadAngle: {
+      if (size != 1) return malformed();
+      std::vector<uint8_t> answer_content = {id, 0, 0};
+      protocol::writeLE16(&answer_content[1], static_cast<uint16_t>(toDecidegrees(s->angle_deg)));
+      reply(Command::kReadAngle, answer_content);
+      break;
+    }
+
+    default:
+      malformed();
+      break;
+  }
+}
+
+void ServoBusSim::stopAll(Servo* s) {
+  s->motions.clear();
+  s->spin_rate_dps = 0.0;
+}
+
+void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
+  if (!motion.answer) stopAll(s);  // response_switch 0: the new command interrupts
+  s->spin_rate_dps = 0.0;
+  s->motions.push_back(motion);
+  runMotions(s, now);
+}
+
+void ServoBusSim::runMotions(Servo* s, TimePoint now) {
+  if (s->spin_rate_dps != 0.0) {
+    s->angle_deg = wrapDegrees(s->angle_deg + s->spin_rate_dps * toSeconds(now - s->last_step));
+  }
+  s->last_step = now;
+  TimePoint cursor = now;
+  while (!s->motions.empty()) {
+    Motion& motion = s->motions.front();
+    if (!motion.started) {
+      motion.started = true;
+      motion.start = cursor;
+      motion.start_angle = s->angle_deg;
+    }
+    const double elapsed = toSeconds(now - motion.start);
+    const bool done = elapsed >= motion.duration_s;
+    const double progress = done ? motion.duration_s : elapsed;
+    if (motion.kind == Motion::Kind::kRotate) {
+      const double fraction = motion.duration_s > 0 ? progress / motion.duration_s : 1.0;
+      s->angle_deg = motion.start_angle + (motion.target_angle - motion.start_angle) * fraction;
+    } else {
+      s->angle_deg = wrapDegrees(motion.start_angle + motion.rate_dps * progress);
+    }
+    if (!done) break;
+    const TimePoint finished = motion.start + fromSeconds(motion.duration_s);
+    if (motion.answer) {
+      answer(std::max(finished, now) + fromSeconds(config_.answer_latency_s), motion.cmd,
+             {motion.answer_id, 1});
+    }
+    cursor = finished;  // the next queued motion starts where this one ended
+    s->motions.pop_front();
+  }
+}
+
+void ServoBusSim::driftReadOnly(Servo* s) {
+  std::uniform_int_distribution<int> step(-1, 1);
+  const bool moving = !s->motions.empty() || s->spin_rate_dps != 0.0;
+  int64_t& voltage = s->params[kVoltage];
+  voltage =
+      std::clamp<int64_t>(voltage + 5 * step(rng_), kNominalVoltage - 60, kNominalVoltage + 60);
+  int64_t& temperature = s->params[kTemperature];
+  if (std::uniform_int_distribution<int>(0, 49)(rng_) == 0) {
+    temperature = std::clamp<int64_t>(temperature + step(rng_), kNominalTemperature - 1,
+                                      kNominalTemperature + 2);
+  }
+  const int64_t current =
+      (moving ? kMovingCurrent : kIdleCurrent) + std::uniform_int_distribution<int>(0, 5)(rng_);
+  s->params[kCurrent] = current;
+  s->params[kPower] = voltage * current / 1000;
+}
+
+void ServoBusSim::tick(TimePoint now, Outbox* out) {
+  const bool drift = now - last_drift_ >= kDriftPeriod;
+  if (drift) last_drift_ = now;
+  for (Servo& s : servos_) {
+    runMotions(&s, now);
+    if (drift) driftReadOnly(&s);
+  }
+  while (!pending_.empty() && pending_.front().due <= now) {
+    out->push_back(Outgoing{OutputKind::kServoResponse, std::move(pending_.front().bytes)});
+    pending_.pop_front();
+    ++stats_.answers;
+  }
+}
+
+TimePoint ServoBusSim::nextEvent() const {
+  TimePoint next = last_drift_ + kDriftPeriod;
+  if (!pending_.empty()) next = std::min(next, pending_.front().due);
+  for (const Servo& s : servos_) {
+    if (s.motions.empty()) continue;
+    const Motion& motion = s.motions.front();
+    if (motion.started) next = std::min(next, motion.start + fromSeconds(motion.duration_s));
+  }
+  return next;
+}
+
+ServoBusSimStats ServoBusSim::stats() const {
+  ServoBusSimStats copy = stats_;
+  copy.servos.clear();
+  for (const Servo& s : servos_) {
+    BusServoSnapshot snapshot;
+    snapshot.id = static_cast<uint8_t>(param(s, kServoId));
+    snapshot.angle_deg = s.angle_deg;
+    snapshot.moving = !s.motions.empty() || s.spin_rate_dps != 0.0;
+    snapshot.params = s.params;
+    copy.servos.push_back(std::move(snapshot));
+  }
+  return copy;
+}
+
+}  // namespace serial_robot_driver::sim

@@ -1,1 +1,231 @@
-// placeholder: being written
+#include "serial_robot_driver/transport/serial_port.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#ifdef __linux__
+#include <linux/serial.h>
+#endif
+
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <utility>
+
+namespace serial_robot_driver::transport {
+namespace {
+
+std::string errnoText(int error_number) { return std::strerror(error_number); }
+
+bool isDisconnectErrno(int error_number) {
+  // EIO: pty whose master closed / USB adapter gone; ENXIO, ENODEV: device node vanished.
+  return error_number == EIO || error_number == EPIPE || error_number == ENXIO ||
+         error_number == ENODEV || error_number == EBADF;
+}
+
+[[noreturn]] void throwErrno(TransportErrorKind kind, const std::string& message,
+                             int error_number) {
+  throw TransportError(kind, message + ": " + errnoText(error_number));
+}
+
+[[noreturn]] void throwIoErrno(const std::string& operation, const std::string& what,
+                               int error_number) {
+  const TransportErrorKind kind = isDisconnectErrno(error_number)
+                                      ? TransportErrorKind::kDisconnected
+                                      : TransportErrorKind::kIoError;
+  throwErrno(kind, operation + " " + what, error_number);
+}
+
+// Returns whether the driver accepted ASYNC_LOW_LATENCY. Ptys and many drivers reject the ioctl
+// (ENOTTY/EINVAL): that only means "not supported".
+bool requestLowLatency(int fd) {
+#if defined(__linux__) && defined(TIOCGSERIAL) && defined(TIOCSSERIAL)
+  serial_struct serial_info{};
+  if (::ioctl(fd, TIOCGSERIAL, &serial_info) != 0) return false;
+  if (serial_info.flags & ASYNC_LOW_LATENCY) return true;
+  serial_info.flags |= ASYNC_LOW_LATENCY;
+  return ::ioctl(fd, TIOCSSERIAL, &serial_info) == 0;
+#else
+  (void)fd;
+  return false;
+#endif
+}
+
+void configureRaw8N1(int fd, speed_t speed, const std::string& path) {
+  termios settings{};
+  if (::tcgetattr(fd, &settings) != 0) {
+    throwErrno(TransportErrorKind::kConfigureFailed, "cannot read terminal settings of " + path,
+               errno);
+  }
+  ::cfmakeraw(&settings);
+  settings.c_cflag &= ~(CSIZE | PARENB | CSTOPB | CRTSCTS);
+  settings.c_cflag |= CS8 | CLOCAL | CREAD;
+  settings.c_iflag &= ~(IXON | IXOFF | IXANY);
+  // Non-blocking reads; timeouts come from poll(), which termios VTIME cannot express below 100 ms.
+  settings.c_cc[VMIN] = 0;
+  settings.c_cc[VTIME] = 0;
+  if (::cfsetispeed(&settings, speed) != 0 || ::cfsetospeed(&settings, speed) != 0) {
+    throwErrno(TransportErrorKind::kConfigureFailed, "cannot set the baud rate of " + path, errno);
+  }
+  if (::tcsetattr(fd, TCSANOW, &settings) != 0) {
+    throwErrno(TransportErrorKind::kConfigureFailed, "cannot configure " + path, errno);
+  }
+}
+
+}  // namespace
+
+std::optional<unsigned> baudToSpeed(unsigned baud) {
+  switch (baud) {
+    case 1200: return B1200;
+    case 2400: return B2400;
+    case 4800: return B4800;
+    case 9600: return B9600;
+    case 19200: return B19200;
+    case 38400: return B38400;
+    case 57600: return B57600;
+    case 115200: return B115200;
+    case 230400: return B230400;
+#ifdef B460800
+    case 460800: return B460800;
+    case 500000: return B500000;
+    case 576000: return B576000;
+    case 921600: return B921600;
+    case 1000000: return B1000000;
+    case 1152000: return B1152000;
+    case 1500000: return B1500000;
+    case 2000000: return B2000000;
+    case 2500000: return B2500000;
+    case 3000000: return B3000000;
+    case 3500000: return B3500000;
+    case 4000000: return B4000000;
+#endif
+    default: return std::nullopt;
+  }
+}
+
+std::optional<int> readLatencyTimerMs(const std::string& device_path) {
+  char resolved[PATH_MAX];
+  if (::realpath(device_path.c_str(), resolved) == nullptr) return std::nullopt;
+  const std::string device(resolved);
+  const std::string tty_name = device.substr(device.find_last_of('/') + 1);
+  if (tty_name.empty()) return std::nullopt;
+  std::ifstream file("/sys/bus/usb-serial/devices/" + tty_name + "/latency_timer");
+  int latency_ms = 0;
+  if (!(file >> latency_ms)) return std::nullopt;
+  return latency_ms;
+}
+
+std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
+                       const std::string& what) {
+  if (fd < 0) throw TransportError(TransportErrorKind::kDisconnected, what + " is not open");
+  if (capacity == 0) return 0;
+
+  pollfd waiter{fd, POLLIN, 0};
+  const int ready = ::poll(&waiter, 1, timeout_ms);
+  if (ready < 0) {
+    if (errno == EINTR) return 0;
+    throwIoErrno("poll on", what, errno);
+  }
+  if (ready == 0) return 0;
+  if (waiter.revents & POLLNVAL) {
+    throw TransportError(TransportErrorKind::kDisconnected, what + " is not open (POLLNVAL)");
+  }
+  // Read even when POLLHUP is set too: bytes that arrived before the hang-up are still delivered.
+  if (!(waiter.revents & POLLIN)) {
+    throw TransportError(TransportErrorKind::kDisconnected, what + " hung up");
+  }
+
+  const ssize_t received = ::read(fd, buffer, capacity);
+  if (received > 0) return static_cast<std::size_t>(received);
+  if (received == 0) {
+    throw TransportError(TransportErrorKind::kDisconnected, what + " reached end of file");
+  }
+  if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) return 0;
+  throwIoErrno("read from", what, errno);
+}
+
+void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::string& what,
+                  std::chrono::milliseconds stall_limit) {
+  if (fd < 0) throw TransportError(TransportErrorKind::kDisconnected, what + " is not open");
+  using Clock = std::chrono::steady_clock;
+  std::size_t written = 0;
+  auto last_progress = Clock::now();
+  while (written < size) {
+    const ssize_t count = ::write(fd, data + written, size - written);
+    if (count > 0) {
+      written += static_cast<std::size_t>(count);
+      last_progress = Clock::now();
+      continue;
+    }
+    if (count < 0 && errno == EINTR) continue;
+    if (count < 0 && errno != EAGAIN && errno != EWOULDBLOCK) throwIoErrno("write to", what, errno);
+
+    // Output buffer full: wait for room, but not forever (flow stalled, adapter wedged).
+    const auto stalled =
+        std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - last_progress);
+    const auto remaining = stall_limit - stalled;
+    if (remaining.count() <= 0) {
+      throw TransportError(TransportErrorKind::kIoError, "write to " + what + " timed out after " +
+                                                             std::to_string(written) + " of " +
+                                                             std::to_string(size) + " bytes");
+    }
+    pollfd waiter{fd, POLLOUT, 0};
+    const int ready = ::poll(&waiter, 1, static_cast<int>(remaining.count()));
+    if (ready < 0 && errno != EINTR) throwIoErrno("poll on", what, errno);
+    if (ready > 0 && (waiter.revents & (POLLHUP | POLLERR | POLLNVAL)) &&
+        !(waiter.revents & POLLOUT)) {
+      throw TransportError(TransportErrorKind::kDisconnected, what + " hung up during write");
+    }
+  }
+}
+
+SerialPort::SerialPort(SerialPortOptions options) : options_(std::move(options)) {}
+
+SerialPort::~SerialPort() { close(); }
+
+void SerialPort::open() {
+  close();
+  const std::optional<unsigned> speed = baudToSpeed(options_.baud);
+  if (!speed) {
+    throw TransportError(
+        TransportErrorKind::kConfigureFailed,
+        "unsupported baud rate " + std::to_string(options_.baud) + " for " + options_.path);
+  }
+
+  const int fd = ::open(options_.path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throwErrno(TransportErrorKind::kOpenFailed, "cannot open " + options_.path, errno);
+
+  try {
+    configureRaw8N1(fd, *speed, options_.path);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  // Bytes queued before we attached belong to nobody's request: drop them.
+  ::tcflush(fd, TCIOFLUSH);
+  low_latency_ = requestLowLatency(fd);
+  latency_timer_ms_ = readLatencyTimerMs(options_.path);
+  fd_ = fd;
+}
+
+void SerialPort::close() {
+  const int fd = fd_.exchange(-1);
+  if (fd >= 0) ::close(fd);
+  low_latency_ = false;
+  latency_timer_ms_.reset();
+}
+
+std::size_t SerialPort::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {
+  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path);
+}
+
+void SerialPort::write(const uint8_t* data, std::size_t size) {
+  writeAllToFd(fd_, data, size, options_.path);
+}
+
+}  // namespace serial_robot_driver::transport

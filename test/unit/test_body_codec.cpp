@@ -1,1 +1,317 @@
-// placeholder: being written
+// Servo controller board codec: golden vectors from PROTOCOLS.md section 2, written out by hand.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/protocol/body_codec.h"
+
+namespace serial_robot_driver::protocol::body {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+
+// --- sync write ----------------------------------------------------------------------------------
+
+struct SyncWriteCase {
+  std::string name;
+  std::vector<ServoTarget> targets;
+  Bytes expected;
+};
+
+// The CRCs of the PROTOCOLS.md vector come from the document; the others were checked against an
+// independent bitwise CRC-16/BUYPASS, never against the code under test.
+// clang-format off
+const SyncWriteCase kSyncWrites[] = {
+    {"Id2To2048Id3To1024",
+     {{2, 2048}, {3, 1024}},
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68}},
+    {"Id1To512",
+     {{1, 512}},
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x01, 0x00, 0x02, 0x3A, 0x8E}},
+    {"NoServos",
+     {},
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x07, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00, 0x6D, 0x0F}},
+};
+// clang-format on
+
+class BodyCodecSyncWrite : public ::testing::TestWithParam<SyncWriteCase> {};
+
+TEST_P(BodyCodecSyncWrite, EncoderReproducesGoldenBytes) {
+  EXPECT_EQ(encodeSyncWrite(GetParam().targets), GetParam().expected);
+}
+
+TEST_P(BodyCodecSyncWrite, DecoderReadsGoldenBytes) {
+  const SyncWriteCase& c = GetParam();
+  const auto targets = decodeSyncWrite(c.expected.data(), c.expected.size());
+  ASSERT_TRUE(targets.ok()) << toString(targets.error());
+  ASSERT_EQ(targets->size(), c.targets.size());
+  for (std::size_t i = 0; i < c.targets.size(); ++i) {
+    EXPECT_EQ((*targets)[i].id, c.targets[i].id);
+    EXPECT_EQ((*targets)[i].position, c.targets[i].position);
+  }
+}
+
+TEST_P(BodyCodecSyncWrite, CrcIsLittleEndianOverAllPrecedingBytes) {
+  const Bytes& bytes = GetParam().expected;
+  const uint16_t crc = dynamixelCrc(bytes.data(), bytes.size() - 2);
+  EXPECT_EQ(crc & 0xFF, bytes[bytes.size() - 2]);
+  EXPECT_EQ(crc >> 8, bytes[bytes.size() - 1]);
+}
+
+INSTANTIATE_TEST_SUITE_P(BodyCodecGolden, BodyCodecSyncWrite, ::testing::ValuesIn(kSyncWrites),
+                         [](const auto& info) { return info.param.name; });
+
+TEST(BodyCodec, DynamixelReferencePingCrc) {
+  // Dynamixel 2.0 reference: PING to ID 1 ends in CRC 19 4E (0x4E19).
+  const Bytes ping = {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x03, 0x00, 0x01, 0x19, 0x4E};
+  EXPECT_EQ(dynamixelCrc(ping.data(), ping.size() - 2), 0x4E19);
+}
+
+TEST(BodyCodec, SyncWriteLenFormula) {
+  EXPECT_EQ(syncWriteLen(0), 7u);
+  EXPECT_EQ(syncWriteLen(2), 13u);
+}
+
+TEST(BodyCodec, SyncWriteWithTooManyServosIsNotBuilt) {
+  EXPECT_TRUE(encodeSyncWrite(std::vector<ServoTarget>(kMaxSyncWriteServos + 1)).empty());
+}
+
+struct MalformedCase {
+  std::string name;
+  Bytes frame;
+  DecodeError error;
+};
+
+// clang-format off
+const MalformedCase kMalformedSyncWrites[] = {
+    // The vendor's misprint "03 00 40" under the CRC of the correct "03 00 04".
+    {"VendorErratumBytes",
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x40, 0x79, 0x68},
+     DecodeError::kBadChecksum},
+    {"CrcBytesSwapped",
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x68, 0x79},
+     DecodeError::kBadChecksum},
+    {"BadHeader",
+     {0xFF, 0xFF, 0xFD, 0x01, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
+     DecodeError::kBadHeader},
+    {"Truncated",
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00, 0x02, 0x00},
+     DecodeError::kTooShort},
+    {"OnlyHeader", {0xFF, 0xFF, 0xFD, 0x00}, DecodeError::kTooShort},
+    // LEN 14 is not 7 + 3N.
+    {"LenNotSevenPlusThreeN",
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0E, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
+     DecodeError::kBadLength},
+    // LEN 10 (N = 1) but the bytes of N = 2.
+    {"LenInconsistentWithSize",
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
+     DecodeError::kBadLength},
+    {"LenFFFF",
+     {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0xFF, 0xFF, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
+     DecodeError::kBadLength},
+    // A valid Dynamixel PING is not a sync write: LEN 3 is below 7.
+    {"DynamixelPing", {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x03, 0x00, 0x01, 0x19, 0x4E},
+     DecodeError::kBadLength},
+    // Same layout addressed to ID 1 instead of broadcast, with its own valid CRC (0x42D2).
+    {"NotBroadcast",
+     {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x0A, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
+      0x01, 0x00, 0x02, 0xD2, 0x42},
+     DecodeError::kUnexpectedContent},
+};
+// clang-format on
+
+class BodyCodecMalformedSyncWrite : public ::testing::TestWithParam<MalformedCase> {};
+
+TEST_P(BodyCodecMalformedSyncWrite, Rejected) {
+  const MalformedCase& c = GetParam();
+  const auto targets = decodeSyncWrite(c.frame.data(), c.frame.size());
+  ASSERT_FALSE(targets.ok());
+  EXPECT_EQ(targets.error(), c.error) << toString(targets.error());
+}
+
+INSTANTIATE_TEST_SUITE_P(BodyCodecErrors, BodyCodecMalformedSyncWrite,
+                         ::testing::ValuesIn(kMalformedSyncWrites),
+                         [](const auto& info) { return info.param.name; });
+
+// --- telemetry -----------------------------------------------------------------------------------
+
+// PROTOCOLS.md golden frame, N = 2, no foot data, LEN 32.
+// SUM = 20+08+00+00+0A+04+00+FF+FB+00+01+FF+FF+40+00+00+00+00+00+00+64+00+00+00+00+C0+00
+//     = 32+8+10+4+255+251+1+255+255+64+100+192 = 1427 = 5*256 + 147 -> 147 = 0x93
+// clang-format off
+const Bytes kGoldenTelemetry = {
+    0x12, 0x34, 0x20,                                // header, LEN 32
+    0x08, 0x00, 0x00, 0x0A,                          // servo 0: 2048, speed 10
+    0x04, 0x00, 0xFF, 0xFB,                          // servo 1: 1024, speed -5
+    0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00,              // accel 1, -1, 16384
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x64,              // gyro 0, 0, 100
+    0x00, 0x00, 0x00, 0x00, 0xC0, 0x00,              // angles 0, 0, -16384
+    0x93, 0x1F, 0x2F};                               // SUM, tail
+// clang-format on
+
+Telemetry goldenTelemetry() {
+  Telemetry t;
+  t.servo_count = 2;
+  t.servos[0] = {2048, 10};
+  t.servos[1] = {1024, -5};
+  t.imu = {1, -1, 16384, 0, 0, 100, 0, 0, -16384};
+  return t;
+}
+
+// Hand-made frame WITH the foot block, N = 1, LEN = 40 + 4 = 44 = 0x2C.
+// SUM = LEN 44 + servo (01+2C+FF+FE = 1+44+255+254) + imu (01+02+FF+FF = 513)
+//     + foot (01+00+00+01+34+12+FF+FF+E8+03 = 817) = 44+554+513+817 = 1928 = 7*256 + 136 -> 0x88
+// clang-format off
+const Bytes kFootTelemetry = {
+    0x12, 0x34, 0x2C,                                // header, LEN 44
+    0x01, 0x2C, 0xFF, 0xFE,                          // servo 0: 300, speed -2
+    0x01, 0x02, 0x00, 0x00, 0x00, 0x00,              // accel 258, 0, 0
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00,              // gyro 0, 0, 0
+    0x00, 0x00, 0x00, 0x00, 0xFF, 0xFF,              // angles 0, 0, -1
+    0x01, 0x00, 0x00, 0x01, 0x34, 0x12, 0xFF, 0xFF,  // foot 1, 256, 0x1234, 65535 (little-endian)
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xE8, 0x03,  // foot 0, 0, 0, 1000
+    0x88, 0x1F, 0x2F};                               // SUM, tail
+// clang-format on
+
+Telemetry footTelemetry() {
+  Telemetry t;
+  t.servo_count = 1;
+  t.servos[0] = {300, -2};
+  t.imu = {258, 0, 0, 0, 0, 0, 0, 0, -1};
+  t.has_foot = true;
+  t.foot = {1, 256, 0x1234, 65535, 0, 0, 0, 1000};
+  return t;
+}
+
+void expectSameTelemetry(const Telemetry& actual, const Telemetry& expected) {
+  ASSERT_EQ(actual.servo_count, expected.servo_count);
+  for (std::size_t i = 0; i < expected.servo_count; ++i) {
+    EXPECT_EQ(actual.servos[i].position, expected.servos[i].position) << "servo " << i;
+    EXPECT_EQ(actual.servos[i].speed, expected.servos[i].speed) << "servo " << i;
+  }
+  EXPECT_EQ(actual.imu, expected.imu);
+  EXPECT_EQ(actual.has_foot, expected.has_foot);
+  if (expected.has_foot) {
+    EXPECT_EQ(actual.foot, expected.foot);
+  }
+}
+
+struct TelemetryCase {
+  std::string name;
+  Bytes frame;
+  Telemetry telemetry;
+};
+
+class BodyCodecTelemetry : public ::testing::TestWithParam<TelemetryCase> {};
+
+TEST_P(BodyCodecTelemetry, DecoderReadsHandWrittenFrame) {
+  const TelemetryCase& c = GetParam();
+  const auto decoded = decodeTelemetry(c.frame.data(), c.frame.size(), c.telemetry.servo_count);
+  ASSERT_TRUE(decoded.ok()) << toString(decoded.error());
+  expectSameTelemetry(*decoded, c.telemetry);
+}
+
+TEST_P(BodyCodecTelemetry, EncoderReproducesHandWrittenFrame) {
+  EXPECT_EQ(encodeTelemetry(GetParam().telemetry), GetParam().frame);
+}
+
+TEST_P(BodyCodecTelemetry, SumCoversLenAndContent) {
+  const Bytes& frame = GetParam().frame;
+  EXPECT_EQ(telemetrySum(frame.data(), frame.size()), frame[frame.size() - 3]);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BodyCodecGolden, BodyCodecTelemetry,
+    ::testing::Values(TelemetryCase{"TwoServosNoFoot", kGoldenTelemetry, goldenTelemetry()},
+                      TelemetryCase{"OneServoWithFoot", kFootTelemetry, footTelemetry()}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(BodyCodec, TelemetryLenFormula) {
+  EXPECT_EQ(telemetryLen(2, false), 32u);
+  EXPECT_EQ(telemetryLen(1, true), 44u);
+}
+
+TEST(BodyCodec, ServoCountDecidesBetweenFootAndMoreServos) {
+  // LEN 44 is N = 1 with foot data, or N = 5 without: only the configuration can tell.
+  const auto as_five = decodeTelemetry(kFootTelemetry.data(), kFootTelemetry.size(), 5);
+  ASSERT_TRUE(as_five.ok());
+  EXPECT_EQ(as_five->servo_count, 5u);
+  EXPECT_FALSE(as_five->has_foot);
+  EXPECT_EQ(as_five->servos[1].position, 258);  // the first IMU value read as a position
+  EXPECT_EQ(as_five->imu[1], 256);              // the first foot value 01 00 read big-endian
+}
+
+TEST(BodyCodec, EncodeRefusesFramesLongerThan255) {
+  Telemetry too_many;
+  too_many.servo_count = kMaxTelemetryServos;
+  too_many.has_foot = true;  // 40 + 4*57 = 268 bytes
+  EXPECT_TRUE(encodeTelemetry(too_many).empty());
+  too_many.has_foot = false;  // 24 + 4*57 = 252 bytes
+  EXPECT_EQ(encodeTelemetry(too_many).size(), 252u);
+}
+
+Bytes withByte(Bytes frame, std::size_t index, uint8_t value) {
+  frame[index] = value;
+  return frame;
+}
+
+struct MalformedTelemetryCase {
+  std::string name;
+  Bytes frame;
+  std::size_t servo_count;
+  DecodeError error;
+};
+
+const MalformedTelemetryCase kMalformedTelemetry[] = {
+    {"BadSum", withByte(kGoldenTelemetry, 29, 0x94), 2, DecodeError::kBadChecksum},
+    {"CorruptedContent", withByte(kGoldenTelemetry, 10, 0xFA), 2, DecodeError::kBadChecksum},
+    {"BadTail", withByte(kGoldenTelemetry, 31, 0x2E), 2, DecodeError::kBadTail},
+    {"BadHeader", withByte(kGoldenTelemetry, 1, 0x35), 2, DecodeError::kBadHeader},
+    {"Truncated", Bytes(kGoldenTelemetry.begin(), kGoldenTelemetry.begin() + 20), 2,
+     DecodeError::kTooShort},
+    {"OnlyHeader", {0x12, 0x34}, 2, DecodeError::kTooShort},
+    {"Empty", {}, 2, DecodeError::kTooShort},
+    {"LenZero", withByte(kGoldenTelemetry, 2, 0x00), 2, DecodeError::kBadLength},
+    {"LenOne", withByte(kGoldenTelemetry, 2, 0x01), 2, DecodeError::kBadLength},
+    {"Len255", withByte(kGoldenTelemetry, 2, 0xFF), 2, DecodeError::kBadLength},
+    // LEN 32 is right for N = 2 but not for N = 3 (36 or 52) or N = 1 (28 or 44).
+    {"LenInconsistentWithThreeServos", kGoldenTelemetry, 3, DecodeError::kBadLength},
+    {"LenInconsistentWithOneServo", kGoldenTelemetry, 1, DecodeError::kBadLength},
+    // LEN 36 would be valid for N = 3, but only 32 bytes are there.
+    {"LenBeyondSize", withByte(kGoldenTelemetry, 2, 0x24), 3, DecodeError::kTooShort},
+    {"ServoCountAboveMax", kGoldenTelemetry, kMaxTelemetryServos + 1, DecodeError::kBadLength},
+};
+
+class BodyCodecMalformedTelemetry : public ::testing::TestWithParam<MalformedTelemetryCase> {};
+
+TEST_P(BodyCodecMalformedTelemetry, Rejected) {
+  const MalformedTelemetryCase& c = GetParam();
+  const auto decoded = decodeTelemetry(c.frame.data(), c.frame.size(), c.servo_count);
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.error(), c.error) << toString(decoded.error());
+}
+
+INSTANTIATE_TEST_SUITE_P(BodyCodecErrors, BodyCodecMalformedTelemetry,
+                         ::testing::ValuesIn(kMalformedTelemetry),
+                         [](const auto& info) { return info.param.name; });
+
+TEST(BodyCodec, TrailingByteAfterFrameIsBadLength) {
+  Bytes frame = kGoldenTelemetry;
+  frame.push_back(0x12);
+  const auto decoded = decodeTelemetry(frame.data(), frame.size(), 2);
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.error(), DecodeError::kBadLength);
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::protocol::body

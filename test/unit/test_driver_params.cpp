@@ -1,1 +1,89 @@
-// placeholder: being written
+// DriverParams::validate(): defaults are valid, and every kind of bad value is reported with the
+// name of the parameter at fault.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "serial_robot_driver/ros/driver_params.h"
+
+namespace serial_robot_driver::ros_layer {
+namespace {
+
+TEST(DriverParams, DefaultsAreValid) { EXPECT_NO_THROW(DriverParams().validate()); }
+
+struct BadCase {
+  const char* expected_name;
+  std::function<void(DriverParams&)> spoil;
+};
+
+class DriverParamsBad : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(DriverParamsBad, NamesTheParameter) {
+  DriverParams params;
+  GetParam().spoil(params);
+  try {
+    params.validate();
+    FAIL() << "no error for " << GetParam().expected_name;
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), GetParam().expected_name) << e.what();
+    EXPECT_NE(std::string(e.what()).find(GetParam().expected_name), std::string::npos);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, DriverParamsBad,
+    ::testing::Values(
+        BadCase{"port", [](DriverParams& p) { p.port.clear(); }},
+        BadCase{"baud", [](DriverParams& p) { p.baud = 12345; }},
+        BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 0; }},
+        BadCase{"reconnect_interval", [](DriverParams& p) { p.reconnect_interval = -1; }},
+        BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = -0.25; }},
+        BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = std::nan(""); }},
+        BadCase{"base/encoder_resolution", [](DriverParams& p) { p.base.encoder_resolution = 0; }},
+        BadCase{"base/pid_rate", [](DriverParams& p) { p.base.pid_rate = 0; }},
+        BadCase{"base/wheel_separation", [](DriverParams& p) { p.base.wheel_separation = 0; }},
+        BadCase{"base/max_wheel_speed", [](DriverParams& p) { p.base.max_wheel_speed = -1; }},
+        BadCase{"base/max_wheel_accel", [](DriverParams& p) { p.base.max_wheel_accel = -1; }},
+        BadCase{"base/cmd_vel_timeout", [](DriverParams& p) { p.base.cmd_vel_timeout = 0; }},
+        BadCase{"base/battery_poll_rate", [](DriverParams& p) { p.base.battery_poll_rate = -1; }},
+        BadCase{"base/baud", [](DriverParams& p) { p.base.baud = 7; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {}; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 1}; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 300}; }},
+        BadCase{"body/joint_names", [](DriverParams& p) { p.body.joint_names = {"a"}; }},
+        BadCase{"body/joint_names", [](DriverParams& p) { p.body.joint_names = {"a", "a"}; }},
+        BadCase{"body/zero_ticks", [](DriverParams& p) { p.body.zero_ticks = {0}; }},
+        BadCase{"body/zero_ticks", [](DriverParams& p) { p.body.zero_ticks = {0, 70000}; }},
+        BadCase{"body/directions", [](DriverParams& p) { p.body.directions = {1, 2}; }},
+        BadCase{"body/ticks_per_revolution", [](DriverParams& p) { p.body.ticks_per_revolution = 0; }},
+        BadCase{"body/velocity_scale", [](DriverParams& p) { p.body.velocity_scale = -1; }},
+        BadCase{"imu/frame_id", [](DriverParams& p) { p.imu.frame_id.clear(); }},
+        BadCase{"imu/accel_scale", [](DriverParams& p) { p.imu.accel_scale = 0; }},
+        BadCase{"servo_bus/timeout", [](DriverParams& p) { p.servo_bus.timeout = 0; }},
+        BadCase{"servo_bus/retries", [](DriverParams& p) { p.servo_bus.retries = -1; }},
+        BadCase{"servo_bus/baud", [](DriverParams& p) { p.servo_bus.baud = 9600; }},
+        BadCase{"base/enabled", [](DriverParams& p) {
+                  p.base.enabled = p.body.enabled = p.servo_bus.enabled = false;
+                }}));
+
+TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
+  DriverParams params;
+  params.servo_bus.port = "/dev/ttyUSB1";
+  params.servo_bus.baud = 9600;
+  EXPECT_NO_THROW(params.validate());
+  EXPECT_EQ(params.servoBusPort(), "/dev/ttyUSB1");
+  EXPECT_EQ(params.servoBusBaud(), 9600);
+  EXPECT_EQ(params.basePort(), "/dev/ttyUSB0");
+  EXPECT_EQ(params.baseBaud(), 115200);
+}
+
+TEST(DriverParams, DisabledDeviceIsNotValidated) {
+  DriverParams params;
+  params.body.enabled = false;
+  params.body.joint_names = {};
+  EXPECT_NO_THROW(params.validate());
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::ros_layer

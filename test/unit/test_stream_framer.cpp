@@ -1,1 +1,764 @@
-// placeholder: being written
+// Stream framer: resynchronisation, chunking and statistics. Every frame below is written out by
+// hand from PROTOCOLS.md (golden vectors) or derived from one with a hand-computed checksum.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
+
+namespace serial_robot_driver::protocol {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+
+// --- hand-written frames -----------------------------------------------------------------------
+// AP1 base (PROTOCOLS.md section 1 golden vectors).
+const Bytes kBaseReset = {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA};
+const Bytes kBaseBatteryRequest = {0x55, 0xAA, 0x02, 0x01, 0x02, 0x00, 0xFE};
+const Bytes kBaseClearEncoders = {0x55, 0xAA, 0x02, 0x03, 0x06, 0x00, 0xF8};
+const Bytes kBaseLeft4 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x04,
+                          0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xF3};
+const Bytes kBaseRight4 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x00,
+                           0x00, 0x04, 0x00, 0x00, 0x00, 0x00, 0xF3};
+const Bytes kBaseBoth4 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x04,
+                          0x00, 0x04, 0x00, 0x00, 0x00, 0x00, 0xF7};
+const Bytes kBaseBothMinus6 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0xFF, 0xFA,
+                               0xFF, 0xFA, 0x00, 0x00, 0x00, 0x00, 0xF7};
+// Base replies: battery 100 % (SEQ 07) and the timeout error status (SEQ 08); XOR by hand.
+const Bytes kBaseBatteryReply = {0x55, 0xAA, 0x02, 0x07, 0x02, 0x64, 0x9C};
+const Bytes kBaseErrorStatus = {0x55, 0xAA, 0x02, 0x08, 0xFF, 0x00, 0x0A};
+// Shortest legal base frame: LEN 1 (MSGID only), XOR = 55^AA^01^00^02 = FC.
+const Bytes kBaseLen1 = {0x55, 0xAA, 0x01, 0x00, 0x02, 0xFC};
+
+// Telemetry, N = 2 (section 2b golden vector; SUM = 0x93 checked by hand).
+const Bytes kTelemetry = {0x12, 0x34, 0x20, 0x08, 0x00, 0x00, 0x0A, 0x04, 0x00, 0xFF, 0xFB,
+                          0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+                          0x64, 0x00, 0x00, 0x00, 0x00, 0xC0, 0x00, 0x93, 0x1F, 0x2F};
+// Same content with the foot block 1..8 (LE), LEN 48 = 0x30, SUM = 0x93 + 0x10 + 36 = 0xC7.
+const Bytes kTelemetryFoot = {
+    0x12, 0x34, 0x30, 0x08, 0x00, 0x00, 0x0A, 0x04, 0x00, 0xFF, 0xFB, 0x00, 0x01, 0xFF, 0xFF, 0x40,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x64, 0x00, 0x00, 0x00, 0x00, 0xC0, 0x00, 0x01, 0x00, 0x02,
+    0x00, 0x03, 0x00, 0x04, 0x00, 0x05, 0x00, 0x06, 0x00, 0x07, 0x00, 0x08, 0x00, 0xC7, 0x1F, 0x2F};
+
+// Sync write ID 2 -> 2048, ID 3 -> 1024 (section 2a golden vector).
+const Bytes kSyncWrite = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00,
+                          0x02, 0x00, 0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68};
+// Sync write with no servo (LEN 7), CRC-16/BUYPASS computed by hand: 0x0F6D.
+const Bytes kSyncWriteEmpty = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x07, 0x00,
+                               0x83, 0x74, 0x00, 0x02, 0x00, 0x6D, 0x0F};
+// Dynamixel 2.0 PING to ID 1: a valid Dynamixel frame, but not a broadcast sync write.
+const Bytes kDynamixelPing = {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x03, 0x00, 0x01, 0x19, 0x4E};
+
+// UART bus servos (section 3 golden vectors).
+const Bytes kServoPing = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63};
+const Bytes kServoRotate = {0x12, 0x4C, 0x08, 0x07, 0x02, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00, 0xEB};
+const Bytes kServoReadAngle = {0x12, 0x4C, 0x0A, 0x01, 0x00, 0x69};
+const Bytes kServoSpinCcw = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x01, 0x64, 0x00, 0x00, 0x00, 0xD0};
+const Bytes kServoSpinStop = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x00, 0x64, 0x00, 0x00, 0x00, 0xCF};
+const Bytes kServoSpinTurns = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x82, 0x64, 0x00, 0x05, 0x00, 0x56};
+const Bytes kServoSpinMs = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x83, 0x64, 0x00, 0xE8, 0x03, 0x3D};
+const Bytes kServoDamping = {0x12, 0x4C, 0x09, 0x03, 0x00, 0xF4, 0x01, 0x5F};
+const Bytes kServoPingReply = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
+const Bytes kServoReadAngleReply = {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86, 0x03, 0xB7};
+// Response with an empty CONTENT (N = 0): SUM = 05+1C+01 = 0x22.
+const Bytes kServoEmptyReply = {0x05, 0x1C, 0x01, 0x00, 0x22};
+
+constexpr std::size_t kServoCount = 2;
+
+FramerConfig allFamilies() {
+  FramerConfig config;
+  config.base = true;
+  config.telemetry = true;
+  config.servo_response = true;
+  config.servo_request = true;
+  config.sync_write = true;
+  config.telemetry_servo_count = kServoCount;
+  return config;
+}
+
+Bytes concat(std::initializer_list<Bytes> parts) {
+  Bytes out;
+  for (const Bytes& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
+struct Frame {
+  FrameFamily family;
+  Bytes bytes;
+  bool operator==(const Frame& other) const {
+    return family == other.family && bytes == other.bytes;
+  }
+};
+
+std::ostream& operator<<(std::ostream& os, const Frame& frame) {
+  os << toString(frame.family) << " [" << frame.bytes.size() << " bytes]";
+  return os;
+}
+
+// A framer that records every frame it emits.
+class RecordingFramer {
+ public:
+  explicit RecordingFramer(const FramerConfig& config)
+      : framer_(config, [this](FrameFamily family, const uint8_t* data, std::size_t size) {
+          frames_.push_back({family, Bytes(data, data + size)});
+        }) {}
+  RecordingFramer(const RecordingFramer&) = delete;
+  RecordingFramer& operator=(const RecordingFramer&) = delete;
+
+  void feed(const Bytes& bytes) { framer_.feed(bytes.data(), bytes.size()); }
+  void feedByteByByte(const Bytes& bytes) {
+    for (uint8_t byte : bytes) framer_.feed(&byte, 1);
+  }
+  void feedInRandomChunks(const Bytes& bytes, std::mt19937* rng, std::size_t max_chunk) {
+    std::uniform_int_distribution<std::size_t> chunk_size(1, max_chunk);
+    std::size_t pos = 0;
+    while (pos < bytes.size()) {
+      const std::size_t n = std::min(chunk_size(*rng), bytes.size() - pos);
+      framer_.feed(bytes.data() + pos, n);
+      pos += n;
+      ASSERT_LT(framer_.buffered(), 2 * StreamFramer::kLongestFrame);
+    }
+  }
+
+  StreamFramer& framer() { return framer_; }
+  const FramerStats& stats() const { return framer_.stats(); }
+  const std::vector<Frame>& frames() const { return frames_; }
+
+ private:
+  std::vector<Frame> frames_;
+  StreamFramer framer_;
+};
+
+uint64_t frameCount(const FramerStats& stats, FrameFamily family) {
+  return stats.frames[static_cast<std::size_t>(family)];
+}
+
+uint64_t totalFrames(const FramerStats& stats) {
+  return std::accumulate(stats.frames.begin(), stats.frames.end(), uint64_t{0});
+}
+
+uint64_t errorCount(const FramerStats& stats) {
+  return stats.checksum_errors + stats.bad_tails + stats.bad_lengths;
+}
+
+// Every input byte is either in an emitted frame, skipped, or still buffered.
+void expectBytesAccountedFor(const RecordingFramer& framer, std::size_t buffered) {
+  uint64_t frame_bytes = 0;
+  for (const Frame& frame : framer.frames()) frame_bytes += frame.bytes.size();
+  EXPECT_EQ(framer.stats().bytes_in, frame_bytes + framer.stats().bytes_skipped + buffered);
+}
+
+// The mixed stream used by several tests, with what the framer must find in it.
+struct MixedStream {
+  Bytes bytes;
+  std::vector<Frame> frames;
+  std::size_t junk = 0;
+};
+
+MixedStream mixedStream() {
+  // Junk without any header byte, so the skip count is exact.
+  const Bytes junk = {0x00, 0x01, 0xAA, 0x34, 0x4C, 0x1C, 0xFD, 0x7E};
+  const std::vector<Frame> frames = {
+      {FrameFamily::kTelemetry, kTelemetry},
+      {FrameFamily::kBase, kBaseBatteryReply},
+      {FrameFamily::kServoResponse, kServoPingReply},
+      {FrameFamily::kServoRequest, kServoRotate},
+      {FrameFamily::kSyncWrite, kSyncWrite},
+      {FrameFamily::kTelemetry, kTelemetryFoot},
+      {FrameFamily::kBase, kBaseErrorStatus},
+      {FrameFamily::kServoRequest, kServoReadAngle},
+      {FrameFamily::kServoResponse, kServoReadAngleReply},
+  };
+  MixedStream stream;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (i % 3 == 1) {
+      stream.bytes.insert(stream.bytes.end(), junk.begin(), junk.end());
+      stream.junk += junk.size();
+    }
+    stream.bytes.insert(stream.bytes.end(), frames[i].bytes.begin(), frames[i].bytes.end());
+    stream.frames.push_back(frames[i]);
+  }
+  return stream;
+}
+
+// --- small pieces ------------------------------------------------------------------------------
+
+TEST(StreamFramerConfig, ToStringNamesEveryFamily) {
+  EXPECT_STREQ(toString(FrameFamily::kBase), "base");
+  EXPECT_STREQ(toString(FrameFamily::kTelemetry), "telemetry");
+  EXPECT_STREQ(toString(FrameFamily::kServoResponse), "servo_response");
+  EXPECT_STREQ(toString(FrameFamily::kServoRequest), "servo_request");
+  EXPECT_STREQ(toString(FrameFamily::kSyncWrite), "sync_write");
+}
+
+TEST(StreamFramerConfig, ForDriverEnablesWhatTheDevicesSend) {
+  const FramerConfig all = FramerConfig::forDriver(true, true, true, 7);
+  EXPECT_TRUE(all.base);
+  EXPECT_TRUE(all.telemetry);
+  EXPECT_TRUE(all.servo_response);
+  EXPECT_TRUE(all.servo_request);  // the half-duplex echo of our own requests
+  EXPECT_FALSE(all.sync_write);
+  EXPECT_EQ(all.telemetry_servo_count, 7u);
+
+  const FramerConfig body_only = FramerConfig::forDriver(false, true, false, 2);
+  EXPECT_FALSE(body_only.base);
+  EXPECT_TRUE(body_only.telemetry);
+  EXPECT_FALSE(body_only.servo_response);
+  EXPECT_FALSE(body_only.servo_request);
+
+  const FramerConfig bus_only = FramerConfig::forDriver(false, false, true, 0);
+  EXPECT_FALSE(bus_only.base);
+  EXPECT_FALSE(bus_only.telemetry);
+  EXPECT_TRUE(bus_only.servo_response);
+  EXPECT_TRUE(bus_only.servo_request);
+}
+
+TEST(StreamFramerConfig, ForSimulatorEnablesWhatTheHostSends) {
+  const FramerConfig config = FramerConfig::forSimulator();
+  EXPECT_TRUE(config.base);
+  EXPECT_FALSE(config.telemetry);
+  EXPECT_FALSE(config.servo_response);
+  EXPECT_TRUE(config.servo_request);
+  EXPECT_TRUE(config.sync_write);
+}
+
+// --- every golden frame, alone
+// ---------------------------------------------------------------------
+
+struct GoldenCase {
+  std::string name;
+  Bytes bytes;
+  FrameFamily family;
+};
+void PrintTo(const GoldenCase& c, std::ostream* os) { *os << c.name; }
+
+class StreamFramerGolden : public ::testing::TestWithParam<GoldenCase> {};
+
+TEST_P(StreamFramerGolden, WholeFrameIsEmittedOnce) {
+  RecordingFramer framer(allFamilies());
+  framer.feed(GetParam().bytes);
+  ASSERT_EQ(framer.frames().size(), 1u);
+  EXPECT_EQ(framer.frames()[0], (Frame{GetParam().family, GetParam().bytes}));
+  EXPECT_EQ(frameCount(framer.stats(), GetParam().family), 1u);
+  EXPECT_EQ(framer.stats().bytes_in, GetParam().bytes.size());
+  EXPECT_EQ(framer.stats().bytes_skipped, 0u);
+  EXPECT_EQ(errorCount(framer.stats()), 0u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+TEST_P(StreamFramerGolden, ByteByByteEmitsOnlyAfterTheLastByte) {
+  RecordingFramer framer(allFamilies());
+  const Bytes& bytes = GetParam().bytes;
+  for (std::size_t i = 0; i + 1 < bytes.size(); ++i) {
+    framer.framer().feed(&bytes[i], 1);
+    EXPECT_EQ(framer.framer().buffered(), i + 1);
+  }
+  EXPECT_TRUE(framer.frames().empty());
+  framer.framer().feed(&bytes.back(), 1);
+  ASSERT_EQ(framer.frames().size(), 1u);
+  EXPECT_EQ(framer.frames()[0], (Frame{GetParam().family, bytes}));
+  EXPECT_EQ(framer.stats().bytes_skipped, 0u);
+}
+
+TEST_P(StreamFramerGolden, IgnoredWhenItsFamilyIsDisabled) {
+  FramerConfig config = allFamilies();
+  switch (GetParam().family) {
+    case FrameFamily::kBase:
+      config.base = false;
+      break;
+    case FrameFamily::kTelemetry:
+      config.telemetry = false;
+      break;
+    case FrameFamily::kServoResponse:
+      config.servo_response = false;
+      break;
+    case FrameFamily::kServoRequest:
+      config.servo_request = false;
+      break;
+    case FrameFamily::kSyncWrite:
+      config.sync_write = false;
+      break;
+  }
+  RecordingFramer framer(config);
+  framer.feed(GetParam().bytes);
+  EXPECT_TRUE(framer.frames().empty());
+  EXPECT_EQ(framer.stats().bytes_skipped, GetParam().bytes.size());
+  EXPECT_EQ(errorCount(framer.stats()), 0u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    StreamFramerVectors, StreamFramerGolden,
+    ::testing::Values(GoldenCase{"BaseReset", kBaseReset, FrameFamily::kBase},
+                      GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, FrameFamily::kBase},
+                      GoldenCase{"BaseClearEncoders", kBaseClearEncoders, FrameFamily::kBase},
+                      GoldenCase{"BaseLeft4", kBaseLeft4, FrameFamily::kBase},
+                      GoldenCase{"BaseRight4", kBaseRight4, FrameFamily::kBase},
+                      GoldenCase{"BaseBoth4", kBaseBoth4, FrameFamily::kBase},
+                      GoldenCase{"BaseBothMinus6", kBaseBothMinus6, FrameFamily::kBase},
+                      GoldenCase{"BaseBatteryReply", kBaseBatteryReply, FrameFamily::kBase},
+                      GoldenCase{"BaseErrorStatus", kBaseErrorStatus, FrameFamily::kBase},
+                      GoldenCase{"BaseLen1", kBaseLen1, FrameFamily::kBase},
+                      GoldenCase{"Telemetry", kTelemetry, FrameFamily::kTelemetry},
+                      GoldenCase{"TelemetryFoot", kTelemetryFoot, FrameFamily::kTelemetry},
+                      GoldenCase{"SyncWrite", kSyncWrite, FrameFamily::kSyncWrite},
+                      GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, FrameFamily::kSyncWrite},
+                      GoldenCase{"ServoPing", kServoPing, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoRotate", kServoRotate, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoReadAngle", kServoReadAngle, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoSpinCcw", kServoSpinCcw, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoSpinStop", kServoSpinStop, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoSpinTurns", kServoSpinTurns, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoSpinMs", kServoSpinMs, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoDamping", kServoDamping, FrameFamily::kServoRequest},
+                      GoldenCase{"ServoPingReply", kServoPingReply, FrameFamily::kServoResponse},
+                      GoldenCase{"ServoReadAngleReply", kServoReadAngleReply,
+                                 FrameFamily::kServoResponse},
+                      GoldenCase{"ServoEmptyReply", kServoEmptyReply, FrameFamily::kServoResponse}),
+    [](const ::testing::TestParamInfo<GoldenCase>& info) { return info.param.name; });
+
+// --- streams -----------------------------------------------------------------------------------
+
+TEST(StreamFramerStream, BackToBackFramesAllComeOutInOrder) {
+  const Bytes stream = concat({kBaseReset, kBaseBoth4, kServoPing, kServoPingReply, kTelemetry,
+                               kTelemetry, kSyncWrite, kServoDamping, kBaseLen1});
+  RecordingFramer framer(allFamilies());
+  framer.feed(stream);
+  const std::vector<Frame> expected = {
+      {FrameFamily::kBase, kBaseReset},         {FrameFamily::kBase, kBaseBoth4},
+      {FrameFamily::kServoRequest, kServoPing}, {FrameFamily::kServoResponse, kServoPingReply},
+      {FrameFamily::kTelemetry, kTelemetry},    {FrameFamily::kTelemetry, kTelemetry},
+      {FrameFamily::kSyncWrite, kSyncWrite},    {FrameFamily::kServoRequest, kServoDamping},
+      {FrameFamily::kBase, kBaseLen1}};
+  EXPECT_EQ(framer.frames(), expected);
+  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kBase), 3u);
+  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kTelemetry), 2u);
+  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kServoRequest), 2u);
+  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kServoResponse), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kSyncWrite), 1u);
+  EXPECT_EQ(framer.stats().bytes_skipped, 0u);
+  EXPECT_EQ(errorCount(framer.stats()), 0u);
+}
+
+TEST(StreamFramerStream, AllFamiliesInterleavedWithJunkOneByteAtATime) {
+  const MixedStream stream = mixedStream();
+  RecordingFramer framer(allFamilies());
+  framer.feedByteByByte(stream.bytes);
+  EXPECT_EQ(framer.frames(), stream.frames);
+  EXPECT_EQ(framer.stats().bytes_in, stream.bytes.size());
+  EXPECT_EQ(framer.stats().bytes_skipped, stream.junk);
+  EXPECT_EQ(errorCount(framer.stats()), 0u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+TEST(StreamFramerStream, RandomChunkSizesGiveTheSameFrames) {
+  const MixedStream stream = mixedStream();
+  constexpr int kRepeats = 40;
+  Bytes bytes;
+  std::vector<Frame> expected;
+  for (int i = 0; i < kRepeats; ++i) {
+    bytes.insert(bytes.end(), stream.bytes.begin(), stream.bytes.end());
+    expected.insert(expected.end(), stream.frames.begin(), stream.frames.end());
+  }
+  for (std::size_t max_chunk : {2u, 7u, 64u, 300u, 5000u}) {
+    SCOPED_TRACE("max chunk " + std::to_string(max_chunk));
+    std::mt19937 rng(20240611);
+    RecordingFramer framer(allFamilies());
+    framer.feedInRandomChunks(bytes, &rng, max_chunk);
+    EXPECT_EQ(framer.frames(), expected);
+    EXPECT_EQ(framer.stats().bytes_skipped, kRepeats * stream.junk);
+    EXPECT_EQ(errorCount(framer.stats()), 0u);
+    EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kTelemetry), 2u * kRepeats);
+    EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kSyncWrite), 1u * kRepeats);
+    EXPECT_EQ(framer.framer().buffered(), 0u);
+  }
+}
+
+TEST(StreamFramerStream, ChunkLargerThanTheBuffer) {
+  Bytes bytes;
+  std::size_t frames = 0;
+  while (bytes.size() < 3 * StreamFramer::kBufferSize) {
+    bytes = concat({bytes, kTelemetry, kBaseBatteryReply, kServoReadAngleReply});
+    frames += 3;
+  }
+  // End on half a frame so the tail must be buffered from a chunk bigger than the buffer.
+  bytes.insert(bytes.end(), kTelemetry.begin(), kTelemetry.begin() + 10);
+  RecordingFramer framer(allFamilies());
+  framer.feed(bytes);
+  EXPECT_EQ(framer.frames().size(), frames);
+  EXPECT_EQ(framer.framer().buffered(), 10u);
+  framer.feed(Bytes(kTelemetry.begin() + 10, kTelemetry.end()));
+  ASSERT_EQ(framer.frames().size(), frames + 1);
+  EXPECT_EQ(framer.frames().back(), (Frame{FrameFamily::kTelemetry, kTelemetry}));
+  EXPECT_EQ(framer.stats().bytes_skipped, 0u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+TEST(StreamFramerStream, JunkWithLoneHeaderBytesIsSkipped) {
+  // Each byte below starts some family but is not followed by the rest of its header.
+  const Bytes junk = {0x55, 0x55, 0x12, 0x12, 0x05, 0xFF, 0xFE, 0x12, 0x00, 0xFF, 0xFF, 0x00};
+  RecordingFramer framer(allFamilies());
+  framer.feed(concat({junk, kServoPingReply, junk, kBaseReset, junk}));
+  const std::vector<Frame> expected = {{FrameFamily::kServoResponse, kServoPingReply},
+                                       {FrameFamily::kBase, kBaseReset}};
+  EXPECT_EQ(framer.frames(), expected);
+  EXPECT_EQ(framer.stats().bytes_skipped, 3 * junk.size());
+  EXPECT_EQ(errorCount(framer.stats()), 0u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+TEST(StreamFramerStream, DynamixelFrameThatIsNotASyncWriteIsSkipped) {
+  FramerConfig config = FramerConfig::forSimulator();
+  RecordingFramer framer(config);
+  framer.feed(concat({kDynamixelPing, kSyncWrite}));
+  const std::vector<Frame> expected = {{FrameFamily::kSyncWrite, kSyncWrite}};
+  EXPECT_EQ(framer.frames(), expected);
+  EXPECT_EQ(framer.stats().bytes_skipped, kDynamixelPing.size());
+  EXPECT_EQ(errorCount(framer.stats()), 0u);
+}
+
+TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
+  FramerConfig requests_only;
+  requests_only.servo_request = true;
+  RecordingFramer framer(requests_only);
+  framer.feed(concat({kTelemetry, kServoPing, kTelemetryFoot, kServoRotate}));
+  const std::vector<Frame> expected = {{FrameFamily::kServoRequest, kServoPing},
+                                       {FrameFamily::kServoRequest, kServoRotate}};
+  EXPECT_EQ(framer.frames(), expected);
+  EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size() + kTelemetryFoot.size());
+
+  RecordingFramer telemetry_only(FramerConfig::forDriver(false, true, false, kServoCount));
+  telemetry_only.feed(concat({kServoPing, kTelemetry, kServoRotate, kTelemetryFoot}));
+  const std::vector<Frame> expected_telemetry = {{FrameFamily::kTelemetry, kTelemetry},
+                                                 {FrameFamily::kTelemetry, kTelemetryFoot}};
+  EXPECT_EQ(telemetry_only.frames(), expected_telemetry);
+  EXPECT_EQ(telemetry_only.stats().bytes_skipped, kServoPing.size() + kServoRotate.size());
+}
+
+TEST(StreamFramerStream, TelemetryLengthFollowsTheConfiguredServoCount) {
+  // LEN 32 is 24 + 4*2; with 3 servos only 36 and 52 are legal.
+  RecordingFramer three(FramerConfig::forDriver(false, true, false, 3));
+  three.feed(kTelemetry);
+  EXPECT_TRUE(three.frames().empty());
+  EXPECT_EQ(three.stats().bad_lengths, 1u);
+  EXPECT_EQ(three.stats().bytes_skipped, kTelemetry.size());
+
+  // LEN 48 is 40 + 4*2 (foot block) but also 24 + 4*6: the configuration decides, not the framer.
+  RecordingFramer six(FramerConfig::forDriver(false, true, false, 6));
+  six.feed(kTelemetryFoot);
+  ASSERT_EQ(six.frames().size(), 1u);
+  EXPECT_EQ(six.stats().bad_lengths, 0u);
+}
+
+TEST(StreamFramerStream, RealFrameHiddenInsideABrokenOneIsFound) {
+  // 55 AA 09 announces a 14-byte base frame; the servo reply and base frame after it complete
+  // the candidate, whose XOR (0x35 != 0x05) fails. Dropping one byte then finds both frames.
+  const Bytes broken_header = {0x55, 0xAA, 0x09};
+  RecordingFramer framer(allFamilies());
+  framer.feed(concat({broken_header, kServoPingReply, kBaseReset}));
+  const std::vector<Frame> expected = {{FrameFamily::kServoResponse, kServoPingReply},
+                                       {FrameFamily::kBase, kBaseReset}};
+  EXPECT_EQ(framer.frames(), expected);
+  EXPECT_EQ(framer.stats().checksum_errors, 1u);
+  EXPECT_EQ(framer.stats().bytes_skipped, broken_header.size());
+}
+
+// --- broken frames followed by a good one --------------------------------------------------------
+
+struct BrokenCase {
+  std::string name;
+  Bytes broken;
+  uint64_t checksum_errors;
+  uint64_t bad_tails;
+  uint64_t bad_lengths;
+};
+void PrintTo(const BrokenCase& c, std::ostream* os) { *os << c.name; }
+
+class StreamFramerBroken : public ::testing::TestWithParam<BrokenCase> {};
+
+TEST_P(StreamFramerBroken, CountedSkippedAndTheNextFrameStillComesThrough) {
+  const BrokenCase& c = GetParam();
+  for (const Frame& good :
+       {Frame{FrameFamily::kServoResponse, kServoPingReply},
+        Frame{FrameFamily::kBase, kBaseBatteryReply}, Frame{FrameFamily::kSyncWrite, kSyncWrite}}) {
+    SCOPED_TRACE(toString(good.family));
+    RecordingFramer framer(allFamilies());
+    framer.feed(concat({c.broken, good.bytes}));
+    ASSERT_EQ(framer.frames().size(), 1u);
+    EXPECT_EQ(framer.frames()[0], good);
+    EXPECT_EQ(framer.stats().checksum_errors, c.checksum_errors);
+    EXPECT_EQ(framer.stats().bad_tails, c.bad_tails);
+    EXPECT_EQ(framer.stats().bad_lengths, c.bad_lengths);
+    EXPECT_EQ(framer.stats().bytes_skipped, c.broken.size());
+    EXPECT_EQ(framer.framer().buffered(), 0u);
+    expectBytesAccountedFor(framer, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    StreamFramerBadChecksum, StreamFramerBroken,
+    ::testing::Values(
+        BrokenCase{"Base", {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFB}, 1, 0, 0},
+        BrokenCase{"Telemetry",
+                   {0x12, 0x34, 0x20, 0x08, 0x00, 0x00, 0x0A, 0x04, 0x00, 0xFF, 0xFB,
+                    0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+                    0x64, 0x00, 0x00, 0x00, 0x00, 0xC0, 0x00, 0x94, 0x1F, 0x2F},
+                   1,
+                   0,
+                   0},
+        BrokenCase{"ServoRequest", {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64}, 1, 0, 0},
+        BrokenCase{"ServoResponse", {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86, 0x03, 0xB8}, 1, 0, 0},
+        BrokenCase{"SyncWriteCrcLow",
+                   {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00,
+                    0x02, 0x00, 0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x78, 0x68},
+                   1,
+                   0,
+                   0},
+        BrokenCase{"SyncWriteCrcHigh",
+                   {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00,
+                    0x02, 0x00, 0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x69},
+                   1,
+                   0,
+                   0},
+        // The vendor's erratum (03 00 40 instead of 03 00 04) must fail the CRC.
+        BrokenCase{"SyncWriteVendorErratum",
+                   {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00,
+                    0x02, 0x00, 0x02, 0x00, 0x08, 0x03, 0x00, 0x40, 0x79, 0x68},
+                   1,
+                   0,
+                   0}),
+    [](const ::testing::TestParamInfo<BrokenCase>& info) { return info.param.name; });
+
+INSTANTIATE_TEST_SUITE_P(
+    StreamFramerBadTail, StreamFramerBroken,
+    ::testing::Values(BrokenCase{"Tail1E2F",
+                                 {0x12, 0x34, 0x20, 0x08, 0x00, 0x00, 0x0A, 0x04, 0x00, 0xFF, 0xFB,
+                                  0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+                                  0x64, 0x00, 0x00, 0x00, 0x00, 0xC0, 0x00, 0x93, 0x1E, 0x2F},
+                                 0,
+                                 1,
+                                 0},
+                      BrokenCase{"Tail1F2E",
+                                 {0x12, 0x34, 0x20, 0x08, 0x00, 0x00, 0x0A, 0x04, 0x00, 0xFF, 0xFB,
+                                  0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+                                  0x64, 0x00, 0x00, 0x00, 0x00, 0xC0, 0x00, 0x93, 0x1F, 0x2E},
+                                 0,
+                                 1,
+                                 0}),
+    [](const ::testing::TestParamInfo<BrokenCase>& info) { return info.param.name; });
+
+// Impossible LEN bytes: the framer must reject them from the header alone, without waiting for
+// LEN bytes. (Base LEN 1/2/5 and servo N 0/1/2/5 are legal; see the golden table.)
+INSTANTIATE_TEST_SUITE_P(
+    StreamFramerBadLength, StreamFramerBroken,
+    ::testing::Values(
+        BrokenCase{"BaseLen0", {0x55, 0xAA, 0x00}, 0, 0, 1},
+        BrokenCase{"BaseLen33", {0x55, 0xAA, 0x21}, 0, 0, 1},
+        BrokenCase{"BaseLen255", {0x55, 0xAA, 0xFF}, 0, 0, 1},
+        BrokenCase{"TelemetryLen0", {0x12, 0x34, 0x00}, 0, 0, 1},
+        BrokenCase{"TelemetryLen1", {0x12, 0x34, 0x01}, 0, 0, 1},
+        BrokenCase{"TelemetryLen2", {0x12, 0x34, 0x02}, 0, 0, 1},
+        BrokenCase{"TelemetryLen5", {0x12, 0x34, 0x05}, 0, 0, 1},
+        BrokenCase{"TelemetryLen31", {0x12, 0x34, 0x1F}, 0, 0, 1},
+        BrokenCase{"TelemetryLen36", {0x12, 0x34, 0x24}, 0, 0, 1},
+        BrokenCase{"TelemetryLen255", {0x12, 0x34, 0xFF}, 0, 0, 1},
+        BrokenCase{"ServoResponseN34", {0x05, 0x1C, 0x05, 0x22}, 0, 0, 1},
+        BrokenCase{"ServoResponseN255", {0x05, 0x1C, 0x01, 0xFF}, 0, 0, 1},
+        BrokenCase{"ServoResponseCmd0", {0x05, 0x1C, 0x00, 0x01}, 0, 0, 1},
+        BrokenCase{"ServoResponseCmd11", {0x05, 0x1C, 0x0B, 0x01}, 0, 0, 1},
+        BrokenCase{"ServoRequestN255", {0x12, 0x4C, 0x01, 0xFF}, 0, 0, 1},
+        BrokenCase{"ServoRequestCmd255", {0x12, 0x4C, 0xFF, 0x01}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen0", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x00, 0x00}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen1", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x01, 0x00}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen2", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x02, 0x00}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen5", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x05, 0x00}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen11", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0B, 0x00}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen255", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0xFF, 0x00}, 0, 0, 1},
+        // 7 + 3 * 65: one servo more than kMaxSyncWriteServos.
+        BrokenCase{"SyncWrite65Servos", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0xCA, 0x00}, 0, 0, 1},
+        BrokenCase{"SyncWriteLen65535", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0xFF, 0xFF}, 0, 0, 1}),
+    [](const ::testing::TestParamInfo<BrokenCase>& info) { return info.param.name; });
+
+// --- truncated frames ----------------------------------------------------------------------------
+
+struct TruncatedCase {
+  std::string name;
+  Bytes full;
+  std::size_t kept;  ///< bytes of `full` that arrive before the next frames
+};
+void PrintTo(const TruncatedCase& c, std::ostream* os) { *os << c.name; }
+
+class StreamFramerTruncated : public ::testing::TestWithParam<TruncatedCase> {};
+
+TEST_P(StreamFramerTruncated, FollowingFramesStillComeThrough) {
+  const TruncatedCase& c = GetParam();
+  const Bytes truncated(c.full.begin(), c.full.begin() + c.kept);
+  // Enough good frames after it to complete (and so disprove) the truncated candidate.
+  const Bytes followers = concat({kServoPingReply, kBaseBatteryReply, kServoPingReply,
+                                  kBaseBatteryReply, kServoPingReply, kBaseBatteryReply});
+  std::mt19937 rng(7);
+  RecordingFramer framer(allFamilies());
+  framer.feedInRandomChunks(concat({truncated, followers, kTelemetry}), &rng, 16);
+  ASSERT_EQ(framer.frames().size(), 7u);
+  EXPECT_EQ(framer.frames()[0], (Frame{FrameFamily::kServoResponse, kServoPingReply}));
+  EXPECT_EQ(framer.frames()[5], (Frame{FrameFamily::kBase, kBaseBatteryReply}));
+  EXPECT_EQ(framer.frames()[6], (Frame{FrameFamily::kTelemetry, kTelemetry}));
+  EXPECT_EQ(framer.stats().bytes_skipped, truncated.size());
+  // The truncated candidate failed exactly once (which check fails depends on the bytes after it).
+  EXPECT_EQ(errorCount(framer.stats()), 1u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(StreamFramerVectors, StreamFramerTruncated,
+                         ::testing::Values(TruncatedCase{"Base", kBaseBothMinus6, 9},
+                                           TruncatedCase{"Telemetry", kTelemetry, 20},
+                                           TruncatedCase{"TelemetryFoot", kTelemetryFoot, 40},
+                                           TruncatedCase{"ServoRequest", kServoRotate, 8},
+                                           TruncatedCase{"ServoResponse", kServoReadAngleReply, 6},
+                                           TruncatedCase{"SyncWrite", kSyncWrite, 15}),
+                         [](const ::testing::TestParamInfo<TruncatedCase>& info) {
+                           return info.param.name;
+                         });
+
+// --- reset and accounting ----------------------------------------------------------------------
+
+TEST(StreamFramerState, IncompleteFrameIsKeptUntilTheRestArrives) {
+  RecordingFramer framer(allFamilies());
+  framer.feed(Bytes(kTelemetry.begin(), kTelemetry.begin() + 10));
+  EXPECT_TRUE(framer.frames().empty());
+  EXPECT_EQ(framer.framer().buffered(), 10u);
+  framer.feed(Bytes(kTelemetry.begin() + 10, kTelemetry.end()));
+  ASSERT_EQ(framer.frames().size(), 1u);
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+}
+
+TEST(StreamFramerState, ResetDropsThePartialFrame) {
+  RecordingFramer framer(allFamilies());
+  framer.feed(Bytes(kTelemetry.begin(), kTelemetry.begin() + 10));
+  framer.framer().reset();
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+  EXPECT_EQ(framer.stats().bytes_skipped, 10u);
+  // The rest of the old frame is now garbage; a new frame afterwards is found.
+  framer.feed(Bytes(kTelemetry.begin() + 10, kTelemetry.end()));
+  EXPECT_TRUE(framer.frames().empty());
+  EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size());
+  framer.feed(kServoPing);
+  ASSERT_EQ(framer.frames().size(), 1u);
+  EXPECT_EQ(framer.frames()[0], (Frame{FrameFamily::kServoRequest, kServoPing}));
+  // Statistics survive a reset: they describe the port, not the buffer.
+  EXPECT_EQ(framer.stats().bytes_in, kTelemetry.size() + kServoPing.size());
+  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kServoRequest), 1u);
+  expectBytesAccountedFor(framer, 0);
+}
+
+TEST(StreamFramerState, EmptyFeedChangesNothing) {
+  RecordingFramer framer(allFamilies());
+  framer.feed(Bytes{});
+  framer.feed(Bytes(kBaseReset.begin(), kBaseReset.begin() + 3));
+  framer.framer().feed(nullptr, 0);
+  EXPECT_EQ(framer.framer().buffered(), 3u);
+  EXPECT_EQ(framer.stats().bytes_in, 3u);
+  EXPECT_TRUE(framer.frames().empty());
+}
+
+// --- random junk
+// -----------------------------------------------------------------------------------
+
+// Checks a frame the framer emitted against the family's own decoder.
+void expectDecoderAccepts(const Frame& frame) {
+  const uint8_t* data = frame.bytes.data();
+  const std::size_t size = frame.bytes.size();
+  switch (frame.family) {
+    case FrameFamily::kBase: {
+      const auto decoded = base::decodeFrame(data, size);
+      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
+      break;
+    }
+    case FrameFamily::kTelemetry: {
+      const auto decoded = body::decodeTelemetry(data, size, kServoCount);
+      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
+      break;
+    }
+    case FrameFamily::kServoResponse: {
+      const auto decoded = servo::decodeResponse(data, size);
+      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
+      break;
+    }
+    case FrameFamily::kServoRequest: {
+      const auto decoded = servo::decodeRequest(data, size);
+      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
+      break;
+    }
+    case FrameFamily::kSyncWrite: {
+      const auto decoded = body::decodeSyncWrite(data, size);
+      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
+      break;
+    }
+  }
+}
+
+TEST(StreamFramerJunk, UniformRandomBytesNeverYieldABadFrame) {
+  std::mt19937 rng(12345);
+  std::uniform_int_distribution<int> byte(0, 255);
+  Bytes junk(1 << 20);
+  for (uint8_t& b : junk) b = static_cast<uint8_t>(byte(rng));
+  RecordingFramer framer(allFamilies());
+  framer.feedInRandomChunks(junk, &rng, 1000);
+  for (const Frame& frame : framer.frames()) expectDecoderAccepts(frame);
+  expectBytesAccountedFor(framer, framer.framer().buffered());
+  EXPECT_GT(framer.stats().bytes_skipped, junk.size() / 2);
+}
+
+TEST(StreamFramerJunk, HeaderRichRandomBytesNeverYieldABadFrame) {
+  // Bytes drawn mostly from the headers and small lengths, so that candidates are everywhere and
+  // some pass their 8-bit check by chance: those must still satisfy the decoders.
+  const Bytes alphabet = {0x55, 0xAA, 0x12, 0x34, 0x4C, 0x05, 0x1C, 0xFF, 0xFD, 0x00, 0xFE,
+                          0x83, 0x01, 0x02, 0x03, 0x07, 0x0A, 0x0D, 0x20, 0x30, 0x1F, 0x2F};
+  std::mt19937 rng(777);
+  std::uniform_int_distribution<std::size_t> pick(0, alphabet.size() - 1);
+  std::uniform_int_distribution<int> byte(0, 255);
+  Bytes junk(1 << 19);
+  for (uint8_t& b : junk) {
+    b = (rng() % 4 == 0) ? static_cast<uint8_t>(byte(rng)) : alphabet[pick(rng)];
+  }
+  RecordingFramer framer(allFamilies());
+  framer.feedInRandomChunks(junk, &rng, 64);
+  for (const Frame& frame : framer.frames()) expectDecoderAccepts(frame);
+  expectBytesAccountedFor(framer, framer.framer().buffered());
+  EXPECT_GT(totalFrames(framer.stats()), 0u);  // the test exercised the emit path
+  EXPECT_GT(framer.stats().checksum_errors, 0u);
+  EXPECT_GT(framer.stats().bad_lengths, 0u);
+}
+
+TEST(StreamFramerJunk, GoodFramesSurviveBeingSurroundedByJunk) {
+  std::mt19937 rng(99);
+  std::uniform_int_distribution<int> byte(0, 255);
+  const MixedStream stream = mixedStream();
+  Bytes bytes;
+  for (int i = 0; i < 50; ++i) {
+    for (int j = 0; j < 300; ++j) bytes.push_back(static_cast<uint8_t>(byte(rng)));
+    bytes.insert(bytes.end(), stream.bytes.begin(), stream.bytes.end());
+  }
+  RecordingFramer framer(allFamilies());
+  framer.feedInRandomChunks(bytes, &rng, 100);
+  // Junk may hide a frame only by forming a longer candidate that swallows it and then passes its
+  // check, which random bytes practically never do: every good frame must come through.
+  std::size_t found = 0;
+  for (const Frame& frame : framer.frames()) {
+    expectDecoderAccepts(frame);
+    if (found < 50 * stream.frames.size() && frame == stream.frames[found % stream.frames.size()]) {
+      ++found;
+    }
+  }
+  EXPECT_EQ(found, 50 * stream.frames.size());
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::protocol

@@ -2,9 +2,8 @@
 // per PID period, the unit of the base's speed frame. Eigen carries the left/right pairs.
 #pragma once
 
-#include <cstdint>
-
 #include <Eigen/Core>
+#include <cstdint>
 
 namespace serial_robot_driver::kinematics {
 
@@ -12,10 +11,10 @@ namespace serial_robot_driver::kinematics {
 using WheelSpeeds = Eigen::Vector2d;
 
 struct DiffDriveGeometry {
-  double wheel_diameter = 0.25;     ///< m
-  double wheel_separation = 0.40;   ///< m, between the wheel contact points
-  double encoder_resolution = 1600; ///< ticks per wheel revolution
-  double pid_rate = 50;             ///< Hz, the base's speed-control period
+  double wheel_diameter = 0.25;      ///< m
+  double wheel_separation = 0.40;    ///< m, between the wheel contact points
+  double encoder_resolution = 1600;  ///< ticks per wheel revolution
+  double pid_rate = 50;              ///< Hz, the base's speed-control period
 
   double ticksPerMeter() const;
   /// Ticks per PID period for 1 m/s.
@@ -23,7 +22,8 @@ struct DiffDriveGeometry {
 };
 
 /// Body twist (linear.x m/s, angular.z rad/s) to wheel speeds.
-WheelSpeeds wheelSpeedsFromTwist(const DiffDriveGeometry& geometry, double linear_x, double angular_z);
+WheelSpeeds wheelSpeedsFromTwist(const DiffDriveGeometry& geometry, double linear_x,
+                                 double angular_z);
 
 /// Scales both wheels by the same factor so that neither exceeds `max_wheel_speed`: the turn radius
 /// (the ratio between the wheels) is kept. `max_wheel_speed` <= 0 disables the clamp.
@@ -48,7 +48,9 @@ class AccelerationLimiter {
 struct WheelTicks {
   int16_t left = 0;
   int16_t right = 0;
-  bool operator==(const WheelTicks& other) const { return left == other.left && right == other.right; }
+  bool operator==(const WheelTicks& other) const {
+    return left == other.left && right == other.right;
+  }
 };
 
 /// Wheel speeds (m/s) to integer ticks per PID period.

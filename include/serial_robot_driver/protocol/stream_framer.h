@@ -18,11 +18,11 @@
 namespace serial_robot_driver::protocol {
 
 enum class FrameFamily : uint8_t {
-  kBase = 0,          ///< 55 AA, XOR (both directions share the layout)
-  kTelemetry,         ///< 12 34 ... SUM 1F 2F (board -> host)
-  kServoResponse,     ///< 05 1C, sum (servo -> host)
-  kServoRequest,      ///< 12 4C, sum (host -> servo; the half-duplex echo, or the simulator's input)
-  kSyncWrite,         ///< FF FF FD 00, CRC-16 (host -> board; the simulator's input)
+  kBase = 0,       ///< 55 AA, XOR (both directions share the layout)
+  kTelemetry,      ///< 12 34 ... SUM 1F 2F (board -> host)
+  kServoResponse,  ///< 05 1C, sum (servo -> host)
+  kServoRequest,   ///< 12 4C, sum (host -> servo: the half-duplex echo or the simulator input)
+  kSyncWrite,      ///< FF FF FD 00, CRC-16 (host -> board; the simulator's input)
 };
 constexpr std::size_t kFrameFamilyCount = 5;
 const char* toString(FrameFamily family);
@@ -44,42 +44,65 @@ struct FramerConfig {
 
 struct FramerStats {
   uint64_t bytes_in = 0;
-  uint64_t bytes_skipped = 0;     ///< bytes dropped while resynchronising
-  uint64_t checksum_errors = 0;   ///< complete candidates whose XOR/sum/CRC failed
-  uint64_t bad_tails = 0;         ///< telemetry with a wrong 1F 2F tail
-  uint64_t bad_lengths = 0;       ///< impossible LEN bytes
+  uint64_t bytes_skipped = 0;    ///< bytes dropped while resynchronising
+  uint64_t checksum_errors = 0;  ///< complete candidates whose XOR/sum/CRC failed
+  uint64_t bad_tails = 0;        ///< telemetry with a wrong 1F 2F tail
+  uint64_t bad_lengths = 0;      ///< impossible LEN bytes
   std::array<uint64_t, kFrameFamilyCount> frames{};  ///< verified frames per family
 };
 
 class StreamFramer {
  public:
-  /// Called for every verified frame; `data` is valid only during the call.
-  using FrameHandler = std::function<void(FrameFamily family, const uint8_t* data, std::size_t size)>;
+  /// Called for every verified frame. `data` points into the framer's buffer or into the chunk
+  /// passed to feed(), and is valid only during the call. The handler must not throw, nor call
+  /// feed() or reset() on the same framer.
+  using FrameHandler =
+      std::function<void(FrameFamily family, const uint8_t* data, std::size_t size)>;
 
   /// Large enough for several of the longest frames (telemetry: 255 bytes).
   static constexpr std::size_t kBufferSize = 4096;
+  /// The longest frame of any family (telemetry: LEN is one byte and counts the whole frame).
+  static constexpr std::size_t kLongestFrame = 255;
 
   StreamFramer(const FramerConfig& config, FrameHandler handler);
 
-  /// Feeds bytes as they arrived from the port; calls the handler for each complete frame.
+  /// Feeds bytes as they arrived from the port (any size, also larger than kBufferSize); calls the
+  /// handler for each complete frame. Never allocates.
   void feed(const uint8_t* data, std::size_t size);
-  /// Drops buffered bytes (after a reconnect the old partial frame is meaningless).
+  /// Drops buffered bytes (after a reconnect the old partial frame is meaningless). They are
+  /// counted in bytes_skipped; the other statistics are kept.
   void reset();
 
   const FramerStats& stats() const { return stats_; }
   const FramerConfig& config() const { return config_; }
+  /// Bytes of an incomplete candidate frame kept for the next feed() (always < 2 * kLongestFrame).
   std::size_t buffered() const { return size_; }
 
  private:
   enum class Candidate { kFrame, kNeedMore, kInvalid };
-  /// Examines the bytes at buffer_[pos..size_): a complete verified frame (its size in *frame_size),
-  /// a plausible but incomplete one, or not a frame at this position.
-  Candidate examine(std::size_t pos, std::size_t* frame_size, FrameFamily* family);
-  void scan();
+  /// Examines the `available` bytes at `data`: a complete verified frame (its size in
+  /// *frame_size), a plausible but incomplete one, or not a frame at this position. Counts the
+  /// checksum / tail / length errors it finds.
+  Candidate examine(const uint8_t* data, std::size_t available, std::size_t* frame_size,
+                    FrameFamily* family);
+  Candidate examineBase(const uint8_t* data, std::size_t available, std::size_t* frame_size);
+  Candidate examineTelemetry(const uint8_t* data, std::size_t available, std::size_t* frame_size);
+  Candidate examineServo(const uint8_t* data, std::size_t available, std::size_t* frame_size);
+  Candidate examineSyncWrite(const uint8_t* data, std::size_t available, std::size_t* frame_size);
+  /// Emits the frames found among the bytes at `data`, examining candidates that start before
+  /// `start_limit`. Returns how many bytes were consumed: it stops early only at an incomplete
+  /// candidate.
+  std::size_t scan(const uint8_t* data, std::size_t available, std::size_t start_limit);
+  /// Position of the first byte in [from, to) that may start an enabled family, or `to`.
+  std::size_t findStart(const uint8_t* data, std::size_t from, std::size_t to) const;
 
   FramerConfig config_;
   FrameHandler handler_;
   FramerStats stats_;
+  /// is_start_[b]: b is the first header byte of an enabled family.
+  std::array<bool, 256> is_start_{};
+  /// The only start byte when exactly one is enabled (memchr applies), else -1.
+  int single_start_ = -1;
   std::array<uint8_t, kBufferSize> buffer_{};
   std::size_t size_ = 0;
 };

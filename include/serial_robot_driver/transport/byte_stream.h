@@ -16,7 +16,8 @@ enum class TransportErrorKind { kOpenFailed, kConfigureFailed, kDisconnected, kI
 
 class TransportError : public std::runtime_error {
  public:
-  TransportError(TransportErrorKind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
+  TransportError(TransportErrorKind kind, const std::string& what)
+      : std::runtime_error(what), kind_(kind) {}
   TransportErrorKind kind() const { return kind_; }
 
  private:

@@ -2,6 +2,10 @@
 // (one reader thread, writers serialized by the caller), as in wjwwood/serial.
 #pragma once
 
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -14,6 +18,8 @@ struct SerialPortOptions {
   unsigned baud = 115200;
 };
 
+/// Threading: one thread may read while another writes (the two share no mutable state besides
+/// the fd). open() and close() must not race with a read or write in progress.
 class SerialPort : public ByteStream {
  public:
   explicit SerialPort(SerialPortOptions options);
@@ -21,12 +27,20 @@ class SerialPort : public ByteStream {
   SerialPort(const SerialPort&) = delete;
   SerialPort& operator=(const SerialPort&) = delete;
 
-  /// Opens and configures the port. Requests ASYNC_LOW_LATENCY where the driver supports it; a pty
-  /// or a driver that refuses the ioctl is "not supported", not an error.
+  /// Opens and configures the port (raw 8N1, no flow control) and drops stale buffered bytes.
+  /// Requests ASYNC_LOW_LATENCY where the driver supports it; a pty or a driver that refuses the
+  /// ioctl is "not supported", not an error. Reopens when already open.
+  /// \throws TransportError kConfigureFailed for an unsupported baud or a path that is no tty,
+  ///         kOpenFailed when the path cannot be opened.
   void open() override;
+  /// Idempotent; the destructor calls it.
   void close() override;
   bool isOpen() const override { return fd_ >= 0; }
+  /// \throws TransportError kDisconnected on hang-up, EOF or EIO (and when not open), kIoError
+  ///         for other failures.
   std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms) override;
+  /// \throws TransportError kDisconnected on EIO/EPIPE/hang-up (and when not open), kIoError when
+  ///         the device accepts nothing for ~100 ms or fails otherwise.
   void write(const uint8_t* data, std::size_t size) override;
   std::string name() const override { return options_.path; }
 
@@ -36,7 +50,7 @@ class SerialPort : public ByteStream {
 
  private:
   SerialPortOptions options_;
-  int fd_ = -1;
+  std::atomic<int> fd_{-1};
   bool low_latency_ = false;
   std::optional<int> latency_timer_ms_;
 };
@@ -46,5 +60,16 @@ std::optional<unsigned> baudToSpeed(unsigned baud);
 
 /// Reads /sys/bus/usb-serial/devices/<ttyX>/latency_timer for a device path (symlinks resolved).
 std::optional<int> readLatencyTimerMs(const std::string& device_path);
+
+/// Shared by SerialPort and PseudoTerminal: waits up to `timeout_ms` for input on the non-blocking
+/// `fd` and reads what is there (0 on timeout or EAGAIN/EINTR). Hang-up, EOF and EIO throw
+/// TransportError kDisconnected; `what` names the device in error messages.
+std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
+                       const std::string& what);
+
+/// Shared by SerialPort and PseudoTerminal: writes all bytes to the non-blocking `fd`, waiting for
+/// room at most `stall_limit` without progress (then kIoError). EIO/EPIPE/hang-up → kDisconnected.
+void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::string& what,
+                  std::chrono::milliseconds stall_limit = std::chrono::milliseconds(100));
 
 }  // namespace serial_robot_driver::transport

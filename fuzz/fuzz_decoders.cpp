@@ -1,0 +1,190 @@
+// libFuzzer target: each decoder on raw bytes, and on bytes whose integrity fields were fixed up so
+// that malformed payloads get past the XOR / sum / CRC / tail and reach the field parsing.
+//
+// Input layout:
+//   byte 0  decoder = byte % 5 (base, telemetry, servo response, servo request, sync write),
+//           mode = (byte / 5) % 3: 0 raw, 1 fix the checksum, 2 fix header/length/tail/checksum
+//   byte 1  telemetry servo count (used modulo 64, so also beyond the legal 57)
+//   rest    the frame, passed to the decoder in an exact-size heap buffer (ASan sees over-reads)
+//
+// Aborts when a decoded frame does not re-encode to the same bytes (telemetry, servo response,
+// sync write), when decoded sizes contradict the input, or on any sanitizer report.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/protocol/servo_params.h"
+
+namespace {
+
+namespace base = serial_robot_driver::protocol::base;
+namespace body = serial_robot_driver::protocol::body;
+namespace servo = serial_robot_driver::protocol::servo;
+using serial_robot_driver::protocol::writeLE16;
+
+enum class Target { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite, kCount };
+enum class Mode { kRaw, kFixChecksum, kFixEverything, kCount };
+
+void check(bool condition) {
+  if (!condition) std::abort();
+}
+
+bool sameBytes(const std::vector<uint8_t>& encoded, const uint8_t* data, std::size_t size) {
+  return encoded.size() == size && std::memcmp(encoded.data(), data, size) == 0;
+}
+
+// --- fix-ups (the codec's own checksum functions compute the value to write) ------------------
+
+void fixBase(uint8_t* d, std::size_t n, Mode mode) {
+  if (mode == Mode::kFixEverything && n >= base::kOverhead) {
+    d[0] = base::kHeader0;
+    d[1] = base::kHeader1;
+    d[2] = static_cast<uint8_t>(n - base::kOverhead);
+  }
+  if (n >= 1) d[n - 1] = base::xorChecksum(d, n - 1);
+}
+
+void fixTelemetry(uint8_t* d, std::size_t n, Mode mode) {
+  if (n < 3) return;
+  if (mode == Mode::kFixEverything && n >= 5) {
+    d[0] = body::kTelemetryHeader0;
+    d[1] = body::kTelemetryHeader1;
+    d[2] = static_cast<uint8_t>(n);
+    d[n - 2] = body::kTelemetryTail0;
+    d[n - 1] = body::kTelemetryTail1;
+  }
+  d[n - 3] = body::telemetrySum(d, n);
+}
+
+void fixServo(uint8_t* d, std::size_t n, Mode mode, uint8_t header0, uint8_t header1) {
+  if (mode == Mode::kFixEverything && n >= servo::kOverhead) {
+    d[0] = header0;
+    d[1] = header1;
+    d[3] = static_cast<uint8_t>(n - servo::kOverhead);
+  }
+  if (n >= 1) d[n - 1] = servo::byteSum(d, n - 1);
+}
+
+void fixSyncWrite(uint8_t* d, std::size_t n, Mode mode) {
+  constexpr std::size_t kFixedPart = 12;  // header, id, LEN, instruction, address, data size
+  if (mode == Mode::kFixEverything && n >= kFixedPart + 2) {
+    std::memcpy(d, body::kSyncWriteHeader.data(), body::kSyncWriteHeader.size());
+    d[4] = body::kBroadcastId;
+    writeLE16(d + 5, static_cast<uint16_t>(n - body::kSyncWritePrefix));
+    d[7] = body::kSyncWriteInstruction;
+    writeLE16(d + 8, body::kGoalPositionAddress);
+    writeLE16(d + 10, body::kGoalPositionSize);
+  }
+  if (n >= 2) writeLE16(d + n - 2, body::dynamixelCrc(d, n - 2));
+}
+
+// --- decoders --------------------------------------------------------------------------------
+
+void runBase(const uint8_t* d, std::size_t n) {
+  const auto frame = base::decodeFrame(d, n);
+  if (!frame.ok()) return;
+  check(frame->param_count + 1u == d[2] && n == base::frameSize(d[2]));
+  const auto reply = base::interpretReply(*frame);
+  if (reply.ok() && reply->kind == base::Reply::Kind::kBattery) {
+    check(reply->battery_percent <= 100);
+  }
+  (void)base::interpretWheelSpeed(*frame);
+}
+
+void runTelemetry(const uint8_t* d, std::size_t n, std::size_t servo_count) {
+  const auto telemetry = body::decodeTelemetry(d, n, servo_count);
+  if (!telemetry.ok()) return;
+  check(telemetry->servo_count == servo_count);
+  check(sameBytes(body::encodeTelemetry(*telemetry), d, n));
+}
+
+void runServoParams(const servo::Packet& packet) {
+  const auto cmd = static_cast<servo::Command>(packet.cmd);
+  if (cmd == servo::Command::kReadData && packet.content_size >= 2) {
+    if (const servo::ParamInfo* param = servo::findParamById(packet.content[1])) {
+      (void)servo::readValue(*param, &packet.content[2], packet.content_size - 2u);
+    }
+  }
+  if (cmd == servo::Command::kReadBatchData && packet.content_size == 1 + servo::kUserBlockSize) {
+    for (const servo::ParamInfo& param : servo::paramTable()) {
+      const auto offset = servo::userBlockOffset(param);
+      if (!offset) continue;
+      const std::size_t size = servo::typeSize(param.type);
+      check(*offset + size <= servo::kUserBlockSize);
+      (void)servo::readValue(param, &packet.content[1 + *offset], size);
+    }
+  }
+}
+
+void runServoResponse(const uint8_t* d, std::size_t n) {
+  const auto packet = servo::decodeResponse(d, n);
+  if (!packet.ok()) return;
+  const std::vector<uint8_t> content(packet->content.begin(),
+                                     packet->content.begin() + packet->content_size);
+  check(sameBytes(servo::encodeResponse(static_cast<servo::Command>(packet->cmd), content), d, n));
+  runServoParams(*packet);
+}
+
+void runServoRequest(const uint8_t* d, std::size_t n) {
+  const auto packet = servo::decodeRequest(d, n);
+  if (!packet.ok()) return;
+  check(packet->content_size + servo::kOverhead == n);
+  check(packet->cmd >= servo::kMinCommand && packet->cmd <= servo::kMaxCommand);
+}
+
+void runSyncWrite(const uint8_t* d, std::size_t n) {
+  const auto targets = body::decodeSyncWrite(d, n);
+  if (!targets.ok()) return;
+  check(targets->size() <= body::kMaxSyncWriteServos);
+  check(sameBytes(body::encodeSyncWrite(*targets), d, n));
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* input, std::size_t input_size) {
+  constexpr std::size_t kPrefix = 2;
+  if (input_size < kPrefix) return 0;
+  const auto target = static_cast<Target>(input[0] % static_cast<int>(Target::kCount));
+  const auto mode = static_cast<Mode>((input[0] / static_cast<int>(Target::kCount)) %
+                                      static_cast<int>(Mode::kCount));
+  const std::size_t servo_count = input[1] % 64;
+  const std::size_t n = input_size - kPrefix;
+  std::unique_ptr<uint8_t[]> frame(new uint8_t[n]);  // n == 0: any access is an overflow
+  if (n > 0) std::memcpy(frame.get(), input + kPrefix, n);
+  uint8_t* d = frame.get();
+
+  switch (target) {
+    case Target::kBase:
+      if (mode != Mode::kRaw) fixBase(d, n, mode);
+      runBase(d, n);
+      break;
+    case Target::kTelemetry:
+      if (mode != Mode::kRaw) fixTelemetry(d, n, mode);
+      runTelemetry(d, n, servo_count);
+      break;
+    case Target::kServoResponse:
+      if (mode != Mode::kRaw) {
+        fixServo(d, n, mode, servo::kResponseHeader0, servo::kResponseHeader1);
+      }
+      runServoResponse(d, n);
+      break;
+    case Target::kServoRequest:
+      if (mode != Mode::kRaw) fixServo(d, n, mode, servo::kRequestHeader0, servo::kRequestHeader1);
+      runServoRequest(d, n);
+      break;
+    case Target::kSyncWrite:
+      if (mode != Mode::kRaw) fixSyncWrite(d, n, mode);
+      runSyncWrite(d, n);
+      break;
+    case Target::kCount:
+      break;
+  }
+  return 0;
+}

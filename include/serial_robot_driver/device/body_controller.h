@@ -1,0 +1,124 @@
+// The servo controller board (PROTOCOLS.md section 2), ROS-free: telemetry frames in, goal
+// positions out as one Dynamixel 2.0 sync-write frame.
+//
+// Threading: onFrame() runs on the link's reader thread and calls the telemetry callback right
+// there (no queue, so a message is published as soon as its frame is complete).
+// sendJointCommand() may be called from any thread; it serializes on an internal mutex.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/protocol/decode_result.h"
+
+namespace serial_robot_driver::device {
+
+/// Maps one servo's raw ticks to a joint angle and back:
+///   position [rad] = direction * (ticks - zero_ticks) * 2 pi / ticks_per_revolution
+///   velocity [rad/s] = direction * velocity_scale * raw, or, when velocity_scale is 0,
+///                      direction * raw * 2 pi / ticks_per_revolution (raw read as ticks/s).
+struct JointCalibration {
+  int zero_ticks = 2048;
+  int direction = 1;  ///< +1 or -1
+  int ticks_per_revolution = 4096;
+  double velocity_scale = 0.0;  ///< rad/s per raw speed unit; 0: raw is ticks/s
+
+  double toRadians(uint16_t ticks) const;
+  double toRadiansPerSecond(int16_t raw_speed) const;
+  /// The inverse of toRadians(), rounded to the nearest tick and clamped to 0..65535.
+  /// std::nullopt for NaN or infinity.
+  std::optional<uint16_t> toTicks(double radians) const;
+};
+
+/// One joint of the board, in telemetry / sync-write order.
+struct BodyJoint {
+  std::string name;
+  uint8_t servo_id = 0;
+  JointCalibration calibration;
+};
+
+struct BodyStats {
+  uint64_t frames_decoded = 0;
+  uint64_t decode_errors = 0;  ///< verified telemetry frames that still did not decode (e.g. LEN)
+  std::optional<protocol::DecodeError> last_decode_error;
+  uint64_t commands_sent = 0;
+  uint64_t commands_rejected = 0;  ///< invalid commands: nothing was written
+  uint64_t write_failures = 0;     ///< valid commands the link refused (port down)
+};
+
+enum class JointCommandStatus {
+  kSent,
+  kEmpty,           ///< no joint named (nothing to do, nothing written)
+  kLengthMismatch,  ///< names and positions differ in length
+  kUnknownJoint,    ///< a name that is not one of the configured joints
+  kDuplicateJoint,  ///< the same joint named twice in one command
+  kNotFinite,       ///< a NaN or infinite position
+  kWriteFailed,     ///< valid, but the link refused the frame (port down)
+};
+
+/// What became of one joint command: the ROS layer logs message() (throttled) when !ok().
+struct JointCommandResult {
+  JointCommandStatus status = JointCommandStatus::kSent;
+  std::string joint;  ///< the offending joint, when the status is about one
+
+  bool ok() const { return status == JointCommandStatus::kSent; }
+  std::string message() const;
+};
+
+class BodyController : public LinkListener {
+ public:
+  /// Sends one whole frame; returns false when it could not be written (SerialLink::write).
+  using WriteFunction = std::function<bool(const std::vector<uint8_t>&)>;
+  /// Called on the reader thread for every decoded telemetry frame with its arrival time.
+  using TelemetryCallback =
+      std::function<void(const protocol::body::Telemetry& telemetry, Clock::time_point arrival)>;
+
+  /// `joints` in frame order (the order of ~body/servo_ids). The callback may be empty.
+  BodyController(std::vector<BodyJoint> joints, WriteFunction write,
+                 TelemetryCallback on_telemetry);
+
+  /// A WriteFunction that writes to `link` (which must outlive the controller).
+  static WriteFunction writerFor(SerialLink& link);
+
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) override;
+
+  /// Validates a command (positions in rad) and writes one sync-write frame in servo_ids order.
+  ///
+  /// Joints the command does not name are sent again at their last commanded position, so a
+  /// partial command never moves the other joints. Joints that were never commanded are left out
+  /// of the frame: the driver cannot know a safe target for them, and a servo that is not
+  /// addressed keeps whatever it is doing. An invalid command writes nothing and changes no stored
+  /// position.
+  JointCommandResult sendJointCommand(const std::vector<std::string>& names,
+                                      const std::vector<double>& positions);
+
+  const std::vector<BodyJoint>& joints() const { return joints_; }
+  std::size_t servoCount() const { return joints_.size(); }
+  BodyStats stats() const;
+
+ private:
+  const std::vector<BodyJoint> joints_;
+  WriteFunction write_;
+  TelemetryCallback on_telemetry_;
+
+  std::atomic<uint64_t> frames_decoded_{0};
+  std::atomic<uint64_t> decode_errors_{0};
+  std::atomic<int> last_decode_error_{-1};  // DecodeError as int, -1: none yet
+
+  mutable std::mutex command_mutex_;  // guards the fields below
+  std::vector<std::optional<uint16_t>> last_commanded_ticks_;
+  uint64_t commands_sent_ = 0;
+  uint64_t commands_rejected_ = 0;
+  uint64_t write_failures_ = 0;
+};
+
+}  // namespace serial_robot_driver::device

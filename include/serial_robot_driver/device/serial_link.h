@@ -1,0 +1,117 @@
+// One serial port shared by the devices that name its path: the port, its framer, its reader thread
+// and its reconnect loop.
+//
+// Threading model of a link:
+//  - ONE reader thread per port owns every read. It opens the port (retrying every
+//    reconnect_interval while the device node is missing), feeds the bytes to the port's
+//    StreamFramer and hands each verified frame to the listeners, stamped with the time the chunk
+//    holding its last byte was read. Listeners run on this thread: they decode, publish and return;
+//    they never wait on the wire.
+//  - Any thread may write(): writes are serialized by a per-port mutex and never wait for an answer.
+//    A failed write marks the port lost; the reader thread then closes and reopens it.
+//  - Only the reader thread opens and closes the stream, so a read never races a close.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "serial_robot_driver/protocol/stream_framer.h"
+#include "serial_robot_driver/transport/byte_stream.h"
+
+namespace serial_robot_driver::device {
+
+using Clock = std::chrono::steady_clock;
+
+/// Implemented by the devices on a port. All calls come from the link's reader thread.
+class LinkListener {
+ public:
+  virtual ~LinkListener() = default;
+  /// The port was (re)opened: e.g. the base must send a Reset before its next speed frame.
+  virtual void onLinkUp() {}
+  virtual void onLinkDown() {}
+  /// A verified frame of one of the families the port's framer accepts.
+  virtual void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+                       Clock::time_point arrival) = 0;
+};
+
+struct SerialLinkOptions {
+  std::string path;
+  unsigned baud = 115200;
+  double reconnect_interval = 1.0;  ///< s between attempts to reopen a lost port
+  protocol::FramerConfig framer;
+};
+
+struct LinkStats {
+  bool connected = false;
+  uint64_t connects = 0;        ///< successful opens (the first one included)
+  uint64_t disconnects = 0;
+  uint64_t frames_out = 0;
+  uint64_t bytes_out = 0;
+  uint64_t write_failures = 0;  ///< writes refused because the port was down, or that failed
+  protocol::FramerStats framer;
+  bool low_latency = false;
+  std::optional<int> latency_timer_ms;  ///< USB adapter's latency_timer, when known
+  std::string last_error;               ///< why the port was last lost or could not be opened
+};
+
+class SerialLink {
+ public:
+  using StreamFactory = std::function<std::unique_ptr<transport::ByteStream>(const SerialLinkOptions&)>;
+
+  /// `factory` builds the stream to open; the default is a termios SerialPort.
+  explicit SerialLink(SerialLinkOptions options, StreamFactory factory = {});
+  ~SerialLink();
+  SerialLink(const SerialLink&) = delete;
+  SerialLink& operator=(const SerialLink&) = delete;
+
+  /// Listeners must be added before start() and outlive the link's thread.
+  void addListener(LinkListener* listener);
+  void start();
+  /// Stops the reader thread and closes the port. Idempotent.
+  void stop();
+
+  /// Writes one whole frame. Returns false (and counts it) when the port is down or the write
+  /// failed; a failed write also schedules a reconnect.
+  bool write(const std::vector<uint8_t>& frame);
+  bool write(const uint8_t* data, std::size_t size);
+
+  bool connected() const { return connected_.load(); }
+  LinkStats stats() const;
+  const SerialLinkOptions& options() const { return options_; }
+
+  /// Blocks until the link is connected or `timeout` elapses (start-up helpers and tests).
+  bool waitConnected(std::chrono::milliseconds timeout) const;
+
+ private:
+  void readerLoop();
+  bool tryOpen();
+  void closeStream(const std::string& reason);
+  void sleepBeforeRetry();
+
+  SerialLinkOptions options_;
+  StreamFactory factory_;
+  std::vector<LinkListener*> listeners_;
+  protocol::StreamFramer framer_;
+  Clock::time_point chunk_arrival_;
+
+  std::unique_ptr<transport::ByteStream> stream_;  // opened/closed by the reader thread only
+  mutable std::mutex write_mutex_;                  // serializes writes and guards stream_ swaps
+  std::atomic<bool> connected_{false};
+  std::atomic<bool> lost_{false};                   // a writer saw the port fail
+  std::atomic<bool> stopping_{false};
+  mutable std::mutex state_mutex_;                  // guards stats_ and the stop condition
+  mutable std::condition_variable state_cv_;
+  LinkStats stats_;
+  std::thread reader_;
+};
+
+}  // namespace serial_robot_driver::device

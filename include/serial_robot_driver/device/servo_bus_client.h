@@ -1,0 +1,191 @@
+// A client for the UART bus servos (PROTOCOLS.md section 3). ROS-free: the ROS services
+// (ros/servo_bus_interface.h) are a thin layer that turns requests into calls of this class.
+//
+// Threading model:
+//  - Any thread may call the operations. The bus is half duplex, so they are serialized by one bus
+//    mutex: a caller writes its request and waits (condition variable) for the answer, up to
+//    `timeout`, re-sending up to `retries` times. Nobody else writes to the bus meanwhile.
+//  - The answer arrives on the link's reader thread through onFrame(), which only matches it
+//    against the pending transaction, stores it and wakes the caller: the reader never waits.
+//  - The write seam is called without any lock of this class held, so a fake in a test may answer
+//    synchronously by calling onFrame() from inside it.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/protocol/servo_params.h"
+
+namespace serial_robot_driver::device {
+
+/// Why a servo operation failed. Every error before kTimeout is a rejection: nothing was written.
+enum class ServoError {
+  kOk = 0,
+  kInvalidArgument,   ///< broadcast id where an answer is needed, angle or spin mode out of range
+  kUnknownParam,      ///< no parameter of that name or data_id
+  kReadOnly,          ///< write to a read-only parameter
+  kOutOfRange,        ///< write value outside the parameter's range
+  kDangerous,         ///< servo_id / baudrate / reset_user_data without allow_dangerous_writes
+  kNotConnected,      ///< the port is down (or was lost while waiting)
+  kIdInUse,           ///< servo_id change refused: a servo already answers at the new id
+  kTimeout,           ///< no answer in any attempt
+  kBadAnswer,         ///< an answer with the right CMD and id whose content does not fit
+  kRefused,           ///< the servo answered with result 0
+  kReadBackMismatch,  ///< the value read back after a write differs from the one written
+  kShutdown,          ///< the client is shutting down
+};
+const char* toString(ServoError error);
+
+/// The outcome of an operation: a typed error plus one sentence for the user.
+struct ServoStatus {
+  ServoError error = ServoError::kOk;
+  std::string message;
+  bool ok() const { return error == ServoError::kOk; }
+};
+
+struct ServoBusOptions {
+  std::chrono::milliseconds timeout{50};  ///< wait for one answer
+  int retries = 1;                        ///< re-sends after a timeout (attempts = retries + 1)
+  bool allow_dangerous_writes = false;    ///< arms servo_id, baudrate and reset_user_data
+};
+
+/// A parameter value in the unit of the parameter table (mV, mA, mW, degC, ms, 0.1deg or raw "").
+struct ServoParamValue {
+  std::string name;
+  uint8_t data_id = 0;
+  int64_t value = 0;
+  std::string unit;
+};
+
+struct RotateRequest {
+  uint8_t id = 0;
+  double angle_deg = 0.0;  ///< sent as int16 in 0.1 deg: -3276.8 .. 3276.7
+  uint16_t interval_ms = 0;
+  uint16_t power_mw = 0;   ///< 0: the servo's default
+  /// Wait for the completion answer (sent only when response_switch = 1) up to
+  /// interval_ms + timeout; never re-sent.
+  bool wait = false;
+};
+
+struct SpinRequest {
+  uint8_t id = 0;
+  bool clockwise = false;
+  uint8_t mode = 0;        ///< 0 stop, 1 continuous, 2 `value` turns, 3 `value` ms
+  uint16_t speed_dps = 0;
+  uint16_t value = 0;
+  /// Wait for the completion answer (response_switch = 1) up to the expected duration (mode 2:
+  /// value * 360 / speed_dps s, mode 3: value ms, else 0) + timeout; never re-sent.
+  bool wait = false;
+};
+
+struct ServoBusStats {
+  uint64_t transactions = 0;   ///< requests that expected an answer (once, however many attempts)
+  uint64_t commands = 0;       ///< motion frames written without waiting for an answer
+  uint64_t timeouts = 0;       ///< transactions that got no answer in any attempt
+  uint64_t retries = 0;        ///< requests re-sent after a timeout or a malformed answer
+  uint64_t mismatched = 0;     ///< answers matching no pending transaction (other CMD/id, late)
+  uint64_t garbled = 0;        ///< right CMD and id, but a content that does not fit
+  uint64_t echoes = 0;         ///< our own requests read back (half-duplex echo), skipped
+  double last_latency_ms = 0.0;  ///< request written -> answer's last byte read
+  double max_latency_ms = 0.0;
+};
+
+class ServoBusClient : public LinkListener {
+ public:
+  /// Writes one whole frame; false when the port is down (SerialLink::write).
+  using WriteFunction = std::function<bool(const std::vector<uint8_t>&)>;
+
+  /// The longest motion a caller may wait for (the longest ROTATE interval).
+  static constexpr std::chrono::milliseconds kMaxMotionWait{65535};
+
+  ServoBusClient(ServoBusOptions options, WriteFunction write);
+
+  /// PING: ok when the servo answered.
+  ServoStatus ping(uint8_t id);
+  /// READ_DATA of a parameter given by name or data_id as text ("51").
+  ServoStatus readParam(uint8_t id, std::string_view param, ServoParamValue* value);
+  /// WRITE_DATA after checkWrite, then a read-back to confirm. A servo_id change first pings the
+  /// new id and is refused if a servo answers there; a baudrate write is not read back (it takes
+  /// effect at once).
+  ServoStatus writeParam(uint8_t id, std::string_view param, int64_t value);
+  /// READ_ANGLE in degrees.
+  ServoStatus readAngle(uint8_t id, double* angle_deg);
+  /// ROTATE / SPIN / DAMPING return once the frame is written unless `wait` is set. Id 255
+  /// (broadcast) is accepted only without wait.
+  ServoStatus rotate(const RotateRequest& request);
+  ServoStatus spin(const SpinRequest& request);
+  ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait);
+  /// READ_BATCH_DATA: the 22 user-block parameters (data_id 32..53) in table order.
+  ServoStatus readAll(uint8_t id, std::vector<ServoParamValue>* values);
+  /// RESET_USER_DATA (dangerous: refused unless allow_dangerous_writes).
+  ServoStatus resetUserData(uint8_t id);
+
+  /// Wakes a waiting caller and fails every later call with kShutdown. Idempotent.
+  void shutdown();
+
+  ServoBusStats stats() const;
+  const ServoBusOptions& options() const { return options_; }
+
+  // LinkListener (reader thread).
+  void onLinkDown() override;
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) override;
+
+ private:
+  /// What an answer must look like to complete the pending transaction.
+  struct Expectation {
+    protocol::servo::Command cmd = protocol::servo::Command::kPing;
+    uint8_t id = 0;
+    std::optional<uint8_t> alt_id;   ///< also accepted (a servo_id change may answer at the new id)
+    std::optional<uint8_t> data_id;  ///< READ_DATA / WRITE_DATA: content[1]
+    std::size_t content_size = 0;
+  };
+  struct Pending {
+    bool active = false;
+    Expectation expect;
+    bool answered = false;
+    bool garbled = false;
+    protocol::servo::Packet answer;
+    Clock::time_point arrival;
+  };
+
+  // The helpers below expect bus_mutex_ to be held by the caller.
+  ServoStatus transact(const std::vector<uint8_t>& request, const Expectation& expect,
+                       std::chrono::milliseconds timeout, int attempts,
+                       protocol::servo::Packet* answer);
+  /// Fire and forget: a motion command without wait.
+  ServoStatus sendCommand(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
+                          uint8_t id);
+  /// The shared tail of ROTATE/SPIN/DAMPING: send, or transact and check the result byte.
+  ServoStatus sendMotion(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
+                         uint8_t id, bool wait, std::chrono::milliseconds motion_time);
+  ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
+                              ServoParamValue* value);
+  ServoStatus pingLocked(uint8_t id);
+  bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
+
+  const ServoBusOptions options_;
+  const WriteFunction write_;
+
+  std::mutex bus_mutex_;  // one transaction on the wire at a time
+
+  mutable std::mutex state_mutex_;  // guards everything below; shared with the reader thread
+  std::condition_variable answer_cv_;
+  Pending pending_;
+  std::vector<uint8_t> last_request_;  // recognises the half-duplex echo
+  bool link_lost_ = false;             // the port went down while a transaction was pending
+  bool stopping_ = false;
+  ServoBusStats stats_;
+};
+
+}  // namespace serial_robot_driver::device

@@ -1,0 +1,50 @@
+// ROS face of the servo controller board: joint_states, imu/data, foot_pressure and telemetry out
+// (published on the link's reader thread as each frame is decoded, stamped with the frame's
+// arrival time); joint_commands in (one sync-write frame per message); one diagnostic status.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
+#include <memory>
+
+#include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/ros/driver_params.h"
+
+namespace serial_robot_driver::ros_layer {
+
+class BodyInterface {
+ public:
+  /// Registers the controller on `link` (before the link starts), advertises the topics and adds
+  /// the "body" diagnostic task. `link` and `diagnostics` must outlive this object.
+  BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
+                diagnostic_updater::Updater& diagnostics);
+
+  /// Stops taking joint commands. Frames that still arrive before the link stops are published.
+  void shutdown();
+
+  const device::BodyController& controller() const { return controller_; }
+
+ private:
+  void publishTelemetry(const protocol::body::Telemetry& telemetry,
+                        device::Clock::time_point arrival);
+  void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  device::SerialLink& link_;
+  const ImuParams imu_params_;
+  device::BodyController controller_;
+  // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
+  double min_rate_ = 1.0;
+  double max_rate_ = 1000.0;
+  diagnostic_updater::FrequencyStatus telemetry_rate_;  // ticked on the reader thread (locks)
+  ros::Publisher joint_states_pub_;
+  ros::Publisher imu_pub_;
+  ros::Publisher foot_pressure_pub_;
+  ros::Publisher telemetry_pub_;
+  ros::Subscriber joint_commands_sub_;
+};
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,67 @@
+// Pure conversions between the ROS-free device structs and ROS messages: no node, no I/O, so they
+// are unit-tested without a roscore.
+#pragma once
+
+#include <geometry_msgs/Quaternion.h>
+#include <ros/time.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/JointState.h>
+#include <serial_robot_driver/FootPressure.h>
+#include <serial_robot_driver/Telemetry.h>
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/ros/driver_params.h"
+
+namespace serial_robot_driver::ros_layer {
+
+/// The ROS time at which a steady_clock event happened: `ros_now` minus how long ago it was
+/// (`steady_now` - `event`). Saturates at ros::Time(0) instead of going negative.
+ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time& ros_now,
+                    std::chrono::steady_clock::time_point steady_now);
+
+/// The same, against the current ros::Time::now() and steady_clock::now().
+ros::Time toRosTime(std::chrono::steady_clock::time_point event);
+
+/// The joints configured from ~body (servo_ids, joint_names, zero_ticks, directions,
+/// ticks_per_revolution, velocity_scale), in frame order. Assumes validated parameters.
+std::vector<device::BodyJoint> makeBodyJoints(const BodyParams& params);
+
+/// Orientation quaternion from attitude angles in rad, applied as yaw (Z) * pitch (Y) * roll (X).
+geometry_msgs::Quaternion quaternionFromRollPitchYaw(double roll, double pitch, double yaw);
+
+/// Joint positions (rad) and velocities (rad/s) of every configured joint. Joints beyond the
+/// frame's servo_count are left out (cannot happen when the frame was decoded for these joints).
+sensor_msgs::JointState toJointState(const protocol::body::Telemetry& telemetry,
+                                     const std::vector<device::BodyJoint>& joints,
+                                     const ros::Time& stamp);
+
+/// REP-145 IMU message: accel (m/s^2) and gyro (rad/s) scaled from raw LSB, orientation from the
+/// attitude angles, diagonal covariances from `params`. A negative orientation_variance marks the
+/// orientation as unknown (orientation_covariance[0] = -1).
+sensor_msgs::Imu toImu(const protocol::body::Telemetry& telemetry, const ImuParams& params,
+                       const ros::Time& stamp);
+
+/// The 8 raw foot readings, or nothing when the frame did not carry the foot block.
+std::optional<serial_robot_driver::FootPressure> toFootPressure(
+    const protocol::body::Telemetry& telemetry, const ros::Time& stamp,
+    const std::string& frame_id = "");
+
+/// The whole frame in raw units (for rosbag). `joints` give the servo ids in frame order.
+serial_robot_driver::Telemetry toTelemetryMsg(const protocol::body::Telemetry& telemetry,
+                                              const std::vector<device::BodyJoint>& joints,
+                                              const ros::Time& stamp);
+
+/// A joint command taken out of a JointState (only name and position matter).
+struct JointCommand {
+  std::vector<std::string> names;
+  std::vector<double> positions;
+};
+JointCommand fromJointState(const sensor_msgs::JointState& msg);
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,69 @@
+// driver_node: one node that owns the robot's serial port(s).
+//
+// Topics (in the node's namespace):
+//   in : cmd_vel (geometry_msgs/Twist), joint_commands (sensor_msgs/JointState)
+//   out: wheel_command (serial_robot_driver/WheelCommand), battery (sensor_msgs/BatteryState),
+//        joint_states (sensor_msgs/JointState), imu/data (sensor_msgs/Imu),
+//        foot_pressure (serial_robot_driver/FootPressure), telemetry (serial_robot_driver/Telemetry),
+//        /diagnostics
+// Services: base/reset, base/clear_encoders (std_srvs/Trigger); servo/ping, servo/read, servo/write,
+//   servo/read_angle, servo/rotate, servo/spin, servo/damping, servo/read_all, servo/reset_user_data.
+// Parameters: see ros/driver_params.h and config/robot.yaml.
+//
+// Threading model:
+//  - one reader thread per port (device::SerialLink) decodes and publishes telemetry and base replies
+//    as soon as their last byte is read;
+//  - the base control loop runs on its own thread (device::BaseController);
+//  - cmd_vel, joint_commands and base/* services run on the global callback queue (an AsyncSpinner
+//    in main); servo/* services have their own queue and spinner because they wait on the bus;
+//  - diagnostics are updated from a steady timer on the global queue.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/ros/driver_params.h"
+
+namespace serial_robot_driver::ros_layer {
+
+class BaseInterface;
+class BodyInterface;
+class ServoBusInterface;
+class PortMonitor;
+
+class DriverNode {
+ public:
+  DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params);
+  ~DriverNode();
+
+  /// Opens the ports (in the background: a missing port is waited for) and starts the base loop.
+  void start();
+  /// Stops the base (writing a zero-speed frame), the servo services and the ports. Idempotent.
+  void shutdown();
+
+ private:
+  struct Port {
+    std::unique_ptr<device::SerialLink> link;
+    std::unique_ptr<PortMonitor> monitor;
+  };
+  device::SerialLink& portFor(const std::string& path);
+  void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  ros::NodeHandle nh_;
+  DriverParams params_;
+  diagnostic_updater::Updater diagnostics_;
+  std::map<std::string, Port> ports_;
+  std::unique_ptr<BaseInterface> base_;
+  std::unique_ptr<BodyInterface> body_;
+  std::unique_ptr<ServoBusInterface> servo_bus_;
+  ros::SteadyTimer diagnostics_timer_;
+  bool shut_down_ = false;
+};
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,97 @@
+// Every parameter of driver_node, loaded once at start-up into one struct (names and defaults:
+// ../shared/INTERFACE.md and config/robot.yaml). validate() throws ParameterError naming the first
+// bad parameter; the node prints it and exits non-zero.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ros {
+class NodeHandle;
+}
+
+namespace serial_robot_driver::ros_layer {
+
+class ParameterError : public std::runtime_error {
+ public:
+  ParameterError(const std::string& name, const std::string& problem)
+      : std::runtime_error("parameter ~" + name + ": " + problem), name_(name) {}
+  const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+};
+
+/// Where a device talks: its own port/baud, or the node-wide ones.
+struct DevicePortParams {
+  bool enabled = true;
+  std::string port;  ///< empty: the node-wide ~port
+  int baud = 0;      ///< 0: the node-wide ~baud
+};
+
+struct BaseParams : DevicePortParams {
+  double wheel_diameter = 0.25;
+  int encoder_resolution = 1600;
+  double pid_rate = 50;
+  double wheel_separation = 0.40;
+  double max_wheel_speed = 1.0;
+  double max_wheel_accel = 0.0;
+  double cmd_vel_timeout = 0.5;
+  bool speed_dithering = true;
+  double battery_poll_rate = 1.0;
+};
+
+struct BodyParams : DevicePortParams {
+  std::vector<int> servo_ids{1, 2};
+  std::vector<std::string> joint_names{"joint_1", "joint_2"};
+  int ticks_per_revolution = 4096;
+  std::vector<int> zero_ticks{2048, 2048};
+  std::vector<int> directions{1, 1};
+  double velocity_scale = 0.0;
+};
+
+struct ImuParams {
+  std::string frame_id = "imu_link";
+  double accel_scale = 0.0047884;        ///< m/s^2 per LSB (16 g / 32768)
+  double gyro_scale = 0.0010653;         ///< rad/s per LSB (2000 deg/s / 32768)
+  double angle_scale = 0.0000958738;     ///< rad per LSB (180 deg / 32768)
+  /// Diagonal variances (REP-145); a negative orientation variance would mean "no orientation".
+  double orientation_variance = 0.0003;  ///< rad^2 (about 1 deg std)
+  double angular_velocity_variance = 0.0001;   ///< (rad/s)^2
+  double linear_acceleration_variance = 0.01;  ///< (m/s^2)^2
+};
+
+struct ServoBusParams : DevicePortParams {
+  double timeout = 0.05;
+  int retries = 1;
+  bool allow_dangerous_writes = false;
+};
+
+struct DriverParams {
+  std::string port = "/dev/ttyUSB0";
+  int baud = 115200;
+  double loop_rate = 50.0;
+  double reconnect_interval = 1.0;
+  BaseParams base;
+  BodyParams body;
+  ImuParams imu;
+  ServoBusParams servo_bus;
+
+  /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
+  void validate() const;
+
+  std::string basePort() const { return base.port.empty() ? port : base.port; }
+  std::string bodyPort() const { return body.port.empty() ? port : body.port; }
+  std::string servoBusPort() const { return servo_bus.port.empty() ? port : servo_bus.port; }
+  int baseBaud() const { return base.baud > 0 ? base.baud : baud; }
+  int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
+  int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
+};
+
+/// Reads every parameter from the private namespace of `private_nh` (missing keys keep their
+/// defaults; a key of the wrong type is a ParameterError). `unknown_keys` receives the keys under ~
+/// that the driver does not know (typos), for a warning.
+DriverParams loadParams(const ros::NodeHandle& private_nh, std::vector<std::string>* unknown_keys);
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,106 @@
+// Simulated chain of UART bus servos (PROTOCOLS.md section 3).
+//
+// Each servo keeps the full parameter table: read-only values that drift a little (voltage,
+// temperature, ...) and the 32-byte user block, persistent across requests. Motions (ROTATE, SPIN)
+// run in simulated time. Answers leave after a small latency; the optional SPIN/ROTATE/DAMPING
+// answers only when response_switch is 1, and only once the motion has completed. Requests that
+// reach no present servo, broadcasts (id 255) and READ_DATA of an unknown data_id get no answer.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/sim/sim_types.h"
+
+namespace serial_robot_driver::sim {
+
+struct ServoBusSimConfig {
+  std::vector<uint8_t> servo_ids = {0, 1, 2};
+  std::vector<uint8_t> offline_ids;  ///< listed servos that never answer
+  double answer_latency_s = 0.0015;
+  uint32_t seed = 1;
+};
+
+struct BusServoSnapshot {
+  uint8_t id = 0;
+  double angle_deg = 0.0;
+  bool moving = false;
+  /// Every parameter by data_id (read-only ones included).
+  std::map<uint8_t, int64_t> params;
+};
+
+struct ServoBusSimStats {
+  uint64_t requests = 0;  ///< verified request packets
+  uint64_t answers = 0;   ///< answers emitted
+  uint64_t broadcasts = 0;
+  uint64_t unaddressed = 0;  ///< for an id no present servo has (offline ids included)
+  uint64_t unknown_data_ids = 0;
+  uint64_t malformed = 0;        ///< verified sum but content that does not fit the command
+  uint64_t writes_rejected = 0;  ///< answered with result 0
+  std::vector<BusServoSnapshot> servos;
+};
+
+class ServoBusSim {
+ public:
+  ServoBusSim(const ServoBusSimConfig& config, TimePoint now);
+
+  /// A sum-verified 12 4C request from the host.
+  void handleRequest(const uint8_t* data, std::size_t size, TimePoint now);
+  /// Runs motions and emits the answers that are due.
+  void tick(TimePoint now, Outbox* out);
+  TimePoint nextEvent() const;
+
+  ServoBusSimStats stats() const;
+
+ private:
+  /// A finite motion: a ROTATE, or a SPIN for some turns or milliseconds.
+  struct Motion {
+    enum class Kind { kRotate, kSpin } kind = Kind::kRotate;
+    double target_angle = 0.0;  ///< kRotate
+    double rate_dps = 0.0;      ///< kSpin, signed (counter-clockwise positive)
+    double duration_s = 0.0;
+    bool started = false;
+    double start_angle = 0.0;
+    TimePoint start;
+    bool answer = false;  ///< response_switch was 1 when it was requested
+    uint8_t answer_id = 0;
+    protocol::servo::Command cmd = protocol::servo::Command::kRotate;
+  };
+  struct Servo {
+    uint8_t factory_id = 0;
+    double angle_deg = 0.0;
+    double spin_rate_dps = 0.0;  ///< continuous SPIN in force
+    std::map<uint8_t, int64_t> params;
+    std::deque<Motion> motions;  ///< front runs; the rest are queued (response_switch 1)
+    TimePoint last_step;
+  };
+  struct PendingAnswer {
+    TimePoint due;
+    std::vector<uint8_t> bytes;
+  };
+
+  void resetUserData(Servo* servo) const;
+  void execute(Servo* servo, const protocol::servo::Packet& packet, bool broadcast, TimePoint now);
+  void answer(TimePoint due, protocol::servo::Command cmd, const std::vector<uint8_t>& content);
+  /// Response_switch 0 interrupts whatever runs; 1 queues behind it and answers at completion.
+  void startMotion(Servo* servo, Motion motion, TimePoint now);
+  void stopAll(Servo* servo);
+  void runMotions(Servo* servo, TimePoint now);
+  void driftReadOnly(Servo* servo);
+  static int64_t param(const Servo& servo, uint8_t data_id);
+
+  ServoBusSimConfig config_;
+  ServoBusSimStats stats_;
+  std::vector<Servo> servos_;
+  std::deque<PendingAnswer> pending_;  ///< ordered by due time
+  std::mt19937 rng_;
+  TimePoint last_drift_;
+};
+
+}  // namespace serial_robot_driver::sim

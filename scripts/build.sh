@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Builds the package in a catkin workspace at .ws/ (git-ignored) next to the sources.
+# Usage: scripts/build.sh [extra catkin_make arguments]
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+ws="$repo/.ws"
+mkdir -p "$ws/src"
+ln -sfn "$repo" "$ws/src/serial_robot_driver"
+# catkin needs Debian's python3 (with the ROS modules), not another python3 earlier on PATH.
+export PATH="/usr/bin:$PATH"
+cd "$ws"
+catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCATKIN_ENABLE_TESTING=ON "$@"

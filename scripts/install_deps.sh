@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs what a fresh Debian 12 machine lacks to build, run and test serial_robot_driver
+# (ROS 1 from Debian's packages). Idempotent and quiet: apt-get runs only when something is missing.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  ros-base-dev catkin python3-catkin-pkg
+  libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev libstd-srvs-dev
+  libdiagnostic-msgs-dev libdiagnostic-updater-dev ros-message-generation ros-message-runtime
+  librostest-dev python3-rostest python3-rosbag rosbash
+  libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
+  clang libclang-rt-14-dev catkin-lint catkin-tools
+)
+
+missing=()
+for package in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+echo "installing: ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

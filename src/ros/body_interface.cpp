@@ -1,0 +1,81 @@
+#include "serial_robot_driver/ros/body_interface.h"
+
+#include <sensor_msgs/Imu.h>
+
+#include "serial_robot_driver/FootPressure.h"
+#include "serial_robot_driver/Telemetry.h"
+#include "serial_robot_driver/protocol/decode_result.h"
+#include "serial_robot_driver/ros/conversions.h"
+
+namespace serial_robot_driver::ros_layer {
+
+BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
+                             device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
+    : link_(link),
+      imu_params_(params.imu),
+      controller_(
+          makeBodyJoints(params.body), device::BodyController::writerFor(link),
+          [this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
+            publishTelemetry(telemetry, arrival);
+          }),
+      telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
+                      "telemetry rate") {
+  // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
+  joint_states_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 20);
+  imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", 20);
+  foot_pressure_pub_ = nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", 20);
+  telemetry_pub_ = nh.advertise<serial_robot_driver::Telemetry>("telemetry", 20);
+  // tcpNoDelay: a joint command must not wait in Nagle's buffer.
+  joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
+                                     ros::TransportHints().tcpNoDelay());
+  link.addListener(&controller_);
+  diagnostics.add("body", this, &BodyInterface::diagnose);
+}
+
+void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
+
+void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
+                                     device::Clock::time_point arrival) {
+  // Runs on the link's reader thread; ros::Publisher::publish is thread-safe.
+  telemetry_rate_.tick();
+  const ros::Time stamp = toRosTime(arrival);
+  const auto& joints = controller_.joints();
+  joint_states_pub_.publish(toJointState(telemetry, joints, stamp));
+  imu_pub_.publish(toImu(telemetry, imu_params_, stamp));
+  if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
+  telemetry_pub_.publish(toTelemetryMsg(telemetry, joints, stamp));
+}
+
+void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
+  const JointCommand command = fromJointState(*msg);
+  const device::JointCommandResult result =
+      controller_.sendJointCommand(command.names, command.positions);
+  if (!result.ok()) ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
+}
+
+void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
+  const device::BodyStats stats = controller_.stats();
+  const bool connected = link_.connected();
+  if (!connected) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                        "port " + link_.options().path + " not connected");
+  } else if (stats.frames_decoded == 0) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "no telemetry received yet");
+  }
+  status.add("port", link_.options().path);
+  status.add("connected", connected);
+  status.add("frames decoded", stats.frames_decoded);
+  status.add("decode errors", stats.decode_errors);
+  status.add("last decode error",
+             stats.last_decode_error ? protocol::toString(*stats.last_decode_error) : "none");
+  status.add("commands sent", stats.commands_sent);
+  status.add("commands rejected", stats.commands_rejected);
+  status.add("command write failures", stats.write_failures);
+  const device::LinkStats link_stats = link_.stats();
+  status.add("port checksum errors", link_stats.framer.checksum_errors);
+  status.add("port bad tails", link_stats.framer.bad_tails);
+  status.add("port bytes skipped (resync)", link_stats.framer.bytes_skipped);
+}
+
+}  // namespace serial_robot_driver::ros_layer

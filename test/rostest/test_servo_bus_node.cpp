@@ -1,0 +1,603 @@
+// End-to-end tests of the servo/* services of driver_node (PROTOCOLS.md section 3, INTERFACE.md).
+//
+// servo_bus_node.test launches two driver_nodes with only the servo bus enabled: /driver_node
+// (dangerous writes refused) and /armed/driver_node (allowed). This test creates their ptys and
+// plays the servos itself: a thread per bus reads every byte the node writes, splits the requests
+// with the project's StreamFramer and answers the requests it has a script for with response
+// frames written out by hand below. The safe bus also echoes every request first, like a
+// half-duplex adapter, so the node has to skip its own echo.
+//
+// "Nothing was written" is checked without timing: after a rejected call the test pings servo 3
+// and requires that the bytes the pty received in between are exactly that PING.
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "serial_robot_driver/ServoDamping.h"
+#include "serial_robot_driver/ServoPing.h"
+#include "serial_robot_driver/ServoRead.h"
+#include "serial_robot_driver/ServoReadAll.h"
+#include "serial_robot_driver/ServoReadAngle.h"
+#include "serial_robot_driver/ServoResetUserData.h"
+#include "serial_robot_driver/ServoRotate.h"
+#include "serial_robot_driver/ServoSpin.h"
+#include "serial_robot_driver/ServoWrite.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
+#include "serial_robot_driver/transport/byte_stream.h"
+#include "serial_robot_driver/transport/pseudo_terminal.h"
+
+namespace {
+
+namespace srd = serial_robot_driver;
+namespace protocol = serial_robot_driver::protocol;
+namespace transport = serial_robot_driver::transport;
+using Clock = std::chrono::steady_clock;
+using Bytes = std::vector<uint8_t>;
+
+// --- frames written out by hand from PROTOCOLS.md section 3 (SUM = byte sum mod 256, LE values) --
+const Bytes kPing3 = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63};
+const Bytes kPing3Reply = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
+const Bytes kPing4 = {0x12, 0x4C, 0x01, 0x01, 0x04, 0x64};
+const Bytes kPing4Reply = {0x05, 0x1C, 0x01, 0x01, 0x04, 0x27};
+const Bytes kPing5 = {0x12, 0x4C, 0x01, 0x01, 0x05, 0x65};
+const Bytes kPing7 = {0x12, 0x4C, 0x01, 0x01, 0x07, 0x67};
+
+const Bytes kReadAngle0 = {0x12, 0x4C, 0x0A, 0x01, 0x00, 0x69};
+const Bytes kReadAngle0Reply902 = {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86, 0x03, 0xB7};
+
+// voltage (data_id 1) of servo 3: 7400 mV; angle_limit_low (52 = 0x34): -900 (0xFC7C).
+const Bytes kReadVoltage3 = {0x12, 0x4C, 0x03, 0x02, 0x03, 0x01, 0x67};
+const Bytes kReadVoltage3Reply = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x01, 0xE8, 0x1C, 0x30};
+const Bytes kReadLimitLow3 = {0x12, 0x4C, 0x03, 0x02, 0x03, 0x34, 0x9A};
+const Bytes kReadLimitLow3Reply = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x34, 0x7C, 0xFC, 0xD7};
+
+// soft_start_time (50 = 0x32) of servo 3 := 300 (0x012C), and its read-back.
+const Bytes kWriteSoftStart3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x32, 0x2C, 0x01, 0xC8};
+const Bytes kWriteSoftStart3Ok = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x32, 0x01, 0x5E};
+const Bytes kReadSoftStart3 = {0x12, 0x4C, 0x03, 0x02, 0x03, 0x32, 0x98};
+const Bytes kReadSoftStart3Reply300 = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x32, 0x2C, 0x01, 0x8A};
+// over_temperature (41 = 0x29) of servo 3 := 80, answered with result 0.
+const Bytes kWriteOverTemp3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x29, 0x50, 0x00, 0xE2};
+const Bytes kWriteOverTemp3Failed = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x29, 0x00, 0x54};
+
+// servo_id (34 = 0x22) of servo 3 := 5, read back at id 5.
+const Bytes kWriteServoId3To5 = {0x12, 0x4C, 0x04, 0x03, 0x03, 0x22, 0x05, 0x8F};
+const Bytes kWriteServoId3To5Ok = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x22, 0x01, 0x4E};
+const Bytes kReadServoId5 = {0x12, 0x4C, 0x03, 0x02, 0x05, 0x22, 0x8A};
+const Bytes kReadServoId5Reply = {0x05, 0x1C, 0x03, 0x03, 0x05, 0x22, 0x05, 0x53};
+
+const Bytes kResetUserData3 = {0x12, 0x4C, 0x02, 0x01, 0x03, 0x64};
+const Bytes kResetUserData3Ok = {0x05, 0x1C, 0x02, 0x02, 0x03, 0x01, 0x29};
+
+const Bytes kRotate2To90In500 = {0x12, 0x4C, 0x08, 0x07, 0x02, 0x84, 0x03, 0xF4, 0x01, 0x00,
+                                 0x00, 0xEB};
+const Bytes kSpin0Cw1000Ms = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x83, 0x64, 0x00, 0xE8, 0x03, 0x3D};
+const Bytes kDamping0At500 = {0x12, 0x4C, 0x09, 0x03, 0x00, 0xF4, 0x01, 0x5F};
+
+const Bytes kReadBatch3 = {0x12, 0x4C, 0x05, 0x01, 0x03, 0x67};
+const Bytes kReadBatch3Reply = {
+    0x05, 0x1C, 0x05, 0x21, 0x03,
+    0x00, 0x00, 0x03, 0x00, 0x05, 0x01,  // 32..37 reserved, response_switch, servo_id 3, reserved,
+                                         //        baudrate 5, stall_protect_mode 1
+    0xA0, 0x0F, 0x94, 0x11, 0xB0, 0x36,  // 38..40 4000 mW, 4500 mV, 14000 mV
+    0x50, 0x00, 0xE0, 0x2E, 0xB8, 0x0B,  // 41..43 80 degC, 12000 mW, 3000 mA
+    0x01, 0x00, 0x00, 0x01, 0x01, 0x00,  // 44..49 switches
+    0x2C, 0x01,                          // 50 soft_start_time 300 ms
+    0x08, 0x07, 0xF8, 0xF8, 0xFB, 0xFF,  // 51..53 1800, -1800, -5 (0.1 deg)
+    0xD7};
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// --- the servos on a pty ----------------------------------------------------------------------
+
+/// Plays the bus servos on a pty with a symlink at `path`: records every byte the node writes and
+/// answers scripted requests.
+class ServoBusPlayer {
+ public:
+  ServoBusPlayer(const std::string& path, bool echo) : pty_(path), echo_(echo) {
+    protocol::FramerConfig config;
+    config.servo_request = true;
+    framer_ = std::make_unique<protocol::StreamFramer>(
+        config, [this](protocol::FrameFamily, const uint8_t* data, std::size_t size) {
+          onRequest(Bytes(data, data + size));
+        });
+    reader_ = std::thread([this] { readLoop(); });
+  }
+  ~ServoBusPlayer() {
+    running_ = false;
+    reader_.join();
+    pty_.close();
+  }
+
+  /// Answers `request` with `replies` (in this order) every time it arrives.
+  void answer(const Bytes& request, std::vector<Bytes> replies) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    script_[request] = std::move(replies);
+  }
+  std::size_t mark() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return received_.size();
+  }
+  Bytes bytesSince(std::size_t mark) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return Bytes(received_.begin() + static_cast<std::ptrdiff_t>(mark), received_.end());
+  }
+
+ private:
+  void readLoop() {
+    std::array<uint8_t, 1024> buffer{};
+    while (running_) {
+      std::size_t n = 0;
+      try {
+        n = pty_.read(buffer.data(), buffer.size(), 20);
+      } catch (const transport::TransportError&) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        continue;
+      }
+      if (n == 0) continue;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        received_.insert(received_.end(), buffer.begin(), buffer.begin() + n);
+      }
+      framer_->feed(buffer.data(), n);
+    }
+  }
+
+  void onRequest(const Bytes& request) {
+    std::vector<Bytes> replies;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto it = script_.find(request);
+      if (it != script_.end()) replies = it->second;
+    }
+    Bytes out;
+    if (echo_) out = request;
+    for (const Bytes& reply : replies) out.insert(out.end(), reply.begin(), reply.end());
+    if (!out.empty()) pty_.write(out.data(), out.size());
+  }
+
+  transport::PseudoTerminal pty_;
+  const bool echo_;
+  std::unique_ptr<protocol::StreamFramer> framer_;  // reader thread only
+  std::atomic<bool> running_{true};
+  mutable std::mutex mutex_;
+  Bytes received_;
+  std::map<Bytes, std::vector<Bytes>> script_;
+  std::thread reader_;
+};
+
+ServoBusPlayer* g_safe = nullptr;   // /driver_node: dangerous writes refused, echoing adapter
+ServoBusPlayer* g_armed = nullptr;  // /armed/driver_node: dangerous writes allowed
+
+std::string safeService(const std::string& name) { return "servo/" + name; }
+std::string armedService(const std::string& name) { return "armed/servo/" + name; }
+
+template <typename Srv>
+Srv call(const std::string& service, Srv srv) {
+  EXPECT_TRUE(ros::service::call(service, srv)) << service;
+  return srv;
+}
+
+srd::ServoPing ping(const std::string& service, uint8_t id) {
+  srd::ServoPing srv;
+  srv.request.id = id;
+  return call(service, srv);
+}
+
+/// Pings servo 3 (which answers) and returns what the pty received since `mark` before that PING:
+/// everything the node wrote in between. The trailing PING frames are checked and cut off (more
+/// than one only if a busy machine made the node re-send).
+Bytes bytesBeforeNextPing(ServoBusPlayer& bus, const std::string& ping_service, std::size_t mark) {
+  const srd::ServoPing srv = ping(ping_service, 3);
+  EXPECT_TRUE(srv.response.online) << srv.response.message;
+  Bytes bytes = bus.bytesSince(mark);
+  std::size_t pings = 0;
+  while (bytes.size() >= kPing3.size() &&
+         std::equal(kPing3.begin(), kPing3.end(), bytes.end() - kPing3.size())) {
+    bytes.resize(bytes.size() - kPing3.size());
+    ++pings;
+  }
+  EXPECT_GE(pings, 1u) << "the PING of servo 3 did not reach the pty last";
+  return bytes;
+}
+
+Bytes concat(std::initializer_list<Bytes> frames) {
+  Bytes all;
+  for (const Bytes& frame : frames) all.insert(all.end(), frame.begin(), frame.end());
+  return all;
+}
+
+// --- tests --------------------------------------------------------------------------------------
+
+TEST(ServoBusNode, PingOnline) {
+  const std::size_t mark = g_safe->mark();
+  const srd::ServoPing srv = ping(safeService("ping"), 3);
+  EXPECT_TRUE(srv.response.online) << srv.response.message;
+  EXPECT_EQ(g_safe->bytesSince(mark), kPing3);
+}
+
+TEST(ServoBusNode, PingOfflineReturnsAfterAllAttempts) {
+  const std::size_t mark = g_safe->mark();
+  const Clock::time_point start = Clock::now();
+  const srd::ServoPing srv = ping(safeService("ping"), 7);
+  // timeout 0.25 s x (retries 1 + 1), plus a generous margin for a busy machine.
+  EXPECT_LT(secondsSince(start), 0.5 + 3.0);
+  EXPECT_FALSE(srv.response.online);
+  EXPECT_EQ(srv.response.message, "servo 7 did not answer PING within 250 ms (2 attempts)");
+  EXPECT_EQ(bytesBeforeNextPing(*g_safe, safeService("ping"), mark), concat({kPing7, kPing7}));
+}
+
+TEST(ServoBusNode, ReadUnsignedParameter) {
+  srd::ServoRead srv;
+  srv.request.id = 3;
+  srv.request.param = "voltage";
+  srv = call(safeService("read"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.value, 7400);
+  EXPECT_EQ(srv.response.unit, "mV");
+}
+
+TEST(ServoBusNode, ReadSignedParameterByDataId) {
+  srd::ServoRead srv;
+  srv.request.id = 3;
+  srv.request.param = "52";
+  srv = call(safeService("read"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.value, -900);
+  EXPECT_EQ(srv.response.unit, "0.1deg");
+}
+
+TEST(ServoBusNode, WriteIsReadBack) {
+  const std::size_t mark = g_safe->mark();
+  srd::ServoWrite srv;
+  srv.request.id = 3;
+  srv.request.param = "soft_start_time";
+  srv.request.value = 300;
+  srv = call(safeService("write"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(g_safe->bytesSince(mark), concat({kWriteSoftStart3, kReadSoftStart3}));
+}
+
+TEST(ServoBusNode, WriteResultZeroIsAFailure) {
+  srd::ServoWrite srv;
+  srv.request.id = 3;
+  srv.request.param = "over_temperature";
+  srv.request.value = 80;
+  srv = call(safeService("write"), srv);
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("result 0"), std::string::npos) << srv.response.message;
+}
+
+TEST(ServoBusNode, ReadAngle) {
+  srd::ServoReadAngle srv;
+  srv.request.id = 0;
+  srv = call(safeService("read_angle"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_DOUBLE_EQ(srv.response.angle_deg, 90.2);
+}
+
+TEST(ServoBusNode, ReadAllReturnsTheTwentyTwoUserParameters) {
+  srd::ServoReadAll srv;
+  srv.request.id = 3;
+  srv = call(safeService("read_all"), srv);
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  const std::vector<std::string> names = {
+      "reserved_32",     "response_switch",  "servo_id",           "reserved_35",
+      "baudrate",        "stall_protect_mode", "stall_power_limit", "over_volt_low",
+      "over_volt_high",  "over_temperature", "over_power",         "over_current",
+      "accel_switch",    "reserved_45",      "po_lock_switch",     "wb_lock_switch",
+      "angle_limit_switch", "soft_start_switch", "soft_start_time", "angle_limit_high",
+      "angle_limit_low", "angle_mid_offset"};
+  const std::vector<int64_t> values = {0, 0,    3,     0,  5, 1, 4000, 4500, 14000, 80,   12000,
+                                       3000, 1, 0, 0, 1, 1, 0, 300,  1800, -1800, -5};
+  EXPECT_EQ(srv.response.names, names);
+  EXPECT_EQ(srv.response.values, values);
+}
+
+TEST(ServoBusNode, RotateSendsTheExactFrameWithoutWaiting) {
+  const std::size_t mark = g_safe->mark();
+  srd::ServoRotate srv;
+  srv.request.id = 2;
+  srv.request.angle_deg = 90.0;
+  srv.request.interval_ms = 500;
+  srv.request.power_mw = 0;
+  srv = call(safeService("rotate"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(bytesBeforeNextPing(*g_safe, safeService("ping"), mark), kRotate2To90In500);
+}
+
+TEST(ServoBusNode, SpinAndDampingSendTheirFrames) {
+  const std::size_t mark = g_safe->mark();
+  srd::ServoSpin spin;
+  spin.request.id = 0;
+  spin.request.clockwise = true;
+  spin.request.mode = 3;
+  spin.request.speed_dps = 100;
+  spin.request.value = 1000;
+  spin = call(safeService("spin"), spin);
+  EXPECT_TRUE(spin.response.success) << spin.response.message;
+  srd::ServoDamping damping;
+  damping.request.id = 0;
+  damping.request.power_mw = 500;
+  damping = call(safeService("damping"), damping);
+  EXPECT_TRUE(damping.response.success) << damping.response.message;
+  EXPECT_EQ(bytesBeforeNextPing(*g_safe, safeService("ping"), mark),
+            concat({kSpin0Cw1000Ms, kDamping0At500}));
+}
+
+TEST(ServoBusNode, MotionWaitWithoutAnAnswerTimesOut) {
+  srd::ServoDamping srv;
+  srv.request.id = 0;
+  srv.request.power_mw = 500;
+  srv.request.wait = true;
+  srv = call(safeService("damping"), srv);
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("response_switch"), std::string::npos)
+      << srv.response.message;
+}
+
+// Every rejection: success false, a message naming the problem, and not one byte on the pty.
+struct Rejection {
+  const char* name;
+  bool armed;
+  const char* message_part;
+  std::function<std::pair<bool, std::string>(const std::string& prefix)> call;
+};
+
+std::pair<bool, std::string> readParam(const std::string& prefix, uint8_t id, const char* param) {
+  srd::ServoRead srv;
+  srv.request.id = id;
+  srv.request.param = param;
+  srv = call(prefix + "read", srv);
+  return {srv.response.success, srv.response.message};
+}
+
+std::pair<bool, std::string> writeParam(const std::string& prefix, uint8_t id, const char* param,
+                                        int64_t value) {
+  srd::ServoWrite srv;
+  srv.request.id = id;
+  srv.request.param = param;
+  srv.request.value = value;
+  srv = call(prefix + "write", srv);
+  return {srv.response.success, srv.response.message};
+}
+
+const Rejection kRejections[] = {
+    {"UnknownParam", false, "unknown servo parameter",
+     [](const std::string& p) { return readParam(p, 3, "volts"); }},
+    {"ReadOnly", false, "read-only",
+     [](const std::string& p) { return writeParam(p, 3, "voltage", 7000); }},
+    {"OutOfRange", false, "out of range",
+     [](const std::string& p) { return writeParam(p, 3, "response_switch", 2); }},
+    {"ServoIdUnarmed", false, "allow_dangerous_writes",
+     [](const std::string& p) { return writeParam(p, 3, "servo_id", 5); }},
+    {"BaudrateUnarmed", false, "allow_dangerous_writes",
+     [](const std::string& p) { return writeParam(p, 3, "baudrate", 7); }},
+    {"ResetUnarmed", false, "allow_dangerous_writes",
+     [](const std::string& p) {
+       srd::ServoResetUserData srv;
+       srv.request.id = 3;
+       srv = call(p + "reset_user_data", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"ServoIdOutOfRangeArmed", true, "out of range",
+     [](const std::string& p) { return writeParam(p, 3, "servo_id", 255); }},
+    {"PingBroadcast", false, "broadcast",
+     [](const std::string& p) {
+       const srd::ServoPing srv = ping(p + "ping", 255);
+       return std::make_pair(static_cast<bool>(srv.response.online), srv.response.message);
+     }},
+    {"ReadBroadcast", false, "broadcast",
+     [](const std::string& p) { return readParam(p, 255, "voltage"); }},
+    {"WriteBroadcastArmed", true, "broadcast",
+     [](const std::string& p) { return writeParam(p, 255, "soft_start_time", 10); }},
+    {"ReadAngleBroadcast", false, "broadcast",
+     [](const std::string& p) {
+       srd::ServoReadAngle srv;
+       srv.request.id = 255;
+       srv = call(p + "read_angle", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"ReadAllBroadcast", false, "broadcast",
+     [](const std::string& p) {
+       srd::ServoReadAll srv;
+       srv.request.id = 255;
+       srv = call(p + "read_all", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"ResetBroadcastArmed", true, "broadcast",
+     [](const std::string& p) {
+       srd::ServoResetUserData srv;
+       srv.request.id = 255;
+       srv = call(p + "reset_user_data", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"RotateBroadcastWait", false, "broadcast",
+     [](const std::string& p) {
+       srd::ServoRotate srv;
+       srv.request.id = 255;
+       srv.request.angle_deg = 10.0;
+       srv.request.wait = true;
+       srv = call(p + "rotate", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"RotateAngleOutOfRange", false, "out of range",
+     [](const std::string& p) {
+       srd::ServoRotate srv;
+       srv.request.id = 2;
+       srv.request.angle_deg = 5000.0;
+       srv = call(p + "rotate", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"SpinModeOutOfRange", false, "spin mode 4",
+     [](const std::string& p) {
+       srd::ServoSpin srv;
+       srv.request.id = 0;
+       srv.request.mode = 4;
+       srv = call(p + "spin", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"DampingBroadcastWait", false, "broadcast",
+     [](const std::string& p) {
+       srd::ServoDamping srv;
+       srv.request.id = 255;
+       srv.request.wait = true;
+       srv = call(p + "damping", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+};
+
+class ServoBusNodeRejection : public ::testing::TestWithParam<Rejection> {};
+
+TEST_P(ServoBusNodeRejection, FailsWithAMessageAndWritesNothing) {
+  const Rejection& rejection = GetParam();
+  ServoBusPlayer& bus = rejection.armed ? *g_armed : *g_safe;
+  const std::string prefix = rejection.armed ? "armed/servo/" : "servo/";
+  const std::size_t mark = bus.mark();
+  const auto [success, message] = rejection.call(prefix);
+  EXPECT_FALSE(success);
+  EXPECT_NE(message.find(rejection.message_part), std::string::npos) << message;
+  EXPECT_EQ(bytesBeforeNextPing(bus, prefix + "ping", mark), Bytes{});
+}
+
+INSTANTIATE_TEST_SUITE_P(ServoBusNode, ServoBusNodeRejection, ::testing::ValuesIn(kRejections),
+                         [](const ::testing::TestParamInfo<Rejection>& info) {
+                           return std::string(info.param.name);
+                         });
+
+TEST(ServoBusNodeArmed, ServoIdChangePingsTheNewIdWritesAndReadsBack) {
+  const std::size_t mark = g_armed->mark();
+  const auto [success, message] = writeParam(armedService(""), 3, "servo_id", 5);
+  EXPECT_TRUE(success) << message;
+  // PING 5 twice (nobody answers), the write, the read-back at the new id.
+  EXPECT_EQ(g_armed->bytesSince(mark),
+            concat({kPing5, kPing5, kWriteServoId3To5, kReadServoId5}));
+}
+
+TEST(ServoBusNodeArmed, ServoIdChangeRefusedWhenTheNewIdAnswers) {
+  const std::size_t mark = g_armed->mark();
+  const auto [success, message] = writeParam(armedService(""), 3, "servo_id", 4);
+  EXPECT_FALSE(success);
+  EXPECT_NE(message.find("already answers at id 4"), std::string::npos) << message;
+  EXPECT_EQ(bytesBeforeNextPing(*g_armed, armedService("ping"), mark), kPing4);
+}
+
+TEST(ServoBusNodeArmed, ResetUserData) {
+  const std::size_t mark = g_armed->mark();
+  srd::ServoResetUserData srv;
+  srv.request.id = 3;
+  srv = call(armedService("reset_user_data"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(g_armed->bytesSince(mark), kResetUserData3);
+}
+
+TEST(ServoBusNode, DiagnosticsReportTransactionsTimeoutsAndSkippedEchoes) {
+  // An offline PING makes sure there is a timeout to report; the safe bus echoes every request.
+  EXPECT_FALSE(ping(safeService("ping"), 7).response.online);
+  ros::NodeHandle nh;
+  std::mutex mutex;
+  std::map<std::string, std::string> values;
+  auto subscriber = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+        for (const auto& status : msg->status) {
+          if (status.name != "driver_node: serial_robot_driver: servo_bus") continue;
+          std::lock_guard<std::mutex> lock(mutex);
+          for (const auto& kv : status.values) values[kv.key] = kv.value;
+        }
+      });
+  auto counter = [&](const std::string& key) -> uint64_t {
+    auto it = values.find(key);
+    return it == values.end() ? 0 : std::stoull(it->second);
+  };
+  const Clock::time_point start = Clock::now();
+  bool seen = false;
+  while (!seen && secondsSince(start) < 15.0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::lock_guard<std::mutex> lock(mutex);
+    seen = counter("timeouts") > 0 && counter("echoes skipped") > 0 && counter("transactions") > 0;
+  }
+  EXPECT_TRUE(seen) << "no servo_bus diagnostics with transactions, timeouts and echoes";
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_GT(values.count("max latency (ms)"), 0u);
+}
+
+void scriptServos(ServoBusPlayer& safe, ServoBusPlayer& armed) {
+  safe.answer(kPing3, {kPing3Reply});
+  safe.answer(kReadVoltage3, {kReadVoltage3Reply});
+  safe.answer(kReadLimitLow3, {kReadLimitLow3Reply});
+  safe.answer(kWriteSoftStart3, {kWriteSoftStart3Ok});
+  safe.answer(kReadSoftStart3, {kReadSoftStart3Reply300});
+  safe.answer(kWriteOverTemp3, {kWriteOverTemp3Failed});
+  safe.answer(kReadAngle0, {kReadAngle0Reply902});
+  safe.answer(kReadBatch3, {kReadBatch3Reply});
+
+  armed.answer(kPing3, {kPing3Reply});
+  armed.answer(kPing4, {kPing4Reply});
+  armed.answer(kWriteServoId3To5, {kWriteServoId3To5Ok});
+  armed.answer(kReadServoId5, {kReadServoId5Reply});
+  armed.answer(kResetUserData3, {kResetUserData3Ok});
+}
+
+/// Waits until the node behind `ping_service` has opened its pty and servo 3 answers.
+bool waitUntilOnline(const std::string& ping_service) {
+  if (!ros::service::waitForService(ping_service, ros::Duration(30.0))) return false;
+  const Clock::time_point start = Clock::now();
+  while (secondsSince(start) < 30.0) {
+    srd::ServoPing srv;
+    srv.request.id = 3;
+    if (ros::service::call(ping_service, srv) && srv.response.online) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_servo_bus_node");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+
+  std::string safe_port;
+  std::string armed_port;
+  if (!ros::param::get("/driver_node/port", safe_port) ||
+      !ros::param::get("/armed/driver_node/port", armed_port)) {
+    std::fprintf(stderr, "the .test file must set /driver_node/port and /armed/driver_node/port\n");
+    return 1;
+  }
+  int result = 1;
+  {
+    ServoBusPlayer safe(safe_port, /*echo=*/true);
+    ServoBusPlayer armed(armed_port, /*echo=*/false);
+    scriptServos(safe, armed);
+    g_safe = &safe;
+    g_armed = &armed;
+    if (!waitUntilOnline("servo/ping") || !waitUntilOnline("armed/servo/ping")) {
+      std::fprintf(stderr, "driver_node did not come up on its pty\n");
+    } else {
+      result = RUN_ALL_TESTS();
+    }
+    g_safe = nullptr;
+    g_armed = nullptr;
+  }
+  spinner.stop();
+  ros::shutdown();
+  return result;
+}

@@ -1,0 +1,147 @@
+// SerialLink over a real pseudo-terminal: frames in through the reader thread, writes out,
+// unplug (EIO) and replug at the same symlink, and a port that appears only after start().
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/transport/pseudo_terminal.h"
+
+namespace serial_robot_driver::device {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+using std::chrono::milliseconds;
+
+class RecordingListener : public LinkListener {
+ public:
+  void onLinkUp() override { ++ups; }
+  void onLinkDown() override { ++downs; }
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    frames.emplace_back(family, Bytes(data, data + size));
+  }
+  std::size_t frameCount() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return frames.size();
+  }
+
+  std::atomic<int> ups{0};
+  std::atomic<int> downs{0};
+  std::mutex mutex;
+  std::vector<std::pair<protocol::FrameFamily, Bytes>> frames;
+};
+
+template <typename Predicate>
+bool waitFor(Predicate predicate, milliseconds timeout = milliseconds(3000)) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    if (predicate()) return true;
+    std::this_thread::sleep_for(milliseconds(5));
+  }
+  return predicate();
+}
+
+std::string uniqueLinkPath(const char* name) {
+  return "/tmp/srd_link_test_" + std::string(name) + "_" + std::to_string(::getpid());
+}
+
+SerialLinkOptions optionsFor(const std::string& path) {
+  SerialLinkOptions options;
+  options.path = path;
+  options.reconnect_interval = 0.05;
+  options.framer = protocol::FramerConfig::forDriver(true, true, true, 2);
+  return options;
+}
+
+// Battery reply, 87 %, SEQ 00 (55^AA^02^00^02^57 = A8) and PING reply id 3 (PROTOCOLS.md).
+const Bytes kBatteryReply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
+const Bytes kPingReply = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
+
+TEST(SerialLink, DeliversFramesAndWritesBytes) {
+  const std::string path = uniqueLinkPath("basic");
+  transport::PseudoTerminal pty(path);
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  link.addListener(&listener);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+  EXPECT_EQ(listener.ups, 1);
+
+  Bytes stream = {0x00, 0x13};  // junk first
+  stream.insert(stream.end(), kBatteryReply.begin(), kBatteryReply.end());
+  stream.insert(stream.end(), kPingReply.begin(), kPingReply.end());
+  pty.write(stream.data(), stream.size());
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 2; }));
+  EXPECT_EQ(listener.frames[0].first, protocol::FrameFamily::kBase);
+  EXPECT_EQ(listener.frames[0].second, kBatteryReply);
+  EXPECT_EQ(listener.frames[1].first, protocol::FrameFamily::kServoResponse);
+  EXPECT_EQ(listener.frames[1].second, kPingReply);
+
+  const Bytes reset = {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA};
+  ASSERT_TRUE(link.write(reset));
+  Bytes received(reset.size());
+  std::size_t got = 0;
+  ASSERT_TRUE(waitFor([&] {
+    got += pty.read(received.data() + got, received.size() - got, 10);
+    return got == received.size();
+  }));
+  EXPECT_EQ(received, reset);
+
+  const LinkStats stats = link.stats();
+  EXPECT_TRUE(stats.connected);
+  EXPECT_EQ(stats.frames_out, 1u);
+  EXPECT_EQ(stats.framer.bytes_skipped, 2u);
+  link.stop();
+}
+
+TEST(SerialLink, RecoversAfterUnplugAtTheSameSymlink) {
+  const std::string path = uniqueLinkPath("unplug");
+  auto pty = std::make_unique<transport::PseudoTerminal>(path);
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  link.addListener(&listener);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+
+  pty->close();  // the driver's reads now fail with EIO: an unplugged adapter
+  ASSERT_TRUE(waitFor([&] { return listener.downs == 1; }));
+  EXPECT_FALSE(link.connected());
+  EXPECT_FALSE(link.write(kBatteryReply)) << "writes fail fast while the port is gone";
+
+  pty = std::make_unique<transport::PseudoTerminal>(path);
+  ASSERT_TRUE(waitFor([&] { return link.connected(); }));
+  EXPECT_EQ(listener.ups, 2) << "listeners hear of the reconnect before the link reports it";
+  pty->write(kPingReply.data(), kPingReply.size());
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }));
+  const LinkStats stats = link.stats();
+  EXPECT_EQ(stats.connects, 2u);
+  EXPECT_EQ(stats.disconnects, 1u);
+  EXPECT_GE(stats.write_failures, 1u);
+  link.stop();
+}
+
+TEST(SerialLink, WaitsForAPortThatDoesNotExistYet) {
+  const std::string path = uniqueLinkPath("late");
+  ::unlink(path.c_str());
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  link.addListener(&listener);
+  link.start();
+  std::this_thread::sleep_for(milliseconds(150));
+  EXPECT_FALSE(link.connected());
+  EXPECT_NE(link.stats().last_error.find(path), std::string::npos) << link.stats().last_error;
+
+  transport::PseudoTerminal pty(path);
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+  link.stop();
+  EXPECT_FALSE(link.connected());
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::device

@@ -1,0 +1,569 @@
+// ServoBusClient against a fake bus: the write seam records every frame and answers synchronously
+// by calling onFrame() with response bytes written out by hand from PROTOCOLS.md section 3.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "serial_robot_driver/device/servo_bus_client.h"
+
+namespace serial_robot_driver::device {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+using protocol::FrameFamily;
+
+// --- golden frames (PROTOCOLS.md section 3; SUM = byte sum mod 256, values little-endian) ------
+const Bytes kPing3 = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63};
+const Bytes kPing3Reply = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
+const Bytes kPing4Reply = {0x05, 0x1C, 0x01, 0x01, 0x04, 0x27};
+const Bytes kPing5 = {0x12, 0x4C, 0x01, 0x01, 0x05, 0x65};
+const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
+const Bytes kPing7 = {0x12, 0x4C, 0x01, 0x01, 0x07, 0x67};
+// A PING answer with two content bytes: right CMD and id, wrong shape.
+const Bytes kPing3ReplyTooLong = {0x05, 0x1C, 0x01, 0x02, 0x03, 0x00, 0x27};
+
+const Bytes kReadAngle0 = {0x12, 0x4C, 0x0A, 0x01, 0x00, 0x69};
+const Bytes kReadAngle0Reply902 = {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86, 0x03, 0xB7};
+
+// READ_DATA id 3 voltage (data_id 1) -> 7400 mV (0x1CE8).
+const Bytes kReadVoltage3 = {0x12, 0x4C, 0x03, 0x02, 0x03, 0x01, 0x67};
+const Bytes kReadVoltage3Reply = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x01, 0xE8, 0x1C, 0x30};
+// READ_DATA id 3 angle_limit_low (data_id 52 = 0x34) -> -900 (0xFC7C).
+const Bytes kReadLimitLow3 = {0x12, 0x4C, 0x03, 0x02, 0x03, 0x34, 0x9A};
+const Bytes kReadLimitLow3Reply = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x34, 0x7C, 0xFC, 0xD7};
+
+// WRITE_DATA id 3 soft_start_time (data_id 50 = 0x32) = 300 (0x012C), and its read-back.
+const Bytes kWriteSoftStart3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x32, 0x2C, 0x01, 0xC8};
+const Bytes kWriteSoftStart3Ok = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x32, 0x01, 0x5E};
+const Bytes kWriteSoftStart3Failed = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x32, 0x00, 0x5D};
+const Bytes kReadSoftStart3 = {0x12, 0x4C, 0x03, 0x02, 0x03, 0x32, 0x98};
+const Bytes kReadSoftStart3Reply300 = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x32, 0x2C, 0x01, 0x8A};
+const Bytes kReadSoftStart3Reply200 = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x32, 0xC8, 0x00, 0x25};
+
+// servo_id (data_id 34 = 0x22) of servo 3 := 5, and the read-back at the new id.
+const Bytes kWriteServoId3To5 = {0x12, 0x4C, 0x04, 0x03, 0x03, 0x22, 0x05, 0x8F};
+const Bytes kWriteServoId3To5Ok = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x22, 0x01, 0x4E};
+const Bytes kReadServoId5 = {0x12, 0x4C, 0x03, 0x02, 0x05, 0x22, 0x8A};
+const Bytes kReadServoId5Reply = {0x05, 0x1C, 0x03, 0x03, 0x05, 0x22, 0x05, 0x53};
+
+const Bytes kResetUserData3 = {0x12, 0x4C, 0x02, 0x01, 0x03, 0x64};
+const Bytes kResetUserData3Ok = {0x05, 0x1C, 0x02, 0x02, 0x03, 0x01, 0x29};
+
+const Bytes kRotate2To90In500 = {0x12, 0x4C, 0x08, 0x07, 0x02, 0x84, 0x03, 0xF4, 0x01, 0x00,
+                                 0x00, 0xEB};
+const Bytes kRotate2Done = {0x05, 0x1C, 0x08, 0x02, 0x02, 0x01, 0x2E};
+const Bytes kSpin0CcwContinuous = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x01, 0x64, 0x00, 0x00, 0x00,
+                                   0xD0};
+const Bytes kSpin0Cw5Turns = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x82, 0x64, 0x00, 0x05, 0x00, 0x56};
+const Bytes kDamping0At500 = {0x12, 0x4C, 0x09, 0x03, 0x00, 0xF4, 0x01, 0x5F};
+
+// READ_BATCH_DATA id 3 and its answer: id, then the 32-byte user block (data_id 32..53 packed).
+const Bytes kReadBatch3 = {0x12, 0x4C, 0x05, 0x01, 0x03, 0x67};
+const Bytes kReadBatch3Reply = {
+    0x05, 0x1C, 0x05, 0x21, 0x03,
+    0x00,        // 32 reserved_32
+    0x00,        // 33 response_switch
+    0x03,        // 34 servo_id
+    0x00,        // 35 reserved_35
+    0x05,        // 36 baudrate (115200)
+    0x01,        // 37 stall_protect_mode
+    0xA0, 0x0F,  // 38 stall_power_limit 4000 mW
+    0x94, 0x11,  // 39 over_volt_low 4500 mV
+    0xB0, 0x36,  // 40 over_volt_high 14000 mV
+    0x50, 0x00,  // 41 over_temperature 80 degC
+    0xE0, 0x2E,  // 42 over_power 12000 mW
+    0xB8, 0x0B,  // 43 over_current 3000 mA
+    0x01,        // 44 accel_switch
+    0x00,        // 45 reserved_45
+    0x00,        // 46 po_lock_switch
+    0x01,        // 47 wb_lock_switch
+    0x01,        // 48 angle_limit_switch
+    0x00,        // 49 soft_start_switch
+    0x2C, 0x01,  // 50 soft_start_time 300 ms
+    0x08, 0x07,  // 51 angle_limit_high 1800 (180.0 deg)
+    0xF8, 0xF8,  // 52 angle_limit_low -1800
+    0xFB, 0xFF,  // 53 angle_mid_offset -5
+    0xD7};
+
+// The bus: records what the client writes and plays the servos by answering synchronously.
+class FakeBus {
+ public:
+  bool connected = true;
+  bool echo = false;          // send our own request back first, like a half-duplex adapter
+  bool drop_link_on_write = false;
+  bool from_other_thread = false;  // answer from a thread of its own, like the link's reader
+  ServoBusClient* client = nullptr;
+  std::vector<Bytes> written;
+
+  ~FakeBus() { joinAnswerThreads(); }
+  void joinAnswerThreads() {
+    for (std::thread& thread : answer_threads_) thread.join();
+    answer_threads_.clear();
+  }
+
+  /// After `request`, deliver `frames`, starting with its `first_answered_write`-th occurrence.
+  void answer(const Bytes& request, std::vector<Bytes> frames, int first_answered_write = 1) {
+    script_[request] = Script{std::move(frames), first_answered_write, 0};
+  }
+
+  bool write(const Bytes& frame) {
+    if (!connected) return false;
+    std::lock_guard<std::mutex> lock(mutex_);  // two callers may write (the client serializes them)
+    written.push_back(frame);
+    if (echo) deliver(FrameFamily::kServoRequest, frame);
+    if (drop_link_on_write) client->onLinkDown();
+    auto it = script_.find(frame);
+    if (it == script_.end()) return true;
+    Script& script = it->second;
+    if (++script.writes < script.first_answered_write) return true;
+    if (from_other_thread) {
+      answer_threads_.emplace_back([this, frames = script.frames] {
+        for (const Bytes& reply : frames) deliver(FrameFamily::kServoResponse, reply);
+      });
+      return true;
+    }
+    for (const Bytes& reply : script.frames) deliver(FrameFamily::kServoResponse, reply);
+    return true;
+  }
+
+ private:
+  struct Script {
+    std::vector<Bytes> frames;
+    int first_answered_write;
+    int writes;
+  };
+  void deliver(FrameFamily family, const Bytes& frame) {
+    client->onFrame(family, frame.data(), frame.size(), Clock::now());
+  }
+  std::map<Bytes, Script> script_;
+  std::mutex mutex_;
+  std::vector<std::thread> answer_threads_;
+};
+
+ServoBusOptions testOptions(bool armed) {
+  ServoBusOptions options;
+  options.timeout = std::chrono::milliseconds(20);
+  options.retries = 1;
+  options.allow_dangerous_writes = armed;
+  return options;
+}
+
+class ServoBusClientTest : public ::testing::Test {
+ protected:
+  explicit ServoBusClientTest(bool armed = false)
+      : client_(testOptions(armed), [this](const Bytes& frame) { return bus_.write(frame); }) {
+    bus_.client = &client_;
+  }
+
+  FakeBus bus_;
+  ServoBusClient client_;
+};
+
+class ServoBusClientArmedTest : public ServoBusClientTest {
+ protected:
+  ServoBusClientArmedTest() : ServoBusClientTest(true) {}
+};
+
+TEST_F(ServoBusClientTest, PingOnlineSendsGoldenRequest) {
+  bus_.answer(kPing3, {kPing3Reply});
+  const ServoStatus status = client_.ping(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kPing3});
+  EXPECT_NE(status.message.find("servo 3 is online"), std::string::npos) << status.message;
+  const ServoBusStats stats = client_.stats();
+  EXPECT_EQ(stats.transactions, 1u);
+  EXPECT_EQ(stats.retries, 0u);
+  EXPECT_EQ(stats.timeouts, 0u);
+}
+
+TEST_F(ServoBusClientTest, PingOfflineTriesRetriesPlusOneTimes) {
+  const ServoStatus status = client_.ping(7);
+  EXPECT_EQ(status.error, ServoError::kTimeout);
+  EXPECT_EQ(status.message, "servo 7 did not answer PING within 20 ms (2 attempts)");
+  EXPECT_EQ(bus_.written, (std::vector<Bytes>{kPing7, kPing7}));
+  const ServoBusStats stats = client_.stats();
+  EXPECT_EQ(stats.transactions, 1u);
+  EXPECT_EQ(stats.retries, 1u);
+  EXPECT_EQ(stats.timeouts, 1u);
+}
+
+TEST_F(ServoBusClientTest, AnswerToTheRetryCompletesTheTransaction) {
+  bus_.answer(kPing3, {kPing3Reply}, /*first_answered_write=*/2);
+  const ServoStatus status = client_.ping(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written.size(), 2u);
+  EXPECT_EQ(client_.stats().retries, 1u);
+  EXPECT_EQ(client_.stats().timeouts, 0u);
+}
+
+TEST_F(ServoBusClientTest, MismatchedAnswersAreCountedAndIgnored) {
+  // Another servo's PING answer and an answer to another command come first.
+  bus_.answer(kPing3, {kPing4Reply, kReadAngle0Reply902, kPing3Reply});
+  const ServoStatus status = client_.ping(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(client_.stats().mismatched, 2u);
+  EXPECT_EQ(bus_.written.size(), 1u);
+}
+
+TEST_F(ServoBusClientTest, OnlyMismatchedAnswersMeanOffline) {
+  bus_.answer(kPing7, {kPing4Reply});
+  const ServoStatus status = client_.ping(7);
+  EXPECT_EQ(status.error, ServoError::kTimeout);
+  EXPECT_EQ(client_.stats().mismatched, 2u);
+}
+
+TEST_F(ServoBusClientTest, EchoOfOurRequestIsSkipped) {
+  bus_.echo = true;
+  bus_.answer(kPing3, {kPing3Reply});
+  const ServoStatus status = client_.ping(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(client_.stats().echoes, 1u);
+  EXPECT_EQ(client_.stats().mismatched, 0u);
+}
+
+TEST_F(ServoBusClientTest, AnswerOfTheWrongShapeIsReportedAsMalformed) {
+  bus_.answer(kPing3, {kPing3ReplyTooLong});
+  const ServoStatus status = client_.ping(3);
+  EXPECT_EQ(status.error, ServoError::kBadAnswer);
+  EXPECT_EQ(bus_.written.size(), 2u);  // re-sent once
+  EXPECT_EQ(client_.stats().garbled, 2u);
+}
+
+TEST_F(ServoBusClientTest, AnswersArrivingWithoutARequestAreMismatched) {
+  client_.onFrame(FrameFamily::kServoResponse, kPing3Reply.data(), kPing3Reply.size(),
+                  Clock::now());
+  EXPECT_EQ(client_.stats().mismatched, 1u);
+}
+
+TEST(ServoBusClientThreadsTest, ConcurrentCallersAreServedOneAfterTheOther) {
+  FakeBus bus;
+  bus.from_other_thread = true;
+  ServoBusOptions options;
+  options.timeout = std::chrono::milliseconds(5000);  // generous: the answer comes from a thread
+  ServoBusClient client(options, [&bus](const Bytes& frame) { return bus.write(frame); });
+  bus.client = &client;
+  bus.answer(kPing3, {kPing3Reply});
+  bus.answer(kReadVoltage3, {kReadVoltage3Reply});
+
+  ServoStatus ping_status;
+  std::thread pinger([&] { ping_status = client.ping(3); });
+  ServoParamValue voltage;
+  const ServoStatus read_status = client.readParam(3, "voltage", &voltage);
+  pinger.join();
+  bus.joinAnswerThreads();
+  EXPECT_TRUE(ping_status.ok()) << ping_status.message;
+  EXPECT_TRUE(read_status.ok()) << read_status.message;
+  EXPECT_EQ(voltage.value, 7400);
+  EXPECT_EQ(client.stats().transactions, 2u);
+  EXPECT_EQ(client.stats().mismatched, 0u);
+  EXPECT_EQ(bus.written.size(), 2u);
+}
+
+TEST_F(ServoBusClientTest, PortDownFailsFast) {
+  bus_.connected = false;
+  const ServoStatus status = client_.ping(3);
+  EXPECT_EQ(status.error, ServoError::kNotConnected);
+  EXPECT_EQ(status.message, "servo bus port is not connected");
+  EXPECT_EQ(client_.stats().timeouts, 0u);
+}
+
+TEST_F(ServoBusClientTest, PortLostWhileWaitingFailsWithoutWaitingOut) {
+  bus_.drop_link_on_write = true;
+  const ServoStatus status = client_.ping(3);
+  EXPECT_EQ(status.error, ServoError::kNotConnected);
+  EXPECT_EQ(bus_.written.size(), 1u);  // not re-sent on a dead port
+}
+
+TEST_F(ServoBusClientTest, ShutdownFailsLaterCalls) {
+  client_.shutdown();
+  EXPECT_EQ(client_.ping(3).error, ServoError::kShutdown);
+  EXPECT_TRUE(bus_.written.empty());
+}
+
+TEST_F(ServoBusClientTest, ReadUnsignedParameterInItsUnit) {
+  bus_.answer(kReadVoltage3, {kReadVoltage3Reply});
+  ServoParamValue value;
+  const ServoStatus status = client_.readParam(3, "voltage", &value);
+  ASSERT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(value.value, 7400);
+  EXPECT_EQ(value.unit, "mV");
+  EXPECT_EQ(value.data_id, 1);
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kReadVoltage3});
+}
+
+TEST_F(ServoBusClientTest, ReadSignedParameterByDataIdText) {
+  bus_.answer(kReadLimitLow3, {kReadLimitLow3Reply});
+  ServoParamValue value;
+  const ServoStatus status = client_.readParam(3, "52", &value);
+  ASSERT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(value.value, -900);
+  EXPECT_EQ(value.unit, "0.1deg");
+  EXPECT_EQ(value.name, "angle_limit_low");
+}
+
+TEST_F(ServoBusClientTest, ReadAnswerAboutAnotherParameterIsIgnored) {
+  bus_.answer(kReadLimitLow3, {kReadVoltage3Reply, kReadLimitLow3Reply});
+  ServoParamValue value;
+  ASSERT_TRUE(client_.readParam(3, "angle_limit_low", &value).ok());
+  EXPECT_EQ(value.value, -900);
+  EXPECT_EQ(client_.stats().mismatched, 1u);
+}
+
+TEST_F(ServoBusClientTest, ReadAngleInDegrees) {
+  bus_.answer(kReadAngle0, {kReadAngle0Reply902});
+  double angle = 0.0;
+  const ServoStatus status = client_.readAngle(0, &angle);
+  ASSERT_TRUE(status.ok()) << status.message;
+  EXPECT_DOUBLE_EQ(angle, 90.2);
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kReadAngle0});
+}
+
+TEST_F(ServoBusClientTest, WriteIsReadBack) {
+  bus_.answer(kWriteSoftStart3, {kWriteSoftStart3Ok});
+  bus_.answer(kReadSoftStart3, {kReadSoftStart3Reply300});
+  const ServoStatus status = client_.writeParam(3, "soft_start_time", 300);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written, (std::vector<Bytes>{kWriteSoftStart3, kReadSoftStart3}));
+}
+
+TEST_F(ServoBusClientTest, WriteResultZeroIsAFailureWithoutReadBack) {
+  bus_.answer(kWriteSoftStart3, {kWriteSoftStart3Failed});
+  const ServoStatus status = client_.writeParam(3, "50", 300);
+  EXPECT_EQ(status.error, ServoError::kRefused);
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kWriteSoftStart3});
+}
+
+TEST_F(ServoBusClientTest, WriteWithDifferentReadBackFails) {
+  bus_.answer(kWriteSoftStart3, {kWriteSoftStart3Ok});
+  bus_.answer(kReadSoftStart3, {kReadSoftStart3Reply200});
+  const ServoStatus status = client_.writeParam(3, "soft_start_time", 300);
+  EXPECT_EQ(status.error, ServoError::kReadBackMismatch);
+  EXPECT_NE(status.message.find("reads back 200"), std::string::npos) << status.message;
+}
+
+TEST_F(ServoBusClientTest, RotateSendsGoldenFrameWithoutWaiting) {
+  RotateRequest request;
+  request.id = 2;
+  request.angle_deg = 90.0;
+  request.interval_ms = 500;
+  const ServoStatus status = client_.rotate(request);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kRotate2To90In500});
+  EXPECT_EQ(client_.stats().commands, 1u);
+  EXPECT_EQ(client_.stats().transactions, 0u);
+}
+
+TEST_F(ServoBusClientTest, RotateWithWaitGetsTheCompletionAnswer) {
+  bus_.answer(kRotate2To90In500, {kRotate2Done});
+  RotateRequest request;
+  request.id = 2;
+  request.angle_deg = 90.0;
+  request.interval_ms = 500;
+  request.wait = true;
+  const ServoStatus status = client_.rotate(request);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(client_.stats().transactions, 1u);
+}
+
+TEST_F(ServoBusClientTest, MotionWaitTimesOutWithoutResending) {
+  const ServoStatus status = client_.damping(0, 500, /*wait=*/true);
+  EXPECT_EQ(status.error, ServoError::kTimeout);
+  EXPECT_NE(status.message.find("response_switch"), std::string::npos) << status.message;
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kDamping0At500});
+}
+
+TEST_F(ServoBusClientTest, SpinAndDampingSendGoldenFrames) {
+  SpinRequest spin;
+  spin.id = 0;
+  spin.mode = 1;
+  spin.speed_dps = 100;
+  ASSERT_TRUE(client_.spin(spin).ok());
+  spin.clockwise = true;
+  spin.mode = 2;
+  spin.value = 5;
+  ASSERT_TRUE(client_.spin(spin).ok());
+  ASSERT_TRUE(client_.damping(0, 500, false).ok());
+  EXPECT_EQ(bus_.written,
+            (std::vector<Bytes>{kSpin0CcwContinuous, kSpin0Cw5Turns, kDamping0At500}));
+}
+
+TEST_F(ServoBusClientTest, BroadcastMotionWithoutWaitIsAllowed) {
+  RotateRequest rotate;
+  rotate.id = 255;
+  EXPECT_TRUE(client_.rotate(rotate).ok());
+  SpinRequest spin;
+  spin.id = 255;
+  EXPECT_TRUE(client_.spin(spin).ok());
+  EXPECT_TRUE(client_.damping(255, 0, false).ok());
+  EXPECT_EQ(bus_.written.size(), 3u);
+}
+
+TEST_F(ServoBusClientTest, ReadAllDecodesTheUserBlock) {
+  bus_.answer(kReadBatch3, {kReadBatch3Reply});
+  std::vector<ServoParamValue> values;
+  const ServoStatus status = client_.readAll(3, &values);
+  ASSERT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kReadBatch3});
+
+  const std::vector<std::pair<std::string, int64_t>> expected = {
+      {"reserved_32", 0},         {"response_switch", 0},     {"servo_id", 3},
+      {"reserved_35", 0},         {"baudrate", 5},            {"stall_protect_mode", 1},
+      {"stall_power_limit", 4000}, {"over_volt_low", 4500},   {"over_volt_high", 14000},
+      {"over_temperature", 80},   {"over_power", 12000},      {"over_current", 3000},
+      {"accel_switch", 1},        {"reserved_45", 0},         {"po_lock_switch", 0},
+      {"wb_lock_switch", 1},      {"angle_limit_switch", 1},  {"soft_start_switch", 0},
+      {"soft_start_time", 300},   {"angle_limit_high", 1800}, {"angle_limit_low", -1800},
+      {"angle_mid_offset", -5}};
+  ASSERT_EQ(values.size(), 22u);
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(values[i].name, expected[i].first) << i;
+    EXPECT_EQ(values[i].value, expected[i].second) << values[i].name;
+    EXPECT_EQ(values[i].data_id, 32 + i);
+  }
+  EXPECT_EQ(values[6].unit, "mW");
+  EXPECT_EQ(values[20].unit, "0.1deg");
+}
+
+TEST_F(ServoBusClientArmedTest, ServoIdChangePingsTheNewIdThenReadsBackThere) {
+  bus_.answer(kWriteServoId3To5, {kWriteServoId3To5Ok});
+  bus_.answer(kReadServoId5, {kReadServoId5Reply});
+  const ServoStatus status = client_.writeParam(3, "servo_id", 5);
+  EXPECT_TRUE(status.ok()) << status.message;
+  // PING 5 twice (nobody there), then the write, then the read-back at the new id.
+  EXPECT_EQ(bus_.written,
+            (std::vector<Bytes>{kPing5, kPing5, kWriteServoId3To5, kReadServoId5}));
+}
+
+TEST_F(ServoBusClientArmedTest, ServoIdChangeRefusedWhenTheNewIdAnswers) {
+  bus_.answer(kPing5, {kPing5Reply});
+  const ServoStatus status = client_.writeParam(3, "servo_id", 5);
+  EXPECT_EQ(status.error, ServoError::kIdInUse);
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kPing5});
+}
+
+TEST_F(ServoBusClientArmedTest, ResetUserData) {
+  bus_.answer(kResetUserData3, {kResetUserData3Ok});
+  const ServoStatus status = client_.resetUserData(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kResetUserData3});
+}
+
+// --- every rejection: the right error, a message naming the problem, and not one byte written ---
+
+struct Rejection {
+  const char* name;
+  bool armed;
+  ServoError error;
+  const char* message_part;
+  std::function<ServoStatus(ServoBusClient&)> call;
+};
+
+RotateRequest rotateTo(uint8_t id, double angle_deg, bool wait) {
+  RotateRequest request;
+  request.id = id;
+  request.angle_deg = angle_deg;
+  request.interval_ms = 100;
+  request.wait = wait;
+  return request;
+}
+
+SpinRequest spinWith(uint8_t id, uint8_t mode, uint16_t speed, uint16_t value, bool wait) {
+  SpinRequest request;
+  request.id = id;
+  request.mode = mode;
+  request.speed_dps = speed;
+  request.value = value;
+  request.wait = wait;
+  return request;
+}
+
+ServoStatus readInto(ServoBusClient& client, uint8_t id, const char* param) {
+  ServoParamValue value;
+  return client.readParam(id, param, &value);
+}
+
+const Rejection kRejections[] = {
+    {"ReadUnknownParam", false, ServoError::kUnknownParam, "'volts'",
+     [](ServoBusClient& c) { return readInto(c, 3, "volts"); }},
+    {"ReadUnknownDataId", false, ServoError::kUnknownParam, "'9'",
+     [](ServoBusClient& c) { return readInto(c, 3, "9"); }},
+    {"WriteUnknownParam", false, ServoError::kUnknownParam, "'speed'",
+     [](ServoBusClient& c) { return c.writeParam(3, "speed", 1); }},
+    {"WriteReadOnly", false, ServoError::kReadOnly, "read-only",
+     [](ServoBusClient& c) { return c.writeParam(3, "voltage", 7000); }},
+    {"WriteOutOfRange", false, ServoError::kOutOfRange, "out of range",
+     [](ServoBusClient& c) { return c.writeParam(3, "response_switch", 2); }},
+    {"WriteOutOfTypeRange", false, ServoError::kOutOfRange, "out of range",
+     [](ServoBusClient& c) { return c.writeParam(3, "angle_limit_low", -40000); }},
+    {"WriteServoIdUnarmed", false, ServoError::kDangerous, "allow_dangerous_writes",
+     [](ServoBusClient& c) { return c.writeParam(3, "servo_id", 5); }},
+    {"WriteBaudrateUnarmed", false, ServoError::kDangerous, "allow_dangerous_writes",
+     [](ServoBusClient& c) { return c.writeParam(3, "36", 5); }},
+    {"ArmedServoIdOutOfRange", true, ServoError::kOutOfRange, "out of range",
+     [](ServoBusClient& c) { return c.writeParam(3, "servo_id", 255); }},
+    {"ResetUnarmed", false, ServoError::kDangerous, "allow_dangerous_writes",
+     [](ServoBusClient& c) { return c.resetUserData(3); }},
+    {"PingBroadcast", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return c.ping(255); }},
+    {"ReadBroadcast", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return readInto(c, 255, "voltage"); }},
+    {"WriteBroadcast", true, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return c.writeParam(255, "soft_start_time", 10); }},
+    {"ReadAngleBroadcast", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) {
+       double angle = 0.0;
+       return c.readAngle(255, &angle);
+     }},
+    {"ReadAllBroadcast", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) {
+       std::vector<ServoParamValue> values;
+       return c.readAll(255, &values);
+     }},
+    {"ResetBroadcastArmed", true, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return c.resetUserData(255); }},
+    {"RotateBroadcastWait", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return c.rotate(rotateTo(255, 10.0, true)); }},
+    {"SpinBroadcastWait", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return c.spin(spinWith(255, 0, 0, 0, true)); }},
+    {"DampingBroadcastWait", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) { return c.damping(255, 100, true); }},
+    {"RotateAngleTooLarge", false, ServoError::kInvalidArgument, "out of range",
+     [](ServoBusClient& c) { return c.rotate(rotateTo(2, 3276.8, false)); }},
+    {"RotateAngleTooSmall", false, ServoError::kInvalidArgument, "out of range",
+     [](ServoBusClient& c) { return c.rotate(rotateTo(2, -3276.9, false)); }},
+    {"RotateAngleNaN", false, ServoError::kInvalidArgument, "finite",
+     [](ServoBusClient& c) { return c.rotate(rotateTo(2, std::nan(""), false)); }},
+    {"SpinModeOutOfRange", false, ServoError::kInvalidArgument, "spin mode 4",
+     [](ServoBusClient& c) { return c.spin(spinWith(0, 4, 100, 0, false)); }},
+    {"SpinWaitTooLong", false, ServoError::kInvalidArgument, "wait = false",
+     [](ServoBusClient& c) { return c.spin(spinWith(0, 2, 1, 1000, true)); }},
+};
+
+class ServoBusClientRejectionTest : public ::testing::TestWithParam<Rejection> {};
+
+TEST_P(ServoBusClientRejectionTest, RejectsWithoutWritingAByte) {
+  const Rejection& rejection = GetParam();
+  FakeBus bus;
+  ServoBusClient client(testOptions(rejection.armed),
+                        [&bus](const Bytes& frame) { return bus.write(frame); });
+  bus.client = &client;
+  const ServoStatus status = rejection.call(client);
+  EXPECT_EQ(status.error, rejection.error) << status.message;
+  EXPECT_NE(status.message.find(rejection.message_part), std::string::npos) << status.message;
+  EXPECT_TRUE(bus.written.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(ServoBusClient, ServoBusClientRejectionTest,
+                         ::testing::ValuesIn(kRejections),
+                         [](const ::testing::TestParamInfo<Rejection>& info) {
+                           return std::string(info.param.name);
+                         });
+
+}  // namespace
+}  // namespace serial_robot_driver::device
