@@ -156,6 +156,10 @@ void SerialLink::sleepBeforeRetry() {
 
 void SerialLink::readerLoop() {
   std::array<uint8_t, kReadChunk> chunk{};
+  const bool polling = options_.poll_interval > 0;
+  const auto poll_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(polling ? options_.poll_interval : 1.0));
+  Clock::time_point next_poll = Clock::now();
   while (!stopping_) {
     if (!connected_) {
       if (!tryOpen()) sleepBeforeRetry();
@@ -171,9 +175,13 @@ void SerialLink::readerLoop() {
       sleepBeforeRetry();
       continue;
     }
+    if (polling) {
+      next_poll += poll_period;
+      std::this_thread::sleep_until(next_poll);
+    }
     std::size_t n = 0;
     try {
-      n = stream_->read(chunk.data(), chunk.size(), kReadTimeoutMs);
+      n = stream_->read(chunk.data(), chunk.size(), polling ? 0 : kReadTimeoutMs);
     } catch (const transport::TransportError& e) {
       closeStream(e.what());
       sleepBeforeRetry();

@@ -58,6 +58,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     options.path = path;
     options.baud = static_cast<unsigned>(use.baud);
     options.reconnect_interval = params_.reconnect_interval;
+    options.poll_interval = params_.read_poll_interval;
     options.framer = protocol::FramerConfig::forDriver(use.base, use.body, use.servo_bus,
                                                        params_.body.servo_ids.size());
     Port port;

@@ -57,6 +57,7 @@ void DriverParams::validate() const {
   requirePositive(loop_rate, "loop_rate");
   require(loop_rate <= 1000, "loop_rate", "must be at most 1000 Hz");
   requirePositive(reconnect_interval, "reconnect_interval");
+  requireNonNegative(read_poll_interval, "read_poll_interval");
   require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
           "every device is disabled (base, body, servo_bus): nothing to drive");
 
@@ -146,6 +147,7 @@ DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unk
   load(nh, "baud", &p.baud, "an integer");
   load(nh, "loop_rate", &p.loop_rate, "a number");
   load(nh, "reconnect_interval", &p.reconnect_interval, "a number");
+  load(nh, "read_poll_interval", &p.read_poll_interval, "a number");
 
   auto loadDevice = [&nh](const std::string& prefix, DevicePortParams* device) {
     load(nh, prefix + "/enabled", &device->enabled, "true or false");
@@ -187,7 +189,7 @@ DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unk
 
   if (unknown_keys) {
     static const std::set<std::string> kKnown = {
-        "port", "baud", "loop_rate", "reconnect_interval",
+        "port", "baud", "loop_rate", "reconnect_interval", "read_poll_interval",
         "base/enabled", "base/port", "base/baud", "base/wheel_diameter", "base/encoder_resolution",
         "base/pid_rate", "base/wheel_separation", "base/max_wheel_speed", "base/max_wheel_accel",
         "base/cmd_vel_timeout", "base/speed_dithering", "base/battery_poll_rate",

@@ -48,6 +48,10 @@ struct SerialLinkOptions {
   unsigned baud = 115200;
   double reconnect_interval = 1.0;  ///< s between attempts to reopen a lost port
   protocol::FramerConfig framer;
+  /// 0 (default): event-driven, a frame is handled as soon as its bytes arrive. > 0: read only once
+  /// per interval (s), like a driver that polls its port from a timer. Kept so benchmarks can show
+  /// what the event-driven design buys; no robot should run with it.
+  double poll_interval = 0.0;
 };
 
 struct LinkStats {

@@ -1,0 +1,922 @@
+// driver_bench: end-to-end performance numbers of driver_node, measured from the outside the way a
+// robot sees it: bytes on a pseudo-terminal and messages on ROS topics/services.
+//
+// One run starts its own roscore, then one driver_node (and robot_sim) per measurement:
+//  1. cmd_vel publish -> speed frame's last byte on the pty (p50/p99)
+//  2. base loop period at 50 Hz from pty arrival times (std, worst, missed ticks)
+//  3. node CPU while idle at 50 Hz
+//  4. telemetry frame's last byte written -> joint_states received (p50/p99), node CPU at 100 Hz
+//  5. delivered fraction of telemetry at 100 .. 5000 Hz
+//  6. servo/read round trip (new connection per call and persistent), wheel loop under service
+//  stress
+//  7. 1, 4 and 5 again with ~read_poll_interval (a port polled every 20 ms), and the ratios
+// Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
+#include <geometry_msgs/Twist.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_support.h"
+#include "ros_bench_support.h"
+#include "serial_robot_driver/ServoRead.h"
+#include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+
+namespace serial_robot_driver::bench {
+namespace {
+
+namespace base = protocol::base;
+namespace body = protocol::body;
+using namespace std::chrono_literals;
+
+// --- options ------------------------------------------------------------------------------------
+
+struct Options {
+  bool long_run = false;
+  std::set<int> sections{1, 2, 3, 4, 5, 6, 7};
+  std::string output;                   ///< Markdown copy of the results; "" = none
+  std::string bin_dir;                  ///< "" = the directory of this executable
+  int master_port = 0;                  ///< 0 = any free port
+  std::size_t commands = 1000;          ///< 1: cmd_vel commands timed
+  double loop_seconds = 20;             ///< 2, 3: idle loop window
+  std::size_t telemetry_frames = 1000;  ///< 4: frames timed at 100 Hz
+  double rate_step_seconds = 2;         ///< 5: length of each rate step
+  std::vector<double> rates{100, 200, 500, 1000, 2000, 5000};
+  std::size_t service_calls = 200;  ///< 6: calls timed per client kind
+  double stress_seconds = 5;        ///< 6: idle and stress windows of the wheel loop
+
+  bool runs(int section) const { return sections.count(section) > 0; }
+};
+
+const char* const kUsage = R"(usage: driver_bench [options]
+  --long                  longer runs (5000 commands, 120 s loop window, 6000 frames, ...)
+  --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run)
+  --output FILE           also write the results (Markdown) to FILE
+  --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
+  --master-port N         port of the private roscore (default: a free one)
+  --commands N            1: cmd_vel commands timed (default 1000)
+  --loop-seconds S        2/3: idle window (default 20)
+  --telemetry-frames N    4: telemetry frames timed at 100 Hz (default 1000)
+  --rate-step-seconds S   5: length of each rate step (default 2)
+  --service-calls N       6: servo/read calls per client kind (default 200)
+  --stress-seconds S      6: idle and stress windows of the wheel loop (default 5)
+)";
+
+std::set<int> parseSections(const std::string& text) {
+  std::set<int> sections;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    const int section = std::stoi(item);
+    if (section < 1 || section > 7) throw std::invalid_argument("no section " + item);
+    sections.insert(section);
+  }
+  return sections;
+}
+
+Options parseOptions(int argc, char** argv) {
+  Options options;
+  // --long first, so explicit knobs override it wherever they stand.
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--long") {
+      options.long_run = true;
+      options.commands = 5000;
+      options.loop_seconds = 120;
+      options.telemetry_frames = 6000;
+      options.rate_step_seconds = 10;
+      options.service_calls = 2000;
+      options.stress_seconds = 30;
+    }
+  }
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (flag == "--long" || flag.find(":=") != std::string::npos) continue;  // ROS remappings
+    if (flag == "--help" || flag == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    }
+    if (i + 1 >= argc) throw std::invalid_argument("unknown flag or missing value: " + flag);
+    const std::string value = argv[++i];
+    if (flag == "--sections") {
+      options.sections = parseSections(value);
+    } else if (flag == "--output") {
+      options.output = value;
+    } else if (flag == "--bin-dir") {
+      options.bin_dir = value;
+    } else if (flag == "--master-port") {
+      options.master_port = std::stoi(value);
+    } else if (flag == "--commands") {
+      options.commands = std::stoul(value);
+    } else if (flag == "--loop-seconds") {
+      options.loop_seconds = std::stod(value);
+    } else if (flag == "--telemetry-frames") {
+      options.telemetry_frames = std::stoul(value);
+    } else if (flag == "--rate-step-seconds") {
+      options.rate_step_seconds = std::stod(value);
+    } else if (flag == "--service-calls") {
+      options.service_calls = std::stoul(value);
+    } else if (flag == "--stress-seconds") {
+      options.stress_seconds = std::stod(value);
+    } else {
+      throw std::invalid_argument("unknown flag: " + flag);
+    }
+  }
+  return options;
+}
+
+// --- shared measurement pieces ------------------------------------------------------------------
+
+constexpr double kLoopRate = 50.0;
+constexpr double kLoopPeriodMs = 1000.0 / kLoopRate;
+
+/// How the node reads its port.
+struct Variant {
+  std::string name;
+  std::string tag;  ///< part of the node namespace
+  double read_poll_interval;
+};
+const Variant kEventDriven{"event-driven", "event", 0.0};
+const Variant kPolling{"polling 20 ms", "poll", 0.02};
+
+struct Context {
+  Options options;
+  RunPaths paths;
+  ros::NodeHandle nh;
+  ResultTable results;
+  std::size_t failures = 0;  ///< measurements that could not complete
+};
+
+void require(bool condition, const std::string& what) {
+  if (!condition) throw std::runtime_error(stopRequested() ? "stopped by a signal" : what);
+}
+
+ParamList commonParams(const std::string& port, const Variant& variant) {
+  return {{"port", port},
+          {"loop_rate", kLoopRate},
+          {"reconnect_interval", 0.2},
+          {"read_poll_interval", variant.read_poll_interval}};
+}
+
+struct LatencyResult {
+  Summary ms;
+  std::size_t attempted = 0;
+  std::size_t lost = 0;  ///< no answer/frame within the timeout (or a failed call)
+};
+
+LatencyResult latencyResult(const std::vector<double>& samples_ms, std::size_t attempted) {
+  return {summarize(samples_ms), attempted, attempted - samples_ms.size()};
+}
+
+struct LoopResult {
+  Summary period_ms;
+  std::size_t missed_ticks = 0;
+  double cpu_percent = 0;
+};
+
+/// Periods between consecutive event times (s); a period of k nominal periods missed k-1 ticks.
+LoopResult analyzePeriods(const std::vector<double>& times_s) {
+  LoopResult result;
+  std::vector<double> periods_ms;
+  for (std::size_t i = 1; i < times_s.size(); ++i) {
+    const double period_ms = (times_s[i] - times_s[i - 1]) * 1e3;
+    periods_ms.push_back(period_ms);
+    const long ticks = std::lround(period_ms / kLoopPeriodMs);
+    if (ticks > 1) result.missed_ticks += static_cast<std::size_t>(ticks - 1);
+  }
+  result.period_ms = summarize(periods_ms);
+  return result;
+}
+
+std::string ms(double value) { return format("%.3f ms", value); }
+std::string percent(double value) { return format("%.2f %%", value); }
+
+/// Rows p50 / p99 / max of a latency measurement, the p99 checked against `p99_goal_ms`.
+void addLatencyRows(ResultTable& table, const std::string& what, const LatencyResult& result,
+                    std::optional<double> p99_goal_ms) {
+  table.row(what + ": samples (lost)", format("%zu (%zu)", result.ms.count, result.lost), "",
+            result.lost == 0);
+  table.row(what + ": p50", ms(result.ms.p50));
+  if (p99_goal_ms) {
+    table.row(what + ": p99", ms(result.ms.p99), format("<= %.1f ms", *p99_goal_ms),
+              result.ms.count > 0 && result.ms.p99 <= *p99_goal_ms);
+  } else {
+    table.row(what + ": p99", ms(result.ms.p99));
+  }
+  table.row(what + ": max", ms(result.ms.max));
+}
+
+void addLoopRows(ResultTable& table, const std::string& what, const LoopResult& loop,
+                 bool with_goals) {
+  const Summary& p = loop.period_ms;
+  table.row(what + ": periods", format("%zu, mean %.3f ms", p.count, p.mean));
+  if (with_goals) {
+    table.row(what + ": period std", ms(p.stddev), "<= 0.1 ms", p.stddev <= 0.1);
+    table.row(what + ": worst period", ms(p.max), "<= 22 ms", p.max <= 22.0);
+    table.row(what + ": missed ticks", format("%zu", loop.missed_ticks), "0",
+              loop.missed_ticks == 0);
+  } else {
+    table.row(what + ": period std", ms(p.stddev));
+    table.row(what + ": worst period", ms(p.max));
+    table.row(what + ": missed ticks", format("%zu", loop.missed_ticks));
+  }
+}
+
+// --- base: speed frames on the pty --------------------------------------------------------------
+
+struct SpeedFrame {
+  Clock::time_point arrival;
+  int16_t left = 0;
+  int16_t right = 0;
+};
+
+/// Every wheel-speed frame the node wrote, in order, with its pty arrival time.
+class SpeedFrameLog {
+ public:
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) {
+    if (family != protocol::FrameFamily::kBase) return;
+    const auto frame = base::decodeFrame(data, size);
+    if (!frame || frame->msg_id != static_cast<uint8_t>(base::MsgId::kWheelSpeed)) return;
+    const auto speed = base::interpretWheelSpeed(*frame);
+    if (!speed) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      frames_.push_back({arrival, speed->left_ticks, speed->right_ticks});
+    }
+    arrived_.notify_all();
+  }
+
+  std::size_t count() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return frames_.size();
+  }
+
+  /// Frame number `index` (0-based), waiting for it until `deadline`.
+  std::optional<SpeedFrame> waitFor(std::size_t index, Clock::time_point deadline) const {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!arrived_.wait_until(lock, deadline, [&] { return frames_.size() > index; })) return {};
+    return frames_[index];
+  }
+
+  /// Arrival times (s) of frames [begin, end).
+  std::vector<double> arrivalSeconds(std::size_t begin, std::size_t end) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<double> times;
+    for (std::size_t i = begin; i < end && i < frames_.size(); ++i) {
+      times.push_back(toSeconds(frames_[i].arrival.time_since_epoch()));
+    }
+    return times;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::condition_variable arrived_;
+  std::vector<SpeedFrame> frames_;
+};
+
+/// Times cmd_vel -> first speed frame carrying it. Each command is published 12 ms after a speed
+/// frame: past the node's rate limit (no immediate frame within half a period of the last one),
+/// so what is timed is the path, not the rate limit. Hence one command per loop period.
+LatencyResult timeCmdVel(ros::Publisher& publisher, const SpeedFrameLog& log,
+                         std::size_t commands) {
+  constexpr std::size_t kWarmUp = 20;
+  constexpr auto kPublishAfterFrame = 12ms;
+  constexpr auto kTimeout = 200ms;
+  // Truncated ticks per PID period for a wheel speed (AP1 defaults; dithering off in the node).
+  const double ticks_per_mps = 1600.0 / (0.25 * M_PI) / 50.0;
+
+  std::vector<double> samples_ms;
+  std::size_t measured = 0;
+  std::size_t next = log.count();
+  for (std::size_t i = 0; i < kWarmUp + commands && !stopRequested(); ++i) {
+    const auto tick = log.waitFor(next, Clock::now() + kTimeout);
+    require(tick.has_value(), "the node stopped writing speed frames");
+    // 1..600 ticks: each command differs from the one before, so its first frame is recognised.
+    const auto ticks = static_cast<int16_t>(1 + i % 600);
+    geometry_msgs::Twist command;
+    command.linear.x = (ticks + 0.5) / ticks_per_mps;
+    std::this_thread::sleep_until(tick->arrival + kPublishAfterFrame);
+    const Clock::time_point published = Clock::now();
+    publisher.publish(command);
+
+    std::optional<SpeedFrame> match;
+    std::size_t index = next + 1;
+    while (const auto frame = log.waitFor(index++, published + kTimeout)) {
+      if (frame->left == ticks && frame->right == ticks) {
+        match = frame;
+        break;
+      }
+    }
+    if (i >= kWarmUp) {
+      ++measured;
+      if (match) samples_ms.push_back(toMs(match->arrival - published));
+    }
+    // `index` is one past the match: the next loop tick, after which the next command goes.
+    next = match ? index : log.count();
+  }
+  return latencyResult(samples_ms, measured);
+}
+
+struct BaseSessionResult {
+  std::optional<LatencyResult> cmd_vel;
+  std::optional<LoopResult> idle_loop;
+};
+
+/// driver_node with the base alone on a pty owned here.
+BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool time_cmd_vel,
+                                 bool measure_idle_loop) {
+  const std::string ns = "base_" + variant.tag;
+  transport::PseudoTerminal pty(context.paths.link(ns));
+  SpeedFrameLog log;
+  protocol::FramerConfig framer;
+  framer.base = true;
+  PtyFrameReader reader(pty, framer, [&log](auto family, auto data, auto size, auto arrival) {
+    log.onFrame(family, data, size, arrival);
+  });
+  ParamList params = commonParams(pty.linkPath(), variant);
+  params.insert(params.end(), {{"body/enabled", false},
+                               {"servo_bus/enabled", false},
+                               {"base/speed_dithering", false},   // one tick value per command
+                               {"base/max_wheel_speed", 20.0}});  // room for 600 distinct ticks
+  DriverProcess driver(context.paths, ns, params);
+  ros::Publisher publisher =
+      context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
+  require(waitUntil([&] { return log.count() > 0; }, 30s),
+          "no speed frame on the pty within 30 s; see " + context.paths.log(ns));
+  require(waitUntil([&] { return publisher.getNumSubscribers() > 0; }, 10s),
+          "driver_node did not subscribe to cmd_vel");
+
+  BaseSessionResult result;
+  if (time_cmd_vel) result.cmd_vel = timeCmdVel(publisher, log, context.options.commands);
+  if (measure_idle_loop) {
+    require(sleepUntil(Clock::now() + 1s), "stopped");  // past cmd_vel_timeout: no more commands
+    const std::size_t first = log.count();
+    const CpuWindow cpu(driver.pid());
+    require(sleepUntil(Clock::now() + fromSeconds(context.options.loop_seconds)), "stopped");
+    LoopResult loop = analyzePeriods(log.arrivalSeconds(first, log.count()));
+    loop.cpu_percent = cpu.percent();
+    result.idle_loop = loop;
+  }
+  return result;
+}
+
+// --- body: telemetry written to the pty, joint_states received -----------------------------------
+
+/// Writes numbered telemetry frames and matches the joint_states they become. The frame number is
+/// carried in the first two servo positions (12 bits each), which the node publishes as angles.
+class TelemetryProbe {
+ public:
+  static constexpr std::size_t kServos = 20;
+
+  /// Node parameters that make positions decode back to raw ticks (zero 0, direction +1).
+  static ParamList nodeParams() {
+    std::vector<int> ids, zeros(kServos, 0), directions(kServos, 1);
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < kServos; ++i) {
+      ids.push_back(static_cast<int>(i + 1));
+      names.push_back("joint_" + std::to_string(i + 1));
+    }
+    return {{"body/servo_ids", toXmlRpc(ids)},
+            {"body/joint_names", toXmlRpc(names)},
+            {"body/zero_ticks", toXmlRpc(zeros)},
+            {"body/directions", toXmlRpc(directions)},
+            {"body/ticks_per_revolution", kTicksPerRevolution}};
+  }
+
+  TelemetryProbe(ros::NodeHandle& nh, const std::string& topic, std::size_t capacity)
+      : written_(capacity), latency_ms_(capacity, kNotReceived) {
+    subscriber_ = nh.subscribe(topic, 10000, &TelemetryProbe::onJointState, this,
+                               ros::TransportHints().tcpNoDelay());
+  }
+
+  std::size_t capacity() const { return written_.size(); }
+
+  /// Writes frame `seq`; false when the pty could not take it at once (dropped, like an overrun).
+  bool write(transport::PseudoTerminal& pty, uint32_t seq) {
+    const std::vector<uint8_t> frame = encode(seq);
+    // Locked across write + timestamp so the answer cannot be matched before its write time.
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!writeFrameOrDrop(pty, frame)) return false;
+    written_[seq] = Clock::now();
+    return true;
+  }
+
+  std::size_t delivered(uint32_t begin, uint32_t end) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::size_t count = 0;
+    for (uint32_t seq = begin; seq < end; ++seq) count += latency_ms_[seq] != kNotReceived;
+    return count;
+  }
+
+  std::vector<double> latenciesMs(uint32_t begin, uint32_t end) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<double> samples;
+    for (uint32_t seq = begin; seq < end; ++seq) {
+      if (latency_ms_[seq] != kNotReceived) samples.push_back(latency_ms_[seq]);
+    }
+    return samples;
+  }
+
+ private:
+  static constexpr int kTicksPerRevolution = 4096;
+  static constexpr double kNotReceived = -1.0;
+
+  static std::vector<uint8_t> encode(uint32_t seq) {
+    body::Telemetry telemetry;
+    telemetry.servo_count = kServos;
+    for (std::size_t i = 0; i < kServos; ++i) telemetry.servos[i].position = 2048;
+    telemetry.servos[0].position = static_cast<uint16_t>(seq & 0xFFF);
+    telemetry.servos[1].position = static_cast<uint16_t>((seq >> 12) & 0xFFF);
+    return body::encodeTelemetry(telemetry);
+  }
+
+  static uint32_t ticksOf(double radians) {
+    const long ticks = std::lround(radians * kTicksPerRevolution / (2 * M_PI));
+    return static_cast<uint32_t>(((ticks % kTicksPerRevolution) + kTicksPerRevolution) %
+                                 kTicksPerRevolution);
+  }
+
+  void onJointState(const sensor_msgs::JointState::ConstPtr& message) {
+    const Clock::time_point received = Clock::now();  // before the lock: the lock is not timed
+    if (message->position.size() < 2) return;
+    const uint32_t seq = ticksOf(message->position[0]) | (ticksOf(message->position[1]) << 12);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (seq >= written_.size() || written_[seq] == Clock::time_point{}) return;
+    latency_ms_[seq] = toMs(received - written_[seq]);
+  }
+
+  mutable std::mutex mutex_;
+  std::vector<Clock::time_point> written_;  ///< per frame number; epoch = not written
+  std::vector<double> latency_ms_;          ///< per frame number; kNotReceived
+  ros::Subscriber subscriber_;
+};
+
+struct RateStep {
+  double target_hz = 0;
+  double achieved_hz = 0;
+  std::size_t attempted = 0;
+  std::size_t dropped_at_pty = 0;  ///< the pty buffer was full: the node did not read in time
+  std::size_t delivered = 0;
+  double ratio() const { return attempted ? static_cast<double>(delivered) / attempted : 0.0; }
+};
+
+/// Writes `count` frames at `rate_hz` (absolute schedule), numbered from *next_seq, then waits up
+/// to 1 s for the last joint_states to come in.
+RateStep streamTelemetry(TelemetryProbe& probe, transport::PseudoTerminal& pty, double rate_hz,
+                         std::size_t count, uint32_t* next_seq) {
+  RateStep step;
+  step.target_hz = rate_hz;
+  const uint32_t first = *next_seq;
+  require(first + count <= probe.capacity(), "telemetry probe too small");
+  const Clock::time_point start = Clock::now();
+  for (std::size_t k = 0; k < count && !stopRequested(); ++k) {
+    std::this_thread::sleep_until(start + fromSeconds(k / rate_hz));
+    if (!probe.write(pty, (*next_seq)++)) ++step.dropped_at_pty;
+    ++step.attempted;
+  }
+  // Frames over the time between the first and the last write.
+  const double elapsed = toSeconds(Clock::now() - start);
+  step.achieved_hz = elapsed > 0 && step.attempted > 1 ? (step.attempted - 1) / elapsed : 0.0;
+  const std::size_t written = step.attempted - step.dropped_at_pty;
+  waitUntil([&] { return probe.delivered(first, *next_seq) >= written; }, 1s);
+  step.delivered = probe.delivered(first, *next_seq);
+  return step;
+}
+
+struct TelemetrySessionResult {
+  std::optional<LatencyResult> latency;
+  double cpu_percent = 0;
+  std::vector<RateStep> steps;
+  std::optional<double> max_rate_hz;  ///< highest step with >= 99.9 % delivered
+};
+
+/// driver_node with the body alone on a pty owned here; this process plays the servo board.
+TelemetrySessionResult runTelemetrySession(Context& context, const Variant& variant,
+                                           bool time_latency, bool step_rates) {
+  constexpr std::size_t kWarmUpFrames = 2000;
+  constexpr double kLatencyRateHz = 100.0;
+  const Options& options = context.options;
+  const std::string ns = "body_" + variant.tag;
+  transport::PseudoTerminal pty(context.paths.link(ns));
+  ParamList params = commonParams(pty.linkPath(), variant);
+  params.insert(params.end(), {{"base/enabled", false}, {"servo_bus/enabled", false}});
+  const ParamList body_params = TelemetryProbe::nodeParams();
+  params.insert(params.end(), body_params.begin(), body_params.end());
+
+  std::size_t capacity = kWarmUpFrames + options.telemetry_frames;
+  for (double rate : options.rates) capacity += std::lround(rate * options.rate_step_seconds);
+  DriverProcess driver(context.paths, ns, params);
+  TelemetryProbe probe(context.nh, driver.topic("joint_states"), capacity);
+
+  // Warm-up: 50 Hz until the node is connected, publishing, and this subscriber is attached.
+  uint32_t seq = 0;
+  const Clock::time_point give_up = Clock::now() + 30s;
+  while (probe.delivered(0, seq) == 0 && Clock::now() < give_up && !stopRequested() &&
+         seq < kWarmUpFrames) {
+    probe.write(pty, seq++);
+    std::this_thread::sleep_for(20ms);
+  }
+  require(probe.delivered(0, seq) > 0,
+          "no joint_states for the telemetry written; see " + context.paths.log(ns));
+  sleepUntil(Clock::now() + 300ms);
+  seq = kWarmUpFrames;
+
+  TelemetrySessionResult result;
+  if (time_latency) {
+    const uint32_t first = seq;
+    const CpuWindow cpu(driver.pid());
+    const RateStep run =
+        streamTelemetry(probe, pty, kLatencyRateHz, options.telemetry_frames, &seq);
+    result.cpu_percent = cpu.percent();
+    result.latency = latencyResult(probe.latenciesMs(first, seq), run.attempted);
+  }
+  if (step_rates) {
+    for (double rate : options.rates) {
+      if (stopRequested()) break;
+      const auto count = static_cast<std::size_t>(std::lround(rate * options.rate_step_seconds));
+      result.steps.push_back(streamTelemetry(probe, pty, rate, count, &seq));
+      if (result.steps.back().ratio() >= 0.999) result.max_rate_hz = rate;
+    }
+  }
+  return result;
+}
+
+// --- servo bus: services against robot_sim ---------------------------------------------------
+
+/// One servo/read of servo 0's voltage; false when the call failed or the servo did not answer.
+bool readVoltage(const std::string& service, ros::ServiceClient* persistent) {
+  ServoRead call;
+  call.request.id = 0;
+  call.request.param = "voltage";
+  const bool called = persistent ? persistent->call(call) : ros::service::call(service, call);
+  return called && call.response.success;
+}
+
+LatencyResult timeServoReads(ros::NodeHandle& nh, const std::string& service, std::size_t calls,
+                             bool persistent) {
+  ros::ServiceClient client;
+  std::vector<double> samples_ms;
+  std::size_t attempted = 0;
+  for (; attempted < calls && !stopRequested(); ++attempted) {
+    if (persistent && !client.isValid()) client = nh.serviceClient<ServoRead>(service, true);
+    const Clock::time_point start = Clock::now();
+    if (readVoltage(service, persistent ? &client : nullptr)) {
+      samples_ms.push_back(toMs(Clock::now() - start));
+    }
+  }
+  return latencyResult(samples_ms, attempted);
+}
+
+/// header.stamp of every wheel_command (the node stamps it right after writing the frame).
+class WheelCommandLog {
+ public:
+  WheelCommandLog(ros::NodeHandle& nh, const std::string& topic) {
+    subscriber_ = nh.subscribe(topic, 1000, &WheelCommandLog::onMessage, this,
+                               ros::TransportHints().tcpNoDelay());
+  }
+  std::size_t count() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return stamps_.size();
+  }
+  std::vector<double> stamps(std::size_t begin, std::size_t end) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return {stamps_.begin() + begin, stamps_.begin() + std::min(end, stamps_.size())};
+  }
+
+ private:
+  void onMessage(const WheelCommand::ConstPtr& message) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stamps_.push_back(message->header.stamp.toSec());
+  }
+  mutable std::mutex mutex_;
+  std::vector<double> stamps_;
+  ros::Subscriber subscriber_;
+};
+
+struct ServoSessionResult {
+  LatencyResult new_connection;
+  LatencyResult persistent;
+  LoopResult idle;
+  LoopResult stress;
+  double calls_per_second = 0;
+  std::size_t failed_stress_calls = 0;
+};
+
+ServoSessionResult runServoSession(Context& context) {
+  const Options& options = context.options;
+  ServoSessionResult result;
+  {
+    // Round trips: the servo bus alone (robot_sim answers after its default 1.5 ms latency).
+    const std::string ns = "servo_event";
+    const std::string link = context.paths.link(ns);
+    const auto sim =
+        startRobotSim(context.paths, "robot_sim_" + ns, {"--link", link, "--no-base", "--no-body"});
+    ParamList params = commonParams(link, kEventDriven);
+    params.insert(params.end(), {{"base/enabled", false}, {"body/enabled", false}});
+    DriverProcess driver(context.paths, ns, params);
+    const std::string service = driver.topic("servo/read");
+    require(ros::service::waitForService(service, ros::Duration(30)),
+            service + " did not come up; see " + context.paths.log(ns));
+    require(waitUntil([&] { return readVoltage(service, nullptr); }, 20s),
+            "servo/read never succeeded against robot_sim");
+    result.new_connection = timeServoReads(context.nh, service, options.service_calls, false);
+    result.persistent = timeServoReads(context.nh, service, options.service_calls, true);
+  }
+  {
+    // The wheel loop, idle and under a stress of servo/read calls: every device simulated.
+    const std::string ns = "full_event";
+    const std::string link = context.paths.link(ns);
+    const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, {"--link", link});
+    DriverProcess driver(context.paths, ns, commonParams(link, kEventDriven));
+    WheelCommandLog wheel(context.nh, driver.topic("wheel_command"));
+    const std::string service = driver.topic("servo/read");
+    require(ros::service::waitForService(service, ros::Duration(30)),
+            service + " did not come up; see " + context.paths.log(ns));
+    require(waitUntil([&] { return wheel.count() > 0; }, 20s), "no wheel_command received");
+    require(sleepUntil(Clock::now() + 1s), "stopped");
+
+    const auto window = fromSeconds(options.stress_seconds);
+    std::size_t first = wheel.count();
+    require(sleepUntil(Clock::now() + window), "stopped");
+    result.idle = analyzePeriods(wheel.stamps(first, wheel.count()));
+
+    // Stress: three persistent clients back to back plus one opening a connection per call.
+    std::atomic<bool> stress_done{false};
+    std::atomic<std::size_t> calls{0}, failures{0};
+    std::vector<std::thread> clients;
+    for (int i = 0; i < 4; ++i) {
+      clients.emplace_back([&, persistent = i < 3] {
+        ros::ServiceClient client;
+        while (!stress_done) {
+          if (persistent && !client.isValid()) {
+            client = context.nh.serviceClient<ServoRead>(service, true);
+          }
+          ++(readVoltage(service, persistent ? &client : nullptr) ? calls : failures);
+        }
+      });
+    }
+    first = wheel.count();
+    const Clock::time_point start = Clock::now();
+    sleepUntil(start + window);
+    const std::size_t last = wheel.count();
+    result.calls_per_second = calls / toSeconds(Clock::now() - start);
+    stress_done = true;
+    for (auto& client : clients) client.join();
+    result.stress = analyzePeriods(wheel.stamps(first, last));
+    result.failed_stress_calls = failures;
+  }
+  return result;
+}
+
+// --- the run ------------------------------------------------------------------------------------
+
+/// Runs one measurement; a failure is reported in the table and the run goes on.
+template <typename Function>
+bool attempt(Context& context, const std::string& what, Function&& function) {
+  if (stopRequested()) return false;
+  std::cerr << "driver_bench: " << what << " ..." << std::endl;
+  try {
+    function();
+    return true;
+  } catch (const std::exception& error) {
+    ++context.failures;
+    context.results.section(what + ": FAILED");
+    context.results.note(std::string("error: ") + error.what());
+    std::cerr << "driver_bench: " << what << " failed: " << error.what() << std::endl;
+    return false;
+  }
+}
+
+std::string ratio(double polling, double event) {
+  return event > 0 ? format("%.1fx", polling / event) : "-";
+}
+
+void run(Context& context) {
+  const Options& o = context.options;
+  ResultTable& table = context.results;
+  BaseSessionResult base_event, base_polling;
+  TelemetrySessionResult body_event, body_polling;
+
+  if (o.runs(1) || o.runs(2) || o.runs(3)) {
+    attempt(context, "base session (1-3)", [&] {
+      base_event = runBaseSession(context, kEventDriven, o.runs(1), o.runs(2) || o.runs(3));
+    });
+  }
+  if (base_event.cmd_vel) {
+    table.section("1. cmd_vel publish -> speed frame's last byte on the pty (50 Hz loop)");
+    addLatencyRows(table, "cmd_vel -> frame", *base_event.cmd_vel, 1.0);
+    table.note(
+        "One command per loop period, published 12 ms after a loop frame (outside the "
+        "node's 2x-loop-rate limit), distinct wheel ticks per command.");
+  }
+  if (base_event.idle_loop && o.runs(2)) {
+    table.section(format("2. Base loop period at 50 Hz, idle, from pty arrival times (%.0f s)",
+                         o.loop_seconds));
+    addLoopRows(table, "loop", *base_event.idle_loop, true);
+  }
+  if (base_event.idle_loop && o.runs(3)) {
+    table.section("3. driver_node CPU, idle at 50 Hz (base only)");
+    table.row("CPU (utime+stime / wall)", percent(base_event.idle_loop->cpu_percent), "<= 0.5 %",
+              base_event.idle_loop->cpu_percent <= 0.5);
+    table.note("/proc/<pid>/stat has 10 ms resolution: over the window that is +-" +
+               percent(1.0 / o.loop_seconds) + ".");
+  }
+
+  if (o.runs(4) || o.runs(5)) {
+    attempt(context, "telemetry session (4-5)",
+            [&] { body_event = runTelemetrySession(context, kEventDriven, o.runs(4), o.runs(5)); });
+  }
+  if (body_event.latency) {
+    table.section("4. Telemetry last byte written -> joint_states received (20 servos, 100 Hz)");
+    addLatencyRows(table, "telemetry -> joint_states", *body_event.latency, 0.5);
+    table.row("driver_node CPU at 100 Hz", percent(body_event.cpu_percent), "<= 0.5 %",
+              body_event.cpu_percent <= 0.5);
+  }
+  // The goal applies to the node as shipped (event-driven); the polling variant is only compared.
+  auto addRateSteps = [&](const std::string& title, const TelemetrySessionResult& session,
+                          bool with_goal) {
+    table.section(title, {"target", "achieved", "frames", "dropped at pty", "delivered", "ratio",
+                          ">= 99.9 %"});
+    for (const RateStep& step : session.steps) {
+      table.row({format("%.0f Hz", step.target_hz), format("%.0f Hz", step.achieved_hz),
+                 format("%zu", step.attempted), format("%zu", step.dropped_at_pty),
+                 format("%zu", step.delivered), format("%.2f %%", 100 * step.ratio()),
+                 verdict(step.ratio() >= 0.999)});
+    }
+    const double best = session.max_rate_hz.value_or(0);
+    table.note(
+        format("Highest rate with >= 99.9 %% published: %.0f Hz%s. Each step %g s.", best,
+               with_goal ? (" (goal >= 1000 Hz: " + verdict(best >= 1000) + ")").c_str() : "",
+               o.rate_step_seconds));
+  };
+  if (!body_event.steps.empty()) {
+    addRateSteps("5. Telemetry rate steps: frames published as joint_states", body_event, true);
+  }
+
+  if (o.runs(6)) {
+    attempt(context, "servo session (6)", [&] {
+      const ServoSessionResult servo = runServoSession(context);
+      table.section("6. servo/read round trip against robot_sim, and the wheel loop under calls");
+      addLatencyRows(table, "servo/read, new connection per call", servo.new_connection, {});
+      addLatencyRows(table, "servo/read, persistent client", servo.persistent, {});
+      addLoopRows(table, "wheel loop idle", servo.idle, false);
+      addLoopRows(table, "wheel loop under servo/read stress", servo.stress, false);
+      table.row("stress: servo/read calls completed",
+                format("%.0f /s (%zu failed)", servo.calls_per_second, servo.failed_stress_calls));
+      table.note(
+          "robot_sim answers after 1.5 ms (its default --servo-latency-ms). Wheel periods "
+          "from wheel_command header stamps; stress = 3 persistent clients + 1 opening a "
+          "connection per call, back to back.");
+    });
+  }
+
+  if (o.runs(7)) {
+    if (o.runs(1) && base_event.cmd_vel) {
+      attempt(context, "polling base session (7)",
+              [&] { base_polling = runBaseSession(context, kPolling, true, false); });
+    }
+    if ((o.runs(4) && body_event.latency) || (o.runs(5) && !body_event.steps.empty())) {
+      attempt(context, "polling telemetry session (7)",
+              [&] { body_polling = runTelemetrySession(context, kPolling, o.runs(4), o.runs(5)); });
+    }
+    table.section("7. Event-driven vs polling reads (~read_poll_interval 0.02)",
+                  {"measurement", kEventDriven.name, kPolling.name, "polling / event"});
+    auto compare = [&](const std::string& what, double event, double polling,
+                       const std::string& unit, int decimals) {
+      table.row({what, format("%.*f %s", decimals, event, unit.c_str()),
+                 format("%.*f %s", decimals, polling, unit.c_str()), ratio(polling, event)});
+    };
+    if (base_event.cmd_vel && base_polling.cmd_vel) {
+      compare("1. cmd_vel -> frame p50", base_event.cmd_vel->ms.p50, base_polling.cmd_vel->ms.p50,
+              "ms", 3);
+      compare("1. cmd_vel -> frame p99", base_event.cmd_vel->ms.p99, base_polling.cmd_vel->ms.p99,
+              "ms", 3);
+    }
+    if (body_event.latency && body_polling.latency) {
+      compare("4. telemetry -> joint_states p50", body_event.latency->ms.p50,
+              body_polling.latency->ms.p50, "ms", 3);
+      compare("4. telemetry -> joint_states p99", body_event.latency->ms.p99,
+              body_polling.latency->ms.p99, "ms", 3);
+      compare("4. node CPU at 100 Hz", body_event.cpu_percent, body_polling.cpu_percent, "%", 2);
+    }
+    if (!body_event.steps.empty() && !body_polling.steps.empty()) {
+      compare("5. highest rate >= 99.9 %", body_event.max_rate_hz.value_or(0),
+              body_polling.max_rate_hz.value_or(0), "Hz", 0);
+    }
+    table.note(
+        "cmd_vel -> frame does not go through the port reader, so polling should not "
+        "change it; telemetry does.");
+    if (!body_polling.steps.empty()) {
+      addRateSteps("7b. Telemetry rate steps, polling variant", body_polling, false);
+    }
+  }
+}
+
+std::string executableDirectory() {
+  std::vector<char> path(4096);
+  const ssize_t length = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
+  if (length <= 0) return ".";
+  const std::string exe(path.data(), static_cast<std::size_t>(length));
+  return exe.substr(0, exe.rfind('/'));
+}
+
+std::string header(const Options& options) {
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof(date), "%Y-%m-%d %H:%M:%S", std::localtime(&now));
+  double load[3] = {0, 0, 0};
+  ::getloadavg(load, 3);
+  return format("# driver_node benchmarks\n\n%s, %ld CPUs, load average %.2f %.2f %.2f, %s run.\n",
+                date, ::sysconf(_SC_NPROCESSORS_ONLN), load[0], load[1], load[2],
+                options.long_run ? "long" : "default");
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::bench
+
+int main(int argc, char** argv) {
+  namespace bench = serial_robot_driver::bench;
+  bench::Options options;
+  try {
+    options = bench::parseOptions(argc, argv);
+  } catch (const std::exception& error) {
+    std::cerr << "driver_bench: " << error.what() << "\n\n" << bench::kUsage;
+    return 2;
+  }
+  bench::installStopHandler();
+
+  bench::RunPaths paths;
+  paths.bin_dir = options.bin_dir.empty() ? bench::executableDirectory() : options.bin_dir;
+  for (const char* program : {"driver_node", "robot_sim"}) {
+    if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
+      std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
+                << " not found: build driver_node and robot_sim first\n";
+      return 2;
+    }
+  }
+  char work_dir[] = "/tmp/srd_bench_XXXXXX";
+  if (::mkdtemp(work_dir) == nullptr) {
+    std::cerr << "driver_bench: cannot create a work directory in /tmp\n";
+    return 1;
+  }
+  paths.work_dir = work_dir;
+  const std::string started = bench::header(options);
+
+  int status = 0;
+  std::string report;
+  try {
+    bench::RosMaster master(paths,
+                            options.master_port ? options.master_port : bench::findFreeTcpPort());
+    ros::init(argc, argv, "driver_bench", ros::init_options::NoSigintHandler);
+    // Our own INFO lines (waitForService ...) would interleave with the table on stdout.
+    if (ros::console::set_logger_level("ros", ros::console::levels::Warn)) {
+      ros::console::notifyLoggerLevelsChanged();
+    }
+    std::cerr << "driver_bench: roscore at " << master.uri() << ", logs in " << paths.work_dir
+              << std::endl;
+    master.waitUntilUp(std::chrono::seconds(60));
+    bench::Context context{options, paths, ros::NodeHandle(), {}};
+    ros::AsyncSpinner spinner(2);
+    spinner.start();
+    bench::run(context);
+    spinner.stop();
+    report = started + context.results.markdown();
+    if (bench::stopRequested()) report += "\n**Interrupted: partial results.**\n";
+    if (context.failures > 0) status = 1;
+    ros::shutdown();
+  } catch (const std::exception& error) {
+    std::cerr << "driver_bench: " << error.what() << std::endl;
+    status = 1;
+  }
+  if (bench::stopRequested()) status = 130;
+  if (!report.empty()) {
+    double load[3] = {0, 0, 0};
+    ::getloadavg(load, 3);
+    report += bench::format("\nLoad average at the end: %.2f %.2f %.2f. Logs of the nodes: %s\n",
+                            load[0], load[1], load[2], paths.work_dir.c_str());
+    std::cout << report << std::flush;
+    if (!options.output.empty()) {
+      std::ofstream(options.output) << report;
+      std::cerr << "driver_bench: results written to " << options.output << std::endl;
+    }
+  }
+  return status;
+}
