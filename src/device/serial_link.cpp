@@ -8,8 +8,9 @@ namespace serial_robot_driver::device {
 
 namespace {
 /// How long one read waits before the reader thread checks for stop/lost flags. Data wakes it at
-/// once, so this only bounds shutdown and reconnect latency.
-constexpr int kReadTimeoutMs = 20;
+/// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on; a
+/// longer wait keeps an idle port from waking the CPU.
+constexpr int kReadTimeoutMs = 100;
 constexpr std::size_t kReadChunk = 4096;
 
 std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& options) {

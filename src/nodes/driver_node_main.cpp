@@ -1,22 +1,34 @@
 // driver_node: loads and validates the parameters, builds the node, spins until SIGINT/SIGTERM,
 // then writes a last zero-speed frame before the ports close.
-#include <atomic>
+#include <pthread.h>
+
 #include <csignal>
+#include <ctime>
 
 #include <ros/ros.h>
 
 #include "serial_robot_driver/ros/driver_node.h"
 
 namespace {
-std::atomic<bool> g_stop_requested{false};
-void requestStop(int) { g_stop_requested = true; }
+/// Waits for SIGINT/SIGTERM (blocked in every thread, taken here synchronously) or for roscpp to shut
+/// down (rosnode kill), checking the latter twice a second.
+void waitForStopRequest(const sigset_t& stop_signals) {
+  const timespec half_second{0, 500000000};
+  while (ros::ok()) {
+    if (sigtimedwait(&stop_signals, nullptr, &half_second) > 0) return;
+  }
+}
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Our own SIGINT handler: roscpp's would tear the node down before the zero-speed frame is out.
+  // We take SIGINT ourselves: roscpp's handler would tear the node down before the zero-speed frame
+  // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
-  std::signal(SIGINT, requestStop);
-  std::signal(SIGTERM, requestStop);
 
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
@@ -37,13 +49,11 @@ int main(int argc, char** argv) {
 
   serial_robot_driver::ros_layer::DriverNode node(nh, private_nh, params);
   node.start();
-  // Global queue: cmd_vel, joint_commands, base services, diagnostics timer. Two threads so a
-  // subscriber callback never waits behind the diagnostics update.
-  ros::AsyncSpinner spinner(2);
+  // Global queue: cmd_vel, joint_commands, base services and the diagnostics timer. None of them
+  // waits on the wire (servo/* services have their own queue), so one thread keeps up.
+  ros::AsyncSpinner spinner(1);
   spinner.start();
-  while (!g_stop_requested && ros::ok()) {
-    ros::WallDuration(0.05).sleep();
-  }
+  waitForStopRequest(stop_signals);
   ROS_INFO("shutting down: stopping the wheels");
   node.shutdown();
   spinner.stop();

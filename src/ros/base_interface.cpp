@@ -30,6 +30,7 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, de
   battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", 5);
 
   controller_.on_wheel_frame = [this](const device::WheelFrameSent& sent) {
+    if (wheel_command_pub_.getNumSubscribers() == 0) return;  // 50 Hz: skip work nobody reads
     serial_robot_driver::WheelCommand msg;
     msg.header.stamp = ros::Time::now();
     msg.left_ticks = sent.ticks.left;
