@@ -45,11 +45,9 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, de
     sensor_msgs::BatteryState msg;
     msg.header.stamp = ros::Time::now();
     // The base reports only a percentage; everything else is unknown (NaN per the message docs).
-    msg.voltage = std::numeric_limits<float>::quiet_NaN();
-    msg.current = std::numeric_limits<float>::quiet_NaN();
-    msg.charge = std::numeric_limits<float>::quiet_NaN();
-    msg.capacity = std::numeric_limits<float>::quiet_NaN();
-    msg.design_capacity = std::numeric_limits<float>::quiet_NaN();
+    const float unknown = std::numeric_limits<float>::quiet_NaN();
+    msg.voltage = msg.temperature = msg.current = unknown;
+    msg.charge = msg.capacity = msg.design_capacity = unknown;
     msg.percentage = percent / 100.0f;
     msg.power_supply_status = sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
     msg.power_supply_health = sensor_msgs::BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;

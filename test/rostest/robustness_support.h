@@ -180,6 +180,17 @@ inline long vmRssKb(int pid) {
   return 0;
 }
 
+/// What a process's resources look like at one moment.
+struct ProcessSample {
+  std::size_t fds = 0;
+  std::size_t threads = 0;
+  std::size_t pty_fds = 0;
+  long rss_kb = 0;
+};
+inline ProcessSample sampleProcess(int pid) {
+  return ProcessSample{openFdCount(pid), threadCount(pid), ptyFdCount(pid), vmRssKb(pid)};
+}
+
 /// The latest /diagnostics status of each name ending in one of the watched suffixes, as key/value
 /// strings, with how many times it was received.
 class DiagnosticsWatch {

@@ -143,19 +143,6 @@ class HandPlayedRobot {
   std::vector<uint8_t> msg_ids_;
 };
 
-/// What the node's resources look like at one moment.
-struct ProcessSample {
-  std::size_t fds = 0;
-  std::size_t threads = 0;
-  std::size_t pty_fds = 0;
-  long rss_kb = 0;
-};
-
-ProcessSample sample(int pid) {
-  return ProcessSample{robustness::openFdCount(pid), robustness::threadCount(pid),
-                       robustness::ptyFdCount(pid), robustness::vmRssKb(pid)};
-}
-
 TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
   const std::string node_name = "/unplug/driver_node";
   const std::string path = robustness::nodeParam(node_name, "port");
@@ -170,8 +157,8 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
   constexpr int kWarmUpCycles = 5;  // ROS connections and lazy allocations settle first
   constexpr int kTelemetryPerCycle = 3;
   HandPlayedRobot robot(path);
-  ProcessSample warm;
-  ProcessSample last;
+  robustness::ProcessSample warm;
+  robustness::ProcessSample last;
   std::vector<double> recovery_s;
   for (int cycle = 1; cycle <= kCycles; ++cycle) {
     const auto plugged_at = robustness::Clock::now();
@@ -197,8 +184,8 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
         << "cycle " << cycle << ": " << joints.count() - before << " of " << kTelemetryPerCycle
         << " telemetry frames published";
 
-    if (cycle == kWarmUpCycles) warm = sample(pid);
-    if (cycle == kCycles) last = sample(pid);
+    if (cycle == kWarmUpCycles) warm = robustness::sampleProcess(pid);
+    if (cycle == kCycles) last = robustness::sampleProcess(pid);
     if (cycle == kWarmUpCycles || cycle == kCycles) {
       EXPECT_EQ(robustness::ptyFdCount(pid), 1u) << "cycle " << cycle << ": one port, one fd";
     }
@@ -563,7 +550,8 @@ TEST_F(ExtremeInputs, ServoRequestsOutOfRangeFailCleanlyWithoutBytes) {
   }
 
   for (const Rejection& r : results) {
-    std::printf("%-45s -> %s\n", r.request.c_str(), r.message.c_str());
+    // (a 10000-character parameter name comes back in full: shortened here for the log)
+    std::printf("%-45s -> %s\n", r.request.substr(0, 45).c_str(), r.message.substr(0, 160).c_str());
     EXPECT_TRUE(r.call_ok) << r.request << ": the call itself failed";
     EXPECT_FALSE(r.success) << r.request << " was accepted: " << r.message;
     EXPECT_GE(r.message.size(), 10u) << r.request << ": no reason given";
