@@ -1,5 +1,6 @@
 #include "serial_robot_driver/device/base_controller.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace serial_robot_driver::device {
@@ -169,8 +170,16 @@ WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now) {
   if (timed_out && !command_timed_out_ && last_command_) ++stats_.cmd_vel_timeouts;
   command_timed_out_ = timed_out;
   if (timed_out) return WheelSpeeds::Zero();
-  const WheelSpeeds wheels = kinematics::wheelSpeedsFromTwist(config_.geometry, linear_x_, angular_z_);
-  return kinematics::clampWheelSpeeds(wheels, config_.max_wheel_speed);
+  // Work on the twist scaled to at most 1 so absurd (finite) commands cannot overflow to inf and
+  // lose their direction; the clamp then restores the right magnitude.
+  const double scale = std::max({1.0, std::abs(linear_x_), std::abs(angular_z_)});
+  const WheelSpeeds unit =
+      kinematics::wheelSpeedsFromTwist(config_.geometry, linear_x_ / scale, angular_z_ / scale);
+  const double largest = unit.cwiseAbs().maxCoeff();
+  if (config_.max_wheel_speed > 0 && largest * scale > config_.max_wheel_speed) {
+    return unit * (config_.max_wheel_speed / largest);
+  }
+  return unit * scale;
 }
 
 void BaseController::sendSpeed(Clock::time_point now, bool immediate) {

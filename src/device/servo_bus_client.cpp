@@ -62,7 +62,13 @@ std::string servoName(uint8_t id) {
   return "servo " + std::to_string(id);
 }
 
-std::string quoted(std::string_view name) { return "'" + std::string(name) + "'"; }
+/// Quotes a name for a message; a caller's absurdly long string is cut, not echoed in full.
+std::string quoted(std::string_view name) {
+  constexpr std::size_t kMaxShown = 40;
+  if (name.size() <= kMaxShown) return "'" + std::string(name) + "'";
+  return "'" + std::string(name.substr(0, kMaxShown)) + "...' (" + std::to_string(name.size()) +
+         " characters)";
+}
 
 std::string formatMs(double ms) {
   char text[32];

@@ -199,7 +199,9 @@ DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unk
         "imu/orientation_variance", "imu/angular_velocity_variance",
         "imu/linear_acceleration_variance",
         "servo_bus/enabled", "servo_bus/port", "servo_bus/baud", "servo_bus/timeout",
-        "servo_bus/retries", "servo_bus/allow_dangerous_writes"};
+        "servo_bus/retries", "servo_bus/allow_dangerous_writes",
+        // Read by diagnostic_updater itself (its publish period), not a typo.
+        "diagnostic_period"};
     std::vector<std::string> all;
     ros::param::getParamNames(all);
     const std::string prefix = nh.getNamespace() + "/";

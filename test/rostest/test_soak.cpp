@@ -72,9 +72,12 @@ using robustness::waitFor;
 
 constexpr std::size_t kShortestTelemetryFrame = 32;  // 24 + 4 * 2 servos, no foot block
 constexpr double kUnplugEvery = 5.0;
-// Longer than the 1 s diagnostics period, so the port is seen down; not a multiple of the node's
-// 0.1 s reconnect interval, so the reopen does not fall just after the replug every time.
-constexpr double kUnplugDuration = 1.75;
+// Longer than the 1 s diagnostics period, so the port is seen down at rest. A multiple of the
+// node's 0.1 s reconnect interval: the driver's retries, which started at the unplug, then fall a
+// few ms after each replug, so most episodes lose nothing to the flush on open and must reconcile
+// exactly, while the first episode (the simulator starts at a random phase) and the occasional
+// late reopen exercise the bound.
+constexpr double kUnplugDuration = 1.5;
 constexpr uint64_t kMaxHostFramesLostPerUnplug = 3;
 constexpr long kRssSlackKb = 1024;
 
@@ -333,8 +336,15 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
           return !st.flag("connected") && st.number("disconnects") == k;
         },
         [&] { return unpluggedAt(k); }, 5.0);
-    // Messages published before the loss reach this process (local TCP), then read the counters.
-    robustness::sleepSeconds(0.2);
+    // Messages published before the loss may still be on their way (local TCP, a busy machine):
+    // the port is down, so nothing new can come; wait until the counts have been still a while.
+    uint64_t still_polls = 0, seen = joints.count() + imu.count() + telemetry.count();
+    while (status && still_polls < 3 && unpluggedAt(k)) {
+      robustness::sleepSeconds(0.1);
+      const uint64_t now = joints.count() + imu.count() + telemetry.count();
+      still_polls = now == seen ? still_polls + 1 : 0;
+      seen = now;
+    }
     Boundary boundary;
     boundary.joint_states = joints.count();
     boundary.imu = imu.count();

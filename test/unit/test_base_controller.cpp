@@ -76,6 +76,16 @@ TEST_F(BaseControllerTest, TurnInPlaceGivesOppositeTicks) {
   EXPECT_EQ(sent_[0].ticks.right, 8);
 }
 
+TEST_F(BaseControllerTest, HugeCommandKeepsItsDirectionAtFullSpeed) {
+  controller_.setCommand(1e308, 1e308);  // the wheel sum would overflow to inf
+  controller_.sendSpeed(Clock::now(), true);
+  ASSERT_EQ(sent_.size(), 1u);
+  EXPECT_NEAR(sent_[0].speeds.y(), 1.0, 1e-9) << "the faster wheel at max_wheel_speed";
+  EXPECT_GT(sent_[0].speeds.x(), 0.0);
+  EXPECT_LT(sent_[0].speeds.x(), 1.0);
+  EXPECT_EQ(sent_[0].ticks.right, 41);  // 40.74 ticks per period, rounded on the first frame
+}
+
 TEST_F(BaseControllerTest, CommandTimesOutToZero) {
   controller_.setCommand(0.5, 0.0);
   const Clock::time_point now = Clock::now();
