@@ -16,7 +16,7 @@ per_target=$(( total / ${#targets[@]} ))
 
 CC="${CC:-clang}" CXX="${CXX:-clang++}" cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$build" -j2 -- --no-print-directory >/dev/null
-"$here/make_corpus.sh" >/dev/null
+bash "$here/make_corpus.sh" >/dev/null
 
 status=0
 for target in "${targets[@]}"; do
