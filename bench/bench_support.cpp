@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -18,8 +19,7 @@
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
-
-#include "serial_robot_driver/transport/byte_stream.h"
+#include <thread>
 
 namespace serial_robot_driver::bench {
 
@@ -238,34 +238,6 @@ int findFreeTcpPort() {
 }
 
 // --- pty ----------------------------------------------------------------------------------------
-
-PtyFrameReader::PtyFrameReader(transport::PseudoTerminal& pty, const protocol::FramerConfig& config,
-                               FrameCallback on_frame)
-    : pty_(pty),
-      framer_(config, [this](protocol::FrameFamily family, const uint8_t* data,
-                             std::size_t size) { on_frame_(family, data, size, chunk_arrival_); }),
-      on_frame_(std::move(on_frame)),
-      thread_([this] { run(); }) {}
-
-PtyFrameReader::~PtyFrameReader() {
-  stopping_ = true;
-  thread_.join();
-}
-
-void PtyFrameReader::run() {
-  std::vector<uint8_t> chunk(4096);
-  while (!stopping_) {
-    std::size_t count = 0;
-    try {
-      count = pty_.read(chunk.data(), chunk.size(), 50);
-    } catch (const transport::TransportError&) {
-      return;  // the pty was closed under us: nothing more to read
-    }
-    if (count == 0) continue;
-    chunk_arrival_ = Clock::now();
-    framer_.feed(chunk.data(), count);
-  }
-}
 
 bool writeFrameOrDrop(transport::PseudoTerminal& pty, const std::vector<uint8_t>& frame) {
   ssize_t written;

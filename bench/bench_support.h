@@ -1,11 +1,11 @@
 // ROS-free helpers shared by the driver benchmarks: sample statistics, child processes that never
-// outlive the benchmark, CPU accounting from /proc, a pty reader that timestamps every verified
-// frame, and the result table.
+// outlive the benchmark, CPU accounting from /proc, non-blocking frame writes to a pty, and the
+// result table. The pty reader that timestamps every verified frame is the tests' one
+// (test/support/pty_frame_reader.h).
 #pragma once
 
 #include <sys/types.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -13,10 +13,8 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/transport/pseudo_terminal.h"
 
 namespace serial_robot_driver::bench {
@@ -94,30 +92,6 @@ class CpuWindow {
 int findFreeTcpPort();
 
 // --- pty ----------------------------------------------------------------------------------------
-
-/// Reads the master side of a pty on its own thread, feeds a StreamFramer and hands every verified
-/// frame to `on_frame` with the time the chunk holding its last byte was read.
-class PtyFrameReader {
- public:
-  using FrameCallback = std::function<void(protocol::FrameFamily family, const uint8_t* data,
-                                           std::size_t size, Clock::time_point arrival)>;
-
-  PtyFrameReader(transport::PseudoTerminal& pty, const protocol::FramerConfig& config,
-                 FrameCallback on_frame);
-  ~PtyFrameReader();
-  PtyFrameReader(const PtyFrameReader&) = delete;
-  PtyFrameReader& operator=(const PtyFrameReader&) = delete;
-
- private:
-  void run();
-
-  transport::PseudoTerminal& pty_;
-  protocol::StreamFramer framer_;
-  Clock::time_point chunk_arrival_;
-  FrameCallback on_frame_;
-  std::atomic<bool> stopping_{false};
-  std::thread thread_;
-};
 
 /// Writes one whole frame to the pty master without blocking, the way a UART overruns: when the
 /// buffer cannot take the frame at once, the rest is dropped and false is returned.

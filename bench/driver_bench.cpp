@@ -39,6 +39,7 @@
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/base_codec.h"
 #include "serial_robot_driver/protocol/body_codec.h"
+#include "support/pty_frame_reader.h"
 
 namespace serial_robot_driver::bench {
 namespace {
@@ -46,6 +47,7 @@ namespace {
 namespace base = protocol::base;
 namespace body = protocol::body;
 using namespace std::chrono_literals;
+using test_support::PtyFrameReader;
 
 // --- options ------------------------------------------------------------------------------------
 

@@ -3,8 +3,9 @@
 add_executable(driver_bench
   bench/bench_support.cpp
   bench/driver_bench.cpp
-  bench/ros_bench_support.cpp)
-target_include_directories(driver_bench PRIVATE ${catkin_INCLUDE_DIRS})
+  bench/ros_bench_support.cpp
+  test/support/pty_frame_reader.cpp)  # the tests' pty reader; srd_test_support exists only with tests
+target_include_directories(driver_bench PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})
 target_link_libraries(driver_bench srd_core ${catkin_LIBRARIES})
 # The benchmark launches these executables, so building it builds them.
 add_dependencies(driver_bench driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)

@@ -3,15 +3,15 @@
 # The soak runs 60 s; SRD_SOAK_SECONDS=<s> in the environment runs it longer on demand.
 add_rostest_gtest(test_multi_port test/rostest/multi_port.test test/rostest/test_multi_port.cpp)
 target_include_directories(test_multi_port PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_multi_port srd_core srd_sim ${catkin_LIBRARIES})
+target_link_libraries(test_multi_port srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_multi_port driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
 
 add_rostest_gtest(test_faults test/rostest/faults.test test/rostest/test_faults.cpp)
 target_include_directories(test_faults PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_faults srd_core srd_sim ${catkin_LIBRARIES})
+target_link_libraries(test_faults srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_faults driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
 
 add_rostest_gtest(test_soak test/rostest/soak.test test/rostest/test_soak.cpp)
 target_include_directories(test_soak PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_soak srd_core srd_sim ${catkin_LIBRARIES})
+target_link_libraries(test_soak srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_soak driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)

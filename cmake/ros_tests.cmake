@@ -1,18 +1,30 @@
 # rostest integration tests: driver_node (and robot_sim) against pseudo-terminals, checked through
 # ROS topics/services and the raw bytes on the pty.
+
+# The helpers every rostest shares (test/support/): ROS-free ones (pty reader, child processes,
+# /proc readers, polling) and ROS ones (topic counters, diagnostics, the node's pid, main()).
+add_library(srd_test_support STATIC
+  test/support/pty_frame_reader.cpp
+  test/support/process_support.cpp
+  test/support/ros_test_support.cpp)
+target_include_directories(srd_test_support PUBLIC ${PROJECT_SOURCE_DIR}/test
+  PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(srd_test_support PUBLIC srd_core ${catkin_LIBRARIES})
+add_dependencies(srd_test_support ${PROJECT_NAME}_generate_messages_cpp)
+
 add_rostest_gtest(test_base_node test/rostest/base_node.test test/rostest/test_base_node.cpp)
 target_include_directories(test_base_node PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_base_node srd_core ${catkin_LIBRARIES})
+target_link_libraries(test_base_node srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_base_node driver_node ${PROJECT_NAME}_generate_messages_cpp)
 
 add_rostest_gtest(test_body_node test/rostest/body_node.test test/rostest/test_body_node.cpp)
 target_include_directories(test_body_node PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_body_node srd_core ${catkin_LIBRARIES})
+target_link_libraries(test_body_node srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_body_node driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
 
 add_rostest_gtest(test_servo_bus_node test/rostest/servo_bus_node.test
   test/rostest/test_servo_bus_node.cpp)
 target_include_directories(test_servo_bus_node PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_servo_bus_node srd_core srd_sim ${catkin_LIBRARIES})
+target_link_libraries(test_servo_bus_node srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_servo_bus_node driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
 

@@ -305,6 +305,17 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
                                         attemptsText(attempts) + ")");
 }
 
+ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
+                                           const Expectation& expect, servo::Packet* answer) {
+  return transact(request, expect, options_.timeout, options_.retries + 1, answer);
+}
+
+ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const Expectation& expect,
+                                     servo::Packet* answer) {
+  std::lock_guard<std::mutex> bus(bus_mutex_);
+  return exchangeLocked(request, expect, answer);
+}
+
 ServoStatus ServoBusClient::sendCommand(const std::vector<uint8_t>& request, Command cmd,
                                         uint8_t id) {
   {
@@ -324,14 +335,11 @@ ServoStatus ServoBusClient::sendCommand(const std::vector<uint8_t>& request, Com
 ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
                                        bool wait, std::chrono::milliseconds motion_time) {
   if (!wait) return sendCommand(request, cmd, id);
-  Expectation expect;
-  expect.cmd = cmd;
-  expect.id = id;
-  expect.content_size = kResultAnswer;
   servo::Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
-  ServoStatus status = transact(request, expect, motion_time + options_.timeout, 1, &answer);
+  ServoStatus status = transact(request, Expectation(cmd, id, kResultAnswer),
+                                motion_time + options_.timeout, 1, &answer);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";
@@ -347,13 +355,9 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
 }
 
 ServoStatus ServoBusClient::pingLocked(uint8_t id) {
-  Expectation expect;
-  expect.cmd = Command::kPing;
-  expect.id = id;
-  expect.content_size = kIdOnlyAnswer;
   servo::Packet answer;
-  const ServoStatus status =
-      transact(servo::encodePing(id), expect, options_.timeout, options_.retries + 1, &answer);
+  const ServoStatus status = exchangeLocked(
+      servo::encodePing(id), Expectation(Command::kPing, id, kIdOnlyAnswer), &answer);
   if (!status.ok()) return status;
   return ok(servoName(id) + " is online (" + status.message + ")");
 }
@@ -366,14 +370,11 @@ ServoStatus ServoBusClient::ping(uint8_t id) {
 
 ServoStatus ServoBusClient::readParamLocked(uint8_t id, const ParamInfo& param,
                                             ServoParamValue* value) {
-  Expectation expect;
-  expect.cmd = Command::kReadData;
-  expect.id = id;
+  Expectation expect(Command::kReadData, id, kReadDataHeader + servo::typeSize(param.type));
   expect.data_id = param.data_id;
-  expect.content_size = kReadDataHeader + servo::typeSize(param.type);
   servo::Packet answer;
-  const ServoStatus status = transact(servo::encodeReadData(id, param.data_id), expect,
-                                      options_.timeout, options_.retries + 1, &answer);
+  const ServoStatus status =
+      exchangeLocked(servo::encodeReadData(id, param.data_id), expect, &answer);
   if (!status.ok()) return status;
   const std::optional<int64_t> raw = servo::readValue(
       param, answer.content.data() + kReadDataHeader, answer.content_size - kReadDataHeader);
@@ -423,15 +424,12 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
     if (probe.error != ServoError::kTimeout) return probe;
   }
 
-  Expectation expect;
-  expect.cmd = Command::kWriteData;
-  expect.id = id;
+  Expectation expect(Command::kWriteData, id, kWriteDataAnswer);
   if (id_change) expect.alt_id = new_id;  // the answer may already come from the new address
   expect.data_id = param->data_id;
-  expect.content_size = kWriteDataAnswer;
   servo::Packet answer;
-  const ServoStatus status = transact(servo::encodeWriteData(id, *param, value), expect,
-                                      options_.timeout, options_.retries + 1, &answer);
+  const ServoStatus status =
+      exchangeLocked(servo::encodeWriteData(id, *param, value), expect, &answer);
   if (!status.ok()) return status;
   const std::string assignment = quoted(param->name) + " = " + std::to_string(value);
   if (answer.content[2] == kResultFailed) {
@@ -464,14 +462,9 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
 
 ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg) {
   if (auto rejection = rejectBroadcast(id, Command::kReadAngle)) return *rejection;
-  std::lock_guard<std::mutex> bus(bus_mutex_);
-  Expectation expect;
-  expect.cmd = Command::kReadAngle;
-  expect.id = id;
-  expect.content_size = kReadAngleAnswer;
   servo::Packet answer;
-  const ServoStatus status = transact(servo::encodeReadAngle(id), expect, options_.timeout,
-                                      options_.retries + 1, &answer);
+  const ServoStatus status = exchange(
+      servo::encodeReadAngle(id), Expectation(Command::kReadAngle, id, kReadAngleAnswer), &answer);
   if (!status.ok()) return status;
   const int16_t decidegrees = protocol::readLE16Signed(&answer.content[1]);
   *angle_deg = decidegrees / kDecidegreesPerDegree;
@@ -547,14 +540,10 @@ ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait) {
 
 ServoStatus ServoBusClient::readAll(uint8_t id, std::vector<ServoParamValue>* values) {
   if (auto rejection = rejectBroadcast(id, Command::kReadBatchData)) return *rejection;
-  std::lock_guard<std::mutex> bus(bus_mutex_);
-  Expectation expect;
-  expect.cmd = Command::kReadBatchData;
-  expect.id = id;
-  expect.content_size = kBatchAnswer;
   servo::Packet answer;
-  const ServoStatus status = transact(servo::encodeReadBatchData(id), expect, options_.timeout,
-                                      options_.retries + 1, &answer);
+  const ServoStatus status =
+      exchange(servo::encodeReadBatchData(id),
+               Expectation(Command::kReadBatchData, id, kBatchAnswer), &answer);
   if (!status.ok()) return status;
 
   const uint8_t* block = answer.content.data() + 1;
@@ -585,14 +574,10 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
                 "unreachable; refused because dangerous writes are not allowed (set "
                 "~servo_bus/allow_dangerous_writes to true to arm it)");
   }
-  std::lock_guard<std::mutex> bus(bus_mutex_);
-  Expectation expect;
-  expect.cmd = Command::kResetUserData;
-  expect.id = id;
-  expect.content_size = kResultAnswer;
   servo::Packet answer;
-  const ServoStatus status = transact(servo::encodeResetUserData(id), expect, options_.timeout,
-                                      options_.retries + 1, &answer);
+  const ServoStatus status =
+      exchange(servo::encodeResetUserData(id),
+               Expectation(Command::kResetUserData, id, kResultAnswer), &answer);
   if (!status.ok()) return status;
   if (answer.content[1] == kResultFailed) {
     return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");

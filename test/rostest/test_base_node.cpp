@@ -9,13 +9,8 @@
 // Every TEST starts on a fresh pty, so the node reconnects and no state leaks between tests. The
 // machine may be busy: the tests count frames and use generous deadlines, never tight timing.
 #include <signal.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
-#include <array>
-#include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -23,7 +18,6 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -31,7 +25,6 @@
 #include <thread>
 #include <vector>
 
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -41,15 +34,18 @@
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/base_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
-#include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "support/pty_frame_reader.h"
+#include "support/ros_test_support.h"
 
 namespace {
 
 namespace protocol = serial_robot_driver::protocol;
 namespace transport = serial_robot_driver::transport;
-using Clock = std::chrono::steady_clock;
-using Bytes = std::vector<uint8_t>;
+using test_support::Bytes;
+using test_support::ChildProcess;
+using test_support::Clock;
+using test_support::waitFor;
 
 // --- numbers from PROTOCOLS.md section 1 and the node's defaults ---------------------------------
 // 1600 ticks/rev, 0.25 m wheels, 50 Hz PID: 1600 / (0.25 pi) / 50 ticks per period at 1 m/s.
@@ -77,20 +73,6 @@ Bytes zeroSpeedFrame(uint8_t seq) {
 // Base -> host frames, written out by hand (XOR included).
 const Bytes kTimeoutErrorFrame = {0x55, 0xAA, 0x02, 0x20, 0xFF, 0x00, 0x22};   // FF status
 const Bytes kBattery87PercentFrame = {0x55, 0xAA, 0x02, 0x10, 0x02, 0x57, 0xB8};  // 0x57 = 87 %
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// Polls `done` every 10 ms until it is true or `timeout_s` has passed.
-bool waitFor(const std::function<bool()>& done, double timeout_s) {
-  const Clock::time_point start = Clock::now();
-  while (!done()) {
-    if (secondsSince(start) > timeout_s) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return true;
-}
 
 // --- the fake base on a pty ----------------------------------------------------------------------
 
@@ -120,28 +102,26 @@ class FakeBase {
   /// Creates a new pty at the path (a fresh session: the frame list starts empty).
   void plug() {
     unplug();
-    protocol::FramerConfig config;
-    config.base = true;
-    framer_ = std::make_unique<protocol::StreamFramer>(
-        config, [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size) {
-          onFrame(family, data, size);
-        });
     {
       std::lock_guard<std::mutex> lock(mutex_);
       frames_.clear();
       undecodable_ = 0;
-      framer_stats_ = protocol::FramerStats{};
     }
+    unplugged_framer_stats_ = protocol::FramerStats{};
     pty_ = std::make_unique<transport::PseudoTerminal>(path_);
     plugged_at_ = Clock::now();
-    running_ = true;
-    reader_ = std::thread([this] { readLoop(); });
+    protocol::FramerConfig config;
+    config.base = true;
+    reader_ = std::make_unique<test_support::PtyFrameReader>(
+        *pty_, config,
+        [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) { onFrame(family, data, size, arrival); });
   }
 
   /// Closes the pty and removes the symlink: to the node this looks like an unplugged adapter.
   void unplug() {
-    running_ = false;
-    if (reader_.joinable()) reader_.join();
+    if (reader_) unplugged_framer_stats_ = reader_->framerStats();
+    reader_.reset();
     if (pty_) pty_->close();
     pty_.reset();
   }
@@ -168,31 +148,15 @@ class FakeBase {
 
   /// Bytes that were not part of a valid base frame (checksum errors, resyncs, bad lengths).
   uint64_t garbage() const {
+    const protocol::FramerStats stats = reader_ ? reader_->framerStats() : unplugged_framer_stats_;
     std::lock_guard<std::mutex> lock(mutex_);
-    return framer_stats_.checksum_errors + framer_stats_.bad_lengths + undecodable_ +
-           framer_stats_.bytes_skipped;
+    return stats.checksum_errors + stats.bad_lengths + undecodable_ + stats.bytes_skipped;
   }
   Clock::time_point pluggedAt() const { return plugged_at_; }
 
  private:
-  void readLoop() {
-    std::array<uint8_t, 4096> buffer{};
-    while (running_) {
-      std::size_t n = 0;
-      try {
-        n = pty_->read(buffer.data(), buffer.size(), 20);
-      } catch (const transport::TransportError&) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        continue;
-      }
-      if (n == 0) continue;
-      framer_->feed(buffer.data(), n);
-      std::lock_guard<std::mutex> lock(mutex_);
-      framer_stats_ = framer_->stats();
-    }
-  }
-
-  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size) {
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) {
     const auto decoded = protocol::base::decodeFrame(data, size);
     std::lock_guard<std::mutex> lock(mutex_);
     if (family != protocol::FrameFamily::kBase || !decoded) {
@@ -203,21 +167,19 @@ class FakeBase {
     frame.bytes.assign(data, data + size);
     frame.seq = decoded->seq;
     frame.msg_id = decoded->msg_id;
-    frame.arrival = Clock::now();
+    frame.arrival = arrival;
     frames_.push_back(std::move(frame));
   }
 
   const std::string path_;
   std::unique_ptr<transport::PseudoTerminal> pty_;
-  std::unique_ptr<protocol::StreamFramer> framer_;  // reader thread only
-  std::thread reader_;
-  std::atomic<bool> running_{false};
+  std::unique_ptr<test_support::PtyFrameReader> reader_;
+  protocol::FramerStats unplugged_framer_stats_;  // the last session's, once unplugged
   Clock::time_point plugged_at_;
 
   mutable std::mutex mutex_;
   std::vector<SeenFrame> frames_;
   uint64_t undecodable_ = 0;
-  protocol::FramerStats framer_stats_;
 };
 
 // Frame-list helpers ----------------------------------------------------------------------------
@@ -273,11 +235,11 @@ struct TimedWheelCommand {
 /// Subscriptions to the node under test, created once in main().
 class RosSide {
  public:
-  RosSide() {
+  /// `node_name`: the driver's, whose "<node>: base" diagnostic status is watched.
+  explicit RosSide(const std::string& node_name) : diagnostics_(nh_, node_name) {
     cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     wheel_sub_ = nh_.subscribe("wheel_command", 1000, &RosSide::onWheelCommand, this);
     battery_sub_ = nh_.subscribe("battery", 10, &RosSide::onBattery, this);
-    diagnostics_sub_ = nh_.subscribe("diagnostics", 10, &RosSide::onDiagnostics, this);
   }
 
   ros::NodeHandle& nh() { return nh_; }
@@ -305,16 +267,9 @@ class RosSide {
     return battery_;
   }
 
-  /// A value of the node's "<node>: base" diagnostic status, from its latest message.
-  std::optional<std::string> baseDiagnostic(const std::string& key) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = base_diagnostics_.find(key);
-    if (it == base_diagnostics_.end()) return std::nullopt;
-    return it->second;
-  }
-  void setDiagnosticStatusName(const std::string& name) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    base_status_name_ = name;
+  /// The node's latest "<node>: base" diagnostic status.
+  test_support::DiagnosticsWatch::Status baseDiagnostics() const {
+    return diagnostics_.latest("base");
   }
 
  private:
@@ -326,22 +281,14 @@ class RosSide {
     std::lock_guard<std::mutex> lock(mutex_);
     battery_.push_back(*msg);
   }
-  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& status : msg->status) {
-      if (status.name != base_status_name_) continue;
-      for (const auto& kv : status.values) base_diagnostics_[kv.key] = kv.value;
-    }
-  }
 
   ros::NodeHandle nh_;
+  test_support::DiagnosticsWatch diagnostics_;
   ros::Publisher cmd_vel_;
-  ros::Subscriber wheel_sub_, battery_sub_, diagnostics_sub_;
+  ros::Subscriber wheel_sub_, battery_sub_;
   mutable std::mutex mutex_;
   std::vector<TimedWheelCommand> wheel_commands_;
   std::vector<sensor_msgs::BatteryState> battery_;
-  std::string base_status_name_;
-  std::map<std::string, std::string> base_diagnostics_;
 };
 
 RosSide* g_ros = nullptr;
@@ -403,82 +350,6 @@ class CmdVelStreamer {
 
 // --- child processes (tests that need their own driver_node) -------------------------------------
 
-class ChildProcess {
- public:
-  /// Starts `path` with `args`; stdout and stderr go to a pipe read by output().
-  ChildProcess(const std::string& path, const std::vector<std::string>& args) {
-    int fds[2];
-    if (::pipe(fds) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fds[1], STDOUT_FILENO);
-      ::dup2(fds[1], STDERR_FILENO);
-      // Leave the test's own sockets and ptys behind.
-      for (int fd = 3; fd < 1024; ++fd) ::close(fd);
-      std::vector<char*> argv;
-      argv.push_back(const_cast<char*>(path.c_str()));
-      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      ::execv(path.c_str(), argv.data());
-      ::_exit(127);
-    }
-    ::close(fds[1]);
-    output_fd_ = fds[0];
-    // Drained all the time, so a chatty child never blocks on a full pipe.
-    drainer_ = std::thread([this] { drain(); });
-  }
-  ~ChildProcess() {
-    if (running()) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-    if (drainer_.joinable()) drainer_.join();  // EOF once the child is gone
-    if (output_fd_ >= 0) ::close(output_fd_);
-  }
-
-  bool started() const { return pid_ > 0; }
-  bool running() const { return pid_ > 0 && !status_; }
-  void signal(int sig) {
-    if (running()) ::kill(pid_, sig);
-  }
-  /// Waits for the process to exit; its wait status, or nullopt on timeout.
-  std::optional<int> waitExit(double timeout_s) {
-    waitFor(
-        [&] {
-          if (status_) return true;
-          int status = 0;
-          if (::waitpid(pid_, &status, WNOHANG) == pid_) status_ = status;
-          return status_.has_value();
-        },
-        timeout_s);
-    if (status_ && drainer_.joinable()) drainer_.join();  // all of its output
-    return status_;
-  }
-  std::string output() const {
-    std::lock_guard<std::mutex> lock(output_mutex_);
-    return output_;
-  }
-
- private:
-  void drain() {
-    char buffer[4096];
-    for (;;) {
-      const ssize_t n = ::read(output_fd_, buffer, sizeof(buffer));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      std::lock_guard<std::mutex> lock(output_mutex_);
-      output_.append(buffer, static_cast<std::size_t>(n));
-    }
-  }
-
-  pid_t pid_ = -1;
-  int output_fd_ = -1;
-  std::optional<int> status_;
-  mutable std::mutex output_mutex_;
-  std::string output_;
-  std::thread drainer_;
-};
-
 /// Arguments for a base-only driver_node named `name` in namespace `ns` on `port`.
 std::vector<std::string> driverArgs(const std::string& ns, const std::string& name,
                                     const std::string& port) {
@@ -489,11 +360,6 @@ std::vector<std::string> driverArgs(const std::string& ns, const std::string& na
           "_body/enabled:=false",
           "_servo_bus/enabled:=false",
           "_base/battery_poll_rate:=0.0"};
-}
-
-void removeStaleLink(const std::string& path) {
-  struct stat info {};
-  if (::lstat(path.c_str(), &info) == 0 && S_ISLNK(info.st_mode)) ::unlink(path.c_str());
 }
 
 // --- the fixture ---------------------------------------------------------------------------------
@@ -707,8 +573,8 @@ TEST_F(BaseNodeTest, CmdVelTimeoutStopsTheWheels) {
 TEST_F(BaseNodeTest, NanCmdVelStopsTheWheels) {
   ASSERT_EQ(driveAndCollect(0.2, 0.0, 10).size(), 10u);
   const std::string kRejected = "rejected cmd_vel (NaN/Inf)";
-  ASSERT_TRUE(waitFor([&] { return g_ros->baseDiagnostic(kRejected).has_value(); }, 5.0));
-  const long rejected_before = std::stol(*g_ros->baseDiagnostic(kRejected));
+  ASSERT_TRUE(waitFor([&] { return !g_ros->baseDiagnostics().value(kRejected).empty(); }, 5.0));
+  const uint64_t rejected_before = g_ros->baseDiagnostics().number(kRejected);
 
   const std::size_t from = base_->count();
   streamer().set(std::numeric_limits<double>::quiet_NaN(), 0.0);  // keeps streaming NaN
@@ -724,11 +590,8 @@ TEST_F(BaseNodeTest, NanCmdVelStopsTheWheels) {
   for (const auto& f : speedFramesFrom(base_->frames(), first_zero)) {
     EXPECT_TRUE(f.isZeroSpeed()) << f.left() << " " << f.right();
   }
-  EXPECT_TRUE(waitFor(
-      [&] {
-        return std::stol(g_ros->baseDiagnostic(kRejected).value_or("0")) > rejected_before;
-      },
-      5.0))
+  EXPECT_TRUE(
+      waitFor([&] { return g_ros->baseDiagnostics().number(kRejected) > rejected_before; }, 5.0))
       << "the NaN cmd_vel was not counted as rejected";
 
   // Still alive and driving.
@@ -850,7 +713,7 @@ TEST_F(BaseNodeTest, ServicesWriteResetAndClearEncoders) {
 TEST(BaseNodeProcess, ConnectsWhenThePortAppearsLater) {
   ASSERT_FALSE(g_driver_path.empty());
   const std::string port = g_port + "_late";
-  removeStaleLink(port);
+  test_support::removeStaleLink(port);
   ChildProcess node(g_driver_path, driverArgs("/late", "driver_late", port));
   ASSERT_TRUE(node.started());
   // Up and failing to open its port (its services exist once the base interface is built).
@@ -923,27 +786,12 @@ TEST(BaseNodeProcess, SigintStopsTheWheelsBeforeExit) {
   EXPECT_EQ(base.garbage(), 0u);
 }
 
-/// driver_node sits next to this test binary (devel/lib/serial_robot_driver/).
-std::string findDriverNode() {
-  std::string from_param;
-  if (ros::param::get("~driver_path", from_param) && !from_param.empty()) return from_param;
-  char self[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", self, sizeof(self) - 1);
-  if (n <= 0) return {};
-  std::string dir(self, static_cast<std::size_t>(n));
-  dir = dir.substr(0, dir.find_last_of('/'));
-  const std::string path = dir + "/driver_node";
-  return ::access(path.c_str(), X_OK) == 0 ? path : std::string();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_base_node");
+  test_support::RosTestNode node(argc, argv, "test_base_node");
   ros::NodeHandle private_nh("~");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
 
   std::string node_name = "driver_node";
   private_nh.getParam("node_name", node_name);
@@ -951,14 +799,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cannot read /%s/port from the parameter server\n", node_name.c_str());
     return 1;
   }
-  g_driver_path = findDriverNode();
+  g_driver_path = test_support::findDriverNode();
 
-  RosSide ros_side;
-  ros_side.setDiagnosticStatusName(node_name + ": base");
+  RosSide ros_side(node_name);
   g_ros = &ros_side;
   const int result = RUN_ALL_TESTS();
   g_ros = nullptr;
-  spinner.stop();
-  ros::shutdown();
   return result;
 }

@@ -8,7 +8,6 @@
 // Counting without timing assumptions: every batch of frames ends with a sentinel frame, and a
 // topic delivers in order, so "messages before the sentinel" is exact.
 #include <diagnostic_msgs/DiagnosticArray.h>
-#include <fcntl.h>
 #include <geometry_msgs/Twist.h>
 #include <glob.h>
 #include <gtest/gtest.h>
@@ -18,10 +17,7 @@
 #include <serial_robot_driver/FootPressure.h>
 #include <serial_robot_driver/Telemetry.h>
 #include <signal.h>
-#include <spawn.h>
 #include <stdlib.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <chrono>
@@ -38,16 +34,17 @@
 #include <vector>
 
 #include "serial_robot_driver/transport/pseudo_terminal.h"
-
-extern char** environ;
+#include "support/ros_test_support.h"
 
 namespace {
 
-using Bytes = std::vector<uint8_t>;
 using sensor_msgs::Imu;
 using sensor_msgs::JointState;
 using serial_robot_driver::FootPressure;
 using serial_robot_driver::Telemetry;
+using test_support::Bytes;
+using test_support::waitFor;
+using test_support::withByte;
 
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 
@@ -84,11 +81,6 @@ const Bytes kSyncFoot = {0x12, 0x34, 0x30, 0x05, 0x00, 0x00, 0x00, 0x06, 0x00, 0
 const Bytes kSync = {0x12, 0x34, 0x20, 0x07, 0x00, 0x00, 0x00, 0x08, 0x00, 0x00, 0x00,
                      0x05, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
                      0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x34, 0x1F, 0x2F};
-
-Bytes withByte(Bytes frame, std::size_t index, uint8_t value) {
-  frame[index] = value;
-  return frame;
-}
 
 // joint_states of the sentinel: hip = (256 - 2048) ticks, knee (direction -1) = -(512 - 2048).
 bool isSentinel(const JointState& m) {
@@ -160,15 +152,6 @@ ros::Subscriber subscribe(ros::NodeHandle& nh, const std::string& topic, Inbox<M
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
 }
 
-bool waitUntil(const std::function<bool()>& condition, double timeout_s) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > deadline || !ros::ok()) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return true;
-}
-
 // --- the pty driver_node
 // ---------------------------------------------------------------------------
 
@@ -238,7 +221,7 @@ class BodyNode : public testing::Test {
       board.connect_failed = true;  // until proven otherwise: later tests then fail fast
       // The node opens the pty within reconnect_interval of starting; keep offering a sentinel
       // until one comes back as joint_states.
-      ASSERT_TRUE(waitUntil([&] { return board.subscribers[0].getNumPublishers() > 0; }, 60.0))
+      ASSERT_TRUE(waitFor([&] { return board.subscribers[0].getNumPublishers() > 0; }, 60.0))
           << "driver_node never advertised joint_states";
       for (int attempt = 0; attempt < 100 && !board.connected; ++attempt) {
         board.write(kSentinel);
@@ -383,7 +366,7 @@ JointState command(const std::vector<std::string>& names, const std::vector<doub
 }
 
 TEST_F(BodyNode, JointCommandsBecomeExactSyncWriteBytes) {
-  ASSERT_TRUE(waitUntil([&] { return board().joint_commands.getNumSubscribers() > 0; }, 30.0));
+  ASSERT_TRUE(waitFor([&] { return board().joint_commands.getNumSubscribers() > 0; }, 30.0));
   board().drainInput();
 
   // Rejected commands write nothing: the first bytes on the wire belong to the valid one.
@@ -415,7 +398,7 @@ TEST_F(BodyNode, DiagnosticsCountFramesAndRejectedCommands) {
   ros::NodeHandle nh;
   Inbox<diagnostic_msgs::DiagnosticArray> diagnostics;
   ros::Subscriber sub = subscribe(nh, "/diagnostics", &diagnostics);
-  ASSERT_TRUE(waitUntil([&] { return board().joint_commands.getNumSubscribers() > 0; }, 30.0));
+  ASSERT_TRUE(waitFor([&] { return board().joint_commands.getNumSubscribers() > 0; }, 30.0));
   board().joint_commands.publish(command({"elbow"}, {0.0}));
 
   // The updater runs once a second; wait for a report that has seen both.
@@ -451,7 +434,7 @@ TEST(BodyNodeSim, JointCommandsMoveTheSimulatedServos) {
   ros::Publisher commands = nh.advertise<JointState>("joint_commands", 10);
   ASSERT_TRUE(joints.waitFor([](const JointState&) { return true; }, 60.0))
       << "no joint_states from the driver attached to robot_sim";
-  ASSERT_TRUE(waitUntil([&] { return commands.getNumSubscribers() > 0; }, 30.0));
+  ASSERT_TRUE(waitFor([&] { return commands.getNumSubscribers() > 0; }, 30.0));
 
   const double hip = 0.5, knee = -0.25;
   commands.publish(command({"hip", "knee"}, {hip, knee}));
@@ -502,33 +485,16 @@ TEST(BodyNodeSim, RecordLaunchRecordsEveryTopic) {
   const std::string ns = g_sim_ns;
 
   // roslaunch record.launch against this test's master, as a child we stop with SIGINT (Ctrl-C).
-  std::vector<std::string> args = {"roslaunch", "serial_robot_driver", "record.launch",
-                                   "bag:=" + dir + "/test", "ns:=" + ns};
-  std::vector<char*> argv;
-  for (std::string& arg : args) argv.push_back(arg.data());
-  argv.push_back(nullptr);
-  std::vector<std::string> env_strings = {"ROS_MASTER_URI=" + ros::master::getURI()};
-  for (char** e = environ; *e != nullptr; ++e) {
-    if (std::string(*e).rfind("ROS_MASTER_URI=", 0) != 0) env_strings.push_back(*e);
-  }
-  std::vector<char*> envp;
-  for (std::string& entry : env_strings) envp.push_back(entry.data());
-  envp.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  const std::string log = dir + "/roslaunch.log";
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t pid = -1;
-  const int spawned = posix_spawnp(&pid, "roslaunch", &actions, nullptr, argv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&actions);
-  ASSERT_EQ(spawned, 0) << "could not start roslaunch";
+  test_support::ChildProcess launch(
+      "roslaunch", {"serial_robot_driver", "record.launch", "bag:=" + dir + "/test", "ns:=" + ns},
+      {"ROS_MASTER_URI=" + ros::master::getURI()});
+  ASSERT_TRUE(launch.started()) << "could not start roslaunch";
 
   const std::string prefix = "/" + ns + "/";
   ros::NodeHandle nh(ns);
   ros::Publisher cmd_vel = nh.advertise<geometry_msgs::Twist>("cmd_vel", 10);
   ros::Publisher joint_commands = nh.advertise<JointState>("joint_commands", 10);
-  const bool subscribed = waitUntil(
+  const bool subscribed = waitFor(
       [&] {
         // Each input topic has the driver and the recorder as subscribers.
         return recorderSubscribed(prefix + "telemetry") && cmd_vel.getNumSubscribers() >= 2 &&
@@ -541,14 +507,9 @@ TEST(BodyNodeSim, RecordLaunchRecordsEveryTopic) {
     // A few seconds: diagnostics and battery come at 1 Hz.
     ros::WallDuration(3.5).sleep();
   }
-  kill(pid, SIGINT);
-  int status = 0;
-  const bool exited = waitUntil([&] { return waitpid(pid, &status, WNOHANG) == pid; }, 60.0);
-  if (!exited) {
-    kill(pid, SIGKILL);
-    waitpid(pid, &status, 0);
-  }
-  ASSERT_TRUE(subscribed) << "rosbag record never subscribed; see " << log;
+  launch.signal(SIGINT);
+  const bool exited = launch.waitExit(60.0).has_value();  // if not, the destructor kills it
+  ASSERT_TRUE(subscribed) << "rosbag record never subscribed; roslaunch said:\n" << launch.output();
   ASSERT_TRUE(exited) << "roslaunch did not stop on SIGINT";
 
   glob_t found;
@@ -571,15 +532,13 @@ TEST(BodyNodeSim, RecordLaunchRecordsEveryTopic) {
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_body_node");
+  test_support::RosTestNode node(argc, argv, "test_body_node");
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
   std::string port = "/tmp/srd_test_body";
   private_nh.param("port", port, port);
   private_nh.param("sim_ns", g_sim_ns, std::string("sim"));
 
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
   Board board;
   // The pty first: the node keeps retrying its port until the symlink exists.
   board.pty = std::make_unique<serial_robot_driver::transport::PseudoTerminal>(port);
@@ -592,8 +551,6 @@ int main(int argc, char** argv) {
 
   const int result = RUN_ALL_TESTS();
   g_board = nullptr;
-  spinner.stop();
   board.pty->close();
-  ros::shutdown();
   return result;
 }

@@ -13,8 +13,6 @@
 //    byte on the wire, and every servo service must answer success = false with a reason.
 //
 // The machine may be busy (2 shared cores): the tests count frames and use generous deadlines.
-#include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -22,7 +20,6 @@
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <geometry_msgs/Twist.h>
@@ -30,7 +27,6 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
-#include "robustness_support.h"
 #include "serial_robot_driver/ServoDamping.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/ServoRead.h"
@@ -44,8 +40,9 @@
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
-#include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "support/pty_frame_reader.h"
+#include "support/ros_test_support.h"
 
 namespace {
 
@@ -53,8 +50,8 @@ namespace protocol = serial_robot_driver::protocol;
 namespace sim = serial_robot_driver::sim;
 namespace transport = serial_robot_driver::transport;
 namespace srd = serial_robot_driver;
-using robustness::TopicCounter;
-using robustness::waitFor;
+using test_support::TopicCounter;
+using test_support::waitFor;
 
 constexpr uint8_t kMsgWheelSpeed = 0x01;  // PROTOCOLS.md section 1
 constexpr uint8_t kMsgReset = 0x05;
@@ -79,27 +76,25 @@ class HandPlayedRobot {
 
   void plug() {
     unplug();
-    protocol::FramerConfig config;
-    config.base = true;
-    framer_ = std::make_unique<protocol::StreamFramer>(
-        config, [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size) {
-          if (family != protocol::FrameFamily::kBase || size < 5) return;
-          std::lock_guard<std::mutex> lock(mutex_);
-          msg_ids_.push_back(data[4]);  // 55 AA LEN SEQ MSGID ...
-        });
     {
       std::lock_guard<std::mutex> lock(mutex_);
       msg_ids_.clear();
     }
     pty_ = std::make_unique<transport::PseudoTerminal>(path_);
-    running_ = true;
-    reader_ = std::thread([this] { readLoop(); });
+    protocol::FramerConfig config;
+    config.base = true;
+    reader_ = std::make_unique<test_support::PtyFrameReader>(
+        *pty_, config,
+        [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size, auto) {
+          if (family != protocol::FrameFamily::kBase || size < 5) return;
+          std::lock_guard<std::mutex> lock(mutex_);
+          msg_ids_.push_back(data[4]);  // 55 AA LEN SEQ MSGID ...
+        });
   }
 
   /// Closes the pty and removes the symlink: an unplugged adapter, as the node sees it.
   void unplug() {
-    running_ = false;
-    if (reader_.joinable()) reader_.join();
+    reader_.reset();
     if (pty_) pty_->close();
     pty_.reset();
   }
@@ -120,48 +115,32 @@ class HandPlayedRobot {
   }
 
  private:
-  void readLoop() {
-    std::array<uint8_t, 4096> buffer{};
-    while (running_) {
-      std::size_t n = 0;
-      try {
-        n = pty_->read(buffer.data(), buffer.size(), 20);
-      } catch (const transport::TransportError&) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        continue;
-      }
-      if (n > 0) framer_->feed(buffer.data(), n);
-    }
-  }
-
   const std::string path_;
   std::unique_ptr<transport::PseudoTerminal> pty_;
-  std::unique_ptr<protocol::StreamFramer> framer_;
-  std::atomic<bool> running_{false};
-  std::thread reader_;
+  std::unique_ptr<test_support::PtyFrameReader> reader_;
   mutable std::mutex mutex_;
   std::vector<uint8_t> msg_ids_;
 };
 
 TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
   const std::string node_name = "/unplug/driver_node";
-  const std::string path = robustness::nodeParam(node_name, "port");
+  const std::string path = test_support::nodeParam(node_name, "port");
   ASSERT_FALSE(path.empty());
   ros::NodeHandle nh("unplug");
   TopicCounter<sensor_msgs::JointState> joints(nh, "joint_states", 10);
   ASSERT_TRUE(joints.waitConnected(20));
   int pid = -1;
-  ASSERT_TRUE(waitFor([&] { return (pid = robustness::nodePid(node_name)) > 0; }, 20));
+  ASSERT_TRUE(waitFor([&] { return (pid = test_support::nodePid(node_name)) > 0; }, 20));
 
   constexpr int kCycles = 100;
   constexpr int kWarmUpCycles = 5;  // ROS connections and lazy allocations settle first
   constexpr int kTelemetryPerCycle = 3;
   HandPlayedRobot robot(path);
-  robustness::ProcessSample warm;
-  robustness::ProcessSample last;
+  test_support::ProcessSample warm;
+  test_support::ProcessSample last;
   std::vector<double> recovery_s;
   for (int cycle = 1; cycle <= kCycles; ++cycle) {
-    const auto plugged_at = robustness::Clock::now();
+    const auto plugged_at = test_support::Clock::now();
     robot.plug();
     // Recovery: the node reopens the port and sends a Reset before its first speed frame.
     const bool driving = waitFor(
@@ -173,7 +152,7 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
         },
         20);
     ASSERT_TRUE(driving) << "cycle " << cycle << ": no speed frame after the replug";
-    recovery_s.push_back(robustness::secondsSince(plugged_at));
+    recovery_s.push_back(test_support::secondsSince(plugged_at));
     const std::vector<uint8_t> ids = robot.msgIds();
     ASSERT_EQ(ids.front(), kMsgReset) << "cycle " << cycle << ": the first frame is not a Reset";
 
@@ -184,21 +163,21 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
         << "cycle " << cycle << ": " << joints.count() - before << " of " << kTelemetryPerCycle
         << " telemetry frames published";
 
-    if (cycle == kWarmUpCycles) warm = robustness::sampleProcess(pid);
-    if (cycle == kCycles) last = robustness::sampleProcess(pid);
+    if (cycle == kWarmUpCycles) warm = test_support::sampleProcess(pid);
+    if (cycle == kCycles) last = test_support::sampleProcess(pid);
     if (cycle == kWarmUpCycles || cycle == kCycles) {
-      EXPECT_EQ(robustness::ptyFdCount(pid), 1u) << "cycle " << cycle << ": one port, one fd";
+      EXPECT_EQ(test_support::ptyFdCount(pid), 1u) << "cycle " << cycle << ": one port, one fd";
     }
     robot.unplug();
   }
   // Nothing more than what was written (no duplicates).
-  robustness::sleepSeconds(0.2);
+  test_support::sleepSeconds(0.2);
   EXPECT_EQ(joints.count(), static_cast<uint64_t>(kCycles * kTelemetryPerCycle));
 
   // Once the port is gone the node holds no pty fd at all.
-  EXPECT_TRUE(waitFor([&] { return robustness::ptyFdCount(pid) == 0; }, 10))
-      << robustness::ptyFdCount(pid) << " pty fds left open after the unplug";
-  EXPECT_TRUE(robustness::processAlive(pid));
+  EXPECT_TRUE(waitFor([&] { return test_support::ptyFdCount(pid) == 0; }, 10))
+      << test_support::ptyFdCount(pid) << " pty fds left open after the unplug";
+  EXPECT_TRUE(test_support::processAlive(pid));
 
   double worst = 0, sum = 0;
   for (double s : recovery_s) {
@@ -223,7 +202,7 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
 sim::RobotSim& extremeRobot() {
   static std::unique_ptr<sim::RobotSim> robot = [] {
     sim::SimOptions options;
-    options.link = robustness::nodeParam("/extreme/driver_node", "port");
+    options.link = test_support::nodeParam("/extreme/driver_node", "port");
     auto created = std::make_unique<sim::RobotSim>(options);
     created->start();
     return created;
@@ -234,7 +213,7 @@ sim::RobotSim& extremeRobot() {
 int extremePid() {
   static const int pid = [] {
     int found = -1;
-    waitFor([&] { return (found = robustness::nodePid("/extreme/driver_node")) > 0; }, 20);
+    waitFor([&] { return (found = test_support::nodePid("/extreme/driver_node")) > 0; }, 20);
     return found;
   }();
   return pid;
@@ -243,14 +222,14 @@ int extremePid() {
 class ExtremeInputs : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_FALSE(robustness::nodeParam("/extreme/driver_node", "port").empty());
+    ASSERT_FALSE(test_support::nodeParam("/extreme/driver_node", "port").empty());
     extremeRobot();
     pid_ = extremePid();
     ASSERT_GT(pid_, 0);
   }
   void TearDown() override {
-    EXPECT_TRUE(robustness::processAlive(pid_)) << "driver_node died";
-    EXPECT_EQ(robustness::nodePid("/extreme/driver_node"), pid_) << "driver_node was restarted";
+    EXPECT_TRUE(test_support::processAlive(pid_)) << "driver_node died";
+    EXPECT_EQ(test_support::nodePid("/extreme/driver_node"), pid_) << "driver_node was restarted";
   }
 
   ros::NodeHandle nh_{"extreme"};
@@ -350,7 +329,7 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   ros::Publisher commands = nh_.advertise<sensor_msgs::JointState>("joint_commands", 50);
   TopicCounter<sensor_msgs::JointState> joints(nh_, "joint_states", 10);
   ros::NodeHandle root;
-  robustness::DiagnosticsWatch diagnostics(root, "extreme/driver_node");
+  test_support::DiagnosticsWatch diagnostics(root, "extreme/driver_node");
   ASSERT_TRUE(waitFor([&] { return commands.getNumSubscribers() > 0; }, 20));
   ASSERT_TRUE(joints.waitForCount(5, 20)) << "no telemetry";
   ASSERT_TRUE(waitFor([&] { return diagnostics.latest("body").received > 0; }, 20));
@@ -378,7 +357,7 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   // A good command last: once it is on the wire, every malformed one before it was handled.
   commands.publish(command({"joint_2"}, {0.5}));
   ASSERT_TRUE(waitFor([&] { return robot.stats().body.sync_writes_ok >= writes_before + 1; }, 20));
-  robustness::sleepSeconds(0.3);
+  test_support::sleepSeconds(0.3);
   sim::SimStats stats = robot.stats();
   EXPECT_EQ(stats.body.sync_writes_ok, writes_before + 1) << "a malformed command reached the wire";
   EXPECT_EQ(stats.body.sync_writes_malformed + stats.body_port_checksum_errors, 0u);
@@ -388,7 +367,7 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   // Every one of them counted as rejected (diagnostics are published once a second).
   const auto counted = diagnostics.waitFor(
       "body", 0,
-      [&](const robustness::DiagnosticsWatch::Status& s) {
+      [&](const test_support::DiagnosticsWatch::Status& s) {
         return s.number("commands rejected") >= rejected_before + malformed.size();
       },
       [] { return true; }, 10);
@@ -580,12 +559,6 @@ TEST_F(ExtremeInputs, ServoRequestsOutOfRangeFailCleanlyWithoutBytes) {
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_faults");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  test_support::RosTestNode node(argc, argv, "test_faults");
+  return RUN_ALL_TESTS();
 }

@@ -21,18 +21,18 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
-#include "robustness_support.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/sim/robot_sim.h"
+#include "support/ros_test_support.h"
 
 namespace {
 
 namespace sim = serial_robot_driver::sim;
-using robustness::TopicCounter;
-using robustness::waitFor;
 using serial_robot_driver::ServoPing;
 using serial_robot_driver::WheelCommand;
+using test_support::TopicCounter;
+using test_support::waitFor;
 
 constexpr double kTwoPi = 6.283185307179586;
 // 1600 ticks/rev, 0.25 m wheels, 50 Hz PID (the defaults): 40.74 ticks per period at 1 m/s.
@@ -52,9 +52,9 @@ Layout readLayout(const std::string& ns) {
   Layout layout;
   layout.ns = ns;
   const std::string node = layout.node();
-  const std::string shared = robustness::nodeParam(node, "port");
+  const std::string shared = test_support::nodeParam(node, "port");
   const auto own = [&](const std::string& device) {
-    const std::string port = robustness::nodeParam(node, device + "/port");
+    const std::string port = test_support::nodeParam(node, device + "/port");
     return port.empty() ? shared : port;
   };
   layout.base_port = own("base");
@@ -255,7 +255,7 @@ TEST_F(MultiPortTest, EachDeviceOnItsOwnPortAndServoBusUnplugAlone) {
     during = node.ping(1);
     EXPECT_FALSE(during.online);
     EXPECT_FALSE(during.message.empty());
-    robustness::sleepSeconds(0.1);
+    test_support::sleepSeconds(0.1);
   }
   EXPECT_NE(during.message.find("not connected"), std::string::npos) << during.message;
 
@@ -312,12 +312,6 @@ TEST_F(MultiPortTest, EachDeviceOnItsOwnPortAndServoBusUnplugAlone) {
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_multi_port");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  test_support::RosTestNode node(argc, argv, "test_multi_port");
+  return RUN_ALL_TESTS();
 }

@@ -10,9 +10,6 @@
 // "Nothing was written" is checked without timing: after a rejected call the test pings servo 3
 // and requires that the bytes the pty received in between are exactly that PING.
 #include <algorithm>
-#include <array>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -20,10 +17,8 @@
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -37,16 +32,19 @@
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
-#include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "support/pty_frame_reader.h"
+#include "support/ros_test_support.h"
 
 namespace {
 
 namespace srd = serial_robot_driver;
 namespace protocol = serial_robot_driver::protocol;
 namespace transport = serial_robot_driver::transport;
-using Clock = std::chrono::steady_clock;
-using Bytes = std::vector<uint8_t>;
+using test_support::Bytes;
+using test_support::Clock;
+using test_support::concat;
+using test_support::secondsSince;
 
 // --- frames written out by hand from PROTOCOLS.md section 3 (SUM = byte sum mod 256, LE values) --
 const Bytes kPing3 = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63};
@@ -100,10 +98,6 @@ const Bytes kReadBatch3Reply = {
     0x08, 0x07, 0xF8, 0xF8, 0xFB, 0xFF,  // 51..53 1800, -1800, -5 (0.1 deg)
     0xD7};
 
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 // --- the servos on a pty ----------------------------------------------------------------------
 
 /// Plays the bus servos on a pty with a symlink at `path`: records every byte the node writes and
@@ -113,15 +107,18 @@ class ServoBusPlayer {
   ServoBusPlayer(const std::string& path, bool echo) : pty_(path), echo_(echo) {
     protocol::FramerConfig config;
     config.servo_request = true;
-    framer_ = std::make_unique<protocol::StreamFramer>(
-        config, [this](protocol::FrameFamily, const uint8_t* data, std::size_t size) {
+    reader_ = std::make_unique<test_support::PtyFrameReader>(
+        pty_, config,
+        [this](protocol::FrameFamily, const uint8_t* data, std::size_t size, auto) {
           onRequest(Bytes(data, data + size));
+        },
+        [this](const uint8_t* data, std::size_t size) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          received_.insert(received_.end(), data, data + size);
         });
-    reader_ = std::thread([this] { readLoop(); });
   }
   ~ServoBusPlayer() {
-    running_ = false;
-    reader_.join();
+    reader_.reset();
     pty_.close();
   }
 
@@ -140,25 +137,6 @@ class ServoBusPlayer {
   }
 
  private:
-  void readLoop() {
-    std::array<uint8_t, 1024> buffer{};
-    while (running_) {
-      std::size_t n = 0;
-      try {
-        n = pty_.read(buffer.data(), buffer.size(), 20);
-      } catch (const transport::TransportError&) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        continue;
-      }
-      if (n == 0) continue;
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        received_.insert(received_.end(), buffer.begin(), buffer.begin() + n);
-      }
-      framer_->feed(buffer.data(), n);
-    }
-  }
-
   void onRequest(const Bytes& request) {
     std::vector<Bytes> replies;
     {
@@ -174,12 +152,10 @@ class ServoBusPlayer {
 
   transport::PseudoTerminal pty_;
   const bool echo_;
-  std::unique_ptr<protocol::StreamFramer> framer_;  // reader thread only
-  std::atomic<bool> running_{true};
   mutable std::mutex mutex_;
   Bytes received_;
   std::map<Bytes, std::vector<Bytes>> script_;
-  std::thread reader_;
+  std::unique_ptr<test_support::PtyFrameReader> reader_;  // last: it calls back into the above
 };
 
 ServoBusPlayer* g_safe = nullptr;   // /driver_node: dangerous writes refused, echoing adapter
@@ -215,12 +191,6 @@ Bytes bytesBeforeNextPing(ServoBusPlayer& bus, const std::string& ping_service, 
   }
   EXPECT_GE(pings, 1u) << "the PING of servo 3 did not reach the pty last";
   return bytes;
-}
-
-Bytes concat(std::initializer_list<Bytes> frames) {
-  Bytes all;
-  for (const Bytes& frame : frames) all.insert(all.end(), frame.begin(), frame.end());
-  return all;
 }
 
 // --- tests --------------------------------------------------------------------------------------
@@ -511,30 +481,17 @@ TEST(ServoBusNode, DiagnosticsReportTransactionsTimeoutsAndSkippedEchoes) {
   // An offline PING makes sure there is a timeout to report; the safe bus echoes every request.
   EXPECT_FALSE(ping(safeService("ping"), 7).response.online);
   ros::NodeHandle nh;
-  std::mutex mutex;
-  std::map<std::string, std::string> values;
-  auto subscriber = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
-        for (const auto& status : msg->status) {
-          if (status.name != "driver_node: serial_robot_driver: servo_bus") continue;
-          std::lock_guard<std::mutex> lock(mutex);
-          for (const auto& kv : status.values) values[kv.key] = kv.value;
-        }
-      });
-  auto counter = [&](const std::string& key) -> uint64_t {
-    auto it = values.find(key);
-    return it == values.end() ? 0 : std::stoull(it->second);
-  };
-  const Clock::time_point start = Clock::now();
-  bool seen = false;
-  while (!seen && secondsSince(start) < 15.0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    std::lock_guard<std::mutex> lock(mutex);
-    seen = counter("timeouts") > 0 && counter("echoes skipped") > 0 && counter("transactions") > 0;
-  }
+  const test_support::DiagnosticsWatch diagnostics(nh, "driver_node");
+  const auto servo_bus = [&] { return diagnostics.latest("serial_robot_driver: servo_bus"); };
+  const bool seen = test_support::waitFor(
+      [&] {
+        const test_support::DiagnosticsWatch::Status status = servo_bus();
+        return status.number("timeouts") > 0 && status.number("echoes skipped") > 0 &&
+               status.number("transactions") > 0;
+      },
+      15.0);
   EXPECT_TRUE(seen) << "no servo_bus diagnostics with transactions, timeouts and echoes";
-  std::lock_guard<std::mutex> lock(mutex);
-  EXPECT_GT(values.count("max latency (ms)"), 0u);
+  EXPECT_GT(servo_bus().values.count("max latency (ms)"), 0u);
 }
 
 void scriptServos(ServoBusPlayer& safe, ServoBusPlayer& armed) {
@@ -557,23 +514,20 @@ void scriptServos(ServoBusPlayer& safe, ServoBusPlayer& armed) {
 /// Waits until the node behind `ping_service` has opened its pty and servo 3 answers.
 bool waitUntilOnline(const std::string& ping_service) {
   if (!ros::service::waitForService(ping_service, ros::Duration(30.0))) return false;
-  const Clock::time_point start = Clock::now();
-  while (secondsSince(start) < 30.0) {
-    srd::ServoPing srv;
-    srv.request.id = 3;
-    if (ros::service::call(ping_service, srv) && srv.response.online) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return false;
+  return test_support::waitFor(
+      [&] {
+        srd::ServoPing srv;
+        srv.request.id = 3;
+        return ros::service::call(ping_service, srv) && srv.response.online;
+      },
+      30.0);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_servo_bus_node");
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
+  test_support::RosTestNode node(argc, argv, "test_servo_bus_node", /*spinner_threads=*/1);
 
   std::string safe_port;
   std::string armed_port;
@@ -597,7 +551,5 @@ int main(int argc, char** argv) {
     g_safe = nullptr;
     g_armed = nullptr;
   }
-  spinner.stop();
-  ros::shutdown();
   return result;
 }

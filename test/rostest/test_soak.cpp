@@ -50,7 +50,6 @@
 #include <sensor_msgs/JointState.h>
 #include <std_srvs/Trigger.h>
 
-#include "robustness_support.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoReadAll.h"
@@ -60,15 +59,16 @@
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
+#include "support/ros_test_support.h"
 
 namespace {
 
 namespace protocol = serial_robot_driver::protocol;
 namespace sim = serial_robot_driver::sim;
 namespace srd = serial_robot_driver;
-using robustness::DiagnosticsWatch;
-using robustness::TopicCounter;
-using robustness::waitFor;
+using test_support::DiagnosticsWatch;
+using test_support::TopicCounter;
+using test_support::waitFor;
 
 constexpr std::size_t kShortestTelemetryFrame = 32;  // 24 + 4 * 2 servos, no foot block
 constexpr double kUnplugEvery = 5.0;
@@ -105,7 +105,7 @@ struct Boundary {
   uint64_t joint_states = 0;
   uint64_t imu = 0;
   uint64_t telemetry = 0;
-  robustness::ProcessSample process;
+  test_support::ProcessSample process;
 };
 
 /// Publishes cmd_vel (20 Hz) and joint_commands (10 Hz) until stopped.
@@ -121,9 +121,9 @@ class Motion {
   }
   void start() {
     thread_ = std::thread([this] {
-      const auto start = robustness::Clock::now();
+      const auto start = test_support::Clock::now();
       for (uint64_t tick = 0; !stop_; ++tick) {
-        const double t = robustness::secondsSince(start);
+        const double t = test_support::secondsSince(start);
         geometry_msgs::Twist twist;
         twist.linear.x = 0.4 * std::sin(t);
         twist.angular.z = 0.8 * std::cos(0.7 * t);
@@ -135,7 +135,7 @@ class Motion {
           joint_commands_.publish(command);
           ++joint_commands_sent_;
         }
-        robustness::sleepSeconds(0.05);
+        test_support::sleepSeconds(0.05);
       }
     });
   }
@@ -173,7 +173,7 @@ class ServiceCaller {
     thread_ = std::thread([this] {
       for (uint64_t i = 0; !stop_; ++i) {
         callOne(i);
-        robustness::sleepSeconds(0.05);
+        test_support::sleepSeconds(0.05);
       }
     });
   }
@@ -191,9 +191,9 @@ class ServiceCaller {
   void account(ros::ServiceClient& client, Srv& srv, bool needs_answer,
                bool (*success)(const typename Srv::Response&),
                const std::string& (*message)(const typename Srv::Response&)) {
-    const auto start = robustness::Clock::now();
+    const auto start = test_support::Clock::now();
     const bool ok = client.call(srv);
-    slowest_s = std::max(slowest_s, robustness::secondsSince(start));
+    slowest_s = std::max(slowest_s, test_support::secondsSince(start));
     ++calls;
     if (!ok) {
       ++call_failures;
@@ -271,7 +271,7 @@ class ServiceCaller {
 
 TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   const std::string node_name = "/soak/driver_node";
-  const std::string port = robustness::nodeParam(node_name, "port");
+  const std::string port = test_support::nodeParam(node_name, "port");
   ASSERT_FALSE(port.empty());
   const std::string port_status = "port " + port;
   ros::NodeHandle nh("soak");
@@ -292,7 +292,7 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   ASSERT_TRUE(waitFor([&] { return diagnostics.latest(port_status).received > 0; }, 20))
       << "no diagnostics for the port";
   int pid = -1;
-  ASSERT_TRUE(waitFor([&] { return (pid = robustness::nodePid(node_name)) > 0; }, 20));
+  ASSERT_TRUE(waitFor([&] { return (pid = test_support::nodePid(node_name)) > 0; }, 20));
   ASSERT_EQ(diagnostics.latest(port_status).number("bytes in"), 0u);
 
   sim::SimOptions options;
@@ -312,7 +312,7 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   services.start();
 
   const double soak_s = soakSeconds();
-  const auto started = robustness::Clock::now();
+  const auto started = test_support::Clock::now();
   std::vector<Boundary> boundaries;
   uint64_t handled_unplugs = 0;
   uint64_t skipped_boundaries = 0;
@@ -321,10 +321,10 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
     return !robot.ports().at(0).plugged && s.unplugs == k && s.replugs + 1 == k;
   };
   // Until the soak time is over and one more boundary has been captured after it.
-  while (boundaries.empty() || robustness::secondsSince(started) < soak_s ||
+  while (boundaries.empty() || test_support::secondsSince(started) < soak_s ||
          boundaries.back().sim.uptime_s < soak_s) {
-    if (robustness::secondsSince(started) > soak_s + 4 * (kUnplugEvery + kUnplugDuration)) break;
-    robustness::sleepSeconds(0.02);
+    if (test_support::secondsSince(started) > soak_s + 4 * (kUnplugEvery + kUnplugDuration)) break;
+    test_support::sleepSeconds(0.02);
     const sim::SimStats s = robot.stats();
     if (s.unplugs == handled_unplugs || !unpluggedAt(s.unplugs)) continue;
     const uint64_t k = s.unplugs;
@@ -340,7 +340,7 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
     // the port is down, so nothing new can come; wait until the counts have been still a while.
     uint64_t still_polls = 0, seen = joints.count() + imu.count() + telemetry.count();
     while (status && still_polls < 3 && unpluggedAt(k)) {
-      robustness::sleepSeconds(0.1);
+      test_support::sleepSeconds(0.1);
       const uint64_t now = joints.count() + imu.count() + telemetry.count();
       still_polls = now == seen ? still_polls + 1 : 0;
       seen = now;
@@ -349,7 +349,7 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
     boundary.joint_states = joints.count();
     boundary.imu = imu.count();
     boundary.telemetry = telemetry.count();
-    boundary.process = robustness::sampleProcess(pid);
+    boundary.process = test_support::sampleProcess(pid);
     if (!status || !unpluggedAt(k)) {
       ++skipped_boundaries;  // the episode merges with the next one
       continue;
@@ -361,11 +361,11 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   }
   motion.stop();
   services.stop();
-  const double soaked_s = robustness::secondsSince(started);
+  const double soaked_s = test_support::secondsSince(started);
   ASSERT_GE(boundaries.size(), 2u) << "too few unplugs observed";
   EXPECT_LE(skipped_boundaries, boundaries.size() / 2) << "most unplugs were not observed at rest";
-  EXPECT_TRUE(robustness::processAlive(pid)) << "driver_node died";
-  EXPECT_EQ(robustness::nodePid(node_name), pid) << "driver_node was restarted";
+  EXPECT_TRUE(test_support::processAlive(pid)) << "driver_node died";
+  EXPECT_EQ(test_support::nodePid(node_name), pid) << "driver_node was restarted";
 
   // --- telemetry, episode by episode ---
   std::printf("soak: %.0f s, %zu episodes reconciled (%llu unplugs not seen at rest, merged)\n",
@@ -502,8 +502,8 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   EXPECT_LE(services.answered_successes, servo_answers);
 
   // Flat resources, compared at rest (port down) at the first and the last boundary.
-  const robustness::ProcessSample& first = boundaries.front().process;
-  const robustness::ProcessSample& end = last.process;
+  const test_support::ProcessSample& first = boundaries.front().process;
+  const test_support::ProcessSample& end = last.process;
   std::printf("driver_node (pid %d): RSS %ld -> %ld kB, fds %zu -> %zu, threads %zu -> %zu, "
               "pty fds %zu -> %zu\n",
               pid, first.rss_kb, end.rss_kb, first.fds, end.fds, first.threads, end.threads,
@@ -520,12 +520,6 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_soak");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  test_support::RosTestNode node(argc, argv, "test_soak");
+  return RUN_ALL_TESTS();
 }

@@ -6,11 +6,13 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/body_codec.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::protocol::body {
 namespace {
 
-using Bytes = std::vector<uint8_t>;
+using test_support::Bytes;
+using test_support::withByte;
 
 // --- sync write ----------------------------------------------------------------------------------
 
@@ -258,11 +260,6 @@ TEST(BodyCodec, EncodeRefusesFramesLongerThan255) {
   EXPECT_TRUE(encodeTelemetry(too_many).empty());
   too_many.has_foot = false;  // 24 + 4*57 = 252 bytes
   EXPECT_EQ(encodeTelemetry(too_many).size(), 252u);
-}
-
-Bytes withByte(Bytes frame, std::size_t index, uint8_t value) {
-  frame[index] = value;
-  return frame;
 }
 
 struct MalformedTelemetryCase {

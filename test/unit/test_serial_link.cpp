@@ -1,7 +1,6 @@
 // SerialLink over a real pseudo-terminal: frames in through the reader thread, writes out,
 // unplug (EIO) and replug at the same symlink, and a port that appears only after start().
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <atomic>
@@ -10,12 +9,14 @@
 
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::device {
 namespace {
 
-using Bytes = std::vector<uint8_t>;
 using std::chrono::milliseconds;
+using test_support::Bytes;
+using test_support::waitFor;
 
 class RecordingListener : public LinkListener {
  public:
@@ -37,15 +38,7 @@ class RecordingListener : public LinkListener {
   std::vector<std::pair<protocol::FrameFamily, Bytes>> frames;
 };
 
-template <typename Predicate>
-bool waitFor(Predicate predicate, milliseconds timeout = milliseconds(3000)) {
-  const auto deadline = Clock::now() + timeout;
-  while (Clock::now() < deadline) {
-    if (predicate()) return true;
-    std::this_thread::sleep_for(milliseconds(5));
-  }
-  return predicate();
-}
+constexpr double kWaitSeconds = 3.0;  // generous: the machine may be busy
 
 std::string uniqueLinkPath(const char* name) {
   return "/tmp/srd_link_test_" + std::string(name) + "_" + std::to_string(::getpid());
@@ -77,7 +70,7 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   stream.insert(stream.end(), kBatteryReply.begin(), kBatteryReply.end());
   stream.insert(stream.end(), kPingReply.begin(), kPingReply.end());
   pty.write(stream.data(), stream.size());
-  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 2; }));
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 2; }, kWaitSeconds));
   EXPECT_EQ(listener.frames[0].first, protocol::FrameFamily::kBase);
   EXPECT_EQ(listener.frames[0].second, kBatteryReply);
   EXPECT_EQ(listener.frames[1].first, protocol::FrameFamily::kServoResponse);
@@ -87,10 +80,12 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   ASSERT_TRUE(link.write(reset));
   Bytes received(reset.size());
   std::size_t got = 0;
-  ASSERT_TRUE(waitFor([&] {
-    got += pty.read(received.data() + got, received.size() - got, 10);
-    return got == received.size();
-  }));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        got += pty.read(received.data() + got, received.size() - got, 10);
+        return got == received.size();
+      },
+      kWaitSeconds));
   EXPECT_EQ(received, reset);
 
   const LinkStats stats = link.stats();
@@ -110,15 +105,15 @@ TEST(SerialLink, RecoversAfterUnplugAtTheSameSymlink) {
   ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
 
   pty->close();  // the driver's reads now fail with EIO: an unplugged adapter
-  ASSERT_TRUE(waitFor([&] { return listener.downs == 1; }));
+  ASSERT_TRUE(waitFor([&] { return listener.downs == 1; }, kWaitSeconds));
   EXPECT_FALSE(link.connected());
   EXPECT_FALSE(link.write(kBatteryReply)) << "writes fail fast while the port is gone";
 
   pty = std::make_unique<transport::PseudoTerminal>(path);
-  ASSERT_TRUE(waitFor([&] { return link.connected(); }));
+  ASSERT_TRUE(waitFor([&] { return link.connected(); }, kWaitSeconds));
   EXPECT_EQ(listener.ups, 2) << "listeners hear of the reconnect before the link reports it";
   pty->write(kPingReply.data(), kPingReply.size());
-  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }));
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
   const LinkStats stats = link.stats();
   EXPECT_EQ(stats.connects, 2u);
   EXPECT_EQ(stats.disconnects, 1u);

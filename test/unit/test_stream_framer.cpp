@@ -12,11 +12,13 @@
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
 
-using Bytes = std::vector<uint8_t>;
+using test_support::Bytes;
+using test_support::concat;
 
 // --- hand-written frames -----------------------------------------------------------------------
 // AP1 base (PROTOCOLS.md section 1 golden vectors).
@@ -81,12 +83,6 @@ FramerConfig allFamilies() {
   config.sync_write = true;
   config.telemetry_servo_count = kServoCount;
   return config;
-}
-
-Bytes concat(std::initializer_list<Bytes> parts) {
-  Bytes out;
-  for (const Bytes& part : parts) out.insert(out.end(), part.begin(), part.end());
-  return out;
 }
 
 struct Frame {

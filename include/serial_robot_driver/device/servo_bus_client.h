@@ -144,6 +144,10 @@ class ServoBusClient : public LinkListener {
  private:
   /// What an answer must look like to complete the pending transaction.
   struct Expectation {
+    Expectation() = default;
+    Expectation(protocol::servo::Command answer_cmd, uint8_t answer_id, std::size_t size)
+        : cmd(answer_cmd), id(answer_id), content_size(size) {}
+
     protocol::servo::Command cmd = protocol::servo::Command::kPing;
     uint8_t id = 0;
     std::optional<uint8_t> alt_id;   ///< also accepted (a servo_id change may answer at the new id)
@@ -163,6 +167,9 @@ class ServoBusClient : public LinkListener {
   ServoStatus transact(const std::vector<uint8_t>& request, const Expectation& expect,
                        std::chrono::milliseconds timeout, int attempts,
                        protocol::servo::Packet* answer);
+  /// transact() with the configured timeout and retries: the usual request/answer exchange.
+  ServoStatus exchangeLocked(const std::vector<uint8_t>& request, const Expectation& expect,
+                             protocol::servo::Packet* answer);
   /// Fire and forget: a motion command without wait.
   ServoStatus sendCommand(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
                           uint8_t id);
@@ -173,6 +180,9 @@ class ServoBusClient : public LinkListener {
                               ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);
   bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
+  /// exchangeLocked() of a single request, taking bus_mutex_ itself.
+  ServoStatus exchange(const std::vector<uint8_t>& request, const Expectation& expect,
+                       protocol::servo::Packet* answer);
 
   const ServoBusOptions options_;
   const WriteFunction write_;

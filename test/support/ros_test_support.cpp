@@ -1,0 +1,117 @@
+// ROS helpers shared by the rostests (see the header).
+#include "support/ros_test_support.h"
+
+#include <ros/network.h>
+#include <unistd.h>
+#include <xmlrpcpp/XmlRpcClient.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+namespace test_support {
+
+RosTestNode::RosTestNode(int& argc, char** argv, const std::string& name, int spinner_threads) {
+  ros::init(argc, argv, name);
+  nh_ = std::make_unique<ros::NodeHandle>();
+  spinner_ = std::make_unique<ros::AsyncSpinner>(spinner_threads);
+  spinner_->start();
+}
+
+RosTestNode::~RosTestNode() {
+  spinner_->stop();
+  ros::shutdown();
+}
+
+std::string findDriverNode() {
+  std::string from_param;
+  if (ros::param::get("~driver_path", from_param) && !from_param.empty()) return from_param;
+  char self[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (n <= 0) return {};
+  std::string dir(self, static_cast<std::size_t>(n));
+  dir = dir.substr(0, dir.find_last_of('/'));
+  const std::string path = dir + "/driver_node";
+  return ::access(path.c_str(), X_OK) == 0 ? path : std::string();
+}
+
+std::string nodeParam(const std::string& node, const std::string& key) {
+  std::string value;
+  ros::param::get(node + "/" + key, value);
+  return value;
+}
+
+int nodePid(const std::string& node) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  request[1] = node;
+  if (!ros::master::execute("lookupNode", request, response, payload, false)) return -1;
+  const std::string uri = static_cast<std::string>(payload);
+  std::string host;
+  uint32_t port = 0;
+  if (!ros::network::splitURI(uri, host, port)) return -1;
+  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue pid_request, pid_response;
+  pid_request[0] = ros::this_node::getName();
+  if (!client.execute("getPid", pid_request, pid_response)) return -1;
+  if (pid_response.getType() != XmlRpc::XmlRpcValue::TypeArray || pid_response.size() < 3 ||
+      static_cast<int>(pid_response[0]) != 1) {
+    return -1;
+  }
+  return static_cast<int>(pid_response[2]);
+}
+
+std::string DiagnosticsWatch::Status::value(const std::string& key) const {
+  const auto it = values.find(key);
+  return it == values.end() ? std::string() : it->second;
+}
+
+uint64_t DiagnosticsWatch::Status::number(const std::string& key) const {
+  const std::string text = value(key);
+  return text.empty() ? 0 : std::stoull(text);
+}
+
+DiagnosticsWatch::DiagnosticsWatch(ros::NodeHandle& nh, const std::string& node)
+    : prefix_(node + ": ") {
+  sub_ = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& status : msg->status) {
+          if (status.name.rfind(prefix_, 0) != 0) continue;
+          Status& stored = statuses_[status.name.substr(prefix_.size())];
+          ++stored.received;
+          stored.message = status.message;
+          stored.values.clear();
+          for (const auto& kv : status.values) stored.values[kv.key] = kv.value;
+        }
+      });
+}
+
+DiagnosticsWatch::Status DiagnosticsWatch::latest(const std::string& name) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = statuses_.find(name);
+  return it == statuses_.end() ? Status{} : it->second;
+}
+
+std::optional<DiagnosticsWatch::Status> DiagnosticsWatch::waitFor(
+    const std::string& name, uint64_t after_count, const std::function<bool(const Status&)>& pred,
+    const std::function<bool()>& keep_waiting, double timeout_s) const {
+  std::optional<Status> found;
+  test_support::waitFor(
+      [&] {
+        const Status status = latest(name);
+        if (status.received > after_count && pred(status)) {
+          found = status;
+          return true;
+        }
+        return !keep_waiting();
+      },
+      timeout_s);
+  return found;
+}
+
+std::vector<std::string> DiagnosticsWatch::names() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> result;
+  for (const auto& [name, status] : statuses_) result.push_back(name);
+  return result;
+}
+
+}  // namespace test_support
