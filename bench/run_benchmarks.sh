@@ -9,6 +9,7 @@
 #   SRD_BENCH_WS=DIR    the catkin workspace to use (default: the sourced one, or the one this
 #                       script was installed into)
 set -euo pipefail
+export PATH="/usr/bin:$PATH"  # Debian's python3 for the ROS tools
 
 script_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 package_dir=$(cd "${script_dir}/.." && pwd)
@@ -27,10 +28,13 @@ if [[ -n "${SRD_BENCH_WS:-}" ]]; then
   if (( build )); then
     (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 --make-args -j2 driver_bench)
   fi
-  set +u  # ROS's setup scripts read unset variables
-  # shellcheck disable=SC1091
-  source "${SRD_BENCH_WS}/devel/setup.bash"
-  set -u
+  load_workspace() {  # a function, so setup.bash does not see this script's arguments
+    set +u  # ROS's setup scripts read unset variables
+    # shellcheck disable=SC1091
+    source "${SRD_BENCH_WS}/devel/setup.bash"
+    set -u
+  }
+  load_workspace
   bench="${SRD_BENCH_WS}/devel/lib/serial_robot_driver/driver_bench"
 elif [[ -x "${script_dir}/driver_bench" ]]; then
   bench="${script_dir}/driver_bench"  # installed next to driver_node
