@@ -101,8 +101,11 @@ bool SerialLink::tryOpen() {
     error = e.what();
   }
   if (!error.empty()) {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    stats_.last_error = error;
+    {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      stats_.last_error = error;
+    }
+    for (LinkListener* listener : listeners_) listener->onOpenFailed(error);
     return false;
   }
   framer_.reset();  // a partial frame from before the loss means nothing now

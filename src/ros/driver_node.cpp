@@ -12,6 +12,7 @@ class PortMonitor : public device::LinkListener {
   explicit PortMonitor(const device::SerialLink& link) : link_(link) {}
 
   void onLinkUp() override {
+    waiting_logged_ = false;
     const device::LinkStats stats = link_.stats();
     ROS_INFO("port %s connected (low latency: %s)", link_.options().path.c_str(),
              stats.low_latency ? "yes" : "not supported");
@@ -24,11 +25,19 @@ class PortMonitor : public device::LinkListener {
   void onLinkDown() override {
     ROS_WARN("port %s lost (%s); reopening every %.1f s", link_.options().path.c_str(),
              link_.stats().last_error.c_str(), link_.options().reconnect_interval);
+    waiting_logged_ = true;  // the retries that follow need no message of their own
+  }
+  void onOpenFailed(const std::string& error) override {
+    if (waiting_logged_) return;  // once per outage, not once per retry
+    waiting_logged_ = true;
+    ROS_WARN("waiting for port %s (%s); retrying every %.1f s", link_.options().path.c_str(),
+             error.c_str(), link_.options().reconnect_interval);
   }
   void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t, device::Clock::time_point) override {}
 
  private:
   const device::SerialLink& link_;
+  bool waiting_logged_ = false;  // reader thread only
 };
 
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params)

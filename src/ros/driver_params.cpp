@@ -42,12 +42,44 @@ void validateDevicePort(const DevicePortParams& device, const std::string& prefi
 
 // --- loading --------------------------------------------------------------------------------
 
-/// Reads `key` when present; a present key of the wrong type is an error, not a silent default.
-template <typename T>
-void load(const ros::NodeHandle& nh, const std::string& key, T* value, const char* type_name) {
-  if (!nh.hasParam(key)) return;
-  if (!nh.getParam(key, *value)) throw ParameterError(key, std::string("must be ") + type_name);
-}
+/// Reads keys under ~ and remembers which ones it was asked for, so what is left on the parameter
+/// server afterwards is exactly the keys the driver does not know.
+class ParamReader {
+ public:
+  explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
+
+  /// Reads `key` when present; a present key of the wrong type is an error, not a silent default.
+  template <typename T>
+  void read(const std::string& key, T* value, const char* type_name) {
+    known_.insert(key);
+    if (!nh_.hasParam(key)) return;
+    if (!nh_.getParam(key, *value)) throw ParameterError(key, std::string("must be ") + type_name);
+  }
+
+  void readDevice(const std::string& prefix, DevicePortParams* device) {
+    read(prefix + "/enabled", &device->enabled, "true or false");
+    read(prefix + "/port", &device->port, "a string");
+    read(prefix + "/baud", &device->baud, "an integer");
+  }
+
+  /// Keys under ~ that no read() asked for.
+  std::vector<std::string> unreadKeys() const {
+    std::vector<std::string> all;
+    ros::param::getParamNames(all);
+    const std::string prefix = nh_.getNamespace() + "/";
+    std::vector<std::string> unread;
+    for (const auto& full : all) {
+      if (full.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string key = full.substr(prefix.size());
+      if (!known_.count(key)) unread.push_back(key);
+    }
+    return unread;
+  }
+
+ private:
+  const ros::NodeHandle& nh_;
+  std::set<std::string> known_ = {"diagnostic_period"};  // read by diagnostic_updater itself
+};
 
 }  // namespace
 
@@ -143,74 +175,46 @@ void DriverParams::validate() const {
 
 DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unknown_keys) {
   DriverParams p;
-  load(nh, "port", &p.port, "a string");
-  load(nh, "baud", &p.baud, "an integer");
-  load(nh, "loop_rate", &p.loop_rate, "a number");
-  load(nh, "reconnect_interval", &p.reconnect_interval, "a number");
-  load(nh, "read_poll_interval", &p.read_poll_interval, "a number");
+  ParamReader reader(nh);
+  reader.read("port", &p.port, "a string");
+  reader.read("baud", &p.baud, "an integer");
+  reader.read("loop_rate", &p.loop_rate, "a number");
+  reader.read("reconnect_interval", &p.reconnect_interval, "a number");
+  reader.read("read_poll_interval", &p.read_poll_interval, "a number");
 
-  auto loadDevice = [&nh](const std::string& prefix, DevicePortParams* device) {
-    load(nh, prefix + "/enabled", &device->enabled, "true or false");
-    load(nh, prefix + "/port", &device->port, "a string");
-    load(nh, prefix + "/baud", &device->baud, "an integer");
-  };
+  reader.readDevice("base", &p.base);
+  reader.read("base/wheel_diameter", &p.base.wheel_diameter, "a number");
+  reader.read("base/encoder_resolution", &p.base.encoder_resolution, "an integer");
+  reader.read("base/pid_rate", &p.base.pid_rate, "a number");
+  reader.read("base/wheel_separation", &p.base.wheel_separation, "a number");
+  reader.read("base/max_wheel_speed", &p.base.max_wheel_speed, "a number");
+  reader.read("base/max_wheel_accel", &p.base.max_wheel_accel, "a number");
+  reader.read("base/cmd_vel_timeout", &p.base.cmd_vel_timeout, "a number");
+  reader.read("base/speed_dithering", &p.base.speed_dithering, "true or false");
+  reader.read("base/battery_poll_rate", &p.base.battery_poll_rate, "a number");
 
-  loadDevice("base", &p.base);
-  load(nh, "base/wheel_diameter", &p.base.wheel_diameter, "a number");
-  load(nh, "base/encoder_resolution", &p.base.encoder_resolution, "an integer");
-  load(nh, "base/pid_rate", &p.base.pid_rate, "a number");
-  load(nh, "base/wheel_separation", &p.base.wheel_separation, "a number");
-  load(nh, "base/max_wheel_speed", &p.base.max_wheel_speed, "a number");
-  load(nh, "base/max_wheel_accel", &p.base.max_wheel_accel, "a number");
-  load(nh, "base/cmd_vel_timeout", &p.base.cmd_vel_timeout, "a number");
-  load(nh, "base/speed_dithering", &p.base.speed_dithering, "true or false");
-  load(nh, "base/battery_poll_rate", &p.base.battery_poll_rate, "a number");
+  reader.readDevice("body", &p.body);
+  reader.read("body/servo_ids", &p.body.servo_ids, "a list of integers");
+  reader.read("body/joint_names", &p.body.joint_names, "a list of strings");
+  reader.read("body/ticks_per_revolution", &p.body.ticks_per_revolution, "an integer");
+  reader.read("body/zero_ticks", &p.body.zero_ticks, "a list of integers");
+  reader.read("body/directions", &p.body.directions, "a list of integers");
+  reader.read("body/velocity_scale", &p.body.velocity_scale, "a number");
 
-  loadDevice("body", &p.body);
-  load(nh, "body/servo_ids", &p.body.servo_ids, "a list of integers");
-  load(nh, "body/joint_names", &p.body.joint_names, "a list of strings");
-  load(nh, "body/ticks_per_revolution", &p.body.ticks_per_revolution, "an integer");
-  load(nh, "body/zero_ticks", &p.body.zero_ticks, "a list of integers");
-  load(nh, "body/directions", &p.body.directions, "a list of integers");
-  load(nh, "body/velocity_scale", &p.body.velocity_scale, "a number");
+  reader.read("imu/frame_id", &p.imu.frame_id, "a string");
+  reader.read("imu/accel_scale", &p.imu.accel_scale, "a number");
+  reader.read("imu/gyro_scale", &p.imu.gyro_scale, "a number");
+  reader.read("imu/angle_scale", &p.imu.angle_scale, "a number");
+  reader.read("imu/orientation_variance", &p.imu.orientation_variance, "a number");
+  reader.read("imu/angular_velocity_variance", &p.imu.angular_velocity_variance, "a number");
+  reader.read("imu/linear_acceleration_variance", &p.imu.linear_acceleration_variance, "a number");
 
-  load(nh, "imu/frame_id", &p.imu.frame_id, "a string");
-  load(nh, "imu/accel_scale", &p.imu.accel_scale, "a number");
-  load(nh, "imu/gyro_scale", &p.imu.gyro_scale, "a number");
-  load(nh, "imu/angle_scale", &p.imu.angle_scale, "a number");
-  load(nh, "imu/orientation_variance", &p.imu.orientation_variance, "a number");
-  load(nh, "imu/angular_velocity_variance", &p.imu.angular_velocity_variance, "a number");
-  load(nh, "imu/linear_acceleration_variance", &p.imu.linear_acceleration_variance, "a number");
+  reader.readDevice("servo_bus", &p.servo_bus);
+  reader.read("servo_bus/timeout", &p.servo_bus.timeout, "a number");
+  reader.read("servo_bus/retries", &p.servo_bus.retries, "an integer");
+  reader.read("servo_bus/allow_dangerous_writes", &p.servo_bus.allow_dangerous_writes, "true or false");
 
-  loadDevice("servo_bus", &p.servo_bus);
-  load(nh, "servo_bus/timeout", &p.servo_bus.timeout, "a number");
-  load(nh, "servo_bus/retries", &p.servo_bus.retries, "an integer");
-  load(nh, "servo_bus/allow_dangerous_writes", &p.servo_bus.allow_dangerous_writes, "true or false");
-
-  if (unknown_keys) {
-    static const std::set<std::string> kKnown = {
-        "port", "baud", "loop_rate", "reconnect_interval", "read_poll_interval",
-        "base/enabled", "base/port", "base/baud", "base/wheel_diameter", "base/encoder_resolution",
-        "base/pid_rate", "base/wheel_separation", "base/max_wheel_speed", "base/max_wheel_accel",
-        "base/cmd_vel_timeout", "base/speed_dithering", "base/battery_poll_rate",
-        "body/enabled", "body/port", "body/baud", "body/servo_ids", "body/joint_names",
-        "body/ticks_per_revolution", "body/zero_ticks", "body/directions", "body/velocity_scale",
-        "imu/frame_id", "imu/accel_scale", "imu/gyro_scale", "imu/angle_scale",
-        "imu/orientation_variance", "imu/angular_velocity_variance",
-        "imu/linear_acceleration_variance",
-        "servo_bus/enabled", "servo_bus/port", "servo_bus/baud", "servo_bus/timeout",
-        "servo_bus/retries", "servo_bus/allow_dangerous_writes",
-        // Read by diagnostic_updater itself (its publish period), not a typo.
-        "diagnostic_period"};
-    std::vector<std::string> all;
-    ros::param::getParamNames(all);
-    const std::string prefix = nh.getNamespace() + "/";
-    for (const auto& full : all) {
-      if (full.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string key = full.substr(prefix.size());
-      if (!kKnown.count(key)) unknown_keys->push_back(key);
-    }
-  }
+  if (unknown_keys) *unknown_keys = reader.unreadKeys();
   return p;
 }
 

@@ -38,6 +38,8 @@ class LinkListener {
   /// The port was (re)opened: e.g. the base must send a Reset before its next speed frame.
   virtual void onLinkUp() {}
   virtual void onLinkDown() {}
+  /// An attempt to open the port failed (it is retried every reconnect_interval).
+  virtual void onOpenFailed(const std::string& /*error*/) {}
   /// A verified frame of one of the families the port's framer accepts.
   virtual void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                        Clock::time_point arrival) = 0;
