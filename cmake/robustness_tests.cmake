@@ -15,3 +15,11 @@ add_rostest_gtest(test_soak test/rostest/soak.test test/rostest/test_soak.cpp)
 target_include_directories(test_soak PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_soak srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_soak driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
+
+# Servo-bus stress: a few hundred service calls (some to offline servos) on the port shared with
+# the base and 100 Hz telemetry, counting that the wheel heartbeat and the telemetry never lapse.
+add_rostest_gtest(test_servo_stress test/rostest/servo_stress.test
+                  test/rostest/test_servo_stress.cpp)
+target_include_directories(test_servo_stress PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_servo_stress srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_servo_stress driver_node ${PROJECT_NAME}_generate_messages_cpp)
