@@ -3,7 +3,9 @@
 //
 // Input layout:
 //   byte 0  decoder = byte % 5 (base, telemetry, servo response, servo request, sync write),
-//           mode = (byte / 5) % 3: 0 raw, 1 fix the checksum, 2 fix header/length/tail/checksum
+//           mode = (byte / 5) % 3: 0 raw, 1 fix the checksum, 2 fix header/length/tail/checksum.
+//           Built with SRD_FUZZ_DECODER=k, the target fuzzes decoder k only (one libFuzzer target per
+//           decoder: fuzz_base, fuzz_telemetry, ...), so coverage feedback stays per decoder.
 //   byte 1  telemetry servo count (used modulo 64, so also beyond the legal 57)
 //   rest    the frame, passed to the decoder in an exact-size heap buffer (ASan sees over-reads)
 //
@@ -151,7 +153,11 @@ void runSyncWrite(const uint8_t* d, std::size_t n) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* input, std::size_t input_size) {
   constexpr std::size_t kPrefix = 2;
   if (input_size < kPrefix) return 0;
+#ifdef SRD_FUZZ_DECODER
+  constexpr auto target = static_cast<Target>(SRD_FUZZ_DECODER);
+#else
   const auto target = static_cast<Target>(input[0] % static_cast<int>(Target::kCount));
+#endif
   const auto mode = static_cast<Mode>((input[0] / static_cast<int>(Target::kCount)) %
                                       static_cast<int>(Mode::kCount));
   const std::size_t servo_count = input[1] % 64;
