@@ -42,6 +42,14 @@ void validateDevicePort(const DevicePortParams& device, const std::string& prefi
 
 // --- loading --------------------------------------------------------------------------------
 
+/// How a parameter's expected type reads in an error message.
+std::string typeName(bool) { return "true or false"; }
+std::string typeName(int) { return "an integer"; }
+std::string typeName(double) { return "a number"; }
+std::string typeName(const std::string&) { return "a string"; }
+std::string typeName(const std::vector<int>&) { return "a list of integers"; }
+std::string typeName(const std::vector<std::string>&) { return "a list of strings"; }
+
 /// Reads keys under ~ and remembers which ones it was asked for, so what is left on the parameter
 /// server afterwards is exactly the keys the driver does not know.
 class ParamReader {
@@ -50,16 +58,16 @@ class ParamReader {
 
   /// Reads `key` when present; a present key of the wrong type is an error, not a silent default.
   template <typename T>
-  void read(const std::string& key, T* value, const char* type_name) {
+  void read(const std::string& key, T* value) {
     known_.insert(key);
     if (!nh_.hasParam(key)) return;
-    if (!nh_.getParam(key, *value)) throw ParameterError(key, std::string("must be ") + type_name);
+    if (!nh_.getParam(key, *value)) throw ParameterError(key, "must be " + typeName(*value));
   }
 
   void readDevice(const std::string& prefix, DevicePortParams* device) {
-    read(prefix + "/enabled", &device->enabled, "true or false");
-    read(prefix + "/port", &device->port, "a string");
-    read(prefix + "/baud", &device->baud, "an integer");
+    read(prefix + "/enabled", &device->enabled);
+    read(prefix + "/port", &device->port);
+    read(prefix + "/baud", &device->baud);
   }
 
   /// Keys under ~ that no read() asked for.
@@ -176,43 +184,43 @@ void DriverParams::validate() const {
 DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unknown_keys) {
   DriverParams p;
   ParamReader reader(nh);
-  reader.read("port", &p.port, "a string");
-  reader.read("baud", &p.baud, "an integer");
-  reader.read("loop_rate", &p.loop_rate, "a number");
-  reader.read("reconnect_interval", &p.reconnect_interval, "a number");
-  reader.read("read_poll_interval", &p.read_poll_interval, "a number");
+  reader.read("port", &p.port);
+  reader.read("baud", &p.baud);
+  reader.read("loop_rate", &p.loop_rate);
+  reader.read("reconnect_interval", &p.reconnect_interval);
+  reader.read("read_poll_interval", &p.read_poll_interval);
 
   reader.readDevice("base", &p.base);
-  reader.read("base/wheel_diameter", &p.base.wheel_diameter, "a number");
-  reader.read("base/encoder_resolution", &p.base.encoder_resolution, "an integer");
-  reader.read("base/pid_rate", &p.base.pid_rate, "a number");
-  reader.read("base/wheel_separation", &p.base.wheel_separation, "a number");
-  reader.read("base/max_wheel_speed", &p.base.max_wheel_speed, "a number");
-  reader.read("base/max_wheel_accel", &p.base.max_wheel_accel, "a number");
-  reader.read("base/cmd_vel_timeout", &p.base.cmd_vel_timeout, "a number");
-  reader.read("base/speed_dithering", &p.base.speed_dithering, "true or false");
-  reader.read("base/battery_poll_rate", &p.base.battery_poll_rate, "a number");
+  reader.read("base/wheel_diameter", &p.base.wheel_diameter);
+  reader.read("base/encoder_resolution", &p.base.encoder_resolution);
+  reader.read("base/pid_rate", &p.base.pid_rate);
+  reader.read("base/wheel_separation", &p.base.wheel_separation);
+  reader.read("base/max_wheel_speed", &p.base.max_wheel_speed);
+  reader.read("base/max_wheel_accel", &p.base.max_wheel_accel);
+  reader.read("base/cmd_vel_timeout", &p.base.cmd_vel_timeout);
+  reader.read("base/speed_dithering", &p.base.speed_dithering);
+  reader.read("base/battery_poll_rate", &p.base.battery_poll_rate);
 
   reader.readDevice("body", &p.body);
-  reader.read("body/servo_ids", &p.body.servo_ids, "a list of integers");
-  reader.read("body/joint_names", &p.body.joint_names, "a list of strings");
-  reader.read("body/ticks_per_revolution", &p.body.ticks_per_revolution, "an integer");
-  reader.read("body/zero_ticks", &p.body.zero_ticks, "a list of integers");
-  reader.read("body/directions", &p.body.directions, "a list of integers");
-  reader.read("body/velocity_scale", &p.body.velocity_scale, "a number");
+  reader.read("body/servo_ids", &p.body.servo_ids);
+  reader.read("body/joint_names", &p.body.joint_names);
+  reader.read("body/ticks_per_revolution", &p.body.ticks_per_revolution);
+  reader.read("body/zero_ticks", &p.body.zero_ticks);
+  reader.read("body/directions", &p.body.directions);
+  reader.read("body/velocity_scale", &p.body.velocity_scale);
 
-  reader.read("imu/frame_id", &p.imu.frame_id, "a string");
-  reader.read("imu/accel_scale", &p.imu.accel_scale, "a number");
-  reader.read("imu/gyro_scale", &p.imu.gyro_scale, "a number");
-  reader.read("imu/angle_scale", &p.imu.angle_scale, "a number");
-  reader.read("imu/orientation_variance", &p.imu.orientation_variance, "a number");
-  reader.read("imu/angular_velocity_variance", &p.imu.angular_velocity_variance, "a number");
-  reader.read("imu/linear_acceleration_variance", &p.imu.linear_acceleration_variance, "a number");
+  reader.read("imu/frame_id", &p.imu.frame_id);
+  reader.read("imu/accel_scale", &p.imu.accel_scale);
+  reader.read("imu/gyro_scale", &p.imu.gyro_scale);
+  reader.read("imu/angle_scale", &p.imu.angle_scale);
+  reader.read("imu/orientation_variance", &p.imu.orientation_variance);
+  reader.read("imu/angular_velocity_variance", &p.imu.angular_velocity_variance);
+  reader.read("imu/linear_acceleration_variance", &p.imu.linear_acceleration_variance);
 
   reader.readDevice("servo_bus", &p.servo_bus);
-  reader.read("servo_bus/timeout", &p.servo_bus.timeout, "a number");
-  reader.read("servo_bus/retries", &p.servo_bus.retries, "an integer");
-  reader.read("servo_bus/allow_dangerous_writes", &p.servo_bus.allow_dangerous_writes, "true or false");
+  reader.read("servo_bus/timeout", &p.servo_bus.timeout);
+  reader.read("servo_bus/retries", &p.servo_bus.retries);
+  reader.read("servo_bus/allow_dangerous_writes", &p.servo_bus.allow_dangerous_writes);
 
   if (unknown_keys) *unknown_keys = reader.unreadKeys();
   return p;

@@ -566,6 +566,11 @@ CommandLine parseCommandLine(int argc, const char* const* argv) {
     const auto nonNegative = [&](double* target) {
       return takeValue() && parseDouble(value, target) && *target >= 0.0;
     };
+    const auto text = [&](auto* target) {  // std::string or std::optional<std::string>
+      if (!takeValue()) return false;
+      *target = value;
+      return true;
+    };
 
     const bool takes_value = flag != "--help" && flag != "-h" && flag != "--foot" &&
                              flag != "--foot-alternate" && flag != "--imu-noise" &&
@@ -587,20 +592,15 @@ CommandLine parseCommandLine(int argc, const char* const* argv) {
     } else if (flag == "--no-servo-bus") {
       options.enable_servo_bus = false;
     } else if (flag == "--link") {
-      if (!takeValue()) return fail(needValue());
-      options.link = value;
+      if (!text(&options.link)) return fail(needValue());
     } else if (flag == "--base-link") {
-      if (!takeValue()) return fail(needValue());
-      options.base_link = value;
+      if (!text(&options.base_link)) return fail(needValue());
     } else if (flag == "--body-link") {
-      if (!takeValue()) return fail(needValue());
-      options.body_link = value;
+      if (!text(&options.body_link)) return fail(needValue());
     } else if (flag == "--servo-link") {
-      if (!takeValue()) return fail(needValue());
-      options.servo_link = value;
+      if (!text(&options.servo_link)) return fail(needValue());
     } else if (flag == "--stats-file") {
-      if (!takeValue()) return fail(needValue());
-      options.stats_file = value;
+      if (!text(&options.stats_file)) return fail(needValue());
     } else if (flag == "--battery") {
       uint64_t percent = 0;
       if (!takeValue()) return fail(needValue());
