@@ -239,7 +239,7 @@ int findFreeTcpPort() {
 
 // --- pty ----------------------------------------------------------------------------------------
 
-bool writeFrameOrDrop(transport::PseudoTerminal& pty, const std::vector<uint8_t>& frame) {
+bool writeFrameOrDrop(sim::PseudoTerminal& pty, const std::vector<uint8_t>& frame) {
   ssize_t written;
   do {
     written = ::write(pty.masterFd(), frame.data(), frame.size());

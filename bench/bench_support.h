@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 
 namespace serial_robot_driver::bench {
 
@@ -95,7 +95,7 @@ int findFreeTcpPort();
 
 /// Writes one whole frame to the pty master without blocking, the way a UART overruns: when the
 /// buffer cannot take the frame at once, the rest is dropped and false is returned.
-bool writeFrameOrDrop(transport::PseudoTerminal& pty, const std::vector<uint8_t>& frame);
+bool writeFrameOrDrop(sim::PseudoTerminal& pty, const std::vector<uint8_t>& frame);
 
 // --- results ------------------------------------------------------------------------------------
 

@@ -9,7 +9,7 @@
 //  5. delivered fraction of telemetry at 100 .. 5000 Hz
 //  6. servo/read round trip (new connection per call and persistent), wheel loop under service
 //  stress
-//  7. 1, 4 and 5 again with ~read_poll_interval (a port polled every 20 ms), and the ratios
+//  7. 1, 4 and 5 again with polling_driver_node (the same node reading every 20 ms), and the ratios
 // Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
@@ -149,14 +149,16 @@ Options parseOptions(int argc, char** argv) {
 constexpr double kLoopRate = 50.0;
 constexpr double kLoopPeriodMs = 1000.0 / kLoopRate;
 
-/// How the node reads its port.
+/// How the node reads its port: driver_node itself, or polling_driver_node (the same node with a
+/// stream that reads once per ~read_poll_interval).
 struct Variant {
   std::string name;
   std::string tag;  ///< part of the node namespace
-  double read_poll_interval;
+  std::string program;
+  double read_poll_interval;  ///< 0: event-driven
 };
-const Variant kEventDriven{"event-driven", "event", 0.0};
-const Variant kPolling{"polling 20 ms", "poll", 0.02};
+const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
+const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
 
 struct Context {
   Options options;
@@ -171,10 +173,9 @@ void require(bool condition, const std::string& what) {
 }
 
 ParamList commonParams(const std::string& port, const Variant& variant) {
-  return {{"port", port},
-          {"loop_rate", kLoopRate},
-          {"reconnect_interval", 0.2},
-          {"read_poll_interval", variant.read_poll_interval}};
+  ParamList params = {{"port", port}, {"loop_rate", kLoopRate}, {"reconnect_interval", 0.2}};
+  if (variant.read_poll_interval > 0) params.emplace_back("read_poll_interval", variant.read_poll_interval);
+  return params;
 }
 
 struct LatencyResult {
@@ -346,7 +347,7 @@ struct BaseSessionResult {
 BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool time_cmd_vel,
                                  bool measure_idle_loop) {
   const std::string ns = "base_" + variant.tag;
-  transport::PseudoTerminal pty(context.paths.link(ns));
+  sim::PseudoTerminal pty(context.paths.link(ns));
   SpeedFrameLog log;
   protocol::FramerConfig framer;
   framer.base = true;
@@ -358,7 +359,7 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
                                {"servo_bus/enabled", false},
                                {"base/speed_dithering", false},   // one tick value per command
                                {"base/max_wheel_speed", 20.0}});  // room for 600 distinct ticks
-  DriverProcess driver(context.paths, ns, params);
+  DriverProcess driver(context.paths, ns, params, variant.program);
   ros::Publisher publisher =
       context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
   require(waitUntil([&] { return log.count() > 0; }, 30s),
@@ -412,7 +413,7 @@ class TelemetryProbe {
   std::size_t capacity() const { return written_.size(); }
 
   /// Writes frame `seq`; false when the pty could not take it at once (dropped, like an overrun).
-  bool write(transport::PseudoTerminal& pty, uint32_t seq) {
+  bool write(sim::PseudoTerminal& pty, uint32_t seq) {
     const std::vector<uint8_t> frame = encode(seq);
     // Locked across write + timestamp so the answer cannot be matched before its write time.
     std::lock_guard<std::mutex> lock(mutex_);
@@ -482,7 +483,7 @@ struct RateStep {
 
 /// Writes `count` frames at `rate_hz` (absolute schedule), numbered from *next_seq, then waits up
 /// to 1 s for the last joint_states to come in.
-RateStep streamTelemetry(TelemetryProbe& probe, transport::PseudoTerminal& pty, double rate_hz,
+RateStep streamTelemetry(TelemetryProbe& probe, sim::PseudoTerminal& pty, double rate_hz,
                          std::size_t count, uint32_t* next_seq) {
   RateStep step;
   step.target_hz = rate_hz;
@@ -517,7 +518,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
   constexpr double kLatencyRateHz = 100.0;
   const Options& options = context.options;
   const std::string ns = "body_" + variant.tag;
-  transport::PseudoTerminal pty(context.paths.link(ns));
+  sim::PseudoTerminal pty(context.paths.link(ns));
   ParamList params = commonParams(pty.linkPath(), variant);
   params.insert(params.end(), {{"base/enabled", false}, {"servo_bus/enabled", false}});
   const ParamList body_params = TelemetryProbe::nodeParams();
@@ -525,7 +526,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
 
   std::size_t capacity = kWarmUpFrames + options.telemetry_frames;
   for (double rate : options.rates) capacity += std::lround(rate * options.rate_step_seconds);
-  DriverProcess driver(context.paths, ns, params);
+  DriverProcess driver(context.paths, ns, params, variant.program);
   TelemetryProbe probe(context.nh, driver.topic("joint_states"), capacity);
 
   // Warm-up: 50 Hz until the node is connected, publishing, and this subscriber is attached.
@@ -867,10 +868,10 @@ int main(int argc, char** argv) {
 
   bench::RunPaths paths;
   paths.bin_dir = options.bin_dir.empty() ? bench::executableDirectory() : options.bin_dir;
-  for (const char* program : {"driver_node", "robot_sim"}) {
+  for (const char* program : {"driver_node", "polling_driver_node", "robot_sim"}) {
     if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
       std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
-                << " not found: build driver_node and robot_sim first\n";
+                << " not found: build the driver_bench target first\n";
       return 2;
     }
   }

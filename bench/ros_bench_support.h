@@ -40,11 +40,13 @@ using ParamList = std::vector<std::pair<std::string, XmlRpc::XmlRpcValue>>;
 XmlRpc::XmlRpcValue toXmlRpc(const std::vector<int>& values);
 XmlRpc::XmlRpcValue toXmlRpc(const std::vector<std::string>& values);
 
-/// One driver_node in namespace `ns`, named "driver"; `params` are set under its private
-/// namespace before it starts. Stopped (SIGINT: it writes its zero-speed frame) on destruction.
+/// One driver_node (or `program`, a build of the same node such as polling_driver_node) in
+/// namespace `ns`, named "driver"; `params` are set under its private namespace before it starts.
+/// Stopped (SIGINT: it writes its zero-speed frame) on destruction.
 class DriverProcess {
  public:
-  DriverProcess(const RunPaths& paths, const std::string& ns, const ParamList& params);
+  DriverProcess(const RunPaths& paths, const std::string& ns, const ParamList& params,
+                const std::string& program = "driver_node");
   /// A name in the node's namespace, e.g. topic("cmd_vel") = "/<ns>/cmd_vel".
   std::string topic(const std::string& name) const { return "/" + ns_ + "/" + name; }
   pid_t pid() const { return process_->pid(); }

@@ -6,9 +6,16 @@ add_executable(driver_bench
   bench/ros_bench_support.cpp
   test/support/pty_frame_reader.cpp)  # the tests' pty reader; srd_test_support exists only with tests
 target_include_directories(driver_bench PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})
-target_link_libraries(driver_bench srd_core ${catkin_LIBRARIES})
-# The benchmark launches these executables, so building it builds them.
-add_dependencies(driver_bench driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
+target_link_libraries(driver_bench srd_core srd_sim ${catkin_LIBRARIES})
 
-install(TARGETS driver_bench RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# The same node reading its ports once per ~read_poll_interval: the polling side of section 7.
+add_executable(polling_driver_node bench/polling_driver_node_main.cpp bench/polling_stream.cpp)
+target_include_directories(polling_driver_node PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(polling_driver_node srd_ros)
+
+# The benchmark launches these executables, so building it builds them.
+add_dependencies(driver_bench driver_node polling_driver_node robot_sim
+  ${PROJECT_NAME}_generate_messages_cpp)
+
+install(TARGETS driver_bench polling_driver_node RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 install(PROGRAMS bench/run_benchmarks.sh DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

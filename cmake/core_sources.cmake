@@ -8,15 +8,16 @@ set(SRD_CORE_SOURCES
   src/protocol/stream_framer.cpp
   src/kinematics/diff_drive.cpp
   src/transport/serial_port.cpp
-  src/transport/pseudo_terminal.cpp
   src/device/serial_link.cpp
   src/device/base_controller.cpp
   src/device/body_controller.cpp
   src/device/servo_bus_client.cpp
 )
 
-# The simulated robot (ROS-free as well): robot_sim and the tests drive it.
+# The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,
+# the tests and the benchmarks use them; the driver never does.
 set(SRD_SIM_SOURCES
+  src/sim/pseudo_terminal.cpp
   src/sim/base_sim.cpp
   src/sim/body_sim.cpp
   src/sim/servo_bus_sim.cpp

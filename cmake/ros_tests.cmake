@@ -9,7 +9,7 @@ add_library(srd_test_support STATIC
   test/support/ros_test_support.cpp)
 target_include_directories(srd_test_support PUBLIC ${PROJECT_SOURCE_DIR}/test
   PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(srd_test_support PUBLIC srd_core ${catkin_LIBRARIES})
+target_link_libraries(srd_test_support PUBLIC srd_core srd_sim ${catkin_LIBRARIES})
 add_dependencies(srd_test_support ${PROJECT_NAME}_generate_messages_cpp)
 
 add_rostest_gtest(test_base_node test/rostest/base_node.test test/rostest/test_base_node.cpp)

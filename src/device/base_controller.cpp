@@ -12,9 +12,10 @@ namespace {
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 }  // namespace
 
-BaseController::BaseController(BaseConfig config, FrameWriter writer)
+BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents events)
     : config_(config),
       writer_(std::move(writer)),
+      events_(std::move(events)),
       period_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / config.loop_rate))),
       limiter_(config.max_wheel_accel),
       quantizer_(config.geometry, config.speed_dithering) {}
@@ -74,16 +75,16 @@ void BaseController::stop() {
   wake_.notify_all();
   if (loop_.joinable()) loop_.join();
   // Last words: a zero-speed frame, so the wheels stop now rather than at the base's 1 s timeout.
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<uint8_t> frame = base::encodeWheelSpeed(seq_.peek(), 0, 0);
-  const uint8_t seq = seq_.peek();
-  if (writeLocked(frame, Clock::now())) {
-    ++stats_.speed_frames;
-    WheelFrameSent sent;
-    sent.seq = seq;
+  WheelFrameSent sent;
+  bool written = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sent.seq = seq_.peek();
     sent.time = Clock::now();
-    if (on_wheel_frame) on_wheel_frame(sent);
+    written = writeLocked(base::encodeWheelSpeed(sent.seq, 0, 0), sent.time);
+    if (written) ++stats_.speed_frames;
   }
+  if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
 }
 
 BaseStats BaseController::stats() const {
@@ -130,7 +131,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
         command_pending_ = true;  // Reset on the wire now, not at the next tick
       }
       wake_.notify_all();
-      if (on_timeout_error) on_timeout_error();
+      if (events_.on_timeout_error) events_.on_timeout_error();
       break;
     }
     case base::Reply::Kind::kBattery: {
@@ -139,7 +140,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
         ++stats_.battery_replies;
         stats_.battery_percent = reply->battery_percent;
       }
-      if (on_battery) on_battery(reply->battery_percent);
+      if (events_.on_battery) events_.on_battery(reply->battery_percent);
       break;
     }
     case base::Reply::Kind::kUnknown: {
@@ -147,7 +148,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
         std::lock_guard<std::mutex> lock(mutex_);
         ++stats_.unknown_replies;
       }
-      if (on_unknown_reply) on_unknown_reply(reply->frame);
+      if (events_.on_unknown_reply) events_.on_unknown_reply(reply->frame);
       break;
     }
   }
@@ -210,7 +211,7 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
       last_speed_frame_ = now;
     }
   }
-  if (written && on_wheel_frame) on_wheel_frame(sent);
+  if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
 }
 
 void BaseController::tick(Clock::time_point now) {

@@ -55,29 +55,27 @@ std::string JointCommandResult::message() const {
   return "unknown joint command status";
 }
 
-BodyController::BodyController(std::vector<BodyJoint> joints, WriteFunction write,
-                               TelemetryCallback on_telemetry)
+BodyController::BodyController(std::vector<BodyJoint> joints, FrameWriter writer, BodyEvents events)
     : joints_(std::move(joints)),
-      write_(std::move(write)),
-      on_telemetry_(std::move(on_telemetry)),
+      writer_(std::move(writer)),
+      events_(std::move(events)),
       last_commanded_ticks_(joints_.size()) {}
-
-BodyController::WriteFunction BodyController::writerFor(SerialLink& link) {
-  return [&link](const std::vector<uint8_t>& frame) { return link.write(frame); };
-}
 
 void BodyController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                              Clock::time_point arrival) {
   // A shared port hands every listener every frame: only telemetry is ours.
   if (family != protocol::FrameFamily::kTelemetry) return;
   const auto telemetry = protocol::body::decodeTelemetry(data, size, joints_.size());
-  if (!telemetry) {
-    decode_errors_.fetch_add(1);
-    last_decode_error_.store(static_cast<int>(telemetry.error()));
-    return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!telemetry) {
+      ++stats_.decode_errors;
+      stats_.last_decode_error = telemetry.error();
+      return;
+    }
+    ++stats_.frames_decoded;
   }
-  frames_decoded_.fetch_add(1);
-  if (on_telemetry_) on_telemetry_(*telemetry, arrival);
+  if (events_.on_telemetry) events_.on_telemetry(*telemetry, arrival);
 }
 
 JointCommandResult BodyController::sendJointCommand(const std::vector<std::string>& names,
@@ -110,9 +108,9 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
     if (result.ok()) result.joint.clear();
   }
 
-  std::lock_guard<std::mutex> lock(command_mutex_);
+  std::lock_guard<std::mutex> lock(mutex_);
   if (!result.ok()) {
-    ++commands_rejected_;
+    ++stats_.commands_rejected;
     return result;
   }
   std::vector<protocol::body::ServoTarget> targets;
@@ -123,26 +121,18 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
       targets.push_back({joints_[i].servo_id, *last_commanded_ticks_[i]});
   }
   // Writing under the lock keeps frames in the order their positions were stored.
-  if (!write_ || !write_(protocol::body::encodeSyncWrite(targets))) {
-    ++write_failures_;
+  if (!writer_ || !writer_(protocol::body::encodeSyncWrite(targets))) {
+    ++stats_.write_failures;
     result.status = JointCommandStatus::kWriteFailed;
     return result;
   }
-  ++commands_sent_;
+  ++stats_.commands_sent;
   return result;
 }
 
 BodyStats BodyController::stats() const {
-  BodyStats stats;
-  stats.frames_decoded = frames_decoded_.load();
-  stats.decode_errors = decode_errors_.load();
-  const int last_error = last_decode_error_.load();
-  if (last_error >= 0) stats.last_decode_error = static_cast<protocol::DecodeError>(last_error);
-  std::lock_guard<std::mutex> lock(command_mutex_);
-  stats.commands_sent = commands_sent_;
-  stats.commands_rejected = commands_rejected_;
-  stats.write_failures = write_failures_;
-  return stats;
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
 }
 
 }  // namespace serial_robot_driver::device

@@ -50,6 +50,10 @@ void SerialLink::stop() {
 
 bool SerialLink::write(const std::vector<uint8_t>& frame) { return write(frame.data(), frame.size()); }
 
+FrameWriter SerialLink::writer() {
+  return [this](const std::vector<uint8_t>& frame) { return write(frame); };
+}
+
 bool SerialLink::write(const uint8_t* data, std::size_t size) {
   std::string error;
   {
@@ -109,17 +113,12 @@ bool SerialLink::tryOpen() {
     return false;
   }
   framer_.reset();  // a partial frame from before the loss means nothing now
-  bool low_latency = false;
-  std::optional<int> latency_timer;
-  if (auto* port = dynamic_cast<transport::SerialPort*>(stream.get())) {
-    low_latency = port->lowLatencyEnabled();
-    latency_timer = port->latencyTimerMs();
-  }
+  const transport::StreamInfo info = stream->info();
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.connects;
-    stats_.low_latency = low_latency;
-    stats_.latency_timer_ms = latency_timer;
+    stats_.low_latency = info.low_latency;
+    stats_.latency_timer_ms = info.latency_timer_ms;
   }
   // Listeners hear "up" before any write can succeed: the base must have queued its Reset first.
   for (LinkListener* listener : listeners_) listener->onLinkUp();
@@ -160,10 +159,6 @@ void SerialLink::sleepBeforeRetry() {
 
 void SerialLink::readerLoop() {
   std::array<uint8_t, kReadChunk> chunk{};
-  const bool polling = options_.poll_interval > 0;
-  const auto poll_period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(polling ? options_.poll_interval : 1.0));
-  Clock::time_point next_poll = Clock::now();
   while (!stopping_) {
     if (!connected_) {
       if (!tryOpen()) sleepBeforeRetry();
@@ -179,13 +174,9 @@ void SerialLink::readerLoop() {
       sleepBeforeRetry();
       continue;
     }
-    if (polling) {
-      next_poll += poll_period;
-      std::this_thread::sleep_until(next_poll);
-    }
     std::size_t n = 0;
     try {
-      n = stream_->read(chunk.data(), chunk.size(), polling ? 0 : kReadTimeoutMs);
+      n = stream_->read(chunk.data(), chunk.size(), kReadTimeoutMs);
     } catch (const transport::TransportError& e) {
       closeStream(e.what());
       sleepBeforeRetry();

@@ -167,8 +167,8 @@ const char* toString(ServoError error) {
   return "unknown";
 }
 
-ServoBusClient::ServoBusClient(ServoBusOptions options, WriteFunction write)
-    : options_(std::move(options)), write_(std::move(write)) {}
+ServoBusClient::ServoBusClient(ServoBusOptions options, FrameWriter writer)
+    : options_(std::move(options)), writer_(std::move(writer)) {}
 
 ServoBusStats ServoBusClient::stats() const {
   std::lock_guard<std::mutex> lock(state_mutex_);
@@ -253,7 +253,7 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
       link_lost_ = false;
     }
     const Clock::time_point sent_at = Clock::now();
-    if (!write_(request)) {
+    if (!writer_(request)) {
       std::lock_guard<std::mutex> lock(state_mutex_);
       pending_.active = false;
       return notConnected();
@@ -323,7 +323,7 @@ ServoStatus ServoBusClient::sendCommand(const std::vector<uint8_t>& request, Com
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
     last_request_ = request;
   }
-  if (!write_(request)) return notConnected();
+  if (!writer_(request)) return notConnected();
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.commands;

@@ -21,15 +21,10 @@ device::BaseConfig makeBaseConfig(const DriverParams& params) {
   return config;
 }
 
-BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                             diagnostic_updater::Updater& diagnostics)
-    : link_(link),
-      controller_(makeBaseConfig(params),
-                  [&link](const std::vector<uint8_t>& frame) { return link.write(frame); }) {
-  wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
-  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", 5);
-
-  controller_.on_wheel_frame = [this](const device::WheelFrameSent& sent) {
+device::BaseEvents BaseInterface::events() {
+  // The publishers are advertised in the constructor's body, before the controller can report.
+  device::BaseEvents events;
+  events.on_wheel_frame = [this](const device::WheelFrameSent& sent) {
     if (wheel_command_pub_.getNumSubscribers() == 0) return;  // 50 Hz: skip work nobody reads
     serial_robot_driver::WheelCommand msg;
     msg.header.stamp = ros::Time::now();
@@ -41,7 +36,7 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, de
     msg.right_speed = sent.speeds.y();
     wheel_command_pub_.publish(msg);
   };
-  controller_.on_battery = [this](uint8_t percent) {
+  events.on_battery = [this](uint8_t percent) {
     sensor_msgs::BatteryState msg;
     msg.header.stamp = ros::Time::now();
     // The base reports only a percentage; everything else is unknown (NaN per the message docs).
@@ -55,12 +50,21 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, de
     msg.present = true;
     battery_pub_.publish(msg);
   };
-  controller_.on_timeout_error = [] {
+  events.on_timeout_error = [] {
     ROS_WARN_THROTTLE(5.0, "base reported a connection-timeout error (FF): sending Reset");
   };
-  controller_.on_unknown_reply = [](const protocol::base::Frame& frame) {
+  events.on_unknown_reply = [](const protocol::base::Frame& frame) {
     ROS_DEBUG_THROTTLE(5.0, "base sent a frame with unknown MSGID 0x%02X", frame.msg_id);
   };
+  return events;
+}
+
+BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
+                             diagnostic_updater::Updater& diagnostics)
+    : link_(link), controller_(makeBaseConfig(params), link.writer(), events()) {
+  wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
+  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", 5);
+
   link.addListener(&controller_);
 
   // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.

@@ -13,11 +13,9 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
     : link_(link),
       imu_params_(params.imu),
-      controller_(
-          makeBodyJoints(params.body), device::BodyController::writerFor(link),
-          [this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
-            publishTelemetry(telemetry, arrival);
-          }),
+      controller_(makeBodyJoints(params.body), link.writer(),
+                  {[this](const protocol::body::Telemetry& telemetry,
+                          device::Clock::time_point arrival) { publishTelemetry(telemetry, arrival); }}),
       telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
                       "telemetry rate") {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.

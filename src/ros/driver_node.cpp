@@ -1,5 +1,7 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
+#include <functional>
+
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
 #include "serial_robot_driver/ros/servo_bus_interface.h"
@@ -40,7 +42,41 @@ class PortMonitor : public device::LinkListener {
   bool waiting_logged_ = false;  // reader thread only
 };
 
-DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params)
+namespace {
+
+/// One kind of device the node can drive: whether it is enabled, where it is, and how its ROS
+/// interface is built. A new device is one more row in devices().
+struct DeviceEntry {
+  bool enabled;
+  std::string port;
+  int baud;
+  bool base, body, servo_bus;  ///< the frame families its port's framer must accept
+  std::function<std::unique_ptr<DeviceInterface>(ros::NodeHandle&, const DriverParams&,
+                                                 device::SerialLink&, diagnostic_updater::Updater&)>
+      make;
+};
+
+template <typename Interface>
+std::unique_ptr<DeviceInterface> make(ros::NodeHandle& nh, const DriverParams& params,
+                                      device::SerialLink& link, diagnostic_updater::Updater& diagnostics) {
+  return std::make_unique<Interface>(nh, params, link, diagnostics);
+}
+
+/// In start and shutdown order: the base first, so its zero-speed frame goes out before anything
+/// else stops.
+std::vector<DeviceEntry> devices(const DriverParams& p) {
+  return {
+      {p.base.enabled, p.basePort(), p.baseBaud(), true, false, false, make<BaseInterface>},
+      {p.body.enabled, p.bodyPort(), p.bodyBaud(), false, true, false, make<BodyInterface>},
+      {p.servo_bus.enabled, p.servoBusPort(), p.servoBusBaud(), false, false, true,
+       make<ServoBusInterface>},
+  };
+}
+
+}  // namespace
+
+DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
+                       device::SerialLink::StreamFactory stream_factory)
     : nh_(nh), params_(std::move(params)), diagnostics_(nh, private_nh) {
   diagnostics_.setHardwareID("serial_robot_driver");
 
@@ -49,29 +85,25 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     bool base = false, body = false, servo_bus = false;
     int baud = 0;
   };
+  const std::vector<DeviceEntry> entries = devices(params_);
   std::map<std::string, Users> users;
-  if (params_.base.enabled) {
-    users[params_.basePort()].base = true;
-    users[params_.basePort()].baud = params_.baseBaud();
-  }
-  if (params_.body.enabled) {
-    users[params_.bodyPort()].body = true;
-    users[params_.bodyPort()].baud = params_.bodyBaud();
-  }
-  if (params_.servo_bus.enabled) {
-    users[params_.servoBusPort()].servo_bus = true;
-    users[params_.servoBusPort()].baud = params_.servoBusBaud();
+  for (const DeviceEntry& entry : entries) {
+    if (!entry.enabled) continue;
+    Users& use = users[entry.port];
+    use.base |= entry.base;
+    use.body |= entry.body;
+    use.servo_bus |= entry.servo_bus;
+    use.baud = entry.baud;
   }
   for (const auto& [path, use] : users) {
     device::SerialLinkOptions options;
     options.path = path;
     options.baud = static_cast<unsigned>(use.baud);
     options.reconnect_interval = params_.reconnect_interval;
-    options.poll_interval = params_.read_poll_interval;
     options.framer = protocol::FramerConfig::forDriver(use.base, use.body, use.servo_bus,
                                                        params_.body.servo_ids.size());
     Port port;
-    port.link = std::make_unique<device::SerialLink>(options);
+    port.link = std::make_unique<device::SerialLink>(options, stream_factory);
     port.monitor = std::make_unique<PortMonitor>(*port.link);
     port.link->addListener(port.monitor.get());
     Port& stored = ports_[path] = std::move(port);
@@ -80,15 +112,8 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     });
   }
 
-  if (params_.base.enabled) {
-    base_ = std::make_unique<BaseInterface>(nh_, params_, portFor(params_.basePort()), diagnostics_);
-  }
-  if (params_.body.enabled) {
-    body_ = std::make_unique<BodyInterface>(nh_, params_, portFor(params_.bodyPort()), diagnostics_);
-  }
-  if (params_.servo_bus.enabled) {
-    servo_bus_ = std::make_unique<ServoBusInterface>(nh_, params_, portFor(params_.servoBusPort()),
-                                                     diagnostics_);
+  for (const DeviceEntry& entry : entries) {
+    if (entry.enabled) devices_.push_back(entry.make(nh_, params_, portFor(entry.port), diagnostics_));
   }
   diagnostics_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0),
                                              [this](const ros::SteadyTimerEvent&) { diagnostics_.update(); });
@@ -100,15 +125,15 @@ device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports
 
 void DriverNode::start() {
   for (auto& [path, port] : ports_) port.link->start();
-  if (base_) base_->start();
+  for (auto& device : devices_) device->start();
 }
 
 void DriverNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   diagnostics_timer_.stop();
-  if (base_) base_->shutdown();  // zero-speed frame while the port is still open
-  if (servo_bus_) servo_bus_->shutdown();
+  // Base first: its zero-speed frame goes out while the port is still open.
+  for (auto& device : devices_) device->shutdown();
   for (auto& [path, port] : ports_) port.link->stop();
 }
 

@@ -97,7 +97,6 @@ void DriverParams::validate() const {
   requirePositive(loop_rate, "loop_rate");
   require(loop_rate <= 1000, "loop_rate", "must be at most 1000 Hz");
   requirePositive(reconnect_interval, "reconnect_interval");
-  requireNonNegative(read_poll_interval, "read_poll_interval");
   require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
           "every device is disabled (base, body, servo_bus): nothing to drive");
 
@@ -188,7 +187,6 @@ DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unk
   reader.read("baud", &p.baud);
   reader.read("loop_rate", &p.loop_rate);
   reader.read("reconnect_interval", &p.reconnect_interval);
-  reader.read("read_poll_interval", &p.read_poll_interval);
 
   reader.readDevice("base", &p.base);
   reader.read("base/wheel_diameter", &p.base.wheel_diameter);

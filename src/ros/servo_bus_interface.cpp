@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <string>
 #include <utility>
 
@@ -12,26 +13,60 @@ namespace {
 constexpr int kSpinnerThreads = 2;
 constexpr double kMsPerSecond = 1000.0;
 
-// Runs one service body. A service never throws through to its caller and always returns true, so
-// the caller gets the message instead of a bare "service call failed".
-template <typename Body, typename Fail>
-bool serve(const char* service, Body&& body, Fail&& fail) {
-  try {
-    body();
-  } catch (const std::exception& error) {
-    ROS_ERROR("%s: internal error: %s", service, error.what());
-    fail(std::string("internal error: ") + error.what());
-  }
-  return true;
-}
-
-void logOutcome(const char* service, const device::ServoStatus& status) {
+void logOutcome(const std::string& service, const device::ServoStatus& status) {
   if (status.ok()) {
-    ROS_DEBUG("%s: %s", service, status.message.c_str());
+    ROS_DEBUG("%s: %s", service.c_str(), status.message.c_str());
   } else {
-    ROS_DEBUG("%s failed (%s): %s", service, device::toString(status.error),
+    ROS_DEBUG("%s failed (%s): %s", service.c_str(), device::toString(status.error),
               status.message.c_str());
   }
+}
+
+// The outcome fields every servo/* response has; servo/ping calls its flag `online`.
+template <typename Response>
+void setOutcome(Response& res, bool ok, const std::string& message) {
+  res.success = ok;
+  res.message = message;
+}
+void setOutcome(ServoPing::Response& res, bool ok, const std::string& message) {
+  res.online = ok;
+  res.message = message;
+}
+
+/// Whether a successful call is logged at INFO (it changed a servo's settings) or DEBUG only.
+enum class Announce { kDebug, kInfo };
+
+/// The client operation behind one service: it fills the response's own fields (values, angle)
+/// and returns the status; the outcome fields are filled by advertiseServo().
+template <typename Service>
+using ServoCall =
+    std::function<device::ServoStatus(typename Service::Request&, typename Service::Response&)>;
+
+/// Advertises one servo/* service from its call. The service logs the outcome, never throws
+/// through to its caller and always returns true, so the caller gets the message instead of a bare
+/// "service call failed".
+template <typename Service>
+ros::ServiceServer advertiseServo(ros::NodeHandle& nh, const std::string& name,
+                                  ServoCall<Service> call, Announce announce = Announce::kDebug) {
+  using Request = typename Service::Request;
+  using Response = typename Service::Response;
+  const boost::function<bool(Request&, Response&)> serve = [name, call, announce](Request& req,
+                                                                                  Response& res) {
+    try {
+      const device::ServoStatus status = call(req, res);
+      logOutcome(name, status);
+      if (status.ok() && announce == Announce::kInfo) {
+        ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
+      }
+      setOutcome(res, status.ok(), status.message);
+    } catch (const std::exception& error) {
+      ROS_ERROR("%s: internal error: %s", name.c_str(), error.what());
+      res = Response();
+      setOutcome(res, false, std::string("internal error: ") + error.what());
+    }
+    return true;
+  };
+  return nh.advertiseService<Request, Response>(name, serve);
 }
 
 }  // namespace
@@ -49,8 +84,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                      device::SerialLink& link,
                                      diagnostic_updater::Updater& diagnostics)
     : link_(link),
-      client_(makeServoBusOptions(params),
-              [&link](const std::vector<uint8_t>& frame) { return link.write(frame); }),
+      client_(makeServoBusOptions(params), link.writer()),
       diagnostics_(diagnostics),
       nh_(nh) {
   link_.addListener(&client_);
@@ -58,23 +92,91 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
   // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
   // wait = true) and must never hold up cmd_vel or joint_commands on the global queue.
   nh_.setCallbackQueue(&queue_);
-  services_.push_back(nh_.advertiseService("servo/ping", &ServoBusInterface::onPing, this));
-  services_.push_back(nh_.advertiseService("servo/read", &ServoBusInterface::onRead, this));
-  services_.push_back(nh_.advertiseService("servo/write", &ServoBusInterface::onWrite, this));
-  services_.push_back(
-      nh_.advertiseService("servo/read_angle", &ServoBusInterface::onReadAngle, this));
-  services_.push_back(nh_.advertiseService("servo/rotate", &ServoBusInterface::onRotate, this));
-  services_.push_back(nh_.advertiseService("servo/spin", &ServoBusInterface::onSpin, this));
-  services_.push_back(nh_.advertiseService("servo/damping", &ServoBusInterface::onDamping, this));
-  services_.push_back(nh_.advertiseService("servo/read_all", &ServoBusInterface::onReadAll, this));
-  services_.push_back(
-      nh_.advertiseService("servo/reset_user_data", &ServoBusInterface::onResetUserData, this));
+  services_ = {
+      advertiseServo<ServoPing>(nh_, "servo/ping",
+                                [this](ServoPing::Request& req, ServoPing::Response&) {
+                                  return client_.ping(req.id);
+                                }),
+      advertiseServo<ServoRead>(nh_, "servo/read",
+                                [this](ServoRead::Request& req, ServoRead::Response& res) {
+                                  device::ServoParamValue value;
+                                  const device::ServoStatus status =
+                                      client_.readParam(req.id, req.param, &value);
+                                  if (status.ok()) {
+                                    res.value = value.value;
+                                    res.unit = value.unit;
+                                  }
+                                  return status;
+                                }),
+      advertiseServo<ServoWrite>(
+          nh_, "servo/write",
+          [this](ServoWrite::Request& req, ServoWrite::Response&) {
+            return client_.writeParam(req.id, req.param, req.value);
+          },
+          Announce::kInfo),
+      advertiseServo<ServoReadAngle>(
+          nh_, "servo/read_angle",
+          [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
+            double angle_deg = 0.0;
+            const device::ServoStatus status = client_.readAngle(req.id, &angle_deg);
+            res.angle_deg = status.ok() ? angle_deg : 0.0;
+            return status;
+          }),
+      advertiseServo<ServoRotate>(nh_, "servo/rotate",
+                                  [this](ServoRotate::Request& req, ServoRotate::Response&) {
+                                    device::RotateRequest request;
+                                    request.id = req.id;
+                                    request.angle_deg = req.angle_deg;
+                                    request.interval_ms = req.interval_ms;
+                                    request.power_mw = req.power_mw;
+                                    request.wait = req.wait;
+                                    return client_.rotate(request);
+                                  }),
+      advertiseServo<ServoSpin>(nh_, "servo/spin",
+                                [this](ServoSpin::Request& req, ServoSpin::Response&) {
+                                  device::SpinRequest request;
+                                  request.id = req.id;
+                                  request.clockwise = req.clockwise;
+                                  request.mode = req.mode;
+                                  request.speed_dps = req.speed_dps;
+                                  request.value = req.value;
+                                  request.wait = req.wait;
+                                  return client_.spin(request);
+                                }),
+      advertiseServo<ServoDamping>(nh_, "servo/damping",
+                                   [this](ServoDamping::Request& req, ServoDamping::Response&) {
+                                     return client_.damping(req.id, req.power_mw, req.wait);
+                                   }),
+      advertiseServo<ServoReadAll>(
+          nh_, "servo/read_all",
+          [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
+            std::vector<device::ServoParamValue> values;
+            const device::ServoStatus status = client_.readAll(req.id, &values);
+            res.names.clear();
+            res.values.clear();
+            for (const device::ServoParamValue& value : values) {
+              res.names.push_back(value.name);
+              res.values.push_back(value.value);
+            }
+            return status;
+          }),
+      advertiseServo<ServoResetUserData>(
+          nh_, "servo/reset_user_data",
+          [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
+            return client_.resetUserData(req.id);
+          },
+          Announce::kInfo),
+  };
 
   diagnostics_.add("serial_robot_driver: servo_bus", this, &ServoBusInterface::diagnose);
 
   if (params.servo_bus.allow_dangerous_writes) {
     ROS_WARN("servo_bus: dangerous writes (servo_id, baudrate, reset_user_data) are ARMED");
   }
+}
+
+void ServoBusInterface::start() {
+  if (spinner_ || shut_down_) return;
   // Two threads: one call waits on the bus while another is accepted and queued behind the bus
   // mutex, so ROS never sees the service as unresponsive.
   spinner_ = std::make_unique<ros::AsyncSpinner>(kSpinnerThreads, &queue_);
@@ -90,173 +192,6 @@ void ServoBusInterface::shutdown() {
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
   diagnostics_.removeByName("serial_robot_driver: servo_bus");
-}
-
-bool ServoBusInterface::onPing(ServoPing::Request& req, ServoPing::Response& res) {
-  return serve(
-      "servo/ping",
-      [&] {
-        const device::ServoStatus status = client_.ping(req.id);
-        logOutcome("servo/ping", status);
-        res.online = status.ok();
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.online = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onRead(ServoRead::Request& req, ServoRead::Response& res) {
-  return serve(
-      "servo/read",
-      [&] {
-        device::ServoParamValue value;
-        const device::ServoStatus status = client_.readParam(req.id, req.param, &value);
-        logOutcome("servo/read", status);
-        res.success = status.ok();
-        res.message = status.message;
-        if (status.ok()) {
-          res.value = value.value;
-          res.unit = value.unit;
-        }
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onWrite(ServoWrite::Request& req, ServoWrite::Response& res) {
-  return serve(
-      "servo/write",
-      [&] {
-        const device::ServoStatus status = client_.writeParam(req.id, req.param, req.value);
-        logOutcome("servo/write", status);
-        if (status.ok()) ROS_INFO("servo/write: %s", status.message.c_str());
-        res.success = status.ok();
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onReadAngle(ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
-  return serve(
-      "servo/read_angle",
-      [&] {
-        double angle_deg = 0.0;
-        const device::ServoStatus status = client_.readAngle(req.id, &angle_deg);
-        logOutcome("servo/read_angle", status);
-        res.success = status.ok();
-        res.angle_deg = status.ok() ? angle_deg : 0.0;
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onRotate(ServoRotate::Request& req, ServoRotate::Response& res) {
-  return serve(
-      "servo/rotate",
-      [&] {
-        device::RotateRequest request;
-        request.id = req.id;
-        request.angle_deg = req.angle_deg;
-        request.interval_ms = req.interval_ms;
-        request.power_mw = req.power_mw;
-        request.wait = req.wait;
-        const device::ServoStatus status = client_.rotate(request);
-        logOutcome("servo/rotate", status);
-        res.success = status.ok();
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onSpin(ServoSpin::Request& req, ServoSpin::Response& res) {
-  return serve(
-      "servo/spin",
-      [&] {
-        device::SpinRequest request;
-        request.id = req.id;
-        request.clockwise = req.clockwise;
-        request.mode = req.mode;
-        request.speed_dps = req.speed_dps;
-        request.value = req.value;
-        request.wait = req.wait;
-        const device::ServoStatus status = client_.spin(request);
-        logOutcome("servo/spin", status);
-        res.success = status.ok();
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onDamping(ServoDamping::Request& req, ServoDamping::Response& res) {
-  return serve(
-      "servo/damping",
-      [&] {
-        const device::ServoStatus status = client_.damping(req.id, req.power_mw, req.wait);
-        logOutcome("servo/damping", status);
-        res.success = status.ok();
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
-}
-
-bool ServoBusInterface::onReadAll(ServoReadAll::Request& req, ServoReadAll::Response& res) {
-  return serve(
-      "servo/read_all",
-      [&] {
-        std::vector<device::ServoParamValue> values;
-        const device::ServoStatus status = client_.readAll(req.id, &values);
-        logOutcome("servo/read_all", status);
-        res.success = status.ok();
-        res.message = status.message;
-        res.names.clear();
-        res.values.clear();
-        for (const device::ServoParamValue& value : values) {
-          res.names.push_back(value.name);
-          res.values.push_back(value.value);
-        }
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-        res.names.clear();
-        res.values.clear();
-      });
-}
-
-bool ServoBusInterface::onResetUserData(ServoResetUserData::Request& req,
-                                        ServoResetUserData::Response& res) {
-  return serve(
-      "servo/reset_user_data",
-      [&] {
-        const device::ServoStatus status = client_.resetUserData(req.id);
-        logOutcome("servo/reset_user_data", status);
-        if (status.ok()) ROS_INFO("servo/reset_user_data: %s", status.message.c_str());
-        res.success = status.ok();
-        res.message = status.message;
-      },
-      [&](const std::string& message) {
-        res.success = false;
-        res.message = message;
-      });
 }
 
 void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

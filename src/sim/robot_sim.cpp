@@ -18,12 +18,11 @@
 #include <stdexcept>
 
 #include "serial_robot_driver/transport/byte_stream.h"
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 
 namespace serial_robot_driver::sim {
 
 using protocol::FrameFamily;
-using transport::PseudoTerminal;
 
 namespace {
 

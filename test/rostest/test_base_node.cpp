@@ -34,14 +34,14 @@
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/base_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/pty_frame_reader.h"
 #include "support/ros_test_support.h"
 
 namespace {
 
 namespace protocol = serial_robot_driver::protocol;
-namespace transport = serial_robot_driver::transport;
+namespace sim = serial_robot_driver::sim;
 using test_support::Bytes;
 using test_support::ChildProcess;
 using test_support::Clock;
@@ -108,7 +108,7 @@ class FakeBase {
       undecodable_ = 0;
     }
     unplugged_framer_stats_ = protocol::FramerStats{};
-    pty_ = std::make_unique<transport::PseudoTerminal>(path_);
+    pty_ = std::make_unique<sim::PseudoTerminal>(path_);
     plugged_at_ = Clock::now();
     protocol::FramerConfig config;
     config.base = true;
@@ -172,7 +172,7 @@ class FakeBase {
   }
 
   const std::string path_;
-  std::unique_ptr<transport::PseudoTerminal> pty_;
+  std::unique_ptr<sim::PseudoTerminal> pty_;
   std::unique_ptr<test_support::PtyFrameReader> reader_;
   protocol::FramerStats unplugged_framer_stats_;  // the last session's, once unplugged
   Clock::time_point plugged_at_;

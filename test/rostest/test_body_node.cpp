@@ -33,7 +33,7 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/ros_test_support.h"
 
 namespace {
@@ -156,7 +156,7 @@ ros::Subscriber subscribe(ros::NodeHandle& nh, const std::string& topic, Inbox<M
 // ---------------------------------------------------------------------------
 
 struct Board {
-  std::unique_ptr<serial_robot_driver::transport::PseudoTerminal> pty;
+  std::unique_ptr<serial_robot_driver::sim::PseudoTerminal> pty;
   Inbox<JointState> joints;
   Inbox<Imu> imu;
   Inbox<FootPressure> foot;
@@ -541,7 +541,7 @@ int main(int argc, char** argv) {
 
   Board board;
   // The pty first: the node keeps retrying its port until the symlink exists.
-  board.pty = std::make_unique<serial_robot_driver::transport::PseudoTerminal>(port);
+  board.pty = std::make_unique<serial_robot_driver::sim::PseudoTerminal>(port);
   board.subscribers.push_back(subscribe(nh, "joint_states", &board.joints));
   board.subscribers.push_back(subscribe(nh, "imu/data", &board.imu));
   board.subscribers.push_back(subscribe(nh, "foot_pressure", &board.foot));

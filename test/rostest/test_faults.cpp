@@ -40,7 +40,7 @@
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/pty_frame_reader.h"
 #include "support/ros_test_support.h"
 
@@ -48,7 +48,6 @@ namespace {
 
 namespace protocol = serial_robot_driver::protocol;
 namespace sim = serial_robot_driver::sim;
-namespace transport = serial_robot_driver::transport;
 namespace srd = serial_robot_driver;
 using test_support::TopicCounter;
 using test_support::waitFor;
@@ -80,7 +79,7 @@ class HandPlayedRobot {
       std::lock_guard<std::mutex> lock(mutex_);
       msg_ids_.clear();
     }
-    pty_ = std::make_unique<transport::PseudoTerminal>(path_);
+    pty_ = std::make_unique<sim::PseudoTerminal>(path_);
     protocol::FramerConfig config;
     config.base = true;
     reader_ = std::make_unique<test_support::PtyFrameReader>(
@@ -116,7 +115,7 @@ class HandPlayedRobot {
 
  private:
   const std::string path_;
-  std::unique_ptr<transport::PseudoTerminal> pty_;
+  std::unique_ptr<sim::PseudoTerminal> pty_;
   std::unique_ptr<test_support::PtyFrameReader> reader_;
   mutable std::mutex mutex_;
   std::vector<uint8_t> msg_ids_;

@@ -32,7 +32,7 @@
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/pty_frame_reader.h"
 #include "support/ros_test_support.h"
 #include "support/servo_bus_frames.h"
@@ -41,7 +41,7 @@ namespace {
 
 namespace srd = serial_robot_driver;
 namespace protocol = serial_robot_driver::protocol;
-namespace transport = serial_robot_driver::transport;
+namespace sim = serial_robot_driver::sim;
 using test_support::Bytes;
 using test_support::Clock;
 using test_support::concat;
@@ -108,7 +108,7 @@ class ServoBusPlayer {
     if (!out.empty()) pty_.write(out.data(), out.size());
   }
 
-  transport::PseudoTerminal pty_;
+  sim::PseudoTerminal pty_;
   const bool echo_;
   mutable std::mutex mutex_;
   Bytes received_;

@@ -9,8 +9,9 @@ namespace test_support {
 
 namespace protocol = serial_robot_driver::protocol;
 namespace transport = serial_robot_driver::transport;
+namespace sim = serial_robot_driver::sim;
 
-PtyFrameReader::PtyFrameReader(transport::PseudoTerminal& pty, const protocol::FramerConfig& config,
+PtyFrameReader::PtyFrameReader(sim::PseudoTerminal& pty, const protocol::FramerConfig& config,
                                FrameCallback on_frame, ChunkCallback on_chunk)
     : pty_(pty),
       framer_(config, [this](protocol::FrameFamily family, const uint8_t* data,

@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "serial_robot_driver/protocol/stream_framer.h"
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 
 namespace test_support {
 
@@ -28,7 +28,7 @@ class PtyFrameReader {
   /// Every chunk as read, before the framer sees it.
   using ChunkCallback = std::function<void(const uint8_t* data, std::size_t size)>;
 
-  PtyFrameReader(serial_robot_driver::transport::PseudoTerminal& pty,
+  PtyFrameReader(serial_robot_driver::sim::PseudoTerminal& pty,
                  const serial_robot_driver::protocol::FramerConfig& config, FrameCallback on_frame,
                  ChunkCallback on_chunk = nullptr);
   /// Stops and joins the thread.
@@ -42,7 +42,7 @@ class PtyFrameReader {
  private:
   void run();
 
-  serial_robot_driver::transport::PseudoTerminal& pty_;
+  serial_robot_driver::sim::PseudoTerminal& pty_;
   serial_robot_driver::protocol::StreamFramer framer_;  // reader thread only
   Clock::time_point chunk_arrival_;
   FrameCallback on_frame_;

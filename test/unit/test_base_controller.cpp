@@ -15,8 +15,13 @@ using std::chrono::milliseconds;
 
 class BaseControllerTest : public ::testing::Test {
  protected:
-  BaseControllerTest() : controller_(config(), [this](const Bytes& frame) { return write(frame); }) {
-    controller_.on_wheel_frame = [this](const WheelFrameSent& sent) { sent_.push_back(sent); };
+  BaseControllerTest()
+      : controller_(config(), [this](const Bytes& frame) { return write(frame); }, events()) {}
+
+  BaseEvents events() {
+    BaseEvents events;
+    events.on_wheel_frame = [this](const WheelFrameSent& sent) { sent_.push_back(sent); };
+    return events;
   }
 
   static BaseConfig config() {
@@ -168,12 +173,16 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   BaseConfig config;
   config.battery_poll_rate = 1.0;
   std::vector<Bytes> frames;
-  BaseController controller(config, [&frames](const Bytes& f) {
-    frames.push_back(f);
-    return true;
-  });
   std::vector<int> percents;
-  controller.on_battery = [&percents](uint8_t p) { percents.push_back(p); };
+  BaseEvents events;
+  events.on_battery = [&percents](uint8_t p) { percents.push_back(p); };
+  BaseController controller(
+      config,
+      [&frames](const Bytes& f) {
+        frames.push_back(f);
+        return true;
+      },
+      events);
   const Clock::time_point t0 = Clock::now();
   for (int i = 0; i <= 100; ++i) controller.tick(t0 + milliseconds(20 * i));  // 2 s
   int requests = 0;

@@ -121,11 +121,11 @@ struct Received {
   std::vector<Clock::time_point> arrivals;
 };
 
-BodyController::TelemetryCallback recorder(Received* received) {
-  return [received](const Telemetry& telemetry, Clock::time_point arrival) {
+BodyEvents recorder(Received* received) {
+  return {[received](const Telemetry& telemetry, Clock::time_point arrival) {
     received->frames.push_back(telemetry);
     received->arrivals.push_back(arrival);
-  };
+  }};
 }
 
 TEST(BodyControllerTelemetry, GoldenFrameReachesTheCallbackWithItsArrivalTime) {
@@ -194,7 +194,7 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
 }
 
 TEST(BodyControllerTelemetry, WorksWithoutACallback) {
-  BodyController controller(twoJoints(), nullptr, nullptr);
+  BodyController controller(twoJoints(), nullptr);
   controller.onFrame(FrameFamily::kTelemetry, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
                      Clock::now());
   EXPECT_EQ(controller.stats().frames_decoded, 1u);
@@ -204,7 +204,7 @@ TEST(BodyControllerTelemetry, WorksWithoutACallback) {
 
 class BodyControllerCommand : public testing::Test {
  protected:
-  BodyController::WriteFunction sink() {
+  FrameWriter sink() {
     return [this](const Bytes& frame) {
       written_.push_back(frame);
       return port_up_;
@@ -213,7 +213,7 @@ class BodyControllerCommand : public testing::Test {
 
   std::vector<Bytes> written_;
   bool port_up_ = true;
-  BodyController controller_{twoJoints(), sink(), nullptr};
+  BodyController controller_{twoJoints(), sink()};
 };
 
 TEST_F(BodyControllerCommand, GoldenSyncWrite) {
@@ -317,7 +317,7 @@ TEST_F(BodyControllerCommand, RefusedWriteIsReportedAndCounted) {
 }
 
 TEST(BodyControllerCommandNoSink, MissingWriterIsAWriteFailure) {
-  BodyController controller(twoJoints(), nullptr, nullptr);
+  BodyController controller(twoJoints(), nullptr);
   EXPECT_EQ(controller.sendJointCommand({"hip"}, {0.0}).status, JointCommandStatus::kWriteFailed);
 }
 

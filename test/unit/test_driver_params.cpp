@@ -38,7 +38,6 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"baud", [](DriverParams& p) { p.baud = 12345; }},
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 0; }},
         BadCase{"reconnect_interval", [](DriverParams& p) { p.reconnect_interval = -1; }},
-        BadCase{"read_poll_interval", [](DriverParams& p) { p.read_poll_interval = -0.02; }},
         BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = -0.25; }},
         BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = std::nan(""); }},
         BadCase{"base/encoder_resolution", [](DriverParams& p) { p.base.encoder_resolution = 0; }},

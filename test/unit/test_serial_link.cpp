@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/serial_link.h"
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/test_helpers.h"
 
 namespace serial_robot_driver::device {
@@ -58,7 +58,7 @@ const Bytes kPingReply = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
 
 TEST(SerialLink, DeliversFramesAndWritesBytes) {
   const std::string path = uniqueLinkPath("basic");
-  transport::PseudoTerminal pty(path);
+  sim::PseudoTerminal pty(path);
   SerialLink link(optionsFor(path));
   RecordingListener listener;
   link.addListener(&listener);
@@ -97,7 +97,7 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
 
 TEST(SerialLink, RecoversAfterUnplugAtTheSameSymlink) {
   const std::string path = uniqueLinkPath("unplug");
-  auto pty = std::make_unique<transport::PseudoTerminal>(path);
+  auto pty = std::make_unique<sim::PseudoTerminal>(path);
   SerialLink link(optionsFor(path));
   RecordingListener listener;
   link.addListener(&listener);
@@ -109,7 +109,7 @@ TEST(SerialLink, RecoversAfterUnplugAtTheSameSymlink) {
   EXPECT_FALSE(link.connected());
   EXPECT_FALSE(link.write(kBatteryReply)) << "writes fail fast while the port is gone";
 
-  pty = std::make_unique<transport::PseudoTerminal>(path);
+  pty = std::make_unique<sim::PseudoTerminal>(path);
   ASSERT_TRUE(waitFor([&] { return link.connected(); }, kWaitSeconds));
   EXPECT_EQ(listener.ups, 2) << "listeners hear of the reconnect before the link reports it";
   pty->write(kPingReply.data(), kPingReply.size());
@@ -132,7 +132,7 @@ TEST(SerialLink, WaitsForAPortThatDoesNotExistYet) {
   EXPECT_FALSE(link.connected());
   EXPECT_NE(link.stats().last_error.find(path), std::string::npos) << link.stats().last_error;
 
-  transport::PseudoTerminal pty(path);
+  sim::PseudoTerminal pty(path);
   ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
   link.stop();
   EXPECT_FALSE(link.connected());

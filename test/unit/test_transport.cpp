@@ -18,13 +18,14 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/transport/serial_port.h"
 
 namespace serial_robot_driver::transport {
 namespace {
 
 using Bytes = std::vector<uint8_t>;
+using sim::PseudoTerminal;
 
 constexpr int kPatientTimeoutMs = 2000;  // generous: only the failure case waits this long
 
@@ -327,8 +328,8 @@ TEST_F(TransportTest, LowLatencyRequestOnAPtyIsNotAnError) {
   SerialPort port({pty.slavePath(), 115200});
   EXPECT_NO_THROW(port.open());
   EXPECT_TRUE(port.isOpen());
-  EXPECT_FALSE(port.lowLatencyEnabled());  // ptys do not implement TIOCGSERIAL
-  EXPECT_FALSE(port.latencyTimerMs().has_value());
+  EXPECT_FALSE(port.info().low_latency);  // ptys do not implement TIOCGSERIAL
+  EXPECT_FALSE(port.info().latency_timer_ms.has_value());
 }
 
 TEST_F(TransportTest, LatencyTimerOfAPtyOrMissingPathIsUnknown) {

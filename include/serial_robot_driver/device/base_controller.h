@@ -11,6 +11,8 @@
 //  - onFrame() runs on the port's reader thread: an FF error frame wakes the loop to send a Reset.
 //  - Every base write happens with mutex_ held, so the sequence counter and "Reset before the next
 //    speed frame" are consistent whichever thread writes (loop, or a base/* service).
+//  - The BaseEvents hooks are called without mutex_ held, on the thread that caused them (loop,
+//    reader, or the caller of stop()). Stats are one struct under mutex_; stats() is a snapshot.
 #pragma once
 
 #include <condition_variable>
@@ -66,18 +68,18 @@ struct BaseStats {
   std::optional<uint8_t> battery_percent;
 };
 
-class BaseController : public LinkListener {
- public:
-  using FrameWriter = std::function<bool(const std::vector<uint8_t>&)>;
-
-  BaseController(BaseConfig config, FrameWriter writer);
-  ~BaseController() override;
-
-  /// Event hooks; set them before start(). Called without the controller's lock held.
+/// What the base reports; every hook may be empty. Called without the controller's lock held.
+struct BaseEvents {
   std::function<void(const WheelFrameSent&)> on_wheel_frame;
   std::function<void(uint8_t percent)> on_battery;
   std::function<void(const protocol::base::Frame&)> on_unknown_reply;
   std::function<void()> on_timeout_error;
+};
+
+class BaseController : public LinkListener {
+ public:
+  BaseController(BaseConfig config, FrameWriter writer, BaseEvents events = {});
+  ~BaseController() override;
 
   /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded and false returned.
   bool setCommand(double linear_x, double angular_z);
@@ -112,6 +114,7 @@ class BaseController : public LinkListener {
 
   const BaseConfig config_;
   const FrameWriter writer_;
+  const BaseEvents events_;
   const Clock::duration period_;
 
   mutable std::mutex mutex_;

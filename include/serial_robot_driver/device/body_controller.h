@@ -1,12 +1,12 @@
 // The servo controller board (PROTOCOLS.md section 2), ROS-free: telemetry frames in, goal
 // positions out as one Dynamixel 2.0 sync-write frame.
 //
-// Threading: onFrame() runs on the link's reader thread and calls the telemetry callback right
-// there (no queue, so a message is published as soon as its frame is complete).
-// sendJointCommand() may be called from any thread; it serializes on an internal mutex.
+// Threading: onFrame() runs on the link's reader thread and calls on_telemetry right there (no
+// queue, so a message is published as soon as its frame is complete), without the lock held.
+// sendJointCommand() may be called from any thread; it serializes on mutex_, which also guards the
+// stats (stats() returns a snapshot).
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -73,20 +73,18 @@ struct JointCommandResult {
   std::string message() const;
 };
 
-class BodyController : public LinkListener {
- public:
-  /// Sends one whole frame; returns false when it could not be written (SerialLink::write).
-  using WriteFunction = std::function<bool(const std::vector<uint8_t>&)>;
+/// What the body reports; every hook may be empty. Called without the controller's lock held.
+struct BodyEvents {
   /// Called on the reader thread for every decoded telemetry frame with its arrival time.
   using TelemetryCallback =
       std::function<void(const protocol::body::Telemetry& telemetry, Clock::time_point arrival)>;
+  TelemetryCallback on_telemetry;
+};
 
-  /// `joints` in frame order (the order of ~body/servo_ids). The callback may be empty.
-  BodyController(std::vector<BodyJoint> joints, WriteFunction write,
-                 TelemetryCallback on_telemetry);
-
-  /// A WriteFunction that writes to `link` (which must outlive the controller).
-  static WriteFunction writerFor(SerialLink& link);
+class BodyController : public LinkListener {
+ public:
+  /// `joints` in frame order (the order of ~body/servo_ids).
+  BodyController(std::vector<BodyJoint> joints, FrameWriter writer, BodyEvents events = {});
 
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) override;
@@ -107,18 +105,12 @@ class BodyController : public LinkListener {
 
  private:
   const std::vector<BodyJoint> joints_;
-  WriteFunction write_;
-  TelemetryCallback on_telemetry_;
+  const FrameWriter writer_;
+  const BodyEvents events_;
 
-  std::atomic<uint64_t> frames_decoded_{0};
-  std::atomic<uint64_t> decode_errors_{0};
-  std::atomic<int> last_decode_error_{-1};  // DecodeError as int, -1: none yet
-
-  mutable std::mutex command_mutex_;  // guards the fields below
+  mutable std::mutex mutex_;  // guards the fields below
   std::vector<std::optional<uint16_t>> last_commanded_ticks_;
-  uint64_t commands_sent_ = 0;
-  uint64_t commands_rejected_ = 0;
-  uint64_t write_failures_ = 0;
+  BodyStats stats_;
 };
 
 }  // namespace serial_robot_driver::device

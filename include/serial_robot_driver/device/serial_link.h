@@ -31,6 +31,10 @@ namespace serial_robot_driver::device {
 
 using Clock = std::chrono::steady_clock;
 
+/// How every device puts a frame on its port: writes one whole frame and returns false when the
+/// port is down or the write failed (SerialLink::write). Tests pass a fake.
+using FrameWriter = std::function<bool(const std::vector<uint8_t>&)>;
+
 /// Implemented by the devices on a port. All calls come from the link's reader thread.
 class LinkListener {
  public:
@@ -50,10 +54,6 @@ struct SerialLinkOptions {
   unsigned baud = 115200;
   double reconnect_interval = 1.0;  ///< s between attempts to reopen a lost port
   protocol::FramerConfig framer;
-  /// 0 (default): event-driven, a frame is handled as soon as its bytes arrive. > 0: read only once
-  /// per interval (s), like a driver that polls its port from a timer. Kept so benchmarks can show
-  /// what the event-driven design buys; no robot should run with it.
-  double poll_interval = 0.0;
 };
 
 struct LinkStats {
@@ -73,7 +73,8 @@ class SerialLink {
  public:
   using StreamFactory = std::function<std::unique_ptr<transport::ByteStream>(const SerialLinkOptions&)>;
 
-  /// `factory` builds the stream to open; the default is a termios SerialPort.
+  /// `factory` builds the stream to open; the default is a termios SerialPort. Benchmarks plug in
+  /// other streams here (e.g. one that polls), so the link itself has one way of reading.
   explicit SerialLink(SerialLinkOptions options, StreamFactory factory = {});
   ~SerialLink();
   SerialLink(const SerialLink&) = delete;
@@ -89,6 +90,8 @@ class SerialLink {
   /// failed; a failed write also schedules a reconnect.
   bool write(const std::vector<uint8_t>& frame);
   bool write(const uint8_t* data, std::size_t size);
+  /// A FrameWriter that writes to this link (which must outlive it).
+  FrameWriter writer();
 
   bool connected() const { return connected_.load(); }
   LinkStats stats() const;

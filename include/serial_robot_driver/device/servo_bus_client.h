@@ -7,8 +7,10 @@
 //    `timeout`, re-sending up to `retries` times. Nobody else writes to the bus meanwhile.
 //  - The answer arrives on the link's reader thread through onFrame(), which only matches it
 //    against the pending transaction, stores it and wakes the caller: the reader never waits.
-//  - The write seam is called without any lock of this class held, so a fake in a test may answer
-//    synchronously by calling onFrame() from inside it.
+//  - The FrameWriter is called with bus_mutex_ held (that is what keeps the bus half duplex) but
+//    never state_mutex_, the only lock onFrame() takes: a fake in a test may answer synchronously
+//    by calling onFrame() from inside it.
+//  - Stats are kept in one struct under state_mutex_; stats() returns a snapshot.
 #pragma once
 
 #include <chrono>
@@ -102,13 +104,10 @@ struct ServoBusStats {
 
 class ServoBusClient : public LinkListener {
  public:
-  /// Writes one whole frame; false when the port is down (SerialLink::write).
-  using WriteFunction = std::function<bool(const std::vector<uint8_t>&)>;
-
   /// The longest motion a caller may wait for (the longest ROTATE interval).
   static constexpr std::chrono::milliseconds kMaxMotionWait{65535};
 
-  ServoBusClient(ServoBusOptions options, WriteFunction write);
+  ServoBusClient(ServoBusOptions options, FrameWriter writer);
 
   /// PING: ok when the servo answered.
   ServoStatus ping(uint8_t id);
@@ -185,7 +184,7 @@ class ServoBusClient : public LinkListener {
                        protocol::servo::Packet* answer);
 
   const ServoBusOptions options_;
-  const WriteFunction write_;
+  const FrameWriter writer_;
 
   std::mutex bus_mutex_;  // one transaction on the wire at a time
 

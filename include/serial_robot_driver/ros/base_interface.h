@@ -10,26 +10,30 @@
 #include <std_srvs/Trigger.h>
 
 #include "serial_robot_driver/device/base_controller.h"
+#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
 
 device::BaseConfig makeBaseConfig(const DriverParams& params);
 
-class BaseInterface {
+class BaseInterface : public DeviceInterface {
  public:
+  /// Registers the controller on `link` (before the link starts), advertises the topics and
+  /// services and adds the "base" diagnostic task. `link` must outlive this object.
   BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
                 diagnostic_updater::Updater& diagnostics);
   /// Starts the control loop (after the links are started).
-  void start() { controller_.start(); }
+  void start() override { controller_.start(); }
   /// Stops the loop and writes a zero-speed frame (before the port closes).
-  void shutdown() { controller_.stop(); }
+  void shutdown() override { controller_.stop(); }
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
 
  private:
+  device::BaseEvents events();
   void onCmdVel(const geometry_msgs::Twist::ConstPtr& msg);
   bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   device::SerialLink& link_;
   device::BaseController controller_;

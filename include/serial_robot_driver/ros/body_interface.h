@@ -11,19 +11,23 @@
 #include <memory>
 
 #include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
 
-class BodyInterface {
+class BodyInterface : public DeviceInterface {
  public:
   /// Registers the controller on `link` (before the link starts), advertises the topics and adds
   /// the "body" diagnostic task. `link` and `diagnostics` must outlive this object.
   BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
                 diagnostic_updater::Updater& diagnostics);
 
+  /// Nothing to start: the body speaks when the link's reader hands it a frame.
+  void start() override {}
   /// Stops taking joint commands. Frames that still arrive before the link stops are published.
-  void shutdown();
+  void shutdown() override;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
 
   const device::BodyController& controller() const { return controller_; }
 
@@ -31,7 +35,6 @@ class BodyInterface {
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
                         device::Clock::time_point arrival);
   void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   device::SerialLink& link_;
   const ImuParams imu_params_;

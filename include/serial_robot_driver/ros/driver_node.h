@@ -32,19 +32,22 @@
 
 namespace serial_robot_driver::ros_layer {
 
-class BaseInterface;
-class BodyInterface;
-class ServoBusInterface;
+class DeviceInterface;
 class PortMonitor;
 
 class DriverNode {
  public:
-  DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params);
+  /// `stream_factory` builds each port's stream (default: a termios serial port); benchmarks pass
+  /// their own, e.g. a stream that polls.
+  DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
+             device::SerialLink::StreamFactory stream_factory = {});
   ~DriverNode();
 
-  /// Opens the ports (in the background: a missing port is waited for) and starts the base loop.
+  /// Opens the ports (in the background: a missing port is waited for), then starts the devices
+  /// (the base loop, the servo service spinner).
   void start();
-  /// Stops the base (writing a zero-speed frame), the servo services and the ports. Idempotent.
+  /// Shuts the devices down in order (the base first, writing a zero-speed frame), then stops the
+  /// ports. Idempotent.
   void shutdown();
 
  private:
@@ -59,9 +62,8 @@ class DriverNode {
   DriverParams params_;
   diagnostic_updater::Updater diagnostics_;
   std::map<std::string, Port> ports_;
-  std::unique_ptr<BaseInterface> base_;
-  std::unique_ptr<BodyInterface> body_;
-  std::unique_ptr<ServoBusInterface> servo_bus_;
+  /// In start and shutdown order: base, body, servo bus.
+  std::vector<std::unique_ptr<DeviceInterface>> devices_;
   ros::SteadyTimer diagnostics_timer_;
   bool shut_down_ = false;
 };

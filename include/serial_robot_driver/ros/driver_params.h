@@ -73,8 +73,6 @@ struct DriverParams {
   int baud = 115200;
   double loop_rate = 50.0;
   double reconnect_interval = 1.0;
-  /// Benchmark-only: > 0 makes every port read once per interval instead of on arrival.
-  double read_poll_interval = 0.0;
   BaseParams base;
   BodyParams body;
   ImuParams imu;

@@ -24,6 +24,7 @@
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/device/servo_bus_client.h"
+#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -31,30 +32,23 @@ namespace serial_robot_driver::ros_layer {
 /// Client options from ~servo_bus/{timeout, retries, allow_dangerous_writes}.
 device::ServoBusOptions makeServoBusOptions(const DriverParams& params);
 
-class ServoBusInterface {
+class ServoBusInterface : public DeviceInterface {
  public:
-  /// Registers the client with `link`, advertises servo/* in `nh`'s namespace and starts the
-  /// service spinner. Must be constructed before the link is started.
+  /// Registers the client with `link` and advertises servo/* in `nh`'s namespace. Must be
+  /// constructed before the link is started.
   ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
                     diagnostic_updater::Updater& diagnostics);
   ~ServoBusInterface();
   ServoBusInterface(const ServoBusInterface&) = delete;
   ServoBusInterface& operator=(const ServoBusInterface&) = delete;
 
+  /// Starts the service spinner: calls are served from here on.
+  void start() override;
   /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
-  void shutdown();
+  void shutdown() override;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
 
  private:
-  bool onPing(ServoPing::Request& req, ServoPing::Response& res);
-  bool onRead(ServoRead::Request& req, ServoRead::Response& res);
-  bool onWrite(ServoWrite::Request& req, ServoWrite::Response& res);
-  bool onReadAngle(ServoReadAngle::Request& req, ServoReadAngle::Response& res);
-  bool onRotate(ServoRotate::Request& req, ServoRotate::Response& res);
-  bool onSpin(ServoSpin::Request& req, ServoSpin::Response& res);
-  bool onDamping(ServoDamping::Request& req, ServoDamping::Response& res);
-  bool onReadAll(ServoReadAll::Request& req, ServoReadAll::Response& res);
-  bool onResetUserData(ServoResetUserData::Request& req, ServoResetUserData::Response& res);
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   device::SerialLink& link_;
   device::ServoBusClient client_;

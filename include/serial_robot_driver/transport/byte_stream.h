@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -24,6 +25,12 @@ class TransportError : public std::runtime_error {
   TransportErrorKind kind_;
 };
 
+/// What a stream tells about itself once open (diagnostics and the latency hint).
+struct StreamInfo {
+  bool low_latency = false;             ///< the driver honours ASYNC_LOW_LATENCY
+  std::optional<int> latency_timer_ms;  ///< USB-serial adapter's latency_timer, when known
+};
+
 class ByteStream {
  public:
   virtual ~ByteStream() = default;
@@ -36,6 +43,8 @@ class ByteStream {
   /// Writes all bytes or throws TransportError.
   virtual void write(const uint8_t* data, std::size_t size) = 0;
   virtual std::string name() const = 0;
+  /// Valid after open(); a stream that is no serial port has nothing to tell.
+  virtual StreamInfo info() const { return {}; }
 };
 
 }  // namespace serial_robot_driver::transport

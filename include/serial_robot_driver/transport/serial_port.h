@@ -44,9 +44,9 @@ class SerialPort : public ByteStream {
   void write(const uint8_t* data, std::size_t size) override;
   std::string name() const override { return options_.path; }
 
-  bool lowLatencyEnabled() const { return low_latency_; }
-  /// The USB-serial adapter's latency_timer in ms (sysfs), when the port is such an adapter.
-  std::optional<int> latencyTimerMs() const { return latency_timer_ms_; }
+  /// Low latency mode, and the USB-serial adapter's latency_timer in ms (sysfs) when the port is
+  /// such an adapter.
+  StreamInfo info() const override { return {low_latency_, latency_timer_ms_}; }
 
  private:
   SerialPortOptions options_;
@@ -61,13 +61,13 @@ std::optional<unsigned> baudToSpeed(unsigned baud);
 /// Reads /sys/bus/usb-serial/devices/<ttyX>/latency_timer for a device path (symlinks resolved).
 std::optional<int> readLatencyTimerMs(const std::string& device_path);
 
-/// Shared by SerialPort and PseudoTerminal: waits up to `timeout_ms` for input on the non-blocking
+/// Shared by SerialPort and sim::PseudoTerminal: waits up to `timeout_ms` for input on the non-blocking
 /// `fd` and reads what is there (0 on timeout or EAGAIN/EINTR). Hang-up, EOF and EIO throw
 /// TransportError kDisconnected; `what` names the device in error messages.
 std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
                        const std::string& what);
 
-/// Shared by SerialPort and PseudoTerminal: writes all bytes to the non-blocking `fd`, waiting for
+/// Shared by SerialPort and sim::PseudoTerminal: writes all bytes to the non-blocking `fd`, waiting for
 /// room at most `stall_limit` without progress (then kIoError). EIO/EPIPE/hang-up → kDisconnected.
 void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::string& what,
                   std::chrono::milliseconds stall_limit = std::chrono::milliseconds(100));

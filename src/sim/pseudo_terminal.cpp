@@ -1,4 +1,4 @@
-#include "serial_robot_driver/transport/pseudo_terminal.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -13,7 +13,13 @@
 #include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/transport/serial_port.h"
 
-namespace serial_robot_driver::transport {
+namespace serial_robot_driver::sim {
+
+using transport::readFromFd;
+using transport::TransportError;
+using transport::TransportErrorKind;
+using transport::writeAllToFd;
+
 namespace {
 
 [[noreturn]] void throwOpenFailed(const std::string& message, int error_number) {
@@ -114,4 +120,4 @@ void PseudoTerminal::write(const uint8_t* data, std::size_t size) {
   writeAllToFd(master_fd_, data, size, slave_path_);
 }
 
-}  // namespace serial_robot_driver::transport
+}  // namespace serial_robot_driver::sim

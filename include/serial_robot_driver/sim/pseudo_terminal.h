@@ -1,5 +1,6 @@
-// A pseudo-terminal pair for the simulator and for tests: the master side plays the robot, the
-// slave path is what the driver opens like a serial port. Closing the master makes the driver's
+// A pseudo-terminal pair for the simulator, the tests and the benchmarks (part of srd_sim, not of
+// the driver's core): the master side plays the robot, the slave path is what the driver opens
+// like a serial port. Closing the master makes the driver's
 // reads fail with EIO, which is how an unplugged adapter looks.
 #pragma once
 
@@ -8,14 +9,14 @@
 #include <cstdint>
 #include <string>
 
-namespace serial_robot_driver::transport {
+namespace serial_robot_driver::sim {
 
 /// Threading: one thread may read while another writes; close() must not race with them.
 class PseudoTerminal {
  public:
   /// Opens a pty in raw mode. If `link_path` is not empty, a symlink to the slave is (re)created
   /// there (replacing a stale symlink, never a regular file) and removed again on close.
-  /// \throws TransportError kOpenFailed on failure.
+  /// \throws transport::TransportError kOpenFailed on failure.
   explicit PseudoTerminal(const std::string& link_path = "");
   ~PseudoTerminal();
   PseudoTerminal(const PseudoTerminal&) = delete;
@@ -26,9 +27,9 @@ class PseudoTerminal {
   const std::string& linkPath() const { return link_path_; }
 
   /// Waits up to `timeout_ms` and reads what the driver wrote (0 on timeout).
-  /// \throws TransportError as SerialPort::read.
+  /// \throws transport::TransportError as SerialPort::read.
   std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms);
-  /// \throws TransportError as SerialPort::write.
+  /// \throws transport::TransportError as SerialPort::write.
   void write(const uint8_t* data, std::size_t size);
   /// Closes both sides and removes the symlink (a simulated unplug). Idempotent.
   void close();
@@ -41,4 +42,4 @@ class PseudoTerminal {
   std::string link_path_;
 };
 
-}  // namespace serial_robot_driver::transport
+}  // namespace serial_robot_driver::sim

@@ -1,0 +1,21 @@
+// The shape every ROS-side device (or input) has, so DriverNode handles them all one way: each is
+// constructed on its port before the ports start (it registers its listener, topics, services and
+// diagnostic task there), started once the ports run, and shut down before the ports close.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+
+namespace serial_robot_driver::ros_layer {
+
+class DeviceInterface {
+ public:
+  virtual ~DeviceInterface() = default;
+  /// Starts what runs on its own (threads, spinners); called after the ports are started.
+  virtual void start() = 0;
+  /// Stops taking requests and says its last words while the port is still open. Idempotent.
+  virtual void shutdown() = 0;
+  /// Fills the device's diagnostic status (called from the diagnostics timer).
+  virtual void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) = 0;
+};
+
+}  // namespace serial_robot_driver::ros_layer
