@@ -1,9 +1,9 @@
 // polling_driver_node: driver_node whose ports are read once per ~read_poll_interval (s) instead
 // of as bytes arrive, built from the same DriverNode. driver_bench runs it to show what the
 // event-driven reader buys; it is never installed for a robot.
-#include <memory>
-
 #include <ros/ros.h>
+
+#include <memory>
 
 #include "polling_stream.h"
 #include "serial_robot_driver/ros/driver_params.h"
@@ -20,9 +20,11 @@ serial_robot_driver::device::SerialLink::StreamFactory pollingStreams(ros::NodeH
   if (!(interval > 0.0)) {
     throw ros_layer::ParameterError("read_poll_interval", "must be > 0 s for the polling node");
   }
-  return [interval](const device::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
+  return [interval](
+             const device::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
     return std::make_unique<bench::PollingStream>(
-        std::make_unique<transport::SerialPort>(transport::SerialPortOptions{options.path, options.baud}),
+        std::make_unique<transport::SerialPort>(
+            transport::SerialPortOptions{options.path, options.baud}),
         interval);
   };
 }

@@ -10,12 +10,23 @@ using kinematics::WheelSpeeds;
 
 namespace {
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+class SteadyLoopClock : public LoopClock {
+ public:
+  Clock::time_point now() const override { return Clock::now(); }
+  void waitUntil(std::unique_lock<std::mutex>& lock, std::condition_variable& wake,
+                 Clock::time_point deadline) override {
+    wake.wait_until(lock, deadline);
+  }
+};
 }  // namespace
 
-BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents events)
+BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents events,
+                               std::shared_ptr<LoopClock> clock)
     : config_(config),
       writer_(std::move(writer)),
       events_(std::move(events)),
+      clock_(clock ? std::move(clock) : std::make_shared<SteadyLoopClock>()),
       period_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / config.loop_rate))),
       limiter_(config.max_wheel_accel),
       quantizer_(config.geometry, config.speed_dithering) {}
@@ -35,7 +46,7 @@ bool BaseController::setCommand(double linear_x, double angular_z) {
     std::lock_guard<std::mutex> lock(mutex_);
     linear_x_ = valid ? linear_x : 0.0;
     angular_z_ = valid ? angular_z : 0.0;
-    last_command_ = Clock::now();
+    last_command_ = clock_->now();
     command_pending_ = true;
     if (!valid) ++stats_.rejected_commands;
   }
@@ -45,7 +56,7 @@ bool BaseController::setCommand(double linear_x, double angular_z) {
 
 bool BaseController::sendReset() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool ok = writeLocked(base::encodeReset(seq_.peek()), Clock::now());
+  const bool ok = writeLocked(base::encodeReset(seq_.peek()), clock_->now());
   if (ok) {
     ++stats_.resets_sent;
     needs_reset_ = false;
@@ -55,7 +66,7 @@ bool BaseController::sendReset() {
 
 bool BaseController::sendClearEncoders() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool ok = writeLocked(base::encodeClearEncoders(seq_.peek()), Clock::now());
+  const bool ok = writeLocked(base::encodeClearEncoders(seq_.peek()), clock_->now());
   if (ok) ++stats_.clear_encoders_sent;
   return ok;
 }
@@ -80,7 +91,7 @@ void BaseController::stop() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     sent.seq = seq_.peek();
-    sent.time = Clock::now();
+    sent.time = clock_->now();
     written = writeLocked(base::encodeWheelSpeed(sent.seq, 0, 0), sent.time);
     if (written) ++stats_.speed_frames;
   }
@@ -236,20 +247,22 @@ void BaseController::tick(Clock::time_point now) {
 }
 
 void BaseController::run() {
-  Clock::time_point deadline = Clock::now() + period_;
+  Clock::time_point deadline = clock_->now() + period_;
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stopping_) {
     // Wake at the next tick, or earlier for a new command that may be rushed out.
-    wake_.wait_until(lock, deadline, [this] { return stopping_ || command_pending_; });
+    while (!stopping_ && !command_pending_ && clock_->now() < deadline) {
+      clock_->waitUntil(lock, wake_, deadline);
+    }
     if (stopping_) break;
-    const Clock::time_point now = Clock::now();
+    const Clock::time_point now = clock_->now();
     if (now < deadline) {
       // Woken early by a command: send it at once unless the last frame is too recent; then it
       // waits for the tick, which is at most one period away.
       const bool may_rush = !last_speed_frame_ || (now - *last_speed_frame_) * 2 >= period_;
       if (!may_rush) {
-        wake_.wait_until(lock, std::min(deadline, *last_speed_frame_ + period_ / 2),
-                         [this] { return stopping_; });
+        const Clock::time_point until = std::min(deadline, *last_speed_frame_ + period_ / 2);
+        while (!stopping_ && clock_->now() < until) clock_->waitUntil(lock, wake_, until);
         continue;  // re-evaluate with command_pending_ still set
       }
       command_pending_ = false;
@@ -263,10 +276,10 @@ void BaseController::run() {
     tick(now);
     lock.lock();
     deadline += period_;
-    if (Clock::now() >= deadline) {
+    if (clock_->now() >= deadline) {
       // Late by a whole period (machine stalled): count it and re-anchor rather than burst.
       ++stats_.loop_overruns;
-      deadline = Clock::now() + period_;
+      deadline = clock_->now() + period_;
     }
   }
 }

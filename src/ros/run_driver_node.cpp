@@ -12,8 +12,8 @@
 namespace serial_robot_driver::ros_layer {
 
 namespace {
-/// Waits for SIGINT/SIGTERM (blocked in every thread, taken here synchronously) or for roscpp to shut
-/// down (rosnode kill), checking the latter twice a second.
+/// Waits for SIGINT/SIGTERM (blocked in every thread, taken here synchronously) or for roscpp to
+/// shut down (rosnode kill), checking the latter twice a second.
 void waitForStopRequest(const sigset_t& stop_signals) {
   const timespec half_second{0, 500000000};
   while (ros::ok()) {

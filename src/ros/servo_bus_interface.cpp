@@ -93,10 +93,9 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
   // wait = true) and must never hold up cmd_vel or joint_commands on the global queue.
   nh_.setCallbackQueue(&queue_);
   services_ = {
-      advertiseServo<ServoPing>(nh_, "servo/ping",
-                                [this](ServoPing::Request& req, ServoPing::Response&) {
-                                  return client_.ping(req.id);
-                                }),
+      advertiseServo<ServoPing>(
+          nh_, "servo/ping",
+          [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }),
       advertiseServo<ServoRead>(nh_, "servo/read",
                                 [this](ServoRead::Request& req, ServoRead::Response& res) {
                                   device::ServoParamValue value;
@@ -147,19 +146,19 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
                                      return client_.damping(req.id, req.power_mw, req.wait);
                                    }),
-      advertiseServo<ServoReadAll>(
-          nh_, "servo/read_all",
-          [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
-            std::vector<device::ServoParamValue> values;
-            const device::ServoStatus status = client_.readAll(req.id, &values);
-            res.names.clear();
-            res.values.clear();
-            for (const device::ServoParamValue& value : values) {
-              res.names.push_back(value.name);
-              res.values.push_back(value.value);
-            }
-            return status;
-          }),
+      advertiseServo<ServoReadAll>(nh_, "servo/read_all",
+                                   [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
+                                     std::vector<device::ServoParamValue> values;
+                                     const device::ServoStatus status =
+                                         client_.readAll(req.id, &values);
+                                     res.names.clear();
+                                     res.values.clear();
+                                     for (const device::ServoParamValue& value : values) {
+                                       res.names.push_back(value.name);
+                                       res.values.push_back(value.value);
+                                     }
+                                     return status;
+                                   }),
       advertiseServo<ServoResetUserData>(
           nh_, "servo/reset_user_data",
           [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {

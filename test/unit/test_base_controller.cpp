@@ -1,8 +1,13 @@
-// BaseController: the Reset/heartbeat cycle, cmd_vel handling and battery polling, driven with
-// explicit time points and a fake port that records every frame.
+// BaseController: the Reset/heartbeat cycle, cmd_vel handling and battery polling, driven by a
+// manual clock (the loop thread runs; the test moves time) and a fake port that records every
+// frame; two tests run the loop on the real clock.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include "serial_robot_driver/device/base_controller.h"
@@ -13,10 +18,95 @@ namespace {
 using Bytes = std::vector<uint8_t>;
 using std::chrono::milliseconds;
 
+/// A LoopClock the test moves: the controller's loop thread runs for real, but its time only
+/// passes when the test says so, and each step returns once the loop has done what fell due.
+class ManualClock : public LoopClock {
+ public:
+  explicit ManualClock(Clock::time_point start) : now_(start) {}
+
+  Clock::time_point now() const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return now_;
+  }
+
+  void waitUntil(std::unique_lock<std::mutex>& loop_lock, std::condition_variable& wake,
+                 Clock::time_point /*deadline*/) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      loop_mutex_ = loop_lock.mutex();
+      wake_ = &wake;
+      ++waits_;
+      waiting_ = true;
+    }
+    idle_.notify_all();
+    wake.wait(loop_lock);  // until advance() or the controller itself notifies
+    std::lock_guard<std::mutex> lock(mutex_);
+    waiting_ = false;
+  }
+
+  /// Returns once the loop thread waits for the first time (call after start()).
+  void waitForLoop() { settleAfter(0); }
+
+  /// Runs `action` (something that wakes the loop, e.g. a new command) and returns once the loop
+  /// has handled it and waits again.
+  template <typename Action>
+  void step(Action action) {
+    const uint64_t seen = waits();
+    action();
+    settleAfter(seen);
+  }
+
+  /// Moves time forward in one jump (a stalled machine, when `d` spans several periods).
+  void advance(Clock::duration d) {
+    step([&] {
+      std::mutex* loop_mutex = nullptr;
+      std::condition_variable* wake = nullptr;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        now_ += d;
+        loop_mutex = loop_mutex_;
+        wake = wake_;
+      }
+      // Taking the loop's mutex first: the loop is either before its time check or waiting.
+      std::lock_guard<std::mutex> lock(*loop_mutex);
+      wake->notify_all();
+    });
+  }
+
+  /// Moves time forward one loop period at a time, `periods` times.
+  void tick(int periods, Clock::duration period = milliseconds(20)) {
+    for (int i = 0; i < periods; ++i) advance(period);
+  }
+
+ private:
+  uint64_t waits() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return waits_;
+  }
+  void settleAfter(uint64_t seen) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    idle_.wait(lock, [&] { return waiting_ && waits_ > seen; });
+  }
+
+  mutable std::mutex mutex_;
+  std::condition_variable idle_;
+  Clock::time_point now_;
+  std::mutex* loop_mutex_ = nullptr;
+  std::condition_variable* wake_ = nullptr;
+  uint64_t waits_ = 0;
+  bool waiting_ = false;
+};
+
+/// The controller's loop runs at 50 Hz on a ManualClock that starts at t0: the first tick falls
+/// due at t0 + 20 ms.
 class BaseControllerTest : public ::testing::Test {
  protected:
   BaseControllerTest()
-      : controller_(config(), [this](const Bytes& frame) { return write(frame); }, events()) {}
+      : clock_(std::make_shared<ManualClock>(t0_)),
+        controller_(config(), [this](const Bytes& frame) { return write(frame); }, events(), clock_) {
+    controller_.start();
+    clock_->waitForLoop();
+  }
 
   BaseEvents events() {
     BaseEvents events;
@@ -30,21 +120,25 @@ class BaseControllerTest : public ::testing::Test {
     return c;
   }
 
+  // Called on the loop thread while the test waits in a ManualClock step, or on the test thread
+  // while the loop waits: the clock's mutex orders the two.
   bool write(const Bytes& frame) {
     if (!port_up_) return false;
     frames_.push_back(frame);
     return true;
   }
 
-  BaseController controller_;
+  // Declared before the controller, so they outlive its loop thread.
   std::vector<Bytes> frames_;
   std::vector<WheelFrameSent> sent_;
   bool port_up_ = true;
   const Clock::time_point t0_ = Clock::now();
+  std::shared_ptr<ManualClock> clock_;
+  BaseController controller_;
 };
 
 TEST_F(BaseControllerTest, FirstSpeedFrameIsPrecededByReset) {
-  controller_.sendSpeed(t0_, false);
+  clock_->tick(1);
   ASSERT_EQ(frames_.size(), 2u);
   // Reset, SEQ 00: 55^AA^02^00^05^00 = F8
   EXPECT_EQ(frames_[0], (Bytes{0x55, 0xAA, 0x02, 0x00, 0x05, 0x00, 0xF8}));
@@ -53,28 +147,29 @@ TEST_F(BaseControllerTest, FirstSpeedFrameIsPrecededByReset) {
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_TRUE(sent_[0].reset_before);
   EXPECT_EQ(sent_[0].seq, 1);
+  EXPECT_EQ(sent_[0].time, t0_ + milliseconds(20));
 }
 
 TEST_F(BaseControllerTest, HeartbeatFramesCountSequenceWithoutResets) {
-  for (int i = 0; i < 300; ++i) controller_.tick(t0_ + milliseconds(20 * i));
+  clock_->tick(300);
   ASSERT_EQ(frames_.size(), 301u);  // one Reset, then one speed frame per tick
   for (std::size_t i = 0; i < frames_.size(); ++i) {
     EXPECT_EQ(frames_[i][3], static_cast<uint8_t>(i)) << "SEQ wraps 255 -> 0, one per frame";
   }
   EXPECT_EQ(controller_.stats().resets_sent, 1u);
+  EXPECT_EQ(controller_.stats().loop_overruns, 0u);
 }
 
-TEST_F(BaseControllerTest, StraightCommandGivesEqualPositiveTicks) {
-  controller_.setCommand(0.1, 0.0);
-  controller_.sendSpeed(Clock::now(), true);
-  ASSERT_EQ(frames_.size(), 2u);
+TEST_F(BaseControllerTest, NewCommandGoesOutAtOnceWithEqualPositiveTicksWhenStraight) {
+  clock_->step([&] { controller_.setCommand(0.1, 0.0); });
+  ASSERT_EQ(frames_.size(), 2u) << "sent before the first tick is due";
   // 0.1 m/s = 4.07 ticks per period -> 4 on the first frame; SEQ 01: XOR = F7 ^ 01 = F6
   EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0x00, 0x04, 0x00, 0x04, 0, 0, 0, 0, 0xF6}));
+  EXPECT_EQ(controller_.stats().immediate_frames, 1u);
 }
 
 TEST_F(BaseControllerTest, TurnInPlaceGivesOppositeTicks) {
-  controller_.setCommand(0.0, 1.0);  // wheels at -/+ 0.2 m/s
-  controller_.sendSpeed(Clock::now(), true);
+  clock_->step([&] { controller_.setCommand(0.0, 1.0); });  // wheels at -/+ 0.2 m/s
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_LT(sent_[0].ticks.left, 0);
   EXPECT_EQ(sent_[0].ticks.left, -sent_[0].ticks.right);
@@ -82,8 +177,7 @@ TEST_F(BaseControllerTest, TurnInPlaceGivesOppositeTicks) {
 }
 
 TEST_F(BaseControllerTest, HugeCommandKeepsItsDirectionAtFullSpeed) {
-  controller_.setCommand(1e308, 1e308);  // the wheel sum would overflow to inf
-  controller_.sendSpeed(Clock::now(), true);
+  clock_->step([&] { controller_.setCommand(1e308, 1e308); });  // the wheel sum would overflow to inf
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_NEAR(sent_[0].speeds.y(), 1.0, 1e-9) << "the faster wheel at max_wheel_speed";
   EXPECT_GT(sent_[0].speeds.x(), 0.0);
@@ -92,32 +186,36 @@ TEST_F(BaseControllerTest, HugeCommandKeepsItsDirectionAtFullSpeed) {
 }
 
 TEST_F(BaseControllerTest, CommandTimesOutToZero) {
-  controller_.setCommand(0.5, 0.0);
-  const Clock::time_point now = Clock::now();
-  controller_.sendSpeed(now, true);
+  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
   ASSERT_GT(sent_.back().ticks.left, 0);
-  controller_.sendSpeed(now + milliseconds(600), false);  // cmd_vel_timeout is 0.5 s
+  clock_->tick(24);  // 480 ms: cmd_vel_timeout is 0.5 s
+  EXPECT_GT(sent_.back().ticks.left, 0);
+  EXPECT_EQ(controller_.stats().cmd_vel_timeouts, 0u);
+  clock_->tick(6);  // 600 ms
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
   EXPECT_EQ(controller_.stats().cmd_vel_timeouts, 1u);
 }
 
 TEST_F(BaseControllerTest, NonFiniteCommandIsRejectedAsZero) {
-  controller_.setCommand(0.5, 0.0);
-  EXPECT_FALSE(controller_.setCommand(std::nan(""), 0.0));
-  EXPECT_FALSE(controller_.setCommand(0.1, INFINITY));
-  controller_.sendSpeed(Clock::now(), true);
+  clock_->step([&] {
+    controller_.setCommand(0.5, 0.0);
+    EXPECT_FALSE(controller_.setCommand(std::nan(""), 0.0));
+    EXPECT_FALSE(controller_.setCommand(0.1, INFINITY));
+  });
+  clock_->tick(1);  // the latest command goes out by the next tick at the latest
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
   EXPECT_EQ(controller_.stats().rejected_commands, 2u);
 }
 
 TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
-  controller_.sendSpeed(t0_, false);
-  controller_.sendSpeed(t0_ + milliseconds(20), false);
+  clock_->tick(2);
   frames_.clear();
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
   const Bytes error = {0x55, 0xAA, 0x02, 0x07, 0xFF, 0x00, 0x05};
-  controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), Clock::now());
-  controller_.sendSpeed(t0_ + milliseconds(40), false);
+  clock_->step([&] {
+    controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
+  });
+  clock_->tick(1);
   ASSERT_EQ(frames_.size(), 2u);
   EXPECT_EQ(frames_[0][4], 0x05) << "Reset goes first";
   EXPECT_EQ(frames_[1][4], 0x01);
@@ -126,25 +224,25 @@ TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
 }
 
 TEST_F(BaseControllerTest, OwnSendingGapOfOneSecondForcesReset) {
-  controller_.sendSpeed(t0_, false);
+  clock_->tick(1);
   frames_.clear();
-  controller_.sendSpeed(t0_ + milliseconds(900), false);
+  clock_->advance(milliseconds(900));  // a stalled machine: no tick for 0.9 s
   ASSERT_EQ(frames_.size(), 1u) << "0.9 s gap: the base has not timed out";
-  controller_.sendSpeed(t0_ + milliseconds(1900), false);
+  EXPECT_EQ(controller_.stats().loop_overruns, 1u);
+  clock_->advance(milliseconds(1000));
   ASSERT_EQ(frames_.size(), 3u);
   EXPECT_EQ(frames_[1][4], 0x05);
 }
 
 TEST_F(BaseControllerTest, ReconnectForcesResetAndFailedWritesAreCounted) {
-  controller_.sendSpeed(t0_, false);
+  clock_->tick(1);
   port_up_ = false;
   controller_.onLinkDown();
-  controller_.sendSpeed(t0_ + milliseconds(20), false);
+  clock_->tick(1);
   EXPECT_EQ(controller_.stats().write_failures, 1u);
   port_up_ = true;
-  controller_.onLinkUp();
   frames_.clear();
-  controller_.sendSpeed(t0_ + milliseconds(40), false);
+  clock_->step([&] { controller_.onLinkUp(); });  // the Reset goes out at once
   ASSERT_EQ(frames_.size(), 2u);
   EXPECT_EQ(frames_[0][4], 0x05);
 }
@@ -160,13 +258,14 @@ TEST_F(BaseControllerTest, ResetAndClearEncodersServicesWriteTheirFrames) {
 }
 
 TEST_F(BaseControllerTest, StopWritesAZeroSpeedFrame) {
-  controller_.setCommand(0.5, 0.0);
-  controller_.sendSpeed(Clock::now(), true);
+  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
   frames_.clear();
   controller_.stop();
   ASSERT_EQ(frames_.size(), 1u);
   EXPECT_EQ(frames_[0][4], 0x01);
   for (int i = 5; i < 13; ++i) EXPECT_EQ(frames_[0][i], 0) << "byte " << i;
+  ASSERT_FALSE(sent_.empty());
+  EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
 }
 
 TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
@@ -176,24 +275,27 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   std::vector<int> percents;
   BaseEvents events;
   events.on_battery = [&percents](uint8_t p) { percents.push_back(p); };
+  auto clock = std::make_shared<ManualClock>(Clock::now());
   BaseController controller(
       config,
       [&frames](const Bytes& f) {
         frames.push_back(f);
         return true;
       },
-      events);
-  const Clock::time_point t0 = Clock::now();
-  for (int i = 0; i <= 100; ++i) controller.tick(t0 + milliseconds(20 * i));  // 2 s
+      events, clock);
+  controller.start();
+  clock->waitForLoop();
+  clock->tick(101);  // 2.02 s: the first tick sends the Reset instead, then one request per second
   int requests = 0;
   for (const Bytes& f : frames) requests += (f[4] == 0x02);
-  EXPECT_GE(requests, 2);
-  EXPECT_LE(requests, 3);
+  EXPECT_EQ(requests, 2);
+  EXPECT_EQ(controller.stats().battery_requests, 2u);
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
   const Bytes reply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
   controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), Clock::now());
   ASSERT_EQ(percents.size(), 1u);
   EXPECT_EQ(percents[0], 87);
+  controller.stop();
 }
 
 class RecordingWriter {

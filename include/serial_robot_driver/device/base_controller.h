@@ -3,8 +3,9 @@
 // ROS-free: the ROS layer feeds commands in and publishes the events it reports.
 //
 // Threading model:
-//  - start() runs the control loop on its own thread: absolute deadlines on the steady clock
-//    (deadline += period, never "sleep one period"), so the period does not drift. Each tick writes
+//  - start() runs the control loop on its own thread: absolute deadlines on the LoopClock (the
+//    steady clock unless a test passes its own) (deadline += period, never "sleep one period"), so
+//    the period does not drift. Each tick writes
 //    the current wheel frame, which is also the heartbeat.
 //  - setCommand() (cmd_vel callback) only stores the command and wakes the loop, which puts it on
 //    the wire at once, at most at twice the loop rate. Callbacks never touch the port.
@@ -18,6 +19,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -68,6 +70,19 @@ struct BaseStats {
   std::optional<uint8_t> battery_percent;
 };
 
+/// Where the base loop reads the time and waits for its next tick. The default is the steady
+/// clock; tests pass a clock they move themselves.
+class LoopClock {
+ public:
+  virtual ~LoopClock() = default;
+  virtual Clock::time_point now() const = 0;
+  /// Called by the loop with `lock` (the controller's mutex) held: waits on `wake` until
+  /// `deadline` on this clock or a notification, whichever comes first. May return early; the
+  /// loop checks again.
+  virtual void waitUntil(std::unique_lock<std::mutex>& lock, std::condition_variable& wake,
+                         Clock::time_point deadline) = 0;
+};
+
 /// What the base reports; every hook may be empty. Called without the controller's lock held.
 struct BaseEvents {
   std::function<void(const WheelFrameSent&)> on_wheel_frame;
@@ -78,7 +93,9 @@ struct BaseEvents {
 
 class BaseController : public LinkListener {
  public:
-  BaseController(BaseConfig config, FrameWriter writer, BaseEvents events = {});
+  /// `clock` empty: the steady clock.
+  BaseController(BaseConfig config, FrameWriter writer, BaseEvents events = {},
+                 std::shared_ptr<LoopClock> clock = {});
   ~BaseController() override;
 
   /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded and false returned.
@@ -100,14 +117,12 @@ class BaseController : public LinkListener {
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) override;
 
-  // The loop's steps, public so tests can drive them with their own clock.
+ private:
+  void run();
   /// A scheduled tick: battery poll when due, then the wheel frame.
   void tick(Clock::time_point now);
   /// Sends the wheel frame for the current command (Reset first when needed).
   void sendSpeed(Clock::time_point now, bool immediate);
-
- private:
-  void run();
   /// Requires mutex_. Writes one frame with the next SEQ; false on failure.
   bool writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now);
   kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now);
@@ -115,6 +130,7 @@ class BaseController : public LinkListener {
   const BaseConfig config_;
   const FrameWriter writer_;
   const BaseEvents events_;
+  const std::shared_ptr<LoopClock> clock_;
   const Clock::duration period_;
 
   mutable std::mutex mutex_;

@@ -2,9 +2,9 @@
 // zero-speed frame), shared by the node's main and by benchmark builds of the same node.
 #pragma once
 
-#include <functional>
-
 #include <ros/ros.h>
+
+#include <functional>
 
 #include "serial_robot_driver/device/serial_link.h"
 
@@ -13,7 +13,8 @@ namespace serial_robot_driver::ros_layer {
 /// Builds the ports' stream factory from the node's private namespace before the driver
 /// parameters are loaded (it may read, and must then delete, parameters of its own). An empty
 /// factory means termios serial ports; throwing ParameterError stops the node with that message.
-using StreamFactoryMaker = std::function<device::SerialLink::StreamFactory(ros::NodeHandle& private_nh)>;
+using StreamFactoryMaker =
+    std::function<device::SerialLink::StreamFactory(ros::NodeHandle& private_nh)>;
 
 /// Runs the node until SIGINT/SIGTERM or a roscpp shutdown; returns the process exit code.
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory = {});
