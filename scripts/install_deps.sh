@@ -8,6 +8,9 @@ PACKAGES=(
   ros-base-dev catkin python3-catkin-pkg
   libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev libstd-srvs-dev
   libdiagnostic-msgs-dev libdiagnostic-updater-dev ros-message-generation ros-message-runtime
+  libnav-msgs-dev libtf2-ros-dev libtf2-msgs-dev tf2-tools
+  libnodelet-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
+  librosbag-dev librosbag-storage-dev libdiagnostic-aggregator-dev
   librostest-dev python3-rostest python3-rosbag rosbash
   libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev catkin-lint catkin-tools
