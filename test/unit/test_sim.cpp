@@ -24,6 +24,7 @@
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/base_sim.h"
 #include "serial_robot_driver/sim/body_sim.h"
+#include "serial_robot_driver/sim/command_line.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "serial_robot_driver/sim/servo_bus_sim.h"
 
@@ -761,6 +762,17 @@ TEST(RobotSimCommandLine, RejectsUnknownFlagsAndBadValues) {
   EXPECT_FALSE(parse({"--foot=1"}).error.empty());
   EXPECT_FALSE(parse({"--no-base", "--no-body", "--no-servo-bus"}).error.empty());
   EXPECT_TRUE(parse({"--help"}).help);
+}
+
+TEST(RobotSimCommandLine, HelpListsTheFlagsWithTheirDefaults) {
+  const std::string text = usage();
+  for (const char* expected :
+       {"--battery PCT", "battery percent the base reports (default 87)", "--servo-ids 1,2",
+        "(default 1,2)", "--telemetry-rate HZ", "(default 50)", "--servo-latency-ms MS",
+        "(default 1.5)", "--no-servo-bus", "--foot-alternate", "--seed N", "--stats-file PATH",
+        "--unplug-duration S", "Faults (seeded):"}) {
+    EXPECT_NE(text.find(expected), std::string::npos) << expected << " missing from:\n" << text;
+  }
 }
 
 }  // namespace
