@@ -37,6 +37,7 @@
 #include "serial_robot_driver/transport/pseudo_terminal.h"
 #include "support/pty_frame_reader.h"
 #include "support/ros_test_support.h"
+#include "support/golden_frames.h"
 
 namespace {
 
@@ -71,8 +72,8 @@ Bytes zeroSpeedFrame(uint8_t seq) {
 }
 
 // Base -> host frames, written out by hand (XOR included).
-const Bytes kTimeoutErrorFrame = {0x55, 0xAA, 0x02, 0x20, 0xFF, 0x00, 0x22};   // FF status
-const Bytes kBattery87PercentFrame = {0x55, 0xAA, 0x02, 0x10, 0x02, 0x57, 0xB8};  // 0x57 = 87 %
+const Bytes& kTimeoutErrorFrame = golden::base::kErrorStatusSeq32;     // FF status
+const Bytes& kBattery87PercentFrame = golden::base::kBattery87ReplySeq16;  // 0x57 = 87 %
 
 // --- the fake base on a pty ----------------------------------------------------------------------
 
@@ -427,12 +428,11 @@ class BaseNodeTest : public ::testing::Test {
 // The hand-written XOR helper reproduces the golden vectors of PROTOCOLS.md, so the expected frames
 // built with it below can be trusted.
 TEST(BaseGoldenFrames, HelperMatchesProtocolVectors) {
-  EXPECT_EQ(resetFrame(0x02), (Bytes{0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA}));
-  EXPECT_EQ(batteryRequestFrame(0x01), (Bytes{0x55, 0xAA, 0x02, 0x01, 0x02, 0x00, 0xFE}));
-  EXPECT_EQ(clearEncodersFrame(0x03), (Bytes{0x55, 0xAA, 0x02, 0x03, 0x06, 0x00, 0xF8}));
+  EXPECT_EQ(resetFrame(0x02), golden::base::kResetSeq2);
+  EXPECT_EQ(batteryRequestFrame(0x01), golden::base::kBatteryRequestSeq1);
+  EXPECT_EQ(clearEncodersFrame(0x03), golden::base::kClearEncodersSeq3);
   EXPECT_EQ(withXor({0x55, 0xAA, 0x09, 0x00, 0x01, 0xFF, 0xFA, 0xFF, 0xFA, 0x00, 0x00, 0x00, 0x00}),
-            (Bytes{0x55, 0xAA, 0x09, 0x00, 0x01, 0xFF, 0xFA, 0xFF, 0xFA, 0x00, 0x00, 0x00, 0x00,
-                   0xF7}));
+            golden::base::kBothMinus6Seq0);
 }
 
 // 1. After connecting, the node sends a Reset, then a speed frame reported with reset_before.

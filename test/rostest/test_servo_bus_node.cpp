@@ -35,7 +35,7 @@
 #include "serial_robot_driver/transport/pseudo_terminal.h"
 #include "support/pty_frame_reader.h"
 #include "support/ros_test_support.h"
-#include "support/servo_bus_frames.h"
+#include "support/golden_frames.h"
 
 namespace {
 
@@ -47,14 +47,13 @@ using test_support::Clock;
 using test_support::concat;
 using test_support::secondsSince;
 
-using namespace servo_frames;  // NOLINT: the frames shared with the unit tests
+using namespace golden::servo;  // NOLINT: the frames shared with the unit tests
 
 // --- more frames written out by hand from PROTOCOLS.md section 3 (SUM = byte sum mod 256) --------
 const Bytes kPing4 = {0x12, 0x4C, 0x01, 0x01, 0x04, 0x64};
 // over_temperature (41 = 0x29) of servo 3 := 80, answered with result 0.
 const Bytes kWriteOverTemp3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x29, 0x50, 0x00, 0xE2};
 const Bytes kWriteOverTemp3Failed = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x29, 0x00, 0x54};
-const Bytes kSpin0Cw1000Ms = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x83, 0x64, 0x00, 0xE8, 0x03, 0x3D};
 
 // --- the servos on a pty ----------------------------------------------------------------------
 
