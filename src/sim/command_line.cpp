@@ -117,7 +117,8 @@ Flag number(const std::string& name, const std::string& value_name, const std::s
 Flag nonNegative(const std::string& name, const std::string& value_name, const std::string& help,
                  std::function<double&(SimOptions&)> field, bool show_default = false) {
   std::function<std::string(const SimOptions&)> shown;
-  if (show_default) shown = [field](const SimOptions& o) { return show(field(const_cast<SimOptions&>(o))); };
+  if (show_default)
+    shown = [field](const SimOptions& o) { return show(field(const_cast<SimOptions&>(o))); };
   return number(name, value_name, help, 0.0, HUGE_VAL, field, shown);
 }
 
@@ -146,7 +147,8 @@ Flag idList(const std::string& name, const std::string& value_name, const std::s
             std::size_t max_count, std::function<std::vector<uint8_t>&(SimOptions&)> field,
             bool show_default) {
   std::function<std::string(const SimOptions&)> shown;
-  if (show_default) shown = [field](const SimOptions& o) { return show(field(const_cast<SimOptions&>(o))); };
+  if (show_default)
+    shown = [field](const SimOptions& o) { return show(field(const_cast<SimOptions&>(o))); };
   return Flag{name, value_name, help,
               [name, max_count, field](const std::string& value, SimOptions& options) {
                 std::vector<uint8_t>& ids = field(options);
@@ -166,8 +168,8 @@ Flag idList(const std::string& name, const std::string& value_name, const std::s
 const std::vector<Flag>& flags() {
   static const std::vector<Flag> table = {
       section("Ports:"),
-      text("--link", "PATH",
-           "symlink to the shared pty (default: none, just print the path)", &SimOptions::link),
+      text("--link", "PATH", "symlink to the shared pty (default: none, just print the path)",
+           &SimOptions::link),
       text("--base-link", "PATH", "own pty for the base (devices naming the same link share a pty)",
            &SimOptions::base_link),
       text("--body-link", "PATH", "own pty for the servo controller board", &SimOptions::body_link),
@@ -183,24 +185,28 @@ const std::vector<Flag>& flags() {
           "--battery", "PCT", "battery percent the base reports", 100,
           [](SimOptions& o, uint64_t v) { o.base.battery_percent = static_cast<uint8_t>(v); },
           [](const SimOptions& o) { return show(static_cast<int>(o.base.battery_percent)); }),
-      idList("--servo-ids", "1,2", "body servo ids in telemetry order",
-             protocol::body::kMaxTelemetryServos,
-             [](SimOptions& o) -> std::vector<uint8_t>& { return o.body.servo_ids; }, true),
-      nonNegative("--telemetry-rate", "HZ", "telemetry frames per second (0 = off)",
-                  [](SimOptions& o) -> double& { return o.body.telemetry_rate_hz; }, true),
+      idList(
+          "--servo-ids", "1,2", "body servo ids in telemetry order",
+          protocol::body::kMaxTelemetryServos,
+          [](SimOptions& o) -> std::vector<uint8_t>& { return o.body.servo_ids; }, true),
+      nonNegative(
+          "--telemetry-rate", "HZ", "telemetry frames per second (0 = off)",
+          [](SimOptions& o) -> double& { return o.body.telemetry_rate_hz; }, true),
       toggle("--foot", "every telemetry frame carries the foot block",
              [](SimOptions& o) { o.body.foot_mode = FootMode::kAlways; }),
       toggle("--foot-alternate", "every other telemetry frame carries it",
              [](SimOptions& o) { o.body.foot_mode = FootMode::kAlternate; }),
-      nonNegative("--servo-speed", "TICKS_S", "body servo speed bound in ticks/s",
-                  [](SimOptions& o) -> double& { return o.body.servo_speed; }, true),
+      nonNegative(
+          "--servo-speed", "TICKS_S", "body servo speed bound in ticks/s",
+          [](SimOptions& o) -> double& { return o.body.servo_speed; }, true),
       toggle("--imu-noise", "+-2 LSB noise on the IMU values",
              [](SimOptions& o) { o.body.imu_noise = true; }),
-      idList("--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX,
-             [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.servo_ids; }, true),
-      idList("--offline-ids", "7", "ids that never answer", SIZE_MAX,
-             [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.offline_ids; },
-             false),
+      idList(
+          "--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX,
+          [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.servo_ids; }, true),
+      idList(
+          "--offline-ids", "7", "ids that never answer", SIZE_MAX,
+          [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.offline_ids; }, false),
       Flag{"--servo-latency-ms", "MS", "servo bus answer latency",
            [](const std::string& value, SimOptions& o) {
              double ms = 0;
@@ -223,8 +229,9 @@ const std::vector<Flag>& flags() {
                   [](SimOptions& o) -> double& { return o.faults.drop_rate; }),
       nonNegative("--unplug-every", "S", "close the pty (and its link) every S seconds...",
                   [](SimOptions& o) -> double& { return o.faults.unplug_every_s; }),
-      nonNegative("--unplug-duration", "S", "...for S seconds, then recreate it at the same link",
-                  [](SimOptions& o) -> double& { return o.faults.unplug_duration_s; }, true),
+      nonNegative(
+          "--unplug-duration", "S", "...for S seconds, then recreate it at the same link",
+          [](SimOptions& o) -> double& { return o.faults.unplug_duration_s; }, true),
       probability("--servo-fault-rate", "probability a servo answer is garbled or missing",
                   [](SimOptions& o) -> double& { return o.faults.servo_fault_rate; }),
 
