@@ -23,9 +23,12 @@ void FakeDevice::plug() {
     received_.clear();
     taken_ = 0;
     last_session_stats_ = protocol::FramerStats{};
-    plugged_at_ = Clock::now();
   }
   pty_ = std::make_unique<transport::PseudoTerminal>(link_path_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    plugged_at_ = Clock::now();  // once the link exists: what the node sees from now on is new
+  }
   reader_ = std::make_unique<PtyFrameReader>(
       *pty_, framer_config_,
       [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size,
