@@ -22,4 +22,6 @@ set(SRD_SIM_SOURCES
   src/sim/body_sim.cpp
   src/sim/servo_bus_sim.cpp
   src/sim/robot_sim.cpp
+  src/sim/command_line.cpp
+  src/sim/sim_stats.cpp
 )

@@ -5,6 +5,7 @@
 # /proc readers, polling) and ROS ones (topic counters, diagnostics, the node's pid, main()).
 add_library(srd_test_support STATIC
   test/support/pty_frame_reader.cpp
+  test/support/fake_device.cpp
   test/support/process_support.cpp
   test/support/ros_test_support.cpp)
 target_include_directories(srd_test_support PUBLIC ${PROJECT_SOURCE_DIR}/test

@@ -8,6 +8,7 @@
 #include <exception>
 #include <iostream>
 
+#include "serial_robot_driver/sim/command_line.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 
 namespace sim = serial_robot_driver::sim;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include <ros/node_handle.h>
 #include <ros/param.h>
@@ -36,131 +37,230 @@ void requireBaud(int baud, const std::string& name, bool zero_means_inherit) {
           "unsupported baud rate " + std::to_string(baud) + " (e.g. 9600, 115200, 1000000)");
 }
 
-void validateDevicePort(const DevicePortParams& device, const std::string& prefix) {
-  requireBaud(device.baud, prefix + "/baud", true);
+// --- the table -------------------------------------------------------------------------------
+
+/// A range check of one field's value; throws ParameterError naming `key`.
+template <typename T>
+using Rule = std::function<void(const T& value, const std::string& key)>;
+
+template <typename T>
+struct NoDeduce {
+  using type = T;
+};
+
+template <typename T>
+void positive(const T& value, const std::string& key) {
+  requirePositive(value, key);
 }
 
-// --- loading --------------------------------------------------------------------------------
+template <typename T>
+void nonNegative(const T& value, const std::string& key) {
+  requireNonNegative(value, key);
+}
+
+void baud(const int& value, const std::string& key) { requireBaud(value, key, false); }
+void baudOrInherit(const int& value, const std::string& key) { requireBaud(value, key, true); }
+
+/// Whether a key's range check applies: a device's keys (and the IMU's, which the body reports)
+/// are checked only while that device is enabled.
+bool checked(const DriverParams& p, const std::string& key) {
+  const std::string device = key.substr(0, key.find('/'));
+  if (device == "base") return p.base.enabled;
+  if (device == "body" || device == "imu") return p.body.enabled;
+  if (device == "servo_bus") return p.servo_bus.enabled;
+  return true;
+}
+
+template <typename T, typename Access>
+ParamSpec makeSpec(const char* key, Access access, Rule<T> rule) {
+  ParamSpec spec;
+  spec.key = key;
+  spec.get = [access](const DriverParams& p) {
+    return ParamValue(access(const_cast<DriverParams&>(p)));
+  };
+  spec.set = [access](DriverParams& p, const ParamValue& value) {
+    access(p) = std::get<T>(value);
+  };
+  spec.check = [access, rule, name = std::string(key)](const DriverParams& p) {
+    if (rule && checked(p, name)) rule(access(const_cast<DriverParams&>(p)), name);
+  };
+  return spec;
+}
+
+/// A node-wide key: `row("loop_rate", &DriverParams::loop_rate, positive<double>)`.
+template <typename T>
+ParamSpec row(const char* key, T DriverParams::*field, typename NoDeduce<Rule<T>>::type rule = {}) {
+  return makeSpec<T>(key, [field](DriverParams& p) -> T& { return p.*field; }, rule);
+}
+
+/// A key of one section: `row("base/pid_rate", &DriverParams::base, &BaseParams::pid_rate, ...)`.
+template <typename Section, typename Owner, typename T>
+ParamSpec row(const char* key, Section DriverParams::*section, T Owner::*field,
+              typename NoDeduce<Rule<T>>::type rule = {}) {
+  static_assert(std::is_base_of_v<Owner, Section>, "the field must belong to the section");
+  return makeSpec<T>(
+      key, [section, field](DriverParams& p) -> T& { return static_cast<Owner&>(p.*section).*field; },
+      rule);
+}
+
+std::vector<ParamSpec> buildTable() {
+  using P = DriverParams;
+  using Base = BaseParams;
+  using Body = BodyParams;
+  using Imu = ImuParams;
+  using Bus = ServoBusParams;
+  using Port = DevicePortParams;
+  return {
+      row("port", &P::port,
+          [](const std::string& v, const std::string& key) {
+            require(!v.empty(), key, "must name a serial device, e.g. /dev/ttyUSB0");
+          }),
+      row("baud", &P::baud, baud),
+      row("loop_rate", &P::loop_rate,
+          [](const double& v, const std::string& key) {
+            requirePositive(v, key);
+            require(v <= 1000, key, "must be at most 1000 Hz");
+          }),
+      row("reconnect_interval", &P::reconnect_interval, positive<double>),
+
+      row("base/enabled", &P::base, &Port::enabled),
+      row("base/port", &P::base, &Port::port),
+      row("base/baud", &P::base, &Port::baud, baudOrInherit),
+      row("base/wheel_diameter", &P::base, &Base::wheel_diameter, positive<double>),
+      row("base/encoder_resolution", &P::base, &Base::encoder_resolution, positive<int>),
+      row("base/pid_rate", &P::base, &Base::pid_rate, positive<double>),
+      row("base/wheel_separation", &P::base, &Base::wheel_separation, positive<double>),
+      row("base/max_wheel_speed", &P::base, &Base::max_wheel_speed, nonNegative<double>),
+      row("base/max_wheel_accel", &P::base, &Base::max_wheel_accel, nonNegative<double>),
+      row("base/cmd_vel_timeout", &P::base, &Base::cmd_vel_timeout, positive<double>),
+      row("base/speed_dithering", &P::base, &Base::speed_dithering),
+      row("base/battery_poll_rate", &P::base, &Base::battery_poll_rate, nonNegative<double>),
+
+      row("body/enabled", &P::body, &Port::enabled),
+      row("body/port", &P::body, &Port::port),
+      row("body/baud", &P::body, &Port::baud, baudOrInherit),
+      row("body/servo_ids", &P::body, &Body::servo_ids,
+          [](const std::vector<int>& ids, const std::string& key) {
+            require(!ids.empty(), key, "must list at least one servo id");
+            require(ids.size() <= 57, key, "at most 57 servos fit in a telemetry frame");
+            std::set<int> seen;
+            for (int id : ids) {
+              require(id >= 0 && id <= 253, key,
+                      "ids must be 0..253 (254 is broadcast), got " + std::to_string(id));
+              require(seen.insert(id).second, key, "id " + std::to_string(id) + " is listed twice");
+            }
+          }),
+      row("body/joint_names", &P::body, &Body::joint_names,
+          [](const std::vector<std::string>& names, const std::string& key) {
+            std::set<std::string> seen;
+            for (const auto& name : names) {
+              require(!name.empty(), key, "a joint name is empty");
+              require(seen.insert(name).second, key, "'" + name + "' is listed twice");
+            }
+          }),
+      row("body/ticks_per_revolution", &P::body, &Body::ticks_per_revolution,
+          [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); }),
+      row("body/zero_ticks", &P::body, &Body::zero_ticks,
+          [](const std::vector<int>& zeros, const std::string& key) {
+            for (int zero : zeros) require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
+          }),
+      row("body/directions", &P::body, &Body::directions,
+          [](const std::vector<int>& directions, const std::string& key) {
+            for (int d : directions) require(d == 1 || d == -1, key, "entries must be 1 or -1");
+          }),
+      row("body/velocity_scale", &P::body, &Body::velocity_scale, nonNegative<double>),
+
+      row("imu/frame_id", &P::imu, &Imu::frame_id,
+          [](const std::string& v, const std::string& key) {
+            require(!v.empty(), key, "must not be empty");
+          }),
+      row("imu/accel_scale", &P::imu, &Imu::accel_scale, positive<double>),
+      row("imu/gyro_scale", &P::imu, &Imu::gyro_scale, positive<double>),
+      row("imu/angle_scale", &P::imu, &Imu::angle_scale, positive<double>),
+      row("imu/orientation_variance", &P::imu, &Imu::orientation_variance,
+          [](const double& v, const std::string& key) {
+            require(std::isfinite(v), key, "must be finite");
+          }),
+      row("imu/angular_velocity_variance", &P::imu, &Imu::angular_velocity_variance,
+          nonNegative<double>),
+      row("imu/linear_acceleration_variance", &P::imu, &Imu::linear_acceleration_variance,
+          nonNegative<double>),
+
+      row("servo_bus/enabled", &P::servo_bus, &Port::enabled),
+      row("servo_bus/port", &P::servo_bus, &Port::port),
+      row("servo_bus/baud", &P::servo_bus, &Port::baud, baudOrInherit),
+      row("servo_bus/timeout", &P::servo_bus, &Bus::timeout,
+          [](const double& v, const std::string& key) {
+            requirePositive(v, key);
+            require(v <= 5.0, key, "must be at most 5 s");
+          }),
+      row("servo_bus/retries", &P::servo_bus, &Bus::retries,
+          [](const int& v, const std::string& key) {
+            require(v >= 0 && v <= 10, key, "must be 0..10");
+          }),
+      row("servo_bus/allow_dangerous_writes", &P::servo_bus, &Bus::allow_dangerous_writes),
+  };
+}
 
 /// How a parameter's expected type reads in an error message.
-std::string typeName(bool) { return "true or false"; }
-std::string typeName(int) { return "an integer"; }
-std::string typeName(double) { return "a number"; }
-std::string typeName(const std::string&) { return "a string"; }
-std::string typeName(const std::vector<int>&) { return "a list of integers"; }
-std::string typeName(const std::vector<std::string>&) { return "a list of strings"; }
+std::string typeName(const ParamValue& value) {
+  static const char* const kNames[] = {"true or false", "an integer",          "a number",
+                                       "a string",      "a list of integers", "a list of strings"};
+  return kNames[value.index()];
+}
 
-/// Reads keys under ~ and remembers which ones it was asked for, so what is left on the parameter
-/// server afterwards is exactly the keys the driver does not know.
-class ParamReader {
+/// The parameter server under the node's private namespace.
+class NodeHandleSource : public ParamSource {
  public:
-  explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
+  explicit NodeHandleSource(const ros::NodeHandle& nh) : nh_(nh) {}
 
-  /// Reads `key` when present; a present key of the wrong type is an error, not a silent default.
-  template <typename T>
-  void read(const std::string& key, T* value) {
-    known_.insert(key);
-    if (!nh_.hasParam(key)) return;
-    if (!nh_.getParam(key, *value)) throw ParameterError(key, "must be " + typeName(*value));
+  bool has(const std::string& key) const override { return nh_.hasParam(key); }
+
+  bool get(const std::string& key, ParamValue* value) const override {
+    return std::visit([&](auto& typed) { return nh_.getParam(key, typed); }, *value);
   }
 
-  void readDevice(const std::string& prefix, DevicePortParams* device) {
-    read(prefix + "/enabled", &device->enabled);
-    read(prefix + "/port", &device->port);
-    read(prefix + "/baud", &device->baud);
-  }
-
-  /// Keys under ~ that no read() asked for.
-  std::vector<std::string> unreadKeys() const {
+  std::vector<std::string> keys() const override {
     std::vector<std::string> all;
     ros::param::getParamNames(all);
     const std::string prefix = nh_.getNamespace() + "/";
-    std::vector<std::string> unread;
+    std::vector<std::string> under;
     for (const auto& full : all) {
-      if (full.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string key = full.substr(prefix.size());
-      if (!known_.count(key)) unread.push_back(key);
+      if (full.compare(0, prefix.size(), prefix) == 0) under.push_back(full.substr(prefix.size()));
     }
-    return unread;
+    return under;
   }
 
  private:
   const ros::NodeHandle& nh_;
-  std::set<std::string> known_ = {"diagnostic_period"};  // read by diagnostic_updater itself
 };
 
 }  // namespace
 
+const std::vector<ParamSpec>& parameterTable() {
+  static const std::vector<ParamSpec> table = buildTable();
+  return table;
+}
+
 void DriverParams::validate() const {
-  require(!port.empty(), "port", "must name a serial device, e.g. /dev/ttyUSB0");
-  requireBaud(baud, "baud", false);
-  requirePositive(loop_rate, "loop_rate");
-  require(loop_rate <= 1000, "loop_rate", "must be at most 1000 Hz");
-  requirePositive(reconnect_interval, "reconnect_interval");
+  // Single values first (the table), then what relates several parameters.
+  for (const auto& spec : parameterTable()) spec.check(*this);
+
   require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
           "every device is disabled (base, body, servo_bus): nothing to drive");
-
   if (base.enabled) {
-    validateDevicePort(base, "base");
-    requirePositive(base.wheel_diameter, "base/wheel_diameter");
-    requirePositive(base.encoder_resolution, "base/encoder_resolution");
-    requirePositive(base.pid_rate, "base/pid_rate");
-    requirePositive(base.wheel_separation, "base/wheel_separation");
-    requireNonNegative(base.max_wheel_speed, "base/max_wheel_speed");
-    requireNonNegative(base.max_wheel_accel, "base/max_wheel_accel");
-    requirePositive(base.cmd_vel_timeout, "base/cmd_vel_timeout");
-    requireNonNegative(base.battery_poll_rate, "base/battery_poll_rate");
     require(base.battery_poll_rate <= loop_rate, "base/battery_poll_rate",
             "must not exceed loop_rate (requests go out from the loop)");
   }
-
   if (body.enabled) {
-    validateDevicePort(body, "body");
     const std::size_t n = body.servo_ids.size();
-    require(n > 0, "body/servo_ids", "must list at least one servo id");
-    require(n <= 57, "body/servo_ids", "at most 57 servos fit in a telemetry frame");
-    std::set<int> seen;
-    for (int id : body.servo_ids) {
-      require(id >= 0 && id <= 253, "body/servo_ids",
-              "ids must be 0..253 (254 is broadcast), got " + std::to_string(id));
-      require(seen.insert(id).second, "body/servo_ids", "id " + std::to_string(id) + " is listed twice");
-    }
-    require(body.joint_names.size() == n, "body/joint_names",
-            "has " + std::to_string(body.joint_names.size()) + " entries but body/servo_ids has " +
-                std::to_string(n));
-    std::set<std::string> names;
-    for (const auto& name : body.joint_names) {
-      require(!name.empty(), "body/joint_names", "a joint name is empty");
-      require(names.insert(name).second, "body/joint_names", "'" + name + "' is listed twice");
-    }
-    require(body.ticks_per_revolution > 0, "body/ticks_per_revolution", "must be > 0");
-    require(body.zero_ticks.size() == n, "body/zero_ticks",
-            "has " + std::to_string(body.zero_ticks.size()) + " entries but body/servo_ids has " +
-                std::to_string(n));
-    for (int zero : body.zero_ticks) {
-      require(zero >= 0 && zero <= 65535, "body/zero_ticks", "entries must be 0..65535");
-    }
-    require(body.directions.size() == n, "body/directions",
-            "has " + std::to_string(body.directions.size()) + " entries but body/servo_ids has " +
-                std::to_string(n));
-    for (int direction : body.directions) {
-      require(direction == 1 || direction == -1, "body/directions", "entries must be 1 or -1");
-    }
-    requireNonNegative(body.velocity_scale, "body/velocity_scale");
-    require(!imu.frame_id.empty(), "imu/frame_id", "must not be empty");
-    requirePositive(imu.accel_scale, "imu/accel_scale");
-    requirePositive(imu.gyro_scale, "imu/gyro_scale");
-    requirePositive(imu.angle_scale, "imu/angle_scale");
-    require(std::isfinite(imu.orientation_variance), "imu/orientation_variance", "must be finite");
-    requireNonNegative(imu.angular_velocity_variance, "imu/angular_velocity_variance");
-    requireNonNegative(imu.linear_acceleration_variance, "imu/linear_acceleration_variance");
-  }
-
-  if (servo_bus.enabled) {
-    validateDevicePort(servo_bus, "servo_bus");
-    requirePositive(servo_bus.timeout, "servo_bus/timeout");
-    require(servo_bus.timeout <= 5.0, "servo_bus/timeout", "must be at most 5 s");
-    require(servo_bus.retries >= 0 && servo_bus.retries <= 10, "servo_bus/retries", "must be 0..10");
+    const auto requireOnePerServo = [n](std::size_t size, const std::string& name) {
+      require(size == n, name,
+              "has " + std::to_string(size) + " entries but body/servo_ids has " + std::to_string(n));
+    };
+    requireOnePerServo(body.joint_names.size(), "body/joint_names");
+    requireOnePerServo(body.zero_ticks.size(), "body/zero_ticks");
+    requireOnePerServo(body.directions.size(), "body/directions");
   }
 
   // Devices sharing a path share one port, so they must agree on its baud rate.
@@ -180,48 +280,28 @@ void DriverParams::validate() const {
   }
 }
 
+DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unknown_keys) {
+  DriverParams params;
+  std::set<std::string> known = {"diagnostic_period"};  // read by diagnostic_updater itself
+  for (const auto& spec : parameterTable()) {
+    known.insert(spec.key);
+    if (!source.has(spec.key)) continue;
+    ParamValue value = spec.get(params);
+    // A present key of the wrong type is an error, not a silent default.
+    if (!source.get(spec.key, &value)) throw ParameterError(spec.key, "must be " + typeName(value));
+    spec.set(params, value);
+  }
+  if (unknown_keys) {
+    unknown_keys->clear();
+    for (const auto& key : source.keys()) {
+      if (!known.count(key)) unknown_keys->push_back(key);
+    }
+  }
+  return params;
+}
+
 DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unknown_keys) {
-  DriverParams p;
-  ParamReader reader(nh);
-  reader.read("port", &p.port);
-  reader.read("baud", &p.baud);
-  reader.read("loop_rate", &p.loop_rate);
-  reader.read("reconnect_interval", &p.reconnect_interval);
-
-  reader.readDevice("base", &p.base);
-  reader.read("base/wheel_diameter", &p.base.wheel_diameter);
-  reader.read("base/encoder_resolution", &p.base.encoder_resolution);
-  reader.read("base/pid_rate", &p.base.pid_rate);
-  reader.read("base/wheel_separation", &p.base.wheel_separation);
-  reader.read("base/max_wheel_speed", &p.base.max_wheel_speed);
-  reader.read("base/max_wheel_accel", &p.base.max_wheel_accel);
-  reader.read("base/cmd_vel_timeout", &p.base.cmd_vel_timeout);
-  reader.read("base/speed_dithering", &p.base.speed_dithering);
-  reader.read("base/battery_poll_rate", &p.base.battery_poll_rate);
-
-  reader.readDevice("body", &p.body);
-  reader.read("body/servo_ids", &p.body.servo_ids);
-  reader.read("body/joint_names", &p.body.joint_names);
-  reader.read("body/ticks_per_revolution", &p.body.ticks_per_revolution);
-  reader.read("body/zero_ticks", &p.body.zero_ticks);
-  reader.read("body/directions", &p.body.directions);
-  reader.read("body/velocity_scale", &p.body.velocity_scale);
-
-  reader.read("imu/frame_id", &p.imu.frame_id);
-  reader.read("imu/accel_scale", &p.imu.accel_scale);
-  reader.read("imu/gyro_scale", &p.imu.gyro_scale);
-  reader.read("imu/angle_scale", &p.imu.angle_scale);
-  reader.read("imu/orientation_variance", &p.imu.orientation_variance);
-  reader.read("imu/angular_velocity_variance", &p.imu.angular_velocity_variance);
-  reader.read("imu/linear_acceleration_variance", &p.imu.linear_acceleration_variance);
-
-  reader.readDevice("servo_bus", &p.servo_bus);
-  reader.read("servo_bus/timeout", &p.servo_bus.timeout);
-  reader.read("servo_bus/retries", &p.servo_bus.retries);
-  reader.read("servo_bus/allow_dangerous_writes", &p.servo_bus.allow_dangerous_writes);
-
-  if (unknown_keys) *unknown_keys = reader.unreadKeys();
-  return p;
+  return loadParams(NodeHandleSource(nh), unknown_keys);
 }
 
 }  // namespace serial_robot_driver::ros_layer

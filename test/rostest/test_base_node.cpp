@@ -35,13 +35,14 @@
 #include "serial_robot_driver/protocol/base_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
-#include "support/pty_frame_reader.h"
+#include "support/fake_device.h"
+#include "support/golden_frames.h"
 #include "support/ros_test_support.h"
 
 namespace {
 
 namespace protocol = serial_robot_driver::protocol;
-namespace sim = serial_robot_driver::sim;
+namespace transport = serial_robot_driver::transport;
 using test_support::Bytes;
 using test_support::ChildProcess;
 using test_support::Clock;
@@ -71,8 +72,8 @@ Bytes zeroSpeedFrame(uint8_t seq) {
 }
 
 // Base -> host frames, written out by hand (XOR included).
-const Bytes kTimeoutErrorFrame = {0x55, 0xAA, 0x02, 0x20, 0xFF, 0x00, 0x22};   // FF status
-const Bytes kBattery87PercentFrame = {0x55, 0xAA, 0x02, 0x10, 0x02, 0x57, 0xB8};  // 0x57 = 87 %
+const Bytes& kTimeoutErrorFrame = golden::base::kErrorStatusSeq32;     // FF status
+const Bytes& kBattery87PercentFrame = golden::base::kBattery87ReplySeq16;  // 0x57 = 87 %
 
 // --- the fake base on a pty ----------------------------------------------------------------------
 
@@ -91,51 +92,30 @@ struct SeenFrame {
   bool isZeroSpeed() const { return isSpeed() && left() == 0 && right() == 0; }
 };
 
-/// Plays the AP1 base on a pty with a symlink at `path`. A reader thread drains everything the node
-/// writes (so its writes never stall) and records the frames of the current session (since the
-/// last plug()).
+/// Plays the AP1 base on a pty with a symlink at `path`: a FakeDevice (whose reader drains
+/// everything the node writes, so its writes never stall) seen through the base frames of the
+/// current session (since the last plug()).
 class FakeBase {
  public:
-  explicit FakeBase(std::string path) : path_(std::move(path)) { plug(); }
-  ~FakeBase() { unplug(); }
+  explicit FakeBase(std::string path) : device_(std::move(path), baseFramer()) { plug(); }
 
   /// Creates a new pty at the path (a fresh session: the frame list starts empty).
-  void plug() {
-    unplug();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      frames_.clear();
-      undecodable_ = 0;
-    }
-    unplugged_framer_stats_ = protocol::FramerStats{};
-    pty_ = std::make_unique<sim::PseudoTerminal>(path_);
-    plugged_at_ = Clock::now();
-    protocol::FramerConfig config;
-    config.base = true;
-    reader_ = std::make_unique<test_support::PtyFrameReader>(
-        *pty_, config,
-        [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) { onFrame(family, data, size, arrival); });
-  }
-
+  void plug() { device_.plug(); }
   /// Closes the pty and removes the symlink: to the node this looks like an unplugged adapter.
-  void unplug() {
-    if (reader_) unplugged_framer_stats_ = reader_->framerStats();
-    reader_.reset();
-    if (pty_) pty_->close();
-    pty_.reset();
-  }
+  void unplug() { device_.unplug(); }
 
-  void write(const Bytes& bytes) { pty_->write(bytes.data(), bytes.size()); }
+  void write(const Bytes& bytes) { device_.write(bytes); }
 
   std::vector<SeenFrame> frames() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return frames_;
+    std::vector<SeenFrame> seen;
+    for (const auto& frame : device_.frames()) {
+      const auto decoded = protocol::base::decodeFrame(frame.bytes.data(), frame.bytes.size());
+      if (frame.family != protocol::FrameFamily::kBase || !decoded) continue;
+      seen.push_back(SeenFrame{frame.bytes, decoded->seq, decoded->msg_id, frame.arrival});
+    }
+    return seen;
   }
-  std::size_t count() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return frames_.size();
-  }
+  std::size_t count() const { return frames().size(); }
   /// Waits until at least `n` frames of this session were read.
   bool waitForCount(std::size_t n, double timeout_s) const {
     return waitFor([&] { return count() >= n; }, timeout_s);
@@ -148,38 +128,20 @@ class FakeBase {
 
   /// Bytes that were not part of a valid base frame (checksum errors, resyncs, bad lengths).
   uint64_t garbage() const {
-    const protocol::FramerStats stats = reader_ ? reader_->framerStats() : unplugged_framer_stats_;
-    std::lock_guard<std::mutex> lock(mutex_);
-    return stats.checksum_errors + stats.bad_lengths + undecodable_ + stats.bytes_skipped;
+    const protocol::FramerStats stats = device_.framerStats();
+    const uint64_t undecodable = device_.frameCount() - count();
+    return stats.checksum_errors + stats.bad_lengths + undecodable + stats.bytes_skipped;
   }
-  Clock::time_point pluggedAt() const { return plugged_at_; }
+  Clock::time_point pluggedAt() const { return device_.pluggedAt(); }
 
  private:
-  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) {
-    const auto decoded = protocol::base::decodeFrame(data, size);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (family != protocol::FrameFamily::kBase || !decoded) {
-      ++undecodable_;
-      return;
-    }
-    SeenFrame frame;
-    frame.bytes.assign(data, data + size);
-    frame.seq = decoded->seq;
-    frame.msg_id = decoded->msg_id;
-    frame.arrival = arrival;
-    frames_.push_back(std::move(frame));
+  static protocol::FramerConfig baseFramer() {
+    protocol::FramerConfig config;
+    config.base = true;
+    return config;
   }
 
-  const std::string path_;
-  std::unique_ptr<sim::PseudoTerminal> pty_;
-  std::unique_ptr<test_support::PtyFrameReader> reader_;
-  protocol::FramerStats unplugged_framer_stats_;  // the last session's, once unplugged
-  Clock::time_point plugged_at_;
-
-  mutable std::mutex mutex_;
-  std::vector<SeenFrame> frames_;
-  uint64_t undecodable_ = 0;
+  test_support::FakeDevice device_;
 };
 
 // Frame-list helpers ----------------------------------------------------------------------------
@@ -427,12 +389,11 @@ class BaseNodeTest : public ::testing::Test {
 // The hand-written XOR helper reproduces the golden vectors of PROTOCOLS.md, so the expected frames
 // built with it below can be trusted.
 TEST(BaseGoldenFrames, HelperMatchesProtocolVectors) {
-  EXPECT_EQ(resetFrame(0x02), (Bytes{0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA}));
-  EXPECT_EQ(batteryRequestFrame(0x01), (Bytes{0x55, 0xAA, 0x02, 0x01, 0x02, 0x00, 0xFE}));
-  EXPECT_EQ(clearEncodersFrame(0x03), (Bytes{0x55, 0xAA, 0x02, 0x03, 0x06, 0x00, 0xF8}));
+  EXPECT_EQ(resetFrame(0x02), golden::base::kResetSeq2);
+  EXPECT_EQ(batteryRequestFrame(0x01), golden::base::kBatteryRequestSeq1);
+  EXPECT_EQ(clearEncodersFrame(0x03), golden::base::kClearEncodersSeq3);
   EXPECT_EQ(withXor({0x55, 0xAA, 0x09, 0x00, 0x01, 0xFF, 0xFA, 0xFF, 0xFA, 0x00, 0x00, 0x00, 0x00}),
-            (Bytes{0x55, 0xAA, 0x09, 0x00, 0x01, 0xFF, 0xFA, 0xFF, 0xFA, 0x00, 0x00, 0x00, 0x00,
-                   0xF7}));
+            golden::base::kBothMinus6Seq0);
 }
 
 // 1. After connecting, the node sends a Reset, then a speed frame reported with reset_before.

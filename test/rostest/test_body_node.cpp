@@ -33,7 +33,9 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/sim/pseudo_terminal.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/fake_device.h"
+#include "support/golden_frames.h"
 #include "support/ros_test_support.h"
 
 namespace {
@@ -156,7 +158,7 @@ ros::Subscriber subscribe(ros::NodeHandle& nh, const std::string& topic, Inbox<M
 // ---------------------------------------------------------------------------
 
 struct Board {
-  std::unique_ptr<serial_robot_driver::sim::PseudoTerminal> pty;
+  std::unique_ptr<test_support::FakeDevice> device;  ///< the board: records what the node writes
   Inbox<JointState> joints;
   Inbox<Imu> imu;
   Inbox<FootPressure> foot;
@@ -166,7 +168,7 @@ struct Board {
   bool connected = false;
   bool connect_failed = false;
 
-  void write(const Bytes& bytes) { pty->write(bytes.data(), bytes.size()); }
+  void write(const Bytes& bytes) { device->write(bytes); }
 
   void clear() {
     joints.clear();
@@ -191,21 +193,17 @@ struct Board {
 
   /// Reads exactly `count` bytes the driver wrote, or what came within the timeout.
   Bytes read(std::size_t count, double timeout_s = 10.0) {
-    Bytes bytes(count);
-    std::size_t got = 0;
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (got < count && std::chrono::steady_clock::now() < deadline) {
-      got += pty->read(bytes.data() + got, count - got, 100);
-    }
-    bytes.resize(got);
-    return bytes;
+    return device->takeBytes(count, timeout_s);
   }
 
+  /// Discards what the driver wrote so far, once 50 ms pass without a new byte.
   void drainInput() {
-    uint8_t buffer[256];
-    while (pty->read(buffer, sizeof(buffer), 50) > 0) {
-    }
+    std::size_t received = device->mark();
+    do {
+      received = device->mark();
+      test_support::sleepSeconds(0.05);
+    } while (device->mark() != received);
+    device->skipReceived();
   }
 };
 
@@ -375,8 +373,7 @@ TEST_F(BodyNode, JointCommandsBecomeExactSyncWriteBytes) {
   board().joint_commands.publish(command({"hip", "knee"}, {0.0, std::nan("")}));
   // hip 0 rad -> 2048; knee pi/2 with direction -1 -> 2048 - 1024 = 1024 (PROTOCOLS.md 2a).
   board().joint_commands.publish(command({"hip", "knee"}, {0.0, M_PI / 2}));
-  const Bytes golden = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00,
-                        0x02, 0x00, 0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68};
+  const Bytes& golden = golden::body::kSyncWrite2And3;
   EXPECT_EQ(board().read(golden.size()), golden);
 
   // Only knee, to -pi/2 -> 3072 = 00 0C; hip is sent again at 2048. CRC worked out by hand.
@@ -541,7 +538,10 @@ int main(int argc, char** argv) {
 
   Board board;
   // The pty first: the node keeps retrying its port until the symlink exists.
-  board.pty = std::make_unique<serial_robot_driver::sim::PseudoTerminal>(port);
+  serial_robot_driver::protocol::FramerConfig framer;
+  framer.sync_write = true;
+  board.device = std::make_unique<test_support::FakeDevice>(port, framer);
+  board.device->plug();
   board.subscribers.push_back(subscribe(nh, "joint_states", &board.joints));
   board.subscribers.push_back(subscribe(nh, "imu/data", &board.imu));
   board.subscribers.push_back(subscribe(nh, "foot_pressure", &board.foot));
@@ -551,6 +551,6 @@ int main(int argc, char** argv) {
 
   const int result = RUN_ALL_TESTS();
   g_board = nullptr;
-  board.pty->close();
+  board.device->unplug();
   return result;
 }

@@ -41,13 +41,14 @@
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
-#include "support/pty_frame_reader.h"
+#include "support/fake_device.h"
 #include "support/ros_test_support.h"
 
 namespace {
 
 namespace protocol = serial_robot_driver::protocol;
 namespace sim = serial_robot_driver::sim;
+namespace transport = serial_robot_driver::transport;
 namespace srd = serial_robot_driver;
 using test_support::TopicCounter;
 using test_support::waitFor;
@@ -66,60 +67,33 @@ constexpr double kHuge = std::numeric_limits<double>::max();
 // Unplug / replug
 // =================================================================================================
 
-/// Plays the robot on a pty at `path`: records the MSGID of every base frame the node writes in
-/// the current session (since the last plug()) and writes telemetry frames on demand.
-class HandPlayedRobot {
- public:
-  explicit HandPlayedRobot(std::string path) : path_(std::move(path)) {}
-  ~HandPlayedRobot() { unplug(); }
+/// Plays the robot on a pty at `path` (from plug() on): a FakeDevice that records the base frames
+/// the node writes in the current session.
+std::unique_ptr<test_support::FakeDevice> handPlayedRobot(const std::string& path) {
+  protocol::FramerConfig config;
+  config.base = true;
+  return std::make_unique<test_support::FakeDevice>(path, config);
+}
 
-  void plug() {
-    unplug();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      msg_ids_.clear();
-    }
-    pty_ = std::make_unique<sim::PseudoTerminal>(path_);
-    protocol::FramerConfig config;
-    config.base = true;
-    reader_ = std::make_unique<test_support::PtyFrameReader>(
-        *pty_, config,
-        [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size, auto) {
-          if (family != protocol::FrameFamily::kBase || size < 5) return;
-          std::lock_guard<std::mutex> lock(mutex_);
-          msg_ids_.push_back(data[4]);  // 55 AA LEN SEQ MSGID ...
-        });
+/// The MSGID of every base frame of the current session.
+std::vector<uint8_t> msgIds(const test_support::FakeDevice& robot) {
+  std::vector<uint8_t> ids;
+  for (const auto& frame : robot.frames()) {
+    if (frame.family != protocol::FrameFamily::kBase || frame.bytes.size() < 5) continue;
+    ids.push_back(frame.bytes[4]);  // 55 AA LEN SEQ MSGID ...
   }
+  return ids;
+}
 
-  /// Closes the pty and removes the symlink: an unplugged adapter, as the node sees it.
-  void unplug() {
-    reader_.reset();
-    if (pty_) pty_->close();
-    pty_.reset();
-  }
-
-  std::vector<uint8_t> msgIds() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return msg_ids_;
-  }
-
-  void writeTelemetry(int frames) {
-    protocol::body::Telemetry telemetry;
-    telemetry.servo_count = 2;
-    telemetry.servos[0].position = 2048;
-    telemetry.servos[1].position = 1024;
-    telemetry.imu[protocol::body::kAccelZ] = 2048;
-    const std::vector<uint8_t> bytes = protocol::body::encodeTelemetry(telemetry);
-    for (int i = 0; i < frames; ++i) pty_->write(bytes.data(), bytes.size());
-  }
-
- private:
-  const std::string path_;
-  std::unique_ptr<sim::PseudoTerminal> pty_;
-  std::unique_ptr<test_support::PtyFrameReader> reader_;
-  mutable std::mutex mutex_;
-  std::vector<uint8_t> msg_ids_;
-};
+void writeTelemetry(test_support::FakeDevice& robot, int frames) {
+  protocol::body::Telemetry telemetry;
+  telemetry.servo_count = 2;
+  telemetry.servos[0].position = 2048;
+  telemetry.servos[1].position = 1024;
+  telemetry.imu[protocol::body::kAccelZ] = 2048;
+  const std::vector<uint8_t> bytes = protocol::body::encodeTelemetry(telemetry);
+  for (int i = 0; i < frames; ++i) robot.write(bytes);
+}
 
 TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
   const std::string node_name = "/unplug/driver_node";
@@ -134,17 +108,17 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
   constexpr int kCycles = 100;
   constexpr int kWarmUpCycles = 5;  // ROS connections and lazy allocations settle first
   constexpr int kTelemetryPerCycle = 3;
-  HandPlayedRobot robot(path);
+  const std::unique_ptr<test_support::FakeDevice> robot = handPlayedRobot(path);
   test_support::ProcessSample warm;
   test_support::ProcessSample last;
   std::vector<double> recovery_s;
   for (int cycle = 1; cycle <= kCycles; ++cycle) {
     const auto plugged_at = test_support::Clock::now();
-    robot.plug();
+    robot->plug();
     // Recovery: the node reopens the port and sends a Reset before its first speed frame.
     const bool driving = waitFor(
         [&] {
-          for (uint8_t id : robot.msgIds()) {
+          for (uint8_t id : msgIds(*robot)) {
             if (id == kMsgWheelSpeed) return true;
           }
           return false;
@@ -152,12 +126,12 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
         20);
     ASSERT_TRUE(driving) << "cycle " << cycle << ": no speed frame after the replug";
     recovery_s.push_back(test_support::secondsSince(plugged_at));
-    const std::vector<uint8_t> ids = robot.msgIds();
+    const std::vector<uint8_t> ids = msgIds(*robot);
     ASSERT_EQ(ids.front(), kMsgReset) << "cycle " << cycle << ": the first frame is not a Reset";
 
     // Telemetry flows: every frame written after the node reopened the port is published.
     const uint64_t before = joints.count();
-    robot.writeTelemetry(kTelemetryPerCycle);
+    writeTelemetry(*robot, kTelemetryPerCycle);
     ASSERT_TRUE(joints.waitForCount(before + kTelemetryPerCycle, 20))
         << "cycle " << cycle << ": " << joints.count() - before << " of " << kTelemetryPerCycle
         << " telemetry frames published";
@@ -167,7 +141,7 @@ TEST(UnplugReplug, HundredCyclesRecoverEveryTimeWithoutLeaks) {
     if (cycle == kWarmUpCycles || cycle == kCycles) {
       EXPECT_EQ(test_support::ptyFdCount(pid), 1u) << "cycle " << cycle << ": one port, one fd";
     }
-    robot.unplug();
+    robot->unplug();
   }
   // Nothing more than what was written (no duplicates).
   test_support::sleepSeconds(0.2);

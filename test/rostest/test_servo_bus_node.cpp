@@ -33,88 +33,42 @@
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
-#include "support/pty_frame_reader.h"
+#include "support/fake_device.h"
+#include "support/golden_frames.h"
 #include "support/ros_test_support.h"
-#include "support/servo_bus_frames.h"
 
 namespace {
 
 namespace srd = serial_robot_driver;
 namespace protocol = serial_robot_driver::protocol;
-namespace sim = serial_robot_driver::sim;
+namespace transport = serial_robot_driver::transport;
 using test_support::Bytes;
 using test_support::Clock;
 using test_support::concat;
 using test_support::secondsSince;
 
-using namespace servo_frames;  // NOLINT: the frames shared with the unit tests
+using namespace golden::servo;  // NOLINT: the frames shared with the unit tests
 
 // --- more frames written out by hand from PROTOCOLS.md section 3 (SUM = byte sum mod 256) --------
 const Bytes kPing4 = {0x12, 0x4C, 0x01, 0x01, 0x04, 0x64};
 // over_temperature (41 = 0x29) of servo 3 := 80, answered with result 0.
 const Bytes kWriteOverTemp3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x29, 0x50, 0x00, 0xE2};
 const Bytes kWriteOverTemp3Failed = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x29, 0x00, 0x54};
-const Bytes kSpin0Cw1000Ms = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x83, 0x64, 0x00, 0xE8, 0x03, 0x3D};
 
 // --- the servos on a pty ----------------------------------------------------------------------
 
-/// Plays the bus servos on a pty with a symlink at `path`: records every byte the node writes and
-/// answers scripted requests.
-class ServoBusPlayer {
- public:
-  ServoBusPlayer(const std::string& path, bool echo) : pty_(path), echo_(echo) {
-    protocol::FramerConfig config;
-    config.servo_request = true;
-    reader_ = std::make_unique<test_support::PtyFrameReader>(
-        pty_, config,
-        [this](protocol::FrameFamily, const uint8_t* data, std::size_t size, auto) {
-          onRequest(Bytes(data, data + size));
-        },
-        [this](const uint8_t* data, std::size_t size) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          received_.insert(received_.end(), data, data + size);
-        });
-  }
-  ~ServoBusPlayer() {
-    reader_.reset();
-    pty_.close();
-  }
+/// The bus servos on a pty (a scripted FakeDevice that records every byte the node writes).
+using ServoBusPlayer = test_support::FakeDevice;
 
-  /// Answers `request` with `replies` (in this order) every time it arrives.
-  void answer(const Bytes& request, std::vector<Bytes> replies) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    script_[request] = std::move(replies);
-  }
-  std::size_t mark() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return received_.size();
-  }
-  Bytes bytesSince(std::size_t mark) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return Bytes(received_.begin() + static_cast<std::ptrdiff_t>(mark), received_.end());
-  }
-
- private:
-  void onRequest(const Bytes& request) {
-    std::vector<Bytes> replies;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      auto it = script_.find(request);
-      if (it != script_.end()) replies = it->second;
-    }
-    Bytes out;
-    if (echo_) out = request;
-    for (const Bytes& reply : replies) out.insert(out.end(), reply.begin(), reply.end());
-    if (!out.empty()) pty_.write(out.data(), out.size());
-  }
-
-  sim::PseudoTerminal pty_;
-  const bool echo_;
-  mutable std::mutex mutex_;
-  Bytes received_;
-  std::map<Bytes, std::vector<Bytes>> script_;
-  std::unique_ptr<test_support::PtyFrameReader> reader_;  // last: it calls back into the above
-};
+/// Plays the bus servos at `path`: answers the requests it is scripted for; with `echo`, every
+/// request is written back first, as an adapter with a looped-back transmit line does.
+std::unique_ptr<ServoBusPlayer> servoBus(const std::string& path, bool echo) {
+  protocol::FramerConfig config;
+  config.servo_request = true;
+  auto bus = std::make_unique<ServoBusPlayer>(path, config, echo);
+  bus->plug();
+  return bus;
+}
 
 ServoBusPlayer* g_safe = nullptr;   // /driver_node: dangerous writes refused, echoing adapter
 ServoBusPlayer* g_armed = nullptr;  // /armed/driver_node: dangerous writes allowed
@@ -496,8 +450,10 @@ int main(int argc, char** argv) {
   }
   int result = 1;
   {
-    ServoBusPlayer safe(safe_port, /*echo=*/true);
-    ServoBusPlayer armed(armed_port, /*echo=*/false);
+    const std::unique_ptr<ServoBusPlayer> safe_bus = servoBus(safe_port, /*echo=*/true);
+    const std::unique_ptr<ServoBusPlayer> armed_bus = servoBus(armed_port, /*echo=*/false);
+    ServoBusPlayer& safe = *safe_bus;
+    ServoBusPlayer& armed = *armed_bus;
     scriptServos(safe, armed);
     g_safe = &safe;
     g_armed = &armed;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/base_codec.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::protocol::base {
 namespace {
@@ -110,7 +111,7 @@ INSTANTIATE_TEST_SUITE_P(BaseCodecGolden, BaseCodecWheelSpeed, ::testing::Values
                          [](const auto& info) { return info.param.name; });
 
 TEST(BaseCodec, WheelSpeedOfOtherMessageIsUnexpected) {
-  const Bytes reset = {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA};
+  const Bytes& reset = golden::base::kResetSeq2;
   const Decoded<Frame> frame = decodeFrame(reset.data(), reset.size());
   ASSERT_TRUE(frame.ok());
   const Decoded<WheelSpeed> speed = interpretWheelSpeed(*frame);

@@ -7,6 +7,7 @@
 
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "support/test_helpers.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::protocol::body {
 namespace {
@@ -147,19 +148,8 @@ INSTANTIATE_TEST_SUITE_P(BodyCodecErrors, BodyCodecMalformedSyncWrite,
 
 // --- telemetry -----------------------------------------------------------------------------------
 
-// PROTOCOLS.md golden frame, N = 2, no foot data, LEN 32.
-// SUM = 20+08+00+00+0A+04+00+FF+FB+00+01+FF+FF+40+00+00+00+00+00+00+64+00+00+00+00+C0+00
-//     = 32+8+10+4+255+251+1+255+255+64+100+192 = 1427 = 5*256 + 147 -> 147 = 0x93
-// clang-format off
-const Bytes kGoldenTelemetry = {
-    0x12, 0x34, 0x20,                                // header, LEN 32
-    0x08, 0x00, 0x00, 0x0A,                          // servo 0: 2048, speed 10
-    0x04, 0x00, 0xFF, 0xFB,                          // servo 1: 1024, speed -5
-    0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00,              // accel 1, -1, 16384
-    0x00, 0x00, 0x00, 0x00, 0x00, 0x64,              // gyro 0, 0, 100
-    0x00, 0x00, 0x00, 0x00, 0xC0, 0x00,              // angles 0, 0, -16384
-    0x93, 0x1F, 0x2F};                               // SUM, tail
-// clang-format on
+// Section 2b golden frame, N = 2, no foot data, LEN 32 (test/support/golden_frames.h).
+const Bytes& kGoldenTelemetry = golden::body::kTelemetryTwoServos;
 
 Telemetry goldenTelemetry() {
   Telemetry t;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/body_controller.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::device {
 namespace {
@@ -97,11 +98,9 @@ TEST(BodyControllerCalibration, VelocityUsesScaleWhenSet) {
 
 // --- telemetry -----------------------------------------------------------------------------------
 
-// PROTOCOLS.md 2b golden vector: N = 2, positions 2048, 1024, speeds 10, -5, IMU 1, -1, 16384, 0,
-// 0, 100, 0, 0, -16384. SUM = 0x20+08+0A+04+FF+FB+01+FF+FF+40+64+C0 = 0x593 -> 0x93.
-const Bytes kGoldenTelemetry = {0x12, 0x34, 0x20, 0x08, 0x00, 0x00, 0x0A, 0x04, 0x00, 0xFF, 0xFB,
-                                0x00, 0x01, 0xFF, 0xFF, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
-                                0x64, 0x00, 0x00, 0x00, 0x00, 0xC0, 0x00, 0x93, 0x1F, 0x2F};
+// Section 2b golden vector: N = 2, positions 2048, 1024, speeds 10, -5, IMU 1, -1, 16384, 0,
+// 0, 100, 0, 0, -16384.
+const Bytes& kGoldenTelemetry = golden::body::kTelemetryTwoServos;
 
 // N = 1 with the foot block (LEN = 40 + 4 = 0x2C): position 256, speed 0, IMU all zero, foot
 // sensors little-endian: j0 = 01 02 -> 0x0201, j1 = 03 04 -> 0x0403, j7 = FF 00 -> 0x00FF.
@@ -183,7 +182,7 @@ TEST(BodyControllerTelemetry, FrameOfAnotherServoCountIsADecodeError) {
 TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
-  const Bytes base_reset = {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA};
+  const Bytes& base_reset = golden::base::kResetSeq2;
   controller.onFrame(FrameFamily::kBase, base_reset.data(), base_reset.size(), Clock::now());
   // Even telemetry bytes under another family tag are not ours to decode.
   controller.onFrame(FrameFamily::kServoResponse, kGoldenTelemetry.data(), kGoldenTelemetry.size(),

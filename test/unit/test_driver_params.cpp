@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <functional>
+#include <map>
+#include <set>
 
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -83,6 +85,108 @@ TEST(DriverParams, DisabledDeviceIsNotValidated) {
   params.body.enabled = false;
   params.body.joint_names = {};
   EXPECT_NO_THROW(params.validate());
+}
+
+/// A parameter server stand-in: keys relative to ~ and their values.
+class MapSource : public ParamSource {
+ public:
+  std::map<std::string, ParamValue> values;
+
+  bool has(const std::string& key) const override { return values.count(key) > 0; }
+  bool get(const std::string& key, ParamValue* value) const override {
+    const ParamValue& stored = values.at(key);
+    if (stored.index() != value->index()) return false;
+    *value = stored;
+    return true;
+  }
+  std::vector<std::string> keys() const override {
+    std::vector<std::string> all;
+    for (const auto& entry : values) all.push_back(entry.first);
+    return all;
+  }
+};
+
+/// A value of the same type as `value` that differs from it.
+ParamValue changed(const ParamValue& value) {
+  struct Change {
+    ParamValue operator()(bool v) const { return !v; }
+    ParamValue operator()(int v) const { return v + 7; }
+    ParamValue operator()(double v) const { return v + 0.5; }
+    ParamValue operator()(const std::string& v) const { return v + "_changed"; }
+    ParamValue operator()(std::vector<int> v) const {
+      v.push_back(99);
+      return v;
+    }
+    ParamValue operator()(std::vector<std::string> v) const {
+      v.push_back("changed");
+      return v;
+    }
+  };
+  return std::visit(Change{}, value);
+}
+
+TEST(ParameterTable, KeysAreUnique) {
+  std::set<std::string> keys;
+  for (const auto& spec : parameterTable()) EXPECT_TRUE(keys.insert(spec.key).second) << spec.key;
+  EXPECT_EQ(keys.size(), parameterTable().size());
+}
+
+TEST(ParameterTable, NothingGivenLoadsTheStructDefaults) {
+  const DriverParams defaults;
+  std::vector<std::string> unknown{"stale"};
+  const DriverParams loaded = loadParams(MapSource(), &unknown);
+  EXPECT_TRUE(unknown.empty());
+  for (const auto& spec : parameterTable()) {
+    EXPECT_TRUE(spec.get(loaded) == spec.get(defaults)) << spec.key;
+  }
+  EXPECT_EQ(loaded.base.wheel_diameter, 0.25);
+  EXPECT_EQ(loaded.servo_bus.retries, 1);
+}
+
+TEST(ParameterTable, EachKeyLoadsIntoItsOwnField) {
+  const DriverParams defaults;
+  for (const auto& spec : parameterTable()) {
+    MapSource source;
+    source.values[spec.key] = changed(spec.get(defaults));
+    std::vector<std::string> unknown;
+    const DriverParams loaded = loadParams(source, &unknown);
+    EXPECT_TRUE(unknown.empty()) << spec.key;
+    EXPECT_TRUE(spec.get(loaded) == source.values[spec.key]) << spec.key << " did not load";
+    for (const auto& other : parameterTable()) {
+      if (other.key == spec.key) continue;
+      EXPECT_TRUE(other.get(loaded) == other.get(defaults))
+          << "loading " << spec.key << " changed " << other.key;
+    }
+  }
+}
+
+TEST(ParameterTable, KnownKeysByNameAndType) {
+  MapSource source;
+  source.values["base/wheel_diameter"] = 0.3;
+  source.values["body/servo_ids"] = std::vector<int>{4, 5, 6};
+  source.values["servo_bus/allow_dangerous_writes"] = true;
+  source.values["port"] = std::string("/dev/ttyACM0");
+  source.values["diagnostic_period"] = 2.0;
+  source.values["base/wheel_diamter"] = 0.3;
+  std::vector<std::string> unknown;
+  const DriverParams loaded = loadParams(source, &unknown);
+  EXPECT_EQ(loaded.base.wheel_diameter, 0.3);
+  EXPECT_EQ(loaded.body.servo_ids, (std::vector<int>{4, 5, 6}));
+  EXPECT_TRUE(loaded.servo_bus.allow_dangerous_writes);
+  EXPECT_EQ(loaded.port, "/dev/ttyACM0");
+  EXPECT_EQ(unknown, std::vector<std::string>{"base/wheel_diamter"});
+}
+
+TEST(ParameterTable, WrongTypeNamesTheParameter) {
+  MapSource source;
+  source.values["base/encoder_resolution"] = 1600.5;
+  try {
+    loadParams(source, nullptr);
+    FAIL() << "a number accepted for an integer parameter";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "base/encoder_resolution");
+    EXPECT_NE(std::string(e.what()).find("an integer"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

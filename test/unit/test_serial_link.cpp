@@ -10,6 +10,7 @@
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/test_helpers.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::device {
 namespace {
@@ -52,9 +53,9 @@ SerialLinkOptions optionsFor(const std::string& path) {
   return options;
 }
 
-// Battery reply, 87 %, SEQ 00 (55^AA^02^00^02^57 = A8) and PING reply id 3 (PROTOCOLS.md).
-const Bytes kBatteryReply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
-const Bytes kPingReply = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
+// Battery reply, 87 %, SEQ 00 and PING reply id 3.
+const Bytes& kBatteryReply = golden::base::kBattery87ReplySeq0;
+const Bytes& kPingReply = golden::servo::kPing3Reply;
 
 TEST(SerialLink, DeliversFramesAndWritesBytes) {
   const std::string path = uniqueLinkPath("basic");
@@ -76,7 +77,7 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   EXPECT_EQ(listener.frames[1].first, protocol::FrameFamily::kServoResponse);
   EXPECT_EQ(listener.frames[1].second, kPingReply);
 
-  const Bytes reset = {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA};
+  const Bytes& reset = golden::base::kResetSeq2;
   ASSERT_TRUE(link.write(reset));
   Bytes received(reset.size());
   std::size_t got = 0;

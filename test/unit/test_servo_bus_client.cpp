@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/servo_bus_client.h"
-#include "support/servo_bus_frames.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::device {
 namespace {
@@ -19,7 +19,7 @@ namespace {
 using Bytes = std::vector<uint8_t>;
 using protocol::FrameFamily;
 
-using namespace servo_frames;  // NOLINT: the frames shared with the rostest
+using namespace golden::servo;  // NOLINT: the frames shared with the rostest
 
 // --- more golden frames (PROTOCOLS.md section 3; SUM = byte sum mod 256, values little-endian) -
 const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
@@ -29,11 +29,6 @@ const Bytes kPing3ReplyTooLong = {0x05, 0x1C, 0x01, 0x02, 0x03, 0x00, 0x27};
 // WRITE_DATA id 3 soft_start_time: refused (result 0), and a read-back of 200.
 const Bytes kWriteSoftStart3Failed = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x32, 0x00, 0x5D};
 const Bytes kReadSoftStart3Reply200 = {0x05, 0x1C, 0x03, 0x04, 0x03, 0x32, 0xC8, 0x00, 0x25};
-
-const Bytes kRotate2Done = {0x05, 0x1C, 0x08, 0x02, 0x02, 0x01, 0x2E};
-const Bytes kSpin0CcwContinuous = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x01, 0x64, 0x00, 0x00, 0x00,
-                                   0xD0};
-const Bytes kSpin0Cw5Turns = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x82, 0x64, 0x00, 0x05, 0x00, 0x56};
 
 // The bus: records what the client writes and plays the servos by answering synchronously.
 class FakeBus {

@@ -20,6 +20,7 @@
 
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/transport/serial_port.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::transport {
 namespace {
@@ -88,7 +89,7 @@ TEST_F(TransportTest, OpensBySlavePathAndExchangesBytesBothWays) {
   port.open();
   ASSERT_TRUE(port.isOpen());
 
-  const Bytes to_robot = {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFA};
+  const Bytes& to_robot = golden::base::kResetSeq2;
   writeBytes(port, to_robot);
   EXPECT_EQ(readExactly(pty, to_robot.size()), to_robot);
 

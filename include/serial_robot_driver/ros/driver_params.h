@@ -3,8 +3,10 @@
 // bad parameter; the node prints it and exits non-zero.
 #pragma once
 
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace ros {
@@ -88,6 +90,40 @@ struct DriverParams {
   int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
   int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
 };
+
+/// One parameter's value; the alternative held says the parameter's type.
+using ParamValue =
+    std::variant<bool, int, double, std::string, std::vector<int>, std::vector<std::string>>;
+
+/// One row of the parameter table: the key under ~ and how it reaches its DriverParams field.
+/// The table (parameterTable()) is the only place a key is spelled: loading, the unknown-key
+/// warning and the single-value range checks of validate() all walk it.
+struct ParamSpec {
+  std::string key;
+  std::function<ParamValue(const DriverParams&)> get;
+  std::function<void(DriverParams&, const ParamValue&)> set;
+  /// Throws ParameterError(key, ...) when the field's value is out of range; checked only while
+  /// the device the key belongs to is enabled.
+  std::function<void(const DriverParams&)> check;
+};
+
+const std::vector<ParamSpec>& parameterTable();
+
+/// Where loadParams reads from: the parameter server (loadParams below), or a map in tests.
+class ParamSource {
+ public:
+  virtual ~ParamSource() = default;
+  virtual bool has(const std::string& key) const = 0;
+  /// Overwrites `value` (keeping its alternative) with the stored value of `key`; false when the
+  /// stored value has another type.
+  virtual bool get(const std::string& key, ParamValue* value) const = 0;
+  /// Every key the source holds (relative to ~).
+  virtual std::vector<std::string> keys() const = 0;
+};
+
+/// Reads every table key present in `source` (missing keys keep their defaults; a key of the
+/// wrong type is a ParameterError). `unknown_keys` receives the keys the driver does not know.
+DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unknown_keys);
 
 /// Reads every parameter from the private namespace of `private_nh` (missing keys keep their
 /// defaults; a key of the wrong type is a ParameterError). `unknown_keys` receives the keys under ~
