@@ -42,7 +42,6 @@
 namespace {
 
 namespace protocol = serial_robot_driver::protocol;
-namespace transport = serial_robot_driver::transport;
 using test_support::Bytes;
 using test_support::ChildProcess;
 using test_support::Clock;

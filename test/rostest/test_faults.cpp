@@ -48,7 +48,6 @@ namespace {
 
 namespace protocol = serial_robot_driver::protocol;
 namespace sim = serial_robot_driver::sim;
-namespace transport = serial_robot_driver::transport;
 namespace srd = serial_robot_driver;
 using test_support::TopicCounter;
 using test_support::waitFor;

@@ -41,7 +41,6 @@ namespace {
 
 namespace srd = serial_robot_driver;
 namespace protocol = serial_robot_driver::protocol;
-namespace transport = serial_robot_driver::transport;
 using test_support::Bytes;
 using test_support::Clock;
 using test_support::concat;

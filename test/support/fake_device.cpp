@@ -8,7 +8,7 @@
 namespace test_support {
 
 namespace protocol = serial_robot_driver::protocol;
-namespace transport = serial_robot_driver::transport;
+namespace sim = serial_robot_driver::sim;
 
 FakeDevice::FakeDevice(std::string link_path, protocol::FramerConfig framer, bool echo)
     : link_path_(std::move(link_path)), framer_config_(framer), echo_(echo) {}
