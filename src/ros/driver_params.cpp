@@ -7,6 +7,8 @@
 #include <ros/node_handle.h>
 #include <ros/param.h>
 
+#include "serial_robot_driver/protocol/body_codec.h"
+
 namespace serial_robot_driver::ros_layer {
 
 namespace {
@@ -119,7 +121,9 @@ void DriverParams::validate() const {
     validateDevicePort(body, "body");
     const std::size_t n = body.servo_ids.size();
     require(n > 0, "body/servo_ids", "must list at least one servo id");
-    require(n <= 57, "body/servo_ids", "at most 57 servos fit in a telemetry frame");
+    require(n <= protocol::body::kMaxTelemetryServos, "body/servo_ids",
+            "at most " + std::to_string(protocol::body::kMaxTelemetryServos) +
+                " servos fit in a telemetry frame");
     std::set<int> seen;
     for (int id : body.servo_ids) {
       require(id >= 0 && id <= 253, "body/servo_ids",

@@ -34,6 +34,12 @@ void logOutcome(const char* service, const device::ServoStatus& status) {
   }
 }
 
+/// The core says "dangerous"; only this layer knows which parameter arms such writes.
+std::string messageFor(const device::ServoStatus& status) {
+  if (status.error != device::ServoError::kDangerous) return status.message;
+  return status.message + " (set ~servo_bus/allow_dangerous_writes to true to arm it)";
+}
+
 }  // namespace
 
 device::ServoBusOptions makeServoBusOptions(const DriverParams& params) {
@@ -135,7 +141,7 @@ bool ServoBusInterface::onWrite(ServoWrite::Request& req, ServoWrite::Response& 
         logOutcome("servo/write", status);
         if (status.ok()) ROS_INFO("servo/write: %s", status.message.c_str());
         res.success = status.ok();
-        res.message = status.message;
+        res.message = messageFor(status);
       },
       [&](const std::string& message) {
         res.success = false;
@@ -251,7 +257,7 @@ bool ServoBusInterface::onResetUserData(ServoResetUserData::Request& req,
         logOutcome("servo/reset_user_data", status);
         if (status.ok()) ROS_INFO("servo/reset_user_data: %s", status.message.c_str());
         res.success = status.ok();
-        res.message = status.message;
+        res.message = messageFor(status);
       },
       [&](const std::string& message) {
         res.success = false;
