@@ -16,8 +16,8 @@ using servo::ParamInfo;
 
 namespace {
 
-constexpr uint8_t kServoIdParam = 34;
-constexpr uint8_t kBaudrateParam = 36;
+constexpr uint8_t kServoIdParam = servo::dataId(servo::ServoDataId::kServoId);
+constexpr uint8_t kBaudrateParam = servo::dataId(servo::ServoDataId::kBaudrate);
 constexpr uint8_t kResultFailed = 0;
 constexpr double kDecidegreesPerDegree = 10.0;
 constexpr uint8_t kMaxSpinMode = 3;
@@ -111,11 +111,8 @@ ServoStatus fromWriteCheck(servo::WriteCheck check, const ParamInfo& param, int6
       error = ServoError::kDangerous;
       break;
   }
-  std::string message = servo::describe(check, param, value);
-  if (check == servo::WriteCheck::kDangerous) {
-    message += " (set ~servo_bus/allow_dangerous_writes to true to arm it)";
-  }
-  return fail(error, message);
+  // The switch that arms dangerous writes is named by the caller's layer (a ROS parameter there).
+  return fail(error, servo::describe(check, param, value));
 }
 
 ServoParamValue toParamValue(const ParamInfo& param, int64_t raw) {
@@ -571,8 +568,7 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
   if (!options_.allow_dangerous_writes) {
     return fail(ServoError::kDangerous,
                 "reset_user_data restores the factory id and baud rate and can make the servo "
-                "unreachable; refused because dangerous writes are not allowed (set "
-                "~servo_bus/allow_dangerous_writes to true to arm it)");
+                "unreachable; refused because dangerous writes are not allowed");
   }
   servo::Packet answer;
   const ServoStatus status =

@@ -65,6 +65,23 @@ std::vector<uint8_t> encodeBatteryReply(uint8_t seq, uint8_t percent) {
   return buildFrame(seq, MsgId::kBattery, &percent, 1);
 }
 
+Probe probeFrame(const uint8_t* data, std::size_t available) {
+  constexpr std::size_t kLenOffset = 2;
+  if (available < 1) return Probe::needMore();
+  if (data[0] != kHeader0) return Probe::invalid(DecodeError::kBadHeader);
+  if (available < 2) return Probe::needMore();
+  if (data[1] != kHeader1) return Probe::invalid(DecodeError::kBadHeader);
+  if (available <= kLenOffset) return Probe::needMore();
+  const uint8_t len = data[kLenOffset];
+  if (len < kMinLen || len > kMaxLen) return Probe::invalid(DecodeError::kBadLength);
+  const std::size_t size = frameSize(len);
+  if (available < size) return Probe::needMore();
+  if (xorChecksum(data, size - 1) != data[size - 1]) {
+    return Probe::invalid(DecodeError::kBadChecksum);
+  }
+  return Probe::frame(size);
+}
+
 Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size) {
   constexpr std::size_t kLenOffset = 2;
   if (size <= kLenOffset) return DecodeError::kTooShort;

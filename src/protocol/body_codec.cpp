@@ -62,6 +62,33 @@ std::vector<uint8_t> encodeSyncWrite(const std::vector<ServoTarget>& targets) {
   return frame;
 }
 
+Probe probeSyncWrite(const uint8_t* data, std::size_t available) {
+  // FF FF FD 00 then the broadcast id FE: compare as much of this prefix as has arrived.
+  const std::size_t header_size = kSyncWriteHeader.size();
+  const std::size_t known = std::min(available, header_size + 1);
+  for (std::size_t i = 0; i < known; ++i) {
+    const uint8_t expected = i < header_size ? kSyncWriteHeader[i] : kBroadcastId;
+    if (data[i] != expected) return Probe::invalid(DecodeError::kBadHeader);
+  }
+  if (available < kSyncWritePrefix) return Probe::needMore();
+  const std::size_t len = readLE16(data + kLenOffset);
+  if (len < kMinSyncWriteLen || (len - kMinSyncWriteLen) % kBytesPerTarget != 0 ||
+      (len - kMinSyncWriteLen) / kBytesPerTarget > kMaxSyncWriteServos) {
+    return Probe::invalid(DecodeError::kBadLength);
+  }
+  if (available <= kInstructionOffset) return Probe::needMore();
+  // Another Dynamixel instruction is not a frame of ours; not counted as an error.
+  if (data[kInstructionOffset] != kSyncWriteInstruction) {
+    return Probe::invalid(DecodeError::kBadHeader);
+  }
+  const std::size_t size = kSyncWritePrefix + len;
+  if (available < size) return Probe::needMore();
+  if (dynamixelCrc(data, size - kCrcSize) != readLE16(data + size - kCrcSize)) {
+    return Probe::invalid(DecodeError::kBadChecksum);
+  }
+  return Probe::frame(size);
+}
+
 Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size_t size) {
   if (size < kSyncWritePrefix) return DecodeError::kTooShort;
   if (!std::equal(kSyncWriteHeader.begin(), kSyncWriteHeader.end(), data)) {
@@ -100,6 +127,27 @@ uint8_t telemetrySum(const uint8_t* frame, std::size_t len) {
     sum = static_cast<uint8_t>(sum + frame[i]);
   }
   return sum;
+}
+
+Probe probeTelemetry(const uint8_t* data, std::size_t available, std::size_t servo_count) {
+  if (available < 1) return Probe::needMore();
+  if (data[0] != kTelemetryHeader0) return Probe::invalid(DecodeError::kBadHeader);
+  if (available < 2) return Probe::needMore();
+  if (data[1] != kTelemetryHeader1) return Probe::invalid(DecodeError::kBadHeader);
+  if (available <= kTelemetryLenOffset) return Probe::needMore();
+  const std::size_t len = data[kTelemetryLenOffset];
+  if (len != telemetryLen(servo_count, false) && len != telemetryLen(servo_count, true)) {
+    return Probe::invalid(DecodeError::kBadLength);
+  }
+  if (available < len) return Probe::needMore();
+  // Tail first: a wrong tail means the frame boundary itself is wrong.
+  if (data[len - 2] != kTelemetryTail0 || data[len - 1] != kTelemetryTail1) {
+    return Probe::invalid(DecodeError::kBadTail);
+  }
+  if (telemetrySum(data, len) != data[len - kTelemetryTrailer]) {
+    return Probe::invalid(DecodeError::kBadChecksum);
+  }
+  return Probe::frame(len);
 }
 
 Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::size_t servo_count) {

@@ -55,6 +55,8 @@ Decoded<Packet> decodePacket(uint8_t header0, uint8_t header1, const uint8_t* da
   return packet;
 }
 
+Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data, std::size_t available);
+
 }  // namespace
 
 uint8_t byteSum(const uint8_t* data, std::size_t size) {
@@ -122,6 +124,34 @@ std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw) {
 
 std::vector<uint8_t> encodeReadAngle(uint8_t id) {
   return buildIdOnlyRequest(Command::kReadAngle, id);
+}
+
+namespace {
+Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data, std::size_t available) {
+  if (available < 1) return Probe::needMore();
+  if (data[0] != header0) return Probe::invalid(DecodeError::kBadHeader);
+  if (available < 2) return Probe::needMore();
+  if (data[1] != header1) return Probe::invalid(DecodeError::kBadHeader);
+  if (available <= kSizeOffset) return Probe::needMore();
+  const uint8_t cmd = data[kCmdOffset];
+  const uint8_t content_size = data[kSizeOffset];
+  // An unknown CMD is treated like an impossible N: both mean a corrupted or misaligned header.
+  if (cmd < kMinCommand || cmd > kMaxCommand || content_size > kMaxContent) {
+    return Probe::invalid(DecodeError::kBadLength);
+  }
+  const std::size_t size = content_size + kOverhead;
+  if (available < size) return Probe::needMore();
+  if (byteSum(data, size - 1) != data[size - 1]) return Probe::invalid(DecodeError::kBadChecksum);
+  return Probe::frame(size);
+}
+}  // namespace
+
+Probe probeResponse(const uint8_t* data, std::size_t available) {
+  return probePacket(kResponseHeader0, kResponseHeader1, data, available);
+}
+
+Probe probeRequest(const uint8_t* data, std::size_t available) {
+  return probePacket(kRequestHeader0, kRequestHeader1, data, available);
 }
 
 Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size) {

@@ -14,50 +14,50 @@ constexpr int64_t kU32Max = std::numeric_limits<uint32_t>::max();
 constexpr int64_t kI16Min = std::numeric_limits<int16_t>::min();
 constexpr int64_t kI16Max = std::numeric_limits<int16_t>::max();
 
-constexpr ParamInfo readOnly(uint8_t id, std::string_view name, ParamType type,
+constexpr ParamInfo readOnly(ServoDataId id, std::string_view name, ParamType type,
                              std::string_view unit, int64_t max) {
-  return ParamInfo{id, name, type, unit, true, false, 0, max};
+  return ParamInfo{dataId(id), name, type, unit, true, false, 0, max};
 }
-constexpr ParamInfo readWrite(uint8_t id, std::string_view name, ParamType type,
+constexpr ParamInfo readWrite(ServoDataId id, std::string_view name, ParamType type,
                               std::string_view unit, int64_t min, int64_t max,
                               bool dangerous = false) {
-  return ParamInfo{id, name, type, unit, false, dangerous, min, max};
+  return ParamInfo{dataId(id), name, type, unit, false, dangerous, min, max};
 }
 
 // PROTOCOLS.md section 3. Ranges are the type's unless the datasheet narrows them.
 constexpr std::array<ParamInfo, kParamCount> kParams = {{
-    readOnly(1, "voltage", ParamType::kU16, "mV", kU16Max),
-    readOnly(2, "current", ParamType::kU16, "mA", kU16Max),
-    readOnly(3, "power", ParamType::kU16, "mW", kU16Max),
-    readOnly(4, "temperature", ParamType::kU16, "degC", kU16Max),
-    readOnly(5, "servo_status", ParamType::kU8, "", kU8Max),
-    readOnly(6, "servo_type", ParamType::kU16, "", kU16Max),
-    readOnly(7, "firmware_version", ParamType::kU16, "", kU16Max),
-    readOnly(8, "serial_number", ParamType::kU32, "", kU32Max),
-    readWrite(32, "reserved_32", ParamType::kU8, "", 0, kU8Max),
-    readWrite(33, "response_switch", ParamType::kU8, "", 0, 1),
+    readOnly(ServoDataId::kVoltage, "voltage", ParamType::kU16, "mV", kU16Max),
+    readOnly(ServoDataId::kCurrent, "current", ParamType::kU16, "mA", kU16Max),
+    readOnly(ServoDataId::kPower, "power", ParamType::kU16, "mW", kU16Max),
+    readOnly(ServoDataId::kTemperature, "temperature", ParamType::kU16, "degC", kU16Max),
+    readOnly(ServoDataId::kServoStatus, "servo_status", ParamType::kU8, "", kU8Max),
+    readOnly(ServoDataId::kServoType, "servo_type", ParamType::kU16, "", kU16Max),
+    readOnly(ServoDataId::kFirmwareVersion, "firmware_version", ParamType::kU16, "", kU16Max),
+    readOnly(ServoDataId::kSerialNumber, "serial_number", ParamType::kU32, "", kU32Max),
+    readWrite(ServoDataId::kReserved32, "reserved_32", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kResponseSwitch, "response_switch", ParamType::kU8, "", 0, 1),
     // Changes the address the servo answers to: a mistake loses the servo.
-    readWrite(34, "servo_id", ParamType::kU8, "", 0, 254, true),
-    readWrite(35, "reserved_35", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kServoId, "servo_id", ParamType::kU8, "", 0, 254, true),
+    readWrite(ServoDataId::kReserved35, "reserved_35", ParamType::kU8, "", 0, kU8Max),
     // Takes effect at once: the servo stops understanding us at our baud rate.
-    readWrite(36, "baudrate", ParamType::kU8, "", 1, 7, true),
-    readWrite(37, "stall_protect_mode", ParamType::kU8, "", 0, kU8Max),
-    readWrite(38, "stall_power_limit", ParamType::kU16, "mW", 0, kU16Max),
-    readWrite(39, "over_volt_low", ParamType::kU16, "mV", 0, kU16Max),
-    readWrite(40, "over_volt_high", ParamType::kU16, "mV", 0, kU16Max),
-    readWrite(41, "over_temperature", ParamType::kU16, "degC", 0, kU16Max),
-    readWrite(42, "over_power", ParamType::kU16, "mW", 0, kU16Max),
-    readWrite(43, "over_current", ParamType::kU16, "mA", 0, kU16Max),
-    readWrite(44, "accel_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(45, "reserved_45", ParamType::kU8, "", 0, kU8Max),
-    readWrite(46, "po_lock_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(47, "wb_lock_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(48, "angle_limit_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(49, "soft_start_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(50, "soft_start_time", ParamType::kU16, "ms", 0, kU16Max),
-    readWrite(51, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
-    readWrite(52, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
-    readWrite(53, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(ServoDataId::kBaudrate, "baudrate", ParamType::kU8, "", 1, 7, true),
+    readWrite(ServoDataId::kStallProtectMode, "stall_protect_mode", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kStallPowerLimit, "stall_power_limit", ParamType::kU16, "mW", 0, kU16Max),
+    readWrite(ServoDataId::kOverVoltLow, "over_volt_low", ParamType::kU16, "mV", 0, kU16Max),
+    readWrite(ServoDataId::kOverVoltHigh, "over_volt_high", ParamType::kU16, "mV", 0, kU16Max),
+    readWrite(ServoDataId::kOverTemperature, "over_temperature", ParamType::kU16, "degC", 0, kU16Max),
+    readWrite(ServoDataId::kOverPower, "over_power", ParamType::kU16, "mW", 0, kU16Max),
+    readWrite(ServoDataId::kOverCurrent, "over_current", ParamType::kU16, "mA", 0, kU16Max),
+    readWrite(ServoDataId::kAccelSwitch, "accel_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kReserved45, "reserved_45", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kPoLockSwitch, "po_lock_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kWbLockSwitch, "wb_lock_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kAngleLimitSwitch, "angle_limit_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kSoftStartSwitch, "soft_start_switch", ParamType::kU8, "", 0, kU8Max),
+    readWrite(ServoDataId::kSoftStartTime, "soft_start_time", ParamType::kU16, "ms", 0, kU16Max),
+    readWrite(ServoDataId::kAngleLimitHigh, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(ServoDataId::kAngleLimitLow, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(ServoDataId::kAngleMidOffset, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
 }};
 
 // The vendor's spellings, accepted so that names copied from its datasheet work.

@@ -12,17 +12,6 @@
 namespace serial_robot_driver::protocol {
 namespace {
 
-// Fixed offsets shared by the families' layouts (PROTOCOLS.md sections 1-3).
-constexpr std::size_t kBaseLenOffset = 2;
-constexpr std::size_t kTelemetryLenOffset = 2;
-constexpr std::size_t kTelemetryTrailer = 3;  // SUM + tail
-constexpr std::size_t kServoCmdOffset = 2;
-constexpr std::size_t kServoSizeOffset = 3;
-constexpr std::size_t kSyncWriteLenOffset = 5;
-constexpr std::size_t kSyncWriteInstructionOffset = 7;
-constexpr std::size_t kSyncWriteBytesPerServo = 3;
-constexpr std::size_t kCrcSize = 2;
-
 constexpr std::size_t kLongestSyncWrite =
     body::kSyncWritePrefix + body::syncWriteLen(body::kMaxSyncWriteServos);
 static_assert(base::kMaxFrameSize <= StreamFramer::kLongestFrame, "base frame too long");
@@ -74,11 +63,37 @@ FramerConfig FramerConfig::forSimulator() {
 
 StreamFramer::StreamFramer(const FramerConfig& config, FrameHandler handler)
     : config_(config), handler_(std::move(handler)) {
-  if (config_.base) is_start_[base::kHeader0] = true;
-  if (config_.telemetry) is_start_[body::kTelemetryHeader0] = true;
-  if (config_.servo_response) is_start_[servo::kResponseHeader0] = true;
-  if (config_.servo_request) is_start_[servo::kRequestHeader0] = true;
-  if (config_.sync_write) is_start_[body::kSyncWriteHeader[0]] = true;
+  // Order matters only for the shared first byte 0x12: telemetry is asked before requests.
+  if (config_.base) {
+    addEntry(base::kHeader0, FrameFamily::kBase,
+             [](const uint8_t* data, std::size_t available, std::size_t) {
+               return base::probeFrame(data, available);
+             });
+  }
+  if (config_.servo_response) {
+    addEntry(servo::kResponseHeader0, FrameFamily::kServoResponse,
+             [](const uint8_t* data, std::size_t available, std::size_t) {
+               return servo::probeResponse(data, available);
+             });
+  }
+  if (config_.sync_write) {
+    addEntry(body::kSyncWriteHeader[0], FrameFamily::kSyncWrite,
+             [](const uint8_t* data, std::size_t available, std::size_t) {
+               return body::probeSyncWrite(data, available);
+             });
+  }
+  if (config_.telemetry) {
+    addEntry(body::kTelemetryHeader0, FrameFamily::kTelemetry,
+             [](const uint8_t* data, std::size_t available, std::size_t servo_count) {
+               return body::probeTelemetry(data, available, servo_count);
+             });
+  }
+  if (config_.servo_request) {
+    addEntry(servo::kRequestHeader0, FrameFamily::kServoRequest,
+             [](const uint8_t* data, std::size_t available, std::size_t) {
+               return servo::probeRequest(data, available);
+             });
+  }
   int start_count = 0;
   for (int byte = 0; byte < 256; ++byte) {
     if (!is_start_[byte]) continue;
@@ -86,6 +101,12 @@ StreamFramer::StreamFramer(const FramerConfig& config, FrameHandler handler)
     single_start_ = byte;
   }
   if (start_count != 1) single_start_ = -1;
+}
+
+void StreamFramer::addEntry(uint8_t header0, FrameFamily family,
+                            Probe (*probe)(const uint8_t*, std::size_t, std::size_t)) {
+  entries_[entry_count_++] = Entry{header0, family, probe};
+  is_start_[header0] = true;
 }
 
 void StreamFramer::feed(const uint8_t* data, std::size_t size) {
@@ -147,17 +168,17 @@ std::size_t StreamFramer::scan(const uint8_t* data, std::size_t available,
     pos = start;
     if (pos >= start_limit) break;
 
-    std::size_t frame_size = 0;
     FrameFamily family = FrameFamily::kBase;
-    switch (examine(data + pos, available - pos, &frame_size, &family)) {
-      case Candidate::kFrame:
+    const Probe probe = examine(data + pos, available - pos, &family);
+    switch (probe.status) {
+      case Probe::Status::kFrame:
         ++stats_.frames[familyIndex(family)];
-        if (handler_) handler_(family, data + pos, frame_size);
-        pos += frame_size;
+        if (handler_) handler_(family, data + pos, probe.size);
+        pos += probe.size;
         break;
-      case Candidate::kNeedMore:
+      case Probe::Status::kNeedMore:
         return pos;
-      case Candidate::kInvalid:
+      case Probe::Status::kInvalid:
         // Drop ONE byte only: a real frame may start inside the rejected candidate.
         ++stats_.bytes_skipped;
         ++pos;
@@ -167,133 +188,34 @@ std::size_t StreamFramer::scan(const uint8_t* data, std::size_t available,
   return pos;
 }
 
-StreamFramer::Candidate StreamFramer::examine(const uint8_t* data, std::size_t available,
-                                              std::size_t* frame_size, FrameFamily* family) {
-  const uint8_t first = data[0];
-  if (config_.base && first == base::kHeader0) {
-    *family = FrameFamily::kBase;
-    return examineBase(data, available, frame_size);
-  }
-  if (config_.servo_response && first == servo::kResponseHeader0) {
-    *family = FrameFamily::kServoResponse;
-    return examineServo(data, available, frame_size);
-  }
-  if (config_.sync_write && first == body::kSyncWriteHeader[0]) {
-    *family = FrameFamily::kSyncWrite;
-    return examineSyncWrite(data, available, frame_size);
-  }
-  // 0x12 starts both telemetry (12 34) and servo requests (12 4C): the second byte decides.
-  static_assert(body::kTelemetryHeader0 == servo::kRequestHeader0, "shared first header byte");
-  if (first == body::kTelemetryHeader0 && (config_.telemetry || config_.servo_request)) {
-    if (available < 2) return Candidate::kNeedMore;
-    if (config_.telemetry && data[1] == body::kTelemetryHeader1) {
-      *family = FrameFamily::kTelemetry;
-      return examineTelemetry(data, available, frame_size);
+Probe StreamFramer::examine(const uint8_t* data, std::size_t available, FrameFamily* family) {
+  Probe result = Probe::invalid(DecodeError::kBadHeader);
+  for (std::size_t i = 0; i < entry_count_; ++i) {
+    const Entry& entry = entries_[i];
+    if (entry.header0 != data[0]) continue;
+    result = entry.probe(data, available, config_.telemetry_servo_count);
+    if (result.status == Probe::Status::kInvalid && result.reason == DecodeError::kBadHeader) {
+      continue;
     }
-    if (config_.servo_request && data[1] == servo::kRequestHeader1) {
-      *family = FrameFamily::kServoRequest;
-      return examineServo(data, available, frame_size);
+    *family = entry.family;
+    break;
+  }
+  if (result.status == Probe::Status::kInvalid) {
+    switch (result.reason) {
+      case DecodeError::kBadLength:
+        ++stats_.bad_lengths;
+        break;
+      case DecodeError::kBadChecksum:
+        ++stats_.checksum_errors;
+        break;
+      case DecodeError::kBadTail:
+        ++stats_.bad_tails;
+        break;
+      default:
+        break;  // a header that is not ours is ordinary resynchronisation
     }
   }
-  return Candidate::kInvalid;
-}
-
-StreamFramer::Candidate StreamFramer::examineBase(const uint8_t* data, std::size_t available,
-                                                  std::size_t* frame_size) {
-  if (available < 2) return Candidate::kNeedMore;
-  if (data[1] != base::kHeader1) return Candidate::kInvalid;
-  if (available <= kBaseLenOffset) return Candidate::kNeedMore;
-  const uint8_t len = data[kBaseLenOffset];
-  if (len < base::kMinLen || len > base::kMaxLen) {
-    ++stats_.bad_lengths;
-    return Candidate::kInvalid;
-  }
-  const std::size_t size = base::frameSize(len);
-  if (available < size) return Candidate::kNeedMore;
-  if (base::xorChecksum(data, size - 1) != data[size - 1]) {
-    ++stats_.checksum_errors;
-    return Candidate::kInvalid;
-  }
-  *frame_size = size;
-  return Candidate::kFrame;
-}
-
-StreamFramer::Candidate StreamFramer::examineTelemetry(const uint8_t* data, std::size_t available,
-                                                       std::size_t* frame_size) {
-  // Header already matched by examine().
-  if (available <= kTelemetryLenOffset) return Candidate::kNeedMore;
-  const std::size_t len = data[kTelemetryLenOffset];
-  const std::size_t servo_count = config_.telemetry_servo_count;
-  if (len != body::telemetryLen(servo_count, false) &&
-      len != body::telemetryLen(servo_count, true)) {
-    ++stats_.bad_lengths;
-    return Candidate::kInvalid;
-  }
-  if (available < len) return Candidate::kNeedMore;
-  // Tail first: a wrong tail means the frame boundary itself is wrong.
-  if (data[len - 2] != body::kTelemetryTail0 || data[len - 1] != body::kTelemetryTail1) {
-    ++stats_.bad_tails;
-    return Candidate::kInvalid;
-  }
-  if (body::telemetrySum(data, len) != data[len - kTelemetryTrailer]) {
-    ++stats_.checksum_errors;
-    return Candidate::kInvalid;
-  }
-  *frame_size = len;
-  return Candidate::kFrame;
-}
-
-StreamFramer::Candidate StreamFramer::examineServo(const uint8_t* data, std::size_t available,
-                                                   std::size_t* frame_size) {
-  // Requests and responses share the layout; examine() picked the family from the first byte.
-  const uint8_t header1 =
-      data[0] == servo::kResponseHeader0 ? servo::kResponseHeader1 : servo::kRequestHeader1;
-  if (available < 2) return Candidate::kNeedMore;
-  if (data[1] != header1) return Candidate::kInvalid;
-  if (available <= kServoSizeOffset) return Candidate::kNeedMore;
-  const uint8_t cmd = data[kServoCmdOffset];
-  const uint8_t content_size = data[kServoSizeOffset];
-  if (cmd < servo::kMinCommand || cmd > servo::kMaxCommand || content_size > servo::kMaxContent) {
-    ++stats_.bad_lengths;
-    return Candidate::kInvalid;
-  }
-  const std::size_t size = content_size + servo::kOverhead;
-  if (available < size) return Candidate::kNeedMore;
-  if (servo::byteSum(data, size - 1) != data[size - 1]) {
-    ++stats_.checksum_errors;
-    return Candidate::kInvalid;
-  }
-  *frame_size = size;
-  return Candidate::kFrame;
-}
-
-StreamFramer::Candidate StreamFramer::examineSyncWrite(const uint8_t* data, std::size_t available,
-                                                       std::size_t* frame_size) {
-  // FF FF FD 00 then the broadcast id FE: compare as much of this prefix as has arrived.
-  const std::size_t header_size = body::kSyncWriteHeader.size();
-  const std::size_t known = std::min(available, header_size + 1);
-  for (std::size_t i = 1; i < known; ++i) {
-    const uint8_t expected = i < header_size ? body::kSyncWriteHeader[i] : body::kBroadcastId;
-    if (data[i] != expected) return Candidate::kInvalid;
-  }
-  if (available < body::kSyncWritePrefix) return Candidate::kNeedMore;
-  const std::size_t len = readLE16(data + kSyncWriteLenOffset);
-  const std::size_t min_len = body::syncWriteLen(0);
-  if (len < min_len || (len - min_len) % kSyncWriteBytesPerServo != 0 ||
-      (len - min_len) / kSyncWriteBytesPerServo > body::kMaxSyncWriteServos) {
-    ++stats_.bad_lengths;
-    return Candidate::kInvalid;
-  }
-  if (available <= kSyncWriteInstructionOffset) return Candidate::kNeedMore;
-  if (data[kSyncWriteInstructionOffset] != body::kSyncWriteInstruction) return Candidate::kInvalid;
-  const std::size_t size = body::kSyncWritePrefix + len;
-  if (available < size) return Candidate::kNeedMore;
-  if (body::dynamixelCrc(data, size - kCrcSize) != readLE16(data + size - kCrcSize)) {
-    ++stats_.checksum_errors;
-    return Candidate::kInvalid;
-  }
-  *frame_size = size;
-  return Candidate::kFrame;
+  return result;
 }
 
 }  // namespace serial_robot_driver::protocol

@@ -8,6 +8,8 @@
 #include <ros/node_handle.h>
 #include <ros/param.h>
 
+#include "serial_robot_driver/protocol/body_codec.h"
+
 namespace serial_robot_driver::ros_layer {
 
 namespace {
@@ -142,7 +144,9 @@ std::vector<ParamSpec> buildTable() {
       row("body/servo_ids", &P::body, &Body::servo_ids,
           [](const std::vector<int>& ids, const std::string& key) {
             require(!ids.empty(), key, "must list at least one servo id");
-            require(ids.size() <= 57, key, "at most 57 servos fit in a telemetry frame");
+            require(ids.size() <= protocol::body::kMaxTelemetryServos, key,
+                    "at most " + std::to_string(protocol::body::kMaxTelemetryServos) +
+                        " servos fit in a telemetry frame");
             std::set<int> seen;
             for (int id : ids) {
               require(id >= 0 && id <= 253, key,

@@ -22,6 +22,12 @@ void logOutcome(const std::string& service, const device::ServoStatus& status) {
   }
 }
 
+/// The core says "dangerous"; only this layer knows which parameter arms such writes.
+std::string messageFor(const device::ServoStatus& status) {
+  if (status.error != device::ServoError::kDangerous) return status.message;
+  return status.message + " (set ~servo_bus/allow_dangerous_writes to true to arm it)";
+}
+
 // The outcome fields every servo/* response has; servo/ping calls its flag `online`.
 template <typename Response>
 void setOutcome(Response& res, bool ok, const std::string& message) {
@@ -58,7 +64,7 @@ ros::ServiceServer advertiseServo(ros::NodeHandle& nh, const std::string& name,
       if (status.ok() && announce == Announce::kInfo) {
         ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
       }
-      setOutcome(res, status.ok(), status.message);
+      setOutcome(res, status.ok(), messageFor(status));
     } catch (const std::exception& error) {
       ROS_ERROR("%s: internal error: %s", name.c_str(), error.what());
       res = Response();

@@ -15,19 +15,19 @@ using servo::Command;
 namespace {
 
 // data_ids of PROTOCOLS.md section 3 the simulator gives a behaviour to.
-constexpr uint8_t kVoltage = 1;
-constexpr uint8_t kCurrent = 2;
-constexpr uint8_t kPower = 3;
-constexpr uint8_t kTemperature = 4;
-constexpr uint8_t kServoStatus = 5;
-constexpr uint8_t kServoType = 6;
-constexpr uint8_t kFirmwareVersion = 7;
-constexpr uint8_t kSerialNumber = 8;
-constexpr uint8_t kResponseSwitch = 33;
-constexpr uint8_t kServoId = 34;
-constexpr uint8_t kAngleLimitSwitch = 48;
-constexpr uint8_t kAngleLimitHigh = 51;
-constexpr uint8_t kAngleLimitLow = 52;
+constexpr uint8_t kVoltage = servo::dataId(servo::ServoDataId::kVoltage);
+constexpr uint8_t kCurrent = servo::dataId(servo::ServoDataId::kCurrent);
+constexpr uint8_t kPower = servo::dataId(servo::ServoDataId::kPower);
+constexpr uint8_t kTemperature = servo::dataId(servo::ServoDataId::kTemperature);
+constexpr uint8_t kServoStatus = servo::dataId(servo::ServoDataId::kServoStatus);
+constexpr uint8_t kServoType = servo::dataId(servo::ServoDataId::kServoType);
+constexpr uint8_t kFirmwareVersion = servo::dataId(servo::ServoDataId::kFirmwareVersion);
+constexpr uint8_t kSerialNumber = servo::dataId(servo::ServoDataId::kSerialNumber);
+constexpr uint8_t kResponseSwitch = servo::dataId(servo::ServoDataId::kResponseSwitch);
+constexpr uint8_t kServoId = servo::dataId(servo::ServoDataId::kServoId);
+constexpr uint8_t kAngleLimitSwitch = servo::dataId(servo::ServoDataId::kAngleLimitSwitch);
+constexpr uint8_t kAngleLimitHigh = servo::dataId(servo::ServoDataId::kAngleLimitHigh);
+constexpr uint8_t kAngleLimitLow = servo::dataId(servo::ServoDataId::kAngleLimitLow);
 
 constexpr int64_t kNominalVoltage = 7400;  // mV, a 2S LiPo
 constexpr int64_t kNominalTemperature = 35;
@@ -39,10 +39,30 @@ constexpr auto kDriftPeriod = std::chrono::milliseconds(100);
 // Factory values of the user block (assumption: datasheet-like numbers; the id stays the one the
 // servo was configured with, so a reset never collides with its neighbours on the chain).
 const std::map<uint8_t, int64_t>& userDefaults() {
+  using servo::ServoDataId;
   static const std::map<uint8_t, int64_t> defaults = {
-      {32, 0},     {33, 0},  {35, 0},     {36, 5},    {37, 1},    {38, 4000},  {39, 4500},
-      {40, 14000}, {41, 65}, {42, 12000}, {43, 3000}, {44, 1},    {45, 0},     {46, 0},
-      {47, 0},     {48, 0},  {49, 0},     {50, 3000}, {51, 1800}, {52, -1800}, {53, 0}};
+      {dataId(ServoDataId::kReserved32), 0},
+      {dataId(ServoDataId::kResponseSwitch), 0},
+      {dataId(ServoDataId::kReserved35), 0},
+      {dataId(ServoDataId::kBaudrate), 5},
+      {dataId(ServoDataId::kStallProtectMode), 1},
+      {dataId(ServoDataId::kStallPowerLimit), 4000},
+      {dataId(ServoDataId::kOverVoltLow), 4500},
+      {dataId(ServoDataId::kOverVoltHigh), 14000},
+      {dataId(ServoDataId::kOverTemperature), 65},
+      {dataId(ServoDataId::kOverPower), 12000},
+      {dataId(ServoDataId::kOverCurrent), 3000},
+      {dataId(ServoDataId::kAccelSwitch), 1},
+      {dataId(ServoDataId::kReserved45), 0},
+      {dataId(ServoDataId::kPoLockSwitch), 0},
+      {dataId(ServoDataId::kWbLockSwitch), 0},
+      {dataId(ServoDataId::kAngleLimitSwitch), 0},
+      {dataId(ServoDataId::kSoftStartSwitch), 0},
+      {dataId(ServoDataId::kSoftStartTime), 3000},
+      {dataId(ServoDataId::kAngleLimitHigh), 1800},
+      {dataId(ServoDataId::kAngleLimitLow), -1800},
+      {dataId(ServoDataId::kAngleMidOffset), 0},
+  };
   return defaults;
 }
 

@@ -261,5 +261,47 @@ TEST(BaseCodec, SequenceNumberAfterWrapIsEncoded) {
   EXPECT_EQ(encodeReset(counter.next()), (Bytes{0x55, 0xAA, 0x02, 0x00, 0x05, 0x00, 0xF8}));
 }
 
+
+// --- probe (what the stream framer asks) -------------------------------------------------------
+
+// Every proper prefix of a complete frame needs more bytes; the whole frame, also with trailing
+// bytes of the next one, is a frame of exactly its size.
+template <typename ProbeFn>
+void expectProbeFindsFrame(ProbeFn probe, const Bytes& frame) {
+  for (std::size_t size = 0; size < frame.size(); ++size) {
+    EXPECT_EQ(probe(frame.data(), size).status, Probe::Status::kNeedMore) << "prefix " << size;
+  }
+  Bytes longer = frame;
+  longer.push_back(frame[0]);
+  const Bytes* const candidates[] = {&frame, &longer};
+  for (const Bytes* bytes : candidates) {
+    const Probe result = probe(bytes->data(), bytes->size());
+    EXPECT_EQ(result.status, Probe::Status::kFrame);
+    EXPECT_EQ(result.size, frame.size());
+  }
+}
+
+template <typename ProbeFn>
+void expectProbeRejects(ProbeFn probe, const Bytes& bytes, DecodeError reason) {
+  const Probe result = probe(bytes.data(), bytes.size());
+  EXPECT_EQ(result.status, Probe::Status::kInvalid);
+  EXPECT_EQ(result.reason, reason) << toString(result.reason);
+}
+
+// Reset, SEQ 00: 55^AA^01^00^05 = FB.
+const Bytes kProbeReset = {0x55, 0xAA, 0x01, 0x00, 0x05, 0xFB};
+
+TEST(BaseCodecProbe, FindsGoldenFrameAndNeedsMoreAtEveryTruncation) {
+  expectProbeFindsFrame(probeFrame, kProbeReset);
+}
+
+TEST(BaseCodecProbe, SaysWhyACandidateIsInvalid) {
+  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x01, 0x00, 0x05, 0xFA}, DecodeError::kBadChecksum);
+  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x00, 0x00, 0x05, 0xFA}, DecodeError::kBadLength);
+  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x21}, DecodeError::kBadLength);  // LEN 33 > 32
+  expectProbeRejects(probeFrame, {0x55, 0xAB}, DecodeError::kBadHeader);
+  expectProbeRejects(probeFrame, {0xAA}, DecodeError::kBadHeader);
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::protocol::base

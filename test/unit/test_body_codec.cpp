@@ -300,5 +300,86 @@ TEST(BodyCodec, TrailingByteAfterFrameIsBadLength) {
   EXPECT_EQ(decoded.error(), DecodeError::kBadLength);
 }
 
+
+// --- probe (what the stream framer asks) -------------------------------------------------------
+
+// Every proper prefix of a complete frame needs more bytes; the whole frame, also with trailing
+// bytes of the next one, is a frame of exactly its size.
+template <typename ProbeFn>
+void expectProbeFindsFrame(ProbeFn probe, const Bytes& frame) {
+  for (std::size_t size = 0; size < frame.size(); ++size) {
+    EXPECT_EQ(probe(frame.data(), size).status, Probe::Status::kNeedMore) << "prefix " << size;
+  }
+  Bytes longer = frame;
+  longer.push_back(frame[0]);
+  const Bytes* const candidates[] = {&frame, &longer};
+  for (const Bytes* bytes : candidates) {
+    const Probe result = probe(bytes->data(), bytes->size());
+    EXPECT_EQ(result.status, Probe::Status::kFrame);
+    EXPECT_EQ(result.size, frame.size());
+  }
+}
+
+template <typename ProbeFn>
+void expectProbeRejects(ProbeFn probe, const Bytes& bytes, DecodeError reason) {
+  const Probe result = probe(bytes.data(), bytes.size());
+  EXPECT_EQ(result.status, Probe::Status::kInvalid);
+  EXPECT_EQ(result.reason, reason) << toString(result.reason);
+}
+
+// No servos, no foot block: LEN 24 = 0x18, IMU all zero, SUM = 0x18 (LEN only).
+// clang-format off
+const Bytes kProbeTelemetryNoServos = {
+    0x12, 0x34, 0x18,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x18, 0x1F, 0x2F};
+// Sync write of servo 1 to 512 (PROTOCOLS.md layout, CRC 8E3A checked independently).
+const Bytes kProbeSyncWrite = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0x74, 0x00,
+                               0x02, 0x00, 0x01, 0x00, 0x02, 0x3A, 0x8E};
+// clang-format on
+
+Probe probeTelemetryOfNoServos(const uint8_t* data, std::size_t available) {
+  return probeTelemetry(data, available, 0);
+}
+
+TEST(BodyCodecProbe, TelemetryFrameFoundAndNeedsMoreAtEveryTruncation) {
+  expectProbeFindsFrame(probeTelemetryOfNoServos, kProbeTelemetryNoServos);
+}
+
+TEST(BodyCodecProbe, TelemetryInvalidReasons) {
+  expectProbeRejects(probeTelemetryOfNoServos, withByte(kProbeTelemetryNoServos, 21, 0x19),
+                     DecodeError::kBadChecksum);
+  expectProbeRejects(probeTelemetryOfNoServos, withByte(kProbeTelemetryNoServos, 23, 0x2E),
+                     DecodeError::kBadTail);
+  // LEN 28 is a frame of one servo: wrong for the configured zero.
+  expectProbeRejects(probeTelemetryOfNoServos, withByte(kProbeTelemetryNoServos, 2, 0x1C),
+                     DecodeError::kBadLength);
+  expectProbeRejects(probeTelemetryOfNoServos, {0x12, 0x4C}, DecodeError::kBadHeader);
+}
+
+TEST(BodyCodecProbe, TelemetryLenFollowsTheConfiguredServoCount) {
+  // The same bytes with LEN 0x1C (24 + 4) are one servo's length, 0x2C (40 + 4) one with foot.
+  const Bytes one_servo_len = {0x12, 0x34, 0x1C};
+  EXPECT_EQ(probeTelemetry(one_servo_len.data(), 3, 1).status, Probe::Status::kNeedMore);
+  const Bytes one_servo_foot_len = {0x12, 0x34, 0x2C};
+  EXPECT_EQ(probeTelemetry(one_servo_foot_len.data(), 3, 1).status, Probe::Status::kNeedMore);
+  EXPECT_EQ(probeTelemetry(one_servo_len.data(), 3, 2).status, Probe::Status::kInvalid);
+}
+
+TEST(BodyCodecProbe, SyncWriteFrameFoundAndNeedsMoreAtEveryTruncation) {
+  expectProbeFindsFrame(probeSyncWrite, kProbeSyncWrite);
+}
+
+TEST(BodyCodecProbe, SyncWriteInvalidReasons) {
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 16, 0x8F), DecodeError::kBadChecksum);
+  // LEN 0x0B is not 7 + 3N.
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0x0B), DecodeError::kBadLength);
+  // 7 + 3 * 65 = 202 = 0xCA: one servo more than the 64 accepted.
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0xCA), DecodeError::kBadLength);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 4, 0x01), DecodeError::kBadHeader);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 7, 0x82), DecodeError::kBadHeader);
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::protocol::body

@@ -224,5 +224,53 @@ TEST(ServoBusCodec, RequestDecoderChecksSum) {
   EXPECT_EQ(packet.error(), DecodeError::kBadChecksum);
 }
 
+
+// --- probe (what the stream framer asks) -------------------------------------------------------
+
+// Every proper prefix of a complete frame needs more bytes; the whole frame, also with trailing
+// bytes of the next one, is a frame of exactly its size.
+template <typename ProbeFn>
+void expectProbeFindsFrame(ProbeFn probe, const Bytes& frame) {
+  for (std::size_t size = 0; size < frame.size(); ++size) {
+    EXPECT_EQ(probe(frame.data(), size).status, Probe::Status::kNeedMore) << "prefix " << size;
+  }
+  Bytes longer = frame;
+  longer.push_back(frame[0]);
+  const Bytes* const candidates[] = {&frame, &longer};
+  for (const Bytes* bytes : candidates) {
+    const Probe result = probe(bytes->data(), bytes->size());
+    EXPECT_EQ(result.status, Probe::Status::kFrame);
+    EXPECT_EQ(result.size, frame.size());
+  }
+}
+
+template <typename ProbeFn>
+void expectProbeRejects(ProbeFn probe, const Bytes& bytes, DecodeError reason) {
+  const Probe result = probe(bytes.data(), bytes.size());
+  EXPECT_EQ(result.status, Probe::Status::kInvalid);
+  EXPECT_EQ(result.reason, reason) << toString(result.reason);
+}
+
+// PING id 3: 12+4C+01+01+03 = 63; reply 05+1C+01+01+03 = 26.
+const Bytes kProbePingRequest = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63};
+const Bytes kProbePingResponse = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x26};
+
+TEST(ServoBusCodecProbe, FindsGoldenFramesAndNeedsMoreAtEveryTruncation) {
+  expectProbeFindsFrame(probeRequest, kProbePingRequest);
+  expectProbeFindsFrame(probeResponse, kProbePingResponse);
+}
+
+TEST(ServoBusCodecProbe, SaysWhyACandidateIsInvalid) {
+  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x01, 0x01, 0x03, 0x27}, DecodeError::kBadChecksum);
+  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64}, DecodeError::kBadChecksum);
+  // N = 34 exceeds the longest content (id + 32 bytes).
+  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x05, 0x22}, DecodeError::kBadLength);
+  // CMD 11 does not exist.
+  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x0B, 0x01}, DecodeError::kBadLength);
+  // The request header is not a response's, and the reverse.
+  expectProbeRejects(probeResponse, kProbePingRequest, DecodeError::kBadHeader);
+  expectProbeRejects(probeRequest, kProbePingResponse, DecodeError::kBadHeader);
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::protocol::servo

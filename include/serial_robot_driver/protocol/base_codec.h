@@ -65,6 +65,10 @@ struct Frame {
   std::array<uint8_t, kMaxLen> params{};
 };
 
+/// Probes the `available` bytes at a stream position for a complete, verified frame: header,
+/// LEN range and XOR (kBadHeader / kBadLength / kBadChecksum).
+Probe probeFrame(const uint8_t* data, std::size_t available);
+
 /// Decodes one complete frame (exactly frameSize(LEN) bytes).
 Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size);
 

@@ -37,6 +37,9 @@ struct ServoTarget {
 };
 
 std::vector<uint8_t> encodeSyncWrite(const std::vector<ServoTarget>& targets);
+/// Probes for a complete sync write: header and broadcast id, LEN (7 + 3N, N <= 64),
+/// instruction, CRC (kBadHeader / kBadLength / kBadChecksum).
+Probe probeSyncWrite(const uint8_t* data, std::size_t available);
 /// For the simulator: a complete sync-write frame back into targets (CRC and layout checked).
 Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size_t size);
 
@@ -74,6 +77,10 @@ struct Telemetry {
 
 /// SUM byte: (sum of bytes 2 .. LEN-4) mod 256 of a frame whose LEN byte is already in place.
 uint8_t telemetrySum(const uint8_t* frame, std::size_t len);
+
+/// Probes for a complete telemetry frame of `servo_count` servos: header, LEN (24 + 4N or 40 + 4N),
+/// then tail before SUM (kBadHeader / kBadLength / kBadTail / kBadChecksum).
+Probe probeTelemetry(const uint8_t* data, std::size_t available, std::size_t servo_count);
 
 /// Decodes one complete telemetry frame for `servo_count` configured servos. LEN must be
 /// telemetryLen(servo_count, false|true) and match `size`.

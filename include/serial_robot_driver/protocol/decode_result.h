@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cassert>
+#include <cstddef>
 #include <variant>
 
 namespace serial_robot_driver::protocol {
@@ -17,6 +18,21 @@ enum class DecodeError {
 };
 
 const char* toString(DecodeError error);
+
+/// What a codec's probe says about the bytes at a stream position: the framer asks it and knows
+/// nothing of the layout itself.
+struct Probe {
+  enum class Status { kNeedMore, kInvalid, kFrame };
+  Status status = Status::kNeedMore;
+  DecodeError reason = DecodeError::kTooShort;  ///< why, for kInvalid
+  std::size_t size = 0;                         ///< frame size, for kFrame
+
+  static constexpr Probe needMore() { return {Status::kNeedMore, DecodeError::kTooShort, 0}; }
+  static constexpr Probe invalid(DecodeError why) { return {Status::kInvalid, why, 0}; }
+  static constexpr Probe frame(std::size_t bytes) {
+    return {Status::kFrame, DecodeError::kTooShort, bytes};
+  }
+};
 
 template <typename T>
 class Decoded {

@@ -67,6 +67,11 @@ struct Packet {
   uint8_t id() const { return content_size > 0 ? content[0] : 0; }
 };
 
+/// Probe for a complete response (05 1C) or request (12 4C): header, CMD range and N
+/// (both kBadLength), sum (kBadChecksum).
+Probe probeResponse(const uint8_t* data, std::size_t available);
+Probe probeRequest(const uint8_t* data, std::size_t available);
+
 /// Decodes one complete response (05 1C ...) or request (12 4C ..., for the simulator and for
 /// recognising the half-duplex echo of our own request).
 Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size);

@@ -11,6 +11,41 @@
 
 namespace serial_robot_driver::protocol::servo {
 
+/// Every data_id of the parameter table; the one place where these numbers are spelled.
+enum class ServoDataId : uint8_t {
+  kVoltage = 1,
+  kCurrent = 2,
+  kPower = 3,
+  kTemperature = 4,
+  kServoStatus = 5,
+  kServoType = 6,
+  kFirmwareVersion = 7,
+  kSerialNumber = 8,
+  kReserved32 = 32,
+  kResponseSwitch = 33,
+  kServoId = 34,
+  kReserved35 = 35,
+  kBaudrate = 36,
+  kStallProtectMode = 37,
+  kStallPowerLimit = 38,
+  kOverVoltLow = 39,
+  kOverVoltHigh = 40,
+  kOverTemperature = 41,
+  kOverPower = 42,
+  kOverCurrent = 43,
+  kAccelSwitch = 44,
+  kReserved45 = 45,
+  kPoLockSwitch = 46,
+  kWbLockSwitch = 47,
+  kAngleLimitSwitch = 48,
+  kSoftStartSwitch = 49,
+  kSoftStartTime = 50,
+  kAngleLimitHigh = 51,
+  kAngleLimitLow = 52,
+  kAngleMidOffset = 53,
+};
+constexpr uint8_t dataId(ServoDataId id) { return static_cast<uint8_t>(id); }
+
 enum class ParamType { kU8, kU16, kU32, kI16 };
 
 std::size_t typeSize(ParamType type);
@@ -38,8 +73,8 @@ const ParamInfo* findParamById(uint8_t data_id);
 
 /// The read-write user block (ids 32..53 packed in order) is 32 bytes.
 constexpr std::size_t kUserBlockSize = 32;
-constexpr uint8_t kFirstUserParamId = 32;
-constexpr uint8_t kLastUserParamId = 53;
+constexpr uint8_t kFirstUserParamId = dataId(ServoDataId::kReserved32);
+constexpr uint8_t kLastUserParamId = dataId(ServoDataId::kAngleMidOffset);
 
 enum class WriteCheck { kOk, kReadOnly, kOutOfRange, kDangerous };
 /// Checks a write before any byte is encoded. `allow_dangerous` arms servo_id/baudrate writes.

@@ -1,6 +1,8 @@
 // One stream framer per serial port: it takes byte chunks of any size, finds complete frames of the
-// families it is configured for, verifies them (length rules, checksum, tail) and hands each one to
-// a callback together with its family. Several devices can therefore share one port: their inbound
+// families it is configured for and hands each one to a callback together with its family.
+// The framer knows no layout: it is a table of {first header byte, family, probe}, and each codec's
+// probe says "need more", "invalid (why)" or "frame of N bytes" (verified: LEN, checksum, tail).
+// Adding a family is one table entry in the constructor plus its codec's probe. Several devices can therefore share one port: their inbound
 // headers differ (PROTOCOLS.md, table at the top).
 //
 // Design (after kobuki's packet finder and novatel's multi-family extractor):
@@ -14,6 +16,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+
+#include "serial_robot_driver/protocol/decode_result.h"
 
 namespace serial_robot_driver::protocol {
 
@@ -79,16 +83,17 @@ class StreamFramer {
   std::size_t buffered() const { return size_; }
 
  private:
-  enum class Candidate { kFrame, kNeedMore, kInvalid };
-  /// Examines the `available` bytes at `data`: a complete verified frame (its size in
-  /// *frame_size), a plausible but incomplete one, or not a frame at this position. Counts the
-  /// checksum / tail / length errors it finds.
-  Candidate examine(const uint8_t* data, std::size_t available, std::size_t* frame_size,
-                    FrameFamily* family);
-  Candidate examineBase(const uint8_t* data, std::size_t available, std::size_t* frame_size);
-  Candidate examineTelemetry(const uint8_t* data, std::size_t available, std::size_t* frame_size);
-  Candidate examineServo(const uint8_t* data, std::size_t available, std::size_t* frame_size);
-  Candidate examineSyncWrite(const uint8_t* data, std::size_t available, std::size_t* frame_size);
+  /// One enabled family: frames start with `header0`; `probe` is its codec's probe.
+  struct Entry {
+    uint8_t header0 = 0;
+    FrameFamily family = FrameFamily::kBase;
+    Probe (*probe)(const uint8_t* data, std::size_t available, std::size_t servo_count) = nullptr;
+  };
+  void addEntry(uint8_t header0, FrameFamily family,
+                Probe (*probe)(const uint8_t*, std::size_t, std::size_t));
+  /// Asks the entries whose first header byte matches, in table order; a kBadHeader from one
+  /// (two families share 0x12) passes the candidate to the next. Counts length/checksum/tail errors.
+  Probe examine(const uint8_t* data, std::size_t available, FrameFamily* family);
   /// Emits the frames found among the bytes at `data`, examining candidates that start before
   /// `start_limit`. Returns how many bytes were consumed: it stops early only at an incomplete
   /// candidate.
@@ -99,6 +104,8 @@ class StreamFramer {
   FramerConfig config_;
   FrameHandler handler_;
   FramerStats stats_;
+  std::array<Entry, kFrameFamilyCount> entries_{};
+  std::size_t entry_count_ = 0;
   /// is_start_[b]: b is the first header byte of an enabled family.
   std::array<bool, 256> is_start_{};
   /// The only start byte when exactly one is enabled (memchr applies), else -1.
