@@ -10,12 +10,16 @@
 //  6. servo/read round trip (new connection per call and persistent), wheel loop under service
 //  stress
 //  7. 1, 4 and 5 again with ~read_poll_interval (a port polled every 20 ms), and the ratios
+//  8. driver_node against floor_node (bench/floor_node.cpp, the least a roscpp driver must do):
+//     cmd_vel latency, telemetry latency, CPU at 100 Hz telemetry and idle loop jitter, the two
+//     processes' runs alternated in rounds, and the ratios node / floor
 // Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -53,7 +57,7 @@ using test_support::PtyFrameReader;
 
 struct Options {
   bool long_run = false;
-  std::set<int> sections{1, 2, 3, 4, 5, 6, 7};
+  std::set<int> sections{1, 2, 3, 4, 5, 6, 7, 8};
   std::string output;                   ///< Markdown copy of the results; "" = none
   std::string bin_dir;                  ///< "" = the directory of this executable
   int master_port = 0;                  ///< 0 = any free port
@@ -64,13 +68,16 @@ struct Options {
   std::vector<double> rates{100, 200, 500, 1000, 2000, 5000};
   std::size_t service_calls = 200;  ///< 6: calls timed per client kind
   double stress_seconds = 5;        ///< 6: idle and stress windows of the wheel loop
+  std::size_t floor_rounds = 2;     ///< 8: alternated node/floor rounds
 
   bool runs(int section) const { return sections.count(section) > 0; }
 };
 
 const char* const kUsage = R"(usage: driver_bench [options]
   --long                  longer runs (5000 commands, 120 s loop window, 6000 frames, ...)
-  --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run)
+  --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run;
+                          8 compares driver_node with floor_node, runs alternated)
+  --floor-rounds N        8: alternated node/floor rounds (default 2)
   --output FILE           also write the results (Markdown) to FILE
   --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
   --master-port N         port of the private roscore (default: a free one)
@@ -88,7 +95,7 @@ std::set<int> parseSections(const std::string& text) {
   std::string item;
   while (std::getline(stream, item, ',')) {
     const int section = std::stoi(item);
-    if (section < 1 || section > 7) throw std::invalid_argument("no section " + item);
+    if (section < 1 || section > 8) throw std::invalid_argument("no section " + item);
     sections.insert(section);
   }
   return sections;
@@ -135,6 +142,8 @@ Options parseOptions(int argc, char** argv) {
       options.rate_step_seconds = std::stod(value);
     } else if (flag == "--service-calls") {
       options.service_calls = std::stoul(value);
+    } else if (flag == "--floor-rounds") {
+      options.floor_rounds = std::max<std::size_t>(1, std::stoul(value));
     } else if (flag == "--stress-seconds") {
       options.stress_seconds = std::stod(value);
     } else {
@@ -154,9 +163,11 @@ struct Variant {
   std::string name;
   std::string tag;  ///< part of the node namespace
   double read_poll_interval;
+  std::string program = "driver_node";  ///< or floor_node (section 8)
 };
 const Variant kEventDriven{"event-driven", "event", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", 0.02};
+const Variant kFloor{"floor", "floor", 0.0, "floor_node"};
 
 struct Context {
   Options options;
@@ -358,7 +369,7 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
                                {"servo_bus/enabled", false},
                                {"base/speed_dithering", false},   // one tick value per command
                                {"base/max_wheel_speed", 20.0}});  // room for 600 distinct ticks
-  DriverProcess driver(context.paths, ns, params);
+  DriverProcess driver(context.paths, ns, params, variant.program);
   ros::Publisher publisher =
       context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
   require(waitUntil([&] { return log.count() > 0; }, 30s),
@@ -525,7 +536,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
 
   std::size_t capacity = kWarmUpFrames + options.telemetry_frames;
   for (double rate : options.rates) capacity += std::lround(rate * options.rate_step_seconds);
-  DriverProcess driver(context.paths, ns, params);
+  DriverProcess driver(context.paths, ns, params, variant.program);
   TelemetryProbe probe(context.nh, driver.topic("joint_states"), capacity);
 
   // Warm-up: 50 Hz until the node is connected, publishing, and this subscriber is attached.
@@ -711,6 +722,77 @@ std::string ratio(double polling, double event) {
   return event > 0 ? format("%.1fx", polling / event) : "-";
 }
 
+/// Section 8: driver_node and floor_node, each measured `floor_rounds` times, their runs
+/// alternated (node first in even rounds, floor first in odd ones) so that a change of machine
+/// load falls on both. Each round takes its share of the commands, frames and idle window; a
+/// figure is the mean over the rounds.
+void runFloorComparison(Context& context) {
+  struct Figures {
+    std::vector<double> cmd_p50, cmd_p99, telemetry_p50, telemetry_p99, cpu, jitter;
+  };
+  const Options saved = context.options;
+  const std::size_t rounds = saved.floor_rounds;
+  context.options.commands = std::max<std::size_t>(50, saved.commands / rounds);
+  context.options.telemetry_frames = std::max<std::size_t>(100, saved.telemetry_frames / rounds);
+  context.options.loop_seconds = std::max(5.0, saved.loop_seconds / rounds);
+  Figures node, floor;
+  for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
+    for (int k = 0; k < 2; ++k) {
+      const bool floor_turn = (k == 1) != (round % 2 == 1);
+      const Variant& variant = floor_turn ? kFloor : kEventDriven;
+      Figures& figures = floor_turn ? floor : node;
+      const Variant tagged{variant.name, variant.tag + "_r" + std::to_string(round),
+                           variant.read_poll_interval, variant.program};
+      attempt(context, format("8. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
+        const BaseSessionResult base = runBaseSession(context, tagged, true, true);
+        figures.cmd_p50.push_back(base.cmd_vel->ms.p50);
+        figures.cmd_p99.push_back(base.cmd_vel->ms.p99);
+        figures.jitter.push_back(base.idle_loop->period_ms.stddev);
+      });
+      attempt(context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1),
+              [&] {
+                const TelemetrySessionResult body =
+                    runTelemetrySession(context, tagged, true, false);
+                figures.telemetry_p50.push_back(body.latency->ms.p50);
+                figures.telemetry_p99.push_back(body.latency->ms.p99);
+                figures.cpu.push_back(body.cpu_percent / 100.0);
+              });
+    }
+  }
+  context.options = saved;
+
+  auto mean = [](const std::vector<double>& values) -> std::optional<double> {
+    if (values.empty()) return std::nullopt;
+    double sum = 0;
+    for (double value : values) sum += value;
+    return sum / values.size();
+  };
+  ResultTable& table = context.results;
+  table.section("8. driver_node vs the floor (bench/floor_node.cpp), runs alternated",
+                {"measurement", "driver_node", "floor", "node / floor"});
+  auto compare = [&](const std::string& what, const std::vector<double>& node_values,
+                     const std::vector<double>& floor_values, const char* unit, int decimals) {
+    const auto n = mean(node_values), f = mean(floor_values);
+    if (!n || !f) return;
+    table.row({what, format("%.*f %s", decimals, *n, unit), format("%.*f %s", decimals, *f, unit),
+               f > 0 ? format("%.2fx", *n / *f) : "-"});
+  };
+  compare("telemetry -> joint_states p50", node.telemetry_p50, floor.telemetry_p50, "ms", 3);
+  compare("telemetry -> joint_states p99", node.telemetry_p99, floor.telemetry_p99, "ms", 3);
+  compare("cmd_vel -> speed frame p50", node.cmd_p50, floor.cmd_p50, "ms", 3);
+  compare("cmd_vel -> speed frame p99", node.cmd_p99, floor.cmd_p99, "ms", 3);
+  compare("CPU at 100 Hz telemetry", node.cpu, floor.cpu, "s/s", 4);
+  compare("loop jitter std, idle 50 Hz", node.jitter, floor.jitter, "ms", 3);
+  table.note(format(
+      "%zu rounds, node and floor alternated; per round %zu cmd_vel commands (one per loop "
+      "period, 12 ms after a speed frame), %zu telemetry frames of 20 servos at 100 Hz with one "
+      "external joint_states subscriber, %.0f s idle window. Figures are means over the rounds. "
+      "CPU from /proc/<pid>/stat (10 ms ticks).",
+      rounds, std::max<std::size_t>(50, saved.commands / rounds),
+      std::max<std::size_t>(100, saved.telemetry_frames / rounds),
+      std::max(5.0, saved.loop_seconds / rounds)));
+}
+
 void run(Context& context) {
   const Options& o = context.options;
   ResultTable& table = context.results;
@@ -830,6 +912,8 @@ void run(Context& context) {
       addRateSteps("7b. Telemetry rate steps, polling variant", body_polling, false);
     }
   }
+
+  if (o.runs(8)) runFloorComparison(context);
 }
 
 std::string executableDirectory() {
@@ -867,7 +951,7 @@ int main(int argc, char** argv) {
 
   bench::RunPaths paths;
   paths.bin_dir = options.bin_dir.empty() ? bench::executableDirectory() : options.bin_dir;
-  for (const char* program : {"driver_node", "robot_sim"}) {
+  for (const char* program : {"driver_node", "robot_sim", "floor_node"}) {
     if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
       std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
                 << " not found: build driver_node and robot_sim first\n";

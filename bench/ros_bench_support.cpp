@@ -37,7 +37,8 @@ XmlRpc::XmlRpcValue toXmlRpc(const std::vector<std::string>& values) {
   return list;
 }
 
-DriverProcess::DriverProcess(const RunPaths& paths, const std::string& ns, const ParamList& params)
+DriverProcess::DriverProcess(const RunPaths& paths, const std::string& ns, const ParamList& params,
+                             const std::string& program)
     : ns_(ns) {
   // Parameters go through the master rather than `_name:=value` arguments: lists such as
   // body/servo_ids cannot be written on a command line.
@@ -45,8 +46,8 @@ DriverProcess::DriverProcess(const RunPaths& paths, const std::string& ns, const
     ros::param::set("/" + ns_ + "/driver/" + key, value);
   }
   process_ = std::make_unique<ChildProcess>(
-      "driver_node " + ns_,
-      std::vector<std::string>{paths.bin_dir + "/driver_node", "__name:=driver", "__ns:=/" + ns_},
+      program + " " + ns_,
+      std::vector<std::string>{paths.bin_dir + "/" + program, "__name:=driver", "__ns:=/" + ns_},
       paths.log(ns_));
 }
 

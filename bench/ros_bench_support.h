@@ -44,7 +44,9 @@ XmlRpc::XmlRpcValue toXmlRpc(const std::vector<std::string>& values);
 /// namespace before it starts. Stopped (SIGINT: it writes its zero-speed frame) on destruction.
 class DriverProcess {
  public:
-  DriverProcess(const RunPaths& paths, const std::string& ns, const ParamList& params);
+  /// `program`: driver_node, or the benchmark's floor_node, which reads the same parameters.
+  DriverProcess(const RunPaths& paths, const std::string& ns, const ParamList& params,
+                const std::string& program = "driver_node");
   /// A name in the node's namespace, e.g. topic("cmd_vel") = "/<ns>/cmd_vel".
   std::string topic(const std::string& name) const { return "/" + ns_ + "/" + name; }
   pid_t pid() const { return process_->pid(); }
