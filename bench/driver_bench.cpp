@@ -30,6 +30,7 @@
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -164,10 +165,11 @@ struct Variant {
   std::string tag;  ///< part of the node namespace
   double read_poll_interval;
   std::string program = "driver_node";  ///< or floor_node (section 8)
+  bool spaced_cmd_vel = false;  ///< section 8: commands 10-40 ms apart instead of one per tick
 };
 const Variant kEventDriven{"event-driven", "event", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", 0.02};
-const Variant kFloor{"floor", "floor", 0.0, "floor_node"};
+const Variant kFloor{"floor", "floor", 0.0, "floor_node", true};
 
 struct Context {
   Options options;
@@ -289,6 +291,13 @@ class SpeedFrameLog {
     return frames_[index];
   }
 
+  /// Copies of frames [begin, count()).
+  std::vector<SpeedFrame> framesFrom(std::size_t begin) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (begin >= frames_.size()) return {};
+    return {frames_.begin() + static_cast<std::ptrdiff_t>(begin), frames_.end()};
+  }
+
   /// Arrival times (s) of frames [begin, end).
   std::vector<double> arrivalSeconds(std::size_t begin, std::size_t end) const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -348,6 +357,46 @@ LatencyResult timeCmdVel(ros::Publisher& publisher, const SpeedFrameLog& log,
   return latencyResult(samples_ms, measured);
 }
 
+/// Section 8: cmd_vel commands 10-40 ms apart (uniform, fixed seed), not aligned with the loop,
+/// each timed to the first speed frame carrying its ticks. A command overtaken by the next one
+/// before any frame carries it counts as lost.
+LatencyResult timeCmdVelSpaced(ros::Publisher& publisher, const SpeedFrameLog& log,
+                               std::size_t commands) {
+  constexpr std::size_t kWarmUp = 20;
+  const double ticks_per_mps = 1600.0 / (0.25 * M_PI) / 50.0;
+  std::mt19937 random(14);
+  std::uniform_real_distribution<double> spacing_ms(10.0, 40.0);
+  std::vector<Clock::time_point> published;
+  std::vector<int16_t> sent_ticks;
+  const std::size_t first_frame = log.count();
+  for (std::size_t i = 0; i < kWarmUp + commands && !stopRequested(); ++i) {
+    const auto ticks = static_cast<int16_t>(1 + i % 600);
+    geometry_msgs::Twist command;
+    command.linear.x = (ticks + 0.5) / ticks_per_mps;
+    published.push_back(Clock::now());
+    sent_ticks.push_back(ticks);
+    publisher.publish(command);
+    std::this_thread::sleep_for(fromSeconds(spacing_ms(random) / 1e3));
+  }
+  std::this_thread::sleep_for(100ms);
+  const std::vector<SpeedFrame> frames = log.framesFrom(first_frame);
+  std::vector<double> samples_ms;
+  std::size_t next_frame = 0;
+  for (std::size_t i = kWarmUp; i < published.size(); ++i) {
+    // Frames are in order and commands are distinct from their neighbours: search forward.
+    while (next_frame < frames.size() && frames[next_frame].arrival < published[i]) ++next_frame;
+    const Clock::time_point overtaken =
+        i + 1 < published.size() ? published[i + 1] + 200ms : Clock::time_point::max();
+    for (std::size_t k = next_frame; k < frames.size() && frames[k].arrival < overtaken; ++k) {
+      if (frames[k].left == sent_ticks[i] && frames[k].right == sent_ticks[i]) {
+        samples_ms.push_back(toMs(frames[k].arrival - published[i]));
+        break;
+      }
+    }
+  }
+  return latencyResult(samples_ms, published.size() > kWarmUp ? published.size() - kWarmUp : 0);
+}
+
 struct BaseSessionResult {
   std::optional<LatencyResult> cmd_vel;
   std::optional<LoopResult> idle_loop;
@@ -378,7 +427,11 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
           "driver_node did not subscribe to cmd_vel");
 
   BaseSessionResult result;
-  if (time_cmd_vel) result.cmd_vel = timeCmdVel(publisher, log, context.options.commands);
+  if (time_cmd_vel) {
+    result.cmd_vel = variant.spaced_cmd_vel
+                         ? timeCmdVelSpaced(publisher, log, context.options.commands)
+                         : timeCmdVel(publisher, log, context.options.commands);
+  }
   if (measure_idle_loop) {
     require(sleepUntil(Clock::now() + 1s), "stopped");  // past cmd_vel_timeout: no more commands
     const std::size_t first = log.count();
@@ -728,7 +781,7 @@ std::string ratio(double polling, double event) {
 /// figure is the mean over the rounds.
 void runFloorComparison(Context& context) {
   struct Figures {
-    std::vector<double> cmd_p50, cmd_p99, telemetry_p50, telemetry_p99, cpu, jitter;
+    std::vector<double> cmd_p50, cmd_p99, cmd_lost, telemetry_p50, telemetry_p99, cpu, jitter;
   };
   const Options saved = context.options;
   const std::size_t rounds = saved.floor_rounds;
@@ -742,21 +795,22 @@ void runFloorComparison(Context& context) {
       const Variant& variant = floor_turn ? kFloor : kEventDriven;
       Figures& figures = floor_turn ? floor : node;
       const Variant tagged{variant.name, variant.tag + "_r" + std::to_string(round),
-                           variant.read_poll_interval, variant.program};
+                           variant.read_poll_interval, variant.program, true};
       attempt(context, format("8. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
         const BaseSessionResult base = runBaseSession(context, tagged, true, true);
         figures.cmd_p50.push_back(base.cmd_vel->ms.p50);
         figures.cmd_p99.push_back(base.cmd_vel->ms.p99);
+        figures.cmd_lost.push_back(100.0 * base.cmd_vel->lost /
+                                   std::max<std::size_t>(1, base.cmd_vel->attempted));
         figures.jitter.push_back(base.idle_loop->period_ms.stddev);
       });
-      attempt(context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1),
-              [&] {
-                const TelemetrySessionResult body =
-                    runTelemetrySession(context, tagged, true, false);
-                figures.telemetry_p50.push_back(body.latency->ms.p50);
-                figures.telemetry_p99.push_back(body.latency->ms.p99);
-                figures.cpu.push_back(body.cpu_percent / 100.0);
-              });
+      attempt(
+          context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1), [&] {
+            const TelemetrySessionResult body = runTelemetrySession(context, tagged, true, false);
+            figures.telemetry_p50.push_back(body.latency->ms.p50);
+            figures.telemetry_p99.push_back(body.latency->ms.p99);
+            figures.cpu.push_back(body.cpu_percent / 100.0);
+          });
     }
   }
   context.options = saved;
@@ -781,11 +835,12 @@ void runFloorComparison(Context& context) {
   compare("telemetry -> joint_states p99", node.telemetry_p99, floor.telemetry_p99, "ms", 3);
   compare("cmd_vel -> speed frame p50", node.cmd_p50, floor.cmd_p50, "ms", 3);
   compare("cmd_vel -> speed frame p99", node.cmd_p99, floor.cmd_p99, "ms", 3);
+  compare("cmd_vel never on the wire", node.cmd_lost, floor.cmd_lost, "%", 1);
   compare("CPU at 100 Hz telemetry", node.cpu, floor.cpu, "s/s", 4);
   compare("loop jitter std, idle 50 Hz", node.jitter, floor.jitter, "ms", 3);
   table.note(format(
-      "%zu rounds, node and floor alternated; per round %zu cmd_vel commands (one per loop "
-      "period, 12 ms after a speed frame), %zu telemetry frames of 20 servos at 100 Hz with one "
+      "%zu rounds, node and floor alternated; per round %zu cmd_vel commands 10-40 ms apart "
+      "(uniform; a command overtaken before any frame carries it is not timed), %zu telemetry frames of 20 servos at 100 Hz with one "
       "external joint_states subscriber, %.0f s idle window. Figures are means over the rounds. "
       "CPU from /proc/<pid>/stat (10 ms ticks).",
       rounds, std::max<std::size_t>(50, saved.commands / rounds),
