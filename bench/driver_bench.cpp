@@ -10,12 +10,16 @@
 //  6. servo/read round trip (new connection per call and persistent), wheel loop under service
 //  stress
 //  7. 1, 4 and 5 again with polling_driver_node (the same node reading every 20 ms), and the ratios
+//  8. driver_node against floor_node (bench/floor_node.cpp, the least a roscpp driver must do):
+//     cmd_vel latency, telemetry latency, CPU at 100 Hz telemetry and idle loop jitter, the two
+//     processes' runs alternated in rounds, and the ratios node / floor
 // Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -26,6 +30,7 @@
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -53,7 +58,7 @@ using test_support::PtyFrameReader;
 
 struct Options {
   bool long_run = false;
-  std::set<int> sections{1, 2, 3, 4, 5, 6, 7};
+  std::set<int> sections{1, 2, 3, 4, 5, 6, 7, 8};
   std::string output;                   ///< Markdown copy of the results; "" = none
   std::string bin_dir;                  ///< "" = the directory of this executable
   int master_port = 0;                  ///< 0 = any free port
@@ -64,13 +69,16 @@ struct Options {
   std::vector<double> rates{100, 200, 500, 1000, 2000, 5000};
   std::size_t service_calls = 200;  ///< 6: calls timed per client kind
   double stress_seconds = 5;        ///< 6: idle and stress windows of the wheel loop
+  std::size_t floor_rounds = 2;     ///< 8: alternated node/floor rounds
 
   bool runs(int section) const { return sections.count(section) > 0; }
 };
 
 const char* const kUsage = R"(usage: driver_bench [options]
   --long                  longer runs (5000 commands, 120 s loop window, 6000 frames, ...)
-  --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run)
+  --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run;
+                          8 compares driver_node with floor_node, runs alternated)
+  --floor-rounds N        8: alternated node/floor rounds (default 2)
   --output FILE           also write the results (Markdown) to FILE
   --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
   --master-port N         port of the private roscore (default: a free one)
@@ -88,7 +96,7 @@ std::set<int> parseSections(const std::string& text) {
   std::string item;
   while (std::getline(stream, item, ',')) {
     const int section = std::stoi(item);
-    if (section < 1 || section > 7) throw std::invalid_argument("no section " + item);
+    if (section < 1 || section > 8) throw std::invalid_argument("no section " + item);
     sections.insert(section);
   }
   return sections;
@@ -135,6 +143,8 @@ Options parseOptions(int argc, char** argv) {
       options.rate_step_seconds = std::stod(value);
     } else if (flag == "--service-calls") {
       options.service_calls = std::stoul(value);
+    } else if (flag == "--floor-rounds") {
+      options.floor_rounds = std::max<std::size_t>(1, std::stoul(value));
     } else if (flag == "--stress-seconds") {
       options.stress_seconds = std::stod(value);
     } else {
@@ -156,9 +166,11 @@ struct Variant {
   std::string tag;  ///< part of the node namespace
   std::string program;
   double read_poll_interval;  ///< 0: event-driven
+  bool spaced_cmd_vel = false;  ///< section 8: commands 10-40 ms apart instead of one per tick
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
+const Variant kFloor{"floor", "floor", "floor_node", 0.0, true};
 
 struct Context {
   Options options;
@@ -279,6 +291,13 @@ class SpeedFrameLog {
     return frames_[index];
   }
 
+  /// Copies of frames [begin, count()).
+  std::vector<SpeedFrame> framesFrom(std::size_t begin) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (begin >= frames_.size()) return {};
+    return {frames_.begin() + static_cast<std::ptrdiff_t>(begin), frames_.end()};
+  }
+
   /// Arrival times (s) of frames [begin, end).
   std::vector<double> arrivalSeconds(std::size_t begin, std::size_t end) const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -338,6 +357,46 @@ LatencyResult timeCmdVel(ros::Publisher& publisher, const SpeedFrameLog& log,
   return latencyResult(samples_ms, measured);
 }
 
+/// Section 8: cmd_vel commands 10-40 ms apart (uniform, fixed seed), not aligned with the loop,
+/// each timed to the first speed frame carrying its ticks. A command overtaken by the next one
+/// before any frame carries it counts as lost.
+LatencyResult timeCmdVelSpaced(ros::Publisher& publisher, const SpeedFrameLog& log,
+                               std::size_t commands) {
+  constexpr std::size_t kWarmUp = 20;
+  const double ticks_per_mps = 1600.0 / (0.25 * M_PI) / 50.0;
+  std::mt19937 random(14);
+  std::uniform_real_distribution<double> spacing_ms(10.0, 40.0);
+  std::vector<Clock::time_point> published;
+  std::vector<int16_t> sent_ticks;
+  const std::size_t first_frame = log.count();
+  for (std::size_t i = 0; i < kWarmUp + commands && !stopRequested(); ++i) {
+    const auto ticks = static_cast<int16_t>(1 + i % 600);
+    geometry_msgs::Twist command;
+    command.linear.x = (ticks + 0.5) / ticks_per_mps;
+    published.push_back(Clock::now());
+    sent_ticks.push_back(ticks);
+    publisher.publish(command);
+    std::this_thread::sleep_for(fromSeconds(spacing_ms(random) / 1e3));
+  }
+  std::this_thread::sleep_for(100ms);
+  const std::vector<SpeedFrame> frames = log.framesFrom(first_frame);
+  std::vector<double> samples_ms;
+  std::size_t next_frame = 0;
+  for (std::size_t i = kWarmUp; i < published.size(); ++i) {
+    // Frames are in order and commands are distinct from their neighbours: search forward.
+    while (next_frame < frames.size() && frames[next_frame].arrival < published[i]) ++next_frame;
+    const Clock::time_point overtaken =
+        i + 1 < published.size() ? published[i + 1] + 200ms : Clock::time_point::max();
+    for (std::size_t k = next_frame; k < frames.size() && frames[k].arrival < overtaken; ++k) {
+      if (frames[k].left == sent_ticks[i] && frames[k].right == sent_ticks[i]) {
+        samples_ms.push_back(toMs(frames[k].arrival - published[i]));
+        break;
+      }
+    }
+  }
+  return latencyResult(samples_ms, published.size() > kWarmUp ? published.size() - kWarmUp : 0);
+}
+
 struct BaseSessionResult {
   std::optional<LatencyResult> cmd_vel;
   std::optional<LoopResult> idle_loop;
@@ -368,7 +427,11 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
           "driver_node did not subscribe to cmd_vel");
 
   BaseSessionResult result;
-  if (time_cmd_vel) result.cmd_vel = timeCmdVel(publisher, log, context.options.commands);
+  if (time_cmd_vel) {
+    result.cmd_vel = variant.spaced_cmd_vel
+                         ? timeCmdVelSpaced(publisher, log, context.options.commands)
+                         : timeCmdVel(publisher, log, context.options.commands);
+  }
   if (measure_idle_loop) {
     require(sleepUntil(Clock::now() + 1s), "stopped");  // past cmd_vel_timeout: no more commands
     const std::size_t first = log.count();
@@ -712,6 +775,79 @@ std::string ratio(double polling, double event) {
   return event > 0 ? format("%.1fx", polling / event) : "-";
 }
 
+/// Section 8: driver_node and floor_node, each measured `floor_rounds` times, their runs
+/// alternated (node first in even rounds, floor first in odd ones) so that a change of machine
+/// load falls on both. Each round takes its share of the commands, frames and idle window; a
+/// figure is the mean over the rounds.
+void runFloorComparison(Context& context) {
+  struct Figures {
+    std::vector<double> cmd_p50, cmd_p99, cmd_lost, telemetry_p50, telemetry_p99, cpu, jitter;
+  };
+  const Options saved = context.options;
+  const std::size_t rounds = saved.floor_rounds;
+  context.options.commands = std::max<std::size_t>(50, saved.commands / rounds);
+  context.options.telemetry_frames = std::max<std::size_t>(100, saved.telemetry_frames / rounds);
+  context.options.loop_seconds = std::max(5.0, saved.loop_seconds / rounds);
+  Figures node, floor;
+  for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
+    for (int k = 0; k < 2; ++k) {
+      const bool floor_turn = (k == 1) != (round % 2 == 1);
+      const Variant& variant = floor_turn ? kFloor : kEventDriven;
+      Figures& figures = floor_turn ? floor : node;
+      const Variant tagged{variant.name, variant.tag + "_r" + std::to_string(round),
+                           variant.program, variant.read_poll_interval, true};
+      attempt(context, format("8. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
+        const BaseSessionResult base = runBaseSession(context, tagged, true, true);
+        figures.cmd_p50.push_back(base.cmd_vel->ms.p50);
+        figures.cmd_p99.push_back(base.cmd_vel->ms.p99);
+        figures.cmd_lost.push_back(100.0 * base.cmd_vel->lost /
+                                   std::max<std::size_t>(1, base.cmd_vel->attempted));
+        figures.jitter.push_back(base.idle_loop->period_ms.stddev);
+      });
+      attempt(
+          context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1), [&] {
+            const TelemetrySessionResult body = runTelemetrySession(context, tagged, true, false);
+            figures.telemetry_p50.push_back(body.latency->ms.p50);
+            figures.telemetry_p99.push_back(body.latency->ms.p99);
+            figures.cpu.push_back(body.cpu_percent / 100.0);
+          });
+    }
+  }
+  context.options = saved;
+
+  auto mean = [](const std::vector<double>& values) -> std::optional<double> {
+    if (values.empty()) return std::nullopt;
+    double sum = 0;
+    for (double value : values) sum += value;
+    return sum / values.size();
+  };
+  ResultTable& table = context.results;
+  table.section("8. driver_node vs the floor (bench/floor_node.cpp), runs alternated",
+                {"measurement", "driver_node", "floor", "node / floor"});
+  auto compare = [&](const std::string& what, const std::vector<double>& node_values,
+                     const std::vector<double>& floor_values, const char* unit, int decimals) {
+    const auto n = mean(node_values), f = mean(floor_values);
+    if (!n || !f) return;
+    table.row({what, format("%.*f %s", decimals, *n, unit), format("%.*f %s", decimals, *f, unit),
+               f > 0 ? format("%.2fx", *n / *f) : "-"});
+  };
+  compare("telemetry -> joint_states p50", node.telemetry_p50, floor.telemetry_p50, "ms", 3);
+  compare("telemetry -> joint_states p99", node.telemetry_p99, floor.telemetry_p99, "ms", 3);
+  compare("cmd_vel -> speed frame p50", node.cmd_p50, floor.cmd_p50, "ms", 3);
+  compare("cmd_vel -> speed frame p99", node.cmd_p99, floor.cmd_p99, "ms", 3);
+  compare("cmd_vel never on the wire", node.cmd_lost, floor.cmd_lost, "%", 1);
+  compare("CPU at 100 Hz telemetry", node.cpu, floor.cpu, "s/s", 4);
+  compare("loop jitter std, idle 50 Hz", node.jitter, floor.jitter, "ms", 3);
+  table.note(format(
+      "%zu rounds, node and floor alternated; per round %zu cmd_vel commands 10-40 ms apart "
+      "(uniform; a command overtaken before any frame carries it is not timed), %zu telemetry frames of 20 servos at 100 Hz with one "
+      "external joint_states subscriber, %.0f s idle window. Figures are means over the rounds. "
+      "CPU from /proc/<pid>/stat (10 ms ticks).",
+      rounds, std::max<std::size_t>(50, saved.commands / rounds),
+      std::max<std::size_t>(100, saved.telemetry_frames / rounds),
+      std::max(5.0, saved.loop_seconds / rounds)));
+}
+
 void run(Context& context) {
   const Options& o = context.options;
   ResultTable& table = context.results;
@@ -831,6 +967,8 @@ void run(Context& context) {
       addRateSteps("7b. Telemetry rate steps, polling variant", body_polling, false);
     }
   }
+
+  if (o.runs(8)) runFloorComparison(context);
 }
 
 std::string executableDirectory() {
@@ -868,7 +1006,7 @@ int main(int argc, char** argv) {
 
   bench::RunPaths paths;
   paths.bin_dir = options.bin_dir.empty() ? bench::executableDirectory() : options.bin_dir;
-  for (const char* program : {"driver_node", "polling_driver_node", "robot_sim"}) {
+  for (const char* program : {"driver_node", "polling_driver_node", "robot_sim", "floor_node"}) {
     if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
       std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
                 << " not found: build the driver_bench target first\n";

@@ -40,8 +40,8 @@ using ParamList = std::vector<std::pair<std::string, XmlRpc::XmlRpcValue>>;
 XmlRpc::XmlRpcValue toXmlRpc(const std::vector<int>& values);
 XmlRpc::XmlRpcValue toXmlRpc(const std::vector<std::string>& values);
 
-/// One driver_node (or `program`, a build of the same node such as polling_driver_node) in
-/// namespace `ns`, named "driver"; `params` are set under its private namespace before it starts.
+/// One driver_node (or `program`: polling_driver_node, or the floor_node that reads the same
+/// parameters) in namespace `ns`, named "driver"; `params` are set under its private namespace before it starts.
 /// Stopped (SIGINT: it writes its zero-speed frame) on destruction.
 class DriverProcess {
  public:

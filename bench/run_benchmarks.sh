@@ -4,7 +4,8 @@
 # bench/results/latest.md (or $SRD_BENCH_OUTPUT).
 #
 # usage: bench/run_benchmarks.sh [--build] [--long] [driver_bench options, see --help]
-#   --build             catkin_make driver_bench (and driver_node, robot_sim) first, -j2
+#   --build             catkin_make driver_bench (and driver_node, robot_sim, floor_node) first,
+#                       -j2, with -DSRD_BUILD_BENCHMARKS=ON (benchmarks are off by default)
 #   --long              longer runs (about 15 minutes); also SRD_BENCH_LONG=1
 #   SRD_BENCH_WS=DIR    the catkin workspace to use (default: the sourced one, or the one this
 #                       script was installed into)
@@ -26,7 +27,7 @@ if [[ "${SRD_BENCH_LONG:-0}" == "1" ]]; then args+=(--long); fi
 
 if [[ -n "${SRD_BENCH_WS:-}" ]]; then
   if (( build )); then
-    (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 --make-args -j2 driver_bench)
+    (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DSRD_BUILD_BENCHMARKS=ON --make-args -j2 driver_bench)
   fi
   load_workspace() {  # a function, so setup.bash does not see this script's arguments
     set +u  # ROS's setup scripts read unset variables
@@ -36,8 +37,6 @@ if [[ -n "${SRD_BENCH_WS:-}" ]]; then
   }
   load_workspace
   bench="${SRD_BENCH_WS}/devel/lib/serial_robot_driver/driver_bench"
-elif [[ -x "${script_dir}/driver_bench" ]]; then
-  bench="${script_dir}/driver_bench"  # installed next to driver_node
 elif command -v catkin_find >/dev/null && [[ -n "${ROS_PACKAGE_PATH:-}" ]]; then
   bench=$(catkin_find --first-only serial_robot_driver driver_bench 2>/dev/null || true)
 else

@@ -1,5 +1,18 @@
 # End-to-end benchmarks of driver_node over pseudo-terminals and a private roscore. They print
-# numbers (bench/run_benchmarks.sh) and are never part of the test suite.
+# numbers (bench/run_benchmarks.sh), are never part of the test suite and are not installed.
+# Included only with -DSRD_BUILD_BENCHMARKS=ON.
+find_package(benchmark QUIET)
+if(benchmark_FOUND)
+  add_executable(bench_framer bench/bench_framer.cpp)
+  target_link_libraries(bench_framer srd_core srd_sim benchmark::benchmark)
+endif()
+
+# The floor: the least a roscpp driver of this robot must do, driver_bench's yardstick.
+add_executable(floor_node bench/floor_node.cpp)
+target_include_directories(floor_node PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(floor_node srd_core ${catkin_LIBRARIES})
+add_dependencies(floor_node ${catkin_EXPORTED_TARGETS})
+
 add_executable(driver_bench
   bench/bench_support.cpp
   bench/driver_bench.cpp
@@ -14,8 +27,5 @@ target_include_directories(polling_driver_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(polling_driver_node srd_ros)
 
 # The benchmark launches these executables, so building it builds them.
-add_dependencies(driver_bench driver_node polling_driver_node robot_sim
+add_dependencies(driver_bench driver_node polling_driver_node floor_node robot_sim
   ${PROJECT_NAME}_generate_messages_cpp)
-
-install(TARGETS driver_bench polling_driver_node RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
-install(PROGRAMS bench/run_benchmarks.sh DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

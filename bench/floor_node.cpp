@@ -1,0 +1,145 @@
+// floor_node: the least any roscpp driver of this robot must do, as the yardstick of driver_bench.
+// Benchmark only, never installed. It reads the same parameters as driver_node for what it does:
+// ~port, ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids, ~body/joint_names,
+// ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution.
+//
+// Threading: one reader thread blocks on the port, frames telemetry and publishes one JointState
+// per frame; the cmd_vel callback (ros::spin thread) writes its speed frame at once; the main
+// thread writes the speed frame every loop period on absolute clock_nanosleep deadlines. Writes
+// from the two writers are serialised by one mutex. No validation, diagnostics or services.
+#include <fcntl.h>
+#include <geometry_msgs/Twist.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/kinematics/diff_drive.h"
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
+
+namespace srd = serial_robot_driver;
+
+namespace {
+
+std::atomic<bool> g_running{true};
+int g_fd = -1;
+std::mutex g_write_mutex;
+std::atomic<int16_t> g_left{0}, g_right{0};
+uint8_t g_seq = 0;  // guarded by g_write_mutex
+
+void writeSpeedFrame() {
+  std::lock_guard<std::mutex> lock(g_write_mutex);
+  const auto frame = srd::protocol::base::encodeWheelSpeed(g_seq++, g_left, g_right);
+  if (::write(g_fd, frame.data(), frame.size()) < 0) { /* the floor does not handle errors */
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "floor");
+  ros::NodeHandle nh, pnh("~");
+  const std::string port = pnh.param<std::string>("port", "/dev/ttyUSB0");
+  const double loop_rate = pnh.param("loop_rate", 50.0);
+  const bool base = pnh.param("base/enabled", true);
+  const bool body = pnh.param("body/enabled", true);
+  std::vector<int> ids, zeros, directions;
+  std::vector<std::string> names;
+  pnh.getParam("body/servo_ids", ids);
+  pnh.getParam("body/joint_names", names);
+  pnh.getParam("body/zero_ticks", zeros);
+  pnh.getParam("body/directions", directions);
+  std::vector<srd::device::JointCalibration> calibrations(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (i < zeros.size()) calibrations[i].zero_ticks = zeros[i];
+    if (i < directions.size()) calibrations[i].direction = directions[i];
+    calibrations[i].ticks_per_revolution = pnh.param("body/ticks_per_revolution", 4096);
+  }
+  names.resize(ids.size());
+
+  g_fd = ::open(port.c_str(), O_RDWR | O_NOCTTY);
+  if (g_fd < 0) {
+    ROS_FATAL("floor: cannot open %s", port.c_str());
+    return 1;
+  }
+  termios tio{};
+  ::tcgetattr(g_fd, &tio);
+  ::cfmakeraw(&tio);
+  tio.c_cc[VMIN] = 1;
+  tio.c_cc[VTIME] = 0;
+  ::tcsetattr(g_fd, TCSANOW, &tio);
+
+  ros::Publisher joint_states = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
+  const srd::kinematics::DiffDriveGeometry geometry;
+  ros::Subscriber cmd_vel;
+  if (base) {
+    cmd_vel = nh.subscribe<geometry_msgs::Twist>(
+        "cmd_vel", 10, [&geometry](const geometry_msgs::Twist::ConstPtr& twist) {
+          const auto speeds =
+              srd::kinematics::wheelSpeedsFromTwist(geometry, twist->linear.x, twist->angular.z);
+          g_left = static_cast<int16_t>(speeds[0] * geometry.ticksPerPeriodPerMps());
+          g_right = static_cast<int16_t>(speeds[1] * geometry.ticksPerPeriodPerMps());
+          writeSpeedFrame();
+        });
+  }
+
+  std::thread reader;
+  if (body) {
+    reader = std::thread([&] {
+      const auto config = srd::protocol::FramerConfig::forDriver(false, true, false, ids.size());
+      srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
+                                                     std::size_t size) {
+        if (family != srd::protocol::FrameFamily::kTelemetry) return;
+        const auto telemetry = srd::protocol::body::decodeTelemetry(data, size, ids.size());
+        if (!telemetry) return;
+        sensor_msgs::JointState msg;
+        msg.header.stamp = ros::Time::now();
+        msg.name = names;
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+          msg.position.push_back(calibrations[i].toRadians(telemetry->servos[i].position));
+          msg.velocity.push_back(calibrations[i].toRadiansPerSecond(telemetry->servos[i].speed));
+        }
+        joint_states.publish(msg);
+      });
+      uint8_t buffer[1024];
+      while (g_running) {
+        const ssize_t got = ::read(g_fd, buffer, sizeof(buffer));
+        if (got > 0) framer.feed(buffer, static_cast<std::size_t>(got));
+      }
+    });
+  }
+
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  if (base) {
+    const long period_ns = static_cast<long>(1e9 / loop_rate);
+    timespec deadline{};
+    ::clock_gettime(CLOCK_MONOTONIC, &deadline);
+    while (ros::ok()) {
+      deadline.tv_nsec += period_ns;
+      while (deadline.tv_nsec >= 1000000000L) {
+        deadline.tv_nsec -= 1000000000L;
+        ++deadline.tv_sec;
+      }
+      ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
+      writeSpeedFrame();
+    }
+  } else {
+    ros::waitForShutdown();
+  }
+  // The reader blocks in read(); the process exits without joining it.
+  g_running = false;
+  reader.detach();
+  return 0;
+}
