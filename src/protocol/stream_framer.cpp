@@ -105,8 +105,19 @@ StreamFramer::StreamFramer(const FramerConfig& config, FrameHandler handler)
 
 void StreamFramer::addEntry(uint8_t header0, FrameFamily family,
                             Probe (*probe)(const uint8_t*, std::size_t, std::size_t)) {
-  entries_[entry_count_++] = Entry{header0, family, probe};
+  // Keep entries with the same first byte adjacent and in the order they were added.
+  std::size_t at = entry_count_;
+  for (std::size_t i = 0; i < entry_count_; ++i) {
+    if (entries_[i].header0 == header0) at = i + 1;
+  }
+  std::move_backward(entries_.begin() + at, entries_.begin() + entry_count_,
+                     entries_.begin() + entry_count_ + 1);
+  entries_[at] = Entry{header0, family, probe};
+  ++entry_count_;
   is_start_[header0] = true;
+  first_entry_.fill(kNoEntry);
+  for (std::size_t i = entry_count_; i-- > 0;)
+    first_entry_[entries_[i].header0] = static_cast<uint8_t>(i);
 }
 
 void StreamFramer::feed(const uint8_t* data, std::size_t size) {
@@ -190,9 +201,10 @@ std::size_t StreamFramer::scan(const uint8_t* data, std::size_t available,
 
 Probe StreamFramer::examine(const uint8_t* data, std::size_t available, FrameFamily* family) {
   Probe result = Probe::invalid(DecodeError::kBadHeader);
-  for (std::size_t i = 0; i < entry_count_; ++i) {
+  // Entries sharing a first byte are adjacent (addEntry keeps them so): start at the first one.
+  for (std::size_t i = first_entry_[data[0]]; i < entry_count_; ++i) {
     const Entry& entry = entries_[i];
-    if (entry.header0 != data[0]) continue;
+    if (entry.header0 != data[0]) break;
     result = entry.probe(data, available, config_.telemetry_servo_count);
     if (result.status == Probe::Status::kInvalid && result.reason == DecodeError::kBadHeader) {
       continue;

@@ -2,8 +2,8 @@
 // families it is configured for and hands each one to a callback together with its family.
 // The framer knows no layout: it is a table of {first header byte, family, probe}, and each codec's
 // probe says "need more", "invalid (why)" or "frame of N bytes" (verified: LEN, checksum, tail).
-// Adding a family is one table entry in the constructor plus its codec's probe. Several devices can therefore share one port: their inbound
-// headers differ (PROTOCOLS.md, table at the top).
+// Adding a family is one table entry in the constructor plus its codec's probe. Several devices can
+// therefore share one port: their inbound headers differ (docs/protocols.md, table at the top).
 //
 // Design (after kobuki's packet finder and novatel's multi-family extractor):
 //  - fixed-size buffer, no heap allocation after construction;
@@ -92,7 +92,8 @@ class StreamFramer {
   void addEntry(uint8_t header0, FrameFamily family,
                 Probe (*probe)(const uint8_t*, std::size_t, std::size_t));
   /// Asks the entries whose first header byte matches, in table order; a kBadHeader from one
-  /// (two families share 0x12) passes the candidate to the next. Counts length/checksum/tail errors.
+  /// (two families share 0x12) passes the candidate to the next. Counts length/checksum/tail
+  /// errors.
   Probe examine(const uint8_t* data, std::size_t available, FrameFamily* family);
   /// Emits the frames found among the bytes at `data`, examining candidates that start before
   /// `start_limit`. Returns how many bytes were consumed: it stops early only at an incomplete
@@ -108,6 +109,9 @@ class StreamFramer {
   std::size_t entry_count_ = 0;
   /// is_start_[b]: b is the first header byte of an enabled family.
   std::array<bool, 256> is_start_{};
+  /// first_entry_[b]: index of the first entry whose header starts with b (kNoEntry: none).
+  static constexpr uint8_t kNoEntry = 0xFF;
+  std::array<uint8_t, 256> first_entry_{};
   /// The only start byte when exactly one is enabled (memchr applies), else -1.
   int single_start_ = -1;
   std::array<uint8_t, kBufferSize> buffer_{};
