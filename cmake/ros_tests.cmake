@@ -34,12 +34,12 @@ add_dependencies(test_servo_bus_node driver_node robot_sim ${PROJECT_NAME}_gener
 add_rostest_gtest(test_launch_precedence test/rostest/launch_precedence.test
   test/rostest/test_launch_precedence.cpp)
 target_include_directories(test_launch_precedence PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(test_launch_precedence ${catkin_LIBRARIES})
+target_link_libraries(test_launch_precedence srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_launch_precedence driver_node)
 
 # config/analyzers.yaml against the driver's real statuses, through diagnostic_aggregator's library.
 find_package(diagnostic_aggregator REQUIRED)
 add_rostest_gtest(test_analyzers test/rostest/analyzers.test test/rostest/test_analyzers.cpp)
 target_include_directories(test_analyzers PRIVATE ${catkin_INCLUDE_DIRS} ${diagnostic_aggregator_INCLUDE_DIRS})
-target_link_libraries(test_analyzers ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
+target_link_libraries(test_analyzers srd_test_support ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_analyzers driver_node robot_sim)

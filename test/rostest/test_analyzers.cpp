@@ -14,6 +14,8 @@
 #include <thread>
 #include <vector>
 
+#include "support/ros_test_support.h"
+
 namespace {
 
 const std::string kRoot = "/Serial robot";
@@ -42,7 +44,9 @@ class AggregatedNames {
   std::vector<std::string> names_;
 };
 
-bool startsWith(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
+bool startsWith(const std::string& text, const std::string& prefix) {
+  return text.rfind(prefix, 0) == 0;
+}
 
 // Children per group of the file, and the driver's statuses that landed in "Other".
 struct Grouping {
@@ -77,7 +81,8 @@ TEST(Analyzers, GroupEveryDriverStatus) {
     all_groups = true;
     for (const auto& g : kGroups) all_groups = all_groups && grouping.children[g] > 0;
   }
-  for (const auto& g : kGroups) EXPECT_GT(grouping.children[g], 0) << "no status in " << kRoot << "/" << g;
+  for (const auto& g : kGroups)
+    EXPECT_GT(grouping.children[g], 0) << "no status in " << kRoot << "/" << g;
   EXPECT_TRUE(grouping.driver_in_other.empty())
       << "ungrouped driver status, e.g. " << grouping.driver_in_other.front();
 }
@@ -86,12 +91,6 @@ TEST(Analyzers, GroupEveryDriverStatus) {
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_analyzers");
-  ros::NodeHandle nh;  // keeps the node started while the test runs
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  test_support::RosTestNode node(argc, argv, "test_analyzers", 1);
+  return RUN_ALL_TESTS();
 }

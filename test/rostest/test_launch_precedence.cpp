@@ -17,6 +17,8 @@
 #include <thread>
 #include <utility>
 
+#include "support/ros_test_support.h"
+
 namespace {
 
 std::string requiredParam(const std::string& name) {
@@ -127,12 +129,6 @@ TEST_F(LaunchPrecedence, EachRunningDriverUsesItsPort) {
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_launch_precedence");
-  ros::NodeHandle nh;  // keeps the node started while the tests run
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  test_support::RosTestNode node(argc, argv, "test_launch_precedence", 1);
+  return RUN_ALL_TESTS();
 }

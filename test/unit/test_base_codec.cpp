@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/base_codec.h"
+#include "support/probe_expectations.h"
 #include "support/golden_frames.h"
 
 namespace serial_robot_driver::protocol::base {
@@ -264,29 +265,8 @@ TEST(BaseCodec, SequenceNumberAfterWrapIsEncoded) {
 
 // --- probe (what the stream framer asks) -------------------------------------------------------
 
-// Every proper prefix of a complete frame needs more bytes; the whole frame, also with trailing
-// bytes of the next one, is a frame of exactly its size.
-template <typename ProbeFn>
-void expectProbeFindsFrame(ProbeFn probe, const Bytes& frame) {
-  for (std::size_t size = 0; size < frame.size(); ++size) {
-    EXPECT_EQ(probe(frame.data(), size).status, Probe::Status::kNeedMore) << "prefix " << size;
-  }
-  Bytes longer = frame;
-  longer.push_back(frame[0]);
-  const Bytes* const candidates[] = {&frame, &longer};
-  for (const Bytes* bytes : candidates) {
-    const Probe result = probe(bytes->data(), bytes->size());
-    EXPECT_EQ(result.status, Probe::Status::kFrame);
-    EXPECT_EQ(result.size, frame.size());
-  }
-}
-
-template <typename ProbeFn>
-void expectProbeRejects(ProbeFn probe, const Bytes& bytes, DecodeError reason) {
-  const Probe result = probe(bytes.data(), bytes.size());
-  EXPECT_EQ(result.status, Probe::Status::kInvalid);
-  EXPECT_EQ(result.reason, reason) << toString(result.reason);
-}
+using test_support::expectProbeFindsFrame;
+using test_support::expectProbeRejects;
 
 // Reset, SEQ 00: 55^AA^01^00^05 = FB.
 const Bytes kProbeReset = {0x55, 0xAA, 0x01, 0x00, 0x05, 0xFB};

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/body_codec.h"
+#include "support/probe_expectations.h"
 #include "support/test_helpers.h"
 #include "support/golden_frames.h"
 
@@ -303,29 +304,8 @@ TEST(BodyCodec, TrailingByteAfterFrameIsBadLength) {
 
 // --- probe (what the stream framer asks) -------------------------------------------------------
 
-// Every proper prefix of a complete frame needs more bytes; the whole frame, also with trailing
-// bytes of the next one, is a frame of exactly its size.
-template <typename ProbeFn>
-void expectProbeFindsFrame(ProbeFn probe, const Bytes& frame) {
-  for (std::size_t size = 0; size < frame.size(); ++size) {
-    EXPECT_EQ(probe(frame.data(), size).status, Probe::Status::kNeedMore) << "prefix " << size;
-  }
-  Bytes longer = frame;
-  longer.push_back(frame[0]);
-  const Bytes* const candidates[] = {&frame, &longer};
-  for (const Bytes* bytes : candidates) {
-    const Probe result = probe(bytes->data(), bytes->size());
-    EXPECT_EQ(result.status, Probe::Status::kFrame);
-    EXPECT_EQ(result.size, frame.size());
-  }
-}
-
-template <typename ProbeFn>
-void expectProbeRejects(ProbeFn probe, const Bytes& bytes, DecodeError reason) {
-  const Probe result = probe(bytes.data(), bytes.size());
-  EXPECT_EQ(result.status, Probe::Status::kInvalid);
-  EXPECT_EQ(result.reason, reason) << toString(result.reason);
-}
+using test_support::expectProbeFindsFrame;
+using test_support::expectProbeRejects;
 
 // No servos, no foot block: LEN 24 = 0x18, IMU all zero, SUM = 0x18 (LEN only).
 // clang-format off

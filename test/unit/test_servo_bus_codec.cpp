@@ -10,6 +10,8 @@
 #include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
 
+#include "support/probe_expectations.h"
+
 namespace serial_robot_driver::protocol::servo {
 namespace {
 
@@ -227,29 +229,8 @@ TEST(ServoBusCodec, RequestDecoderChecksSum) {
 
 // --- probe (what the stream framer asks) -------------------------------------------------------
 
-// Every proper prefix of a complete frame needs more bytes; the whole frame, also with trailing
-// bytes of the next one, is a frame of exactly its size.
-template <typename ProbeFn>
-void expectProbeFindsFrame(ProbeFn probe, const Bytes& frame) {
-  for (std::size_t size = 0; size < frame.size(); ++size) {
-    EXPECT_EQ(probe(frame.data(), size).status, Probe::Status::kNeedMore) << "prefix " << size;
-  }
-  Bytes longer = frame;
-  longer.push_back(frame[0]);
-  const Bytes* const candidates[] = {&frame, &longer};
-  for (const Bytes* bytes : candidates) {
-    const Probe result = probe(bytes->data(), bytes->size());
-    EXPECT_EQ(result.status, Probe::Status::kFrame);
-    EXPECT_EQ(result.size, frame.size());
-  }
-}
-
-template <typename ProbeFn>
-void expectProbeRejects(ProbeFn probe, const Bytes& bytes, DecodeError reason) {
-  const Probe result = probe(bytes.data(), bytes.size());
-  EXPECT_EQ(result.status, Probe::Status::kInvalid);
-  EXPECT_EQ(result.reason, reason) << toString(result.reason);
-}
+using test_support::expectProbeFindsFrame;
+using test_support::expectProbeRejects;
 
 // PING id 3: 12+4C+01+01+03 = 63; reply 05+1C+01+01+03 = 26.
 const Bytes kProbePingRequest = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63};
