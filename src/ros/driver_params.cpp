@@ -122,6 +122,9 @@ std::vector<ParamSpec> buildTable() {
             require(v <= 1000, key, "must be at most 1000 Hz");
           }),
       row("reconnect_interval", &P::reconnect_interval, positive<double>),
+      row("capture", &P::capture),
+      row("replay_bag", &P::replay_bag),
+      row("replay_rate", &P::replay_rate, nonNegative<double>),
 
       row("base/enabled", &P::base, &Port::enabled),
       row("base/port", &P::base, &Port::port),
