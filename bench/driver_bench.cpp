@@ -353,7 +353,8 @@ class CaptureListener {
   CaptureListener(ros::NodeHandle& nh, const DriverProcess& driver, const Variant& variant) {
     if (!variant.capture) return;
     subscriber_ = nh.subscribe<serial_robot_driver::SerialChunk>(
-        driver.topic("serial_raw"), 10000, [this](const serial_robot_driver::SerialChunk::ConstPtr&) { ++chunks_; });
+        driver.topic("serial_raw"), 10000,
+        [this](const serial_robot_driver::SerialChunk::ConstPtr&) { ++chunks_; });
   }
 
  private:

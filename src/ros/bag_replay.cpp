@@ -1,12 +1,11 @@
 #include "serial_robot_driver/ros/bag_replay.h"
 
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <sys/stat.h>
 
 #include <algorithm>
 #include <sstream>
-
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/ros/conversions.h"
@@ -51,7 +50,8 @@ Recording readRecording(const std::string& path) {
     if (raw_topics.empty()) {
       throw ReplayError("replay bag " + path +
                         " has no serial_raw topic (record it from a driver running with ~capture: "
-                        "true, e.g. record.launch raw:=true); its topics: " + joined(other_topics));
+                        "true, e.g. record.launch raw:=true); its topics: " +
+                        joined(other_topics));
     }
     if (raw_topics.size() > 1) {
       throw ReplayError("replay bag " + path + " has serial_raw of several drivers (" +
@@ -69,7 +69,8 @@ Recording readRecording(const std::string& path) {
         ++recording.outbound_chunks;
         continue;
       }
-      recording.ports[chunk->port].push_back({arrivalOfRecordedStamp(chunk->header.stamp), chunk->data});
+      recording.ports[chunk->port].push_back(
+          {arrivalOfRecordedStamp(chunk->header.stamp), chunk->data});
     }
   } catch (const rosbag::BagException& e) {
     throw ReplayError("replay bag " + path + " is damaged: " + e.what());
@@ -96,8 +97,8 @@ BagReplay::BagReplay(const DriverParams& params)
   for (const auto& [port, chunks] : recording_.ports) {
     if (!configured.count(port)) {
       throw ReplayError("replay bag " + path_ + " has chunks of port " + port +
-                        ", which the configuration does not have (configured: " + joined(configured) +
-                        "); load the configuration the bag was recorded with");
+                        ", which the configuration does not have (configured: " +
+                        joined(configured) + "); load the configuration the bag was recorded with");
     }
     first = std::min(first, chunks.front().arrival);
   }
@@ -112,13 +113,15 @@ BagReplay::BagReplay(const DriverParams& params)
 
 device::SerialLink::StreamFactory BagReplay::streamFactory() const {
   const auto ports = ports_;
-  return [ports](const device::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
-    return std::make_unique<transport::RecordedStream>(ports.at(options.path));
-  };
+  return
+      [ports](const device::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
+        return std::make_unique<transport::RecordedStream>(ports.at(options.path));
+      };
 }
 
 bool BagReplay::finished() const {
-  return std::all_of(ports_.begin(), ports_.end(), [](const auto& entry) { return entry.second->finished(); });
+  return std::all_of(ports_.begin(), ports_.end(),
+                     [](const auto& entry) { return entry.second->finished(); });
 }
 
 std::string BagReplay::summary() const {
@@ -126,9 +129,9 @@ std::string BagReplay::summary() const {
   text << "replay of " << path_ << " (" << recording_.topic << "):";
   for (const auto& [name, port] : ports_) {
     const transport::RecordedPortStats s = port->stats();
-    text << " port " << name << ": " << s.chunks_fed << " chunks (" << s.bytes_fed << " bytes) fed, "
-         << s.reopens << " opens, " << s.writes_discarded << " writes (" << s.bytes_discarded
-         << " bytes) discarded;";
+    text << " port " << name << ": " << s.chunks_fed << " chunks (" << s.bytes_fed
+         << " bytes) fed, " << s.reopens << " opens, " << s.writes_discarded << " writes ("
+         << s.bytes_discarded << " bytes) discarded;";
   }
   return text.str();
 }

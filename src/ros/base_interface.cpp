@@ -60,9 +60,11 @@ device::BaseEvents BaseInterface::events() {
   return events;
 }
 
-BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                             diagnostic_updater::Updater& diagnostics)
-    : link_(link), arrival_stamps_(params), controller_(makeBaseConfig(params), link.writer(), events()) {
+BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
+                             device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
+    : link_(link),
+      arrival_stamps_(params),
+      controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
   battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
 

@@ -14,16 +14,21 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
     : link_(link),
       arrival_stamps_(params),
       imu_params_(params.imu),
-      controller_(makeBodyJoints(params.body), link.writer(),
-                  {[this](const protocol::body::Telemetry& telemetry,
-                          device::Clock::time_point arrival) { publishTelemetry(telemetry, arrival); }}),
+      controller_(
+          makeBodyJoints(params.body), link.writer(),
+          {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
+            publishTelemetry(telemetry, arrival);
+          }}),
       telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
                       "telemetry rate") {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
-  joint_states_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
+  joint_states_pub_ =
+      nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
   imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", params.publisherQueue(20));
-  foot_pressure_pub_ = nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
-  telemetry_pub_ = nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
+  foot_pressure_pub_ =
+      nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
+  telemetry_pub_ =
+      nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
   // tcpNoDelay: a joint command must not wait in Nagle's buffer.
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());

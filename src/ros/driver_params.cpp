@@ -165,7 +165,8 @@ std::vector<ParamSpec> buildTable() {
           [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); }),
       row("body/zero_ticks", &P::body, &Body::zero_ticks,
           [](const std::vector<int>& zeros, const std::string& key) {
-            for (int zero : zeros) require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
+            for (int zero : zeros)
+              require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
           }),
       row("body/directions", &P::body, &Body::directions,
           [](const std::vector<int>& directions, const std::string& key) {

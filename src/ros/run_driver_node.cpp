@@ -5,8 +5,8 @@
 #include <csignal>
 #include <ctime>
 #include <memory>
-#include <thread>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "serial_robot_driver/ros/bag_replay.h"
@@ -77,9 +77,11 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
     stream_factory = replay->streamFactory();
     // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
     params.reconnect_interval = 0.0;
-    ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(), params.replay_bag.c_str(),
-             params.replay_rate > 0 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
-                                    : "full speed");
+    ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(),
+             params.replay_bag.c_str(),
+             params.replay_rate > 0
+                 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
+                 : "full speed");
   }
 
   DriverNode node(nh, private_nh, params, stream_factory);
@@ -92,9 +94,9 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   // waits on the wire (servo/* services have their own queue), so one thread keeps up.
   ros::AsyncSpinner spinner(1);
   spinner.start();
-  const bool replay_done =
-      waitForStopRequest(stop_signals, replay ? std::function<bool()>([&] { return replay->finished(); })
-                                              : std::function<bool()>());
+  const bool replay_done = waitForStopRequest(
+      stop_signals,
+      replay ? std::function<bool()>([&] { return replay->finished(); }) : std::function<bool()>());
   if (replay_done) {
     node.updateDiagnostics();  // the counters at the end of the recording
     ROS_INFO("%s", replay->summary().c_str());

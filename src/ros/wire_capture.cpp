@@ -59,7 +59,8 @@ WireCaptureStats WireCapture::stats() const {
 void WireCapture::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) const {
   const WireCaptureStats s = stats();
   if (s.dropped > 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "chunks dropped: the publisher fell behind");
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "chunks dropped: the publisher fell behind");
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "capturing on serial_raw");
   }

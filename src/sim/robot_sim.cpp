@@ -261,7 +261,8 @@ void RobotSim::flush(Port* port) {
     if (now < port->tx_line_free) return;
     line_start = std::max(port->tx_line_free, now - kPaceSlice);
     const double seconds = std::chrono::duration<double>(now - line_start + kPaceSlice).count();
-    allowance = std::max<std::size_t>(1, static_cast<std::size_t>(options_.pace_baud / 10.0 * seconds));
+    allowance =
+        std::max<std::size_t>(1, static_cast<std::size_t>(options_.pace_baud / 10.0 * seconds));
   }
   while (!port->backlog.empty() && allowance > 0) {
     Port::PendingWrite& pending = port->backlog.front();
@@ -429,7 +430,8 @@ void RobotSim::run() {
         if (n <= 0) break;
         counters_.bytes_received += static_cast<uint64_t>(n);
         if (options_.pace_baud > 0) {
-          port->rx_line_free = std::max(port->rx_line_free, read_at) + lineTime(static_cast<std::size_t>(n));
+          port->rx_line_free =
+              std::max(port->rx_line_free, read_at) + lineTime(static_cast<std::size_t>(n));
           port->rx_in_flight.emplace_back(port->rx_line_free,
                                           std::vector<uint8_t>(buffer.data(), buffer.data() + n));
         } else {
@@ -448,7 +450,8 @@ void RobotSim::run() {
     for (auto& port : ports_) {
       next = std::min({next, port->next_unplug, port->replug_at, port->next_garbage});
       if (port->draining) next = std::min(next, now + std::chrono::milliseconds(5));
-      if (!port->backlog.empty() && options_.pace_baud > 0) next = std::min(next, port->tx_line_free);
+      if (!port->backlog.empty() && options_.pace_baud > 0)
+        next = std::min(next, port->tx_line_free);
       if (!port->rx_in_flight.empty()) next = std::min(next, port->rx_in_flight.front().first);
     }
     const double wait_ms = std::chrono::duration<double, std::milli>(next - now).count();

@@ -12,7 +12,8 @@ ReplayPacing::ReplayPacing(double rate, SteadyTime first_arrival)
 SteadyTime ReplayPacing::dueAt(SteadyTime arrival) const {
   if (rate_ <= 0) return start_;
   const std::chrono::duration<double> recorded_offset = arrival - first_arrival_;
-  return start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(recorded_offset / rate_);
+  return start_ +
+         std::chrono::duration_cast<std::chrono::steady_clock::duration>(recorded_offset / rate_);
 }
 
 RecordedPort::RecordedPort(std::string name, std::vector<RecordedChunk> chunks,

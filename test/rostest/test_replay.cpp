@@ -10,13 +10,6 @@
 //  3. Message by message, the replayed topics equal the live ones: count, stamps and every field
 //     (the header's seq aside: roscpp numbers each publisher's messages itself); and the framer,
 //     body and base counters of the replay's diagnostics equal the live ones.
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cstdio>
-#include <string>
-#include <vector>
-
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <ros/serialization.h>
@@ -24,6 +17,12 @@
 #include <sensor_msgs/BatteryState.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
 
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/SerialChunk.h"
@@ -171,7 +170,8 @@ TEST(Replay, PublishesExactlyWhatWentOutLive) {
     EXPECT_EQ(replayed_body.value(key), live_body.value(key)) << key;
   }
   const DiagnosticsWatch::Status replayed_base = replayed_diagnostics.latest("base");
-  for (const char* key : {"battery replies", "bad replies", "unknown replies", "FF timeout errors received"}) {
+  for (const char* key :
+       {"battery replies", "bad replies", "unknown replies", "FF timeout errors received"}) {
     EXPECT_EQ(replayed_base.value(key), live_base.value(key)) << key;
   }
 }

@@ -2,15 +2,14 @@
 // each way it can fail (the node prints it and exits non-zero). Bags are written here with the
 // rosbag C++ API into a fresh temporary directory.
 #include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/JointState.h>
 #include <stdlib.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
 #include <string>
-
-#include <rosbag/bag.h>
-#include <sensor_msgs/JointState.h>
 
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/ros/bag_replay.h"
@@ -34,8 +33,8 @@ class BagReplayTest : public ::testing::Test {
     files_.push_back(dir_ + "/" + name);
     return files_.back();
   }
-  static serial_robot_driver::SerialChunk chunk(const std::string& port, bool outbound, double stamp,
-                                                std::vector<uint8_t> data) {
+  static serial_robot_driver::SerialChunk chunk(const std::string& port, bool outbound,
+                                                double stamp, std::vector<uint8_t> data) {
     serial_robot_driver::SerialChunk msg;
     msg.header.stamp = ros::Time(stamp);
     msg.port = port;
@@ -43,7 +42,8 @@ class BagReplayTest : public ::testing::Test {
     msg.data = std::move(data);
     return msg;
   }
-  static void write(rosbag::Bag& bag, const std::string& topic, const serial_robot_driver::SerialChunk& c) {
+  static void write(rosbag::Bag& bag, const std::string& topic,
+                    const serial_robot_driver::SerialChunk& c) {
     bag.write(topic, c.header.stamp, c);
   }
   /// The message readRecording or BagReplay throws.

@@ -16,7 +16,8 @@ using std::chrono::milliseconds;
 SteadyTime at(int ms) { return SteadyTime(milliseconds(1000000 + ms)); }
 
 std::shared_ptr<RecordedPort> portOf(std::vector<RecordedChunk> chunks, double rate = 0.0) {
-  auto pacing = std::make_shared<ReplayPacing>(rate, chunks.empty() ? at(0) : chunks.front().arrival);
+  auto pacing =
+      std::make_shared<ReplayPacing>(rate, chunks.empty() ? at(0) : chunks.front().arrival);
   return std::make_shared<RecordedPort>("/dev/ttyTEST", std::move(chunks), pacing);
 }
 

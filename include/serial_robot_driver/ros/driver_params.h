@@ -75,8 +75,8 @@ struct DriverParams {
   int baud = 115200;
   double loop_rate = 50.0;
   double reconnect_interval = 1.0;
-  bool capture = false;     ///< publish every chunk in and out on serial_raw
-  std::string replay_bag;   ///< non-empty: read the ports from this bag's serial_raw, not the wire
+  bool capture = false;      ///< publish every chunk in and out on serial_raw
+  std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
   double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
   BaseParams base;
   BodyParams body;

@@ -8,14 +8,14 @@
 // chunks are dropped and counted (diagnostics "wire capture").
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <mutex>
 #include <thread>
-
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <ros/ros.h>
 
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/device/serial_link.h"

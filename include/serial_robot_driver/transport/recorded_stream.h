@@ -66,8 +66,8 @@ class RecordedPort {
   std::string name_;
   std::vector<RecordedChunk> chunks_;
   std::shared_ptr<const ReplayPacing> pacing_;
-  std::size_t next_ = 0;     // reader thread only
-  std::size_t offset_ = 0;   // into chunks_[next_], when a chunk exceeds a read's capacity
+  std::size_t next_ = 0;    // reader thread only
+  std::size_t offset_ = 0;  // into chunks_[next_], when a chunk exceeds a read's capacity
   std::atomic<bool> finished_{false};
   std::atomic<uint64_t> chunks_fed_{0}, bytes_fed_{0}, reopens_{0};
   std::atomic<uint64_t> writes_discarded_{0}, bytes_discarded_{0};
