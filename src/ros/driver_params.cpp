@@ -250,6 +250,8 @@ void DriverParams::validate() const {
   // Single values first (the table), then what relates several parameters.
   for (const auto& spec : parameterTable()) spec.check(*this);
 
+  require(!capture || replay_bag.empty(), "capture",
+          "cannot be combined with ~replay_bag: a replay reads a capture and writes nothing");
   require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
           "every device is disabled (base, body, servo_bus): nothing to drive");
   if (base.enabled) {
