@@ -13,6 +13,8 @@
 //  8. driver_node against floor_node (bench/floor_node.cpp, the least a roscpp driver must do):
 //     cmd_vel latency, telemetry latency, CPU at 100 Hz telemetry and idle loop jitter, the two
 //     processes' runs alternated in rounds, and the ratios node / floor
+//  9. ~capture on vs off: base loop period and CPU (2, 3), telemetry -> joint_states and CPU (4),
+//     with a subscriber on serial_raw as rosbag record would be
 // Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
@@ -20,6 +22,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -40,6 +43,7 @@
 
 #include "bench_support.h"
 #include "ros_bench_support.h"
+#include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/base_codec.h"
@@ -58,7 +62,7 @@ using test_support::PtyFrameReader;
 
 struct Options {
   bool long_run = false;
-  std::set<int> sections{1, 2, 3, 4, 5, 6, 7, 8};
+  std::set<int> sections{1, 2, 3, 4, 5, 6, 7, 8, 9};
   std::string output;                   ///< Markdown copy of the results; "" = none
   std::string bin_dir;                  ///< "" = the directory of this executable
   int master_port = 0;                  ///< 0 = any free port
@@ -78,6 +82,8 @@ const char* const kUsage = R"(usage: driver_bench [options]
   --long                  longer runs (5000 commands, 120 s loop window, 6000 frames, ...)
   --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run;
                           8 compares driver_node with floor_node, runs alternated)
+                          9 those of 2, 3, 4 with ~capture, and 2-4 without it if
+                          they do not run)
   --floor-rounds N        8: alternated node/floor rounds (default 2)
   --output FILE           also write the results (Markdown) to FILE
   --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
@@ -96,7 +102,7 @@ std::set<int> parseSections(const std::string& text) {
   std::string item;
   while (std::getline(stream, item, ',')) {
     const int section = std::stoi(item);
-    if (section < 1 || section > 8) throw std::invalid_argument("no section " + item);
+    if (section < 1 || section > 9) throw std::invalid_argument("no section " + item);
     sections.insert(section);
   }
   return sections;
@@ -167,10 +173,12 @@ struct Variant {
   std::string program;
   double read_poll_interval;  ///< 0: event-driven
   bool spaced_cmd_vel = false;  ///< section 8: commands 10-40 ms apart instead of one per tick
+  bool capture = false;         ///< ~capture on, with a subscriber on serial_raw
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
 const Variant kFloor{"floor", "floor", "floor_node", 0.0, true};
+const Variant kCapturing{"capture on", "capture", "driver_node", 0.0, false, true};
 
 struct Context {
   Options options;
@@ -187,6 +195,7 @@ void require(bool condition, const std::string& what) {
 ParamList commonParams(const std::string& port, const Variant& variant) {
   ParamList params = {{"port", port}, {"loop_rate", kLoopRate}, {"reconnect_interval", 0.2}};
   if (variant.read_poll_interval > 0) params.emplace_back("read_poll_interval", variant.read_poll_interval);
+  if (variant.capture) params.emplace_back("capture", true);
   return params;
 }
 
@@ -397,6 +406,22 @@ LatencyResult timeCmdVelSpaced(ros::Publisher& publisher, const SpeedFrameLog& l
   return latencyResult(samples_ms, published.size() > kWarmUp ? published.size() - kWarmUp : 0);
 }
 
+/// With ~capture, a subscriber on serial_raw (as rosbag record would be), so the node really
+/// serializes and sends every chunk.
+class CaptureListener {
+ public:
+  CaptureListener(ros::NodeHandle& nh, const DriverProcess& driver, const Variant& variant) {
+    if (!variant.capture) return;
+    subscriber_ = nh.subscribe<serial_robot_driver::SerialChunk>(
+        driver.topic("serial_raw"), 10000,
+        [this](const serial_robot_driver::SerialChunk::ConstPtr&) { ++chunks_; });
+  }
+
+ private:
+  ros::Subscriber subscriber_;
+  std::atomic<uint64_t> chunks_{0};
+};
+
 struct BaseSessionResult {
   std::optional<LatencyResult> cmd_vel;
   std::optional<LoopResult> idle_loop;
@@ -419,6 +444,7 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
                                {"base/speed_dithering", false},   // one tick value per command
                                {"base/max_wheel_speed", 20.0}});  // room for 600 distinct ticks
   DriverProcess driver(context.paths, ns, params, variant.program);
+  const CaptureListener capture(context.nh, driver, variant);
   ros::Publisher publisher =
       context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
   require(waitUntil([&] { return log.count() > 0; }, 30s),
@@ -590,6 +616,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
   std::size_t capacity = kWarmUpFrames + options.telemetry_frames;
   for (double rate : options.rates) capacity += std::lround(rate * options.rate_step_seconds);
   DriverProcess driver(context.paths, ns, params, variant.program);
+  const CaptureListener capture(context.nh, driver, variant);
   TelemetryProbe probe(context.nh, driver.topic("joint_states"), capacity);
 
   // Warm-up: 50 Hz until the node is connected, publishing, and this subscriber is attached.
@@ -969,6 +996,49 @@ void run(Context& context) {
   }
 
   if (o.runs(8)) runFloorComparison(context);
+
+  if (o.runs(9)) {
+    // The capture-off numbers are those of 2-4 when they ran; otherwise measured here.
+    if (!base_event.idle_loop) {
+      attempt(context, "base session without capture (9)",
+              [&] { base_event = runBaseSession(context, kEventDriven, false, true); });
+    }
+    if (!body_event.latency) {
+      attempt(context, "telemetry session without capture (9)",
+              [&] { body_event = runTelemetrySession(context, kEventDriven, true, false); });
+    }
+    BaseSessionResult base_capture;
+    TelemetrySessionResult body_capture;
+    attempt(context, "base session with capture (9)",
+            [&] { base_capture = runBaseSession(context, kCapturing, false, true); });
+    attempt(context, "telemetry session with capture (9)",
+            [&] { body_capture = runTelemetrySession(context, kCapturing, true, false); });
+    table.section("9. ~capture off vs on (serial_raw subscribed)",
+                  {"measurement", "capture off", "capture on", "on / off"});
+    auto compare = [&](const std::string& what, double off, double on, const std::string& unit,
+                       int decimals) {
+      table.row({what, format("%.*f %s", decimals, off, unit.c_str()),
+                 format("%.*f %s", decimals, on, unit.c_str()), ratio(on, off)});
+    };
+    if (base_event.idle_loop && base_capture.idle_loop) {
+      const LoopResult& off = *base_event.idle_loop;
+      const LoopResult& on = *base_capture.idle_loop;
+      compare("2. base loop period std", off.period_ms.stddev, on.period_ms.stddev, "ms", 3);
+      compare("2. base loop worst period", off.period_ms.max, on.period_ms.max, "ms", 3);
+      compare("2. missed ticks", off.missed_ticks, on.missed_ticks, "", 0);
+      compare("3. node CPU idle at 50 Hz", off.cpu_percent, on.cpu_percent, "%", 2);
+    }
+    if (body_event.latency && body_capture.latency) {
+      compare("4. telemetry -> joint_states p50", body_event.latency->ms.p50,
+              body_capture.latency->ms.p50, "ms", 3);
+      compare("4. telemetry -> joint_states p99", body_event.latency->ms.p99,
+              body_capture.latency->ms.p99, "ms", 3);
+      compare("4. node CPU at 100 Hz", body_event.cpu_percent, body_capture.cpu_percent, "%", 2);
+    }
+    table.note(
+        "With capture every chunk read and every frame written is copied, stamped and queued; "
+        "a thread of its own publishes serial_raw, so the loop and the reader never wait for it.");
+  }
 }
 
 std::string executableDirectory() {

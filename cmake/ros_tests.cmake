@@ -43,3 +43,10 @@ add_rostest_gtest(test_analyzers test/rostest/analyzers.test test/rostest/test_a
 target_include_directories(test_analyzers PRIVATE ${catkin_INCLUDE_DIRS} ${diagnostic_aggregator_INCLUDE_DIRS})
 target_link_libraries(test_analyzers srd_test_support ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_analyzers driver_node robot_sim)
+
+# Capture and replay round trip: a live capture under faults, replayed from a bag, compared message
+# by message.
+add_rostest_gtest(test_replay test/rostest/replay.test test/rostest/test_replay.cpp)
+target_include_directories(test_replay PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_replay srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_replay driver_node ${PROJECT_NAME}_generate_messages_cpp)

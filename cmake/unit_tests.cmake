@@ -7,6 +7,7 @@ catkin_add_gtest(core_tests
   test/unit/test_stream_framer.cpp
   test/unit/test_diff_drive.cpp
   test/unit/test_transport.cpp
+  test/unit/test_recorded_stream.cpp
   test/unit/test_serial_link.cpp
   test/unit/test_base_controller.cpp
   test/unit/test_body_controller.cpp
@@ -18,6 +19,7 @@ target_link_libraries(core_tests srd_core srd_sim gtest_main)
 # Conversions and parameter validation of the ROS layer (pure functions, no roscore needed).
 catkin_add_gtest(ros_layer_tests
   test/unit/test_conversions.cpp
-  test/unit/test_driver_params.cpp)
+  test/unit/test_driver_params.cpp
+  test/unit/test_bag_replay.cpp)
 target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(ros_layer_tests srd_ros gtest_main)

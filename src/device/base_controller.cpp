@@ -119,7 +119,7 @@ void BaseController::onLinkDown() {
 }
 
 void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                             Clock::time_point /*arrival*/) {
+                             Clock::time_point arrival) {
   if (family != protocol::FrameFamily::kBase) return;
   const auto frame = base::decodeFrame(data, size);
   if (!frame) {
@@ -151,7 +151,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
         ++stats_.battery_replies;
         stats_.battery_percent = reply->battery_percent;
       }
-      if (events_.on_battery) events_.on_battery(reply->battery_percent);
+      if (events_.on_battery) events_.on_battery(reply->battery_percent, arrival);
       break;
     }
     case base::Reply::Kind::kUnknown: {

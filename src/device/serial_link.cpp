@@ -63,6 +63,7 @@ bool SerialLink::write(const uint8_t* data, std::size_t size) {
     } else {
       try {
         stream_->write(data, size);
+        if (observer_) observer_->onChunk({options_.path, true, data, size, Clock::now()});
       } catch (const transport::TransportError& e) {
         error = e.what();
         lost_ = true;  // the reader thread closes and reopens the port
@@ -120,6 +121,7 @@ bool SerialLink::tryOpen() {
     stats_.low_latency = info.low_latency;
     stats_.latency_timer_ms = info.latency_timer_ms;
   }
+  if (observer_) observer_->onChunk({options_.path, false, nullptr, 0, Clock::now()});
   // Listeners hear "up" before any write can succeed: the base must have queued its Reset first.
   for (LinkListener* listener : listeners_) listener->onLinkUp();
   {
@@ -183,7 +185,9 @@ void SerialLink::readerLoop() {
       continue;
     }
     if (n == 0) continue;
-    chunk_arrival_ = Clock::now();
+    // A replayed recording knows when its bytes arrived; a live port's bytes arrived now.
+    chunk_arrival_ = stream_->arrivalTime().value_or(Clock::now());
+    if (observer_) observer_->onChunk({options_.path, false, chunk.data(), n, chunk_arrival_});
     framer_.feed(chunk.data(), n);
     std::lock_guard<std::mutex> lock(state_mutex_);
     stats_.framer = framer_.stats();

@@ -3,6 +3,7 @@
 #include <sensor_msgs/BatteryState.h>
 
 #include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -36,9 +37,9 @@ device::BaseEvents BaseInterface::events() {
     msg.right_speed = sent.speeds.y();
     wheel_command_pub_.publish(msg);
   };
-  events.on_battery = [this](uint8_t percent) {
+  events.on_battery = [this](uint8_t percent, device::Clock::time_point arrival) {
     sensor_msgs::BatteryState msg;
-    msg.header.stamp = ros::Time::now();
+    msg.header.stamp = arrival_stamps_(arrival);
     // The base reports only a percentage; everything else is unknown (NaN per the message docs).
     const float unknown = std::numeric_limits<float>::quiet_NaN();
     msg.voltage = msg.temperature = msg.current = unknown;
@@ -59,11 +60,13 @@ device::BaseEvents BaseInterface::events() {
   return events;
 }
 
-BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                             diagnostic_updater::Updater& diagnostics)
-    : link_(link), controller_(makeBaseConfig(params), link.writer(), events()) {
+BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
+                             device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
+    : link_(link),
+      arrival_stamps_(params),
+      controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
-  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", 5);
+  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
 
   link.addListener(&controller_);
 

@@ -12,17 +12,23 @@ namespace serial_robot_driver::ros_layer {
 BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
     : link_(link),
+      arrival_stamps_(params),
       imu_params_(params.imu),
-      controller_(makeBodyJoints(params.body), link.writer(),
-                  {[this](const protocol::body::Telemetry& telemetry,
-                          device::Clock::time_point arrival) { publishTelemetry(telemetry, arrival); }}),
+      controller_(
+          makeBodyJoints(params.body), link.writer(),
+          {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
+            publishTelemetry(telemetry, arrival);
+          }}),
       telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
                       "telemetry rate") {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
-  joint_states_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 20);
-  imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", 20);
-  foot_pressure_pub_ = nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", 20);
-  telemetry_pub_ = nh.advertise<serial_robot_driver::Telemetry>("telemetry", 20);
+  joint_states_pub_ =
+      nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
+  imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", params.publisherQueue(20));
+  foot_pressure_pub_ =
+      nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
+  telemetry_pub_ =
+      nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
   // tcpNoDelay: a joint command must not wait in Nagle's buffer.
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());
@@ -37,7 +43,7 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   // Runs on the link's reader thread; ros::Publisher::publish is thread-safe. A message nobody
   // subscribes to is not even built: at hundreds of frames per second that is most of the CPU.
   telemetry_rate_.tick();
-  const ros::Time stamp = toRosTime(arrival);
+  const ros::Time stamp = arrival_stamps_(arrival);
   const auto& joints = controller_.joints();
   if (joint_states_pub_.getNumSubscribers() > 0) {
     joint_states_pub_.publish(toJointState(telemetry, joints, stamp));

@@ -24,6 +24,27 @@ ros::Time toRosTime(std::chrono::steady_clock::time_point event) {
   return toRosTime(event, ros_now, steady_now);
 }
 
+std::chrono::steady_clock::time_point arrivalOfRecordedStamp(const ros::Time& recorded) {
+  return std::chrono::steady_clock::time_point(
+      std::chrono::nanoseconds(static_cast<int64_t>(recorded.toNSec())));
+}
+
+ros::Time ArrivalStamps::operator()(std::chrono::steady_clock::time_point arrival) const {
+  if (replaying_) {
+    ros::Time stamp;
+    stamp.fromNSec(static_cast<uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(arrival.time_since_epoch()).count()));
+    return stamp;
+  }
+  thread_local std::chrono::steady_clock::time_point last_arrival{};
+  thread_local ros::Time last_stamp;
+  if (arrival != last_arrival || last_stamp.isZero()) {
+    last_stamp = toRosTime(arrival);
+    last_arrival = arrival;
+  }
+  return last_stamp;
+}
+
 std::vector<device::BodyJoint> makeBodyJoints(const BodyParams& params) {
   std::vector<device::BodyJoint> joints(params.servo_ids.size());
   for (std::size_t i = 0; i < joints.size(); ++i) {

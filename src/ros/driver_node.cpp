@@ -5,6 +5,7 @@
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
 #include "serial_robot_driver/ros/servo_bus_interface.h"
+#include "serial_robot_driver/ros/wire_capture.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -95,6 +96,12 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     use.servo_bus |= entry.servo_bus;
     use.baud = entry.baud;
   }
+  if (params_.capture) {
+    capture_ = std::make_unique<WireCapture>(nh_, params_);
+    diagnostics_.add("wire capture", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
+      capture_->diagnose(s);
+    });
+  }
   for (const auto& [path, use] : users) {
     device::SerialLinkOptions options;
     options.path = path;
@@ -106,6 +113,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     port.link = std::make_unique<device::SerialLink>(options, stream_factory);
     port.monitor = std::make_unique<PortMonitor>(*port.link);
     port.link->addListener(port.monitor.get());
+    port.link->setChunkObserver(capture_.get());
     Port& stored = ports_[path] = std::move(port);
     diagnostics_.add("port " + path, [this, &stored](diagnostic_updater::DiagnosticStatusWrapper& s) {
       diagnosePort(stored, s);

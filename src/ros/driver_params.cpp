@@ -124,6 +124,9 @@ std::vector<ParamSpec> buildTable() {
             require(v <= 1000, key, "must be at most 1000 Hz");
           }),
       row("reconnect_interval", &P::reconnect_interval, positive<double>),
+      row("capture", &P::capture),
+      row("replay_bag", &P::replay_bag),
+      row("replay_rate", &P::replay_rate, nonNegative<double>),
 
       row("base/enabled", &P::base, &Port::enabled),
       row("base/port", &P::base, &Port::port),
@@ -166,7 +169,8 @@ std::vector<ParamSpec> buildTable() {
           [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); }),
       row("body/zero_ticks", &P::body, &Body::zero_ticks,
           [](const std::vector<int>& zeros, const std::string& key) {
-            for (int zero : zeros) require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
+            for (int zero : zeros)
+              require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
           }),
       row("body/directions", &P::body, &Body::directions,
           [](const std::vector<int>& directions, const std::string& key) {
@@ -250,6 +254,8 @@ void DriverParams::validate() const {
   // Single values first (the table), then what relates several parameters.
   for (const auto& spec : parameterTable()) spec.check(*this);
 
+  require(!capture || replay_bag.empty(), "capture",
+          "cannot be combined with ~replay_bag: a replay reads a capture and writes nothing");
   require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
           "every device is disabled (base, body, servo_bus): nothing to drive");
   if (base.enabled) {

@@ -4,22 +4,36 @@
 
 #include <csignal>
 #include <ctime>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
 
 namespace serial_robot_driver::ros_layer {
 
 namespace {
-/// Waits for SIGINT/SIGTERM (blocked in every thread, taken here synchronously) or for roscpp to
-/// shut down (rosnode kill), checking the latter twice a second.
-void waitForStopRequest(const sigset_t& stop_signals) {
-  const timespec half_second{0, 500000000};
+/// Waits for SIGINT/SIGTERM (blocked in every thread, taken here synchronously), for roscpp to
+/// shut down (rosnode kill) or for `done` (the end of a replay), checking the latter twice a second
+/// (20 times while replaying, whose end is worth noticing soon).
+/// Returns true when `done` ended the wait.
+bool waitForStopRequest(const sigset_t& stop_signals, const std::function<bool()>& done) {
+  const timespec period{0, done ? 50000000 : 500000000};
   while (ros::ok()) {
-    if (sigtimedwait(&stop_signals, nullptr, &half_second) > 0) return;
+    if (done && done()) return true;
+    if (sigtimedwait(&stop_signals, nullptr, &period) > 0) return false;
   }
+  return false;
 }
+
+/// After the last replayed chunk: how long the node stays up so that subscribers (rosbag record,
+/// a test) receive the tail of what it published before the connections close.
+constexpr std::chrono::milliseconds kReplayLinger{1500};
+/// Before the first replayed chunk: time for subscribers that are already running to connect to the
+/// topics the node has just advertised (a message nobody subscribes to is not even built).
+constexpr std::chrono::milliseconds kReplaySettle{1500};
 }  // namespace
 
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
@@ -50,13 +64,44 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
     return 2;
   }
 
+  // A replay is the same node on recorded ports: only the streams behind the links differ.
+  std::unique_ptr<BagReplay> replay;
+  if (!params.replay_bag.empty()) {
+    try {
+      replay = std::make_unique<BagReplay>(params);
+    } catch (const ReplayError& e) {
+      ROS_FATAL("%s", e.what());
+      ros::shutdown();
+      return 1;
+    }
+    stream_factory = replay->streamFactory();
+    // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
+    params.reconnect_interval = 0.0;
+    ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(),
+             params.replay_bag.c_str(),
+             params.replay_rate > 0
+                 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
+                 : "full speed");
+  }
+
   DriverNode node(nh, private_nh, params, stream_factory);
+  if (replay) {
+    std::this_thread::sleep_for(kReplaySettle);
+    replay->startClock();
+  }
   node.start();
   // Global queue: cmd_vel, joint_commands, base services and the diagnostics timer. None of them
   // waits on the wire (servo/* services have their own queue), so one thread keeps up.
   ros::AsyncSpinner spinner(1);
   spinner.start();
-  waitForStopRequest(stop_signals);
+  const bool replay_done = waitForStopRequest(
+      stop_signals,
+      replay ? std::function<bool()>([&] { return replay->finished(); }) : std::function<bool()>());
+  if (replay_done) {
+    node.updateDiagnostics();  // the counters at the end of the recording
+    ROS_INFO("%s", replay->summary().c_str());
+    std::this_thread::sleep_for(kReplayLinger);
+  }
   ROS_INFO("shutting down: stopping the wheels");
   node.shutdown();
   spinner.stop();

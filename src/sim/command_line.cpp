@@ -216,6 +216,12 @@ const std::vector<Flag>& flags() {
            },
            [](const SimOptions& o) { return show(o.servo_bus.answer_latency_s * 1000.0); }},
 
+      whole(
+          "--pace-baud", "BAUD",
+          "send and receive at most BAUD/10 bytes/s per port, like a real line (0 = pty speed)",
+          4000000, [](SimOptions& o, uint64_t v) { o.pace_baud = static_cast<unsigned>(v); },
+          [](const SimOptions& o) { return show(o.pace_baud); }),
+
       section("Faults (seeded):"),
       whole(
           "--seed", "N", "random seed", 0xFFFFFFFFu,

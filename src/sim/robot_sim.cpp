@@ -32,6 +32,9 @@ constexpr std::size_t kMaxBacklogBytes = 16 * 1024;
 constexpr auto kDrainTimeout = std::chrono::milliseconds(250);
 constexpr auto kReplugRetry = std::chrono::seconds(1);
 constexpr std::size_t kMaxGarbageBurst = 24;
+/// With --pace-baud, what the line carries in this much time goes into the pty at once: a finer
+/// slice would only wake the simulator more often.
+constexpr auto kPaceSlice = std::chrono::milliseconds(2);
 
 void setNonBlocking(int fd) {
   const int flags = ::fcntl(fd, F_GETFL, 0);
@@ -68,6 +71,11 @@ struct RobotSim::Port {
   std::unique_ptr<protocol::StreamFramer> framer;
   std::deque<PendingWrite> backlog;
   std::size_t backlog_bytes = 0;
+  /// --pace-baud: when the line is free again for what we send, and for what the host sent.
+  TimePoint tx_line_free{};
+  TimePoint rx_line_free{};
+  /// --pace-baud: bytes the host wrote, each chunk with the time its last bit is through the line.
+  std::deque<std::pair<TimePoint, std::vector<uint8_t>>> rx_in_flight;
   bool plugged = true;
   bool draining = false;
   int drain_probe_fd = -1;  ///< our own handle on the slave, to see whether the host read it all
@@ -235,16 +243,39 @@ void RobotSim::send(Port* port, Outgoing frame) {
   flush(port);
 }
 
+Clock::duration RobotSim::lineTime(std::size_t bytes) const {
+  return std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(10.0 * static_cast<double>(bytes) / options_.pace_baud));
+}
+
 void RobotSim::flush(Port* port) {
   if (!port->pty || !port->pty->isOpen()) return;
   const int fd = port->pty->masterFd();
-  while (!port->backlog.empty()) {
+  // Paced: nothing while the line still carries earlier bytes, then one slice's worth, plus what
+  // the line could have carried while this thread woke up late (at most another slice), so the
+  // average rate is the baud rate's, not less.
+  std::size_t allowance = SIZE_MAX;
+  TimePoint line_start{};
+  if (options_.pace_baud > 0) {
+    const TimePoint now = Clock::now();
+    if (now < port->tx_line_free) return;
+    line_start = std::max(port->tx_line_free, now - kPaceSlice);
+    const double seconds = std::chrono::duration<double>(now - line_start + kPaceSlice).count();
+    allowance =
+        std::max<std::size_t>(1, static_cast<std::size_t>(options_.pace_baud / 10.0 * seconds));
+  }
+  while (!port->backlog.empty() && allowance > 0) {
     Port::PendingWrite& pending = port->backlog.front();
-    const std::size_t remaining = pending.bytes.size() - pending.offset;
+    const std::size_t remaining = std::min(pending.bytes.size() - pending.offset, allowance);
     const ssize_t written = ::write(fd, pending.bytes.data() + pending.offset, remaining);
     if (written < 0) {
       if (errno == EINTR) continue;
       return;  // EAGAIN: the host is not reading right now; retry when poll says writable
+    }
+    if (options_.pace_baud > 0) {
+      allowance -= static_cast<std::size_t>(written);
+      line_start += lineTime(static_cast<std::size_t>(written));
+      port->tx_line_free = line_start;
     }
     counters_.bytes_sent += static_cast<uint64_t>(written);
     port->backlog_bytes -= static_cast<std::size_t>(written);
@@ -264,6 +295,7 @@ void RobotSim::unplug(Port* port, TimePoint now) {
   }
   port->backlog.clear();
   port->backlog_bytes = 0;
+  port->rx_in_flight.clear();
   if (port->drain_probe_fd >= 0) {
     ::close(port->drain_probe_fd);
     port->drain_probe_fd = -1;
@@ -298,6 +330,15 @@ void RobotSim::replug(Port* port, TimePoint now) {
 }
 
 void RobotSim::step(TimePoint now) {
+  // --pace-baud: what the host wrote reaches the devices once its last bit is through the line.
+  for (auto& owned : ports_) {
+    Port* port = owned.get();
+    while (!port->rx_in_flight.empty() && port->rx_in_flight.front().first <= now) {
+      const std::vector<uint8_t> bytes = std::move(port->rx_in_flight.front().second);
+      port->rx_in_flight.pop_front();
+      port->framer->feed(bytes.data(), bytes.size());
+    }
+  }
   Outbox outbox;
   if (base_) base_->tick(now, &outbox);
   if (body_) body_->tick(now, base_ ? base_->yawRate() : 0.0, &outbox);
@@ -367,7 +408,10 @@ void RobotSim::run() {
       fd_ports.push_back(nullptr);
       for (auto& port : ports_) {
         if (!port->plugged || !port->pty) continue;
-        const short events = port->backlog.empty() ? POLLIN : (POLLIN | POLLOUT);
+        // Paced: no POLLOUT while the line is busy, or poll would return at once until it frees.
+        const bool may_send = !port->backlog.empty() &&
+                              (options_.pace_baud == 0 || Clock::now() >= port->tx_line_free);
+        const short events = may_send ? (POLLIN | POLLOUT) : POLLIN;
         fds.push_back(pollfd{port->pty->masterFd(), events, 0});
         fd_ports.push_back(port.get());
       }
@@ -376,6 +420,7 @@ void RobotSim::run() {
     if (stop_requested_) break;
 
     std::lock_guard<std::mutex> lock(mutex_);
+    const TimePoint read_at = Clock::now();
     for (std::size_t i = 1; i < fds.size(); ++i) {
       Port* port = fd_ports[i];
       if ((fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0 || !port->pty) continue;
@@ -384,7 +429,14 @@ void RobotSim::run() {
         const ssize_t n = ::read(fd, buffer.data(), buffer.size());
         if (n <= 0) break;
         counters_.bytes_received += static_cast<uint64_t>(n);
-        port->framer->feed(buffer.data(), static_cast<std::size_t>(n));
+        if (options_.pace_baud > 0) {
+          port->rx_line_free =
+              std::max(port->rx_line_free, read_at) + lineTime(static_cast<std::size_t>(n));
+          port->rx_in_flight.emplace_back(port->rx_line_free,
+                                          std::vector<uint8_t>(buffer.data(), buffer.data() + n));
+        } else {
+          port->framer->feed(buffer.data(), static_cast<std::size_t>(n));
+        }
       }
     }
     const TimePoint now = Clock::now();
@@ -398,6 +450,9 @@ void RobotSim::run() {
     for (auto& port : ports_) {
       next = std::min({next, port->next_unplug, port->replug_at, port->next_garbage});
       if (port->draining) next = std::min(next, now + std::chrono::milliseconds(5));
+      if (!port->backlog.empty() && options_.pace_baud > 0)
+        next = std::min(next, port->tx_line_free);
+      if (!port->rx_in_flight.empty()) next = std::min(next, port->rx_in_flight.front().first);
     }
     const double wait_ms = std::chrono::duration<double, std::milli>(next - now).count();
     timeout_ms = wait_ms <= 0 ? 0 : static_cast<int>(std::ceil(wait_ms));

@@ -274,7 +274,7 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   std::vector<Bytes> frames;
   std::vector<int> percents;
   BaseEvents events;
-  events.on_battery = [&percents](uint8_t p) { percents.push_back(p); };
+  events.on_battery = [&percents](uint8_t p, Clock::time_point) { percents.push_back(p); };
   auto clock = std::make_shared<ManualClock>(Clock::now());
   BaseController controller(
       config,

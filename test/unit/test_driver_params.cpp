@@ -40,6 +40,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"baud", [](DriverParams& p) { p.baud = 12345; }},
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 0; }},
         BadCase{"reconnect_interval", [](DriverParams& p) { p.reconnect_interval = -1; }},
+        BadCase{"replay_rate", [](DriverParams& p) { p.replay_rate = -1; }},
+        BadCase{"capture",
+                [](DriverParams& p) {
+                  p.capture = true;
+                  p.replay_bag = "/tmp/field.bag";
+                }},
         BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = -0.25; }},
         BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = std::nan(""); }},
         BadCase{"base/encoder_resolution", [](DriverParams& p) { p.base.encoder_resolution = 0; }},

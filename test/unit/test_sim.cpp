@@ -110,9 +110,11 @@ class Host {
     uint8_t buffer[4096];
     ssize_t n = 0;
     while ((n = ::read(fd_, buffer, sizeof(buffer))) > 0) {
+      bytes_read_ += static_cast<std::size_t>(n);
       framer_.feed(buffer, static_cast<std::size_t>(n));
     }
   }
+  std::size_t bytesRead() const { return bytes_read_; }
 
   // Pumps until `done()` or the (generous) timeout; returns done().
   bool waitUntil(const std::function<bool()>& done, milliseconds timeout = milliseconds(3000)) {
@@ -146,6 +148,7 @@ class Host {
 
  private:
   int fd_ = -1;
+  std::size_t bytes_read_ = 0;
   protocol::StreamFramer framer_;
   std::vector<HostFrame> frames_;
 };
@@ -623,6 +626,50 @@ TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
             stats.body.telemetry_generated);
 }
 
+// --pace-baud bounds can only be checked from one side without timing assertions: a paced line is
+// never faster than its baud rate, however slow or busy the machine is.
+TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
+  SimOptions options = onlyBody();
+  options.body.telemetry_rate_hz = 200;  // several times what 9600 baud carries
+  options.pace_baud = 9600;              // 960 bytes/s
+  RobotSim sim(options);
+  sim.start();
+  Host host(slaveOf(sim), bodyHostConfig(2));
+  ASSERT_TRUE(host.ok());
+  for (int i = 0; i < 5; ++i) host.pump(20);  // what was sent before we listened
+  const std::size_t before = host.bytesRead();
+  const auto start = Clock::now();
+  host.waitUntil([&] { return host.bytesRead() - before >= 400; }, milliseconds(10000));
+  const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  const std::size_t received = host.bytesRead() - before;
+  EXPECT_GE(received, 400u);
+  // What the line carried in that time, plus one write's worth the pty may already have held.
+  EXPECT_LE(static_cast<double>(received), 960.0 * elapsed_s + 16.0);
+  EXPECT_FALSE(host.framesOf(FrameFamily::kTelemetry).empty());  // cut into slices, not damaged
+  EXPECT_EQ(host.framerStats().checksum_errors, 0u);
+}
+
+TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
+  SimOptions options = onlyBody();
+  options.body.servo_ids = {2, 3};
+  options.body.telemetry_rate_hz = 0;
+  options.pace_baud = 9600;
+  RobotSim sim(options);
+  sim.start();
+  Host host(slaveOf(sim), bodyHostConfig(2));
+  ASSERT_TRUE(host.ok());
+  constexpr int kFrames = 6;
+  const auto start = Clock::now();
+  for (int i = 0; i < kFrames; ++i) host.send(kSyncWrite2And3);
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return s.body.sync_writes_ok == kFrames; },
+      milliseconds(10000)));
+  const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  // The last frame reached the board only once all its bits were through the line.
+  const double line_s = kFrames * kSyncWrite2And3.size() * 10.0 / 9600.0;
+  EXPECT_GE(elapsed_s, line_s - 0.001);
+}
+
 TEST(RobotSim, ServoFaultsGarbleOrSuppressAnswers) {
   SimOptions options = onlyServoBus();
   options.faults.servo_fault_rate = 1.0;
@@ -729,10 +776,13 @@ TEST(RobotSimCommandLine, ParsesFlagsAndIgnoresRoslaunchArguments) {
   EXPECT_EQ(line.options.base.battery_percent, 40);
   EXPECT_DOUBLE_EQ(line.options.body.telemetry_rate_hz, 0.0);
   EXPECT_EQ(line.options.servo_bus.offline_ids, (std::vector<uint8_t>{7}));
+  EXPECT_EQ(line.options.pace_baud, 0u);  // off unless asked for
+  EXPECT_EQ(parse({"--pace-baud", "115200"}).options.pace_baud, 115200u);
 }
 
 TEST(RobotSimCommandLine, RejectsUnknownFlagsAndBadValues) {
   EXPECT_FALSE(parse({"--bogus"}).error.empty());
+  EXPECT_FALSE(parse({"--pace-baud", "fast"}).error.empty());
   EXPECT_FALSE(parse({"--corrupt-rate", "1.5"}).error.empty());
   EXPECT_FALSE(parse({"--servo-ids", "1,x"}).error.empty());
   EXPECT_FALSE(parse({"--servo-ids", "255"}).error.empty());

@@ -86,7 +86,8 @@ class LoopClock {
 /// What the base reports; every hook may be empty. Called without the controller's lock held.
 struct BaseEvents {
   std::function<void(const WheelFrameSent&)> on_wheel_frame;
-  std::function<void(uint8_t percent)> on_battery;
+  /// `arrival`: when the reply's last byte was read (its stamp).
+  std::function<void(uint8_t percent, Clock::time_point arrival)> on_battery;
   std::function<void(const protocol::base::Frame&)> on_unknown_reply;
   std::function<void()> on_timeout_error;
 };

@@ -10,6 +10,9 @@
 //  - Any thread may write(): writes are serialized by a per-port mutex and never wait for an answer.
 //    A failed write marks the port lost; the reader thread then closes and reopens it.
 //  - Only the reader thread opens and closes the stream, so a read never races a close.
+//  - A ChunkObserver (wire capture), when set, sees every chunk on the thread that moved it: reads
+//    on the reader thread, writes on the writer's thread. It must copy what it keeps and return
+//    at once; without one, the only cost is a null check per read and per write.
 #pragma once
 
 #include <atomic>
@@ -49,6 +52,24 @@ class LinkListener {
                        Clock::time_point arrival) = 0;
 };
 
+/// One chunk as it crossed the port: what one read() returned, or one whole write().
+struct WireChunk {
+  const std::string& port;  ///< the link's path
+  bool outbound;            ///< written by the driver (true) or read from the device (false)
+  /// The bytes; size 0 (inbound) marks the port being (re)opened, so a replay restarts its framer
+  /// where the live link did.
+  const uint8_t* data;
+  std::size_t size;
+  Clock::time_point time;  ///< when it was read (the frames' arrival stamp) or written
+};
+
+/// Sees every chunk of a link (see the threading model above).
+class ChunkObserver {
+ public:
+  virtual ~ChunkObserver() = default;
+  virtual void onChunk(const WireChunk& chunk) = 0;
+};
+
 struct SerialLinkOptions {
   std::string path;
   unsigned baud = 115200;
@@ -82,6 +103,8 @@ class SerialLink {
 
   /// Listeners must be added before start() and outlive the link's thread.
   void addListener(LinkListener* listener);
+  /// At most one; set before start(), it must outlive the link's threads. nullptr: none.
+  void setChunkObserver(ChunkObserver* observer) { observer_ = observer; }
   void start();
   /// Stops the reader thread and closes the port. Idempotent.
   void stop();
@@ -109,6 +132,7 @@ class SerialLink {
   SerialLinkOptions options_;
   StreamFactory factory_;
   std::vector<LinkListener*> listeners_;
+  ChunkObserver* observer_ = nullptr;
   protocol::StreamFramer framer_;
   Clock::time_point chunk_arrival_;
 

@@ -10,6 +10,7 @@
 #include <std_srvs/Trigger.h>
 
 #include "serial_robot_driver/device/base_controller.h"
+#include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -36,6 +37,7 @@ class BaseInterface : public DeviceInterface {
   bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
 
   device::SerialLink& link_;
+  ArrivalStamps arrival_stamps_;  // before controller_: its events use it
   device::BaseController controller_;
   ros::Publisher wheel_command_pub_;
   ros::Publisher battery_pub_;

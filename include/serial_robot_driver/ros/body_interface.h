@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -37,6 +38,7 @@ class BodyInterface : public DeviceInterface {
   void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
 
   device::SerialLink& link_;
+  const ArrivalStamps arrival_stamps_;
   const ImuParams imu_params_;
   device::BodyController controller_;
   // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).

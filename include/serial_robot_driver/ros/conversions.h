@@ -28,6 +28,24 @@ ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time
 /// The same, against the current ros::Time::now() and steady_clock::now().
 ros::Time toRosTime(std::chrono::steady_clock::time_point event);
 
+/// The steady time point a replayed chunk stamped `recorded` arrives at (transport::RecordedStream
+/// hands it to the link): the stamp's nanoseconds since the epoch, so the way back is exact.
+std::chrono::steady_clock::time_point arrivalOfRecordedStamp(const ros::Time& recorded);
+
+/// Header stamps of frames from their arrival time in the core (steady clock).
+/// Live: toRosTime(), with the last conversion remembered per thread, so the users of one chunk
+/// (its wire capture and the frames it completes, all on the port's reader thread) give it the
+/// very same stamp. Replaying (~replay_bag set): the inverse of arrivalOfRecordedStamp(), so a
+/// replay publishes the recorded stamps.
+class ArrivalStamps {
+ public:
+  explicit ArrivalStamps(const DriverParams& params) : replaying_(!params.replay_bag.empty()) {}
+  ros::Time operator()(std::chrono::steady_clock::time_point arrival) const;
+
+ private:
+  bool replaying_;
+};
+
 /// The joints configured from ~body (servo_ids, joint_names, zero_ticks, directions,
 /// ticks_per_revolution, velocity_scale), in frame order. Assumes validated parameters.
 std::vector<device::BodyJoint> makeBodyJoints(const BodyParams& params);

@@ -5,7 +5,7 @@
 //   out: wheel_command (serial_robot_driver/WheelCommand), battery (sensor_msgs/BatteryState),
 //        joint_states (sensor_msgs/JointState), imu/data (sensor_msgs/Imu),
 //        foot_pressure (serial_robot_driver/FootPressure), telemetry (serial_robot_driver/Telemetry),
-//        /diagnostics
+//        /diagnostics, serial_raw (serial_robot_driver/SerialChunk, with ~capture)
 // Services: base/reset, base/clear_encoders (std_srvs/Trigger); servo/ping, servo/read, servo/write,
 //   servo/read_angle, servo/rotate, servo/spin, servo/damping, servo/read_all, servo/reset_user_data.
 // Parameters: see ros/driver_params.h and config/robot.yaml.
@@ -34,6 +34,7 @@ namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface;
 class PortMonitor;
+class WireCapture;
 
 class DriverNode {
  public:
@@ -46,6 +47,8 @@ class DriverNode {
   /// Opens the ports (in the background: a missing port is waited for), then starts the devices
   /// (the base loop, the servo service spinner).
   void start();
+  /// Publishes every diagnostic status now (a replay's last counters before the node exits).
+  void updateDiagnostics() { diagnostics_.force_update(); }
   /// Shuts the devices down in order (the base first, writing a zero-speed frame), then stops the
   /// ports. Idempotent.
   void shutdown();
@@ -61,6 +64,7 @@ class DriverNode {
   ros::NodeHandle nh_;
   DriverParams params_;
   diagnostic_updater::Updater diagnostics_;
+  std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
   std::map<std::string, Port> ports_;
   /// In start and shutdown order: base, body, servo bus.
   std::vector<std::unique_ptr<DeviceInterface>> devices_;

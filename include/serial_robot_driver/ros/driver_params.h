@@ -75,6 +75,9 @@ struct DriverParams {
   int baud = 115200;
   double loop_rate = 50.0;
   double reconnect_interval = 1.0;
+  bool capture = false;      ///< publish every chunk in and out on serial_raw
+  std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
+  double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
   BaseParams base;
   BodyParams body;
   ImuParams imu;
@@ -89,6 +92,9 @@ struct DriverParams {
   int baseBaud() const { return base.baud > 0 ? base.baud : baud; }
   int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
   int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
+  /// A topic's publisher queue: `live` frames (a slow subscriber drops old ones), but unbounded
+  /// while replaying, where a full-speed replay must not lose what subscribers have not read yet.
+  int publisherQueue(int live) const { return replay_bag.empty() ? live : 0; }
 };
 
 /// One parameter's value; the alternative held says the parameter's type.

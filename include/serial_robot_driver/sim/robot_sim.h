@@ -5,7 +5,8 @@
 // Threading: start() spawns one thread that owns the ptys and the devices. It polls the pty master
 // fds, feeds each port's StreamFramer, runs the device timers on the steady clock and writes the
 // emitted frames (non-blocking; whole frames are dropped, never split, when nobody reads the
-// slave). stats() and ports() may be called from any thread; they take a snapshot under a mutex.
+// slave), no faster than --pace-baud allows when it is set. stats() and ports() may be called from
+// any thread; they take a snapshot under a mutex.
 #pragma once
 
 #include <atomic>
@@ -56,6 +57,8 @@ class RobotSim {
   void route(Outgoing frame);  ///< to the port of the device that emitted it
   void send(Port* port, Outgoing frame);
   void flush(Port* port);
+  /// How long the line takes to carry `bytes` at pace_baud (10 bits a byte).
+  Clock::duration lineTime(std::size_t bytes) const;
   void unplug(Port* port, TimePoint now);
   void replug(Port* port, TimePoint now);
   void writeStatsFile() const;

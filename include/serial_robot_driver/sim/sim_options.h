@@ -38,6 +38,10 @@ struct SimOptions {
   BodySimConfig body;
   ServoBusSimConfig servo_bus;
   FaultOptions faults;
+  /// 0: bytes move as fast as the pty takes them. Otherwise the line's baud rate: each port sends
+  /// and receives at most pace_baud / 10 bytes per second (start + 8 data + stop bits), so the
+  /// timing seen through the simulator matches a real wire.
+  unsigned pace_baud = 0;
   std::string stats_file;  ///< written atomically every stats_period_s and at stop(); "" = none
   double stats_period_s = 1.0;
   /// Human-readable events from the sim thread (unplug, replug with the new pty path).

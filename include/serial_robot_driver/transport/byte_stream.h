@@ -3,6 +3,7 @@
 // or an in-memory fake.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -45,6 +46,9 @@ class ByteStream {
   virtual std::string name() const = 0;
   /// Valid after open(); a stream that is no serial port has nothing to tell.
   virtual StreamInfo info() const { return {}; }
+  /// When the bytes of the last read() arrived, for a stream that knows it better than the
+  /// reader's clock (a replayed recording); nothing: they arrived when read() returned.
+  virtual std::optional<std::chrono::steady_clock::time_point> arrivalTime() const { return {}; }
 };
 
 }  // namespace serial_robot_driver::transport
