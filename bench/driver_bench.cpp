@@ -81,9 +81,9 @@ struct Options {
 const char* const kUsage = R"(usage: driver_bench [options]
   --long                  longer runs (5000 commands, 120 s loop window, 6000 frames, ...)
   --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run;
-                          8 compares driver_node with floor_node, runs alternated)
-                          9 those of 2, 3, 4 with ~capture, and 2-4 without it if
-                          they do not run)
+                          8 compares driver_node with floor_node, runs alternated;
+                          9 repeats 2, 3, 4 with ~capture, and runs 2-4 without it if
+                          they did not run)
   --floor-rounds N        8: alternated node/floor rounds (default 2)
   --output FILE           also write the results (Markdown) to FILE
   --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
