@@ -16,6 +16,4 @@ target_link_libraries(polling_driver_node srd_ros)
 # The benchmark launches these executables, so building it builds them.
 add_dependencies(driver_bench driver_node polling_driver_node robot_sim
   ${PROJECT_NAME}_generate_messages_cpp)
-
-install(TARGETS driver_bench polling_driver_node RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
-install(PROGRAMS bench/run_benchmarks.sh DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# Benchmarks are run from the build tree and never installed.

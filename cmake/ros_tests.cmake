@@ -43,3 +43,9 @@ add_rostest_gtest(test_analyzers test/rostest/analyzers.test test/rostest/test_a
 target_include_directories(test_analyzers PRIVATE ${catkin_INCLUDE_DIRS} ${diagnostic_aggregator_INCLUDE_DIRS})
 target_link_libraries(test_analyzers ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_analyzers driver_node robot_sim)
+
+# serial_robot_driver/DriverNodelet in a manager: driving, unloading and a stopped manager.
+add_rostest_gtest(test_nodelet test/rostest/nodelet.test test/rostest/test_nodelet.cpp)
+target_include_directories(test_nodelet PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_nodelet srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_nodelet srd_nodelet ${PROJECT_NAME}_generate_messages_cpp)

@@ -2,6 +2,8 @@
 
 #include <sensor_msgs/Imu.h>
 
+#include <boost/make_shared.hpp>
+
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/decode_result.h"
@@ -39,10 +41,15 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   telemetry_rate_.tick();
   const ros::Time stamp = toRosTime(arrival);
   const auto& joints = controller_.joints();
+  // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
+  // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(toJointState(telemetry, joints, stamp));
+    joint_states_pub_.publish(
+        boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp)));
   }
-  if (imu_pub_.getNumSubscribers() > 0) imu_pub_.publish(toImu(telemetry, imu_params_, stamp));
+  if (imu_pub_.getNumSubscribers() > 0) {
+    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, imu_params_, stamp)));
+  }
   if (foot_pressure_pub_.getNumSubscribers() > 0) {
     if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }
@@ -68,6 +75,7 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   } else if (stats.frames_decoded == 0) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "no telemetry received yet");
   }
+  status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);
   status.add("frames decoded", stats.frames_decoded);
