@@ -65,6 +65,22 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   if (!result.ok()) ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
 }
 
+void BodyInterface::logTelemetryFlow(bool connected, uint64_t frames_decoded) {
+  // Once per outage, not once per period: a frame count that stood still for a whole
+  // diagnostics period while the port is up means the board stopped talking.
+  const bool stalled = connected && frames_decoded > 0 && frames_decoded == frames_at_last_diagnose_;
+  if (stalled && !telemetry_stop_logged_) {
+    ROS_WARN("body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
+             "board powered and streaming?",
+             link_.options().path.c_str());
+    telemetry_stop_logged_ = true;
+  } else if (!stalled && telemetry_stop_logged_ && frames_decoded != frames_at_last_diagnose_) {
+    ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
+    telemetry_stop_logged_ = false;
+  }
+  frames_at_last_diagnose_ = frames_decoded;
+}
+
 void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
   const device::BodyStats stats = controller_.stats();
@@ -74,7 +90,10 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
                         "port " + link_.options().path + " not connected");
   } else if (stats.frames_decoded == 0) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "no telemetry received yet");
+  } else if (stats.frames_decoded == frames_at_last_diagnose_) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "telemetry stopped");
   }
+  logTelemetryFlow(connected, stats.frames_decoded);
   status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);
