@@ -1,5 +1,5 @@
 // Every parameter of driver_node, loaded once at start-up into one struct (names and defaults:
-// ../shared/INTERFACE.md and config/robot.yaml). validate() throws ParameterError naming the first
+// docs/node_api.md and config/robot.yaml). validate() throws ParameterError naming the first
 // bad parameter; the node prints it and exits non-zero.
 #pragma once
 
