@@ -8,9 +8,9 @@
 // manager, destroys it: the destructor shuts the driver down, which writes the last zero-speed
 // frame before the ports close.
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 
 #include <memory>
+#include <pluginlib/class_list_macros.hpp>
 
 #include "serial_robot_driver/ros/driver_node.h"
 #include "serial_robot_driver/ros/run_driver_node.h"

@@ -192,14 +192,17 @@ void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::stri
 
 namespace {
 
-bool processExists(long pid) { return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
+bool processExists(long pid) {
+  return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+}
 
 /// The pid in a UUCP lock file (ASCII, or a binary int from old programs); nullopt when unreadable.
 std::optional<long> readLockFilePid(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) return std::nullopt;
   std::string content((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (content.size() == sizeof(int) && (content[0] != ' ' && (content[0] < '0' || content[0] > '9'))) {
+  if (content.size() == sizeof(int) &&
+      (content[0] != ' ' && (content[0] < '0' || content[0] > '9'))) {
     int binary_pid = 0;
     std::memcpy(&binary_pid, content.data(), sizeof(int));
     return binary_pid;
@@ -216,9 +219,10 @@ std::optional<PortHolder> findPortHolder(const std::string& device_path) {
   // 1. A UUCP lock file (minicom, screen and ModemManager's neighbours write these).
   const std::string base = device_path.substr(device_path.find_last_of('/') + 1);
   char resolved[PATH_MAX];
-  const std::string real_base = ::realpath(device_path.c_str(), resolved)
-                                    ? std::string(resolved).substr(std::string(resolved).find_last_of('/') + 1)
-                                    : base;
+  const std::string real_base =
+      ::realpath(device_path.c_str(), resolved)
+          ? std::string(resolved).substr(std::string(resolved).find_last_of('/') + 1)
+          : base;
   for (const char* dir : {"/run/lock", "/var/lock"}) {
     const std::string lock_file = std::string(dir) + "/LCK.." + real_base;
     const std::optional<long> pid = readLockFilePid(lock_file);
@@ -239,7 +243,8 @@ std::optional<PortHolder> findPortHolder(const std::string& device_path) {
     if (!(fields >> mode >> access >> pid >> where)) continue;
     unsigned major_number = 0, minor_number = 0;
     unsigned long inode = 0;
-    if (std::sscanf(where.c_str(), "%x:%x:%lu", &major_number, &minor_number, &inode) != 3) continue;
+    if (std::sscanf(where.c_str(), "%x:%x:%lu", &major_number, &minor_number, &inode) != 3)
+      continue;
     if (inode == device.st_ino && major_number == major(device.st_dev) &&
         minor_number == minor(device.st_dev) && pid != ::getpid()) {
       return PortHolder{pid, "/proc/locks"};
@@ -268,7 +273,9 @@ void takeExclusively(int fd, const std::string& path) {
     if (error_number == EWOULDBLOCK) throwPortBusy(path, "locked");
     throwErrno(TransportErrorKind::kOpenFailed, "cannot lock " + path, error_number);
   }
-  if (const std::optional<PortHolder> holder = findPortHolder(path); holder && holder->source != "/proc/locks") {
+  // Our flock succeeded, yet another process may hold a UUCP lock file or a POSIX (fcntl) lock,
+  // which do not conflict with flock: respect those too.
+  if (findPortHolder(path)) {
     ::close(fd);
     throwPortBusy(path, "locked");
   }

@@ -6,14 +6,13 @@
 #include <nodelet/NodeletLoad.h>
 #include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
+#include <sys/wait.h>
 
 #include <csignal>
 #include <memory>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <sys/wait.h>
 
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/fake_device.h"
@@ -46,7 +45,8 @@ std::vector<FakeDevice::Frame> speedFrames(const FakeDevice& device) {
 }
 
 std::unique_ptr<FakeDevice> makeBase(const std::string& port) {
-  auto base = std::make_unique<FakeDevice>(port, protocol::FramerConfig::forDriver(true, false, false, 0));
+  auto base =
+      std::make_unique<FakeDevice>(port, protocol::FramerConfig::forDriver(true, false, false, 0));
   base->plug();
   return base;
 }
@@ -140,7 +140,8 @@ TEST(DriverNodelet, ManagerSigintStopsTheWheels) {
   ros::param::set("/sig/driver_node/body/enabled", false);
   ros::param::set("/sig/driver_node/servo_bus/enabled", false);
 
-  test_support::ChildProcess manager("rosrun", {"nodelet", "nodelet", "manager", "__name:=sig_manager"});
+  test_support::ChildProcess manager("rosrun",
+                                     {"nodelet", "nodelet", "manager", "__name:=sig_manager"});
   ASSERT_TRUE(manager.started());
   ASSERT_TRUE(ros::service::waitForService("/sig_manager/load_nodelet", 30000)) << manager.output();
   nodelet::NodeletLoad load;

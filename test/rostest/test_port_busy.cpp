@@ -3,11 +3,10 @@
 // sequence meanwhile.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <sys/wait.h>
 
 #include <string>
 #include <vector>
-
-#include <sys/wait.h>
 
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/fake_device.h"
@@ -25,18 +24,20 @@ TEST(PortBusy, SecondInstanceIsRefusedAndTheFirstKeepsDriving) {
   ASSERT_TRUE(ros::param::get("/driver_node/port", port));
   FakeDevice base(port, protocol::FramerConfig::forDriver(true, false, false, 0));
   base.plug();
-  ASSERT_TRUE(waitFor([&] { return base.frameCount() >= 5; }, 20.0)) << "the first node sends nothing";
+  ASSERT_TRUE(waitFor([&] { return base.frameCount() >= 5; }, 20.0))
+      << "the first node sends nothing";
   const int first_pid = test_support::nodePid("/driver_node");
   ASSERT_GT(first_pid, 0);
 
   const std::string driver = test_support::findDriverNode();
   ASSERT_FALSE(driver.empty());
   test_support::ChildProcess second(
-      driver, {"__name:=second_driver", "_port:=" + port, "_reconnect_interval:=0.2",
-               "_base/battery_poll_rate:=0.0", "_body/enabled:=false", "_servo_bus/enabled:=false"});
+      driver,
+      {"__name:=second_driver", "_port:=" + port, "_reconnect_interval:=0.2",
+       "_base/battery_poll_rate:=0.0", "_body/enabled:=false", "_servo_bus/enabled:=false"});
   ASSERT_TRUE(second.started());
-  const std::string expected = "port busy: " + port + " is locked by another process (pid " +
-                               std::to_string(first_pid);
+  const std::string expected =
+      "port busy: " + port + " is locked by another process (pid " + std::to_string(first_pid);
   ASSERT_TRUE(waitFor([&] { return second.output().find(expected) != std::string::npos; }, 30.0))
       << second.output();
 
@@ -53,7 +54,8 @@ TEST(PortBusy, SecondInstanceIsRefusedAndTheFirstKeepsDriving) {
   EXPECT_TRUE(second.running()) << "the second instance waits for the port rather than exiting";
   const std::vector<FakeDevice::Frame> frames = base.frames();
   for (std::size_t i = 1; i < frames.size(); ++i) {
-    EXPECT_EQ(frames[i].bytes[3], static_cast<uint8_t>(frames[i - 1].bytes[3] + 1)) << "frame " << i;
+    EXPECT_EQ(frames[i].bytes[3], static_cast<uint8_t>(frames[i - 1].bytes[3] + 1))
+        << "frame " << i;
   }
   const protocol::FramerStats stats = base.framerStats();
   EXPECT_EQ(stats.checksum_errors, 0u);
