@@ -16,4 +16,5 @@ target_link_libraries(polling_driver_node srd_ros)
 # The benchmark launches these executables, so building it builds them.
 add_dependencies(driver_bench driver_node polling_driver_node robot_sim
   ${PROJECT_NAME}_generate_messages_cpp)
-# Benchmarks are run from the build tree and never installed.
+# Benchmarks are run from the build tree and never installed (hence the catkin_lint pragma).
+#catkin_lint: ignore uninstalled_script
