@@ -50,3 +50,15 @@ add_rostest_gtest(test_replay test/rostest/replay.test test/rostest/test_replay.
 target_include_directories(test_replay PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_replay srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_replay driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# serial_robot_driver/DriverNodelet in a manager: driving, unloading and a stopped manager.
+add_rostest_gtest(test_nodelet test/rostest/nodelet.test test/rostest/test_nodelet.cpp)
+target_include_directories(test_nodelet PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_nodelet srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_nodelet srd_nodelet ${PROJECT_NAME}_generate_messages_cpp)
+
+# Two processes on one port: the second is told "port busy" (and by whom); the first is unharmed.
+add_rostest_gtest(test_port_busy test/rostest/port_busy.test test/rostest/test_port_busy.cpp)
+target_include_directories(test_port_busy PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_port_busy srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_port_busy driver_node ${PROJECT_NAME}_generate_messages_cpp)

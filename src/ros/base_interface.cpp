@@ -108,6 +108,7 @@ void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "driving");
   }
+  status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);
   status.add("speed frames out", s.speed_frames);

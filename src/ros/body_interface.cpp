@@ -2,6 +2,8 @@
 
 #include <sensor_msgs/Imu.h>
 
+#include <boost/make_shared.hpp>
+
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/decode_result.h"
@@ -45,10 +47,15 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   telemetry_rate_.tick();
   const ros::Time stamp = arrival_stamps_(arrival);
   const auto& joints = controller_.joints();
+  // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
+  // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(toJointState(telemetry, joints, stamp));
+    joint_states_pub_.publish(
+        boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp)));
   }
-  if (imu_pub_.getNumSubscribers() > 0) imu_pub_.publish(toImu(telemetry, imu_params_, stamp));
+  if (imu_pub_.getNumSubscribers() > 0) {
+    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, imu_params_, stamp)));
+  }
   if (foot_pressure_pub_.getNumSubscribers() > 0) {
     if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }
@@ -64,6 +71,22 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   if (!result.ok()) ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
 }
 
+void BodyInterface::logTelemetryFlow(bool connected, uint64_t frames_decoded) {
+  // Once per outage, not once per period: a frame count that stood still for a whole
+  // diagnostics period while the port is up means the board stopped talking.
+  const bool stalled = connected && frames_decoded > 0 && frames_decoded == frames_at_last_diagnose_;
+  if (stalled && !telemetry_stop_logged_) {
+    ROS_WARN("body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
+             "board powered and streaming?",
+             link_.options().path.c_str());
+    telemetry_stop_logged_ = true;
+  } else if (!stalled && telemetry_stop_logged_ && frames_decoded != frames_at_last_diagnose_) {
+    ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
+    telemetry_stop_logged_ = false;
+  }
+  frames_at_last_diagnose_ = frames_decoded;
+}
+
 void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
   const device::BodyStats stats = controller_.stats();
@@ -73,7 +96,11 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
                         "port " + link_.options().path + " not connected");
   } else if (stats.frames_decoded == 0) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "no telemetry received yet");
+  } else if (stats.frames_decoded == frames_at_last_diagnose_) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "telemetry stopped");
   }
+  logTelemetryFlow(connected, stats.frames_decoded);
+  status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);
   status.add("frames decoded", stats.frames_decoded);

@@ -71,6 +71,14 @@ geometry_msgs::Quaternion quaternionFromRollPitchYaw(double roll, double pitch, 
   return msg;
 }
 
+Eigen::Matrix3d axisMapMatrix(const std::vector<std::string>& axis_map) {
+  Eigen::Matrix3d matrix = Eigen::Matrix3d::Zero();
+  const std::optional<AxisMap> map = parseAxisMap(axis_map, nullptr);
+  if (!map) return Eigen::Matrix3d::Identity();  // validate() refuses such a map at start-up
+  for (int i = 0; i < 3; ++i) matrix(i, map->source[i]) = map->sign[i];
+  return matrix;
+}
+
 sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
                                      const std::vector<device::BodyJoint>& joints,
                                      const ros::Time& stamp) {
@@ -79,12 +87,17 @@ sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
   const std::size_t count = std::min(joints.size(), telemetry.servo_count);
   msg.name.reserve(count);
   msg.position.reserve(count);
-  msg.velocity.reserve(count);
+  // The speed's unit is not documented: without a known scale the velocity stays empty rather
+  // than guessed (JointState allows an empty velocity array).
+  const bool velocity_known = count > 0 && joints.front().calibration.velocity_scale > 0;
+  if (velocity_known) msg.velocity.reserve(count);
   for (std::size_t i = 0; i < count; ++i) {
     const device::JointCalibration& calibration = joints[i].calibration;
     msg.name.push_back(joints[i].name);
     msg.position.push_back(calibration.toRadians(telemetry.servos[i].position));
-    msg.velocity.push_back(calibration.toRadiansPerSecond(telemetry.servos[i].speed));
+    if (velocity_known) {
+      msg.velocity.push_back(calibration.toRadiansPerSecond(telemetry.servos[i].speed));
+    }
   }
   return msg;
 }
@@ -95,15 +108,30 @@ sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params
   msg.header.stamp = stamp;
   msg.header.frame_id = params.frame_id;
   const auto& raw = telemetry.imu;
-  msg.linear_acceleration.x = raw[body::kAccelX] * params.accel_scale;
-  msg.linear_acceleration.y = raw[body::kAccelY] * params.accel_scale;
-  msg.linear_acceleration.z = raw[body::kAccelZ] * params.accel_scale;
-  msg.angular_velocity.x = raw[body::kGyroX] * params.gyro_scale;
-  msg.angular_velocity.y = raw[body::kGyroY] * params.gyro_scale;
-  msg.angular_velocity.z = raw[body::kGyroZ] * params.gyro_scale;
-  msg.orientation = quaternionFromRollPitchYaw(raw[body::kRoll] * params.angle_scale,
-                                               raw[body::kPitch] * params.angle_scale,
-                                               raw[body::kYaw] * params.angle_scale);
+  // The axis map M turns sensor-frame vectors into imu-frame ones (v_imu = M v_sensor); the
+  // sensor's orientation R_world_sensor becomes R_world_imu = R_world_sensor * M^T.
+  const Eigen::Matrix3d map = axisMapMatrix(params.axis_map);
+  const Eigen::Vector3d accel =
+      map * Eigen::Vector3d(raw[body::kAccelX], raw[body::kAccelY], raw[body::kAccelZ]) *
+      params.accel_scale;
+  const Eigen::Vector3d gyro =
+      map * Eigen::Vector3d(raw[body::kGyroX], raw[body::kGyroY], raw[body::kGyroZ]) *
+      params.gyro_scale;
+  msg.linear_acceleration.x = accel.x();
+  msg.linear_acceleration.y = accel.y();
+  msg.linear_acceleration.z = accel.z();
+  msg.angular_velocity.x = gyro.x();
+  msg.angular_velocity.y = gyro.y();
+  msg.angular_velocity.z = gyro.z();
+  const geometry_msgs::Quaternion sensor = quaternionFromRollPitchYaw(
+      raw[body::kRoll] * params.angle_scale, raw[body::kPitch] * params.angle_scale,
+      raw[body::kYaw] * params.angle_scale);
+  const Eigen::Quaterniond world_imu =
+      Eigen::Quaterniond(sensor.w, sensor.x, sensor.y, sensor.z) * Eigen::Quaterniond(map.transpose());
+  msg.orientation.x = world_imu.x();
+  msg.orientation.y = world_imu.y();
+  msg.orientation.z = world_imu.z();
+  msg.orientation.w = world_imu.w();
   // Row-major 3x3 matrices: the diagonal is elements 0, 4, 8.
   for (std::size_t i = 0; i < 3; ++i) {
     msg.orientation_covariance[4 * i] = params.orientation_variance;

@@ -1,6 +1,7 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
 #include <functional>
+#include <sstream>
 
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
@@ -48,6 +49,7 @@ namespace {
 /// One kind of device the node can drive: whether it is enabled, where it is, and how its ROS
 /// interface is built. A new device is one more row in devices().
 struct DeviceEntry {
+  const char* name;  ///< as in its parameters and its diagnostic status
   bool enabled;
   std::string port;
   int baud;
@@ -67,9 +69,9 @@ std::unique_ptr<DeviceInterface> make(ros::NodeHandle& nh, const DriverParams& p
 /// else stops.
 std::vector<DeviceEntry> devices(const DriverParams& p) {
   return {
-      {p.base.enabled, p.basePort(), p.baseBaud(), true, false, false, make<BaseInterface>},
-      {p.body.enabled, p.bodyPort(), p.bodyBaud(), false, true, false, make<BodyInterface>},
-      {p.servo_bus.enabled, p.servoBusPort(), p.servoBusBaud(), false, false, true,
+      {"base", p.base.enabled, p.basePort(), p.baseBaud(), true, false, false, make<BaseInterface>},
+      {"body", p.body.enabled, p.bodyPort(), p.bodyBaud(), false, true, false, make<BodyInterface>},
+      {"servo_bus", p.servo_bus.enabled, p.servoBusPort(), p.servoBusBaud(), false, false, true,
        make<ServoBusInterface>},
   };
 }
@@ -78,8 +80,11 @@ std::vector<DeviceEntry> devices(const DriverParams& p) {
 
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
                        device::SerialLink::StreamFactory stream_factory)
-    : nh_(nh), params_(std::move(params)), diagnostics_(nh, private_nh) {
-  diagnostics_.setHardwareID("serial_robot_driver");
+    // The updater prefixes every status with the node's name: the private namespace names the
+    // driver both as a node and as a nodelet (whose process is the manager).
+    : nh_(nh), params_(std::move(params)), diagnostics_(nh, private_nh, private_nh.getNamespace()) {
+  // Each status names its own port as hardware_id; this is only the fallback.
+  diagnostics_.setHardwareID(params_.port);
 
   // Devices naming the same path share one port, one reader thread and one framer.
   struct Users {
@@ -123,8 +128,12 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   for (const DeviceEntry& entry : entries) {
     if (entry.enabled) devices_.push_back(entry.make(nh_, params_, portFor(entry.port), diagnostics_));
   }
-  diagnostics_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0),
-                                             [this](const ros::SteadyTimerEvent&) { diagnostics_.update(); });
+  // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
+  // update: update() would skip a tick that fires a hair before the updater's own deadline.
+  diagnostics_period_ = diagnostics_.getPeriod();
+  diagnostics_timer_ = nh_.createSteadyTimer(
+      ros::WallDuration(diagnostics_period_),
+      [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
 }
 
 DriverNode::~DriverNode() { shutdown(); }
@@ -134,6 +143,32 @@ device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports
 void DriverNode::start() {
   for (auto& [path, port] : ports_) port.link->start();
   for (auto& device : devices_) device->start();
+  ROS_INFO("%s", startupSummary().c_str());
+}
+
+std::string DriverNode::startupSummary() const {
+  // e.g. "driving port /dev/ttyUSB0 (115200 baud: base, body, servo_bus); loop 50 Hz, battery
+  // poll 1 Hz, diagnostics every 1 s"
+  std::ostringstream text;
+  text << "driving";
+  const char* separator = " port ";
+  for (const auto& [path, port] : ports_) {
+    text << separator << path << " (" << port.link->options().baud << " baud:";
+    const char* comma = " ";
+    for (const DeviceEntry& entry : devices(params_)) {
+      if (!entry.enabled || entry.port != path) continue;
+      text << comma << entry.name;
+      comma = ", ";
+    }
+    text << ")";
+    separator = ", port ";
+  }
+  if (params_.base.enabled) {
+    text << "; loop " << params_.loop_rate << " Hz, battery poll " << params_.base.battery_poll_rate
+         << " Hz";
+  }
+  text << "; diagnostics every " << diagnostics_period_ << " s";
+  return text.str();
 }
 
 void DriverNode::shutdown() {
@@ -148,6 +183,7 @@ void DriverNode::shutdown() {
 void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status) {
   const device::LinkStats s = port.link->stats();
   using protocol::FrameFamily;
+  status.hardware_id = port.link->options().path;
   if (s.connected) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "connected");
   } else {

@@ -182,6 +182,11 @@ std::vector<ParamSpec> buildTable() {
           [](const std::string& v, const std::string& key) {
             require(!v.empty(), key, "must not be empty");
           }),
+      row("imu/axis_map", &P::imu, &Imu::axis_map,
+          [](const std::vector<std::string>& entries, const std::string& key) {
+            std::string problem;
+            require(parseAxisMap(entries, &problem).has_value(), key, problem);
+          }),
       row("imu/accel_scale", &P::imu, &Imu::accel_scale, positive<double>),
       row("imu/gyro_scale", &P::imu, &Imu::gyro_scale, positive<double>),
       row("imu/angle_scale", &P::imu, &Imu::angle_scale, positive<double>),
@@ -244,6 +249,43 @@ class NodeHandleSource : public ParamSource {
 };
 
 }  // namespace
+
+std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std::string* problem) {
+  const auto fail = [problem](const std::string& text) {
+    if (problem) *problem = text;
+    return std::nullopt;
+  };
+  if (entries.size() != 3) {
+    return fail("must list 3 axes (imu x, y, z), e.g. [x, y, z] or [-y, x, z]; got " +
+                std::to_string(entries.size()));
+  }
+  AxisMap map;
+  std::array<bool, 3> used{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string entry = entries[i];
+    int sign = 1;
+    if (!entry.empty() && (entry[0] == '-' || entry[0] == '+')) {
+      sign = entry[0] == '-' ? -1 : 1;
+      entry.erase(0, 1);
+    }
+    if (entry != "x" && entry != "y" && entry != "z") {
+      return fail("entry '" + entries[i] + "' is not x, y or z with an optional sign");
+    }
+    const int source = entry[0] - 'x';
+    if (used[source]) return fail("sensor axis " + entry + " is used twice");
+    used[source] = true;
+    map.source[i] = source;
+    map.sign[i] = sign;
+  }
+  // The determinant of a signed permutation: the permutation's parity times the signs.
+  const int inversions = (map.source[0] > map.source[1]) + (map.source[0] > map.source[2]) +
+                         (map.source[1] > map.source[2]);
+  const int determinant = (inversions % 2 ? -1 : 1) * map.sign[0] * map.sign[1] * map.sign[2];
+  if (determinant != 1) {
+    return fail("is a mirror image (left-handed); flip the sign of one axis to make it a rotation");
+  }
+  return map;
+}
 
 const std::vector<ParamSpec>& parameterTable() {
   static const std::vector<ParamSpec> table = buildTable();

@@ -36,6 +36,16 @@ constexpr std::chrono::milliseconds kReplayLinger{1500};
 constexpr std::chrono::milliseconds kReplaySettle{1500};
 }  // namespace
 
+DriverParams loadCheckedParams(const ros::NodeHandle& private_nh) {
+  std::vector<std::string> unknown;
+  DriverParams params = loadParams(private_nh, &unknown);
+  for (const auto& key : unknown) {
+    ROS_WARN("unknown parameter ~%s is ignored (a typo?)", key.c_str());
+  }
+  params.validate();
+  return params;
+}
+
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
   // We take SIGINT ourselves: roscpp's handler would tear the node down before the zero-speed frame
   // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
@@ -52,12 +62,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   DriverParams params;
   try {
     if (make_stream_factory) stream_factory = make_stream_factory(private_nh);
-    std::vector<std::string> unknown;
-    params = loadParams(private_nh, &unknown);
-    for (const auto& key : unknown) {
-      ROS_WARN("unknown parameter ~%s is ignored (a typo?)", key.c_str());
-    }
-    params.validate();
+    params = loadCheckedParams(private_nh);
   } catch (const ParameterError& e) {
     ROS_FATAL("%s", e.what());
     ros::shutdown();

@@ -173,7 +173,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
           Announce::kInfo),
   };
 
-  diagnostics_.add("serial_robot_driver: servo_bus", this, &ServoBusInterface::diagnose);
+  diagnostics_.add("servo_bus", this, &ServoBusInterface::diagnose);
 
   if (params.servo_bus.allow_dangerous_writes) {
     ROS_WARN("servo_bus: dangerous writes (servo_id, baudrate, reset_user_data) are ARMED");
@@ -196,7 +196,7 @@ void ServoBusInterface::shutdown() {
   client_.shutdown();  // wakes a call waiting on the bus, so the spinner can stop quickly
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
-  diagnostics_.removeByName("serial_robot_driver: servo_bus");
+  diagnostics_.removeByName("servo_bus");
 }
 
 void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -208,6 +208,7 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "servo bus port is not connected");
   }
+  status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", link_.connected());
   status.add("transactions", stats.transactions);

@@ -2,7 +2,11 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <signal.h>
+#include <sys/file.h>
 #include <sys/ioctl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -14,7 +18,9 @@
 #include <climits>
 #include <cstdlib>
 #include <cstring>
+#include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <utility>
 
 namespace serial_robot_driver::transport {
@@ -184,6 +190,100 @@ void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::stri
   }
 }
 
+namespace {
+
+bool processExists(long pid) {
+  return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+}
+
+/// The pid in a UUCP lock file (ASCII, or a binary int from old programs); nullopt when unreadable.
+std::optional<long> readLockFilePid(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return std::nullopt;
+  std::string content((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (content.size() == sizeof(int) &&
+      (content[0] != ' ' && (content[0] < '0' || content[0] > '9'))) {
+    int binary_pid = 0;
+    std::memcpy(&binary_pid, content.data(), sizeof(int));
+    return binary_pid;
+  }
+  char* end = nullptr;
+  const long pid = std::strtol(content.c_str(), &end, 10);
+  if (end == content.c_str()) return std::nullopt;
+  return pid;
+}
+
+}  // namespace
+
+std::optional<PortHolder> findPortHolder(const std::string& device_path) {
+  // 1. A UUCP lock file (minicom, screen and ModemManager's neighbours write these).
+  const std::string base = device_path.substr(device_path.find_last_of('/') + 1);
+  char resolved[PATH_MAX];
+  const std::string real_base =
+      ::realpath(device_path.c_str(), resolved)
+          ? std::string(resolved).substr(std::string(resolved).find_last_of('/') + 1)
+          : base;
+  for (const char* dir : {"/run/lock", "/var/lock"}) {
+    const std::string lock_file = std::string(dir) + "/LCK.." + real_base;
+    const std::optional<long> pid = readLockFilePid(lock_file);
+    if (pid && *pid != ::getpid() && processExists(*pid)) return PortHolder{*pid, lock_file};
+  }
+  // 2. An flock or POSIX lock on the device's inode: /proc/locks lines read
+  //    "1: FLOCK  ADVISORY  WRITE 1234 00:18:3 0 EOF" (pid, then major:minor:inode, hex:hex:dec).
+  struct stat device {};
+  if (::stat(device_path.c_str(), &device) != 0) return std::nullopt;
+  std::ifstream locks("/proc/locks");
+  std::string line;
+  while (std::getline(locks, line)) {
+    std::istringstream fields(line);
+    std::string ordinal, kind, mode, access, where;
+    long pid = 0;
+    if (!(fields >> ordinal >> kind)) continue;
+    if (kind == "->") fields >> kind;  // a blocked waiter: "1: -> FLOCK ..."
+    if (!(fields >> mode >> access >> pid >> where)) continue;
+    unsigned major_number = 0, minor_number = 0;
+    unsigned long inode = 0;
+    if (std::sscanf(where.c_str(), "%x:%x:%lu", &major_number, &minor_number, &inode) != 3)
+      continue;
+    if (inode == device.st_ino && major_number == major(device.st_dev) &&
+        minor_number == minor(device.st_dev) && pid != ::getpid()) {
+      return PortHolder{pid, "/proc/locks"};
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+[[noreturn]] void throwPortBusy(const std::string& path, const std::string& how) {
+  std::string message = "port busy: " + path + " is " + how + " by another process";
+  if (const std::optional<PortHolder> holder = findPortHolder(path)) {
+    message += " (pid " + std::to_string(holder->pid) + ", from " + holder->source + ")";
+  }
+  throw TransportError(TransportErrorKind::kOpenFailed, message);
+}
+
+/// Takes the port for this process alone: an advisory flock (which other instances of this driver
+/// and lock-aware programs honour) and TIOCEXCL (further opens fail with EBUSY, except for root).
+/// A pty or a driver refusing TIOCEXCL is "not supported", not an error.
+void takeExclusively(int fd, const std::string& path) {
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int error_number = errno;
+    ::close(fd);
+    if (error_number == EWOULDBLOCK) throwPortBusy(path, "locked");
+    throwErrno(TransportErrorKind::kOpenFailed, "cannot lock " + path, error_number);
+  }
+  // Our flock succeeded, yet another process may hold a UUCP lock file or a POSIX (fcntl) lock,
+  // which do not conflict with flock: respect those too.
+  if (findPortHolder(path)) {
+    ::close(fd);
+    throwPortBusy(path, "locked");
+  }
+  (void)::ioctl(fd, TIOCEXCL);  // ENOTTY/EINVAL where unsupported: the flock still protects us
+}
+
+}  // namespace
+
 SerialPort::SerialPort(SerialPortOptions options) : options_(std::move(options)) {}
 
 SerialPort::~SerialPort() { close(); }
@@ -198,7 +298,9 @@ void SerialPort::open() {
   }
 
   const int fd = ::open(options_.path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0 && errno == EBUSY) throwPortBusy(options_.path, "opened exclusively");
   if (fd < 0) throwErrno(TransportErrorKind::kOpenFailed, "cannot open " + options_.path, errno);
+  takeExclusively(fd, options_.path);  // closes fd when it throws
 
   try {
     configureRaw8N1(fd, *speed, options_.path);
@@ -215,7 +317,11 @@ void SerialPort::open() {
 
 void SerialPort::close() {
   const int fd = fd_.exchange(-1);
-  if (fd >= 0) ::close(fd);
+  if (fd >= 0) {
+    // The exclusive flag outlives this fd while another one (a simulator's pty end) stays open.
+    (void)::ioctl(fd, TIOCNXCL);
+    ::close(fd);  // releases the flock
+  }
   low_latency_ = false;
   latency_timer_ms_.reset();
 }

@@ -393,7 +393,7 @@ TEST(ServoBusNode, DiagnosticsReportTransactionsTimeoutsAndSkippedEchoes) {
   EXPECT_FALSE(ping(safeService("ping"), 7).response.online);
   ros::NodeHandle nh;
   const test_support::DiagnosticsWatch diagnostics(nh, "driver_node");
-  const auto servo_bus = [&] { return diagnostics.latest("serial_robot_driver: servo_bus"); };
+  const auto servo_bus = [&] { return diagnostics.latest("servo_bus"); };
   const bool seen = test_support::waitFor(
       [&] {
         const test_support::DiagnosticsWatch::Status status = servo_bus();

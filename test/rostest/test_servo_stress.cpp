@@ -423,7 +423,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   const DiagnosticsWatch::Status base_status = diagnostics.latest("base");
   const DiagnosticsWatch::Status body_status = diagnostics.latest("body");
   const DiagnosticsWatch::Status servo_status =
-      diagnostics.latest("serial_robot_driver: servo_bus");
+      diagnostics.latest("servo_bus");
 
   // --- service calls ---
   std::vector<CallRecord> all;

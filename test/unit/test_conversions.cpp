@@ -129,17 +129,15 @@ TEST(ConversionsQuaternion, CombinedAnglesAreYawThenPitchThenRoll) {
 
 // --- JointState ----------------------------------------------------------------------------------
 
-TEST(ConversionsJointState, PositionsAndVelocitiesInSiUnits) {
+TEST(ConversionsJointState, PositionsInRadiansAndNoVelocityWithoutItsScale) {
   const ros::Time stamp(42, 5);
   const sensor_msgs::JointState msg = toJointState(goldenTelemetry(), joints(), stamp);
   EXPECT_EQ(msg.header.stamp, stamp);
   ASSERT_EQ(msg.name, (std::vector<std::string>{"hip", "knee"}));
   ASSERT_EQ(msg.position.size(), 2u);
-  ASSERT_EQ(msg.velocity.size(), 2u);
   EXPECT_NEAR(msg.position[0], 0.0, 1e-12);
   EXPECT_NEAR(msg.position[1], -M_PI / 2, 1e-12);
-  EXPECT_NEAR(msg.velocity[0], 10 * kRadPerTick, 1e-12);
-  EXPECT_NEAR(msg.velocity[1], -5 * kRadPerTick, 1e-12);
+  EXPECT_TRUE(msg.velocity.empty());  // velocity_scale 0: unknown, not guessed
   EXPECT_TRUE(msg.effort.empty());
 }
 
@@ -189,6 +187,41 @@ TEST(ConversionsImu, DefaultScalesAreTheDatasheetOnes) {
   EXPECT_NEAR(msg.linear_acceleration.z, 8 * 9.80665, 0.01);
   EXPECT_NEAR(msg.angular_velocity.z, 100 * 2000.0 / 32768 * M_PI / 180, 1e-5);
   EXPECT_NEAR(msg.orientation.z, -kHalfSqrt2, 1e-5);
+}
+
+// Axis map [-y, x, z]: imu x = -sensor y, imu y = sensor x (the board turned +90 deg about z).
+// Golden raw values: accel (1, -1, 16384), gyro (0, 0, 100), yaw -16384 (-90 deg).
+TEST(ConversionsImu, AxisMapRemapsVectorsAndTurnsTheOrientation) {
+  ImuParams params;
+  params.accel_scale = 0.5;
+  params.gyro_scale = 0.25;
+  params.angle_scale = M_PI / 32768.0;
+  params.axis_map = {"-y", "x", "z"};
+  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 0.5);   // -(-1 * 0.5)
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 0.5);   // 1 * 0.5
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, 8192.0);
+  EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 25.0);
+  // The sensor's yaw -90 deg, seen from a frame turned +90 deg about z: yaw -180 deg.
+  EXPECT_NEAR(std::abs(msg.orientation.z), 1.0, 1e-9);
+  EXPECT_NEAR(msg.orientation.w, 0.0, 1e-9);
+}
+
+TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
+  ImuParams params;
+  params.accel_scale = 1.0;
+  params.axis_map = {"x", "-y", "-z"};
+  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 1.0);
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 1.0);
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, -16384.0);
+}
+
+TEST(ConversionsImu, AxisMapMatrixIsTheSignedPermutation) {
+  Eigen::Matrix3d expected;
+  expected << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  EXPECT_TRUE(axisMapMatrix({"-y", "x", "z"}).isApprox(expected));
+  EXPECT_TRUE(axisMapMatrix({"x", "y", "z"}).isIdentity());
 }
 
 TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {

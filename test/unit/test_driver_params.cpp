@@ -68,6 +68,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"body/velocity_scale", [](DriverParams& p) { p.body.velocity_scale = -1; }},
         BadCase{"imu/frame_id", [](DriverParams& p) { p.imu.frame_id.clear(); }},
         BadCase{"imu/accel_scale", [](DriverParams& p) { p.imu.accel_scale = 0; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"x", "y"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"x", "x", "z"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"x", "y", "w"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"x", "y", "-z"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"y", "x", "z"}; }},
         BadCase{"servo_bus/timeout", [](DriverParams& p) { p.servo_bus.timeout = 0; }},
         BadCase{"servo_bus/retries", [](DriverParams& p) { p.servo_bus.retries = -1; }},
         BadCase{"servo_bus/baud", [](DriverParams& p) { p.servo_bus.baud = 9600; }},
@@ -129,6 +134,20 @@ ParamValue changed(const ParamValue& value) {
     }
   };
   return std::visit(Change{}, value);
+}
+
+TEST(AxisMap, RotationsParseAndMirrorsAreRefusedWithAReason) {
+  const std::optional<AxisMap> turned = parseAxisMap({"-y", "x", "z"}, nullptr);
+  ASSERT_TRUE(turned.has_value());
+  EXPECT_EQ(turned->source, (std::array<int, 3>{1, 0, 2}));
+  EXPECT_EQ(turned->sign, (std::array<int, 3>{-1, 1, 1}));
+  EXPECT_TRUE(parseAxisMap({"x", "-y", "-z"}, nullptr).has_value());   // upside down
+  EXPECT_TRUE(parseAxisMap({"+z", "x", "y"}, nullptr).has_value());    // cyclic: a rotation
+  std::string problem;
+  EXPECT_FALSE(parseAxisMap({"y", "x", "z"}, &problem).has_value());
+  EXPECT_NE(problem.find("left-handed"), std::string::npos) << problem;
+  EXPECT_FALSE(parseAxisMap({"x", "y", "y"}, &problem).has_value());
+  EXPECT_NE(problem.find("used twice"), std::string::npos) << problem;
 }
 
 TEST(ParameterTable, KeysAreUnique) {

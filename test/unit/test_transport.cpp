@@ -1,9 +1,11 @@
 // SerialPort and PseudoTerminal over real pseudo-terminals (never a real /dev/tty*).
 #include <fcntl.h>
+#include <signal.h>
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <stdlib.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -398,6 +400,76 @@ TEST(TransportBaud, NonStandardRatesAreUnsupported) {
   EXPECT_FALSE(baudToSpeed(12345).has_value());
   EXPECT_FALSE(baudToSpeed(115201).has_value());
   EXPECT_FALSE(baudToSpeed(5000000).has_value());
+}
+
+std::string openFailure(SerialPort& port) {
+  try {
+    port.open();
+  } catch (const TransportError& error) {
+    EXPECT_EQ(error.kind(), TransportErrorKind::kOpenFailed);
+    return error.what();
+  }
+  return "opened";
+}
+
+// Issue 15: a port is taken exclusively; a second opener is told "port busy" and, once the first
+// lets go, gets the port.
+TEST_F(TransportTest, SecondOpenerOfAPortIsToldItIsBusy) {
+  PseudoTerminal pty(linkPath());
+  SerialPort first({linkPath(), 115200});
+  first.open();
+  SerialPort second({linkPath(), 115200});
+  const std::string failure = openFailure(second);
+  EXPECT_NE(failure.find("port busy: " + linkPath()), std::string::npos) << failure;
+  EXPECT_FALSE(second.isOpen());
+
+  // The first keeps working.
+  const Bytes bytes = {7, 8, 9};
+  writeBytes(pty, bytes);
+  EXPECT_EQ(readExactly(first, bytes.size()), bytes);
+
+  first.close();
+  second.open();
+  EXPECT_TRUE(second.isOpen());
+}
+
+// The holder's pid comes from /proc/locks when another process holds the lock.
+TEST_F(TransportTest, PortBusyNamesTheProcessHoldingTheLock) {
+  PseudoTerminal pty(linkPath());
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    SerialPort holder({linkPath(), 115200});
+    try {
+      holder.open();
+    } catch (...) {
+      ::_exit(1);
+    }
+    const char ok = 1;
+    (void)!::write(ready[1], &ok, 1);
+    ::pause();
+    ::_exit(0);
+  }
+  char ok = 0;
+  ASSERT_EQ(::read(ready[0], &ok, 1), 1);
+  ::close(ready[0]);
+  ::close(ready[1]);
+
+  SerialPort second({linkPath(), 115200});
+  const std::string failure = openFailure(second);
+  EXPECT_NE(failure.find("locked by another process (pid " + std::to_string(child)), std::string::npos)
+      << failure;
+  const std::optional<PortHolder> holder = findPortHolder(linkPath());
+  ASSERT_TRUE(holder.has_value());
+  EXPECT_EQ(holder->pid, child);
+
+  ::kill(child, SIGKILL);
+  ::waitpid(child, nullptr, 0);
+  EXPECT_FALSE(findPortHolder(linkPath()).has_value());
+  second.open();
+  EXPECT_TRUE(second.isOpen());
 }
 
 }  // namespace

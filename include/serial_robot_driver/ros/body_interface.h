@@ -36,6 +36,8 @@ class BodyInterface : public DeviceInterface {
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
                         device::Clock::time_point arrival);
   void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
+  /// Logs "telemetry stopped" once when no frame came for a diagnostics period, and "resumed".
+  void logTelemetryFlow(bool connected, uint64_t frames_decoded);
 
   device::SerialLink& link_;
   const ArrivalStamps arrival_stamps_;
@@ -50,6 +52,9 @@ class BodyInterface : public DeviceInterface {
   ros::Publisher foot_pressure_pub_;
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
+  // Diagnostics timer thread only.
+  uint64_t frames_at_last_diagnose_ = 0;
+  bool telemetry_stop_logged_ = false;
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -2,6 +2,7 @@
 // are unit-tested without a roscore.
 #pragma once
 
+#include <Eigen/Core>
 #include <geometry_msgs/Quaternion.h>
 #include <ros/time.h>
 #include <sensor_msgs/Imu.h>
@@ -52,6 +53,10 @@ std::vector<device::BodyJoint> makeBodyJoints(const BodyParams& params);
 
 /// Orientation quaternion from attitude angles in rad, applied as yaw (Z) * pitch (Y) * roll (X).
 geometry_msgs::Quaternion quaternionFromRollPitchYaw(double roll, double pitch, double yaw);
+
+/// The signed permutation matrix of ~imu/axis_map (v_imu = M v_sensor); identity for a map that
+/// does not parse (validate() refuses those at start-up).
+Eigen::Matrix3d axisMapMatrix(const std::vector<std::string>& axis_map);
 
 /// Joint positions (rad) and velocities (rad/s) of every configured joint. Joints beyond the
 /// frame's servo_count are left out (cannot happen when the frame was decoded for these joints).

@@ -15,8 +15,9 @@
 //    as soon as their last byte is read;
 //  - the base control loop runs on its own thread (device::BaseController);
 //  - cmd_vel, joint_commands and base/* services run on the global callback queue (an AsyncSpinner
-//    in main); servo/* services have their own queue and spinner because they wait on the bus;
-//  - diagnostics are updated from a steady timer on the global queue.
+//    in main, or the nodelet manager's threads); servo/* services have their own queue and
+//    spinner because they wait on the bus;
+//  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
 #pragma once
 
 #include <map>
@@ -59,6 +60,8 @@ class DriverNode {
     std::unique_ptr<PortMonitor> monitor;
   };
   device::SerialLink& portFor(const std::string& path);
+  /// One line for the log: ports, the devices on each, rates.
+  std::string startupSummary() const;
   void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_;
@@ -68,6 +71,7 @@ class DriverNode {
   std::map<std::string, Port> ports_;
   /// In start and shutdown order: base, body, servo bus.
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
+  double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
   bool shut_down_ = false;
 };

@@ -1,9 +1,11 @@
 // Every parameter of driver_node, loaded once at start-up into one struct (names and defaults:
-// ../shared/INTERFACE.md and config/robot.yaml). validate() throws ParameterError naming the first
+// docs/node_api.md and config/robot.yaml). validate() throws ParameterError naming the first
 // bad parameter; the node prints it and exits non-zero.
 #pragma once
 
+#include <array>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -50,11 +52,24 @@ struct BodyParams : DevicePortParams {
   int ticks_per_revolution = 4096;
   std::vector<int> zero_ticks{2048, 2048};
   std::vector<int> directions{1, 1};
+  /// rad/s per raw speed unit; 0: unknown, and joint_states carries no velocity.
   double velocity_scale = 0.0;
 };
 
+/// Where each axis of imu/data comes from: axis i (x, y, z) is sign[i] * the sensor's axis
+/// source[i]. Written as ~imu/axis_map, e.g. ["x", "y", "z"] (as mounted) or ["-y", "x", "z"].
+struct AxisMap {
+  std::array<int, 3> source{0, 1, 2};
+  std::array<int, 3> sign{1, 1, 1};
+};
+
+/// Parses an axis map: three entries "x", "y" or "z" with an optional sign, each sensor axis once,
+/// and right-handed (a rotation, so the orientation can follow). nullopt with `problem` set when not.
+std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std::string* problem);
+
 struct ImuParams {
   std::string frame_id = "imu_link";
+  std::vector<std::string> axis_map{"x", "y", "z"};  ///< see AxisMap
   double accel_scale = 0.0047884;        ///< m/s^2 per LSB (16 g / 32768)
   double gyro_scale = 0.0010653;         ///< rad/s per LSB (2000 deg/s / 32768)
   double angle_scale = 0.0000958738;     ///< rad per LSB (180 deg / 32768)

@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -15,6 +16,10 @@ namespace serial_robot_driver::ros_layer {
 /// factory means termios serial ports; throwing ParameterError stops the node with that message.
 using StreamFactoryMaker =
     std::function<device::SerialLink::StreamFactory(ros::NodeHandle& private_nh)>;
+
+/// Loads the driver's parameters from `private_nh`, warns about unknown keys (typos) and
+/// validates them; throws ParameterError. Shared by driver_node and the nodelet.
+DriverParams loadCheckedParams(const ros::NodeHandle& private_nh);
 
 /// Runs the node until SIGINT/SIGTERM or a roscpp shutdown; returns the process exit code.
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory = {});

@@ -27,11 +27,14 @@ class SerialPort : public ByteStream {
   SerialPort(const SerialPort&) = delete;
   SerialPort& operator=(const SerialPort&) = delete;
 
-  /// Opens and configures the port (raw 8N1, no flow control) and drops stale buffered bytes.
+  /// Opens the port exclusively (an advisory flock plus TIOCEXCL where the driver supports it),
+  /// configures it (raw 8N1, no flow control) and drops stale buffered bytes.
   /// Requests ASYNC_LOW_LATENCY where the driver supports it; a pty or a driver that refuses the
   /// ioctl is "not supported", not an error. Reopens when already open.
   /// \throws TransportError kConfigureFailed for an unsupported baud or a path that is no tty,
-  ///         kOpenFailed when the path cannot be opened.
+  ///         kOpenFailed when the path cannot be opened, or "port busy: ... locked by another
+  ///         process (pid N, from ...)" when another process holds it (the pid when it can be
+  ///         known: a LCK..ttyX lock file or /proc/locks).
   void open() override;
   /// Idempotent; the destructor calls it.
   void close() override;
@@ -54,6 +57,15 @@ class SerialPort : public ByteStream {
   bool low_latency_ = false;
   std::optional<int> latency_timer_ms_;
 };
+
+/// Who holds a port: a pid and where it was found (a lock file's path, or "/proc/locks").
+struct PortHolder {
+  long pid;
+  std::string source;
+};
+/// Another live process's lock on `device_path` (UUCP lock file, flock or POSIX lock); nullopt
+/// when none can be seen.
+std::optional<PortHolder> findPortHolder(const std::string& device_path);
 
 /// termios speed constant for a baud rate; nullopt when unsupported.
 std::optional<unsigned> baudToSpeed(unsigned baud);

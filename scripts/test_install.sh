@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# Install-space test: installs the built workspace (.ws/build by default) into a temporary prefix,
+# then, in an environment that holds only the system's ROS and that prefix (no devel space, no
+# source tree), checks that a user gets what they need and nothing they should not:
+#   - executables, libsrd_nodelet, launch/, config/ (parameters, analyzers, udev rule), msg/srv,
+#     the nodelet plugin description, srd_core's headers; no srd_ros/srd_sim headers, no benchmarks;
+#   - rospack finds the package and its nodelet plugin; every launch file passes roslaunch's check;
+#   - sim.launch runs (joint_states flow, the servo/ping service exists), and driver.launch nodelet:=true
+#     loads serial_robot_driver/DriverNodelet against robot_sim.
+# Usage: scripts/test_install.sh [build dir]. Prints "install test passed" or what failed.
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+build="${1:-$repo/.ws/build}"
+export PATH="/usr/bin:/bin"
+prefix="$(mktemp -d /tmp/srd_install.XXXXXX)"
+# Job control: each background job gets a process group of its own (so its children can be
+# stopped with it) and keeps SIGINT, which a non-interactive shell would otherwise ignore.
+set -m
+stop_group() {  # SIGINT to a job's process group, SIGKILL after 10 s
+  kill -INT -- "-$1" 2>/dev/null || return 0
+  for _ in $(seq 20); do kill -0 -- "-$1" 2>/dev/null || return 0; sleep 0.5; done
+  kill -KILL -- "-$1" 2>/dev/null || true
+}
+cleanup() {
+  # Only the process groups this script started, never by name; the newest first.
+  for pid in ${started_pids:-}; do stop_group "$pid"; done
+  [ -n "${KEEP_INSTALL:-}" ] || rm -rf "$prefix"
+}
+trap cleanup EXIT
+started_pids=""
+
+fail() { echo "install test FAILED: $*"; exit 1; }
+
+cmake --install "$build" --prefix "$prefix" > "$prefix.install.log" 2>&1 ||
+  { tail -n 20 "$prefix.install.log"; fail "cmake --install"; }
+rm -f "$prefix.install.log"
+
+share="$prefix/share/serial_robot_driver"
+for f in lib/serial_robot_driver/driver_node lib/serial_robot_driver/robot_sim lib/libsrd_nodelet.so \
+         lib/libsrd_core.a share/serial_robot_driver/package.xml \
+         share/serial_robot_driver/nodelet_plugins.xml share/serial_robot_driver/launch/driver.launch \
+         share/serial_robot_driver/launch/sim.launch share/serial_robot_driver/launch/record.launch \
+         share/serial_robot_driver/config/robot.yaml share/serial_robot_driver/config/analyzers.yaml \
+         share/serial_robot_driver/config/99-serial-robot.rules \
+         share/serial_robot_driver/msg/Telemetry.msg share/serial_robot_driver/srv/ServoPing.srv \
+         include/serial_robot_driver/protocol/base_codec.h include/serial_robot_driver/Telemetry.h; do
+  [ -e "$prefix/$f" ] || fail "missing $f"
+done
+for f in include/serial_robot_driver/ros include/serial_robot_driver/sim \
+         lib/serial_robot_driver/driver_bench lib/serial_robot_driver/polling_driver_node \
+         lib/serial_robot_driver/bench_framer lib/serial_robot_driver/run_benchmarks.sh; do
+  [ ! -e "$prefix/$f" ] || fail "$f is installed but should not be"
+done
+
+# Everything below runs with the install space alone. (Debian ships no Python classes for
+# sensor_msgs, so data flow is checked with `rostopic bw`, which needs none.)
+master_port=$((20000 + RANDOM % 20000))
+# Debian's catkin installs no setup.bash into a prefix; these are the variables it would set.
+run() {
+  env -i HOME="$prefix/home" PATH="/usr/bin:/bin" ROS_HOME="$prefix/home/.ros" \
+    ROS_MASTER_URI="http://localhost:$master_port" CMAKE_PREFIX_PATH="$prefix" \
+    ROS_PACKAGE_PATH="$prefix/share" LD_LIBRARY_PATH="$prefix/lib" \
+    PYTHONPATH="$(ls -d "$prefix"/lib/python3*/dist-packages 2>/dev/null | head -n 1)" \
+    bash -c "$1"
+}
+mkdir -p "$prefix/home"
+
+[ "$(run 'rospack find serial_robot_driver')" = "$share" ] || fail "rospack does not find $share"
+run 'rospack plugins --attrib=plugin nodelet' | grep -q "^serial_robot_driver $share/nodelet_plugins.xml" ||
+  fail "the nodelet plugin description is not exported"
+run 'rosmsg show serial_robot_driver/Telemetry' | grep -q servo_ids || fail "rosmsg show Telemetry"
+run 'rossrv show serial_robot_driver/ServoPing' | grep -q id || fail "rossrv show ServoPing"
+for launch in "$share"/launch/*.launch; do
+  error="$(run "python3 -c 'import sys, roslaunch.rlutil as r; e = r.check_roslaunch(sys.argv[1]); print(e or \"\")' '$launch'")"
+  [ -z "$error" ] || fail "roslaunch check of $(basename "$launch"): $error"
+done
+
+run "exec roscore -p $master_port" > "$prefix/roscore.log" 2>&1 &
+started_pids="$! $started_pids"
+wait_for() {  # wait_for <seconds> <command run in the install environment>
+  local deadline=$((SECONDS + $1))
+  until run "$2" > /dev/null 2>&1; do
+    [ $SECONDS -lt $deadline ] || return 1
+    sleep 1
+  done
+}
+wait_for 30 'rostopic list' || fail "roscore did not start"
+
+link="$prefix/sim_pty"
+run "exec roslaunch serial_robot_driver sim.launch link:=$link" > "$prefix/sim.log" 2>&1 &
+started_pids="$! $started_pids"
+sim_launch=$!
+wait_for 60 'rosservice list | grep -q "^/servo/ping$"' ||
+  { tail -n 30 "$prefix/sim.log"; fail "sim.launch: no /servo/ping"; }
+wait_for 30 'timeout 6 rostopic bw -w 3 /joint_states 2>&1 | grep -q average' ||
+  { tail -n 30 "$prefix/sim.log"; fail "sim.launch: no joint_states"; }
+stop_group "$sim_launch"
+
+# The nodelet from the install space: robot_sim alone, and driver.launch nodelet:=true on its pty.
+run "exec rosrun serial_robot_driver robot_sim --link $link" > "$prefix/robot_sim.log" 2>&1 &
+started_pids="$! $started_pids"
+run "exec roslaunch serial_robot_driver driver.launch nodelet:=true port:=$link respawn:=false" \
+  > "$prefix/nodelet.log" 2>&1 &
+started_pids="$! $started_pids"
+wait_for 60 'timeout 6 rostopic bw -w 3 /joint_states 2>&1 | grep -q average' ||
+  { tail -n 30 "$prefix/nodelet.log"; fail "driver.launch nodelet:=true: no joint_states"; }
+run 'rostopic info /joint_states' | grep -q "/driver_nodelet_manager" ||
+  fail "joint_states does not come from the nodelet manager"
+
+echo "install test passed"

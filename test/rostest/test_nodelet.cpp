@@ -1,0 +1,176 @@
+// DriverNodelet in a nodelet manager (nodelet.test): it drives the base like driver_node, names
+// its diagnostics after itself (not after the manager), and leaves a zero-speed frame as the last
+// frame on the wire both when it is unloaded and when its manager is stopped with SIGINT.
+#include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
+#include <ros/ros.h>
+#include <sys/wait.h>
+
+#include <csignal>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/fake_device.h"
+#include "support/process_support.h"
+#include "support/ros_test_support.h"
+
+namespace {
+
+using test_support::FakeDevice;
+using test_support::waitFor;
+namespace protocol = serial_robot_driver::protocol;
+
+// A base speed frame (protocol section 1): 55 AA 09 seq 01, left int32 BE, right int32 BE, XOR.
+bool isSpeedFrame(const FakeDevice::Frame& f) { return f.bytes.size() == 14 && f.bytes[4] == 0x01; }
+bool isZeroSpeed(const FakeDevice::Frame& f) {
+  if (!isSpeedFrame(f)) return false;
+  for (std::size_t i = 5; i < 13; ++i) {
+    if (f.bytes[i] != 0) return false;
+  }
+  return true;
+}
+bool isMoving(const FakeDevice::Frame& f) { return isSpeedFrame(f) && !isZeroSpeed(f); }
+
+std::vector<FakeDevice::Frame> speedFrames(const FakeDevice& device) {
+  std::vector<FakeDevice::Frame> speed;
+  for (const auto& f : device.frames()) {
+    if (isSpeedFrame(f)) speed.push_back(f);
+  }
+  return speed;
+}
+
+std::unique_ptr<FakeDevice> makeBase(const std::string& port) {
+  auto base =
+      std::make_unique<FakeDevice>(port, protocol::FramerConfig::forDriver(true, false, false, 0));
+  base->plug();
+  return base;
+}
+
+/// Publishes a forward cmd_vel at 20 Hz until destroyed (the driver keeps moving meanwhile).
+class Driving {
+ public:
+  explicit Driving(const std::string& topic) {
+    ros::NodeHandle nh;
+    pub_ = nh.advertise<geometry_msgs::Twist>(topic, 10);
+    thread_ = std::thread([this] {
+      geometry_msgs::Twist twist;
+      twist.linear.x = 0.5;
+      while (!stop_) {
+        pub_.publish(twist);
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    });
+  }
+  ~Driving() {
+    stop_ = true;
+    thread_.join();
+  }
+  bool connected(double timeout_s) const {
+    return waitFor([&] { return pub_.getNumSubscribers() > 0; }, timeout_s);
+  }
+
+ private:
+  ros::Publisher pub_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+/// Waits for the frames to stop, then checks the last speed frame is zero and the one before moved.
+void expectLastFrameIsZero(const FakeDevice& base) {
+  // No new frame for half a second: the port is closed.
+  std::size_t count = base.frameCount();
+  for (int i = 0; i < 100; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const std::size_t now = base.frameCount();
+    if (now == count) break;
+    count = now;
+  }
+  const std::vector<FakeDevice::Frame> speed = speedFrames(base);
+  ASSERT_GE(speed.size(), 2u);
+  EXPECT_TRUE(isZeroSpeed(speed.back())) << "the last speed frame is not zero";
+  EXPECT_TRUE(isMoving(speed[speed.size() - 2])) << "the wheels had already stopped before";
+  EXPECT_EQ(base.frames().back().bytes, speed.back().bytes);
+}
+
+// 1. Loaded by driver.launch nodelet:=true: drives the base, publishes "driver_node: base" and
+// "driver_node: port <path>" (the nodelet's name, not the manager's), and an unload through the
+// manager's service stops the wheels before the port closes.
+TEST(DriverNodelet, DrivesAndStopsTheWheelsOnUnload) {
+  std::string port;
+  ASSERT_TRUE(ros::param::get("/driver_node/port", port));
+  auto base = makeBase(port);
+  ros::NodeHandle nh;
+  test_support::DiagnosticsWatch diagnostics(nh, "driver_node");
+
+  Driving driving("/cmd_vel");
+  ASSERT_TRUE(driving.connected(30.0)) << "the nodelet does not subscribe to cmd_vel";
+  ASSERT_TRUE(base->waitForFrames(
+      [](const std::vector<FakeDevice::Frame>& frames) {
+        int moving = 0;
+        for (const auto& f : frames) moving += isMoving(f) ? 1 : 0;
+        return moving >= 10;
+      },
+      20.0));
+  ASSERT_TRUE(waitFor([&] { return diagnostics.latest("base").received > 0; }, 10.0));
+  EXPECT_GT(diagnostics.latest("port " + port).received, 0u);
+  EXPECT_EQ(diagnostics.latest("port " + port).value("path"), port);
+
+  nodelet::NodeletUnload unload;
+  unload.request.name = "/driver_node";
+  ASSERT_TRUE(ros::service::waitForService("/driver_nodelet_manager/unload_nodelet", 10000));
+  ASSERT_TRUE(ros::service::call("/driver_nodelet_manager/unload_nodelet", unload));
+  EXPECT_TRUE(unload.response.success);
+  expectLastFrameIsZero(*base);
+}
+
+// 2. A manager of the test's own, stopped with SIGINT while the nodelet drives: the manager's
+// teardown destroys the nodelet, which writes the zero-speed frame; the manager exits.
+TEST(DriverNodelet, ManagerSigintStopsTheWheels) {
+  std::string port;
+  ASSERT_TRUE(ros::param::get("/driver_node/port", port));
+  port += "_sigint";
+  auto base = makeBase(port);
+  ros::param::set("/sig/driver_node/port", port);
+  ros::param::set("/sig/driver_node/base/battery_poll_rate", 0.0);
+  ros::param::set("/sig/driver_node/body/enabled", false);
+  ros::param::set("/sig/driver_node/servo_bus/enabled", false);
+
+  test_support::ChildProcess manager("rosrun",
+                                     {"nodelet", "nodelet", "manager", "__name:=sig_manager"});
+  ASSERT_TRUE(manager.started());
+  ASSERT_TRUE(ros::service::waitForService("/sig_manager/load_nodelet", 30000)) << manager.output();
+  nodelet::NodeletLoad load;
+  load.request.name = "/sig/driver_node";
+  load.request.type = "serial_robot_driver/DriverNodelet";
+  ASSERT_TRUE(ros::service::call("/sig_manager/load_nodelet", load)) << manager.output();
+  ASSERT_TRUE(load.response.success) << manager.output();
+
+  Driving driving("/sig/cmd_vel");
+  ASSERT_TRUE(driving.connected(30.0)) << manager.output();
+  ASSERT_TRUE(base->waitForFrames(
+      [](const std::vector<FakeDevice::Frame>& frames) {
+        int moving = 0;
+        for (const auto& f : frames) moving += isMoving(f) ? 1 : 0;
+        return moving >= 10;
+      },
+      20.0))
+      << manager.output();
+
+  manager.signal(SIGINT);
+  const auto status = manager.waitExit(20.0);
+  ASSERT_TRUE(status.has_value()) << "the manager did not exit on SIGINT\n" << manager.output();
+  expectLastFrameIsZero(*base);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  test_support::RosTestNode node(argc, argv, "test_nodelet");
+  return RUN_ALL_TESTS();
+}
