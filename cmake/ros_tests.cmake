@@ -43,3 +43,9 @@ add_rostest_gtest(test_analyzers test/rostest/analyzers.test test/rostest/test_a
 target_include_directories(test_analyzers PRIVATE ${catkin_INCLUDE_DIRS} ${diagnostic_aggregator_INCLUDE_DIRS})
 target_link_libraries(test_analyzers ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_analyzers driver_node robot_sim)
+
+add_rostest_gtest(test_servo_topics test/rostest/servo_topics.test
+  test/rostest/test_servo_topics.cpp)
+target_include_directories(test_servo_topics PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_servo_topics srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_servo_topics driver_node ${PROJECT_NAME}_generate_messages_cpp)

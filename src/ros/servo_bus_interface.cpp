@@ -363,6 +363,11 @@ void ServoBusInterface::pollOnce(PolledServo& servo) {
   const auto now = device::Clock::now();
   const auto period = std::chrono::duration_cast<device::Clock::duration>(poll_period_);
   std::lock_guard<std::mutex> lock(worker_mutex_);
+  if (status.error == device::ServoError::kNotConnected) {
+    // The port is down, not the servo: ask again at the poll rate once it is back.
+    servo.next_poll = now + period;
+    return;
+  }
   if (!status.ok()) {
     ++servo.failures;
     const bool was_online = servo.backoff.count() == 0;
