@@ -35,10 +35,10 @@ constexpr std::size_t kBatchAnswer = 1 + servo::kUserBlockSize;
 constexpr double kMaxSingleTurnDeg = 180.0;
 constexpr double kMaxMultiTurnDeg = 368640.0;  // 1024 turns
 constexpr double kMaxVelocityDps = 750.0;
-constexpr double kMinVelocityDps = 0.1;        // the wire unit; anything less is sent as 0
-constexpr uint16_t kMinRampMs = 20;            // the firmware's shortest ramp
+constexpr double kMinVelocityDps = 0.1;  // the wire unit; anything less is sent as 0
+constexpr uint16_t kMinRampMs = 20;      // the firmware's shortest ramp
 constexpr uint32_t kMaxMultiTurnIntervalMs = 4096000;
-constexpr uint8_t kDefaultServoId = 0;         // what RESET_USER_DATA sets the id to
+constexpr uint8_t kDefaultServoId = 0;  // what RESET_USER_DATA sets the id to
 
 std::string formatNumber(double value) {
   char text[32];
@@ -535,9 +535,9 @@ ServoStatus ServoBusClient::pollAngle(uint8_t id, double* angle_deg, Clock::time
   bus_mutex_.lockBackground();
   {
     std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
-    status = transact(servo::encodeReadAngle(id),
-                      Expectation(Command::kReadAngle, id, kReadAngleAnswer), options_.timeout, 1,
-                      &answer);
+    status =
+        transact(servo::encodeReadAngle(id), Expectation(Command::kReadAngle, id, kReadAngleAnswer),
+                 options_.timeout, 1, &answer);
     std::lock_guard<std::mutex> lock(state_mutex_);
     answered_at = pending_.arrival;
   }
@@ -592,8 +592,9 @@ ServoStatus ServoBusClient::move(const MoveRequest& request) {
     return invalid("velocity_dps " + formatNumber(request.velocity_dps) +
                    " is below 0.1 deg/s, the unit on the wire");
   }
-  for (const auto& [name, ramp] : {std::pair<const char*, uint16_t>{"accel_ms", request.accel_ms},
-                                   std::pair<const char*, uint16_t>{"decel_ms", request.decel_ms}}) {
+  for (const auto& [name, ramp] :
+       {std::pair<const char*, uint16_t>{"accel_ms", request.accel_ms},
+        std::pair<const char*, uint16_t>{"decel_ms", request.decel_ms}}) {
     if (ramp > 0 && ramp < kMinRampMs) {
       return invalid(std::string(name) + " " + std::to_string(ramp) +
                      " is under 20 ms, the shortest ramp the servo runs (0: not given)");
@@ -624,17 +625,17 @@ ServoStatus ServoBusClient::move(const MoveRequest& request) {
   Command cmd = Command::kRotate;
   if (by_velocity) {
     cmd = request.multi_turn ? Command::kMultiTurnMoveByVelocity : Command::kMoveByVelocity;
-    frame = request.multi_turn
-                ? servo::encodeMultiTurnMoveByVelocity(request.id, angle, velocity, ramps)
-                : servo::encodeMoveByVelocity(request.id, static_cast<int16_t>(angle), velocity,
-                                              ramps);
+    frame =
+        request.multi_turn
+            ? servo::encodeMultiTurnMoveByVelocity(request.id, angle, velocity, ramps)
+            : servo::encodeMoveByVelocity(request.id, static_cast<int16_t>(angle), velocity, ramps);
   } else if (with_ramps) {
     cmd = request.multi_turn ? Command::kMultiTurnMoveByInterval : Command::kMoveByInterval;
-    frame = request.multi_turn
-                ? servo::encodeMultiTurnMoveByInterval(request.id, angle, request.interval_ms,
-                                                       ramps)
-                : servo::encodeMoveByInterval(request.id, static_cast<int16_t>(angle),
-                                              static_cast<uint16_t>(request.interval_ms), ramps);
+    frame =
+        request.multi_turn
+            ? servo::encodeMultiTurnMoveByInterval(request.id, angle, request.interval_ms, ramps)
+            : servo::encodeMoveByInterval(request.id, static_cast<int16_t>(angle),
+                                          static_cast<uint16_t>(request.interval_ms), ramps);
   } else if (request.multi_turn) {
     cmd = Command::kMultiTurnMove;
     frame = servo::encodeMultiTurnMove(request.id, angle, request.interval_ms, request.power_mw);
@@ -790,19 +791,24 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
       if (answer.content[1] == kResultFailed) {
         return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");
       }
-      return ok(servoName(id) + " reset its user data to the factory defaults; it now answers at "
-                "id 0 (answer from id " + std::to_string(answer.id()) + ")");
+      return ok(servoName(id) +
+                " reset its user data to the factory defaults; it now answers at "
+                "id 0 (answer from id " +
+                std::to_string(answer.id()) + ")");
     }
     if (last.error != ServoError::kTimeout) return last;
     // No answer: the servo may have reset and moved to id 0 without answering. (For a servo at
     // id 0 already a PING proves nothing: the reset is re-sent instead.)
     if (id != kDefaultServoId && pingOnceLocked(kDefaultServoId).ok()) {
-      return ok(servoName(id) + " reset its user data to the factory defaults; it gave no answer "
+      return ok(servoName(id) +
+                " reset its user data to the factory defaults; it gave no answer "
                 "but now answers PING at id 0");
     }
   }
-  return fail(ServoError::kTimeout, servoName(id) + " did not answer RESET_USER_DATA and no servo "
-                                    "answers PING at id 0 (" + last.message + ")");
+  return fail(ServoError::kTimeout, servoName(id) +
+                                        " did not answer RESET_USER_DATA and no servo "
+                                        "answers PING at id 0 (" +
+                                        last.message + ")");
 }
 
 }  // namespace serial_robot_driver::device

@@ -57,10 +57,12 @@ constexpr std::array<ParamInfo, kParamCount> kParams = {{
     guarded(ServoDataId::kBaudrate, "baudrate", ParamType::kU8, 1, 7, kUnreachable),
     // 1 limit the power, 2 release the torque.
     readWrite(ServoDataId::kStallProtectMode, "stall_protect_mode", ParamType::kU8, "", 1, 2),
-    readWrite(ServoDataId::kStallPowerLimit, "stall_power_limit", ParamType::kU16, "mW", 0, kU16Max),
+    readWrite(ServoDataId::kStallPowerLimit, "stall_power_limit", ParamType::kU16, "mW", 0,
+              kU16Max),
     readWrite(ServoDataId::kOverVoltLow, "over_volt_low", ParamType::kU16, "mV", 0, kU16Max),
     readWrite(ServoDataId::kOverVoltHigh, "over_volt_high", ParamType::kU16, "mV", 0, kU16Max),
-    readWrite(ServoDataId::kOverTemperature, "over_temperature", ParamType::kU16, "degC", 0, kU16Max),
+    readWrite(ServoDataId::kOverTemperature, "over_temperature", ParamType::kU16, "degC", 0,
+              kU16Max),
     readWrite(ServoDataId::kOverPower, "over_power", ParamType::kU16, "mW", 0, kU16Max),
     readWrite(ServoDataId::kOverCurrent, "over_current", ParamType::kU16, "mA", 0, kU16Max),
     onOff(ServoDataId::kAccelSwitch, "accel_switch"),
@@ -70,9 +72,12 @@ constexpr std::array<ParamInfo, kParamCount> kParams = {{
     onOff(ServoDataId::kAngleLimitSwitch, "angle_limit_switch"),
     onOff(ServoDataId::kSoftStartSwitch, "soft_start_switch"),
     readWrite(ServoDataId::kSoftStartTime, "soft_start_time", ParamType::kU16, "ms", 0, kU16Max),
-    readWrite(ServoDataId::kAngleLimitHigh, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
-    readWrite(ServoDataId::kAngleLimitLow, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
-    readWrite(ServoDataId::kAngleMidOffset, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(ServoDataId::kAngleLimitHigh, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min,
+              kI16Max),
+    readWrite(ServoDataId::kAngleLimitLow, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min,
+              kI16Max),
+    readWrite(ServoDataId::kAngleMidOffset, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min,
+              kI16Max),
 }};
 
 // The vendor's spellings, accepted so that names copied from its datasheet work.

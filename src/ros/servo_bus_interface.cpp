@@ -337,10 +337,9 @@ void ServoBusInterface::workerLoop() {
       continue;
     }
     // The servo whose poll is due first.
-    auto due = std::min_element(polled_.begin(), polled_.end(),
-                                [](const PolledServo& a, const PolledServo& b) {
-                                  return a.next_poll < b.next_poll;
-                                });
+    auto due = std::min_element(
+        polled_.begin(), polled_.end(),
+        [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
     if (due == polled_.end()) {
       worker_cv_.wait(lock, [this] { return worker_stop_ || !queued_moves_.empty(); });
       continue;
@@ -374,7 +373,8 @@ void ServoBusInterface::pollOnce(PolledServo& servo) {
     servo.backoff = was_online ? kFirstBackoff : std::min(servo.backoff * 2, kMaxBackoff);
     servo.next_poll = now + servo.backoff;
     if (was_online) {
-      ROS_WARN_THROTTLE(kWarnThrottleS, "servo_states: %s does not answer (%s); asked again in %.1f s",
+      ROS_WARN_THROTTLE(kWarnThrottleS,
+                        "servo_states: %s does not answer (%s); asked again in %.1f s",
                         servoJointName(servo.id).c_str(), status.message.c_str(),
                         servo.backoff.count() / kMsPerSecond);
     }
@@ -445,7 +445,8 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   std::lock_guard<std::mutex> lock(worker_mutex_);
   std::string offline;
   for (const PolledServo& servo : polled_) {
-    if (servo.backoff.count() > 0) offline += (offline.empty() ? "" : ", ") + std::to_string(servo.id);
+    if (servo.backoff.count() > 0)
+      offline += (offline.empty() ? "" : ", ") + std::to_string(servo.id);
   }
   status.add("servo_states published", states_published_);
   status.add("polled servos offline", offline.empty() ? std::string("none") : offline);

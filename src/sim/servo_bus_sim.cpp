@@ -364,10 +364,9 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
       Motion motion;
       motion.cmd = cmd;
       motion.multi_turn = multi_turn;
-      motion.target_angle =
-          (multi_turn ? static_cast<int32_t>(protocol::readLE32(content + 1))
-                      : protocol::readLE16Signed(content + 1)) /
-          10.0;
+      motion.target_angle = (multi_turn ? static_cast<int32_t>(protocol::readLE32(content + 1))
+                                        : protocol::readLE16Signed(content + 1)) /
+                            10.0;
       const uint8_t* second = content + 1 + angle_size;
       const double second_value =
           second_size == 4 ? protocol::readLE32(second) : protocol::readLE16(second);
@@ -389,9 +388,9 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
       if (size != 1) return malformed();
       servo::MultiTurnAngle reading;
       reading.id = id;
-      const double decidegrees = std::clamp(std::round(s->angle_deg * 10.0),
-                                            double(std::numeric_limits<int32_t>::min()),
-                                            double(std::numeric_limits<int32_t>::max()));
+      const double decidegrees =
+          std::clamp(std::round(s->angle_deg * 10.0), double(std::numeric_limits<int32_t>::min()),
+                     double(std::numeric_limits<int32_t>::max()));
       reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
       reading.turns = static_cast<int16_t>(std::trunc(s->angle_deg / kDegreesPerTurn));
       reply(Command::kReadMultiTurnAngle, servo::multiTurnAngleContent(reading));

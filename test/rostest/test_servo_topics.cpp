@@ -2,16 +2,16 @@
 // and 7 of a simulated bus (sim::RobotSim in this process, servos 0..3; 7 is absent) and moves
 // them from servo_commands. Checked through the topics, the simulator's servo angles and the
 // node's diagnostics. No timing assertions: every wait has a generous deadline.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <ros/ros.h>
-#include <sensor_msgs/JointState.h>
 
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"

@@ -215,8 +215,7 @@ TEST(ServoBusCodec, NegativeMultiTurnAngleAndTurnsAreSigned) {
   ASSERT_TRUE(angle.ok());
   EXPECT_EQ(angle->angle_decidegrees, -12345);
   EXPECT_EQ(angle->turns, -3);
-  EXPECT_EQ(multiTurnAngleContent(*angle),
-            Bytes(reply.begin() + 4, reply.end() - 1));
+  EXPECT_EQ(multiTurnAngleContent(*angle), Bytes(reply.begin() + 4, reply.end() - 1));
 }
 
 TEST(ServoBusCodec, MultiTurnAngleAnswerOfWrongSizeIsRejected) {

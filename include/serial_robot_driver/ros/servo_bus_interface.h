@@ -10,6 +10,11 @@
 // work), so a service call waits for one transaction at most.
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -20,21 +25,15 @@
 #include <thread>
 #include <vector>
 
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <ros/callback_queue.h>
-#include <ros/ros.h>
-
-#include <sensor_msgs/JointState.h>
-
 #include "serial_robot_driver/ServoDamping.h"
 #include "serial_robot_driver/ServoMove.h"
-#include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoReadAll.h"
 #include "serial_robot_driver/ServoReadAngle.h"
 #include "serial_robot_driver/ServoResetUserData.h"
 #include "serial_robot_driver/ServoRotate.h"
+#include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/device/serial_link.h"

@@ -6,9 +6,10 @@
 // trapezoidal speed profile. Each servo keeps a multi-turn angle: READ_ANGLE reports it folded into
 // one turn, CMD 16 reports it whole with its turn count; a single-turn move starts from the folded
 // angle (assumption: the datasheet does not say). RESET_USER_DATA restores the factory user block,
-// id 0 included, and answers from id 0. Answers leave after a small latency; the optional SPIN/ROTATE/DAMPING
-// answers only when response_switch is 1, and only once the motion has completed. Requests that
-// reach no present servo, broadcasts (id 255) and READ_DATA of an unknown data_id get no answer.
+// id 0 included, and answers from id 0. Answers leave after a small latency; the optional
+// SPIN/ROTATE/DAMPING answers only when response_switch is 1, and only once the motion has
+// completed. Requests that reach no present servo, broadcasts (id 255) and READ_DATA of an unknown
+// data_id get no answer.
 #pragma once
 
 #include <array>
