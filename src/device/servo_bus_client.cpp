@@ -205,6 +205,11 @@ void BusMutex::lockBackground() {
   held_ = true;
 }
 
+int BusMutex::foregroundWaiting() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return waiting_;
+}
+
 void BusMutex::unlock() {
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -507,6 +507,31 @@ TEST_F(ServoBusClientTest, ScanListsTheIdsThatAnswerWithOneAttemptEach) {
   EXPECT_EQ(client_.stats().retries, 0u);
 }
 
+TEST(BusMutexTest, AWaitingForegroundCallerGoesBeforeBackgroundWork) {
+  BusMutex bus;
+  std::mutex order_mutex;
+  std::vector<std::string> order;
+  const auto record = [&](const char* who) {
+    std::lock_guard<std::mutex> lock(order_mutex);
+    order.push_back(who);
+  };
+  bus.lock();  // a transaction in progress
+  std::thread foreground([&] {
+    std::lock_guard<BusMutex> held(bus);
+    record("foreground");
+  });
+  while (bus.foregroundWaiting() == 0) std::this_thread::yield();
+  std::thread background([&] {
+    bus.lockBackground();
+    record("background");
+    bus.unlock();
+  });
+  bus.unlock();
+  foreground.join();
+  background.join();
+  EXPECT_EQ(order, (std::vector<std::string>{"foreground", "background"}));
+}
+
 // --- every rejection: the right error, a message naming the problem, and not one byte written ---
 
 struct Rejection {

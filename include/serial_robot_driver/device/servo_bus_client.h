@@ -131,6 +131,8 @@ class BusMutex {
   void lock();
   void unlock();
   void lockBackground();
+  /// Foreground callers waiting right now (for tests and diagnostics).
+  int foregroundWaiting();
 
  private:
   std::mutex mutex_;
