@@ -62,3 +62,9 @@ add_rostest_gtest(test_port_busy test/rostest/port_busy.test test/rostest/test_p
 target_include_directories(test_port_busy PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_port_busy srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_port_busy driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+add_rostest_gtest(test_servo_topics test/rostest/servo_topics.test
+  test/rostest/test_servo_topics.cpp)
+target_include_directories(test_servo_topics PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_servo_topics srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_servo_topics driver_node ${PROJECT_NAME}_generate_messages_cpp)

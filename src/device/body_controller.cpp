@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <utility>
 
@@ -26,18 +27,41 @@ double JointCalibration::toRadiansPerSecond(int16_t raw_speed) const {
   return direction * raw_speed * radiansPerTick(*this);
 }
 
+namespace {
+double highestTick(const JointCalibration& calibration) {
+  return std::min<double>(calibration.ticks_per_revolution - 1,
+                          std::numeric_limits<uint16_t>::max());
+}
+}  // namespace
+
 std::optional<uint16_t> JointCalibration::toTicks(double radians) const {
   if (!std::isfinite(radians)) return std::nullopt;
   // direction is +-1, so dividing by it is multiplying by it.
-  const double ticks = zero_ticks + direction * radians / radiansPerTick(*this);
-  const double clamped =
-      std::clamp(std::round(ticks), 0.0, static_cast<double>(std::numeric_limits<uint16_t>::max()));
-  return static_cast<uint16_t>(clamped);
+  const double ticks = std::round(zero_ticks + direction * radians / radiansPerTick(*this));
+  // Never clamp: a clamped target is a position nobody asked for.
+  if (ticks < 0.0 || ticks > highestTick(*this)) return std::nullopt;
+  return static_cast<uint16_t>(ticks);
+}
+
+std::pair<double, double> JointCalibration::reachableRadians() const {
+  const double a = toRadians(0);
+  const double b = toRadians(static_cast<uint16_t>(highestTick(*this)));
+  return {std::min(a, b), std::max(a, b)};
+}
+
+std::string JointCommandResult::outOfRangeText() const {
+  std::string text;
+  for (const std::string& entry : out_of_range) text += (text.empty() ? "" : "; ") + entry;
+  return text;
 }
 
 std::string JointCommandResult::message() const {
   switch (status) {
     case JointCommandStatus::kSent:
+      if (!out_of_range.empty()) {
+        return "joint command sent without the joints beyond their servo's reach (" +
+               outOfRangeText() + ")";
+      }
       return "sent";
     case JointCommandStatus::kEmpty:
       return "joint command names no joint";
@@ -49,6 +73,9 @@ std::string JointCommandResult::message() const {
       return "joint command names joint '" + joint + "' more than once";
     case JointCommandStatus::kNotFinite:
       return "joint command has a NaN or infinite position for joint '" + joint + "'";
+    case JointCommandStatus::kOutOfRange:
+      return "joint command not written: every target is beyond its servo's reach (" +
+             outOfRangeText() + ")";
     case JointCommandStatus::kWriteFailed:
       return "joint command not written: the body port is not connected";
   }
@@ -102,13 +129,28 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
         result.status = JointCommandStatus::kDuplicateJoint;
         break;
       }
+      if (!std::isfinite(positions[i])) {
+        result.status = JointCommandStatus::kNotFinite;
+        break;
+      }
       requested[index] = joint->calibration.toTicks(positions[i]);
-      if (!requested[index]) result.status = JointCommandStatus::kNotFinite;
+      if (!requested[index]) {
+        // Left out, not clamped: the servo keeps its last target instead of an invented one.
+        const auto [low, high] = joint->calibration.reachableRadians();
+        char text[160];
+        std::snprintf(text, sizeof(text), "%s: %.3f rad is outside %.3f .. %.3f rad",
+                      names[i].c_str(), positions[i], low, high);
+        result.out_of_range.push_back(text);
+      }
     }
     if (result.ok()) result.joint.clear();
+    if (result.ok() && result.out_of_range.size() == names.size()) {
+      result.status = JointCommandStatus::kOutOfRange;
+    }
   }
 
   std::lock_guard<std::mutex> lock(mutex_);
+  stats_.joints_out_of_range += result.out_of_range.size();
   if (!result.ok()) {
     ++stats_.commands_rejected;
     return result;

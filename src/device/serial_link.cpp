@@ -1,5 +1,6 @@
 #include "serial_robot_driver/device/serial_link.h"
 
+#include <algorithm>
 #include <array>
 
 #include "serial_robot_driver/transport/serial_port.h"
@@ -176,9 +177,25 @@ void SerialLink::readerLoop() {
       sleepBeforeRetry();
       continue;
     }
+    int read_timeout_ms = kReadTimeoutMs;
+    if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
+      const auto quiet = Clock::now() - chunk_arrival_;
+      if (quiet >= options_.stale_frame_timeout) {
+        // No byte for a whole timeout: what is buffered will not complete. Frames found behind
+        // the stale candidate keep the arrival time of their bytes.
+        while (framer_.dropStaleCandidate()) {
+        }
+        std::lock_guard<std::mutex> lock(state_mutex_);
+        stats_.framer = framer_.stats();
+        continue;
+      }
+      const auto left = std::chrono::ceil<std::chrono::milliseconds>(
+          options_.stale_frame_timeout - quiet);
+      read_timeout_ms = std::clamp<int>(static_cast<int>(left.count()), 1, kReadTimeoutMs);
+    }
     std::size_t n = 0;
     try {
-      n = stream_->read(chunk.data(), chunk.size(), kReadTimeoutMs);
+      n = stream_->read(chunk.data(), chunk.size(), read_timeout_ms);
     } catch (const transport::TransportError& e) {
       closeStream(e.what());
       sleepBeforeRetry();

@@ -31,6 +31,21 @@ constexpr std::size_t kReadAngleAnswer = 3;     // id, angle (i16)
 constexpr std::size_t kReadDataHeader = 2;      // id, data_id, then the value
 constexpr std::size_t kBatchAnswer = 1 + servo::kUserBlockSize;
 
+// servo/move limits (vendor SDK and datasheet).
+constexpr double kMaxSingleTurnDeg = 180.0;
+constexpr double kMaxMultiTurnDeg = 368640.0;  // 1024 turns
+constexpr double kMaxVelocityDps = 750.0;
+constexpr double kMinVelocityDps = 0.1;  // the wire unit; anything less is sent as 0
+constexpr uint16_t kMinRampMs = 20;      // the firmware's shortest ramp
+constexpr uint32_t kMaxMultiTurnIntervalMs = 4096000;
+constexpr uint8_t kDefaultServoId = 0;  // what RESET_USER_DATA sets the id to
+
+std::string formatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
 const char* commandName(Command cmd) {
   switch (cmd) {
     case Command::kPing:
@@ -53,6 +68,18 @@ const char* commandName(Command cmd) {
       return "DAMPING";
     case Command::kReadAngle:
       return "READ_ANGLE";
+    case Command::kMoveByInterval:
+      return "MOVE_BY_INTERVAL (CMD 11)";
+    case Command::kMoveByVelocity:
+      return "MOVE_BY_VELOCITY (CMD 12)";
+    case Command::kMultiTurnMove:
+      return "MULTI_TURN_MOVE (CMD 13)";
+    case Command::kMultiTurnMoveByInterval:
+      return "MULTI_TURN_MOVE_BY_INTERVAL (CMD 14)";
+    case Command::kMultiTurnMoveByVelocity:
+      return "MULTI_TURN_MOVE_BY_VELOCITY (CMD 15)";
+    case Command::kReadMultiTurnAngle:
+      return "READ_MULTI_TURN_ANGLE (CMD 16)";
   }
   return "UNKNOWN";
 }
@@ -162,6 +189,33 @@ const char* toString(ServoError error) {
       return "shutting down";
   }
   return "unknown";
+}
+
+void BusMutex::lock() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  ++waiting_;
+  released_.wait(lock, [this] { return !held_; });
+  --waiting_;
+  held_ = true;
+}
+
+void BusMutex::lockBackground() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  released_.wait(lock, [this] { return !held_ && waiting_ == 0; });
+  held_ = true;
+}
+
+int BusMutex::foregroundWaiting() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return waiting_;
+}
+
+void BusMutex::unlock() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    held_ = false;
+  }
+  released_.notify_all();
 }
 
 ServoBusClient::ServoBusClient(ServoBusOptions options, FrameWriter writer)
@@ -309,7 +363,7 @@ ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
 
 ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const Expectation& expect,
                                      servo::Packet* answer) {
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   return exchangeLocked(request, expect, answer);
 }
 
@@ -361,7 +415,7 @@ ServoStatus ServoBusClient::pingLocked(uint8_t id) {
 
 ServoStatus ServoBusClient::ping(uint8_t id) {
   if (auto rejection = rejectBroadcast(id, Command::kPing)) return *rejection;
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   return pingLocked(id);
 }
 
@@ -392,7 +446,7 @@ ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
                     " (use a name such as 'voltage' or a data_id such as '51')");
   }
   if (auto rejection = rejectBroadcast(id, Command::kReadData)) return *rejection;
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   return readParamLocked(id, *param, value);
 }
 
@@ -407,7 +461,7 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
   const servo::WriteCheck check = servo::checkWrite(*param, value, options_.allow_dangerous_writes);
   if (check != servo::WriteCheck::kOk) return fromWriteCheck(check, *param, value);
 
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   const bool id_change = param->data_id == kServoIdParam && value != id;
   const uint8_t new_id = static_cast<uint8_t>(value);
   if (id_change) {
@@ -457,17 +511,177 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
             " (written and read back)");
 }
 
-ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg) {
+ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival) {
   if (auto rejection = rejectBroadcast(id, Command::kReadAngle)) return *rejection;
   servo::Packet answer;
-  const ServoStatus status = exchange(
-      servo::encodeReadAngle(id), Expectation(Command::kReadAngle, id, kReadAngleAnswer), &answer);
+  Clock::time_point answered_at;
+  ServoStatus status;
+  {
+    std::lock_guard<BusMutex> bus(bus_mutex_);
+    status = exchangeLocked(servo::encodeReadAngle(id),
+                            Expectation(Command::kReadAngle, id, kReadAngleAnswer), &answer);
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    answered_at = pending_.arrival;
+  }
   if (!status.ok()) return status;
+  if (arrival != nullptr) *arrival = answered_at;
   const int16_t decidegrees = protocol::readLE16Signed(&answer.content[1]);
   *angle_deg = decidegrees / kDecidegreesPerDegree;
   char text[32];
   std::snprintf(text, sizeof(text), "%.1f deg", *angle_deg);
   return ok(servoName(id) + " is at " + text);
+}
+
+ServoStatus ServoBusClient::pollAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival) {
+  if (auto rejection = rejectBroadcast(id, Command::kReadAngle)) return *rejection;
+  servo::Packet answer;
+  Clock::time_point answered_at;
+  ServoStatus status;
+  bus_mutex_.lockBackground();
+  {
+    std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
+    status =
+        transact(servo::encodeReadAngle(id), Expectation(Command::kReadAngle, id, kReadAngleAnswer),
+                 options_.timeout, 1, &answer);
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    answered_at = pending_.arrival;
+  }
+  if (!status.ok()) return status;
+  *arrival = answered_at;
+  *angle_deg = protocol::readLE16Signed(&answer.content[1]) / kDecidegreesPerDegree;
+  return status;
+}
+
+ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* reading) {
+  if (auto rejection = rejectBroadcast(id, Command::kReadMultiTurnAngle)) return *rejection;
+  servo::Packet answer;
+  const ServoStatus status = exchange(
+      servo::encodeReadMultiTurnAngle(id),
+      Expectation(Command::kReadMultiTurnAngle, id, servo::kMultiTurnAngleAnswerSize), &answer);
+  if (!status.ok()) return status;
+  const protocol::Decoded<servo::MultiTurnAngle> decoded =
+      servo::decodeMultiTurnAngle(answer.content.data(), answer.content_size);
+  if (!decoded) {
+    return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable multi-turn angle");
+  }
+  reading->angle_deg = decoded->angle_decidegrees / kDecidegreesPerDegree;
+  reading->turns = decoded->turns;
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.1f deg (%d turns)", reading->angle_deg, reading->turns);
+  return ok(servoName(id) + " is at " + text);
+}
+
+ServoStatus ServoBusClient::move(const MoveRequest& request) {
+  const auto invalid = [](const std::string& text) {
+    return fail(ServoError::kInvalidArgument, text);
+  };
+  if (!std::isfinite(request.angle_deg)) return invalid("angle_deg is not a finite number");
+  if (!std::isfinite(request.velocity_dps)) return invalid("velocity_dps is not a finite number");
+  const double max_angle = request.multi_turn ? kMaxMultiTurnDeg : kMaxSingleTurnDeg;
+  if (std::fabs(request.angle_deg) > max_angle) {
+    return invalid("angle_deg " + formatNumber(request.angle_deg) + " is out of range +-" +
+                   formatNumber(max_angle) + " deg for a " +
+                   (request.multi_turn ? "multi-turn" : "single-turn") + " move");
+  }
+  if (request.velocity_dps < 0) {
+    return invalid("velocity_dps " + formatNumber(request.velocity_dps) +
+                   " is negative (0: not by velocity; the sign of the motion is the angle's)");
+  }
+  const bool by_velocity = request.velocity_dps > 0;
+  const bool with_ramps = by_velocity || request.accel_ms > 0 || request.decel_ms > 0;
+  if (by_velocity && request.velocity_dps > kMaxVelocityDps) {
+    return invalid("velocity_dps " + formatNumber(request.velocity_dps) +
+                   " is above the servo's 750 deg/s");
+  }
+  if (by_velocity && request.velocity_dps < kMinVelocityDps) {
+    return invalid("velocity_dps " + formatNumber(request.velocity_dps) +
+                   " is below 0.1 deg/s, the unit on the wire");
+  }
+  for (const auto& [name, ramp] :
+       {std::pair<const char*, uint16_t>{"accel_ms", request.accel_ms},
+        std::pair<const char*, uint16_t>{"decel_ms", request.decel_ms}}) {
+    if (ramp > 0 && ramp < kMinRampMs) {
+      return invalid(std::string(name) + " " + std::to_string(ramp) +
+                     " is under 20 ms, the shortest ramp the servo runs (0: not given)");
+    }
+  }
+  const uint32_t max_interval =
+      request.multi_turn ? kMaxMultiTurnIntervalMs : std::numeric_limits<uint16_t>::max();
+  if (!by_velocity && request.interval_ms > max_interval) {
+    return invalid("interval_ms " + std::to_string(request.interval_ms) + " is above " +
+                   std::to_string(max_interval) + " ms for a " +
+                   (request.multi_turn ? "multi-turn" : "single-turn") + " move");
+  }
+  servo::MoveRamps ramps;
+  ramps.accel_ms = std::max(request.accel_ms, kMinRampMs);
+  ramps.decel_ms = std::max(request.decel_ms, kMinRampMs);
+  ramps.power_mw = request.power_mw;
+  if (with_ramps && !by_velocity && request.interval_ms < ramps.accel_ms + ramps.decel_ms) {
+    return invalid("interval_ms " + std::to_string(request.interval_ms) +
+                   " is shorter than accel + decel (" +
+                   std::to_string(ramps.accel_ms + ramps.decel_ms) + " ms)");
+  }
+
+  // On the wire as the vendor SDK puts them: int(value * 10), truncated toward zero.
+  const auto angle = static_cast<int32_t>(std::trunc(request.angle_deg * kDecidegreesPerDegree));
+  const auto velocity =
+      static_cast<uint16_t>(std::trunc(request.velocity_dps * kDecidegreesPerDegree));
+  std::vector<uint8_t> frame;
+  Command cmd = Command::kRotate;
+  if (by_velocity) {
+    cmd = request.multi_turn ? Command::kMultiTurnMoveByVelocity : Command::kMoveByVelocity;
+    frame =
+        request.multi_turn
+            ? servo::encodeMultiTurnMoveByVelocity(request.id, angle, velocity, ramps)
+            : servo::encodeMoveByVelocity(request.id, static_cast<int16_t>(angle), velocity, ramps);
+  } else if (with_ramps) {
+    cmd = request.multi_turn ? Command::kMultiTurnMoveByInterval : Command::kMoveByInterval;
+    frame =
+        request.multi_turn
+            ? servo::encodeMultiTurnMoveByInterval(request.id, angle, request.interval_ms, ramps)
+            : servo::encodeMoveByInterval(request.id, static_cast<int16_t>(angle),
+                                          static_cast<uint16_t>(request.interval_ms), ramps);
+  } else if (request.multi_turn) {
+    cmd = Command::kMultiTurnMove;
+    frame = servo::encodeMultiTurnMove(request.id, angle, request.interval_ms, request.power_mw);
+  } else {
+    frame = servo::encodeRotate(request.id, static_cast<int16_t>(angle),
+                                static_cast<uint16_t>(request.interval_ms), request.power_mw);
+  }
+  std::lock_guard<BusMutex> bus(bus_mutex_);
+  return sendCommand(frame, cmd, request.id);
+}
+
+ServoStatus ServoBusClient::pingOnceLocked(uint8_t id) {
+  servo::Packet answer;
+  return transact(servo::encodePing(id), Expectation(Command::kPing, id, kIdOnlyAnswer),
+                  options_.timeout, 1, &answer);
+}
+
+ServoStatus ServoBusClient::scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids) {
+  if (first_id > last_id) {
+    return fail(ServoError::kInvalidArgument, "first_id " + std::to_string(first_id) +
+                                                  " is above last_id " + std::to_string(last_id));
+  }
+  if (last_id == servo::kBroadcastId) {
+    return fail(ServoError::kInvalidArgument,
+                "id 255 is the broadcast address and cannot be scanned (ids 0..254)");
+  }
+  ids->clear();
+  for (int id = first_id; id <= last_id; ++id) {
+    // The bus is taken per id: a service call or a poll waits for one PING at most.
+    std::lock_guard<BusMutex> bus(bus_mutex_);
+    const ServoStatus status = pingOnceLocked(static_cast<uint8_t>(id));
+    if (status.ok()) {
+      ids->push_back(static_cast<uint8_t>(id));
+    } else if (status.error != ServoError::kTimeout && status.error != ServoError::kBadAnswer) {
+      return fail(status.error, "scan stopped at id " + std::to_string(id) + ": " + status.message);
+    }
+  }
+  std::string list;
+  for (uint8_t id : *ids) list += (list.empty() ? "" : ", ") + std::to_string(id);
+  return ok(std::to_string(ids->size()) + " of " + std::to_string(last_id - first_id + 1) +
+            " ids answered PING" + (list.empty() ? "" : ": " + list));
 }
 
 ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
@@ -488,7 +702,7 @@ ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
   const std::vector<uint8_t> frame =
       servo::encodeRotate(request.id, static_cast<int16_t>(decidegrees), request.interval_ms,
                           request.power_mw);
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   return sendMotion(frame, Command::kRotate, request.id, request.wait,
                     std::chrono::milliseconds(request.interval_ms));
 }
@@ -522,7 +736,7 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request) {
   }
   const std::vector<uint8_t> frame = servo::encodeSpin(request.id, request.clockwise, mode,
                                                        request.speed_dps, request.value);
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time);
 }
 
@@ -531,7 +745,7 @@ ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait) {
     if (auto rejection = rejectBroadcast(id, Command::kDamping)) return *rejection;
   }
   const std::vector<uint8_t> frame = servo::encodeDamping(id, power_mw);
-  std::lock_guard<std::mutex> bus(bus_mutex_);
+  std::lock_guard<BusMutex> bus(bus_mutex_);
   return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0));
 }
 
@@ -570,15 +784,36 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
                 "reset_user_data restores the factory id and baud rate and can make the servo "
                 "unreachable; refused because dangerous writes are not allowed");
   }
-  servo::Packet answer;
-  const ServoStatus status =
-      exchange(servo::encodeResetUserData(id),
-               Expectation(Command::kResetUserData, id, kResultAnswer), &answer);
-  if (!status.ok()) return status;
-  if (answer.content[1] == kResultFailed) {
-    return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");
+  Expectation expect(Command::kResetUserData, id, kResultAnswer);
+  expect.alt_id = kDefaultServoId;  // the reset moves the servo to id 0 and it may answer there
+  std::lock_guard<BusMutex> bus(bus_mutex_);
+  ServoStatus last;
+  for (int attempt = 1; attempt <= options_.retries + 1; ++attempt) {
+    servo::Packet answer;
+    // One attempt at a time: a re-sent reset would go to an id the servo may have left already.
+    last = transact(servo::encodeResetUserData(id), expect, options_.timeout, 1, &answer);
+    if (last.ok()) {
+      if (answer.content[1] == kResultFailed) {
+        return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");
+      }
+      return ok(servoName(id) +
+                " reset its user data to the factory defaults; it now answers at "
+                "id 0 (answer from id " +
+                std::to_string(answer.id()) + ")");
+    }
+    if (last.error != ServoError::kTimeout) return last;
+    // No answer: the servo may have reset and moved to id 0 without answering. (For a servo at
+    // id 0 already a PING proves nothing: the reset is re-sent instead.)
+    if (id != kDefaultServoId && pingOnceLocked(kDefaultServoId).ok()) {
+      return ok(servoName(id) +
+                " reset its user data to the factory defaults; it gave no answer "
+                "but now answers PING at id 0");
+    }
   }
-  return ok(servoName(id) + " reset its user data to the factory defaults");
+  return fail(ServoError::kTimeout, servoName(id) +
+                                        " did not answer RESET_USER_DATA and no servo "
+                                        "answers PING at id 0 (" +
+                                        last.message + ")");
 }
 
 }  // namespace serial_robot_driver::device

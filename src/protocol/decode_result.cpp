@@ -16,6 +16,8 @@ const char* toString(DecodeError error) {
       return "bad tail";
     case DecodeError::kUnexpectedContent:
       return "unexpected content";
+    case DecodeError::kUnknownCommand:
+      return "unknown command";
   }
   return "unknown decode error";
 }

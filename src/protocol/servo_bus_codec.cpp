@@ -45,7 +45,7 @@ Decoded<Packet> decodePacket(uint8_t header0, uint8_t header1, const uint8_t* da
   if (size < content_size + kOverhead) return DecodeError::kTooShort;
   if (size > content_size + kOverhead) return DecodeError::kBadLength;
   const uint8_t cmd = data[kCmdOffset];
-  if (cmd < kMinCommand || cmd > kMaxCommand) return DecodeError::kUnexpectedContent;
+  if (!isKnownCommand(cmd)) return DecodeError::kUnknownCommand;
   if (byteSum(data, size - 1) != data[size - 1]) return DecodeError::kBadChecksum;
 
   Packet packet;
@@ -127,6 +127,96 @@ std::vector<uint8_t> encodeReadAngle(uint8_t id) {
 }
 
 namespace {
+
+constexpr std::size_t kAngle16Size = 2;
+constexpr std::size_t kAngle32Size = 4;
+
+// id | angle (i16 or i32) | u16 or u32 | the ramps (accel, decel, power), all little-endian.
+std::vector<uint8_t> buildMove(Command cmd, uint8_t id, int32_t angle, std::size_t angle_size,
+                               uint32_t interval_or_velocity, std::size_t second_size,
+                               const MoveRamps* ramps, uint16_t power_mw) {
+  std::array<uint8_t, 1 + 4 + 4 + 3 * 2> content{};
+  std::size_t size = 0;
+  content[size++] = id;
+  if (angle_size == kAngle16Size) {
+    writeLE16(&content[size], static_cast<uint16_t>(static_cast<int16_t>(angle)));
+  } else {
+    writeLE32(&content[size], static_cast<uint32_t>(angle));
+  }
+  size += angle_size;
+  if (second_size == 2) {
+    writeLE16(&content[size], static_cast<uint16_t>(interval_or_velocity));
+  } else {
+    writeLE32(&content[size], interval_or_velocity);
+  }
+  size += second_size;
+  if (ramps != nullptr) {
+    writeLE16(&content[size], ramps->accel_ms);
+    writeLE16(&content[size + 2], ramps->decel_ms);
+    size += 4;
+    power_mw = ramps->power_mw;
+  }
+  writeLE16(&content[size], power_mw);
+  size += 2;
+  return buildRequest(cmd, content.data(), size);
+}
+
+}  // namespace
+
+std::vector<uint8_t> encodeMoveByInterval(uint8_t id, int16_t angle_decidegrees,
+                                          uint16_t interval_ms, const MoveRamps& ramps) {
+  return buildMove(Command::kMoveByInterval, id, angle_decidegrees, kAngle16Size, interval_ms, 2,
+                   &ramps, 0);
+}
+
+std::vector<uint8_t> encodeMoveByVelocity(uint8_t id, int16_t angle_decidegrees,
+                                          uint16_t velocity_decidegrees_per_s,
+                                          const MoveRamps& ramps) {
+  return buildMove(Command::kMoveByVelocity, id, angle_decidegrees, kAngle16Size,
+                   velocity_decidegrees_per_s, 2, &ramps, 0);
+}
+
+std::vector<uint8_t> encodeMultiTurnMove(uint8_t id, int32_t angle_decidegrees,
+                                         uint32_t interval_ms, uint16_t power_mw) {
+  return buildMove(Command::kMultiTurnMove, id, angle_decidegrees, kAngle32Size, interval_ms, 4,
+                   nullptr, power_mw);
+}
+
+std::vector<uint8_t> encodeMultiTurnMoveByInterval(uint8_t id, int32_t angle_decidegrees,
+                                                   uint32_t interval_ms, const MoveRamps& ramps) {
+  return buildMove(Command::kMultiTurnMoveByInterval, id, angle_decidegrees, kAngle32Size,
+                   interval_ms, 4, &ramps, 0);
+}
+
+std::vector<uint8_t> encodeMultiTurnMoveByVelocity(uint8_t id, int32_t angle_decidegrees,
+                                                   uint16_t velocity_decidegrees_per_s,
+                                                   const MoveRamps& ramps) {
+  return buildMove(Command::kMultiTurnMoveByVelocity, id, angle_decidegrees, kAngle32Size,
+                   velocity_decidegrees_per_s, 2, &ramps, 0);
+}
+
+std::vector<uint8_t> encodeReadMultiTurnAngle(uint8_t id) {
+  return buildIdOnlyRequest(Command::kReadMultiTurnAngle, id);
+}
+
+Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size) {
+  if (size != kMultiTurnAngleAnswerSize) return DecodeError::kBadLength;
+  MultiTurnAngle angle;
+  angle.id = content[0];
+  angle.angle_decidegrees = static_cast<int32_t>(readLE32(content + 1));
+  angle.turns = readLE16Signed(content + 5);
+  return angle;
+}
+
+std::vector<uint8_t> multiTurnAngleContent(const MultiTurnAngle& angle) {
+  std::vector<uint8_t> content(kMultiTurnAngleAnswerSize);
+  content[0] = angle.id;
+  writeLE32(&content[1], static_cast<uint32_t>(angle.angle_decidegrees));
+  writeLE16(&content[5], static_cast<uint16_t>(angle.turns));
+  return content;
+}
+
+namespace {
 Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data, std::size_t available) {
   if (available < 1) return Probe::needMore();
   if (data[0] != header0) return Probe::invalid(DecodeError::kBadHeader);
@@ -135,10 +225,10 @@ Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data, std::si
   if (available <= kSizeOffset) return Probe::needMore();
   const uint8_t cmd = data[kCmdOffset];
   const uint8_t content_size = data[kSizeOffset];
-  // An unknown CMD is treated like an impossible N: both mean a corrupted or misaligned header.
-  if (cmd < kMinCommand || cmd > kMaxCommand || content_size > kMaxContent) {
-    return Probe::invalid(DecodeError::kBadLength);
-  }
+  // Both mean a corrupted or misaligned header, but they are counted apart: an unknown CMD may
+  // also be a newer firmware's command.
+  if (!isKnownCommand(cmd)) return Probe::invalid(DecodeError::kUnknownCommand);
+  if (content_size > kMaxContent) return Probe::invalid(DecodeError::kBadLength);
   const std::size_t size = content_size + kOverhead;
   if (available < size) return Probe::needMore();
   if (byteSum(data, size - 1) != data[size - 1]) return Probe::invalid(DecodeError::kBadChecksum);

@@ -19,10 +19,21 @@ constexpr ParamInfo readOnly(ServoDataId id, std::string_view name, ParamType ty
   return ParamInfo{dataId(id), name, type, unit, true, false, 0, max};
 }
 constexpr ParamInfo readWrite(ServoDataId id, std::string_view name, ParamType type,
-                              std::string_view unit, int64_t min, int64_t max,
-                              bool dangerous = false) {
-  return ParamInfo{dataId(id), name, type, unit, false, dangerous, min, max};
+                              std::string_view unit, int64_t min, int64_t max) {
+  return ParamInfo{dataId(id), name, type, unit, false, false, min, max};
 }
+/// A write that needs allow_dangerous; `hazard` says why.
+constexpr ParamInfo guarded(ServoDataId id, std::string_view name, ParamType type, int64_t min,
+                            int64_t max, std::string_view hazard) {
+  return ParamInfo{dataId(id), name, type, "", false, true, min, max, hazard};
+}
+/// An on/off switch: 0 or 1 (datasheet).
+constexpr ParamInfo onOff(ServoDataId id, std::string_view name) {
+  return ParamInfo{dataId(id), name, ParamType::kU8, "", false, false, 0, 1};
+}
+
+constexpr std::string_view kUnreachable = "can make the servo unreachable";
+constexpr std::string_view kReservedCell = "is a reserved cell the datasheet does not describe";
 
 // PROTOCOLS.md section 3. Ranges are the type's unless the datasheet narrows them.
 constexpr std::array<ParamInfo, kParamCount> kParams = {{
@@ -34,30 +45,39 @@ constexpr std::array<ParamInfo, kParamCount> kParams = {{
     readOnly(ServoDataId::kServoType, "servo_type", ParamType::kU16, "", kU16Max),
     readOnly(ServoDataId::kFirmwareVersion, "firmware_version", ParamType::kU16, "", kU16Max),
     readOnly(ServoDataId::kSerialNumber, "serial_number", ParamType::kU32, "", kU32Max),
-    readWrite(ServoDataId::kReserved32, "reserved_32", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kResponseSwitch, "response_switch", ParamType::kU8, "", 0, 1),
+    guarded(ServoDataId::kReserved32, "reserved_32", ParamType::kU8, 0, kU8Max, kReservedCell),
+    // 1 makes every motion command queued and answered at completion: commands sent without
+    // waiting then pile up behind each other and their answers collide with later transactions.
+    guarded(ServoDataId::kResponseSwitch, "response_switch", ParamType::kU8, 0, 1,
+            "changes how motion commands are queued and answered on the shared bus"),
     // Changes the address the servo answers to: a mistake loses the servo.
-    readWrite(ServoDataId::kServoId, "servo_id", ParamType::kU8, "", 0, 254, true),
-    readWrite(ServoDataId::kReserved35, "reserved_35", ParamType::kU8, "", 0, kU8Max),
+    guarded(ServoDataId::kServoId, "servo_id", ParamType::kU8, 0, 254, kUnreachable),
+    guarded(ServoDataId::kReserved35, "reserved_35", ParamType::kU8, 0, kU8Max, kReservedCell),
     // Takes effect at once: the servo stops understanding us at our baud rate.
-    readWrite(ServoDataId::kBaudrate, "baudrate", ParamType::kU8, "", 1, 7, true),
-    readWrite(ServoDataId::kStallProtectMode, "stall_protect_mode", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kStallPowerLimit, "stall_power_limit", ParamType::kU16, "mW", 0, kU16Max),
+    guarded(ServoDataId::kBaudrate, "baudrate", ParamType::kU8, 1, 7, kUnreachable),
+    // 1 limit the power, 2 release the torque.
+    readWrite(ServoDataId::kStallProtectMode, "stall_protect_mode", ParamType::kU8, "", 1, 2),
+    readWrite(ServoDataId::kStallPowerLimit, "stall_power_limit", ParamType::kU16, "mW", 0,
+              kU16Max),
     readWrite(ServoDataId::kOverVoltLow, "over_volt_low", ParamType::kU16, "mV", 0, kU16Max),
     readWrite(ServoDataId::kOverVoltHigh, "over_volt_high", ParamType::kU16, "mV", 0, kU16Max),
-    readWrite(ServoDataId::kOverTemperature, "over_temperature", ParamType::kU16, "degC", 0, kU16Max),
+    readWrite(ServoDataId::kOverTemperature, "over_temperature", ParamType::kU16, "degC", 0,
+              kU16Max),
     readWrite(ServoDataId::kOverPower, "over_power", ParamType::kU16, "mW", 0, kU16Max),
     readWrite(ServoDataId::kOverCurrent, "over_current", ParamType::kU16, "mA", 0, kU16Max),
-    readWrite(ServoDataId::kAccelSwitch, "accel_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kReserved45, "reserved_45", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kPoLockSwitch, "po_lock_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kWbLockSwitch, "wb_lock_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kAngleLimitSwitch, "angle_limit_switch", ParamType::kU8, "", 0, kU8Max),
-    readWrite(ServoDataId::kSoftStartSwitch, "soft_start_switch", ParamType::kU8, "", 0, kU8Max),
+    onOff(ServoDataId::kAccelSwitch, "accel_switch"),
+    guarded(ServoDataId::kReserved45, "reserved_45", ParamType::kU8, 0, kU8Max, kReservedCell),
+    onOff(ServoDataId::kPoLockSwitch, "po_lock_switch"),
+    onOff(ServoDataId::kWbLockSwitch, "wb_lock_switch"),
+    onOff(ServoDataId::kAngleLimitSwitch, "angle_limit_switch"),
+    onOff(ServoDataId::kSoftStartSwitch, "soft_start_switch"),
     readWrite(ServoDataId::kSoftStartTime, "soft_start_time", ParamType::kU16, "ms", 0, kU16Max),
-    readWrite(ServoDataId::kAngleLimitHigh, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
-    readWrite(ServoDataId::kAngleLimitLow, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
-    readWrite(ServoDataId::kAngleMidOffset, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min, kI16Max),
+    readWrite(ServoDataId::kAngleLimitHigh, "angle_limit_high", ParamType::kI16, "0.1deg", kI16Min,
+              kI16Max),
+    readWrite(ServoDataId::kAngleLimitLow, "angle_limit_low", ParamType::kI16, "0.1deg", kI16Min,
+              kI16Max),
+    readWrite(ServoDataId::kAngleMidOffset, "angle_mid_offset", ParamType::kI16, "0.1deg", kI16Min,
+              kI16Max),
 }};
 
 // The vendor's spellings, accepted so that names copied from its datasheet work.
@@ -158,8 +178,9 @@ std::string describe(WriteCheck check, const ParamInfo& param, int64_t value) {
       return "value " + std::to_string(value) + " out of range " + std::to_string(param.min) +
              ".." + std::to_string(param.max) + " for parameter " + label(param);
     case WriteCheck::kDangerous:
-      return "writing parameter " + label(param) +
-             " can make the servo unreachable; refused because dangerous writes are not allowed";
+      return "writing parameter " + label(param) + " " +
+             std::string(param.hazard.empty() ? kUnreachable : param.hazard) +
+             "; refused because dangerous writes are not allowed";
   }
   return "unknown write check result";
 }

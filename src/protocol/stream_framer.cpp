@@ -155,6 +155,18 @@ void StreamFramer::feed(const uint8_t* data, std::size_t size) {
   }
 }
 
+bool StreamFramer::dropStaleCandidate() {
+  if (size_ == 0) return false;
+  ++stats_.stale_candidates;
+  ++stats_.bytes_skipped;
+  --size_;
+  std::memmove(buffer_.data(), buffer_.data() + 1, size_);
+  const std::size_t consumed = scan(buffer_.data(), size_, size_);
+  std::memmove(buffer_.data(), buffer_.data() + consumed, size_ - consumed);
+  size_ -= consumed;
+  return true;
+}
+
 void StreamFramer::reset() {
   stats_.bytes_skipped += size_;
   size_ = 0;
@@ -216,6 +228,9 @@ Probe StreamFramer::examine(const uint8_t* data, std::size_t available, FrameFam
     switch (result.reason) {
       case DecodeError::kBadLength:
         ++stats_.bad_lengths;
+        break;
+      case DecodeError::kUnknownCommand:
+        ++stats_.unknown_commands;
         break;
       case DecodeError::kBadChecksum:
         ++stats_.checksum_errors;

@@ -68,7 +68,9 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   const JointCommand command = fromJointState(*msg);
   const device::JointCommandResult result =
       controller_.sendJointCommand(command.names, command.positions);
-  if (!result.ok()) ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
+  if (!result.ok() || !result.out_of_range.empty()) {
+    ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
+  }
 }
 
 void BodyInterface::logTelemetryFlow(bool connected, uint64_t frames_decoded) {
@@ -109,6 +111,7 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
              stats.last_decode_error ? protocol::toString(*stats.last_decode_error) : "none");
   status.add("commands sent", stats.commands_sent);
   status.add("commands rejected", stats.commands_rejected);
+  status.add("joint targets out of range", stats.joints_out_of_range);
   status.add("command write failures", stats.write_failures);
   const device::LinkStats link_stats = link_.stats();
   status.add("port checksum errors", link_stats.framer.checksum_errors);

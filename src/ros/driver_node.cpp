@@ -114,6 +114,11 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     options.reconnect_interval = params_.reconnect_interval;
     options.framer = protocol::FramerConfig::forDriver(use.base, use.body, use.servo_bus,
                                                        params_.body.servo_ids.size());
+    if (use.servo_bus) {
+      // A servo answer must not wait behind a stray header longer than an answer may take.
+      options.stale_frame_timeout = std::chrono::milliseconds(
+          std::max<long>(1, std::lround(params_.servo_bus.timeout * 1000.0)));
+    }
     Port port;
     port.link = std::make_unique<device::SerialLink>(options, stream_factory);
     port.monitor = std::make_unique<PortMonitor>(*port.link);
@@ -208,6 +213,8 @@ void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticSt
   status.add("checksum errors", s.framer.checksum_errors);
   status.add("bad tails", s.framer.bad_tails);
   status.add("bad lengths", s.framer.bad_lengths);
+  status.add("unknown servo commands", s.framer.unknown_commands);
+  status.add("stale partial frames dropped", s.framer.stale_candidates);
   status.add("bytes skipped (resync)", s.framer.bytes_skipped);
   status.add("low latency", s.low_latency);
   status.add("latency_timer (ms)", s.latency_timer_ms ? std::to_string(*s.latency_timer_ms) : "n/a");

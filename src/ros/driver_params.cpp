@@ -152,8 +152,10 @@ std::vector<ParamSpec> buildTable() {
                         " servos fit in a telemetry frame");
             std::set<int> seen;
             for (int id : ids) {
-              require(id >= 0 && id <= 253, key,
-                      "ids must be 0..253 (254 is broadcast), got " + std::to_string(id));
+              // 253 = FD would put FF FF FD, the sync-write header, inside a sync-write frame.
+              require(id >= 0 && id <= 252, key,
+                      "ids must be 0..252 (253 would look like a frame header, 254 is broadcast), "
+                      "got " + std::to_string(id));
               require(seen.insert(id).second, key, "id " + std::to_string(id) + " is listed twice");
             }
           }),
@@ -212,6 +214,24 @@ std::vector<ParamSpec> buildTable() {
             require(v >= 0 && v <= 10, key, "must be 0..10");
           }),
       row("servo_bus/allow_dangerous_writes", &P::servo_bus, &Bus::allow_dangerous_writes),
+      row("servo_bus/state_ids", &P::servo_bus, &Bus::state_ids,
+          [](const std::vector<int>& ids, const std::string& key) {
+            std::set<int> seen;
+            for (int id : ids) {
+              require(id >= 0 && id <= 254, key,
+                      "ids must be 0..254 (255 is broadcast), got " + std::to_string(id));
+              require(seen.insert(id).second, key, "id " + std::to_string(id) + " is listed twice");
+            }
+          }),
+      row("servo_bus/state_rate", &P::servo_bus, &Bus::state_rate,
+          [](const double& v, const std::string& key) {
+            requirePositive(v, key);
+            require(v <= 100, key, "must be at most 100 Hz");
+          }),
+      row("servo_bus/command_interval_ms", &P::servo_bus, &Bus::command_interval_ms,
+          [](const int& v, const std::string& key) {
+            require(v >= 0 && v <= 65535, key, "must be 0..65535 ms");
+          }),
   };
 }
 

@@ -1,10 +1,13 @@
 #include "serial_robot_driver/ros/servo_bus_interface.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <functional>
 #include <string>
 #include <utility>
+
+#include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -12,6 +15,13 @@ namespace {
 
 constexpr int kSpinnerThreads = 2;
 constexpr double kMsPerSecond = 1000.0;
+constexpr double kDegreesPerRadian = 180.0 / M_PI;
+constexpr int kMaxBusId = 254;  // 255 is the broadcast address
+constexpr double kWarnThrottleS = 5.0;
+// A servo that stops answering the poll is asked again after a back-off that doubles up to the
+// maximum, so a dead servo costs one timeout per back-off period, not one per poll.
+constexpr std::chrono::milliseconds kFirstBackoff{500};
+constexpr std::chrono::milliseconds kMaxBackoff{8000};
 
 void logOutcome(const std::string& service, const device::ServoStatus& status) {
   if (status.ok()) {
@@ -36,6 +46,10 @@ void setOutcome(Response& res, bool ok, const std::string& message) {
 }
 void setOutcome(ServoPing::Response& res, bool ok, const std::string& message) {
   res.online = ok;
+  res.message = message;
+}
+// servo/scan has no flag: the ids it found are the outcome.
+void setOutcome(ServoScan::Response& res, bool /*ok*/, const std::string& message) {
   res.message = message;
 }
 
@@ -77,6 +91,61 @@ ros::ServiceServer advertiseServo(ros::NodeHandle& nh, const std::string& name,
 
 }  // namespace
 
+std::string servoJointName(uint8_t id) { return "servo_" + std::to_string(id); }
+
+int servoIdFromJointName(const std::string& name) {
+  static const std::string kPrefix = "servo_";
+  if (name.size() <= kPrefix.size() || name.size() > kPrefix.size() + 3 ||
+      name.compare(0, kPrefix.size(), kPrefix) != 0) {
+    return -1;
+  }
+  int id = 0;
+  for (std::size_t i = kPrefix.size(); i < name.size(); ++i) {
+    if (name[i] < '0' || name[i] > '9') return -1;
+    id = id * 10 + (name[i] - '0');
+  }
+  // "servo_007" is not the canonical name of servo 7: refuse rather than guess.
+  if (name != servoJointName(static_cast<uint8_t>(std::min(id, 255)))) return -1;
+  return id <= kMaxBusId ? id : -1;
+}
+
+ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms) {
+  ServoCommandBatch batch;
+  if (msg.position.size() != msg.name.size()) {
+    batch.error = "has " + std::to_string(msg.name.size()) + " names but " +
+                  std::to_string(msg.position.size()) + " positions";
+    return batch;
+  }
+  if (!msg.velocity.empty() && msg.velocity.size() != msg.name.size()) {
+    batch.error = "has " + std::to_string(msg.name.size()) + " names but " +
+                  std::to_string(msg.velocity.size()) + " velocities (give none or one per name)";
+    return batch;
+  }
+  for (std::size_t i = 0; i < msg.name.size(); ++i) {
+    const int id = servoIdFromJointName(msg.name[i]);
+    if (id < 0) {
+      batch.error = "names '" + msg.name[i].substr(0, 40) +
+                    "', which is not a bus servo (expected servo_<id>, id 0..254)";
+      break;
+    }
+    const double position = msg.position[i];
+    const double velocity = msg.velocity.empty() ? 0.0 : msg.velocity[i];
+    if (!std::isfinite(position) || !std::isfinite(velocity)) {
+      batch.error = "has a non-finite position or velocity for " + msg.name[i];
+      break;
+    }
+    device::MoveRequest move;
+    move.id = static_cast<uint8_t>(id);
+    move.angle_deg = position * kDegreesPerRadian;
+    // The sign of the motion is the target's; a velocity is a speed.
+    move.velocity_dps = std::fabs(velocity) * kDegreesPerRadian;
+    move.interval_ms = interval_ms;
+    batch.moves.push_back(move);
+  }
+  if (!batch.error.empty()) batch.moves.clear();
+  return batch;
+}
+
 device::ServoBusOptions makeServoBusOptions(const DriverParams& params) {
   device::ServoBusOptions options;
   options.timeout =
@@ -92,7 +161,10 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
     : link_(link),
       client_(makeServoBusOptions(params), link.writer()),
       diagnostics_(diagnostics),
-      nh_(nh) {
+      nh_(nh),
+      topics_nh_(nh),
+      poll_period_(1.0 / params.servo_bus.state_rate),
+      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
   link_.addListener(&client_);
 
   // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
@@ -122,11 +194,39 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
       advertiseServo<ServoReadAngle>(
           nh_, "servo/read_angle",
           [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
+            res.angle_deg = 0.0;
+            res.turns = 0;
+            if (req.multi_turn) {
+              device::MultiTurnReading reading;
+              const device::ServoStatus status = client_.readMultiTurnAngle(req.id, &reading);
+              if (status.ok()) {
+                res.angle_deg = reading.angle_deg;
+                res.turns = reading.turns;
+              }
+              return status;
+            }
             double angle_deg = 0.0;
             const device::ServoStatus status = client_.readAngle(req.id, &angle_deg);
-            res.angle_deg = status.ok() ? angle_deg : 0.0;
+            if (status.ok()) res.angle_deg = angle_deg;
             return status;
           }),
+      advertiseServo<ServoMove>(nh_, "servo/move",
+                                [this](ServoMove::Request& req, ServoMove::Response&) {
+                                  device::MoveRequest request;
+                                  request.id = req.id;
+                                  request.angle_deg = req.angle_deg;
+                                  request.multi_turn = req.multi_turn;
+                                  request.interval_ms = req.interval_ms;
+                                  request.velocity_dps = req.velocity_dps;
+                                  request.accel_ms = req.accel_ms;
+                                  request.decel_ms = req.decel_ms;
+                                  request.power_mw = req.power_mw;
+                                  return client_.move(request);
+                                }),
+      advertiseServo<ServoScan>(nh_, "servo/scan",
+                                [this](ServoScan::Request& req, ServoScan::Response& res) {
+                                  return client_.scan(req.first_id, req.last_id, &res.ids);
+                                }),
       advertiseServo<ServoRotate>(nh_, "servo/rotate",
                                   [this](ServoRotate::Request& req, ServoRotate::Response&) {
                                     device::RotateRequest request;
@@ -176,8 +276,119 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
   diagnostics_.add("servo_bus", this, &ServoBusInterface::diagnose);
 
   if (params.servo_bus.allow_dangerous_writes) {
-    ROS_WARN("servo_bus: dangerous writes (servo_id, baudrate, reset_user_data) are ARMED");
+    ROS_WARN(
+        "servo_bus: dangerous writes (servo_id, baudrate, response_switch, reserved cells, "
+        "reset_user_data) are ARMED");
   }
+
+  const auto now = device::Clock::now();
+  for (int id : params.servo_bus.state_ids) {
+    PolledServo servo;
+    servo.id = static_cast<uint8_t>(id);
+    servo.next_poll = now;
+    polled_.push_back(servo);
+  }
+  states_pub_ = topics_nh_.advertise<sensor_msgs::JointState>("servo_states", 10);
+  commands_sub_ = topics_nh_.subscribe("servo_commands", 10, &ServoBusInterface::onServoCommands,
+                                       this, ros::TransportHints().tcpNoDelay());
+}
+
+void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
+  ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
+  std::lock_guard<std::mutex> lock(worker_mutex_);
+  if (!batch.error.empty()) {
+    ++commands_rejected_;
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
+                      batch.error.c_str());
+    return;
+  }
+  for (const device::MoveRequest& move : batch.moves) {
+    // The latest target of a servo replaces a queued one: the queue stays bounded (one entry per
+    // servo) when a long service call holds the bus.
+    auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
+                               [&move](const device::MoveRequest& m) { return m.id == move.id; });
+    if (queued != queued_moves_.end()) {
+      *queued = move;
+    } else {
+      queued_moves_.push_back(move);
+    }
+  }
+  worker_cv_.notify_all();
+}
+
+void ServoBusInterface::workerLoop() {
+  std::unique_lock<std::mutex> lock(worker_mutex_);
+  while (!worker_stop_) {
+    if (!queued_moves_.empty()) {
+      const device::MoveRequest move = queued_moves_.front();
+      queued_moves_.pop_front();
+      lock.unlock();
+      const device::ServoStatus status = client_.move(move);
+      if (!status.ok()) {
+        ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",
+                          servoJointName(move.id).c_str(), messageFor(status).c_str());
+      }
+      lock.lock();
+      if (status.ok()) {
+        ++commands_sent_;
+      } else {
+        ++command_failures_;
+      }
+      continue;
+    }
+    // The servo whose poll is due first.
+    auto due = std::min_element(
+        polled_.begin(), polled_.end(),
+        [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
+    if (due == polled_.end()) {
+      worker_cv_.wait(lock, [this] { return worker_stop_ || !queued_moves_.empty(); });
+      continue;
+    }
+    if (device::Clock::now() < due->next_poll) {
+      worker_cv_.wait_until(lock, due->next_poll);
+      continue;
+    }
+    PolledServo& servo = *due;
+    lock.unlock();
+    pollOnce(servo);  // polled_ is only changed by this thread; the counters under the lock
+    lock.lock();
+  }
+}
+
+void ServoBusInterface::pollOnce(PolledServo& servo) {
+  double angle_deg = 0.0;
+  device::Clock::time_point arrival;
+  const device::ServoStatus status = client_.pollAngle(servo.id, &angle_deg, &arrival);
+  const auto now = device::Clock::now();
+  const auto period = std::chrono::duration_cast<device::Clock::duration>(poll_period_);
+  std::lock_guard<std::mutex> lock(worker_mutex_);
+  if (status.error == device::ServoError::kNotConnected) {
+    // The port is down, not the servo: ask again at the poll rate once it is back.
+    servo.next_poll = now + period;
+    return;
+  }
+  if (!status.ok()) {
+    ++servo.failures;
+    const bool was_online = servo.backoff.count() == 0;
+    servo.backoff = was_online ? kFirstBackoff : std::min(servo.backoff * 2, kMaxBackoff);
+    servo.next_poll = now + servo.backoff;
+    if (was_online) {
+      ROS_WARN_THROTTLE(kWarnThrottleS,
+                        "servo_states: %s does not answer (%s); asked again in %.1f s",
+                        servoJointName(servo.id).c_str(), status.message.c_str(),
+                        servo.backoff.count() / kMsPerSecond);
+    }
+    return;
+  }
+  servo.backoff = std::chrono::milliseconds(0);
+  // Keep the rate without drifting; after a stall, start again from now.
+  servo.next_poll = std::max(servo.next_poll + period, now);
+  sensor_msgs::JointState msg;
+  msg.header.stamp = toRosTime(arrival);
+  msg.name.push_back(servoJointName(servo.id));
+  msg.position.push_back(angle_deg / kDegreesPerRadian);
+  states_pub_.publish(msg);
+  ++states_published_;
 }
 
 void ServoBusInterface::start() {
@@ -186,6 +397,7 @@ void ServoBusInterface::start() {
   // mutex, so ROS never sees the service as unresponsive.
   spinner_ = std::make_unique<ros::AsyncSpinner>(kSpinnerThreads, &queue_);
   spinner_->start();
+  worker_ = std::thread([this] { workerLoop(); });
 }
 
 ServoBusInterface::~ServoBusInterface() { shutdown(); }
@@ -194,6 +406,13 @@ void ServoBusInterface::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   client_.shutdown();  // wakes a call waiting on the bus, so the spinner can stop quickly
+  commands_sub_.shutdown();
+  {
+    std::lock_guard<std::mutex> lock(worker_mutex_);
+    worker_stop_ = true;
+  }
+  worker_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
   diagnostics_.removeByName("servo_bus");
@@ -223,6 +442,22 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("timeout (ms)", static_cast<int>(client_.options().timeout.count()));
   status.add("retries per transaction", client_.options().retries);
   status.add("dangerous writes armed", client_.options().allow_dangerous_writes);
+
+  std::lock_guard<std::mutex> lock(worker_mutex_);
+  std::string offline;
+  for (const PolledServo& servo : polled_) {
+    if (servo.backoff.count() > 0)
+      offline += (offline.empty() ? "" : ", ") + std::to_string(servo.id);
+  }
+  status.add("servo_states published", states_published_);
+  status.add("polled servos offline", offline.empty() ? std::string("none") : offline);
+  status.add("servo_commands moves sent", commands_sent_);
+  status.add("servo_commands rejected", commands_rejected_);
+  status.add("servo_commands moves failed", command_failures_);
+  if (!offline.empty() && link_.connected()) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
+                        "polled servos not answering: " + offline);
+  }
 }
 
 }  // namespace serial_robot_driver::ros_layer

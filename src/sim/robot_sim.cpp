@@ -471,6 +471,7 @@ SimStats RobotSim::snapshotLocked() const {
     stats.framer.checksum_errors += framer.checksum_errors;
     stats.framer.bad_tails += framer.bad_tails;
     stats.framer.bad_lengths += framer.bad_lengths;
+    stats.framer.unknown_commands += framer.unknown_commands;
     for (std::size_t f = 0; f < protocol::kFrameFamilyCount; ++f) {
       stats.framer.frames[f] += framer.frames[f];
     }

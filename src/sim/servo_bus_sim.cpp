@@ -36,8 +36,8 @@ constexpr int64_t kMovingCurrent = 350;
 
 constexpr auto kDriftPeriod = std::chrono::milliseconds(100);
 
-// Factory values of the user block (assumption: datasheet-like numbers; the id stays the one the
-// servo was configured with, so a reset never collides with its neighbours on the chain).
+// Factory values of the user block (assumption: datasheet-like numbers). The id goes back to the
+// factory default 0 like on the real servo, so a reset on a chain may collide with servo 0.
 const std::map<uint8_t, int64_t>& userDefaults() {
   using servo::ServoDataId;
   static const std::map<uint8_t, int64_t> defaults = {
@@ -72,12 +72,21 @@ int16_t toDecidegrees(double degrees) {
   return static_cast<int16_t>(std::lround(std::clamp(degrees * 10.0, kMin, kMax)));
 }
 
-// Spinning servos report an angle inside one turn.
+// An angle folded into one turn, -180 .. 180.
 double wrapDegrees(double degrees) {
   double wrapped = std::fmod(degrees + 180.0, 360.0);
   if (wrapped < 0) wrapped += 360.0;
   return wrapped - 180.0;
 }
+
+// The single-turn view of the multi-turn angle: unchanged within +-180, else folded into one turn.
+double foldDegrees(double degrees) {
+  return std::fabs(degrees) <= 180.0 ? degrees : wrapDegrees(degrees);
+}
+
+constexpr uint8_t kFactoryId = 0;
+constexpr double kDegreesPerTurn = 360.0;
+constexpr double kMsPerSecond = 1000.0;
 
 }  // namespace
 
@@ -88,7 +97,6 @@ ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
                          config_.offline_ids.end();
     if (offline || id == servo::kBroadcastId) continue;
     Servo s;
-    s.factory_id = id;
     s.last_step = now;
     s.params[kVoltage] = kNominalVoltage;
     s.params[kCurrent] = kIdleCurrent;
@@ -99,13 +107,65 @@ ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
     s.params[kFirmwareVersion] = 0x0102;
     s.params[kSerialNumber] = 0x53520000 + id;
     resetUserData(&s);
+    s.params[kServoId] = id;  // configured on this chain
     servos_.push_back(std::move(s));
   }
 }
 
 void ServoBusSim::resetUserData(Servo* s) const {
   for (const auto& [data_id, value] : userDefaults()) s->params[data_id] = value;
-  s->params[kServoId] = s->factory_id;
+  s->params[kServoId] = kFactoryId;
+}
+
+void ServoBusSim::beginMove(Motion* m, double start_angle) {
+  const double distance = std::fabs(m->target_angle - start_angle);
+  if (m->velocity_dps > 0) {
+    // Accelerate to the velocity, cruise, decelerate; a short move never reaches the cruise speed
+    // (triangular profile over the same ramp times).
+    double peak = m->velocity_dps;
+    const double ramps = (m->accel_s + m->decel_s) / 2.0;
+    if (distance < peak * ramps) peak = ramps > 0 ? distance / ramps : peak;
+    m->peak_dps = peak;
+    m->duration_s = peak > 0 ? distance / peak + ramps : 0.0;
+    if (distance == 0.0) m->duration_s = 0.0;
+  } else {
+    // By interval: the ramps share the interval; ramps longer than it are shortened in proportion.
+    const double ramp_sum = m->accel_s + m->decel_s;
+    if (ramp_sum > m->duration_s && ramp_sum > 0) {
+      const double scale = m->duration_s / ramp_sum;
+      m->accel_s *= scale;
+      m->decel_s *= scale;
+    }
+    const double cruise_time = m->duration_s - (m->accel_s + m->decel_s) / 2.0;
+    m->peak_dps = cruise_time > 0 ? distance / cruise_time : 0.0;
+  }
+}
+
+double ServoBusSim::moveAngle(const Motion& m, double elapsed) {
+  if (elapsed >= m.duration_s || m.duration_s <= 0) return m.target_angle;
+  const double direction = m.target_angle >= m.start_angle ? 1.0 : -1.0;
+  const double v = m.peak_dps;
+  double travelled = 0.0;
+  if (elapsed < m.accel_s) {
+    travelled = 0.5 * v / m.accel_s * elapsed * elapsed;
+  } else if (elapsed < m.duration_s - m.decel_s) {
+    travelled = 0.5 * v * m.accel_s + v * (elapsed - m.accel_s);
+  } else {
+    const double left = m.duration_s - elapsed;
+    travelled = std::fabs(m.target_angle - m.start_angle) - 0.5 * v / m.decel_s * left * left;
+  }
+  return m.start_angle + direction * travelled;
+}
+
+void ServoBusSim::requestMove(Servo* s, Motion motion, uint8_t id, bool broadcast, TimePoint now) {
+  if (!motion.multi_turn && param(*s, kAngleLimitSwitch) == 1) {
+    motion.target_angle = std::clamp(motion.target_angle, param(*s, kAngleLimitLow) / 10.0,
+                                     param(*s, kAngleLimitHigh) / 10.0);
+  }
+  motion.kind = Motion::Kind::kRotate;
+  motion.answer = !broadcast && param(*s, kResponseSwitch) == 1;
+  motion.answer_id = id;
+  startMotion(s, motion, now);
 }
 
 int64_t ServoBusSim::param(const Servo& s, uint8_t data_id) {
@@ -163,7 +223,8 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
 
     case Command::kResetUserData:
       resetUserData(s);
-      reply(Command::kResetUserData, {id, 1});
+      // The servo now has its factory id and answers from there.
+      reply(Command::kResetUserData, {kFactoryId, 1});
       break;
 
     case Command::kReadData: {
@@ -274,19 +335,65 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
 
     case Command::kRotate: {
       if (size != 7) return malformed();
-      double target = protocol::readLE16Signed(content + 1) / 10.0;
-      if (param(*s, kAngleLimitSwitch) == 1) {
-        target =
-            std::clamp(target, param(*s, kAngleLimitLow) / 10.0, param(*s, kAngleLimitHigh) / 10.0);
-      }
       Motion motion;
-      motion.kind = Motion::Kind::kRotate;
       motion.cmd = Command::kRotate;
-      motion.target_angle = target;
-      motion.duration_s = protocol::readLE16(content + 3) / 1000.0;
-      motion.answer = !broadcast && param(*s, kResponseSwitch) == 1;
-      motion.answer_id = id;
-      startMotion(s, motion, now);
+      motion.target_angle = protocol::readLE16Signed(content + 1) / 10.0;
+      motion.duration_s = protocol::readLE16(content + 3) / kMsPerSecond;
+      requestMove(s, motion, id, broadcast, now);
+      break;
+    }
+
+    // CMD 11..15: id, angle (i16 or i32, 0.1 deg), interval (u16 / u32 ms) or velocity
+    // (u16, 0.1 deg/s), [accel u16, decel u16], power u16.
+    case Command::kMoveByInterval:
+    case Command::kMoveByVelocity:
+    case Command::kMultiTurnMove:
+    case Command::kMultiTurnMoveByInterval:
+    case Command::kMultiTurnMoveByVelocity: {
+      const auto cmd = static_cast<Command>(packet.cmd);
+      const bool multi_turn = cmd == Command::kMultiTurnMove ||
+                              cmd == Command::kMultiTurnMoveByInterval ||
+                              cmd == Command::kMultiTurnMoveByVelocity;
+      const bool by_velocity =
+          cmd == Command::kMoveByVelocity || cmd == Command::kMultiTurnMoveByVelocity;
+      const bool has_ramps = cmd != Command::kMultiTurnMove;
+      const std::size_t angle_size = multi_turn ? 4 : 2;
+      const std::size_t second_size = multi_turn && !by_velocity ? 4 : 2;
+      const std::size_t expected = 1 + angle_size + second_size + (has_ramps ? 4 : 0) + 2;
+      if (size != expected) return malformed();
+      Motion motion;
+      motion.cmd = cmd;
+      motion.multi_turn = multi_turn;
+      motion.target_angle = (multi_turn ? static_cast<int32_t>(protocol::readLE32(content + 1))
+                                        : protocol::readLE16Signed(content + 1)) /
+                            10.0;
+      const uint8_t* second = content + 1 + angle_size;
+      const double second_value =
+          second_size == 4 ? protocol::readLE32(second) : protocol::readLE16(second);
+      if (by_velocity) {
+        motion.velocity_dps = second_value / 10.0;
+        if (motion.velocity_dps <= 0) return malformed();
+      } else {
+        motion.duration_s = second_value / kMsPerSecond;
+      }
+      if (has_ramps) {
+        motion.accel_s = protocol::readLE16(second + second_size) / kMsPerSecond;
+        motion.decel_s = protocol::readLE16(second + second_size + 2) / kMsPerSecond;
+      }
+      requestMove(s, motion, id, broadcast, now);
+      break;
+    }
+
+    case Command::kReadMultiTurnAngle: {
+      if (size != 1) return malformed();
+      servo::MultiTurnAngle reading;
+      reading.id = id;
+      const double decidegrees =
+          std::clamp(std::round(s->angle_deg * 10.0), double(std::numeric_limits<int32_t>::min()),
+                     double(std::numeric_limits<int32_t>::max()));
+      reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
+      reading.turns = static_cast<int16_t>(std::trunc(s->angle_deg / kDegreesPerTurn));
+      reply(Command::kReadMultiTurnAngle, servo::multiTurnAngleContent(reading));
       break;
     }
 
@@ -299,7 +406,8 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
     case Command::kReadAngle: {
       if (size != 1) return malformed();
       std::vector<uint8_t> answer_content = {id, 0, 0};
-      protocol::writeLE16(&answer_content[1], static_cast<uint16_t>(toDecidegrees(s->angle_deg)));
+      protocol::writeLE16(&answer_content[1],
+                          static_cast<uint16_t>(toDecidegrees(foldDegrees(s->angle_deg))));
       reply(Command::kReadAngle, answer_content);
       break;
     }
@@ -324,7 +432,7 @@ void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
 
 void ServoBusSim::runMotions(Servo* s, TimePoint now) {
   if (s->spin_rate_dps != 0.0) {
-    s->angle_deg = wrapDegrees(s->angle_deg + s->spin_rate_dps * toSeconds(now - s->last_step));
+    s->angle_deg += s->spin_rate_dps * toSeconds(now - s->last_step);  // turns accumulate
   }
   s->last_step = now;
   TimePoint cursor = now;
@@ -333,16 +441,19 @@ void ServoBusSim::runMotions(Servo* s, TimePoint now) {
     if (!motion.started) {
       motion.started = true;
       motion.start = cursor;
+      if (motion.kind == Motion::Kind::kRotate && !motion.multi_turn) {
+        s->angle_deg = foldDegrees(s->angle_deg);  // a single-turn move works within one turn
+      }
       motion.start_angle = s->angle_deg;
+      if (motion.kind == Motion::Kind::kRotate) beginMove(&motion, motion.start_angle);
     }
     const double elapsed = toSeconds(now - motion.start);
     const bool done = elapsed >= motion.duration_s;
     const double progress = done ? motion.duration_s : elapsed;
     if (motion.kind == Motion::Kind::kRotate) {
-      const double fraction = motion.duration_s > 0 ? progress / motion.duration_s : 1.0;
-      s->angle_deg = motion.start_angle + (motion.target_angle - motion.start_angle) * fraction;
+      s->angle_deg = moveAngle(motion, progress);
     } else {
-      s->angle_deg = wrapDegrees(motion.start_angle + motion.rate_dps * progress);
+      s->angle_deg = motion.start_angle + motion.rate_dps * progress;
     }
     if (!done) break;
     const TimePoint finished = motion.start + fromSeconds(motion.duration_s);

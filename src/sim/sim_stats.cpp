@@ -73,6 +73,7 @@ std::string formatStats(const SimStats& stats) {
   line("rx_bytes_skipped", stats.framer.bytes_skipped);
   line("rx_checksum_errors", stats.framer.checksum_errors);
   line("rx_bad_lengths", stats.framer.bad_lengths);
+  line("rx_unknown_commands", stats.framer.unknown_commands);
   line("rx_frames_base", stats.framer.frames[static_cast<std::size_t>(FrameFamily::kBase)]);
   line("rx_frames_servo_request",
        stats.framer.frames[static_cast<std::size_t>(FrameFamily::kServoRequest)]);

@@ -346,14 +346,25 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   ASSERT_TRUE(counted.has_value());
   EXPECT_EQ(counted->number("commands rejected"), rejected_before + malformed.size());
 
-  // Huge but finite positions are commands, clamped to the 16-bit position field; the simulated
-  // board clamps them further to its 0..4095 range.
+  // Huge but finite positions are beyond what the servo can reach (0..4095 ticks): that joint is
+  // left out, never clamped; a command with nothing reachable writes nothing.
+  const auto joint_1_target = robot.stats().body.servos[0].target;
   commands.publish(command({"joint_1"}, {1e9}));
-  ASSERT_TRUE(waitFor([&] { return robot.stats().body.sync_writes_ok >= writes_before + 2; }, 20));
-  EXPECT_EQ(robot.stats().body.servos[0].target, 4095);
   commands.publish(command({"joint_1"}, {-1e300}));
-  ASSERT_TRUE(waitFor([&] { return robot.stats().body.sync_writes_ok >= writes_before + 3; }, 20));
-  EXPECT_EQ(robot.stats().body.servos[0].target, 0);
+  commands.publish(command({"joint_1", "joint_2"}, {4.0, 0.25}));  // joint_2 alone goes out
+  ASSERT_TRUE(waitFor([&] { return robot.stats().body.sync_writes_ok >= writes_before + 2; }, 20));
+  test_support::sleepSeconds(0.3);
+  EXPECT_EQ(robot.stats().body.sync_writes_ok, writes_before + 2);
+  EXPECT_EQ(robot.stats().body.servos[0].target, joint_1_target);
+  EXPECT_EQ(robot.stats().body.servos[1].target, std::lround(2048 + 0.25 * 4096 / kTwoPi));
+  const auto out_of_range = diagnostics.waitFor(
+      "body", 0,
+      [](const test_support::DiagnosticsWatch::Status& s) {
+        return s.number("joint targets out of range") >= 3;
+      },
+      [] { return true; }, 10);
+  ASSERT_TRUE(out_of_range.has_value());
+  EXPECT_EQ(out_of_range->number("joint targets out of range"), 3u);
 
   // Still publishing telemetry.
   const uint64_t joints_now = joints.count();

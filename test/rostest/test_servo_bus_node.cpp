@@ -23,6 +23,8 @@
 #include <ros/ros.h>
 
 #include "serial_robot_driver/ServoDamping.h"
+#include "serial_robot_driver/ServoMove.h"
+#include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoReadAll.h"
@@ -53,6 +55,9 @@ const Bytes kPing4 = {0x12, 0x4C, 0x01, 0x01, 0x04, 0x64};
 // over_temperature (41 = 0x29) of servo 3 := 80, answered with result 0.
 const Bytes kWriteOverTemp3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x29, 0x50, 0x00, 0xE2};
 const Bytes kWriteOverTemp3Failed = {0x05, 0x1C, 0x04, 0x03, 0x03, 0x29, 0x00, 0x54};
+const Bytes kPing2 = {0x12, 0x4C, 0x01, 0x01, 0x02, 0x62};
+// RESET_USER_DATA id 6: 5E + 02 + 01 + 06 = 67 (the armed bus leaves it unanswered).
+const Bytes kResetUserData6 = {0x12, 0x4C, 0x02, 0x01, 0x06, 0x67};
 
 // --- the servos on a pty ----------------------------------------------------------------------
 
@@ -233,6 +238,68 @@ TEST(ServoBusNode, MotionWaitWithoutAnAnswerTimesOut) {
       << srv.response.message;
 }
 
+srd::ServoMove moveRequest(uint8_t id, double angle_deg, bool multi_turn, uint32_t interval_ms,
+                           double velocity_dps, uint16_t accel_ms, uint16_t decel_ms) {
+  srd::ServoMove srv;
+  srv.request.id = id;
+  srv.request.angle_deg = angle_deg;
+  srv.request.multi_turn = multi_turn;
+  srv.request.interval_ms = interval_ms;
+  srv.request.velocity_dps = velocity_dps;
+  srv.request.accel_ms = accel_ms;
+  srv.request.decel_ms = decel_ms;
+  return srv;
+}
+
+TEST(ServoBusNode, MoveSendsTheCommandTheRequestChooses) {
+  const std::size_t mark = g_safe->mark();
+  const srd::ServoMove requests[] = {
+      moveRequest(2, 90.0, false, 500, 0.0, 0, 0),        // plain: ROTATE (CMD 8)
+      moveRequest(1, 90.0, false, 1000, 0.0, 100, 100),   // ramps: CMD 11
+      moveRequest(1, -90.0, false, 0, 360.0, 100, 100),   // velocity: CMD 12
+      moveRequest(1, 720.0, true, 2000, 0.0, 0, 0),       // multi-turn plain: CMD 13
+      moveRequest(1, -360.0, true, 1000, 0.0, 200, 200),  // multi-turn ramps: CMD 14
+      moveRequest(1, 3600.0, true, 0, 360.0, 100, 100),   // multi-turn velocity: CMD 15
+  };
+  for (const srd::ServoMove& request : requests) {
+    const srd::ServoMove srv = call(safeService("move"), request);
+    EXPECT_TRUE(srv.response.success) << srv.response.message;
+  }
+  EXPECT_EQ(bytesBeforeNextPing(*g_safe, safeService("ping"), mark),
+            concat({kRotate2To90In500, kMoveByInterval1To90, kMoveByVelocity1ToMinus90,
+                    kMultiTurnMove1To720, kMultiTurnMoveByInterval1ToMinus360,
+                    kMultiTurnMoveByVelocity1To3600}));
+}
+
+TEST(ServoBusNode, ReadAngleMultiTurnAnswersTheTurns) {
+  const std::size_t mark = g_safe->mark();
+  srd::ServoReadAngle srv;
+  srv.request.id = 1;
+  srv.request.multi_turn = true;
+  srv = call(safeService("read_angle"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_DOUBLE_EQ(srv.response.angle_deg, 720.0);
+  EXPECT_EQ(srv.response.turns, 2);
+  EXPECT_EQ(g_safe->bytesSince(mark), kReadMultiTurn1);
+}
+
+TEST(ServoBusNode, ScanPingsEachIdOnceAndListsTheOnesThatAnswer) {
+  const std::size_t mark = g_safe->mark();
+  srd::ServoScan srv;
+  srv.request.first_id = 2;
+  srv.request.last_id = 4;
+  srv = call(safeService("scan"), srv);
+  EXPECT_EQ(srv.response.ids, std::vector<uint8_t>{3}) << srv.response.message;
+  // One PING per id, none re-sent although 2 and 4 stay silent.
+  EXPECT_EQ(bytesBeforeNextPing(*g_safe, safeService("ping"), mark),
+            concat({kPing2, kPing3, kPing4}));
+}
+
+std::pair<bool, std::string> move(const std::string& prefix, const srd::ServoMove& request) {
+  const srd::ServoMove srv = call(prefix + "move", request);
+  return {srv.response.success, srv.response.message};
+}
+
 // Every rejection: success false, a message naming the problem, and not one byte on the pty.
 struct Rejection {
   const char* name;
@@ -334,6 +401,39 @@ const Rejection kRejections[] = {
        srv = call(p + "spin", srv);
        return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
      }},
+    {"MoveSingleTurnBeyond180", false, "+-180",
+     [](const std::string& p) { return move(p, moveRequest(1, 180.5, false, 100, 0, 0, 0)); }},
+    {"MoveMultiTurnBeyondLimit", false, "+-368640",
+     [](const std::string& p) { return move(p, moveRequest(1, -368641, true, 100, 0, 0, 0)); }},
+    {"MoveVelocityAbove750", false, "750",
+     [](const std::string& p) { return move(p, moveRequest(1, 10, false, 0, 751, 0, 0)); }},
+    {"MoveRampUnder20", false, "under 20 ms",
+     [](const std::string& p) { return move(p, moveRequest(1, 10, false, 500, 0, 10, 100)); }},
+    {"MoveNaN", false, "finite",
+     [](const std::string& p) { return move(p, moveRequest(1, std::nan(""), true, 0, 0, 0, 0)); }},
+    {"MoveInfiniteVelocity", false, "finite",
+     [](const std::string& p) { return move(p, moveRequest(1, 10, false, 0, INFINITY, 0, 0)); }},
+    {"ScanBroadcast", false, "broadcast",
+     [](const std::string& p) {
+       srd::ServoScan srv;
+       srv.request.first_id = 250;
+       srv.request.last_id = 255;
+       srv = call(p + "scan", srv);
+       // servo/scan has no success flag: "no id found" stands for the failure.
+       return std::make_pair(!srv.response.ids.empty(), srv.response.message);
+     }},
+    {"ReadMultiTurnBroadcast", false, "broadcast",
+     [](const std::string& p) {
+       srd::ServoReadAngle srv;
+       srv.request.id = 255;
+       srv.request.multi_turn = true;
+       srv = call(p + "read_angle", srv);
+       return std::make_pair(static_cast<bool>(srv.response.success), srv.response.message);
+     }},
+    {"WriteResponseSwitchUnarmed", false, "allow_dangerous_writes",
+     [](const std::string& p) { return writeParam(p, 3, "response_switch", 1); }},
+    {"WriteStallModeZero", false, "out of range",
+     [](const std::string& p) { return writeParam(p, 3, "stall_protect_mode", 0); }},
     {"DampingBroadcastWait", false, "broadcast",
      [](const std::string& p) {
        srd::ServoDamping srv;
@@ -388,6 +488,17 @@ TEST(ServoBusNodeArmed, ResetUserData) {
   EXPECT_EQ(g_armed->bytesSince(mark), kResetUserData3);
 }
 
+TEST(ServoBusNodeArmed, SilentResetSucceedsWhenTheServoAnswersAtIdZero) {
+  const std::size_t mark = g_armed->mark();
+  srd::ServoResetUserData srv;
+  srv.request.id = 6;
+  srv = call(armedService("reset_user_data"), srv);
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_NE(srv.response.message.find("id 0"), std::string::npos) << srv.response.message;
+  // The reset once (never re-sent to an id the servo may have left), then PING 0.
+  EXPECT_EQ(g_armed->bytesSince(mark), concat({kResetUserData6, kPing0}));
+}
+
 TEST(ServoBusNode, DiagnosticsReportTransactionsTimeoutsAndSkippedEchoes) {
   // An offline PING makes sure there is a timeout to report; the safe bus echoes every request.
   EXPECT_FALSE(ping(safeService("ping"), 7).response.online);
@@ -414,12 +525,14 @@ void scriptServos(ServoBusPlayer& safe, ServoBusPlayer& armed) {
   safe.answer(kWriteOverTemp3, {kWriteOverTemp3Failed});
   safe.answer(kReadAngle0, {kReadAngle0Reply902});
   safe.answer(kReadBatch3, {kReadBatch3Reply});
+  safe.answer(kReadMultiTurn1, {kReadMultiTurn1Reply720});
 
   armed.answer(kPing3, {kPing3Reply});
   armed.answer(kPing4, {kPing4Reply});
   armed.answer(kWriteServoId3To5, {kWriteServoId3To5Ok});
   armed.answer(kReadServoId5, {kReadServoId5Reply});
   armed.answer(kResetUserData3, {kResetUserData3Ok});
+  armed.answer(kPing0, {kPing0Reply});
 }
 
 /// Waits until the node behind `ping_service` has opened its pty and servo 3 answers.

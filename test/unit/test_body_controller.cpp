@@ -55,7 +55,7 @@ INSTANTIATE_TEST_SUITE_P(
     BodyController, BodyControllerCalibrationPosition,
     testing::Values(PositionCase{2048, 1, 2048, 0.0}, PositionCase{2048, 1, 3072, M_PI / 2},
                     PositionCase{2048, 1, 1024, -M_PI / 2}, PositionCase{2048, -1, 3072, -M_PI / 2},
-                    PositionCase{2048, -1, 1024, M_PI / 2}, PositionCase{0, 1, 4096, kTwoPi},
+                    PositionCase{2048, -1, 1024, M_PI / 2}, PositionCase{0, 1, 4095, 4095 * kRadPerTick},
                     PositionCase{1000, -1, 0, 1000 * kRadPerTick},
                     PositionCase{2048, 1, 2049, kRadPerTick}));
 
@@ -69,12 +69,18 @@ TEST(BodyControllerCalibration, ToTicksRoundsToNearest) {
   EXPECT_EQ(reversed.toTicks(-0.6 * kRadPerTick), 2049);
 }
 
-TEST(BodyControllerCalibration, ToTicksClampsToTheWireRange) {
+TEST(BodyControllerCalibration, ToTicksRefusesWhatTheServoCannotReach) {
+  // 4096 ticks per turn: the servo takes 0..4095, never a clamped stand-in.
   const JointCalibration cal = calibration(2048, 1);
-  EXPECT_EQ(cal.toTicks(-M_PI), 0);  // exactly tick 0
-  EXPECT_EQ(cal.toTicks(-100.0), 0);
-  EXPECT_EQ(cal.toTicks(1000.0), 65535);
-  EXPECT_EQ(calibration(2048, -1).toTicks(1000.0), 0);
+  EXPECT_EQ(cal.toTicks(-M_PI), 0);                     // exactly tick 0
+  EXPECT_EQ(cal.toTicks(2047 * kRadPerTick), 4095);     // the highest tick
+  EXPECT_FALSE(cal.toTicks(M_PI).has_value());          // 4096: one turn, not a position
+  EXPECT_FALSE(cal.toTicks(4.0).has_value());           // 4655, the case of the review
+  EXPECT_FALSE(cal.toTicks(-100.0).has_value());
+  EXPECT_FALSE(calibration(2048, -1).toTicks(1000.0).has_value());
+  const auto [low, high] = cal.reachableRadians();
+  EXPECT_NEAR(low, -M_PI, 1e-12);
+  EXPECT_NEAR(high, 2047 * kRadPerTick, 1e-12);
 }
 
 TEST(BodyControllerCalibration, ToTicksRejectsNanAndInfinity) {
@@ -251,6 +257,29 @@ TEST_F(BodyControllerCommand, PartialCommandKeepsTheOtherJointsAtTheirLastPositi
                           0x02, 0x00, 0x02, 0x00, 0x08, 0x03, 0x00, 0x0C, 0x4A, 0xE8};
   ASSERT_EQ(written_.size(), 2u);
   EXPECT_EQ(written_[1], expected);
+}
+
+TEST_F(BodyControllerCommand, UnreachableJointIsLeftOutAndTheOthersAreSent) {
+  // hip 4.0 rad would be tick 4655: left out; knee -pi/2 = 1024 goes alone (frame as above).
+  const JointCommandResult result = controller_.sendJointCommand({"hip", "knee"}, {4.0, -M_PI / 2});
+  EXPECT_TRUE(result.ok()) << result.message();
+  ASSERT_EQ(result.out_of_range.size(), 1u);
+  EXPECT_NE(result.message().find("hip: 4.000 rad is outside -3.142 .. 3.140 rad"),
+            std::string::npos)
+      << result.message();
+  const Bytes expected = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0x74,
+                          0x00, 0x02, 0x00, 0x03, 0x00, 0x04, 0x05, 0x0E};
+  ASSERT_EQ(written_.size(), 1u);
+  EXPECT_EQ(written_[0], expected);
+  EXPECT_EQ(controller_.stats().joints_out_of_range, 1u);
+}
+
+TEST_F(BodyControllerCommand, CommandWithOnlyUnreachableJointsWritesNothing) {
+  const JointCommandResult result = controller_.sendJointCommand({"hip"}, {-4.0});
+  EXPECT_EQ(result.status, JointCommandStatus::kOutOfRange);
+  EXPECT_TRUE(written_.empty());
+  EXPECT_EQ(controller_.stats().commands_rejected, 1u);
+  EXPECT_EQ(controller_.stats().joints_out_of_range, 1u);
 }
 
 TEST_F(BodyControllerCommand, UnknownJointIsRejectedByNameAndWritesNothing) {

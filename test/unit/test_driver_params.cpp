@@ -76,6 +76,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"servo_bus/timeout", [](DriverParams& p) { p.servo_bus.timeout = 0; }},
         BadCase{"servo_bus/retries", [](DriverParams& p) { p.servo_bus.retries = -1; }},
         BadCase{"servo_bus/baud", [](DriverParams& p) { p.servo_bus.baud = 9600; }},
+        // 253 puts FF FF FD (the sync-write header) inside a sync-write frame.
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 253}; }},
+        BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.servo_bus.state_ids = {1, 255}; }},
+        BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.servo_bus.state_ids = {4, 4}; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 0; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 1000; }},
+        BadCase{"servo_bus/command_interval_ms",
+                [](DriverParams& p) { p.servo_bus.command_interval_ms = 70000; }},
         BadCase{"base/enabled", [](DriverParams& p) {
                   p.base.enabled = p.body.enabled = p.servo_bus.enabled = false;
                 }}));

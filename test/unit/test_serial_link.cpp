@@ -57,6 +57,27 @@ SerialLinkOptions optionsFor(const std::string& path) {
 const Bytes& kBatteryReply = golden::base::kBattery87ReplySeq0;
 const Bytes& kPingReply = golden::servo::kPing3Reply;
 
+TEST(SerialLink, GivesUpOnAStalePartialFrameAndDeliversTheFrameBehindIt) {
+  const std::string path = uniqueLinkPath("stale");
+  sim::PseudoTerminal pty(path);
+  SerialLinkOptions options = optionsFor(path);
+  options.stale_frame_timeout = milliseconds(50);
+  SerialLink link(options);
+  RecordingListener listener;
+  link.addListener(&listener);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+
+  // A stray PING-answer header claiming N = 33, then the real answer: nothing more follows.
+  Bytes stream = {0x05, 0x1C, 0x01, 0x21};
+  stream.insert(stream.end(), kPingReply.begin(), kPingReply.end());
+  pty.write(stream.data(), stream.size());
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
+  EXPECT_EQ(listener.frames[0].second, kPingReply);
+  EXPECT_EQ(link.stats().framer.stale_candidates, 1u);
+  link.stop();
+}
+
 TEST(SerialLink, DeliversFramesAndWritesBytes) {
   const std::string path = uniqueLinkPath("basic");
   sim::PseudoTerminal pty(path);

@@ -393,6 +393,145 @@ TEST_F(ServoBusClientArmedTest, ResetUserData) {
   EXPECT_EQ(bus_.written, std::vector<Bytes>{kResetUserData3});
 }
 
+TEST_F(ServoBusClientArmedTest, ResetUserDataAnsweredFromTheDefaultId) {
+  bus_.answer(kResetUserData3, {kResetUserDataOkFromId0});
+  const ServoStatus status = client_.resetUserData(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kResetUserData3});
+}
+
+TEST_F(ServoBusClientArmedTest, SilentResetSucceedsWhenIdZeroAnswersPing) {
+  bus_.answer(kPing0, {kPing0Reply});
+  const ServoStatus status = client_.resetUserData(3);
+  EXPECT_TRUE(status.ok()) << status.message;
+  EXPECT_NE(status.message.find("id 0"), std::string::npos) << status.message;
+  EXPECT_EQ(bus_.written, (std::vector<Bytes>{kResetUserData3, kPing0}));
+}
+
+TEST_F(ServoBusClientArmedTest, SilentResetWithNobodyAtIdZeroFails) {
+  const ServoStatus status = client_.resetUserData(3);
+  EXPECT_EQ(status.error, ServoError::kTimeout) << status.message;
+  // retries = 1: two rounds of reset + PING 0.
+  EXPECT_EQ(bus_.written, (std::vector<Bytes>{kResetUserData3, kPing0, kResetUserData3, kPing0}));
+}
+
+TEST_F(ServoBusClientTest, MoveChoosesTheCommandFromTheRequest) {
+  MoveRequest plain;
+  plain.id = 2;
+  plain.angle_deg = 90.0;
+  plain.interval_ms = 500;
+  EXPECT_TRUE(client_.move(plain).ok());
+
+  MoveRequest ramps;
+  ramps.id = 1;
+  ramps.angle_deg = 90.0;
+  ramps.interval_ms = 1000;
+  ramps.accel_ms = 100;
+  ramps.decel_ms = 100;
+  EXPECT_TRUE(client_.move(ramps).ok());
+
+  MoveRequest velocity;
+  velocity.id = 1;
+  velocity.angle_deg = -90.0;
+  velocity.velocity_dps = 360.0;
+  velocity.accel_ms = 100;
+  velocity.decel_ms = 100;
+  EXPECT_TRUE(client_.move(velocity).ok());
+
+  MoveRequest multi;
+  multi.id = 1;
+  multi.multi_turn = true;
+  multi.angle_deg = 720.0;
+  multi.interval_ms = 2000;
+  EXPECT_TRUE(client_.move(multi).ok());
+
+  MoveRequest multi_ramps;
+  multi_ramps.id = 1;
+  multi_ramps.multi_turn = true;
+  multi_ramps.angle_deg = -360.0;
+  multi_ramps.interval_ms = 1000;
+  multi_ramps.accel_ms = 200;
+  multi_ramps.decel_ms = 200;
+  EXPECT_TRUE(client_.move(multi_ramps).ok());
+
+  MoveRequest multi_velocity;
+  multi_velocity.id = 1;
+  multi_velocity.multi_turn = true;
+  multi_velocity.angle_deg = 3600.0;
+  multi_velocity.velocity_dps = 360.0;
+  multi_velocity.accel_ms = 100;
+  multi_velocity.decel_ms = 100;
+  EXPECT_TRUE(client_.move(multi_velocity).ok());
+
+  EXPECT_EQ(bus_.written,
+            (std::vector<Bytes>{kRotate2To90In500, kMoveByInterval1To90, kMoveByVelocity1ToMinus90,
+                                kMultiTurnMove1To720, kMultiTurnMoveByInterval1ToMinus360,
+                                kMultiTurnMoveByVelocity1To3600}));
+  EXPECT_EQ(client_.stats().commands, 6u);
+}
+
+TEST_F(ServoBusClientTest, MoveByVelocityWithoutRampsSendsTheShortestRamps) {
+  MoveRequest velocity;
+  velocity.id = 1;
+  velocity.angle_deg = -90.0;
+  velocity.velocity_dps = 360.0;
+  ASSERT_TRUE(client_.move(velocity).ok());
+  // CMD 12 id 1, -900 (7C FC), 3600 (10 0E), accel 20 (14 00), decel 20, power 0.
+  // 5E+0C+0B+01+7C+FC+10+0E+14+14 = 0x234 -> 34
+  const Bytes expected = {0x12, 0x4C, 0x0C, 0x0B, 0x01, 0x7C, 0xFC, 0x10,
+                          0x0E, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00, 0x34};
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{expected});
+}
+
+TEST_F(ServoBusClientTest, ReadMultiTurnAngle) {
+  bus_.answer(kReadMultiTurn1, {kReadMultiTurn1Reply720});
+  MultiTurnReading reading;
+  const ServoStatus status = client_.readMultiTurnAngle(1, &reading);
+  ASSERT_TRUE(status.ok()) << status.message;
+  EXPECT_DOUBLE_EQ(reading.angle_deg, 720.0);
+  EXPECT_EQ(reading.turns, 2);
+  EXPECT_EQ(bus_.written, std::vector<Bytes>{kReadMultiTurn1});
+}
+
+TEST_F(ServoBusClientTest, ScanListsTheIdsThatAnswerWithOneAttemptEach) {
+  bus_.answer(kPing3, {kPing3Reply});
+  bus_.answer(kPing5, {kPing5Reply});
+  std::vector<uint8_t> ids;
+  const ServoStatus status = client_.scan(3, 7, &ids);
+  ASSERT_TRUE(status.ok()) << status.message;
+  EXPECT_EQ(ids, (std::vector<uint8_t>{3, 5}));
+  // 3 silent ids (4, 6, 7) cost one PING each: no retries.
+  ASSERT_EQ(bus_.written.size(), 5u);
+  EXPECT_EQ(bus_.written.front(), kPing3);
+  EXPECT_EQ(bus_.written.back(), kPing7);
+  EXPECT_EQ(client_.stats().retries, 0u);
+}
+
+TEST(BusMutexTest, AWaitingForegroundCallerGoesBeforeBackgroundWork) {
+  BusMutex bus;
+  std::mutex order_mutex;
+  std::vector<std::string> order;
+  const auto record = [&](const char* who) {
+    std::lock_guard<std::mutex> lock(order_mutex);
+    order.push_back(who);
+  };
+  bus.lock();  // a transaction in progress
+  std::thread foreground([&] {
+    std::lock_guard<BusMutex> held(bus);
+    record("foreground");
+  });
+  while (bus.foregroundWaiting() == 0) std::this_thread::yield();
+  std::thread background([&] {
+    bus.lockBackground();
+    record("background");
+    bus.unlock();
+  });
+  bus.unlock();
+  foreground.join();
+  background.join();
+  EXPECT_EQ(order, (std::vector<std::string>{"foreground", "background"}));
+}
+
 // --- every rejection: the right error, a message naming the problem, and not one byte written ---
 
 struct Rejection {
@@ -419,6 +558,14 @@ SpinRequest spinWith(uint8_t id, uint8_t mode, uint16_t speed, uint16_t value, b
   request.speed_dps = speed;
   request.value = value;
   request.wait = wait;
+  return request;
+}
+
+MoveRequest moveTo(uint8_t id, double angle_deg, bool multi_turn) {
+  MoveRequest request;
+  request.id = id;
+  request.angle_deg = angle_deg;
+  request.multi_turn = multi_turn;
   return request;
 }
 
@@ -482,6 +629,85 @@ const Rejection kRejections[] = {
      [](ServoBusClient& c) { return c.spin(spinWith(0, 4, 100, 0, false)); }},
     {"SpinWaitTooLong", false, ServoError::kInvalidArgument, "wait = false",
      [](ServoBusClient& c) { return c.spin(spinWith(0, 2, 1, 1000, true)); }},
+    {"WriteResponseSwitchUnarmed", false, ServoError::kDangerous, "answered",
+     [](ServoBusClient& c) { return c.writeParam(3, "response_switch", 1); }},
+    {"WriteReservedUnarmed", false, ServoError::kDangerous, "reserved",
+     [](ServoBusClient& c) { return c.writeParam(3, "reserved_45", 1); }},
+    {"WriteStallModeZero", false, ServoError::kOutOfRange, "1..2",
+     [](ServoBusClient& c) { return c.writeParam(3, "stall_protect_mode", 0); }},
+    {"WriteSwitchTwo", false, ServoError::kOutOfRange, "0..1",
+     [](ServoBusClient& c) { return c.writeParam(3, "angle_limit_switch", 2); }},
+    {"MoveSingleTurnAbove180", false, ServoError::kInvalidArgument, "+-180",
+     [](ServoBusClient& c) { return c.move(moveTo(1, 180.1, false)); }},
+    {"MoveSingleTurnBelowMinus180", false, ServoError::kInvalidArgument, "+-180",
+     [](ServoBusClient& c) { return c.move(moveTo(1, -180.5, false)); }},
+    {"MoveMultiTurnTooFar", false, ServoError::kInvalidArgument, "+-368640",
+     [](ServoBusClient& c) { return c.move(moveTo(1, 368640.5, true)); }},
+    {"MoveAngleNaN", false, ServoError::kInvalidArgument, "finite",
+     [](ServoBusClient& c) { return c.move(moveTo(1, std::nan(""), false)); }},
+    {"MoveAngleInfinite", false, ServoError::kInvalidArgument, "finite",
+     [](ServoBusClient& c) { return c.move(moveTo(1, INFINITY, true)); }},
+    {"MoveVelocityNaN", false, ServoError::kInvalidArgument, "velocity_dps is not",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, false);
+       r.velocity_dps = std::nan("");
+       return c.move(r);
+     }},
+    {"MoveVelocityAbove750", false, ServoError::kInvalidArgument, "750",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, false);
+       r.velocity_dps = 750.5;
+       return c.move(r);
+     }},
+    {"MoveVelocityNegative", false, ServoError::kInvalidArgument, "negative",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, false);
+       r.velocity_dps = -10;
+       return c.move(r);
+     }},
+    {"MoveAccelUnder20", false, ServoError::kInvalidArgument, "accel_ms 19",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, false);
+       r.interval_ms = 1000;
+       r.accel_ms = 19;
+       return c.move(r);
+     }},
+    {"MoveDecelUnder20ByVelocity", false, ServoError::kInvalidArgument, "decel_ms 1",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, true);
+       r.velocity_dps = 100;
+       r.decel_ms = 1;
+       return c.move(r);
+     }},
+    {"MoveSingleTurnIntervalAboveU16", false, ServoError::kInvalidArgument, "65535",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, false);
+       r.interval_ms = 65536;
+       return c.move(r);
+     }},
+    {"MoveRampsLongerThanInterval", false, ServoError::kInvalidArgument, "accel + decel",
+     [](ServoBusClient& c) {
+       MoveRequest r = moveTo(1, 10, false);
+       r.interval_ms = 100;
+       r.accel_ms = 80;
+       r.decel_ms = 80;
+       return c.move(r);
+     }},
+    {"ReadMultiTurnBroadcast", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) {
+       MultiTurnReading reading;
+       return c.readMultiTurnAngle(255, &reading);
+     }},
+    {"ScanBroadcast", false, ServoError::kInvalidArgument, "broadcast",
+     [](ServoBusClient& c) {
+       std::vector<uint8_t> ids;
+       return c.scan(250, 255, &ids);
+     }},
+    {"ScanReversedRange", false, ServoError::kInvalidArgument, "above last_id",
+     [](ServoBusClient& c) {
+       std::vector<uint8_t> ids;
+       return c.scan(9, 3, &ids);
+     }},
 };
 
 class ServoBusClientRejectionTest : public ::testing::TestWithParam<Rejection> {};

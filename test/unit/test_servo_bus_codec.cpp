@@ -9,6 +9,7 @@
 
 #include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "support/golden_frames.h"
 
 #include "support/probe_expectations.h"
 
@@ -86,6 +87,32 @@ const RequestCase kRequests[] = {
     // 5E + 08 + 07 + 01 + 7C + FC + E8 + 03 = 0x2D1 -> D1
     {"RotateId1ToMinus90Deg", [] { return encodeRotate(1, -900, 0, 1000); },
      {0x12, 0x4C, 0x08, 0x07, 0x01, 0x7C, 0xFC, 0x00, 0x00, 0xE8, 0x03, 0xD1}, 8},
+    // The newer motion set (CMD 11..16); the bytes and their sums are in golden_frames.h.
+    {"MoveByIntervalId1To90", [] { return encodeMoveByInterval(1, 900, 1000, {100, 100, 0}); },
+     golden::servo::kMoveByInterval1To90, 11},
+    {"MoveByVelocityId1ToMinus90",
+     [] { return encodeMoveByVelocity(1, -900, 3600, {100, 100, 0}); },
+     golden::servo::kMoveByVelocity1ToMinus90, 12},
+    {"MultiTurnMoveId1To720", [] { return encodeMultiTurnMove(1, 7200, 2000, 0); },
+     golden::servo::kMultiTurnMove1To720, 13},
+    {"MultiTurnMoveByIntervalId1ToMinus360",
+     [] { return encodeMultiTurnMoveByInterval(1, -3600, 1000, {200, 200, 0}); },
+     golden::servo::kMultiTurnMoveByInterval1ToMinus360, 14},
+    {"MultiTurnMoveByVelocityId1To3600",
+     [] { return encodeMultiTurnMoveByVelocity(1, 36000, 3600, {100, 100, 0}); },
+     golden::servo::kMultiTurnMoveByVelocity1To3600, 15},
+    {"ReadMultiTurnAngleId1", [] { return encodeReadMultiTurnAngle(1); },
+     golden::servo::kReadMultiTurn1, 16},
+    // Power is the last field: CMD 11 id 2 -> 0 deg, 500 ms (F4 01), ramps 20 (14), 1000 mW (E8 03).
+    // 5E+0B+0B+02+F4+01+14+14+E8+03 = 0x27E -> 7E
+    {"MoveByIntervalPowerLast", [] { return encodeMoveByInterval(2, 0, 500, {20, 20, 1000}); },
+     {0x12, 0x4C, 0x0B, 0x0B, 0x02, 0x00, 0x00, 0xF4, 0x01, 0x14, 0x00, 0x14, 0x00, 0xE8, 0x03,
+      0x7E}, 11},
+    // CMD 13 power: id 0 -> -0.1 deg (FF FF FF FF), 0 ms, 500 mW (F4 01).
+    // 5E+0D+0B+00+FF*4+F4+01 = 0x567 -> 67
+    {"MultiTurnMovePowerLast", [] { return encodeMultiTurnMove(0, -1, 0, 500); },
+     {0x12, 0x4C, 0x0D, 0x0B, 0x00, 0xFF, 0xFF, 0xFF, 0xFF, 0x00, 0x00, 0x00, 0x00, 0xF4, 0x01,
+      0x67}, 13},
 };
 // clang-format on
 
@@ -130,6 +157,8 @@ const ResponseCase kResponses[] = {
     // 90.2 deg = 902 = 0x0386 -> 86 03
     {"ReadAngleReplyId0", Command::kReadAngle, {0x00, 0x86, 0x03},
      {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86, 0x03, 0xB7}},
+    {"ReadMultiTurnReply720", Command::kReadMultiTurnAngle,
+     {0x01, 0x20, 0x1C, 0x00, 0x00, 0x02, 0x00}, golden::servo::kReadMultiTurn1Reply720},
 };
 // clang-format on
 
@@ -167,6 +196,40 @@ TEST(ServoBusCodec, ReadAngleReplyIs90Point2Degrees) {
   EXPECT_EQ(readLE16Signed(&packet->content[1]), 902);
 }
 
+TEST(ServoBusCodec, MultiTurnAngleAnswerIsDecoded) {
+  const Bytes& reply = golden::servo::kReadMultiTurn1Reply720;
+  const Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
+  ASSERT_TRUE(packet.ok());
+  const Decoded<MultiTurnAngle> angle =
+      decodeMultiTurnAngle(packet->content.data(), packet->content_size);
+  ASSERT_TRUE(angle.ok());
+  EXPECT_EQ(angle->id, 1);
+  EXPECT_EQ(angle->angle_decidegrees, 7200);
+  EXPECT_EQ(angle->turns, 2);
+}
+
+TEST(ServoBusCodec, NegativeMultiTurnAngleAndTurnsAreSigned) {
+  const Bytes& reply = golden::servo::kReadMultiTurn1ReplyMinus1234p5;
+  const Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
+  ASSERT_TRUE(packet.ok());
+  const Decoded<MultiTurnAngle> angle =
+      decodeMultiTurnAngle(packet->content.data(), packet->content_size);
+  ASSERT_TRUE(angle.ok());
+  EXPECT_EQ(angle->angle_decidegrees, -12345);
+  EXPECT_EQ(angle->turns, -3);
+  EXPECT_EQ(multiTurnAngleContent(*angle), Bytes(reply.begin() + 4, reply.end() - 1));
+}
+
+TEST(ServoBusCodec, MultiTurnAngleAnswerOfWrongSizeIsRejected) {
+  const Bytes& reply = golden::servo::kReadMultiTurn1Reply720;
+  const uint8_t* content = reply.data() + 4;
+  for (std::size_t size : {std::size_t{0}, std::size_t{3}, std::size_t{6}, std::size_t{8}}) {
+    const Decoded<MultiTurnAngle> angle = decodeMultiTurnAngle(content, size);
+    ASSERT_FALSE(angle.ok()) << size;
+    EXPECT_EQ(angle.error(), DecodeError::kBadLength);
+  }
+}
+
 TEST(ServoBusCodec, SpinMethodByte) {
   EXPECT_EQ(spinMethod(false, SpinMode::kStop), 0x00);
   EXPECT_EQ(spinMethod(false, SpinMode::kContinuous), 0x01);
@@ -200,9 +263,9 @@ const MalformedCase kMalformedResponses[] = {
     // N = 34 is above the longest content (id + 32-byte block).
     {"LenAboveMax", {0x05, 0x1C, 0x05, 0x22, 0x00, 0x00}, DecodeError::kBadLength},
     {"Len255", {0x05, 0x1C, 0x05, 0xFF, 0x00, 0x00}, DecodeError::kBadLength},
-    // CMD 0 and 11 with correct sums (05+1C+00+01+03 = 25, 05+1C+0B+01+03 = 30).
-    {"CmdZero", {0x05, 0x1C, 0x00, 0x01, 0x03, 0x25}, DecodeError::kUnexpectedContent},
-    {"CmdEleven", {0x05, 0x1C, 0x0B, 0x01, 0x03, 0x30}, DecodeError::kUnexpectedContent},
+    // CMD 0 and 17 with correct sums (05+1C+00+01+03 = 25, 05+1C+11+01+03 = 36).
+    {"CmdZero", {0x05, 0x1C, 0x00, 0x01, 0x03, 0x25}, DecodeError::kUnknownCommand},
+    {"CmdSeventeen", {0x05, 0x1C, 0x11, 0x01, 0x03, 0x36}, DecodeError::kUnknownCommand},
 };
 // clang-format on
 
@@ -246,8 +309,9 @@ TEST(ServoBusCodecProbe, SaysWhyACandidateIsInvalid) {
   expectProbeRejects(probeRequest, {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64}, DecodeError::kBadChecksum);
   // N = 34 exceeds the longest content (id + 32 bytes).
   expectProbeRejects(probeResponse, {0x05, 0x1C, 0x05, 0x22}, DecodeError::kBadLength);
-  // CMD 11 does not exist.
-  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x0B, 0x01}, DecodeError::kBadLength);
+  // CMD 17 does not exist; it has its own reason, not a bad length.
+  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x11, 0x01}, DecodeError::kUnknownCommand);
+  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x00, 0x01}, DecodeError::kUnknownCommand);
   // The request header is not a response's, and the reverse.
   expectProbeRejects(probeResponse, kProbePingRequest, DecodeError::kBadHeader);
   expectProbeRejects(probeRequest, kProbePingResponse, DecodeError::kBadHeader);

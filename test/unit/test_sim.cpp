@@ -508,12 +508,105 @@ TEST_F(RobotSimServoBus, ResponseSwitchOneAnswersAfterTheMotion) {
   expectReply(kDamping2, kDamping2Reply);
 }
 
-TEST_F(RobotSimServoBus, ServoIdWriteMovesTheServoAndResetRestoresIt) {
+TEST_F(RobotSimServoBus, ServoIdWriteMovesTheServoAndResetSendsItToIdZero) {
   expectReply(kWriteId1To9, kWriteId1To9Reply);
   expectReply(kPing9, kPing9Reply);
   expectSilence(kPing1);
-  expectReply(kResetUserData9, kResetUserData9Reply);
-  expectReply(kPing1, kPing1Reply);
+  // Like the servo: the reset restores the factory id 0, and the answer comes from there.
+  expectReply(kResetUserData9, kResetUserDataOkFromId0);
+  expectSilence(kPing9);
+  const auto servos = sim_->stats().servo_bus.servos;
+  EXPECT_EQ(std::count_if(servos.begin(), servos.end(),
+                          [](const BusServoSnapshot& servo) { return servo.id == 0; }),
+            2);
+}
+
+// --- ServoBusSim on its own, in simulated time (no threads, no pty) --------------------------
+
+class ServoBusSimMotion : public ::testing::Test {
+ protected:
+  ServoBusSimMotion() : start_(TimePoint() + std::chrono::hours(1)), sim_(config(), start_) {}
+  static ServoBusSimConfig config() {
+    ServoBusSimConfig c;
+    c.servo_ids = {0, 1};
+    c.answer_latency_s = 0.001;
+    return c;
+  }
+  void send(const Bytes& request, double at_s) {
+    sim_.handleRequest(request.data(), request.size(), start_ + fromSeconds(at_s));
+  }
+  double angleAt(double at_s, uint8_t id = 1) {
+    Outbox out;
+    sim_.tick(start_ + fromSeconds(at_s), &out);
+    for (const BusServoSnapshot& servo : sim_.stats().servos) {
+      if (servo.id == id) return servo.angle_deg;
+    }
+    ADD_FAILURE() << "no servo " << int(id);
+    return 0.0;
+  }
+  std::vector<Bytes> answersUntil(double at_s) {
+    Outbox out;
+    sim_.tick(start_ + fromSeconds(at_s), &out);
+    std::vector<Bytes> frames;
+    for (Outgoing& frame : out) frames.push_back(std::move(frame.bytes));
+    return frames;
+  }
+  TimePoint start_;
+  ServoBusSim sim_;
+};
+
+TEST_F(ServoBusSimMotion, MoveByIntervalRunsATrapezoidInTheInterval) {
+  send(kMoveByInterval1To90, 0.0);  // 90 deg in 1000 ms, 100 ms ramps: cruise 100 deg/s
+  EXPECT_NEAR(angleAt(0.05), 0.5 * 100.0 / 0.1 * 0.05 * 0.05, 1e-6);  // accelerating
+  EXPECT_NEAR(angleAt(0.5), 45.0, 1e-6);                              // symmetric midpoint
+  EXPECT_LT(angleAt(0.95), 90.0);                                     // still decelerating
+  EXPECT_DOUBLE_EQ(angleAt(1.0), 90.0);
+  EXPECT_TRUE(answersUntil(1.1).empty());  // response_switch 0: no answer to a move
+}
+
+TEST_F(ServoBusSimMotion, MoveByVelocityTakesDistanceOverSpeedPlusTheRamps) {
+  send(kMoveByVelocity1ToMinus90, 0.0);  // -90 deg at 360 deg/s, 100 ms ramps: 0.35 s
+  EXPECT_NEAR(angleAt(0.175), -45.0, 1e-6);
+  EXPECT_GT(angleAt(0.34), -90.0);
+  EXPECT_DOUBLE_EQ(angleAt(0.36), -90.0);
+}
+
+TEST_F(ServoBusSimMotion, MultiTurnMoveKeepsTheTurnsAndAnswersCmd16) {
+  send(kMultiTurnMove1To720, 0.0);  // 720 deg in 2000 ms, no ramps
+  EXPECT_NEAR(angleAt(1.0), 360.0, 1e-6);
+  EXPECT_DOUBLE_EQ(angleAt(2.0), 720.0);
+  send(kReadMultiTurn1, 2.0);
+  EXPECT_EQ(answersUntil(2.01), std::vector<Bytes>{kReadMultiTurn1Reply720});
+  // READ_ANGLE folds the same angle into one turn: 0.0 deg (05+1C+0A+03+01 = 2F).
+  send({0x12, 0x4C, 0x0A, 0x01, 0x01, 0x6A}, 2.02);
+  const Bytes folded_reply = {0x05, 0x1C, 0x0A, 0x03, 0x01, 0x00, 0x00, 0x2F};
+  EXPECT_EQ(answersUntil(2.03), std::vector<Bytes>{folded_reply});
+}
+
+TEST_F(ServoBusSimMotion, MultiTurnMovesByIntervalAndVelocityReachTheirTargets) {
+  send(kMultiTurnMoveByInterval1ToMinus360, 0.0);  // 1000 ms, 200 ms ramps
+  EXPECT_NEAR(angleAt(0.5), -180.0, 1e-6);
+  EXPECT_DOUBLE_EQ(angleAt(1.0), -360.0);
+  send(kMultiTurnMoveByVelocity1To3600, 1.0);  // 3960 deg at 360 deg/s + 0.1 s of ramps = 11.1 s
+  EXPECT_LT(angleAt(12.0), 3600.0);
+  EXPECT_DOUBLE_EQ(angleAt(12.2), 3600.0);
+}
+
+TEST_F(ServoBusSimMotion, ResetAnswersFromTheFactoryId) {
+  // RESET_USER_DATA id 1: 5E+02+01+01 = 62.
+  send({0x12, 0x4C, 0x02, 0x01, 0x01, 0x62}, 0.0);
+  EXPECT_EQ(answersUntil(0.01), std::vector<Bytes>{kResetUserDataOkFromId0});
+}
+
+TEST_F(ServoBusSimMotion, MoveWithAWrongLengthIsMalformed) {
+  Bytes short_move(kMoveByInterval1To90.begin(), kMoveByInterval1To90.end());
+  // Drop the power field: N = 9, SUM without the two zero bytes is unchanged, minus 2 for N.
+  short_move.erase(short_move.end() - 3, short_move.end() - 1);
+  short_move[3] = 0x09;
+  short_move.back() = static_cast<uint8_t>(short_move.back() - 2);
+  send(short_move, 0.0);
+  EXPECT_EQ(sim_.stats().malformed, 1u);
+  EXPECT_DOUBLE_EQ(angleAt(2.0), 0.0);
 }
 
 TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {

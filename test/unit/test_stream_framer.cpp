@@ -118,7 +118,7 @@ uint64_t totalFrames(const FramerStats& stats) {
 }
 
 uint64_t errorCount(const FramerStats& stats) {
-  return stats.checksum_errors + stats.bad_tails + stats.bad_lengths;
+  return stats.checksum_errors + stats.bad_tails + stats.bad_lengths + stats.unknown_commands;
 }
 
 // Every input byte is either in an emitted frame, skipped, or still buffered.
@@ -451,6 +451,7 @@ struct BrokenCase {
   uint64_t checksum_errors;
   uint64_t bad_tails;
   uint64_t bad_lengths;
+  uint64_t unknown_commands = 0;
 };
 void PrintTo(const BrokenCase& c, std::ostream* os) { *os << c.name; }
 
@@ -469,6 +470,7 @@ TEST_P(StreamFramerBroken, CountedSkippedAndTheNextFrameStillComesThrough) {
     EXPECT_EQ(framer.stats().checksum_errors, c.checksum_errors);
     EXPECT_EQ(framer.stats().bad_tails, c.bad_tails);
     EXPECT_EQ(framer.stats().bad_lengths, c.bad_lengths);
+    EXPECT_EQ(framer.stats().unknown_commands, c.unknown_commands);
     EXPECT_EQ(framer.stats().bytes_skipped, c.broken.size());
     EXPECT_EQ(framer.framer().buffered(), 0u);
     expectBytesAccountedFor(framer, 0);
@@ -544,10 +546,11 @@ INSTANTIATE_TEST_SUITE_P(
         BrokenCase{"TelemetryLen255", {0x12, 0x34, 0xFF}, 0, 0, 1},
         BrokenCase{"ServoResponseN34", {0x05, 0x1C, 0x05, 0x22}, 0, 0, 1},
         BrokenCase{"ServoResponseN255", {0x05, 0x1C, 0x01, 0xFF}, 0, 0, 1},
-        BrokenCase{"ServoResponseCmd0", {0x05, 0x1C, 0x00, 0x01}, 0, 0, 1},
-        BrokenCase{"ServoResponseCmd11", {0x05, 0x1C, 0x0B, 0x01}, 0, 0, 1},
+        // An unknown CMD has its own counter, not "bad length".
+        BrokenCase{"ServoResponseCmd0", {0x05, 0x1C, 0x00, 0x01}, 0, 0, 0, 1},
+        BrokenCase{"ServoResponseCmd17", {0x05, 0x1C, 0x11, 0x01}, 0, 0, 0, 1},
         BrokenCase{"ServoRequestN255", {0x12, 0x4C, 0x01, 0xFF}, 0, 0, 1},
-        BrokenCase{"ServoRequestCmd255", {0x12, 0x4C, 0xFF, 0x01}, 0, 0, 1},
+        BrokenCase{"ServoRequestCmd255", {0x12, 0x4C, 0xFF, 0x01}, 0, 0, 0, 1},
         BrokenCase{"SyncWriteLen0", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x00, 0x00}, 0, 0, 1},
         BrokenCase{"SyncWriteLen1", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x01, 0x00}, 0, 0, 1},
         BrokenCase{"SyncWriteLen2", {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x02, 0x00}, 0, 0, 1},
@@ -731,6 +734,39 @@ TEST(StreamFramerJunk, GoodFramesSurviveBeingSurroundedByJunk) {
     }
   }
   EXPECT_EQ(found, 50 * stream.frames.size());
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::protocol
+
+// --- a stale incomplete candidate ----------------------------------------------------------------
+
+namespace serial_robot_driver::protocol {
+namespace {
+
+TEST(StreamFramerStale, AStrayHeaderWithALongLenStopsHoldingBackTheAnswerBehindIt) {
+  // 05 1C 01 21: a PING answer header claiming N = 33, so 38 bytes; only the real answer follows.
+  Bytes stream = {0x05, 0x1C, 0x01, 0x21};
+  stream.insert(stream.end(), golden::servo::kPing3Reply.begin(), golden::servo::kPing3Reply.end());
+  RecordingFramer framer(FramerConfig::forDriver(false, false, true, 0));
+  framer.feed(stream);
+  EXPECT_TRUE(framer.frames().empty());
+  EXPECT_EQ(framer.framer().buffered(), stream.size());
+
+  while (framer.framer().dropStaleCandidate()) {
+  }
+  ASSERT_EQ(framer.frames().size(), 1u);
+  EXPECT_EQ(framer.frames()[0], (Frame{FrameFamily::kServoResponse, golden::servo::kPing3Reply}));
+  EXPECT_EQ(framer.framer().buffered(), 0u);
+  EXPECT_EQ(framer.stats().stale_candidates, 1u);
+  EXPECT_EQ(framer.stats().bytes_skipped, 4u);
+  expectBytesAccountedFor(framer, 0);
+}
+
+TEST(StreamFramerStale, NothingBufferedNothingDropped) {
+  RecordingFramer framer(allFamilies());
+  EXPECT_FALSE(framer.framer().dropStaleCandidate());
+  EXPECT_EQ(framer.stats().stale_candidates, 0u);
 }
 
 }  // namespace

@@ -33,9 +33,12 @@ struct JointCalibration {
 
   double toRadians(uint16_t ticks) const;
   double toRadiansPerSecond(int16_t raw_speed) const;
-  /// The inverse of toRadians(), rounded to the nearest tick and clamped to 0..65535.
-  /// std::nullopt for NaN or infinity.
+  /// The inverse of toRadians(), rounded to the nearest tick. std::nullopt for NaN or infinity
+  /// and for a position the servo cannot reach: outside 0 .. ticks_per_revolution - 1 (one turn of
+  /// its position encoder) or 0..65535.
   std::optional<uint16_t> toTicks(double radians) const;
+  /// The reachable positions in rad, for messages: [lowest, highest] (ordered).
+  std::pair<double, double> reachableRadians() const;
 };
 
 /// One joint of the board, in telemetry / sync-write order.
@@ -52,6 +55,7 @@ struct BodyStats {
   uint64_t commands_sent = 0;
   uint64_t commands_rejected = 0;  ///< invalid commands: nothing was written
   uint64_t write_failures = 0;     ///< valid commands the link refused (port down)
+  uint64_t joints_out_of_range = 0;  ///< joint targets left out: beyond what the servo can reach
 };
 
 enum class JointCommandStatus {
@@ -61,6 +65,7 @@ enum class JointCommandStatus {
   kUnknownJoint,    ///< a name that is not one of the configured joints
   kDuplicateJoint,  ///< the same joint named twice in one command
   kNotFinite,       ///< a NaN or infinite position
+  kOutOfRange,      ///< every named joint was beyond its servo's reach: nothing written
   kWriteFailed,     ///< valid, but the link refused the frame (port down)
 };
 
@@ -68,9 +73,15 @@ enum class JointCommandStatus {
 struct JointCommandResult {
   JointCommandStatus status = JointCommandStatus::kSent;
   std::string joint;  ///< the offending joint, when the status is about one
+  /// Joints left out of a sent command because their target is beyond the servo's reach; the
+  /// other joints were sent. Each entry says which joint and what it can take.
+  std::vector<std::string> out_of_range;
 
   bool ok() const { return status == JointCommandStatus::kSent; }
   std::string message() const;
+
+ private:
+  std::string outOfRangeText() const;
 };
 
 /// What the body reports; every hook may be empty. Called without the controller's lock held.
@@ -95,7 +106,8 @@ class BodyController : public LinkListener {
   /// partial command never moves the other joints. Joints that were never commanded are left out
   /// of the frame: the driver cannot know a safe target for them, and a servo that is not
   /// addressed keeps whatever it is doing. An invalid command writes nothing and changes no stored
-  /// position.
+  /// position. A joint whose target the servo cannot reach is left out (its servo keeps its last
+  /// commanded position) and listed in out_of_range; the other joints are sent.
   JointCommandResult sendJointCommand(const std::vector<std::string>& names,
                                       const std::vector<double>& positions);
 

@@ -75,6 +75,9 @@ struct SerialLinkOptions {
   unsigned baud = 115200;
   double reconnect_interval = 1.0;  ///< s between attempts to reopen a lost port
   protocol::FramerConfig framer;
+  /// An incomplete frame with no new byte for this long is given up on, so the frames behind a
+  /// stray header are not held back (the servo bus uses its answer timeout). 0: never.
+  std::chrono::milliseconds stale_frame_timeout{0};
 };
 
 struct LinkStats {

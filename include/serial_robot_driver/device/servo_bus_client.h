@@ -11,6 +11,8 @@
 //    never state_mutex_, the only lock onFrame() takes: a fake in a test may answer synchronously
 //    by calling onFrame() from inside it.
 //  - Stats are kept in one struct under state_mutex_; stats() returns a snapshot.
+//  - Background work (pollAngle: the servo_states poll) takes the bus only when no foreground
+//    caller waits for it, so a service call waits at most for the one transaction in progress.
 #pragma once
 
 #include <chrono>
@@ -90,6 +92,26 @@ struct SpinRequest {
   bool wait = false;
 };
 
+/// One request for the whole motion set of CMD 8 and 11..15 (servo/move). The command follows from
+/// the fields: velocity_dps > 0 -> by velocity (12, multi-turn 15); else accel_ms or decel_ms > 0
+/// -> by interval with ramps (11 / 14); else plain (8 / 13).
+struct MoveRequest {
+  uint8_t id = 0;
+  double angle_deg = 0.0;  ///< single-turn within +-180, multi-turn within +-368640
+  bool multi_turn = false;
+  uint32_t interval_ms = 0;   ///< single-turn at most 65535, multi-turn at most 4096000
+  double velocity_dps = 0.0;  ///< 0: not by velocity; else 0.1 .. 750
+  uint16_t accel_ms = 0;      ///< 0: not given (20, the firmware's shortest, is sent where needed)
+  uint16_t decel_ms = 0;
+  uint16_t power_mw = 0;  ///< 0: the servo's default limit
+};
+
+/// A multi-turn angle (CMD 16).
+struct MultiTurnReading {
+  double angle_deg = 0.0;
+  int16_t turns = 0;
+};
+
 struct ServoBusStats {
   uint64_t transactions = 0;   ///< requests that expected an answer (once, however many attempts)
   uint64_t commands = 0;       ///< motion frames written without waiting for an answer
@@ -100,6 +122,23 @@ struct ServoBusStats {
   uint64_t echoes = 0;         ///< our own requests read back (half-duplex echo), skipped
   double last_latency_ms = 0.0;  ///< request written -> answer's last byte read
   double max_latency_ms = 0.0;
+};
+
+/// The bus lock: foreground callers (lock()) go before background ones (lockBackground()), which
+/// take the bus only while nobody waits for it. Usable with std::lock_guard.
+class BusMutex {
+ public:
+  void lock();
+  void unlock();
+  void lockBackground();
+  /// Foreground callers waiting right now (for tests and diagnostics).
+  int foregroundWaiting();
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable released_;
+  bool held_ = false;
+  int waiting_ = 0;  ///< foreground callers waiting for the bus
 };
 
 class ServoBusClient : public LinkListener {
@@ -117,8 +156,18 @@ class ServoBusClient : public LinkListener {
   /// new id and is refused if a servo answers there; a baudrate write is not read back (it takes
   /// effect at once).
   ServoStatus writeParam(uint8_t id, std::string_view param, int64_t value);
-  /// READ_ANGLE in degrees.
-  ServoStatus readAngle(uint8_t id, double* angle_deg);
+  /// READ_ANGLE in degrees. `arrival` (optional): when the answer's last byte was read.
+  ServoStatus readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival = nullptr);
+  /// CMD 16: the multi-turn angle and the turn count.
+  ServoStatus readMultiTurnAngle(uint8_t id, MultiTurnReading* reading);
+  /// CMD 8 or 11..15, chosen by the request (see MoveRequest); returns once the frame is written.
+  ServoStatus move(const MoveRequest& request);
+  /// PINGs first_id..last_id, one attempt each (a silent id costs one timeout), and lists the ids
+  /// that answered. The bus is taken per id, so other callers are served in between.
+  ServoStatus scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids);
+  /// READ_ANGLE as background work: one attempt, and the bus is taken only while no other caller
+  /// waits for it (the servo_states poll).
+  ServoStatus pollAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival);
   /// ROTATE / SPIN / DAMPING return once the frame is written unless `wait` is set. Id 255
   /// (broadcast) is accepted only without wait.
   ServoStatus rotate(const RotateRequest& request);
@@ -126,7 +175,9 @@ class ServoBusClient : public LinkListener {
   ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait);
   /// READ_BATCH_DATA: the 22 user-block parameters (data_id 32..53) in table order.
   ServoStatus readAll(uint8_t id, std::vector<ServoParamValue>* values);
-  /// RESET_USER_DATA (dangerous: refused unless allow_dangerous_writes).
+  /// RESET_USER_DATA (dangerous: refused unless allow_dangerous_writes). The reset also sets the
+  /// servo's id to its default 0, so the answer may come from id 0 or not at all: without an
+  /// answer the client PINGs id 0, and a servo there means the reset worked.
   ServoStatus resetUserData(uint8_t id);
 
   /// Wakes a waiting caller and fails every later call with kShutdown. Idempotent.
@@ -178,6 +229,8 @@ class ServoBusClient : public LinkListener {
   ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
                               ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);
+  /// One PING attempt, no retries (scan, and the check after a silent reset).
+  ServoStatus pingOnceLocked(uint8_t id);
   bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
   /// exchangeLocked() of a single request, taking bus_mutex_ itself.
   ServoStatus exchange(const std::vector<uint8_t>& request, const Expectation& expect,
@@ -186,7 +239,7 @@ class ServoBusClient : public LinkListener {
   const ServoBusOptions options_;
   const FrameWriter writer_;
 
-  std::mutex bus_mutex_;  // one transaction on the wire at a time
+  BusMutex bus_mutex_;  // one transaction on the wire at a time
 
   mutable std::mutex state_mutex_;  // guards everything below; shared with the reader thread
   std::condition_variable answer_cv_;

@@ -15,6 +15,7 @@ enum class DecodeError {
   kBadChecksum,    ///< XOR / sum / CRC mismatch
   kBadTail,        ///< telemetry tail is not 1F 2F
   kUnexpectedContent,  ///< well-framed, but the payload does not fit the command
+  kUnknownCommand,     ///< a command byte the protocol does not define (servo bus CMD)
 };
 
 const char* toString(DecodeError error);

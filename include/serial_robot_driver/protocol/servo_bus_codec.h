@@ -37,9 +37,18 @@ enum class Command : uint8_t {
   kRotate = 8,
   kDamping = 9,
   kReadAngle = 10,
+  // The newer firmware's motion set, as the vendor SDK packs it (little-endian after the id).
+  kMoveByInterval = 11,           ///< i16 angle, u16 interval, u16 accel, u16 decel, u16 power
+  kMoveByVelocity = 12,           ///< i16 angle, u16 velocity (0.1 deg/s), u16 accel, decel, power
+  kMultiTurnMove = 13,            ///< i32 angle, u32 interval, u16 power
+  kMultiTurnMoveByInterval = 14,  ///< i32 angle, u32 interval, u16 accel, u16 decel, u16 power
+  kMultiTurnMoveByVelocity = 15,  ///< i32 angle, u16 velocity, u16 accel, u16 decel, u16 power
+  kReadMultiTurnAngle = 16,       ///< request: id; answer: id, i32 angle, i16 turns
 };
 constexpr uint8_t kMinCommand = 1;
-constexpr uint8_t kMaxCommand = 10;
+constexpr uint8_t kMaxCommand = 16;
+/// Whether a CMD byte names a command of this protocol.
+constexpr bool isKnownCommand(uint8_t cmd) { return cmd >= kMinCommand && cmd <= kMaxCommand; }
 
 uint8_t byteSum(const uint8_t* data, std::size_t size);
 
@@ -59,6 +68,38 @@ std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_
 std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw);
 std::vector<uint8_t> encodeReadAngle(uint8_t id);
 
+/// Ramps and power of the CMD 11/12/14/15 moves.
+struct MoveRamps {
+  uint16_t accel_ms = 0;
+  uint16_t decel_ms = 0;
+  uint16_t power_mw = 0;  ///< 0: the servo's default limit
+};
+std::vector<uint8_t> encodeMoveByInterval(uint8_t id, int16_t angle_decidegrees,
+                                          uint16_t interval_ms, const MoveRamps& ramps);
+std::vector<uint8_t> encodeMoveByVelocity(uint8_t id, int16_t angle_decidegrees,
+                                          uint16_t velocity_decidegrees_per_s,
+                                          const MoveRamps& ramps);
+std::vector<uint8_t> encodeMultiTurnMove(uint8_t id, int32_t angle_decidegrees,
+                                         uint32_t interval_ms, uint16_t power_mw);
+std::vector<uint8_t> encodeMultiTurnMoveByInterval(uint8_t id, int32_t angle_decidegrees,
+                                                   uint32_t interval_ms, const MoveRamps& ramps);
+std::vector<uint8_t> encodeMultiTurnMoveByVelocity(uint8_t id, int32_t angle_decidegrees,
+                                                   uint16_t velocity_decidegrees_per_s,
+                                                   const MoveRamps& ramps);
+std::vector<uint8_t> encodeReadMultiTurnAngle(uint8_t id);
+
+/// The content of a CMD 16 answer.
+struct MultiTurnAngle {
+  uint8_t id = 0;
+  int32_t angle_decidegrees = 0;
+  int16_t turns = 0;
+};
+constexpr std::size_t kMultiTurnAngleAnswerSize = 7;  ///< id, i32 angle, i16 turns
+/// Decodes the CONTENT of a CMD 16 answer (kBadLength unless exactly 7 bytes).
+Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size);
+/// The CONTENT of a CMD 16 answer (simulator side).
+std::vector<uint8_t> multiTurnAngleContent(const MultiTurnAngle& angle);
+
 /// A request or response packet after header/length/sum checks.
 struct Packet {
   uint8_t cmd = 0;
@@ -67,8 +108,8 @@ struct Packet {
   uint8_t id() const { return content_size > 0 ? content[0] : 0; }
 };
 
-/// Probe for a complete response (05 1C) or request (12 4C): header, CMD range and N
-/// (both kBadLength), sum (kBadChecksum).
+/// Probe for a complete response (05 1C) or request (12 4C): header, CMD (kUnknownCommand),
+/// N (kBadLength), sum (kBadChecksum).
 Probe probeResponse(const uint8_t* data, std::size_t available);
 Probe probeRequest(const uint8_t* data, std::size_t available);
 

@@ -58,9 +58,10 @@ struct ParamInfo {
   ParamType type;
   std::string_view unit;  ///< "mV", "mA", "mW", "degC", "ms", "0.1deg" or "" (raw)
   bool read_only;
-  bool dangerous;  ///< can make the servo unreachable: refused unless explicitly allowed
+  bool dangerous;  ///< refused unless explicitly allowed (see `hazard`)
   int64_t min;     ///< allowed range for writes (the type's range unless the datasheet narrows it)
   int64_t max;
+  std::string_view hazard = {};  ///< why a dangerous write is guarded, for the message
 };
 
 constexpr std::size_t kParamCount = 30;

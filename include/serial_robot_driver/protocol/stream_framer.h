@@ -52,6 +52,8 @@ struct FramerStats {
   uint64_t checksum_errors = 0;  ///< complete candidates whose XOR/sum/CRC failed
   uint64_t bad_tails = 0;        ///< telemetry with a wrong 1F 2F tail
   uint64_t bad_lengths = 0;      ///< impossible LEN bytes
+  uint64_t unknown_commands = 0;  ///< servo-bus headers with a CMD outside 1..16
+  uint64_t stale_candidates = 0;  ///< incomplete candidates given up on (dropStaleCandidate)
   std::array<uint64_t, kFrameFamilyCount> frames{};  ///< verified frames per family
 };
 
@@ -76,6 +78,11 @@ class StreamFramer {
   /// Drops buffered bytes (after a reconnect the old partial frame is meaningless). They are
   /// counted in bytes_skipped; the other statistics are kept.
   void reset();
+  /// Gives up on the incomplete candidate kept for the next feed(): drops its first byte and
+  /// rescans the bytes behind it, handing out the frames found there. A stray header with a long
+  /// LEN would otherwise hold back the answers behind it until enough bytes arrive. The owner calls
+  /// this when no byte has arrived for a while. Returns false when nothing was buffered.
+  bool dropStaleCandidate();
 
   const FramerStats& stats() const { return stats_; }
   const FramerConfig& config() const { return config_; }

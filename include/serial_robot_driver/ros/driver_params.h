@@ -83,6 +83,9 @@ struct ServoBusParams : DevicePortParams {
   double timeout = 0.05;
   int retries = 1;
   bool allow_dangerous_writes = false;
+  std::vector<int> state_ids;     ///< bus servos polled for servo_states (empty: no poll)
+  double state_rate = 10.0;       ///< Hz, polls of every state_ids servo
+  int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
 };
 
 struct DriverParams {

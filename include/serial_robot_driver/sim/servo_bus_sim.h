@@ -1,10 +1,15 @@
 // Simulated chain of UART bus servos (PROTOCOLS.md section 3).
 //
 // Each servo keeps the full parameter table: read-only values that drift a little (voltage,
-// temperature, ...) and the 32-byte user block, persistent across requests. Motions (ROTATE, SPIN)
-// run in simulated time. Answers leave after a small latency; the optional SPIN/ROTATE/DAMPING
-// answers only when response_switch is 1, and only once the motion has completed. Requests that
-// reach no present servo, broadcasts (id 255) and READ_DATA of an unknown data_id get no answer.
+// temperature, ...) and the 32-byte user block, persistent across requests. Motions (ROTATE, SPIN,
+// and the newer CMD 11..15 moves with their accel/decel ramps) run in simulated time on a
+// trapezoidal speed profile. Each servo keeps a multi-turn angle: READ_ANGLE reports it folded into
+// one turn, CMD 16 reports it whole with its turn count; a single-turn move starts from the folded
+// angle (assumption: the datasheet does not say). RESET_USER_DATA restores the factory user block,
+// id 0 included, and answers from id 0. Answers leave after a small latency; the optional
+// SPIN/ROTATE/DAMPING answers only when response_switch is 1, and only once the motion has
+// completed. Requests that reach no present servo, broadcasts (id 255) and READ_DATA of an unknown
+// data_id get no answer.
 #pragma once
 
 #include <array>
@@ -59,10 +64,15 @@ class ServoBusSim {
   ServoBusSimStats stats() const;
 
  private:
-  /// A finite motion: a ROTATE, or a SPIN for some turns or milliseconds.
+  /// A finite motion: a move to an angle (ROTATE, CMD 11..15), or a SPIN for some turns or ms.
   struct Motion {
     enum class Kind { kRotate, kSpin } kind = Kind::kRotate;
     double target_angle = 0.0;  ///< kRotate
+    bool multi_turn = false;    ///< kRotate: starts from the whole angle, not the folded one
+    double velocity_dps = 0.0;  ///< kRotate by velocity (> 0): the duration follows at the start
+    double accel_s = 0.0;       ///< kRotate ramps
+    double decel_s = 0.0;
+    double peak_dps = 0.0;      ///< kRotate: the cruise speed, set when the motion starts
     double rate_dps = 0.0;      ///< kSpin, signed (counter-clockwise positive)
     double duration_s = 0.0;
     bool started = false;
@@ -73,7 +83,6 @@ class ServoBusSim {
     protocol::servo::Command cmd = protocol::servo::Command::kRotate;
   };
   struct Servo {
-    uint8_t factory_id = 0;
     double angle_deg = 0.0;
     double spin_rate_dps = 0.0;  ///< continuous SPIN in force
     std::map<uint8_t, int64_t> params;
@@ -92,6 +101,12 @@ class ServoBusSim {
   void startMotion(Servo* servo, Motion motion, TimePoint now);
   void stopAll(Servo* servo);
   void runMotions(Servo* servo, TimePoint now);
+  /// Sets up the speed profile of a move from the servo's current angle.
+  static void beginMove(Motion* motion, double start_angle);
+  /// Where a move is `elapsed` seconds after its start.
+  static double moveAngle(const Motion& motion, double elapsed);
+  /// A move command (ROTATE, CMD 11..15): clamps to the angle limits and starts or queues it.
+  void requestMove(Servo* servo, Motion motion, uint8_t id, bool broadcast, TimePoint now);
   void driftReadOnly(Servo* servo);
   static int64_t param(const Servo& servo, uint8_t data_id);
 
