@@ -42,6 +42,13 @@ struct BaseParams : DevicePortParams {
   double cmd_vel_timeout = 0.5;
   bool speed_dithering = true;
   double battery_poll_rate = 1.0;
+  int battery_warn_percent = 20;   ///< below: diagnostics WARN
+  int battery_error_percent = 10;  ///< below: diagnostics ERROR
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  bool publish_tf = true;
+  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
+  int right_wheel_direction = 1;
 };
 
 struct BodyParams : DevicePortParams {
@@ -69,6 +76,9 @@ struct ServoBusParams : DevicePortParams {
   int retries = 1;
   bool allow_dangerous_writes = false;
 };
+
+/// Below this loop rate the base's 1 s heartbeat is at risk (validate() says so).
+constexpr double kMinBaseLoopRate = 5.0;
 
 struct DriverParams {
   std::string port = "/dev/ttyUSB0";
