@@ -43,3 +43,9 @@ add_rostest_gtest(test_analyzers test/rostest/analyzers.test test/rostest/test_a
 target_include_directories(test_analyzers PRIVATE ${catkin_INCLUDE_DIRS} ${diagnostic_aggregator_INCLUDE_DIRS})
 target_link_libraries(test_analyzers ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_analyzers driver_node robot_sim)
+
+# Commanded-motion odometry, tf and the e-stop against the simulated base (sim::RobotSim in-process).
+add_rostest_gtest(test_odom test/rostest/odom.test test/rostest/test_odom.cpp)
+target_include_directories(test_odom PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)

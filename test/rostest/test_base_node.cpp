@@ -629,6 +629,22 @@ TEST_F(BaseNodeTest, BatteryReplyIsPublished) {
   EXPECT_TRUE(state.present);
 }
 
+// 10b. A base that never answers the battery requests (2 Hz) is an ERROR in /diagnostics once
+// three poll periods passed, and a reply clears it.
+TEST_F(BaseNodeTest, SilentBaseIsADiagnosticsError) {
+  ASSERT_TRUE(waitFor(
+      [&] {
+        const auto status = g_ros->baseDiagnostics();
+        return status.level == 2 && status.message.find("no reply from the base") != std::string::npos;
+      },
+      15.0))
+      << "last base status: " << g_ros->baseDiagnostics().message;
+  base_->write(kBattery87PercentFrame);
+  EXPECT_TRUE(waitFor(
+      [&] { return g_ros->baseDiagnostics().message.find("no reply") == std::string::npos; }, 10.0))
+      << "last base status: " << g_ros->baseDiagnostics().message;
+}
+
 // 11. base/reset and base/clear_encoders put their exact frames on the wire, in the SEQ sequence.
 TEST_F(BaseNodeTest, ServicesWriteResetAndClearEncoders) {
   ASSERT_TRUE(base_->waitForCount(10, 5.0));
