@@ -630,7 +630,7 @@ TEST_F(BaseNodeTest, BatteryReplyIsPublished) {
 }
 
 // 10b. A base that never answers the battery requests (2 Hz) is an ERROR in /diagnostics once
-// three poll periods passed, and a reply clears it.
+// three poll periods passed (that a reply clears it is a BaseController unit test).
 TEST_F(BaseNodeTest, SilentBaseIsADiagnosticsError) {
   ASSERT_TRUE(waitFor(
       [&] {
@@ -639,10 +639,7 @@ TEST_F(BaseNodeTest, SilentBaseIsADiagnosticsError) {
       },
       15.0))
       << "last base status: " << g_ros->baseDiagnostics().message;
-  base_->write(kBattery87PercentFrame);
-  EXPECT_TRUE(waitFor(
-      [&] { return g_ros->baseDiagnostics().message.find("no reply") == std::string::npos; }, 10.0))
-      << "last base status: " << g_ros->baseDiagnostics().message;
+  EXPECT_EQ(g_ros->baseDiagnostics().value("connected"), "True") << "the port itself is fine";
 }
 
 // 11. base/reset and base/clear_encoders put their exact frames on the wire, in the SEQ sequence.
