@@ -19,7 +19,8 @@ Clock::duration fromSeconds(double s) {
 /// A speed frame's airtime at `baud` (start + 8 data + stop bits per byte), stretched so that
 /// frames sent this closely take at most `line_share` of the line.
 Clock::duration immediateInterval(int baud, double line_share) {
-  const double frame_bits = 10.0 * static_cast<double>(protocol::base::encodeWheelSpeed(0, 0, 0).size());
+  const double frame_bits =
+      10.0 * static_cast<double>(protocol::base::encodeWheelSpeed(0, 0, 0).size());
   const double airtime = frame_bits / std::max(baud, 1);
   return fromSeconds(airtime / std::clamp(line_share, 0.01, 1.0));
 }
@@ -28,7 +29,7 @@ int16_t withDirection(int16_t ticks, int direction) {
   if (direction >= 0) return ticks;
   // -(-32768) does not fit in int16: saturate.
   return ticks == std::numeric_limits<int16_t>::min() ? std::numeric_limits<int16_t>::max()
-                                                       : static_cast<int16_t>(-ticks);
+                                                      : static_cast<int16_t>(-ticks);
 }
 
 class SteadyLoopClock : public LoopClock {
@@ -293,7 +294,8 @@ void BaseController::advanceOdometryLocked(Clock::time_point now) {
   }
 }
 
-void BaseController::acceptedSpeedLocked(const kinematics::WheelTicks& ticks, Clock::time_point now) {
+void BaseController::acceptedSpeedLocked(const kinematics::WheelTicks& ticks,
+                                         Clock::time_point now) {
   advanceOdometryLocked(now);
   const double per_tick = 1.0 / config_.geometry.ticksPerPeriodPerMps();
   held_speeds_ = WheelSpeeds(ticks.left * per_tick, ticks.right * per_tick);
@@ -305,8 +307,7 @@ OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const
   OdometrySample sample;
   sample.time = now;
   sample.pose = odometry_.pose();
-  const bool running =
-      accepted_at_ && seconds(now - *accepted_at_) < config_.heartbeat_gap;
+  const bool running = accepted_at_ && seconds(now - *accepted_at_) < config_.heartbeat_gap;
   if (running) {
     sample.linear = (held_speeds_.x() + held_speeds_.y()) / 2.0;
     sample.angular = (held_speeds_.y() - held_speeds_.x()) / config_.geometry.wheel_separation;

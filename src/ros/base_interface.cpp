@@ -1,10 +1,10 @@
 #include "serial_robot_driver/ros/base_interface.h"
 
-#include <cmath>
-
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/BatteryState.h>
+
+#include <cmath>
 
 #include "serial_robot_driver/WheelCommand.h"
 
@@ -12,9 +12,9 @@ namespace serial_robot_driver::ros_layer {
 
 namespace {
 // Twist variances of odom (see publishOdometry): (m/s)^2 and (rad/s)^2.
-constexpr double kTwistLinearVariance = 0.0025;   // std 0.05 m/s
-constexpr double kTwistLateralVariance = 1e-6;    // a differential drive cannot slide sideways
-constexpr double kTwistAngularVariance = 0.01;    // std 0.1 rad/s
+constexpr double kTwistLinearVariance = 0.0025;  // std 0.05 m/s
+constexpr double kTwistLateralVariance = 1e-6;   // a differential drive cannot slide sideways
+constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
 // An FF from a running base stays a WARN this long (s).
 constexpr double kRecentTimeoutErrorS = 10.0;
 }  // namespace
@@ -72,7 +72,8 @@ device::BaseEvents BaseInterface::events() {
                       params_.cmd_vel_timeout);
   };
   events.on_silent = [this](double seconds) {
-    ROS_ERROR_THROTTLE(10.0, "no reply from the base on %s for %.1f s (battery requests unanswered)",
+    ROS_ERROR_THROTTLE(10.0,
+                       "no reply from the base on %s for %.1f s (battery requests unanswered)",
                        link_.options().path.c_str(), seconds);
   };
   events.on_timeout_error = [] {
@@ -84,12 +85,12 @@ device::BaseEvents BaseInterface::events() {
   return events;
 }
 
-BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                             diagnostic_updater::Updater& diagnostics)
+BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
+                             device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
     : link_(link),
       params_(params.base),
       tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
-                                              : nullptr),
+                                             : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
       controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
@@ -101,8 +102,8 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params, de
   cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &BaseInterface::onCmdVel, this,
                               ros::TransportHints().tcpNoDelay());
   // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
-  e_stop_sub_ = nh.subscribe("e_stop", 10, &BaseInterface::onEStop, this,
-                             ros::TransportHints().tcpNoDelay());
+  e_stop_sub_ =
+      nh.subscribe("e_stop", 10, &BaseInterface::onEStop, this, ros::TransportHints().tcpNoDelay());
   reset_srv_ = nh.advertiseService("base/reset", &BaseInterface::onReset, this);
   reset_odometry_srv_ =
       nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
@@ -228,7 +229,8 @@ void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("resets sent", s.resets_sent);
   status.add("FF timeout errors received", s.timeout_errors_received);
   status.add("FF timeout errors while running", s.timeout_errors_while_running);
-  if (s.seconds_without_reply) status.addf("seconds without reply", "%.1f", *s.seconds_without_reply);
+  if (s.seconds_without_reply)
+    status.addf("seconds without reply", "%.1f", *s.seconds_without_reply);
   status.addf("min immediate frame spacing (ms)", "%.3f", s.min_immediate_interval_ms);
   status.add("battery requests", s.battery_requests);
   status.add("battery replies", s.battery_replies);

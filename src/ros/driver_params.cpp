@@ -65,8 +65,9 @@ void percent(const int& value, const std::string& key) {
 }
 
 void direction(const int& value, const std::string& key) {
-  require(value == 1 || value == -1, key,
-          "must be 1 or -1 (got " + std::to_string(value) + "); -1 flips a wheel that drives backward");
+  require(
+      value == 1 || value == -1, key,
+      "must be 1 or -1 (got " + std::to_string(value) + "); -1 flips a wheel that drives backward");
 }
 
 void frameId(const std::string& value, const std::string& key) {
@@ -183,7 +184,8 @@ std::vector<ParamSpec> buildTable() {
           [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); }),
       row("body/zero_ticks", &P::body, &Body::zero_ticks,
           [](const std::vector<int>& zeros, const std::string& key) {
-            for (int zero : zeros) require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
+            for (int zero : zeros)
+              require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
           }),
       row("body/directions", &P::body, &Body::directions,
           [](const std::vector<int>& directions, const std::string& key) {

@@ -635,7 +635,8 @@ TEST_F(BaseNodeTest, SilentBaseIsADiagnosticsError) {
   ASSERT_TRUE(waitFor(
       [&] {
         const auto status = g_ros->baseDiagnostics();
-        return status.level == 2 && status.message.find("no reply from the base") != std::string::npos;
+        return status.level == 2 &&
+               status.message.find("no reply from the base") != std::string::npos;
       },
       15.0))
       << "last base status: " << g_ros->baseDiagnostics().message;

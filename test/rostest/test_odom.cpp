@@ -2,13 +2,6 @@
 // process on the node's pty). The simulator integrates the speed frames it applied, once per PID
 // period, into its own pose: the reference the node's odom must match (2 % of the distance,
 // 0.02 rad), since odom is the commanded motion the base accepted, not a measurement.
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <memory>
-#include <string>
-#include <thread>
-
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
@@ -16,6 +9,13 @@
 #include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_msgs/TFMessage.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
 
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
@@ -39,9 +39,7 @@ double angleBetween(double a, double b) { return std::abs(std::remainder(a - b, 
 class OdomTest : public ::testing::Test {
  protected:
   OdomTest()
-      : odom_(nh_, "odom", 5),
-        tf_(nh_, "/tf", 5),
-        diagnostics_(nh_, std::string(kNode).substr(1)) {
+      : odom_(nh_, "odom", 5), tf_(nh_, "/tf", 5), diagnostics_(nh_, std::string(kNode).substr(1)) {
     cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     e_stop_ = nh_.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true);
   }
@@ -110,17 +108,23 @@ TEST_F(OdomTest, PoseAfterADriveMatchesTheFramesTheBaseApplied) {
   };
   const auto sim_move = relative(start.x_m, start.y_m, start.yaw_rad, end.x_m, end.y_m);
   const double odom_yaw0 = yawOf(before->pose.pose.orientation);
-  const auto odom_move = relative(before->pose.pose.position.x, before->pose.pose.position.y,
-                                  odom_yaw0, after->pose.pose.position.x, after->pose.pose.position.y);
+  const auto odom_move =
+      relative(before->pose.pose.position.x, before->pose.pose.position.y, odom_yaw0,
+               after->pose.pose.position.x, after->pose.pose.position.y);
   const double sim_turn = std::remainder(end.yaw_rad - start.yaw_rad, 2 * M_PI);
-  const double odom_turn = std::remainder(yawOf(after->pose.pose.orientation) - odom_yaw0, 2 * M_PI);
+  const double odom_turn =
+      std::remainder(yawOf(after->pose.pose.orientation) - odom_yaw0, 2 * M_PI);
   const double distance = std::hypot(sim_move.first, sim_move.second);
   ASSERT_GT(distance, 0.5) << "the simulated base hardly moved";
-  const double error = std::hypot(odom_move.first - sim_move.first, odom_move.second - sim_move.second);
-  std::printf("odom vs simulated base: distance %.4f m, position error %.4f m (%.2f %%), yaw error %.4f rad\n",
-              distance, error, 100.0 * error / distance, angleBetween(odom_turn, sim_turn));
-  EXPECT_LE(error, 0.02 * distance) << "sim moved (" << sim_move.first << ", " << sim_move.second
-                                    << "), odom (" << odom_move.first << ", " << odom_move.second << ")";
+  const double error =
+      std::hypot(odom_move.first - sim_move.first, odom_move.second - sim_move.second);
+  std::printf(
+      "odom vs simulated base: distance %.4f m, position error %.4f m (%.2f %%), yaw error %.4f "
+      "rad\n",
+      distance, error, 100.0 * error / distance, angleBetween(odom_turn, sim_turn));
+  EXPECT_LE(error, 0.02 * distance)
+      << "sim moved (" << sim_move.first << ", " << sim_move.second << "), odom ("
+      << odom_move.first << ", " << odom_move.second << ")";
   EXPECT_LE(angleBetween(odom_turn, sim_turn), 0.02) << "sim " << sim_turn << " odom " << odom_turn;
   EXPECT_GT(std::abs(sim_turn), 0.5);
 
@@ -180,7 +184,8 @@ TEST_F(OdomTest, LatchedEStopHoldsTheBaseUntilReleased) {
       << "speed frames (the heartbeat) keep flowing during the e-stop";
   EXPECT_EQ(g_robot->stats().base.x_m, x_before);
   EXPECT_EQ(g_robot->stats().base.timeouts, 0u);
-  ASSERT_TRUE(waitFor([&] { return diagnostics_.latest("base").number("cmd_vel ignored (e-stop)") >= 10; }, 10));
+  ASSERT_TRUE(waitFor(
+      [&] { return diagnostics_.latest("base").number("cmd_vel ignored (e-stop)") >= 10; }, 10));
 
   stop.data = false;
   latched.publish(stop);

@@ -376,7 +376,8 @@ TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
   BaseEvents events;
   events.on_wheel_frame = [&sent](const WheelFrameSent& s) { sent.push_back(s); };
   auto clock = std::make_shared<ManualClock>(Clock::now());
-  BaseController controller(config, [](const Bytes&) { return true; }, events, clock);
+  BaseController controller(
+      config, [](const Bytes&) { return true; }, events, clock);
   controller.start();
   clock->waitForLoop();
   clock->step([&] { controller.setCommand(0.5, 0.0); });
@@ -461,7 +462,8 @@ TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
   clock->step([&] { controller.setCommand(0.1, 0.0); });
   // 0.1 m/s = 4.07 -> 4 ticks; left flipped: FF FC, right 00 04; XOR 55^AA^09^01^01^FF^FC^04 = F1
   ASSERT_EQ(frames.size(), 2u);
-  EXPECT_EQ(frames[1], (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0xFF, 0xFC, 0x00, 0x04, 0, 0, 0, 0, 0xF1}));
+  EXPECT_EQ(frames[1],
+            (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0xFF, 0xFC, 0x00, 0x04, 0, 0, 0, 0, 0xF1}));
   clock->tick(1);
   ASSERT_FALSE(samples.empty());
   EXPECT_GT(samples.back().pose.x, 0.0) << "the robot drives forward whatever the wire says";
@@ -478,7 +480,8 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   BaseEvents events;
   events.on_silent = [&silent_events](double) { ++silent_events; };
   auto clock = std::make_shared<ManualClock>(Clock::now());
-  BaseController controller(config, [](const Bytes&) { return true; }, events, clock);
+  BaseController controller(
+      config, [](const Bytes&) { return true; }, events, clock);
   controller.start();
   clock->waitForLoop();
   clock->tick(150);  // 3 s: the first request went out at 1.02 s (the first tick sent the Reset)

@@ -139,12 +139,13 @@ TEST_P(DiffDriveTruncation, ReproducesTheVendorNumbers) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(DiffDriveSpecNumbers, DiffDriveTruncation,
-                         ::testing::Values(std::make_tuple(0.1, 4), std::make_tuple(0.2, 8),
-                                           std::make_tuple(1.0, 40), std::make_tuple(-0.15, -6),
-                                           // the dead band: anything under 1 / 40.7437 = 0.02454 m/s is 0
-                                           std::make_tuple(0.02, 0), std::make_tuple(0.0245, 0),
-                                           std::make_tuple(0.0246, 1), std::make_tuple(0.0, 0)));
+INSTANTIATE_TEST_SUITE_P(
+    DiffDriveSpecNumbers, DiffDriveTruncation,
+    ::testing::Values(std::make_tuple(0.1, 4), std::make_tuple(0.2, 8), std::make_tuple(1.0, 40),
+                      std::make_tuple(-0.15, -6),
+                      // the dead band: anything under 1 / 40.7437 = 0.02454 m/s is 0
+                      std::make_tuple(0.02, 0), std::make_tuple(0.0245, 0),
+                      std::make_tuple(0.0246, 1), std::make_tuple(0.0, 0)));
 
 // --- dithering: error feedback keeps the mean exact -------------------------------------------
 

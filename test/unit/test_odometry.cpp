@@ -73,8 +73,8 @@ TEST(Odometry, TurnOnTheSpotThenDriveAlongTheNewHeading) {
 }
 
 TEST(Odometry, TinyTurnUsesTheMidpointStepAndMatchesTheArc) {
-  // v = 0.5 m/s, w = 1e-9 / 0.4 = 2.5e-9 rad/s: the arc radius would be 2e8 m. Over 1 s the arc ends at
-  // x = r sin(th) ~ 0.5, y = r (1 - cos th) ~ v dt th / 2 = 0.5 * 2.5e-9 / 2 = 6.25e-10.
+  // v = 0.5 m/s, w = 1e-9 / 0.4 = 2.5e-9 rad/s: the arc radius would be 2e8 m. Over 1 s the arc
+  // ends at x = r sin(th) ~ 0.5, y = r (1 - cos th) ~ v dt th / 2 = 0.5 * 2.5e-9 / 2 = 6.25e-10.
   Odometry odometry(kSeparation);
   odometry.integrate(WheelSpeeds(0.5 - 5e-10, 0.5 + 5e-10), 1.0);
   EXPECT_NEAR(odometry.pose().x, 0.5, 1e-12);

@@ -49,7 +49,7 @@ struct BaseConfig {
   int baud = 115200;               ///< of the base's port: sets how closely immediate frames follow
   /// Largest share of the line's capacity immediate speed frames may take (a cmd_vel flood).
   double immediate_line_share = 0.5;
-  int left_wheel_direction = 1;   ///< 1 or -1: sign between forward motion and the wire's ticks
+  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
   int right_wheel_direction = 1;
   /// With battery polling on, this many poll periods without any reply mean the base is silent.
   double silent_after_polls = 3.0;
@@ -60,8 +60,8 @@ struct BaseConfig {
 struct OdometrySample {
   Clock::time_point time;
   kinematics::Pose2D pose;
-  double linear = 0;   ///< m/s the base runs at now (0 once its timeout stopped it)
-  double angular = 0;  ///< rad/s
+  double linear = 0;             ///< m/s the base runs at now (0 once its timeout stopped it)
+  double angular = 0;            ///< rad/s
   double position_variance = 0;  ///< m^2, x and y
   double yaw_variance = 0;       ///< rad^2
   double travelled = 0;          ///< m since the last reset
@@ -89,7 +89,7 @@ struct BaseStats {
   uint64_t bad_replies = 0;
   uint64_t cmd_vel_timeouts = 0;
   uint64_t rejected_commands = 0;    ///< NaN/Inf cmd_vel
-  uint64_t ignored_commands_e_stop = 0;  ///< cmd_vel received while the e-stop was engaged
+  uint64_t ignored_commands_e_stop = 0;       ///< cmd_vel received while the e-stop was engaged
   uint64_t timeout_errors_while_running = 0;  ///< FF after the base had accepted our Reset
   std::optional<double> seconds_since_running_timeout_error;
   /// Battery polling on and requests unanswered: seconds since the first unanswered request.
@@ -123,8 +123,8 @@ struct BaseEvents {
   std::function<void(const protocol::base::Frame&)> on_unknown_reply;
   std::function<void()> on_timeout_error;
   std::function<void(const OdometrySample&)> on_odometry;  ///< after every scheduled tick
-  std::function<void()> on_cmd_vel_timeout;       ///< once per timeout, when it starts
-  std::function<void(double seconds)> on_silent;  ///< once, when the base goes silent
+  std::function<void()> on_cmd_vel_timeout;                ///< once per timeout, when it starts
+  std::function<void(double seconds)> on_silent;           ///< once, when the base goes silent
 };
 
 class BaseController : public LinkListener {
@@ -206,7 +206,7 @@ class BaseController : public LinkListener {
   bool e_stop_ = false;
   kinematics::Odometry odometry_;
   kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
-  std::optional<Clock::time_point> accepted_at_;     ///< last speed frame the base accepted
+  std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
   Clock::time_point integrated_until_{};
   std::optional<Clock::time_point> last_reset_sent_;
   std::optional<Clock::time_point> unanswered_since_;  ///< first battery request with no reply yet

@@ -22,10 +22,10 @@ struct Pose2D {
 ///   var(x) = var(y) = initial_position_variance + position_variance_per_meter * travelled
 ///   var(yaw)        = initial_yaw_variance + yaw_variance_per_meter * travelled
 struct PoseCovarianceModel {
-  double initial_position_variance = 1e-6;    ///< m^2
+  double initial_position_variance = 1e-6;      ///< m^2
   double position_variance_per_meter = 0.0025;  ///< m^2 per m: std 5 cm after 1 m, 16 cm after 10 m
-  double initial_yaw_variance = 1e-6;         ///< rad^2
-  double yaw_variance_per_meter = 0.01;       ///< rad^2 per m: std 0.1 rad after 1 m
+  double initial_yaw_variance = 1e-6;           ///< rad^2
+  double yaw_variance_per_meter = 0.01;         ///< rad^2 per m: std 0.1 rad after 1 m
 };
 
 class Odometry {

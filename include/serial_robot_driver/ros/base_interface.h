@@ -5,14 +5,14 @@
 // encoder counts.
 #pragma once
 
-#include <memory>
-
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
+
+#include <memory>
 
 #include "serial_robot_driver/device/base_controller.h"
 #include "serial_robot_driver/ros/device_interface.h"
