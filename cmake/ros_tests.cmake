@@ -68,3 +68,9 @@ add_rostest_gtest(test_servo_topics test/rostest/servo_topics.test
 target_include_directories(test_servo_topics PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_servo_topics srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_servo_topics driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# Commanded-motion odometry, tf and the e-stop against the simulated base (sim::RobotSim in-process).
+add_rostest_gtest(test_odom test/rostest/odom.test test/rostest/test_odom.cpp)
+target_include_directories(test_odom PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)

@@ -6,6 +6,7 @@ catkin_add_gtest(core_tests
   test/unit/test_servo_params.cpp
   test/unit/test_stream_framer.cpp
   test/unit/test_diff_drive.cpp
+  test/unit/test_odometry.cpp
   test/unit/test_transport.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_serial_link.cpp

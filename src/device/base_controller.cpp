@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace serial_robot_driver::device {
 
@@ -10,6 +11,26 @@ using kinematics::WheelSpeeds;
 
 namespace {
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+Clock::duration fromSeconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+/// A speed frame's airtime at `baud` (start + 8 data + stop bits per byte), stretched so that
+/// frames sent this closely take at most `line_share` of the line.
+Clock::duration immediateInterval(int baud, double line_share) {
+  const double frame_bits =
+      10.0 * static_cast<double>(protocol::base::encodeWheelSpeed(0, 0, 0).size());
+  const double airtime = frame_bits / std::max(baud, 1);
+  return fromSeconds(airtime / std::clamp(line_share, 0.01, 1.0));
+}
+
+int16_t withDirection(int16_t ticks, int direction) {
+  if (direction >= 0) return ticks;
+  // -(-32768) does not fit in int16: saturate.
+  return ticks == std::numeric_limits<int16_t>::min() ? std::numeric_limits<int16_t>::max()
+                                                      : static_cast<int16_t>(-ticks);
+}
 
 class SteadyLoopClock : public LoopClock {
  public:
@@ -27,9 +48,11 @@ BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents
       writer_(std::move(writer)),
       events_(std::move(events)),
       clock_(clock ? std::move(clock) : std::make_shared<SteadyLoopClock>()),
-      period_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / config.loop_rate))),
+      period_(fromSeconds(1.0 / config.loop_rate)),
+      min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
       limiter_(config.max_wheel_accel),
-      quantizer_(config.geometry, config.speed_dithering) {}
+      quantizer_(config.geometry, config.speed_dithering),
+      odometry_(config.geometry.wheel_separation, config.odometry_covariance) {}
 
 BaseController::~BaseController() {
   {
@@ -44,6 +67,10 @@ bool BaseController::setCommand(double linear_x, double angular_z) {
   const bool valid = std::isfinite(linear_x) && std::isfinite(angular_z);
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (e_stop_) {
+      ++stats_.ignored_commands_e_stop;
+      return valid;
+    }
     linear_x_ = valid ? linear_x : 0.0;
     angular_z_ = valid ? angular_z : 0.0;
     last_command_ = clock_->now();
@@ -54,12 +81,38 @@ bool BaseController::setCommand(double linear_x, double angular_z) {
   return valid;
 }
 
+void BaseController::setEStop(bool engaged) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (engaged == e_stop_) return;
+    e_stop_ = engaged;
+    stats_.e_stop = engaged;
+    if (engaged) {
+      command_pending_ = true;  // the zero frame goes out now, not at the next tick
+    } else {
+      // Obey cmd_vel from the next message only: the command from before the stop is forgotten.
+      last_command_.reset();
+      linear_x_ = angular_z_ = 0.0;
+    }
+  }
+  wake_.notify_all();
+}
+
+void BaseController::resetOdometry() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = clock_->now();
+  advanceOdometryLocked(now);
+  odometry_.reset();
+}
+
 bool BaseController::sendReset() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool ok = writeLocked(base::encodeReset(seq_.peek()), clock_->now());
+  const Clock::time_point now = clock_->now();
+  const bool ok = writeLocked(base::encodeReset(seq_.peek()), now);
   if (ok) {
     ++stats_.resets_sent;
     needs_reset_ = false;
+    last_reset_sent_ = now;
   }
   return ok;
 }
@@ -93,14 +146,28 @@ void BaseController::stop() {
     sent.seq = seq_.peek();
     sent.time = clock_->now();
     written = writeLocked(base::encodeWheelSpeed(sent.seq, 0, 0), sent.time);
-    if (written) ++stats_.speed_frames;
+    if (written) {
+      ++stats_.speed_frames;
+      if (!needs_reset_) acceptedSpeedLocked(kinematics::WheelTicks{}, sent.time);
+    }
   }
   if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
 }
 
 BaseStats BaseController::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return stats_;
+  const Clock::time_point now = clock_->now();
+  BaseStats snapshot = stats_;
+  snapshot.min_immediate_interval_ms = seconds(min_immediate_interval_) * 1e3;
+  if (last_running_timeout_error_) {
+    snapshot.seconds_since_running_timeout_error = seconds(now - *last_running_timeout_error_);
+  }
+  if (config_.battery_poll_rate > 0 && unanswered_since_) {
+    snapshot.seconds_without_reply = seconds(now - *unanswered_since_);
+    snapshot.base_silent =
+        *snapshot.seconds_without_reply > config_.silent_after_polls / config_.battery_poll_rate;
+  }
+  return snapshot;
 }
 
 void BaseController::onLinkUp() {
@@ -109,6 +176,8 @@ void BaseController::onLinkUp() {
     needs_reset_ = true;  // the base may have timed out while we were away
     quantizer_.reset();
     command_pending_ = true;
+    unanswered_since_.reset();  // a new connection gets its own poll periods to answer
+    silent_reported_ = false;
   }
   wake_.notify_all();
 }
@@ -128,16 +197,31 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
     return;
   }
   const auto reply = base::interpretReply(*frame);
-  if (!reply) {
+  {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++stats_.bad_replies;
-    return;
+    if (!reply) {
+      ++stats_.bad_replies;
+      return;
+    }
+    unanswered_since_.reset();  // any well-formed frame shows the base is there
+    silent_reported_ = false;
   }
   switch (reply->kind) {
     case base::Reply::Kind::kTimeoutError: {
       {
         std::lock_guard<std::mutex> lock(mutex_);
+        const Clock::time_point now = clock_->now();
         ++stats_.timeout_errors_received;
+        // One FF may still be in flight from before our Reset (e.g. at power-on): not "running".
+        const bool running = !needs_reset_ && last_reset_sent_ &&
+                             seconds(now - *last_reset_sent_) >= config_.heartbeat_gap;
+        if (running) {
+          ++stats_.timeout_errors_while_running;
+          last_running_timeout_error_ = now;
+        }
+        // The base has stopped its wheels and ignores speed frames until our next Reset.
+        advanceOdometryLocked(now);
+        held_speeds_.setZero();
         needs_reset_ = true;
         command_pending_ = true;  // Reset on the wire now, not at the next tick
       }
@@ -176,10 +260,14 @@ bool BaseController::writeLocked(const std::vector<uint8_t>& frame, Clock::time_
   return true;
 }
 
-WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now) {
+WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now, bool* timed_out_now) {
+  if (e_stop_) return WheelSpeeds::Zero();
   const bool timed_out =
       !last_command_ || seconds(now - *last_command_) > config_.cmd_vel_timeout;
-  if (timed_out && !command_timed_out_ && last_command_) ++stats_.cmd_vel_timeouts;
+  if (timed_out && !command_timed_out_ && last_command_) {
+    ++stats_.cmd_vel_timeouts;
+    *timed_out_now = true;
+  }
   command_timed_out_ = timed_out;
   if (timed_out) return WheelSpeeds::Zero();
   // Work on the twist scaled to at most 1 so absurd (finite) commands cannot overflow to inf and
@@ -187,20 +275,62 @@ WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now) {
   const double scale = std::max({1.0, std::abs(linear_x_), std::abs(angular_z_)});
   const WheelSpeeds unit =
       kinematics::wheelSpeedsFromTwist(config_.geometry, linear_x_ / scale, angular_z_ / scale);
-  const double largest = unit.cwiseAbs().maxCoeff();
-  if (config_.max_wheel_speed > 0 && largest * scale > config_.max_wheel_speed) {
-    return unit * (config_.max_wheel_speed / largest);
+  if (!(config_.max_wheel_speed > 0)) return unit * scale;
+  return kinematics::clampWheelSpeeds(unit, config_.max_wheel_speed / scale) * scale;
+}
+
+kinematics::WheelTicks BaseController::onWire(const kinematics::WheelTicks& ticks) const {
+  return kinematics::WheelTicks{withDirection(ticks.left, config_.left_wheel_direction),
+                                withDirection(ticks.right, config_.right_wheel_direction)};
+}
+
+void BaseController::advanceOdometryLocked(Clock::time_point now) {
+  if (!accepted_at_) return;
+  // The base runs the last accepted speeds until its heartbeat timeout stops it.
+  const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(config_.heartbeat_gap));
+  if (end > integrated_until_) {
+    odometry_.integrate(held_speeds_, seconds(end - integrated_until_));
+    integrated_until_ = end;
   }
-  return unit * scale;
+}
+
+void BaseController::acceptedSpeedLocked(const kinematics::WheelTicks& ticks,
+                                         Clock::time_point now) {
+  advanceOdometryLocked(now);
+  const double per_tick = 1.0 / config_.geometry.ticksPerPeriodPerMps();
+  held_speeds_ = WheelSpeeds(ticks.left * per_tick, ticks.right * per_tick);
+  accepted_at_ = now;
+  integrated_until_ = now;
+}
+
+OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const {
+  OdometrySample sample;
+  sample.time = now;
+  sample.pose = odometry_.pose();
+  const bool running = accepted_at_ && seconds(now - *accepted_at_) < config_.heartbeat_gap;
+  if (running) {
+    sample.linear = (held_speeds_.x() + held_speeds_.y()) / 2.0;
+    sample.angular = (held_speeds_.y() - held_speeds_.x()) / config_.geometry.wheel_separation;
+  }
+  sample.position_variance = odometry_.positionVariance();
+  sample.yaw_variance = odometry_.yawVariance();
+  sample.travelled = odometry_.travelled();
+  return sample;
 }
 
 void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
   WheelFrameSent sent;
   bool written = false;
+  bool timed_out_now = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const double dt = last_speed_frame_ ? seconds(now - *last_speed_frame_) : seconds(period_);
-    const WheelSpeeds speeds = limiter_.step(targetSpeedsLocked(now), dt);
+    const WheelSpeeds target = targetSpeedsLocked(now, &timed_out_now);
+    if (e_stop_) {
+      limiter_.reset();  // an e-stop does not ramp down
+      quantizer_.reset();
+    }
+    const WheelSpeeds speeds = e_stop_ ? target : limiter_.step(target, dt);
 
     // The base drops into its timeout error after 1 s without a frame; if our own gap reached that,
     // assume it did, even if its FF frame was lost.
@@ -209,9 +339,11 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
       if (!writeLocked(base::encodeReset(seq_.peek()), now)) return;
       ++stats_.resets_sent;
       needs_reset_ = false;
+      last_reset_sent_ = now;
       sent.reset_before = true;
     }
-    sent.ticks = quantizer_.quantize(speeds);
+    const kinematics::WheelTicks ticks = quantizer_.quantize(speeds);
+    sent.ticks = onWire(ticks);
     sent.seq = seq_.peek();
     sent.speeds = speeds;
     sent.time = now;
@@ -220,8 +352,10 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
       ++stats_.speed_frames;
       if (immediate) ++stats_.immediate_frames;
       last_speed_frame_ = now;
+      acceptedSpeedLocked(ticks, now);  // a Reset went out before it whenever one was due
     }
   }
+  if (timed_out_now && events_.on_cmd_vel_timeout) events_.on_cmd_vel_timeout();
   if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
 }
 
@@ -240,10 +374,28 @@ void BaseController::tick(Clock::time_point now) {
       // A Reset pending goes out with the speed frame below; the battery request can wait for it.
       if (!needs_reset_ && writeLocked(base::encodeBatteryRequest(seq_.peek()), now)) {
         ++stats_.battery_requests;
+        if (!unanswered_since_) unanswered_since_ = now;
       }
     }
   }
   sendSpeed(now, false);
+
+  std::optional<double> went_silent;
+  OdometrySample sample;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (config_.battery_poll_rate > 0 && unanswered_since_ && !silent_reported_) {
+      const double silent_for = seconds(now - *unanswered_since_);
+      if (silent_for > config_.silent_after_polls / config_.battery_poll_rate) {
+        silent_reported_ = true;
+        went_silent = silent_for;
+      }
+    }
+    advanceOdometryLocked(now);
+    sample = odometrySampleLocked(now);
+  }
+  if (went_silent && events_.on_silent) events_.on_silent(*went_silent);
+  if (events_.on_odometry) events_.on_odometry(sample);
 }
 
 void BaseController::run() {
@@ -257,11 +409,13 @@ void BaseController::run() {
     if (stopping_) break;
     const Clock::time_point now = clock_->now();
     if (now < deadline) {
-      // Woken early by a command: send it at once unless the last frame is too recent; then it
-      // waits for the tick, which is at most one period away.
-      const bool may_rush = !last_speed_frame_ || (now - *last_speed_frame_) * 2 >= period_;
+      // Woken early by a command: send it at once unless the last frame is so recent that a
+      // flood would overrun the line; then it goes when the line allows (or with the tick).
+      const bool may_rush =
+          !last_speed_frame_ || now - *last_speed_frame_ >= min_immediate_interval_;
       if (!may_rush) {
-        const Clock::time_point until = std::min(deadline, *last_speed_frame_ + period_ / 2);
+        const Clock::time_point until =
+            std::min(deadline, *last_speed_frame_ + min_immediate_interval_);
         while (!stopping_ && clock_->now() < until) clock_->waitUntil(lock, wake_, until);
         continue;  // re-evaluate with command_pending_ still set
       }

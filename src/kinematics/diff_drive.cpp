@@ -10,8 +10,9 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kInt16Max = std::numeric_limits<int16_t>::max();
 constexpr double kInt16Min = std::numeric_limits<int16_t>::min();
 
-// A NaN from a misbehaving publisher must never reach the motors: treat it as "stop".
-double finiteOrZero(double value) { return std::isnan(value) ? 0.0 : value; }
+// A NaN or an infinity from a misbehaving publisher must never reach the motors: treat it as
+// "stop". (An infinity let through would turn into NaN in the clamp: inf * (max / inf).)
+double finiteOrZero(double value) { return std::isfinite(value) ? value : 0.0; }
 
 WheelSpeeds sanitized(const WheelSpeeds& speeds) {
   return WheelSpeeds(finiteOrZero(speeds.x()), finiteOrZero(speeds.y()));
@@ -82,6 +83,12 @@ WheelTicks TickQuantizer::quantize(const WheelSpeeds& speeds) {
   const Eigen::Vector2d wanted = exact + remainder_;
   Eigen::Vector2d sent;
   for (int wheel = 0; wheel < 2; ++wheel) {
+    if (exact[wheel] == 0.0) {
+      // A stop is a stop: a carried +-0.5 would otherwise round to +1, -1, +1 ... forever.
+      sent[wheel] = 0;
+      remainder_[wheel] = 0.0;
+      continue;
+    }
     const double rounded = std::round(wanted[wheel]);
     if (exceedsInt16(rounded) || !std::isfinite(rounded)) {
       // Saturated: the shortfall can never be paid back, so carrying it would only wind up.

@@ -1,11 +1,24 @@
 #include "serial_robot_driver/ros/base_interface.h"
 
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
 #include <sensor_msgs/BatteryState.h>
+
+#include <cmath>
 
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
+
+namespace {
+// Twist variances of odom (see publishOdometry): (m/s)^2 and (rad/s)^2.
+constexpr double kTwistLinearVariance = 0.0025;  // std 0.05 m/s
+constexpr double kTwistLateralVariance = 1e-6;   // a differential drive cannot slide sideways
+constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
+// An FF from a running base stays a WARN this long (s).
+constexpr double kRecentTimeoutErrorS = 10.0;
+}  // namespace
 
 device::BaseConfig makeBaseConfig(const DriverParams& params) {
   device::BaseConfig config;
@@ -19,6 +32,9 @@ device::BaseConfig makeBaseConfig(const DriverParams& params) {
   config.speed_dithering = params.base.speed_dithering;
   config.battery_poll_rate = params.base.battery_poll_rate;
   config.loop_rate = params.loop_rate;
+  config.baud = params.baseBaud();
+  config.left_wheel_direction = params.base.left_wheel_direction;
+  config.right_wheel_direction = params.base.right_wheel_direction;
   return config;
 }
 
@@ -51,6 +67,16 @@ device::BaseEvents BaseInterface::events() {
     msg.present = true;
     battery_pub_.publish(msg);
   };
+  events.on_odometry = [this](const device::OdometrySample& sample) { publishOdometry(sample); };
+  events.on_cmd_vel_timeout = [this] {
+    ROS_INFO_THROTTLE(10.0, "no cmd_vel for %.2f s (base/cmd_vel_timeout): commanding zero speed",
+                      params_.cmd_vel_timeout);
+  };
+  events.on_silent = [this](double seconds) {
+    ROS_ERROR_THROTTLE(10.0,
+                       "no reply from the base on %s for %.1f s (battery requests unanswered)",
+                       link_.options().path.c_str(), seconds);
+  };
   events.on_timeout_error = [] {
     ROS_WARN_THROTTLE(5.0, "base reported a connection-timeout error (FF): sending Reset");
   };
@@ -64,6 +90,10 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
     : link_(link),
       arrival_stamps_(params),
+      params_(params.base),
+      tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
+                                             : nullptr),
+      odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
       controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
   battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
@@ -73,7 +103,12 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
   // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.
   cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &BaseInterface::onCmdVel, this,
                               ros::TransportHints().tcpNoDelay());
+  // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
+  e_stop_sub_ =
+      nh.subscribe("e_stop", 10, &BaseInterface::onEStop, this, ros::TransportHints().tcpNoDelay());
   reset_srv_ = nh.advertiseService("base/reset", &BaseInterface::onReset, this);
+  reset_odometry_srv_ =
+      nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
   clear_encoders_srv_ = nh.advertiseService("base/clear_encoders", &BaseInterface::onClearEncoders, this);
   diagnostics.add("base", this, &BaseInterface::diagnose);
 }
@@ -85,6 +120,63 @@ void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {
   }
 }
 
+void BaseInterface::onEStop(const std_msgs::Bool::ConstPtr& msg) {
+  controller_.setEStop(msg->data);
+  if (msg->data) {
+    ROS_WARN("e_stop engaged: holding zero speed, cmd_vel ignored until e_stop is false");
+  } else {
+    ROS_INFO("e_stop released: obeying cmd_vel from the next message");
+  }
+}
+
+void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
+  // Called on the control loop's thread once per tick; never touches the port.
+  const ros::Time stamp = ros::Time::now();
+  const double half_yaw = sample.pose.yaw / 2.0;
+  geometry_msgs::Quaternion orientation;
+  orientation.z = std::sin(half_yaw);
+  orientation.w = std::cos(half_yaw);
+
+  nav_msgs::Odometry odom;
+  odom.header.stamp = stamp;
+  odom.header.frame_id = params_.odom_frame;
+  odom.child_frame_id = params_.base_frame;
+  odom.pose.pose.position.x = sample.pose.x;
+  odom.pose.pose.position.y = sample.pose.y;
+  odom.pose.pose.orientation = orientation;
+  odom.twist.twist.linear.x = sample.linear;
+  odom.twist.twist.angular.z = sample.angular;
+  // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
+  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all.
+  constexpr double kNotEstimated = 1e6;
+  odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
+  odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
+  odom.pose.covariance[35] = sample.yaw_variance;
+  // The twist is what the base was told, good to about one tick per period (0.0245 m/s with the
+  // default geometry), plus what the wheels fail to follow.
+  odom.twist.covariance[0] = kTwistLinearVariance;
+  odom.twist.covariance[7] = kTwistLateralVariance;
+  odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
+  odom.twist.covariance[35] = kTwistAngularVariance;
+  odom_pub_.publish(odom);
+
+  if (!tf_broadcaster_) return;
+  geometry_msgs::TransformStamped transform;
+  transform.header = odom.header;
+  transform.child_frame_id = odom.child_frame_id;
+  transform.transform.translation.x = sample.pose.x;
+  transform.transform.translation.y = sample.pose.y;
+  transform.transform.rotation = orientation;
+  tf_broadcaster_->sendTransform(transform);
+}
+
+bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  controller_.resetOdometry();
+  res.success = true;
+  res.message = "odometry pose reset to zero";
+  return true;
+}
+
 bool BaseInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   res.success = controller_.sendReset();
   res.message = res.success ? "Reset sent" : "base port " + link_.options().path + " is not connected";
@@ -93,28 +185,56 @@ bool BaseInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
 
 bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   res.success = controller_.sendClearEncoders();
-  res.message = res.success ? "clear-encoders sent"
+  // The AP1 reports no encoder counts, so clearing them changes nothing the node publishes.
+  res.message = res.success ? "clear-encoders sent (the node never reads encoder counts; odom is "
+                              "not affected: use base/reset_odometry)"
                             : "base port " + link_.options().path + " is not connected";
   return true;
 }
 
 void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
   const device::BaseStats s = controller_.stats();
   const bool connected = link_.connected();
+  status.summary(DiagnosticStatus::OK, "driving");
   if (!connected) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "port " + link_.options().path + " not connected");
-  } else if (s.timeout_errors_received > 0 && s.resets_sent == 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "base in timeout error");
+    status.mergeSummary(DiagnosticStatus::ERROR, "port " + link_.options().path + " not connected");
   } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "driving");
+    if (s.base_silent && s.seconds_without_reply) {
+      status.mergeSummaryf(DiagnosticStatus::ERROR, "no reply from the base for %.0f s",
+                           *s.seconds_without_reply);
+    }
+    if (s.seconds_since_running_timeout_error &&
+        *s.seconds_since_running_timeout_error < kRecentTimeoutErrorS) {
+      status.mergeSummaryf(DiagnosticStatus::WARN,
+                           "base reported a timeout error (FF) %.0f s ago: frames were lost",
+                           *s.seconds_since_running_timeout_error);
+    }
   }
+  if (s.battery_percent) {
+    const int percent = *s.battery_percent;
+    if (percent < params_.battery_error_percent) {
+      status.mergeSummaryf(DiagnosticStatus::ERROR, "battery %d %% (below %d %%)", percent,
+                           params_.battery_error_percent);
+    } else if (percent < params_.battery_warn_percent) {
+      status.mergeSummaryf(DiagnosticStatus::WARN, "battery %d %% (below %d %%)", percent,
+                           params_.battery_warn_percent);
+    }
+  }
+  if (s.e_stop) status.mergeSummary(DiagnosticStatus::WARN, "e-stop engaged: holding zero speed");
   status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);
   status.add("speed frames out", s.speed_frames);
   status.add("immediate frames (new cmd_vel)", s.immediate_frames);
+  status.add("e-stop engaged", s.e_stop);
+  status.add("cmd_vel ignored (e-stop)", s.ignored_commands_e_stop);
   status.add("resets sent", s.resets_sent);
   status.add("FF timeout errors received", s.timeout_errors_received);
+  status.add("FF timeout errors while running", s.timeout_errors_while_running);
+  if (s.seconds_without_reply)
+    status.addf("seconds without reply", "%.1f", *s.seconds_without_reply);
+  status.addf("min immediate frame spacing (ms)", "%.3f", s.min_immediate_interval_ms);
   status.add("battery requests", s.battery_requests);
   status.add("battery replies", s.battery_replies);
   status.add("unknown replies", s.unknown_replies);

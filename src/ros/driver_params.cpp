@@ -61,6 +61,21 @@ void nonNegative(const T& value, const std::string& key) {
 }
 
 void baud(const int& value, const std::string& key) { requireBaud(value, key, false); }
+
+void percent(const int& value, const std::string& key) {
+  require(value >= 0 && value <= 100, key, "must be 0..100 (got " + std::to_string(value) + ")");
+}
+
+void direction(const int& value, const std::string& key) {
+  require(
+      value == 1 || value == -1, key,
+      "must be 1 or -1 (got " + std::to_string(value) + "); -1 flips a wheel that drives backward");
+}
+
+void frameId(const std::string& value, const std::string& key) {
+  require(!value.empty(), key, "must name a tf frame");
+  require(value.find(' ') == std::string::npos, key, "must not contain spaces");
+}
 void baudOrInherit(const int& value, const std::string& key) { requireBaud(value, key, true); }
 
 /// Whether a key's range check applies: a device's keys (and the IMU's, which the body reports)
@@ -140,6 +155,13 @@ std::vector<ParamSpec> buildTable() {
       row("base/cmd_vel_timeout", &P::base, &Base::cmd_vel_timeout, positive<double>),
       row("base/speed_dithering", &P::base, &Base::speed_dithering),
       row("base/battery_poll_rate", &P::base, &Base::battery_poll_rate, nonNegative<double>),
+      row("base/battery_warn_percent", &P::base, &Base::battery_warn_percent, percent),
+      row("base/battery_error_percent", &P::base, &Base::battery_error_percent, percent),
+      row("base/odom_frame", &P::base, &Base::odom_frame, frameId),
+      row("base/base_frame", &P::base, &Base::base_frame, frameId),
+      row("base/publish_tf", &P::base, &Base::publish_tf),
+      row("base/left_wheel_direction", &P::base, &Base::left_wheel_direction, direction),
+      row("base/right_wheel_direction", &P::base, &Base::right_wheel_direction, direction),
 
       row("body/enabled", &P::body, &Port::enabled),
       row("body/port", &P::body, &Port::port),
@@ -321,8 +343,21 @@ void DriverParams::validate() const {
   require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
           "every device is disabled (base, body, servo_bus): nothing to drive");
   if (base.enabled) {
+    // Every tick's wheel frame is the base's heartbeat; it stops with a timeout error after 1 s
+    // without one. 5 Hz leaves five frames in that second, so one lost frame is harmless.
+    std::ostringstream rate;
+    rate << "must be at least " << kMinBaseLoopRate
+         << " Hz while the base is enabled: each loop tick sends the wheel frame that keeps the "
+            "base's 1 s heartbeat alive (got "
+         << loop_rate << ")";
+    require(loop_rate >= kMinBaseLoopRate, "loop_rate", rate.str());
     require(base.battery_poll_rate <= loop_rate, "base/battery_poll_rate",
             "must not exceed loop_rate (requests go out from the loop)");
+    require(base.battery_error_percent <= base.battery_warn_percent, "base/battery_error_percent",
+            "must not exceed base/battery_warn_percent (" +
+                std::to_string(base.battery_warn_percent) + ")");
+    require(base.odom_frame != base.base_frame, "base/base_frame",
+            "must differ from base/odom_frame ('" + base.odom_frame + "')");
   }
   if (body.enabled) {
     const std::size_t n = body.servo_ids.size();

@@ -84,6 +84,7 @@ void BaseSim::tick(TimePoint now, Outbox* out) {
   while (next_pid_ <= now) {
     stats_.left_ticks += stats_.last_left_speed;
     stats_.right_ticks += stats_.last_right_speed;
+    advancePose();
     next_pid_ += pid_period_;
   }
 
@@ -107,6 +108,18 @@ TimePoint BaseSim::nextEvent() const {
                               std::chrono::milliseconds(1));
   }
   return next;
+}
+
+void BaseSim::advancePose() {
+  const double meters_per_tick = config_.wheel_diameter_m * M_PI / config_.encoder_resolution;
+  const double left = stats_.last_left_speed * meters_per_tick;
+  const double right = stats_.last_right_speed * meters_per_tick;
+  const double forward = (left + right) / 2.0;
+  const double turn = (right - left) / config_.wheel_separation_m;
+  const double heading = stats_.yaw_rad + turn / 2.0;
+  stats_.x_m += forward * std::cos(heading);
+  stats_.y_m += forward * std::sin(heading);
+  stats_.yaw_rad = std::remainder(stats_.yaw_rad + turn, 2.0 * M_PI);
 }
 
 double BaseSim::yawRate() const {

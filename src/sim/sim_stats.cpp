@@ -30,6 +30,9 @@ std::string formatStats(const SimStats& stats) {
   line("base_in_error", base.in_error ? 1 : 0);
   line("left_ticks", base.left_ticks);
   line("right_ticks", base.right_ticks);
+  line("base_x_m", base.x_m);
+  line("base_y_m", base.y_m);
+  line("base_yaw_rad", base.yaw_rad);
   line("last_left_speed", base.last_left_speed);
   line("last_right_speed", base.last_right_speed);
 

@@ -629,6 +629,45 @@ TEST_F(BaseNodeTest, BatteryReplyIsPublished) {
   EXPECT_TRUE(state.present);
 }
 
+// 10b. A base that never answers the battery requests (2 Hz) is an ERROR in /diagnostics once
+// three poll periods passed (that a reply clears it is a BaseController unit test).
+TEST_F(BaseNodeTest, SilentBaseIsADiagnosticsError) {
+  ASSERT_TRUE(waitFor(
+      [&] {
+        const auto status = g_ros->baseDiagnostics();
+        return status.level == 2 &&
+               status.message.find("no reply from the base") != std::string::npos;
+      },
+      15.0))
+      << "last base status: " << g_ros->baseDiagnostics().message;
+  EXPECT_EQ(g_ros->baseDiagnostics().value("connected"), "True") << "the port itself is fine";
+}
+
+// 10c. Battery below base/battery_error_percent (10) is an ERROR, below base/battery_warn_percent
+// (20) a WARN, as kobuki_node reports it.
+TEST_F(BaseNodeTest, LowBatteryIsReportedInDiagnostics) {
+  // Battery replies written by hand: 55 AA 02 SEQ 02 PCT XOR.
+  const Bytes battery5 = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x05, 0xFA};   // 5 %
+  const Bytes battery15 = {0x55, 0xAA, 0x02, 0x01, 0x02, 0x0F, 0xF1};  // 15 %
+  ASSERT_EQ(battery5, withXor({0x55, 0xAA, 0x02, 0x00, 0x02, 0x05}));
+  ASSERT_EQ(battery15, withXor({0x55, 0xAA, 0x02, 0x01, 0x02, 0x0F}));
+  base_->write(battery5);
+  EXPECT_TRUE(waitFor(
+      [&] {
+        const auto status = g_ros->baseDiagnostics();
+        return status.level == 2 && status.message.find("battery 5 % (below 10 %)") != std::string::npos;
+      },
+      10.0))
+      << "last base status: " << g_ros->baseDiagnostics().message;
+  base_->write(battery15);
+  EXPECT_TRUE(waitFor(
+      [&] {
+        return g_ros->baseDiagnostics().message.find("battery 15 % (below 20 %)") != std::string::npos;
+      },
+      10.0))
+      << "last base status: " << g_ros->baseDiagnostics().message;
+}
+
 // 11. base/reset and base/clear_encoders put their exact frames on the wire, in the SEQ sequence.
 TEST_F(BaseNodeTest, ServicesWriteResetAndClearEncoders) {
   ASSERT_TRUE(base_->waitForCount(10, 5.0));

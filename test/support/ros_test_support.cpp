@@ -77,6 +77,7 @@ DiagnosticsWatch::DiagnosticsWatch(ros::NodeHandle& nh, const std::string& node)
           if (status.name.rfind(prefix_, 0) != 0) continue;
           Status& stored = statuses_[status.name.substr(prefix_.size())];
           ++stored.received;
+          stored.level = status.level;
           stored.message = status.message;
           stored.values.clear();
           for (const auto& kv : status.values) stored.values[kv.key] = kv.value;

@@ -97,6 +97,7 @@ class DiagnosticsWatch {
  public:
   struct Status {
     uint64_t received = 0;  ///< how many statuses of this name arrived so far
+    int level = 0;          ///< diagnostic_msgs::DiagnosticStatus OK / WARN / ERROR / STALE
     std::string message;
     std::map<std::string, std::string> values;
 

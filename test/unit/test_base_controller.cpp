@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -111,6 +112,7 @@ class BaseControllerTest : public ::testing::Test {
   BaseEvents events() {
     BaseEvents events;
     events.on_wheel_frame = [this](const WheelFrameSent& sent) { sent_.push_back(sent); };
+    events.on_odometry = [this](const OdometrySample& sample) { odometry_.push_back(sample); };
     return events;
   }
 
@@ -131,6 +133,7 @@ class BaseControllerTest : public ::testing::Test {
   // Declared before the controller, so they outlive its loop thread.
   std::vector<Bytes> frames_;
   std::vector<WheelFrameSent> sent_;
+  std::vector<OdometrySample> odometry_;
   bool port_up_ = true;
   const Clock::time_point t0_ = Clock::now();
   std::shared_ptr<ManualClock> clock_;
@@ -266,6 +269,251 @@ TEST_F(BaseControllerTest, StopWritesAZeroSpeedFrame) {
   for (int i = 5; i < 13; ++i) EXPECT_EQ(frames_[0][i], 0) << "byte " << i;
   ASSERT_FALSE(sent_.empty());
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
+}
+
+// --- immediate frames: spaced by the line, not by the loop --------------------------------------
+
+// Wheel-speed frame: 14 bytes = 140 bits; at 115200 baud 1.2153 ms on the wire; at most half the
+// line for such frames: one every 2.4306 ms (411 Hz).
+constexpr auto kExpectedImmediateInterval = std::chrono::nanoseconds(2430556);
+
+/// Moves the manual clock to `target`, stopping at every 20 ms tick on the way so each tick runs
+/// at its own deadline (as on the real clock).
+void advanceTo(ManualClock& clock, Clock::time_point t0, Clock::time_point target) {
+  while (clock.now() < target) {
+    const auto since_start = clock.now() - t0;
+    const auto next_tick = t0 + (since_start / milliseconds(20) + 1) * milliseconds(20);
+    clock.advance(std::min(next_tick, target) - clock.now());
+  }
+}
+
+TEST_F(BaseControllerTest, ImmediateSpacingComesFromTheBaudRate) {
+  const auto interval = controller_.minImmediateInterval();
+  EXPECT_NEAR(std::chrono::duration<double>(interval).count(),
+              std::chrono::duration<double>(kExpectedImmediateInterval).count(), 1e-8);
+}
+
+TEST_F(BaseControllerTest, CmdVelAt300HzGoesOutAtOnceEveryTime) {
+  // 300 Hz = 3.333 ms apart, starting 2.9 ms after t0 so no command falls within the spacing
+  // right after a tick (the pattern repeats every 20 ms: six commands per tick).
+  const auto spacing = std::chrono::microseconds(3333);
+  for (int k = 0; k < 60; ++k) {  // 0.2 s
+    const Clock::time_point at = t0_ + std::chrono::microseconds(2900) + k * spacing;
+    advanceTo(*clock_, t0_, at);
+    const double speed = 0.05 + 0.005 * (k % 20);
+    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    ASSERT_FALSE(sent_.empty());
+    EXPECT_EQ(sent_.back().time, at) << "command " << k << " was held back";
+    EXPECT_NEAR(sent_.back().speeds.x(), speed, 1e-12) << "command " << k;
+  }
+  EXPECT_EQ(controller_.stats().immediate_frames, 60u);
+}
+
+TEST_F(BaseControllerTest, CmdVelFloodIsLimitedToTheLineShareAndTicksKeepTheirSchedule) {
+  // 10 kHz for 0.2 s: 2000 commands.
+  const auto spacing = std::chrono::microseconds(100);
+  for (int k = 1; k <= 2000; ++k) {
+    advanceTo(*clock_, t0_, t0_ + k * spacing);
+    clock_->step([&] { controller_.setCommand(0.1 + 0.0001 * (k % 100), 0.0); });
+  }
+  const uint64_t immediate = controller_.stats().immediate_frames;
+  // 200 ms / 2.43 ms = 82.3: at most 83 rushed frames, and they did keep coming.
+  EXPECT_LE(immediate, 83u);
+  EXPECT_GE(immediate, 40u);
+  // Any two speed frames the commands caused are at least the interval apart, and the scheduled
+  // frames stayed on their 20 ms grid.
+  std::optional<Clock::time_point> last_immediate;
+  int scheduled = 0;
+  for (const WheelFrameSent& sent : sent_) {
+    const auto offset = sent.time - t0_;
+    if (offset % milliseconds(20) == Clock::duration::zero()) {
+      ++scheduled;
+      continue;
+    }
+    if (last_immediate) EXPECT_GE(sent.time - *last_immediate, kExpectedImmediateInterval);
+    last_immediate = sent.time;
+  }
+  EXPECT_EQ(scheduled, 10) << "one tick per 20 ms in 200 ms";
+}
+
+// --- e-stop ----------------------------------------------------------------------------------
+
+TEST_F(BaseControllerTest, EStopZeroesAtOnceIgnoresCmdVelAndKeepsTheHeartbeat) {
+  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
+  clock_->tick(2);
+  ASSERT_GT(sent_.back().ticks.left, 0);
+  const std::size_t before = sent_.size();
+  clock_->advance(milliseconds(5));
+  clock_->step([&] { controller_.setEStop(true); });
+  ASSERT_EQ(sent_.size(), before + 1) << "the zero frame goes out at once, not at the tick";
+  EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
+  EXPECT_TRUE(controller_.stats().e_stop);
+
+  controller_.setCommand(0.5, 0.0);  // ignored: does not even wake the loop
+  clock_->tick(10);
+  EXPECT_EQ(sent_.size(), before + 1 + 10) << "frames keep flowing while stopped";
+  for (std::size_t i = before; i < sent_.size(); ++i) {
+    EXPECT_EQ(sent_[i].ticks, (kinematics::WheelTicks{0, 0})) << "frame " << i;
+  }
+  EXPECT_EQ(controller_.stats().ignored_commands_e_stop, 1u);
+
+  // Released: still zero (the old command is not resumed) until the next cmd_vel.
+  clock_->step([&] { controller_.setEStop(false); });
+  clock_->tick(2);
+  EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
+  EXPECT_FALSE(controller_.stats().e_stop);
+  clock_->advance(milliseconds(5));
+  clock_->step([&] { controller_.setCommand(0.1, 0.0); });
+  EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{4, 4}));  // 4.07 ticks
+}
+
+TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  config.max_wheel_accel = 0.5;  // m/s^2: a ramp from 0.5 m/s would take 1 s
+  config.cmd_vel_timeout = 10.0;
+  std::vector<WheelFrameSent> sent;
+  BaseEvents events;
+  events.on_wheel_frame = [&sent](const WheelFrameSent& s) { sent.push_back(s); };
+  auto clock = std::make_shared<ManualClock>(Clock::now());
+  BaseController controller(
+      config, [](const Bytes&) { return true; }, events, clock);
+  controller.start();
+  clock->waitForLoop();
+  clock->step([&] { controller.setCommand(0.5, 0.0); });
+  clock->tick(100);
+  ASSERT_GT(sent.back().ticks.left, 15);
+  clock->advance(milliseconds(5));
+  clock->step([&] { controller.setEStop(true); });
+  EXPECT_EQ(sent.back().ticks, (kinematics::WheelTicks{0, 0}));
+  controller.stop();
+}
+
+// --- odometry from the accepted frames -------------------------------------------------------
+
+TEST_F(BaseControllerTest, OdometryIntegratesTheTicksSent) {
+  // 8 ticks per period exactly: 8 / 40.7437 = 0.19635 m/s on both wheels.
+  const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
+  const double speed = 8 * per_tick;
+  clock_->step([&] { controller_.setCommand(speed, 0.0); });  // at t0, Reset + frame
+  for (int i = 0; i < 20; ++i) {
+    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    clock_->tick(1);
+  }
+  ASSERT_FALSE(odometry_.empty());
+  for (const WheelFrameSent& s : sent_) EXPECT_EQ(s.ticks, (kinematics::WheelTicks{8, 8}));
+  // 20 ticks = 0.4 s at 0.19635 m/s.
+  EXPECT_NEAR(odometry_.back().pose.x, speed * 0.4, 1e-9);
+  EXPECT_NEAR(odometry_.back().pose.y, 0.0, 1e-12);
+  EXPECT_NEAR(odometry_.back().linear, speed, 1e-12);
+  EXPECT_EQ(odometry_.back().time, t0_ + milliseconds(400));
+  EXPECT_GT(odometry_.back().position_variance, odometry_.front().position_variance);
+
+  controller_.resetOdometry();
+  clock_->tick(1);
+  EXPECT_NEAR(odometry_.back().pose.x, speed * 0.02, 1e-9) << "one period since the reset";
+}
+
+TEST_F(BaseControllerTest, OdometryUsesTheRobotsTicksNotTheWheelDirections) {
+  // The fixture's base has both directions 1; a base with a flipped left wheel is checked in
+  // BaseControllerDirections. Here: turning on the spot turns the pose.
+  clock_->step([&] { controller_.setCommand(0.0, 1.0); });  // -/+ 8 ticks
+  clock_->tick(50);  // 1 s, but cmd_vel_timeout stops it after 0.5 s
+  EXPECT_GT(odometry_.back().pose.yaw, 0.3);
+  EXPECT_NEAR(odometry_.back().pose.x, 0.0, 1e-9);
+}
+
+TEST_F(BaseControllerTest, PortDownStopsIntegratingAfterTheBasesOwnTimeout) {
+  const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
+  const double speed = 8 * per_tick;
+  for (int i = 0; i < 10; ++i) {  // 200 ms of driving
+    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    clock_->tick(1);
+  }
+  // The port goes away: nothing more reaches the base, which runs on until its 1 s timeout.
+  port_up_ = false;
+  controller_.onLinkDown();
+  for (int i = 0; i < 150; ++i) {  // 3 s of commands that never reach the wheels
+    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    clock_->tick(1);
+  }
+  EXPECT_NEAR(odometry_.back().pose.x, speed * (0.2 + 1.0), 1e-9);
+  EXPECT_NEAR(odometry_.back().linear, 0.0, 1e-12) << "the base has stopped";
+}
+
+TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  config.left_wheel_direction = -1;
+  std::vector<Bytes> frames;
+  std::vector<OdometrySample> samples;
+  BaseEvents events;
+  events.on_odometry = [&samples](const OdometrySample& s) { samples.push_back(s); };
+  auto clock = std::make_shared<ManualClock>(Clock::now());
+  BaseController controller(
+      config,
+      [&frames](const Bytes& f) {
+        frames.push_back(f);
+        return true;
+      },
+      events, clock);
+  controller.start();
+  clock->waitForLoop();
+  clock->step([&] { controller.setCommand(0.1, 0.0); });
+  // 0.1 m/s = 4.07 -> 4 ticks; left flipped: FF FC, right 00 04; XOR 55^AA^09^01^01^FF^FC^04 = F1
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[1],
+            (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0xFF, 0xFC, 0x00, 0x04, 0, 0, 0, 0, 0xF1}));
+  clock->tick(1);
+  ASSERT_FALSE(samples.empty());
+  EXPECT_GT(samples.back().pose.x, 0.0) << "the robot drives forward whatever the wire says";
+  EXPECT_NEAR(samples.back().angular, 0.0, 1e-12);
+  controller.stop();
+}
+
+// --- the base going silent -------------------------------------------------------------------
+
+TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) {
+  BaseConfig config;
+  config.battery_poll_rate = 1.0;
+  int silent_events = 0;
+  BaseEvents events;
+  events.on_silent = [&silent_events](double) { ++silent_events; };
+  auto clock = std::make_shared<ManualClock>(Clock::now());
+  BaseController controller(
+      config, [](const Bytes&) { return true; }, events, clock);
+  controller.start();
+  clock->waitForLoop();
+  clock->tick(150);  // 3 s: the first request went out at 1.02 s (the first tick sent the Reset)
+  EXPECT_FALSE(controller.stats().base_silent);
+  ASSERT_TRUE(controller.stats().seconds_without_reply.has_value());
+  clock->tick(100);  // 5 s: more than 3 poll periods without a reply
+  EXPECT_TRUE(controller.stats().base_silent);
+  EXPECT_GT(*controller.stats().seconds_without_reply, 3.0);
+  clock->tick(100);
+  EXPECT_EQ(silent_events, 1) << "reported once, not every tick";
+  // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
+  const Bytes reply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
+  controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), clock->now());
+  EXPECT_FALSE(controller.stats().base_silent);
+  controller.stop();
+}
+
+TEST_F(BaseControllerTest, TimeoutErrorWhileRunningIsCountedButNotTheOneAtStart) {
+  // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
+  const Bytes error = {0x55, 0xAA, 0x02, 0x07, 0xFF, 0x00, 0x05};
+  clock_->tick(1);  // Reset + first frame
+  clock_->step([&] {
+    controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
+  });
+  EXPECT_EQ(controller_.stats().timeout_errors_while_running, 0u) << "in flight before our Reset";
+  clock_->tick(100);  // 2 s of running
+  clock_->step([&] {
+    controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
+  });
+  EXPECT_EQ(controller_.stats().timeout_errors_while_running, 1u);
+  ASSERT_TRUE(controller_.stats().seconds_since_running_timeout_error.has_value());
+  EXPECT_EQ(controller_.stats().timeout_errors_received, 2u);
 }
 
 TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {

@@ -139,11 +139,13 @@ TEST_P(DiffDriveTruncation, ReproducesTheVendorNumbers) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(DiffDriveSpecNumbers, DiffDriveTruncation,
-                         ::testing::Values(std::make_tuple(0.1, 4), std::make_tuple(0.2, 8),
-                                           std::make_tuple(1.0, 40), std::make_tuple(-0.15, -6),
-                                           // the dead band: anything under 0.0246 m/s is 0
-                                           std::make_tuple(0.02, 0), std::make_tuple(0.0, 0)));
+INSTANTIATE_TEST_SUITE_P(
+    DiffDriveSpecNumbers, DiffDriveTruncation,
+    ::testing::Values(std::make_tuple(0.1, 4), std::make_tuple(0.2, 8), std::make_tuple(1.0, 40),
+                      std::make_tuple(-0.15, -6),
+                      // the dead band: anything under 1 / 40.7437 = 0.02454 m/s is 0
+                      std::make_tuple(0.02, 0), std::make_tuple(0.0245, 0),
+                      std::make_tuple(0.0246, 1), std::make_tuple(0.0, 0)));
 
 // --- dithering: error feedback keeps the mean exact -------------------------------------------
 
@@ -199,10 +201,38 @@ TEST(DiffDriveQuantizer, SaturatesAtInt16Limits) {
     TickQuantizer quantizer(defaultGeometry(), dithering);
     EXPECT_EQ(quantizer.quantize(WheelSpeeds(1000.0, -1000.0)), (WheelTicks{32767, -32768}))
         << "dithering " << dithering;
-    const double inf = std::numeric_limits<double>::infinity();
-    EXPECT_EQ(quantizer.quantize(WheelSpeeds(-inf, inf)), (WheelTicks{-32768, 32767}))
+  }
+}
+
+TEST(DiffDriveQuantizer, InfiniteSpeedSendsZero) {
+  // Not a number a motor should chase: treated as "stop" like NaN.
+  const double inf = std::numeric_limits<double>::infinity();
+  for (bool dithering : {false, true}) {
+    TickQuantizer quantizer(defaultGeometry(), dithering);
+    EXPECT_EQ(quantizer.quantize(WheelSpeeds(-inf, inf)), (WheelTicks{0, 0}))
         << "dithering " << dithering;
   }
+}
+
+TEST(DiffDriveQuantizer, ZeroCommandGivesZeroTicksWhateverTheRemainder) {
+  // 0.5 / 40.7437 m/s leaves exactly +0.5 tick to carry at first; round(0.5) = 1 is sent and -0.5
+  // carried. A zero command afterwards must send 0, not round(-0.5) = -1 then +1, -1, ...
+  TickQuantizer quantizer(defaultGeometry(), true);
+  const double half_tick = 0.5 / defaultGeometry().ticksPerPeriodPerMps();
+  EXPECT_EQ(quantizer.quantize(WheelSpeeds(half_tick, -half_tick)), (WheelTicks{1, -1}));
+  for (int period = 0; period < 10; ++period) {
+    EXPECT_EQ(quantizer.quantize(WheelSpeeds(0.0, 0.0)), (WheelTicks{0, 0})) << "period " << period;
+  }
+  // The stop forgot the debt: the next small speed starts afresh (0.012 m/s is 0.49 tick: 0).
+  EXPECT_EQ(quantizer.quantize(WheelSpeeds(0.012, 0.012)), (WheelTicks{0, 0}));
+}
+
+TEST(DiffDriveClamp, InfiniteSpeedIsAStopNotNaN) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const WheelSpeeds clamped = clampWheelSpeeds(WheelSpeeds(inf, 0.5), 1.0);
+  EXPECT_TRUE(clamped.allFinite());
+  EXPECT_NEAR(clamped.x(), 0.0, kTol);
+  EXPECT_NEAR(clamped.y(), 0.5, kTol);
 }
 
 TEST(DiffDriveQuantizer, SaturationDoesNotWindUpTheRemainder) {

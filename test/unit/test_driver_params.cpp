@@ -47,7 +47,8 @@ INSTANTIATE_TEST_SUITE_P(
                   p.replay_bag = "/tmp/field.bag";
                 }},
         BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = -0.25; }},
-        BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = std::nan(""); }},
+        BadCase{"base/wheel_diameter",
+                [](DriverParams& p) { p.base.wheel_diameter = std::nan(""); }},
         BadCase{"base/encoder_resolution", [](DriverParams& p) { p.base.encoder_resolution = 0; }},
         BadCase{"base/pid_rate", [](DriverParams& p) { p.base.pid_rate = 0; }},
         BadCase{"base/wheel_separation", [](DriverParams& p) { p.base.wheel_separation = 0; }},
@@ -56,6 +57,24 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"base/cmd_vel_timeout", [](DriverParams& p) { p.base.cmd_vel_timeout = 0; }},
         BadCase{"base/battery_poll_rate", [](DriverParams& p) { p.base.battery_poll_rate = -1; }},
         BadCase{"base/baud", [](DriverParams& p) { p.base.baud = 7; }},
+        BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 1.0; }},  // heartbeat at risk
+        BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 4.9; }},
+        BadCase{"base/battery_warn_percent",
+                [](DriverParams& p) { p.base.battery_warn_percent = 101; }},
+        BadCase{"base/battery_error_percent",
+                [](DriverParams& p) { p.base.battery_error_percent = -1; }},
+        BadCase{"base/battery_error_percent",
+                [](DriverParams& p) {
+                  p.base.battery_warn_percent = 10;
+                  p.base.battery_error_percent = 20;
+                }},
+        BadCase{"base/odom_frame", [](DriverParams& p) { p.base.odom_frame.clear(); }},
+        BadCase{"base/base_frame", [](DriverParams& p) { p.base.base_frame = "base link"; }},
+        BadCase{"base/base_frame", [](DriverParams& p) { p.base.base_frame = "odom"; }},
+        BadCase{"base/left_wheel_direction",
+                [](DriverParams& p) { p.base.left_wheel_direction = 0; }},
+        BadCase{"base/right_wheel_direction",
+                [](DriverParams& p) { p.base.right_wheel_direction = 2; }},
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {}; }},
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 1}; }},
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 300}; }},
@@ -64,7 +83,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"body/zero_ticks", [](DriverParams& p) { p.body.zero_ticks = {0}; }},
         BadCase{"body/zero_ticks", [](DriverParams& p) { p.body.zero_ticks = {0, 70000}; }},
         BadCase{"body/directions", [](DriverParams& p) { p.body.directions = {1, 2}; }},
-        BadCase{"body/ticks_per_revolution", [](DriverParams& p) { p.body.ticks_per_revolution = 0; }},
+        BadCase{"body/ticks_per_revolution",
+                [](DriverParams& p) { p.body.ticks_per_revolution = 0; }},
         BadCase{"body/velocity_scale", [](DriverParams& p) { p.body.velocity_scale = -1; }},
         BadCase{"imu/frame_id", [](DriverParams& p) { p.imu.frame_id.clear(); }},
         BadCase{"imu/accel_scale", [](DriverParams& p) { p.imu.accel_scale = 0; }},
@@ -103,6 +123,22 @@ TEST(DriverParams, DisabledDeviceIsNotValidated) {
   DriverParams params;
   params.body.enabled = false;
   params.body.joint_names = {};
+  EXPECT_NO_THROW(params.validate());
+}
+
+TEST(DriverParams, SlowLoopRateIsRefusedWithTheReason) {
+  DriverParams params;
+  params.loop_rate = 1.0;
+  try {
+    params.validate();
+    FAIL() << "1 Hz accepted: the base would sit in its 1 s timeout";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("heartbeat"), std::string::npos) << e.what();
+  }
+  params.base.enabled = false;  // only the base needs the heartbeat
+  EXPECT_NO_THROW(params.validate());
+  params.base.enabled = true;
+  params.loop_rate = kMinBaseLoopRate;
   EXPECT_NO_THROW(params.validate());
 }
 

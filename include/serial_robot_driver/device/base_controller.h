@@ -7,13 +7,18 @@
 //    steady clock unless a test passes its own) (deadline += period, never "sleep one period"), so
 //    the period does not drift. Each tick writes
 //    the current wheel frame, which is also the heartbeat.
-//  - setCommand() (cmd_vel callback) only stores the command and wakes the loop, which puts it on
-//    the wire at once, at most at twice the loop rate. Callbacks never touch the port.
+//  - setCommand() (cmd_vel callback) and setEStop() only store and wake the loop, which puts the
+//    frame on the wire at once. Such immediate frames are spaced by what the line can carry
+//    (minImmediateInterval()), never by the loop rate, and never move the tick deadlines.
+//    Callbacks never touch the port.
 //  - onFrame() runs on the port's reader thread: an FF error frame wakes the loop to send a Reset.
 //  - Every base write happens with mutex_ held, so the sequence counter and "Reset before the next
 //    speed frame" are consistent whichever thread writes (loop, or a base/* service).
 //  - The BaseEvents hooks are called without mutex_ held, on the thread that caused them (loop,
 //    reader, or the caller of stop()). Stats are one struct under mutex_; stats() is a snapshot.
+//  - Odometry (mutex_) integrates the wheel speeds of each speed frame the base accepted, from its
+//    write until the next accepted frame, the base's own 1 s timeout, or an FF error, whichever
+//    comes first. The loop reports a sample after every scheduled tick (on_odometry).
 #pragma once
 
 #include <condition_variable>
@@ -27,6 +32,7 @@
 
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
+#include "serial_robot_driver/kinematics/odometry.h"
 #include "serial_robot_driver/protocol/base_codec.h"
 
 namespace serial_robot_driver::device {
@@ -40,11 +46,30 @@ struct BaseConfig {
   double battery_poll_rate = 1.0;  ///< Hz; 0: never ask
   double loop_rate = 50.0;         ///< Hz
   double heartbeat_gap = 1.0;      ///< s; a gap this long in our sending means the base timed out
+  int baud = 115200;               ///< of the base's port: sets how closely immediate frames follow
+  /// Largest share of the line's capacity immediate speed frames may take (a cmd_vel flood).
+  double immediate_line_share = 0.5;
+  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
+  int right_wheel_direction = 1;
+  /// With battery polling on, this many poll periods without any reply mean the base is silent.
+  double silent_after_polls = 3.0;
+  kinematics::PoseCovarianceModel odometry_covariance;
+};
+
+/// Where the odometry stood after a scheduled tick.
+struct OdometrySample {
+  Clock::time_point time;
+  kinematics::Pose2D pose;
+  double linear = 0;             ///< m/s the base runs at now (0 once its timeout stopped it)
+  double angular = 0;            ///< rad/s
+  double position_variance = 0;  ///< m^2, x and y
+  double yaw_variance = 0;       ///< rad^2
+  double travelled = 0;          ///< m since the last reset
 };
 
 /// One wheel frame as written.
 struct WheelFrameSent {
-  kinematics::WheelTicks ticks;
+  kinematics::WheelTicks ticks;  ///< as on the wire (wheel directions applied)
   uint8_t seq = 0;
   bool reset_before = false;
   kinematics::WheelSpeeds speeds = kinematics::WheelSpeeds::Zero();  ///< m/s the ticks stand for
@@ -64,6 +89,14 @@ struct BaseStats {
   uint64_t bad_replies = 0;
   uint64_t cmd_vel_timeouts = 0;
   uint64_t rejected_commands = 0;    ///< NaN/Inf cmd_vel
+  uint64_t ignored_commands_e_stop = 0;       ///< cmd_vel received while the e-stop was engaged
+  uint64_t timeout_errors_while_running = 0;  ///< FF after the base had accepted our Reset
+  std::optional<double> seconds_since_running_timeout_error;
+  /// Battery polling on and requests unanswered: seconds since the first unanswered request.
+  std::optional<double> seconds_without_reply;
+  bool base_silent = false;  ///< seconds_without_reply beyond BaseConfig::silent_after_polls
+  bool e_stop = false;
+  double min_immediate_interval_ms = 0;
   uint64_t loop_overruns = 0;        ///< ticks that started more than one period late
   double last_period_ms = 0;
   double worst_period_ms = 0;
@@ -90,6 +123,9 @@ struct BaseEvents {
   std::function<void(uint8_t percent, Clock::time_point arrival)> on_battery;
   std::function<void(const protocol::base::Frame&)> on_unknown_reply;
   std::function<void()> on_timeout_error;
+  std::function<void(const OdometrySample&)> on_odometry;  ///< after every scheduled tick
+  std::function<void()> on_cmd_vel_timeout;                ///< once per timeout, when it starts
+  std::function<void(double seconds)> on_silent;           ///< once, when the base goes silent
 };
 
 class BaseController : public LinkListener {
@@ -100,7 +136,16 @@ class BaseController : public LinkListener {
   ~BaseController() override;
 
   /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded and false returned.
+  /// Ignored (and counted) while the e-stop is engaged.
   bool setCommand(double linear_x, double angular_z);
+  /// Engaged: a zero-speed frame goes out at once (no ramp) and zero is held; frames keep flowing.
+  /// Released: the wheels stay still until the next cmd_vel.
+  void setEStop(bool engaged);
+  /// Puts the odometry pose (and its covariance) back to zero.
+  void resetOdometry();
+  /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
+  /// the port's baud (10 bits per byte) divided by immediate_line_share.
+  Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
   /// Writes a Reset now (base/reset). False when the port is down.
   bool sendReset();
   /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.
@@ -126,13 +171,21 @@ class BaseController : public LinkListener {
   void sendSpeed(Clock::time_point now, bool immediate);
   /// Requires mutex_. Writes one frame with the next SEQ; false on failure.
   bool writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now);
-  kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now);
+  /// `timed_out_now`: set when the cmd_vel timeout started with this call.
+  kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now, bool* timed_out_now);
+  /// Integrates the speeds the base runs on up to `now` (capped at its heartbeat timeout).
+  void advanceOdometryLocked(Clock::time_point now);
+  /// A speed frame with these (robot-side, before wheel directions) ticks was accepted at `now`.
+  void acceptedSpeedLocked(const kinematics::WheelTicks& ticks, Clock::time_point now);
+  OdometrySample odometrySampleLocked(Clock::time_point now) const;
+  kinematics::WheelTicks onWire(const kinematics::WheelTicks& ticks) const;
 
   const BaseConfig config_;
   const FrameWriter writer_;
   const BaseEvents events_;
   const std::shared_ptr<LoopClock> clock_;
   const Clock::duration period_;
+  const Clock::duration min_immediate_interval_;
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -151,6 +204,15 @@ class BaseController : public LinkListener {
   std::optional<Clock::time_point> last_speed_frame_;
   std::optional<Clock::time_point> last_tick_;
   Clock::time_point next_battery_poll_{};
+  bool e_stop_ = false;
+  kinematics::Odometry odometry_;
+  kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
+  std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
+  Clock::time_point integrated_until_{};
+  std::optional<Clock::time_point> last_reset_sent_;
+  std::optional<Clock::time_point> unanswered_since_;  ///< first battery request with no reply yet
+  bool silent_reported_ = false;
+  std::optional<Clock::time_point> last_running_timeout_error_;
   BaseStats stats_;
   std::thread loop_;
 };

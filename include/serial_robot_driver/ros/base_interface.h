@@ -1,13 +1,18 @@
-// ROS face of the AP1 base: cmd_vel in; wheel_command, battery and diagnostics out; base/reset and
-// base/clear_encoders services. The control loop itself is device::BaseController's thread.
+// ROS face of the AP1 base: cmd_vel and e_stop in; wheel_command, odom (+ tf), battery and
+// diagnostics out; base/reset, base/clear_encoders and base/reset_odometry services. The control
+// loop itself is device::BaseController's thread; odom and tf are published from it, once per tick.
+// odom is the motion the base was commanded and accepted, not a measurement: the AP1 reports no
+// encoder counts.
 #pragma once
-
-#include <memory>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
+#include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <memory>
 
 #include "serial_robot_driver/device/base_controller.h"
 #include "serial_robot_driver/ros/conversions.h"
@@ -33,15 +38,24 @@ class BaseInterface : public DeviceInterface {
  private:
   device::BaseEvents events();
   void onCmdVel(const geometry_msgs::Twist::ConstPtr& msg);
+  void onEStop(const std_msgs::Bool::ConstPtr& msg);
+  void publishOdometry(const device::OdometrySample& sample);
+  bool onResetOdometry(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
 
   device::SerialLink& link_;
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
+  const BaseParams params_;
+  // Before the controller: its loop publishes through them until it stops.
+  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  ros::Publisher odom_pub_;
   device::BaseController controller_;
   ros::Publisher wheel_command_pub_;
   ros::Publisher battery_pub_;
   ros::Subscriber cmd_vel_sub_;
+  ros::Subscriber e_stop_sub_;
+  ros::ServiceServer reset_odometry_srv_;
   ros::ServiceServer reset_srv_;
   ros::ServiceServer clear_encoders_srv_;
 };

@@ -44,6 +44,13 @@ struct BaseParams : DevicePortParams {
   double cmd_vel_timeout = 0.5;
   bool speed_dithering = true;
   double battery_poll_rate = 1.0;
+  int battery_warn_percent = 20;   ///< below: diagnostics WARN
+  int battery_error_percent = 10;  ///< below: diagnostics ERROR
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  bool publish_tf = true;
+  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
+  int right_wheel_direction = 1;
 };
 
 struct BodyParams : DevicePortParams {
@@ -87,6 +94,9 @@ struct ServoBusParams : DevicePortParams {
   double state_rate = 10.0;       ///< Hz, polls of every state_ids servo
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
 };
+
+/// Below this loop rate the base's 1 s heartbeat is at risk (validate() says so).
+constexpr double kMinBaseLoopRate = 5.0;
 
 struct DriverParams {
   std::string port = "/dev/ttyUSB0";

@@ -39,6 +39,11 @@ struct BaseSimStats {
   uint64_t unknown_frames = 0;  ///< unknown MSGID or malformed content
   int64_t left_ticks = 0;
   int64_t right_ticks = 0;
+  /// The chassis pose from the speeds applied, one midpoint step per PID period (m, m, rad): the
+  /// reference the driver's commanded-motion odometry is checked against.
+  double x_m = 0;
+  double y_m = 0;
+  double yaw_rad = 0;
   int16_t last_left_speed = 0;  ///< ticks per PID period in force (0 after a timeout)
   int16_t last_right_speed = 0;
   bool in_error = false;
@@ -63,6 +68,7 @@ class BaseSim {
  private:
   void emit(Outbox* out, std::vector<uint8_t> frame);
   void enterError(TimePoint now, Outbox* out);
+  void advancePose();
 
   BaseSimConfig config_;
   BaseSimStats stats_;
