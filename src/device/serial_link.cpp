@@ -8,9 +8,11 @@ namespace serial_robot_driver::device {
 
 namespace {
 /// How long one read waits before the reader thread checks for stop/lost flags. Data wakes it at
-/// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on; a
-/// longer wait keeps an idle port from waking the CPU.
+/// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on, for
+/// streams that cannot be woken. A wakeable stream is woken for those, so its reader sleeps until
+/// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here).
 constexpr int kReadTimeoutMs = 100;
+constexpr int kWakeableReadTimeoutMs = 5000;
 constexpr std::size_t kReadChunk = 4096;
 
 std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& options) {
@@ -44,6 +46,7 @@ void SerialLink::stop() {
     stopping_ = true;
   }
   state_cv_.notify_all();
+  wakeReader();
   if (reader_.joinable()) reader_.join();
   if (stream_) closeStream("stopped");
 }
@@ -66,6 +69,7 @@ bool SerialLink::write(const uint8_t* data, std::size_t size) {
       } catch (const transport::TransportError& e) {
         error = e.what();
         lost_ = true;  // the reader thread closes and reopens the port
+        stream_->wakeRead();
       }
     }
   }
@@ -151,6 +155,11 @@ void SerialLink::closeStream(const std::string& reason) {
   for (LinkListener* listener : listeners_) listener->onLinkDown();
 }
 
+void SerialLink::wakeReader() {
+  std::lock_guard<std::mutex> lock(write_mutex_);  // stream_ is swapped under it
+  if (stream_) stream_->wakeRead();
+}
+
 void SerialLink::sleepBeforeRetry() {
   std::unique_lock<std::mutex> lock(state_mutex_);
   state_cv_.wait_for(lock, std::chrono::duration<double>(options_.reconnect_interval),
@@ -176,7 +185,8 @@ void SerialLink::readerLoop() {
     }
     std::size_t n = 0;
     try {
-      n = stream_->read(chunk.data(), chunk.size(), kReadTimeoutMs);
+      n = stream_->read(chunk.data(), chunk.size(),
+                        stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs);
     } catch (const transport::TransportError& e) {
       closeStream(e.what());
       sleepBeforeRetry();

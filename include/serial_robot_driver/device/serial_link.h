@@ -10,6 +10,8 @@
 //  - Any thread may write(): writes are serialized by a per-port mutex and never wait for an answer.
 //    A failed write marks the port lost; the reader thread then closes and reopens it.
 //  - Only the reader thread opens and closes the stream, so a read never races a close.
+//  - An idle reader sleeps in its read until data comes; stop() and a writer that saw the port
+//    fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
 #pragma once
 
 #include <atomic>
@@ -105,6 +107,7 @@ class SerialLink {
   bool tryOpen();
   void closeStream(const std::string& reason);
   void sleepBeforeRetry();
+  void wakeReader();  // a read in progress returns at once (stop, loss seen by a writer)
 
   SerialLinkOptions options_;
   StreamFactory factory_;

@@ -45,6 +45,12 @@ class ByteStream {
   virtual std::string name() const = 0;
   /// Valid after open(); a stream that is no serial port has nothing to tell.
   virtual StreamInfo info() const { return {}; }
+  /// Whether wakeRead() works. A reader of a stream that cannot be woken must use short read
+  /// timeouts to notice a stop request; one that can sleeps until data or a wake-up comes.
+  virtual bool wakeable() const { return false; }
+  /// Makes a read() in progress in another thread (or the next one) return 0 at once. Thread-safe
+  /// with read(); a no-op for streams that are not wakeable().
+  virtual void wakeRead() {}
 };
 
 }  // namespace serial_robot_driver::transport
