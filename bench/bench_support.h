@@ -72,7 +72,8 @@ class ChildProcess {
   bool exited_ = false;
 };
 
-/// User + system CPU time of a process in seconds (/proc/<pid>/stat, clock-tick resolution).
+/// User + system CPU time of a process in seconds (its kernel CPU clock, ns resolution; falls
+/// back to /proc/<pid>/stat, clock-tick resolution).
 double processCpuSeconds(pid_t pid);
 
 /// Measures a process's CPU share over a window: construct at the start, call percent() at the end.

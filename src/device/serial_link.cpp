@@ -9,9 +9,11 @@ namespace serial_robot_driver::device {
 
 namespace {
 /// How long one read waits before the reader thread checks for stop/lost flags. Data wakes it at
-/// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on; a
-/// longer wait keeps an idle port from waking the CPU.
+/// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on, for
+/// streams that cannot be woken. A wakeable stream is woken for those, so its reader sleeps until
+/// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here).
 constexpr int kReadTimeoutMs = 100;
+constexpr int kWakeableReadTimeoutMs = 5000;
 constexpr std::size_t kReadChunk = 4096;
 
 std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& options) {
@@ -45,6 +47,7 @@ void SerialLink::stop() {
     stopping_ = true;
   }
   state_cv_.notify_all();
+  wakeReader();
   if (reader_.joinable()) reader_.join();
   if (stream_) closeStream("stopped");
 }
@@ -68,6 +71,7 @@ bool SerialLink::write(const uint8_t* data, std::size_t size) {
       } catch (const transport::TransportError& e) {
         error = e.what();
         lost_ = true;  // the reader thread closes and reopens the port
+        stream_->wakeRead();
       }
     }
   }
@@ -154,6 +158,11 @@ void SerialLink::closeStream(const std::string& reason) {
   for (LinkListener* listener : listeners_) listener->onLinkDown();
 }
 
+void SerialLink::wakeReader() {
+  std::lock_guard<std::mutex> lock(write_mutex_);  // stream_ is swapped under it
+  if (stream_) stream_->wakeRead();
+}
+
 void SerialLink::sleepBeforeRetry() {
   std::unique_lock<std::mutex> lock(state_mutex_);
   state_cv_.wait_for(lock, std::chrono::duration<double>(options_.reconnect_interval),
@@ -177,7 +186,9 @@ void SerialLink::readerLoop() {
       sleepBeforeRetry();
       continue;
     }
-    int read_timeout_ms = kReadTimeoutMs;
+    // A wakeable stream sleeps until data, stop() or a failed write wakes it; the others poll.
+    const int longest_read_ms = stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs;
+    int read_timeout_ms = longest_read_ms;
     if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
       const auto quiet = Clock::now() - chunk_arrival_;
       if (quiet >= options_.stale_frame_timeout) {
@@ -191,7 +202,7 @@ void SerialLink::readerLoop() {
       }
       const auto left = std::chrono::ceil<std::chrono::milliseconds>(
           options_.stale_frame_timeout - quiet);
-      read_timeout_ms = std::clamp<int>(static_cast<int>(left.count()), 1, kReadTimeoutMs);
+      read_timeout_ms = std::clamp<int>(static_cast<int>(left.count()), 1, longest_read_ms);
     }
     std::size_t n = 0;
     try {

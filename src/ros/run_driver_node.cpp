@@ -11,6 +11,7 @@
 
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
+#include "serial_robot_driver/ros/queue_spinner.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -96,8 +97,9 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   }
   node.start();
   // Global queue: cmd_vel, joint_commands, base services and the diagnostics timer. None of them
-  // waits on the wire (servo/* services have their own queue), so one thread keeps up.
-  ros::AsyncSpinner spinner(1);
+  // waits on the wire (servo/* services have their own queue), so one thread keeps up. Unlike
+  // ros::AsyncSpinner it does not wake every 100 ms while the node is idle.
+  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1);
   spinner.start();
   const bool replay_done = waitForStopRequest(
       stop_signals,

@@ -394,8 +394,8 @@ void ServoBusInterface::pollOnce(PolledServo& servo) {
 void ServoBusInterface::start() {
   if (spinner_ || shut_down_) return;
   // Two threads: one call waits on the bus while another is accepted and queued behind the bus
-  // mutex, so ROS never sees the service as unresponsive.
-  spinner_ = std::make_unique<ros::AsyncSpinner>(kSpinnerThreads, &queue_);
+  // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
+  spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
   spinner_->start();
   worker_ = std::thread([this] { workerLoop(); });
 }

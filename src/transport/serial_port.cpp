@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/eventfd.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -127,17 +128,24 @@ std::optional<int> readLatencyTimerMs(const std::string& device_path) {
 }
 
 std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
-                       const std::string& what) {
+                       const std::string& what, int wake_fd) {
   if (fd < 0) throw TransportError(TransportErrorKind::kDisconnected, what + " is not open");
   if (capacity == 0) return 0;
 
-  pollfd waiter{fd, POLLIN, 0};
-  const int ready = ::poll(&waiter, 1, timeout_ms);
+  pollfd waiters[2] = {{fd, POLLIN, 0}, {wake_fd, POLLIN, 0}};
+  const int ready = ::poll(waiters, wake_fd >= 0 ? 2 : 1, timeout_ms);
   if (ready < 0) {
     if (errno == EINTR) return 0;
     throwIoErrno("poll on", what, errno);
   }
   if (ready == 0) return 0;
+  if (waiters[1].revents & POLLIN) {
+    uint64_t count = 0;
+    if (::read(wake_fd, &count, sizeof(count)) < 0) { /* already consumed: nothing to do */
+    }
+    return 0;  // the caller checks why it was woken; pending data is read on its next call
+  }
+  const pollfd& waiter = waiters[0];
   if (waiter.revents & POLLNVAL) {
     throw TransportError(TransportErrorKind::kDisconnected, what + " is not open (POLLNVAL)");
   }
@@ -284,9 +292,20 @@ void takeExclusively(int fd, const std::string& path) {
 
 }  // namespace
 
-SerialPort::SerialPort(SerialPortOptions options) : options_(std::move(options)) {}
+SerialPort::SerialPort(SerialPortOptions options)
+    : options_(std::move(options)), wake_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
 
-SerialPort::~SerialPort() { close(); }
+SerialPort::~SerialPort() {
+  close();
+  if (wake_fd_ >= 0) ::close(wake_fd_);
+}
+
+void SerialPort::wakeRead() {
+  if (wake_fd_ < 0) return;
+  const uint64_t one = 1;
+  if (::write(wake_fd_, &one, sizeof(one)) < 0) { /* the count is already non-zero: still woken */
+  }
+}
 
 void SerialPort::open() {
   close();
@@ -327,7 +346,7 @@ void SerialPort::close() {
 }
 
 std::size_t SerialPort::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {
-  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path);
+  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path, wake_fd_);
 }
 
 void SerialPort::write(const uint8_t* data, std::size_t size) {

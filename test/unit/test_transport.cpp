@@ -192,6 +192,22 @@ TEST_F(TransportTest, ReadTimeoutReturnsZero) {
   EXPECT_EQ(pty.read(buffer, sizeof(buffer), 20), 0u);
 }
 
+// The link's reader sleeps in read() with no periodic time-out; stop() and a failed write wake it.
+// A wake-up given before the read is kept for it, and bytes already waiting stay for the next read.
+TEST_F(TransportTest, WakeReadEndsTheNextReadWithZeroAndKeepsPendingBytes) {
+  PseudoTerminal pty;
+  SerialPort port({pty.slavePath(), 115200});
+  port.open();
+  ASSERT_TRUE(port.wakeable());
+
+  const Bytes from_robot = {0xFF, 0xFF, 0xFD, 0x00, 0x01};
+  writeBytes(pty, from_robot);
+  port.wakeRead();
+  uint8_t buffer[8];
+  EXPECT_EQ(port.read(buffer, sizeof(buffer), kPatientTimeoutMs), 0u);
+  EXPECT_EQ(readExactly(port, from_robot.size()), from_robot);
+}
+
 TEST_F(TransportTest, MissingPathThrowsOpenFailedNamingPathAndReason) {
   const std::string path = dir_ + "/no_such_port";
   SerialPort port({path, 115200});

@@ -13,6 +13,8 @@
 //  - A ChunkObserver (wire capture), when set, sees every chunk on the thread that moved it: reads
 //    on the reader thread, writes on the writer's thread. It must copy what it keeps and return
 //    at once; without one, the only cost is a null check per read and per write.
+//  - An idle reader sleeps in its read until data comes; stop() and a writer that saw the port
+//    fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
 #pragma once
 
 #include <atomic>
@@ -131,6 +133,7 @@ class SerialLink {
   bool tryOpen();
   void closeStream(const std::string& reason);
   void sleepBeforeRetry();
+  void wakeReader();  // a read in progress returns at once (stop, loss seen by a writer)
 
   SerialLinkOptions options_;
   StreamFactory factory_;

@@ -40,6 +40,7 @@
 #include "serial_robot_driver/device/servo_bus_client.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/queue_spinner.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -95,7 +96,7 @@ class ServoBusInterface : public DeviceInterface {
   ros::CallbackQueue queue_;
   ros::NodeHandle nh_;  // the caller's namespace, bound to queue_
   std::vector<ros::ServiceServer> services_;
-  std::unique_ptr<ros::AsyncSpinner> spinner_;
+  std::unique_ptr<QueueSpinner> spinner_;
   bool shut_down_ = false;
 
   // servo_states / servo_commands

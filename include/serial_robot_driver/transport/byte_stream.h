@@ -49,6 +49,12 @@ class ByteStream {
   /// When the bytes of the last read() arrived, for a stream that knows it better than the
   /// reader's clock (a replayed recording); nothing: they arrived when read() returned.
   virtual std::optional<std::chrono::steady_clock::time_point> arrivalTime() const { return {}; }
+  /// Whether wakeRead() works. A reader of a stream that cannot be woken must use short read
+  /// timeouts to notice a stop request; one that can sleeps until data or a wake-up comes.
+  virtual bool wakeable() const { return false; }
+  /// Makes a read() in progress in another thread (or the next one) return 0 at once. Thread-safe
+  /// with read(); a no-op for streams that are not wakeable().
+  virtual void wakeRead() {}
 };
 
 }  // namespace serial_robot_driver::transport

@@ -51,11 +51,17 @@ class SerialPort : public ByteStream {
   /// such an adapter.
   StreamInfo info() const override { return {low_latency_, latency_timer_ms_}; }
 
+  /// An eventfd polled beside the port wakes a read (stop, or a writer that saw the port fail),
+  /// so an idle reader needs no periodic time-out.
+  bool wakeable() const override { return wake_fd_ >= 0; }
+  void wakeRead() override;
+
  private:
   SerialPortOptions options_;
   std::atomic<int> fd_{-1};
   bool low_latency_ = false;
   std::optional<int> latency_timer_ms_;
+  int wake_fd_ = -1;  // eventfd, for the object's lifetime; -1 if the kernel refused one
 };
 
 /// Who holds a port: a pid and where it was found (a lock file's path, or "/proc/locks").
@@ -75,9 +81,10 @@ std::optional<int> readLatencyTimerMs(const std::string& device_path);
 
 /// Shared by SerialPort and sim::PseudoTerminal: waits up to `timeout_ms` for input on the non-blocking
 /// `fd` and reads what is there (0 on timeout or EAGAIN/EINTR). Hang-up, EOF and EIO throw
-/// TransportError kDisconnected; `what` names the device in error messages.
+/// TransportError kDisconnected; `what` names the device in error messages. When `wake_fd` (an
+/// eventfd) is readable the wait ends at once: its count is consumed and 0 returned.
 std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
-                       const std::string& what);
+                       const std::string& what, int wake_fd = -1);
 
 /// Shared by SerialPort and sim::PseudoTerminal: writes all bytes to the non-blocking `fd`, waiting for
 /// room at most `stall_limit` without progress (then kIoError). EIO/EPIPE/hang-up → kDisconnected.
