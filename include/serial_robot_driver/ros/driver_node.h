@@ -14,7 +14,7 @@
 //  - one reader thread per port (device::SerialLink) decodes and publishes telemetry and base replies
 //    as soon as their last byte is read;
 //  - the base control loop runs on its own thread (device::BaseController);
-//  - cmd_vel, joint_commands and base/* services run on the global callback queue (an AsyncSpinner
+//  - cmd_vel, joint_commands and base/* services run on the global callback queue (a QueueSpinner
 //    in main, or the nodelet manager's threads); servo/* services have their own queue and
 //    spinner because they wait on the bus;
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.

@@ -1,7 +1,7 @@
-// ROS face of the UART bus servos: the servo/* services and the "serial_robot_driver: servo_bus"
+// ROS face of the UART bus servos: the servo/* services and the "servo_bus"
 // diagnostic status. The bus logic (transactions, validation, messages) is device::ServoBusClient.
 //
-// Threading: the services are served from this class's OWN callback queue by its own AsyncSpinner
+// Threading: the services are served from this class's OWN callback queue by its own QueueSpinner
 // (2 threads). A servo call blocks for up to timeout * (retries + 1), or for a whole motion when
 // `wait` is set; on the global queue that would hold up cmd_vel and joint_commands.
 // servo_commands arrive on the caller's (global) queue: the callback only checks the message and
