@@ -350,7 +350,10 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
     written = writeLocked(base::encodeWheelSpeed(sent.seq, sent.ticks.left, sent.ticks.right), now);
     if (written) {
       ++stats_.speed_frames;
-      if (immediate) ++stats_.immediate_frames;
+      if (immediate) {
+        ++stats_.immediate_frames;
+        last_immediate_frame_ = now;
+      }
       last_speed_frame_ = now;
       acceptedSpeedLocked(ticks, now);  // a Reset went out before it whenever one was due
     }
@@ -409,13 +412,15 @@ void BaseController::run() {
     if (stopping_) break;
     const Clock::time_point now = clock_->now();
     if (now < deadline) {
-      // Woken early by a command: send it at once unless the last frame is so recent that a
-      // flood would overrun the line; then it goes when the line allows (or with the tick).
+      // Woken early by a command: send it at once unless the last rushed frame is so recent that
+      // a flood would take more than its share of the line; then it goes when the line allows (or
+      // with the tick). The 50 Hz ticks are not counted against the share: they are a small,
+      // fixed load, and counting them would hold back every command that follows a tick.
       const bool may_rush =
-          !last_speed_frame_ || now - *last_speed_frame_ >= min_immediate_interval_;
+          !last_immediate_frame_ || now - *last_immediate_frame_ >= min_immediate_interval_;
       if (!may_rush) {
         const Clock::time_point until =
-            std::min(deadline, *last_speed_frame_ + min_immediate_interval_);
+            std::min(deadline, *last_immediate_frame_ + min_immediate_interval_);
         while (!stopping_ && clock_->now() < until) clock_->waitUntil(lock, wake_, until);
         continue;  // re-evaluate with command_pending_ still set
       }

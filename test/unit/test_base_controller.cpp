@@ -219,10 +219,13 @@ TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
     controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
   });
   clock_->tick(1);
-  ASSERT_EQ(frames_.size(), 2u);
+  // The error wakes the loop: Reset, then the speed frame (rushed), then the tick's speed frame.
+  ASSERT_EQ(frames_.size(), 3u);
   EXPECT_EQ(frames_[0][4], 0x05) << "Reset goes first";
   EXPECT_EQ(frames_[1][4], 0x01);
-  EXPECT_TRUE(sent_.back().reset_before);
+  EXPECT_EQ(frames_[2][4], 0x01) << "one Reset per error";
+  EXPECT_TRUE(sent_[sent_.size() - 2].reset_before);
+  EXPECT_FALSE(sent_.back().reset_before);
   EXPECT_EQ(controller_.stats().timeout_errors_received, 1u);
 }
 

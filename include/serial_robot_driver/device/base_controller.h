@@ -8,8 +8,9 @@
 //    the period does not drift. Each tick writes
 //    the current wheel frame, which is also the heartbeat.
 //  - setCommand() (cmd_vel callback) and setEStop() only store and wake the loop, which puts the
-//    frame on the wire at once. Such immediate frames are spaced by what the line can carry
-//    (minImmediateInterval()), never by the loop rate, and never move the tick deadlines.
+//    frame on the wire at once. Such immediate frames are spaced from each other by what the line
+//    can carry (minImmediateInterval()), never by the loop rate or the last tick, and never move
+//    the tick deadlines.
 //    Callbacks never touch the port.
 //  - onFrame() runs on the port's reader thread: an FF error frame wakes the loop to send a Reset.
 //  - Every base write happens with mutex_ held, so the sequence counter and "Reset before the next
@@ -202,6 +203,7 @@ class BaseController : public LinkListener {
   bool needs_reset_ = true;
   std::optional<Clock::time_point> last_write_;        ///< any base frame
   std::optional<Clock::time_point> last_speed_frame_;
+  std::optional<Clock::time_point> last_immediate_frame_;  ///< the last one a command rushed out
   std::optional<Clock::time_point> last_tick_;
   Clock::time_point next_battery_poll_{};
   bool e_stop_ = false;
