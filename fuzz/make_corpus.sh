@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Writes the seed corpora for the fuzz targets from the golden vectors of PROTOCOLS.md, typed here
+# Writes the seed corpora for the fuzz targets from the docs/protocols.md golden vectors, typed
 # in hex by hand. Idempotent: run it again after editing a vector.
 #   fuzz/corpus/fuzz_framer/    3-byte prefix (families, servo count, max chunk) + byte stream
 #   fuzz/corpus/fuzz_decoders/  1-byte selector (decoder + 5 * mode), servo count, frame
@@ -21,7 +21,7 @@ write() {
   printf '%b' "$(echo "$hex" | sed -E 's/(..)/\\x\1/g')" > "$file"
 }
 
-# --- golden frames (PROTOCOLS.md) ---------------------------------------------------------------
+# --- golden frames (docs/protocols.md) ------------------------------------------------------------
 base_reset="55 AA 02 02 05 00 FA"
 base_battery_request="55 AA 02 01 02 00 FE"
 base_clear_encoders="55 AA 02 03 06 00 F8"

@@ -12,6 +12,7 @@ PACKAGES=(
   libnodelet-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
   librosbag-dev librosbag-storage-dev libdiagnostic-aggregator-dev
   librostest-dev python3-rostest python3-rosbag rosbash
+  python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs
   libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev catkin-lint catkin-tools
 )

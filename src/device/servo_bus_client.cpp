@@ -23,7 +23,7 @@ constexpr double kDecidegreesPerDegree = 10.0;
 constexpr uint8_t kMaxSpinMode = 3;
 constexpr double kDegreesPerTurn = 360.0;
 
-// Answer content sizes (PROTOCOLS.md section 3, response column).
+// Answer content sizes (docs/protocols.md, section 3, response column).
 constexpr std::size_t kIdOnlyAnswer = 1;        // id
 constexpr std::size_t kResultAnswer = 2;        // id, result
 constexpr std::size_t kWriteDataAnswer = 3;     // id, data_id, result

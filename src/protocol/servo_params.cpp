@@ -35,7 +35,7 @@ constexpr ParamInfo onOff(ServoDataId id, std::string_view name) {
 constexpr std::string_view kUnreachable = "can make the servo unreachable";
 constexpr std::string_view kReservedCell = "is a reserved cell the datasheet does not describe";
 
-// PROTOCOLS.md section 3. Ranges are the type's unless the datasheet narrows them.
+// docs/protocols.md, section 3. Ranges are the type's unless the datasheet narrows them.
 constexpr std::array<ParamInfo, kParamCount> kParams = {{
     readOnly(ServoDataId::kVoltage, "voltage", ParamType::kU16, "mV", kU16Max),
     readOnly(ServoDataId::kCurrent, "current", ParamType::kU16, "mA", kU16Max),

@@ -14,7 +14,7 @@ using servo::Command;
 
 namespace {
 
-// data_ids of PROTOCOLS.md section 3 the simulator gives a behaviour to.
+// data_ids of docs/protocols.md, section 3 the simulator gives a behaviour to.
 constexpr uint8_t kVoltage = servo::dataId(servo::ServoDataId::kVoltage);
 constexpr uint8_t kCurrent = servo::dataId(servo::ServoDataId::kCurrent);
 constexpr uint8_t kPower = servo::dataId(servo::ServoDataId::kPower);

@@ -1,4 +1,4 @@
-// End-to-end tests of driver_node with the AP1 wheeled base (PROTOCOLS.md section 1).
+// End-to-end tests of driver_node with the AP1 wheeled base (docs/protocols.md, section 1).
 //
 // base_node.test launches driver_node with only the base enabled, on a pty path this test creates.
 // The test plays the base: it reads every byte the node writes, splits it into frames with the
@@ -47,7 +47,7 @@ using test_support::ChildProcess;
 using test_support::Clock;
 using test_support::waitFor;
 
-// --- numbers from PROTOCOLS.md section 1 and the node's defaults ---------------------------------
+// --- numbers from docs/protocols.md, section 1 and the node's defaults ---------------------------
 // 1600 ticks/rev, 0.25 m wheels, 50 Hz PID: 1600 / (0.25 pi) / 50 ticks per period at 1 m/s.
 constexpr double kTicksAt1Mps = 40.7437;
 constexpr uint8_t kMsgWheelSpeed = 0x01;
@@ -385,8 +385,8 @@ class BaseNodeTest : public ::testing::Test {
   std::unique_ptr<CmdVelStreamer> streamer_;
 };
 
-// The hand-written XOR helper reproduces the golden vectors of PROTOCOLS.md, so the expected frames
-// built with it below can be trusted.
+// The hand-written XOR helper reproduces the golden vectors of docs/protocols.md, so the expected
+// frames built with it below can be trusted.
 TEST(BaseGoldenFrames, HelperMatchesProtocolVectors) {
   EXPECT_EQ(resetFrame(0x02), golden::base::kResetSeq2);
   EXPECT_EQ(batteryRequestFrame(0x01), golden::base::kBatteryRequestSeq1);

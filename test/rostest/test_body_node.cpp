@@ -1,7 +1,7 @@
 // driver_node's servo controller board end to end (body_node.test):
-//  - the test plays the board on a pty: it writes telemetry bytes (hand-written from PROTOCOLS.md
-//    2b) and checks joint_states / imu/data / foot_pressure / telemetry, and it reads the
-//    sync-write bytes (PROTOCOLS.md 2a) a joint_commands message produces;
+//  - the test plays the board on a pty: it writes telemetry bytes (hand-written from
+//    docs/protocols.md 2b) and checks joint_states / imu/data / foot_pressure / telemetry, and it
+//    reads the sync-write bytes (docs/protocols.md 2a) a joint_commands message produces;
 //  - a second driver_node in namespace "sim" runs closed-loop with robot_sim;
 //  - launch/record.launch records that namespace and `rosbag info` must list every topic.
 //
@@ -50,7 +50,7 @@ using test_support::withByte;
 
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 
-// --- frames, written out by hand from PROTOCOLS.md 2b (N = 2 servos: ids 2, 3) ----------------
+// --- frames, written out by hand from docs/protocols.md, section 2b (N = 2 servos: ids 2, 3) -----
 
 // The golden vector: positions 2048, 1024; speeds 10, -5; IMU 1, -1, 16384, 0, 0, 100, 0, 0,
 // -16384. SUM = 0x93.
@@ -369,7 +369,7 @@ TEST_F(BodyNode, JointCommandsBecomeExactSyncWriteBytes) {
   board().joint_commands.publish(command({"hip", "elbow"}, {0.0, 0.0}));
   board().joint_commands.publish(command({"hip", "knee"}, {0.0}));
   board().joint_commands.publish(command({"hip", "knee"}, {0.0, std::nan("")}));
-  // hip 0 rad -> 2048; knee pi/2 with direction -1 -> 2048 - 1024 = 1024 (PROTOCOLS.md 2a).
+  // hip 0 rad -> 2048; knee pi/2 with direction -1 -> 2048 - 1024 = 1024 (docs/protocols.md 2a).
   board().joint_commands.publish(command({"hip", "knee"}, {0.0, M_PI / 2}));
   const Bytes& golden = golden::body::kSyncWrite2And3;
   EXPECT_EQ(board().read(golden.size()), golden);

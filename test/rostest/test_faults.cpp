@@ -52,7 +52,7 @@ namespace srd = serial_robot_driver;
 using test_support::TopicCounter;
 using test_support::waitFor;
 
-constexpr uint8_t kMsgWheelSpeed = 0x01;  // PROTOCOLS.md section 1
+constexpr uint8_t kMsgWheelSpeed = 0x01;  // docs/protocols.md, section 1
 constexpr uint8_t kMsgReset = 0x05;
 constexpr double kTwoPi = 6.283185307179586;
 // max_wheel_speed 1.0 m/s = 40.74 ticks per PID period (1600 ticks/rev, 0.25 m, 50 Hz); dithering

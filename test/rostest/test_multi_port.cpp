@@ -1,7 +1,7 @@
-// The port layouts of INTERFACE.md end to end: all devices on one port, base + body on one and the
-// servo bus on another, every device on its own port (multi_port.test launches one driver_node per
-// layout). The robot is the simulator library (sim::RobotSim) running in this process on ptys at
-// the node's paths, so its counters can be read at any moment.
+// The port layouts of docs/node_api.md end to end: all devices on one port, base + body on one and
+// the servo bus on another, every device on its own port (multi_port.test launches one driver_node
+// per layout). The robot is the simulator library (sim::RobotSim) running in this process on ptys
+// at the node's paths, so its counters can be read at any moment.
 //
 // In every layout: wheel frames flow and the first one follows a Reset, joint_states flow, a
 // joint command and a cmd_vel reach the right simulated device, a servo/ping answers, and no frame

@@ -1,4 +1,5 @@
-// End-to-end tests of the servo/* services of driver_node (PROTOCOLS.md section 3, INTERFACE.md).
+// End-to-end tests of the servo/* services of driver_node (docs/protocols.md, section 3,
+// docs/node_api.md).
 //
 // servo_bus_node.test launches two driver_nodes with only the servo bus enabled: /driver_node
 // (dangerous writes refused) and /armed/driver_node (allowed). This test creates their ptys and
@@ -50,7 +51,7 @@ using test_support::secondsSince;
 
 using namespace golden::servo;  // NOLINT: the frames shared with the unit tests
 
-// --- more frames written out by hand from PROTOCOLS.md section 3 (SUM = byte sum mod 256) --------
+// --- more frames written out by hand from docs/protocols.md, section 3 (SUM = byte sum mod 256) --
 const Bytes kPing4 = {0x12, 0x4C, 0x01, 0x01, 0x04, 0x64};
 // over_temperature (41 = 0x29) of servo 3 := 80, answered with result 0.
 const Bytes kWriteOverTemp3 = {0x12, 0x4C, 0x04, 0x04, 0x03, 0x29, 0x50, 0x00, 0xE2};

@@ -1,4 +1,4 @@
-// AP1 wheeled base codec: golden vectors from PROTOCOLS.md section 1, written out by hand.
+// AP1 wheeled base codec: golden vectors from docs/protocols.md, section 1, written out by hand.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -24,8 +24,8 @@ struct HostFrameCase {
   Bytes params;
 };
 
-// Every host -> base vector of PROTOCOLS.md, plus two that exercise signed values and a high SEQ.
-// XOR of the last two computed by hand: 55^AA^09^00^01^FF^FB^01^2C = DE.
+// Every host -> base vector of docs/protocols.md, plus two that exercise signed values and a high
+// SEQ. XOR of the last two computed by hand: 55^AA^09^00^01^FF^FB^01^2C = DE.
 // clang-format off
 const HostFrameCase kHostFrames[] = {
     {"Reset_Seq02", [] { return encodeReset(0x02); },

@@ -1,4 +1,4 @@
-// Servo controller board codec: golden vectors from PROTOCOLS.md section 2, written out by hand.
+// Servo controller board codec: golden vectors from docs/protocols.md, section 2, by hand.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -24,8 +24,8 @@ struct SyncWriteCase {
   Bytes expected;
 };
 
-// The CRCs of the PROTOCOLS.md vector come from the document; the others were checked against an
-// independent bitwise CRC-16/BUYPASS, never against the code under test.
+// The CRCs of the docs/protocols.md vector come from the document; the others were checked
+// against an independent bitwise CRC-16/BUYPASS, never against the code under test.
 // clang-format off
 const SyncWriteCase kSyncWrites[] = {
     {"Id2To2048Id3To1024",
@@ -314,7 +314,7 @@ const Bytes kProbeTelemetryNoServos = {
     0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
     0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
     0x18, 0x1F, 0x2F};
-// Sync write of servo 1 to 512 (PROTOCOLS.md layout, CRC 8E3A checked independently).
+// Sync write of servo 1 to 512 (docs/protocols.md layout, CRC 8E3A checked independently).
 const Bytes kProbeSyncWrite = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0x74, 0x00,
                                0x02, 0x00, 0x01, 0x00, 0x02, 0x3A, 0x8E};
 // clang-format on

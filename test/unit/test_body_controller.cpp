@@ -1,6 +1,6 @@
 // BodyController and JointCalibration: telemetry in through onFrame(), sync-write frames out
 // through an injected write sink (no serial port needed). Expected bytes are written out by hand
-// from PROTOCOLS.md section 2.
+// from docs/protocols.md, section 2.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -222,7 +222,7 @@ class BodyControllerCommand : public testing::Test {
 };
 
 TEST_F(BodyControllerCommand, GoldenSyncWrite) {
-  // hip (id 2) 0 rad -> 2048, knee (id 3) -pi/2 -> 1024 (PROTOCOLS.md 2a).
+  // hip (id 2) 0 rad -> 2048, knee (id 3) -pi/2 -> 1024 (docs/protocols.md, section 2a).
   const JointCommandResult result = controller_.sendJointCommand({"hip", "knee"}, {0.0, -M_PI / 2});
   EXPECT_TRUE(result.ok()) << result.message();
   const Bytes expected = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00,

@@ -16,8 +16,8 @@ using protocol::body::Telemetry;
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 constexpr double kHalfSqrt2 = 0.70710678118654752;
 
-// The values of PROTOCOLS.md 2b's golden frame (positions 2048, 1024, speeds 10, -5, IMU 1, -1,
-// 16384, 0, 0, 100, 0, 0, -16384), optionally with a foot block.
+// The values of docs/protocols.md, section 2b's golden frame (positions 2048, 1024, speeds 10, -5,
+// IMU 1, -1, 16384, 0, 0, 100, 0, 0, -16384), optionally with a foot block.
 Telemetry goldenTelemetry(bool with_foot = false) {
   Telemetry t;
   t.servo_count = 2;

@@ -1,4 +1,5 @@
-// Differential-drive kinematics and tick quantization (PROTOCOLS.md §1 "Wheel speed unit").
+// Differential-drive kinematics and tick quantization (docs/protocols.md, section 1 "Wheel speed
+// unit").
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
 // ServoBusClient against a fake bus: the write seam records every frame and answers synchronously
-// by calling onFrame() with response bytes written out by hand from PROTOCOLS.md section 3.
+// by calling onFrame() with response bytes written out by hand from docs/protocols.md, section 3.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,7 +21,8 @@ using protocol::FrameFamily;
 
 using namespace golden::servo;  // NOLINT: the frames shared with the rostest
 
-// --- more golden frames (PROTOCOLS.md section 3; SUM = byte sum mod 256, values little-endian) -
+// --- more golden frames (docs/protocols.md, section 3; SUM = byte sum mod 256, values
+// little-endian) -
 const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
 // A PING answer with two content bytes: right CMD and id, wrong shape.
 const Bytes kPing3ReplyTooLong = {0x05, 0x1C, 0x01, 0x02, 0x03, 0x00, 0x27};

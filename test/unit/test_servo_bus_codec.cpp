@@ -1,4 +1,4 @@
-// UART bus servo codec: golden vectors from PROTOCOLS.md section 3, written out by hand.
+// UART bus servo codec: golden vectors from docs/protocols.md, section 3, written out by hand.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -35,8 +35,8 @@ struct RequestCase {
   uint8_t cmd;
 };
 
-// All request vectors of PROTOCOLS.md, then vectors for the other commands, computed by hand from
-// the format rules (SUM = sum of every preceding byte mod 256; 12 + 4C = 5E).
+// All request vectors of docs/protocols.md, then vectors for the other commands, computed by hand
+// from the format rules (SUM = sum of every preceding byte mod 256; 12 + 4C = 5E).
 // clang-format off
 const RequestCase kRequests[] = {
     {"PingId3", [] { return encodePing(3); }, {0x12, 0x4C, 0x01, 0x01, 0x03, 0x63}, 1},

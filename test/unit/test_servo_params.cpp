@@ -1,4 +1,4 @@
-// The UART bus servo parameter table, written out by hand from PROTOCOLS.md section 3.
+// The UART bus servo parameter table, written out by hand from docs/protocols.md, section 3.
 #include <gtest/gtest.h>
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // Tests of the simulated robot. The device classes are driven with explicit time points; RobotSim
 // runs in-process on real ptys while the test plays the host through the slave path, with plain
-// POSIX I/O and byte vectors written out by hand from PROTOCOLS.md.
+// POSIX I/O and byte vectors written out by hand from docs/protocols.md.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>

@@ -1,5 +1,5 @@
 // Stream framer: resynchronisation, chunking and statistics. Every frame below is written out by
-// hand from PROTOCOLS.md (golden vectors) or derived from one with a hand-computed checksum.
+// hand from docs/protocols.md (golden vectors) or derived from one with a hand-computed checksum.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// The servo controller board (PROTOCOLS.md section 2), ROS-free: telemetry frames in, goal
+// The servo controller board (docs/protocols.md, section 2), ROS-free: telemetry frames in, goal
 // positions out as one Dynamixel 2.0 sync-write frame.
 //
 // Threading: onFrame() runs on the link's reader thread and calls on_telemetry right there (no

@@ -1,4 +1,4 @@
-// A client for the UART bus servos (PROTOCOLS.md section 3). ROS-free: the ROS services
+// A client for the UART bus servos (docs/protocols.md, section 3). ROS-free: the ROS services
 // (ros/servo_bus_interface.h) are a thin layer that turns requests into calls of this class.
 //
 // Threading model:

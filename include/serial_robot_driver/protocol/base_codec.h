@@ -1,9 +1,9 @@
-// AP1 wheeled base protocol (PROTOCOLS.md section 1).
+// AP1 wheeled base protocol (docs/protocols.md, section 1).
 //
 //   55 AA | LEN | SEQ | MSGID | PARAM... | XOR
 //
 // LEN counts MSGID + PARAM; XOR covers every byte before it, header included. The same layout is
-// used in both directions (the reply layout is an assumption of PROTOCOLS.md).
+// used in both directions (the reply layout is an assumption of docs/protocols.md).
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// Servo controller board protocol (PROTOCOLS.md section 2).
+// Servo controller board protocol (docs/protocols.md, section 2).
 //
 // Host -> board: Dynamixel 2.0 Sync Write of goal positions, CRC-16/BUYPASS (Boost.CRC):
 //   FF FF FD 00 | FE | LEN_L LEN_H | 83 | 74 00 | 02 00 | (ID, POS_L, POS_H) x N | CRC_L CRC_H
@@ -56,7 +56,7 @@ constexpr std::size_t telemetryLen(std::size_t servo_count, bool with_foot) {
   return 24 + 4 * servo_count + (with_foot ? 16 : 0);
 }
 
-/// Indices into Telemetry::imu (assumption of PROTOCOLS.md: accel, gyro, attitude).
+/// Indices into Telemetry::imu (assumption of docs/protocols.md: accel, gyro, attitude).
 enum ImuIndex : std::size_t {
   kAccelX = 0, kAccelY, kAccelZ, kGyroX, kGyroY, kGyroZ, kRoll, kPitch, kYaw
 };

@@ -1,4 +1,4 @@
-// UART bus servo protocol (PROTOCOLS.md section 3).
+// UART bus servo protocol (docs/protocols.md, section 3).
 //
 //   request  12 4C | CMD | N | CONTENT (N) | SUM
 //   response 05 1C | CMD | N | CONTENT (N) | SUM

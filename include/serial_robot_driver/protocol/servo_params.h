@@ -1,5 +1,5 @@
-// The UART bus servo parameter table (PROTOCOLS.md section 3): data_id, name, wire type, unit and
-// safety flags in one place, so validation, encoding and the services read the same facts.
+// The UART bus servo parameter table (docs/protocols.md, section 3): data_id, name, wire type, unit
+// and safety flags in one place, so validation, encoding and the services read the same facts.
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// Simulated AP1 wheeled base (PROTOCOLS.md section 1).
+// Simulated AP1 wheeled base (docs/protocols.md, section 1).
 //
 // Integrates wheel-speed frames into encoder counters at the PID rate, answers battery requests and
 // enforces the vendor heartbeat: more than `heartbeat_timeout_s` without a host frame puts the base
@@ -20,7 +20,7 @@ struct BaseSimConfig {
   double heartbeat_timeout_s = 1.0;
   double error_repeat_s = 1.0;         ///< FF error frame repeat period while in error
   int16_t max_ticks_per_period = 200;  ///< the base clamps faster commands
-  // Geometry, only used to turn wheel ticks into the body's yaw rate (INTERFACE.md defaults).
+  // Geometry, only used to turn wheel ticks into the body's yaw rate (docs/node_api.md defaults).
   double wheel_diameter_m = 0.25;
   double encoder_resolution = 1600.0;
   double wheel_separation_m = 0.40;

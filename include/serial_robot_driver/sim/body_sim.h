@@ -1,4 +1,4 @@
-// Simulated servo controller board (PROTOCOLS.md section 2).
+// Simulated servo controller board (docs/protocols.md, section 2).
 //
 // Streams telemetry frames at a fixed rate: every configured servo moves toward its last
 // sync-write target at a bounded speed and reports that speed; the IMU sees gravity on z and the
@@ -26,7 +26,7 @@ struct BodySimConfig {
   uint16_t initial_position = 2048;
   uint16_t max_position = 4095;  ///< targets are clamped to 0..max_position
   bool imu_noise = false;        ///< add +-2 LSB of noise to the IMU values
-  // IMU raw scales of PROTOCOLS.md (16 g, 2000 deg/s, 180 deg full scale over 32768).
+  // IMU raw scales of docs/protocols.md (16 g, 2000 deg/s, 180 deg full scale over 32768).
   double accel_lsb_per_g = 32768.0 / 16.0;
   double gyro_lsb_per_dps = 32768.0 / 2000.0;
   double angle_lsb_per_deg = 32768.0 / 180.0;

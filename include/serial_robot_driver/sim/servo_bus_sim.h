@@ -1,4 +1,4 @@
-// Simulated chain of UART bus servos (PROTOCOLS.md section 3).
+// Simulated chain of UART bus servos (docs/protocols.md, section 3).
 //
 // Each servo keeps the full parameter table: read-only values that drift a little (voltage,
 // temperature, ...) and the 32-byte user block, persistent across requests. Motions (ROTATE, SPIN,
