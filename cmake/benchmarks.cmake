@@ -29,5 +29,6 @@ target_link_libraries(polling_driver_node srd_ros)
 # The benchmark launches these executables, so building it builds them.
 add_dependencies(driver_bench driver_node polling_driver_node floor_node robot_sim
   ${PROJECT_NAME}_generate_messages_cpp)
-# Benchmarks run from the build tree and are never installed (hence the catkin_lint pragma).
+# Benchmarks run from the build tree and are never installed (hence the catkin_lint pragmas).
+#catkin_lint: ignore uninstalled_target
 #catkin_lint: ignore uninstalled_script
