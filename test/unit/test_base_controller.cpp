@@ -98,6 +98,23 @@ class ManualClock : public LoopClock {
   bool waiting_ = false;
 };
 
+/// A controller whose loop runs on `clock`, started and waiting for its first tick; the frames it
+/// writes go to `frames` when one is given (for tests with a configuration of their own).
+std::unique_ptr<BaseController> startOnManualClock(const BaseConfig& config, BaseEvents events,
+                                                   const std::shared_ptr<ManualClock>& clock,
+                                                   std::vector<Bytes>* frames = nullptr) {
+  auto controller = std::make_unique<BaseController>(
+      config,
+      [frames](const Bytes& frame) {
+        if (frames != nullptr) frames->push_back(frame);
+        return true;
+      },
+      std::move(events), clock);
+  controller->start();
+  clock->waitForLoop();
+  return controller;
+}
+
 /// The controller's loop runs at 50 Hz on a ManualClock that starts at t0: the first tick falls
 /// due at t0 + 20 ms.
 class BaseControllerTest : public ::testing::Test {
@@ -379,10 +396,8 @@ TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
   BaseEvents events;
   events.on_wheel_frame = [&sent](const WheelFrameSent& s) { sent.push_back(s); };
   auto clock = std::make_shared<ManualClock>(Clock::now());
-  BaseController controller(
-      config, [](const Bytes&) { return true; }, events, clock);
-  controller.start();
-  clock->waitForLoop();
+  const auto started = startOnManualClock(config, events, clock);
+  BaseController& controller = *started;
   clock->step([&] { controller.setCommand(0.5, 0.0); });
   clock->tick(100);
   ASSERT_GT(sent.back().ticks.left, 15);
@@ -453,15 +468,8 @@ TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
   BaseEvents events;
   events.on_odometry = [&samples](const OdometrySample& s) { samples.push_back(s); };
   auto clock = std::make_shared<ManualClock>(Clock::now());
-  BaseController controller(
-      config,
-      [&frames](const Bytes& f) {
-        frames.push_back(f);
-        return true;
-      },
-      events, clock);
-  controller.start();
-  clock->waitForLoop();
+  const auto started = startOnManualClock(config, events, clock, &frames);
+  BaseController& controller = *started;
   clock->step([&] { controller.setCommand(0.1, 0.0); });
   // 0.1 m/s = 4.07 -> 4 ticks; left flipped: FF FC, right 00 04; XOR 55^AA^09^01^01^FF^FC^04 = F1
   ASSERT_EQ(frames.size(), 2u);
@@ -483,10 +491,8 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   BaseEvents events;
   events.on_silent = [&silent_events](double) { ++silent_events; };
   auto clock = std::make_shared<ManualClock>(Clock::now());
-  BaseController controller(
-      config, [](const Bytes&) { return true; }, events, clock);
-  controller.start();
-  clock->waitForLoop();
+  const auto started = startOnManualClock(config, events, clock);
+  BaseController& controller = *started;
   clock->tick(150);  // 3 s: the first request went out at 1.02 s (the first tick sent the Reset)
   EXPECT_FALSE(controller.stats().base_silent);
   ASSERT_TRUE(controller.stats().seconds_without_reply.has_value());
@@ -527,15 +533,8 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   BaseEvents events;
   events.on_battery = [&percents](uint8_t p, Clock::time_point) { percents.push_back(p); };
   auto clock = std::make_shared<ManualClock>(Clock::now());
-  BaseController controller(
-      config,
-      [&frames](const Bytes& f) {
-        frames.push_back(f);
-        return true;
-      },
-      events, clock);
-  controller.start();
-  clock->waitForLoop();
+  const auto started = startOnManualClock(config, events, clock, &frames);
+  BaseController& controller = *started;
   clock->tick(101);  // 2.02 s: the first tick sends the Reset instead, then one request per second
   int requests = 0;
   for (const Bytes& f : frames) requests += (f[4] == 0x02);
