@@ -290,6 +290,7 @@ void BaseController::advanceOdometryLocked(Clock::time_point now) {
   const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(config_.heartbeat_gap));
   if (end > integrated_until_) {
     odometry_.integrate(held_speeds_, seconds(end - integrated_until_));
+    wheel_travel_ += held_speeds_ * seconds(end - integrated_until_);
     integrated_until_ = end;
   }
 }
@@ -311,7 +312,9 @@ OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const
   if (running) {
     sample.linear = (held_speeds_.x() + held_speeds_.y()) / 2.0;
     sample.angular = (held_speeds_.y() - held_speeds_.x()) / config_.geometry.wheel_separation;
+    sample.wheel_speeds = held_speeds_;
   }
+  sample.wheel_travel = wheel_travel_;
   sample.position_variance = odometry_.positionVariance();
   sample.yaw_variance = odometry_.yawVariance();
   sample.travelled = odometry_.travelled();

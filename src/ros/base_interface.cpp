@@ -3,6 +3,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/BatteryState.h>
+#include <sensor_msgs/JointState.h>
 
 #include <cmath>
 
@@ -97,6 +98,7 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
       controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
   battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
+  wheel_states_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
 
   link.addListener(&controller_);
 
@@ -159,6 +161,7 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
   odom.twist.covariance[35] = kTwistAngularVariance;
   odom_pub_.publish(odom);
+  publishWheelStates(sample, stamp);
 
   if (!tf_broadcaster_) return;
   geometry_msgs::TransformStamped transform;
@@ -168,6 +171,18 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   transform.transform.translation.y = sample.pose.y;
   transform.transform.rotation = orientation;
   tf_broadcaster_->sendTransform(transform);
+}
+
+void BaseInterface::publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp) {
+  // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
+  const double radius = params_.wheel_diameter / 2.0;
+  sensor_msgs::JointState wheels;
+  wheels.header.stamp = stamp;
+  wheels.header.frame_id = params_.base_frame;
+  wheels.name = {params_.left_wheel_joint, params_.right_wheel_joint};
+  wheels.position = {sample.wheel_travel.x() / radius, sample.wheel_travel.y() / radius};
+  wheels.velocity = {sample.wheel_speeds.x() / radius, sample.wheel_speeds.y() / radius};
+  wheel_states_pub_.publish(wheels);
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {

@@ -162,6 +162,8 @@ std::vector<ParamSpec> buildTable() {
       row("base/publish_tf", &P::base, &Base::publish_tf),
       row("base/left_wheel_direction", &P::base, &Base::left_wheel_direction, direction),
       row("base/right_wheel_direction", &P::base, &Base::right_wheel_direction, direction),
+      row("base/left_wheel_joint", &P::base, &Base::left_wheel_joint, frameId),
+      row("base/right_wheel_joint", &P::base, &Base::right_wheel_joint, frameId),
 
       row("body/enabled", &P::body, &Port::enabled),
       row("body/port", &P::body, &Port::port),
@@ -358,6 +360,8 @@ void DriverParams::validate() const {
                 std::to_string(base.battery_warn_percent) + ")");
     require(base.odom_frame != base.base_frame, "base/base_frame",
             "must differ from base/odom_frame ('" + base.odom_frame + "')");
+    require(base.left_wheel_joint != base.right_wheel_joint, "base/right_wheel_joint",
+            "must differ from base/left_wheel_joint ('" + base.left_wheel_joint + "')");
   }
   if (body.enabled) {
     const std::size_t n = body.servo_ids.size();

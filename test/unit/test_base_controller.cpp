@@ -441,6 +441,31 @@ TEST_F(BaseControllerTest, OdometryUsesTheRobotsTicksNotTheWheelDirections) {
   EXPECT_NEAR(odometry_.back().pose.x, 0.0, 1e-9);
 }
 
+TEST_F(BaseControllerTest, WheelTravelFollowsTheAcceptedTicksAndSurvivesAnOdometryReset) {
+  // Turning on the spot: -8 / +8 ticks per period, so the wheels travel opposite ways.
+  const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
+  for (int i = 0; i < 10; ++i) {
+    clock_->step([&] { controller_.setCommand(0.0, 1.0); });
+    clock_->tick(1);
+  }
+  ASSERT_EQ(sent_.back().ticks, (kinematics::WheelTicks{-8, 8}));
+  const OdometrySample driven = odometry_.back();  // a copy: more samples follow
+  EXPECT_NEAR(driven.wheel_speeds.x(), -8 * per_tick, 1e-12);
+  EXPECT_NEAR(driven.wheel_speeds.y(), 8 * per_tick, 1e-12);
+  EXPECT_NEAR(driven.wheel_travel.x(), -8 * per_tick * 0.2, 1e-9);
+  EXPECT_NEAR(driven.wheel_travel.y(), 8 * per_tick * 0.2, 1e-9);
+  // Half the distance between the wheels' paths over the separation is the heading.
+  EXPECT_NEAR((driven.wheel_travel.y() - driven.wheel_travel.x()) /
+                  kinematics::DiffDriveGeometry{}.wheel_separation,
+              driven.pose.yaw, 1e-9);
+
+  const Eigen::Vector2d before_reset = odometry_.back().wheel_travel;
+  controller_.resetOdometry();
+  clock_->tick(1);
+  EXPECT_LT(odometry_.back().pose.yaw, driven.pose.yaw / 5) << "the pose starts again";
+  EXPECT_GT(odometry_.back().wheel_travel.y(), before_reset.y()) << "wheel angles do not jump back";
+}
+
 TEST_F(BaseControllerTest, PortDownStopsIntegratingAfterTheBasesOwnTimeout) {
   const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
   const double speed = 8 * per_tick;

@@ -66,6 +66,11 @@ struct OdometrySample {
   double position_variance = 0;  ///< m^2, x and y
   double yaw_variance = 0;       ///< rad^2
   double travelled = 0;          ///< m since the last reset
+  /// Each wheel's signed path (left, right; m) since the controller started, from the same
+  /// accepted speeds as the pose; reset_odometry leaves it alone (wheel angles do not jump).
+  kinematics::WheelSpeeds wheel_travel = kinematics::WheelSpeeds::Zero();
+  /// Each wheel's speed (left, right; m/s) the base runs at now (0 once its timeout stopped it).
+  kinematics::WheelSpeeds wheel_speeds = kinematics::WheelSpeeds::Zero();
 };
 
 /// One wheel frame as written.
@@ -209,6 +214,7 @@ class BaseController : public LinkListener {
   bool e_stop_ = false;
   kinematics::Odometry odometry_;
   kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
+  kinematics::WheelSpeeds wheel_travel_ = kinematics::WheelSpeeds::Zero();  ///< see OdometrySample
   std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
   Clock::time_point integrated_until_{};
   std::optional<Clock::time_point> last_reset_sent_;

@@ -51,6 +51,8 @@ struct BaseParams : DevicePortParams {
   bool publish_tf = true;
   int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
   int right_wheel_direction = 1;
+  std::string left_wheel_joint = "left_wheel_joint";  ///< wheel_states and robot description names
+  std::string right_wheel_joint = "right_wheel_joint";
 };
 
 struct BodyParams : DevicePortParams {
