@@ -46,6 +46,40 @@ TEST(Description, EveryLinkHasATransformToOdom) {
   EXPECT_NEAR(imu.transform.translation.z, 0.19, 1e-9) << "the launch's imu_xyz";
 }
 
+/// The angle of `child` about y in `parent` (the servo arms' and wheels' axis).
+double pitchOf(const tf2_ros::Buffer& buffer, const std::string& parent, const std::string& child) {
+  const auto t = buffer.lookupTransform(parent, child, ros::Time(0)).transform.rotation;
+  // Rotation about y only: q = (0, sin(a/2), 0, cos(a/2)).
+  return 2.0 * std::atan2(t.y, t.w);
+}
+
+TEST(Description, TfFollowsTheDriversJointStates) {
+  ros::NodeHandle nh;
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  TopicCounter<sensor_msgs::JointState> joints(nh, "joint_states", 1);
+  ros::Publisher commands = nh.advertise<sensor_msgs::JointState>("joint_commands", 10);
+  ASSERT_TRUE(waitFor([&] { return commands.getNumSubscribers() > 0; }, 30.0));
+  sensor_msgs::JointState command;
+  command.name = {"joint_1", "joint_2"};
+  command.position = {0.6, -0.4};
+  // The simulated servos move there; the description's arms must follow what joint_states says.
+  EXPECT_TRUE(waitFor(
+      [&] {
+        commands.publish(command);
+        const auto last = joints.last();
+        if (!last || last->position.size() != 2 || std::abs(last->position[0] - 0.6) > 0.01) return false;
+        try {
+          return std::abs(pitchOf(buffer, "base_link", "joint_1_link") - last->position[0]) < 0.01 &&
+                 std::abs(pitchOf(buffer, "base_link", "joint_2_link") - last->position[1]) < 0.01;
+        } catch (const tf2::TransformException&) {
+          return false;
+        }
+      },
+      60.0))
+      << "joint_1_link / joint_2_link on tf do not follow joint_states";
+}
+
 TEST(Description, WheelStatesTurnByTheDistanceOdomDrives) {
   ros::NodeHandle nh;
   // Every message of both, to pair them by stamp: the driver stamps a tick's odom and
