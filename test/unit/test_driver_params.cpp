@@ -258,5 +258,63 @@ TEST(ParameterTable, WrongTypeNamesTheParameter) {
   }
 }
 
+// --- tf_prefix ---------------------------------------------------------------------------------
+
+TEST(ResolveFrame, PrefixGoesInFrontWithOneSlash) {
+  EXPECT_EQ(resolveFrame("robot1", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("robot1", "base_link"), "robot1/base_link");
+}
+
+TEST(ResolveFrame, EmptyPrefixLeavesTheFrameAsConfigured) {
+  EXPECT_EQ(resolveFrame("", "odom"), "odom");
+  EXPECT_EQ(resolveFrame("", "some/frame"), "some/frame");
+  EXPECT_EQ(resolveFrame("/", "odom"), "odom") << "a prefix of slashes only is no prefix";
+}
+
+TEST(ResolveFrame, LeadingSlashFrameIsTakenAsItIsWithoutTheSlash) {
+  EXPECT_EQ(resolveFrame("robot1", "/map"), "map");
+  EXPECT_EQ(resolveFrame("", "/odom"), "odom");
+  EXPECT_EQ(resolveFrame("robot1", "/shared/odom"), "shared/odom");
+}
+
+TEST(ResolveFrame, PrefixSlashesAreTrimmedInnerOnesKept) {
+  EXPECT_EQ(resolveFrame("/robot1", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("robot1/", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("//robot1//", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("fleet/robot1", "imu_link"), "fleet/robot1/imu_link");
+}
+
+TEST(DriverParamsFrames, ResolveFramesPrefixesEveryFrameParameter) {
+  DriverParams params;
+  params.tf_prefix = "robot2";
+  params.imu.frame_id = "/imu_shared";
+  params.resolveFrames();
+  EXPECT_EQ(params.base.odom_frame, "robot2/odom");
+  EXPECT_EQ(params.base.base_frame, "robot2/base_link");
+  EXPECT_EQ(params.imu.frame_id, "imu_shared");
+  EXPECT_NO_THROW(params.validate());
+}
+
+TEST(DriverParamsFrames, BadPrefixOrFrameIsNamed) {
+  DriverParams spaced;
+  spaced.tf_prefix = "robot 1";
+  try {
+    spaced.validate();
+    FAIL() << "a tf_prefix with a space passed";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "tf_prefix");
+  }
+  DriverParams slash_only;
+  slash_only.base.base_frame = "/";
+  slash_only.tf_prefix = "robot1";
+  slash_only.resolveFrames();
+  try {
+    slash_only.validate();
+    FAIL() << "base/base_frame '/' passed";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "base/base_frame");
+  }
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::ros_layer
