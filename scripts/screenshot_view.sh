@@ -3,6 +3,7 @@
 # (Xvfb, software OpenGL), drives the simulated robot for a few seconds so odom leaves a trail,
 # and saves a screenshot of the display.
 #   scripts/screenshot_view.sh                 # view.launch  -> docs/images/view.png
+#   scripts/screenshot_view.sh fleet            # fleet_sim.launch rviz:=true -> docs/images/fleet.png
 #   scripts/screenshot_view.sh view OUT.png
 # Needs the built workspace (.ws, or WS=path), Xvfb and ImageMagick's `import` (the dev-only
 # packages of scripts/install_deps.sh --dev). Runs its own roscore on a free port.
@@ -43,17 +44,25 @@ case "$scene" in
     start roslaunch serial_robot_driver view.launch link:="$work/pty" imu_xyz:="0.08 0 0.19"
     drive_ns=("")
     ;;
-  *) echo "screenshot: unknown scene '$scene' (view)"; exit 2 ;;
+  fleet)
+    start roslaunch serial_robot_driver fleet_sim.launch rviz:=true link_prefix:="$work/pty_"
+    drive_ns=(/robot1 /robot2)
+    ;;
+  *) echo "screenshot: unknown scene '$scene' (view, fleet)"; exit 2 ;;
 esac
 
-# Wait for the driver, then drive an arc and raise the body joints for the picture.
+# Wait for the driver(s), then drive an arc and raise the body joints for the picture.
+launch_pid="${started%% *}"
 for _ in $(seq 120); do
-  rostopic list 2>/dev/null | grep -q "/odom$" && break
+  kill -0 "$launch_pid" 2> /dev/null || { tail -n 20 "$work"/roslaunch.*.log; echo "screenshot: roslaunch ended"; exit 1; }
+  [ "$(rostopic list 2>/dev/null | grep -c "/odom$")" -ge "${#drive_ns[@]}" ] && break
   sleep 0.5
 done
 sleep 5  # rviz loads the model
+turn=0.6
 for ns in "${drive_ns[@]}"; do
-  start rostopic pub -r 10 "$ns/cmd_vel" geometry_msgs/Twist '{linear: {x: 0.25}, angular: {z: 0.6}}'
+  start rostopic pub -r 10 "$ns/cmd_vel" geometry_msgs/Twist "{linear: {x: 0.25}, angular: {z: $turn}}"
+  turn="-$turn"  # the second robot turns the other way
   start rostopic pub -r 5 "$ns/joint_commands" sensor_msgs/JointState \
     '{name: [joint_1, joint_2], position: [0.6, -0.6]}'
 done
