@@ -84,7 +84,9 @@ add_dependencies(test_description driver_node robot_sim robot_description)
 
 # fleet_sim.launch: two robots in namespaces on one master, apart in topics, services and tf.
 add_rostest_gtest(test_fleet_sim test/rostest/fleet_sim.test test/rostest/test_fleet_sim.cpp)
-target_include_directories(test_fleet_sim PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS})
-target_link_libraries(test_fleet_sim srd_test_support ${urdf_LIBRARIES} ${catkin_LIBRARIES})
+target_include_directories(test_fleet_sim PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS}
+  ${diagnostic_aggregator_INCLUDE_DIRS})
+target_link_libraries(test_fleet_sim srd_test_support ${urdf_LIBRARIES}
+  ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_fleet_sim driver_node robot_sim robot_description
   ${PROJECT_NAME}_generate_messages_cpp)

@@ -1,5 +1,6 @@
 // Two robots on one master (fleet_sim.test, launch/fleet_sim.launch): namespaces keep commands,
 // services, e_stop and states apart; tf_prefix keeps their frames apart; /diagnostics names them.
+#include <diagnostic_aggregator/aggregator.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <urdf/model.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <set>
@@ -87,6 +89,36 @@ TEST(Fleet, DiagnosticsNameEachDriver) {
   DiagnosticsWatch robot2(nh, "robot2/driver_node");
   EXPECT_TRUE(waitFor([&] { return robot1.latest("base").received > 0; }, 30.0));
   EXPECT_TRUE(waitFor([&] { return robot2.latest("base").received > 0; }, 30.0));
+}
+
+TEST(Fleet, FleetAnalyzersGroupTheStatusesByRobot) {
+  ros::NodeHandle nh;
+  diagnostic_aggregator::Aggregator aggregator;  // config/fleet_analyzers.yaml from ~analyzers
+  std::mutex mutex;
+  std::vector<std::string> names;
+  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics_agg", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        names.clear();
+        for (const auto& status : array->status) names.push_back(status.name);
+      });
+  const auto has = [&](const std::string& name) {
+    std::lock_guard<std::mutex> lock(mutex);
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  EXPECT_TRUE(waitFor(
+      [&] {
+        aggregator.publishData();
+        ros::Duration(0.5).sleep();
+        return has("/Robot 1/base") && has("/Robot 2/base") && has("/Robot 1/servo_bus") &&
+               has("/Robot 2/body");
+      },
+      60.0));
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const std::string& name : names) {
+    EXPECT_FALSE(name.rfind("/Other/", 0) == 0 && name.find("driver_node") != std::string::npos)
+        << name << " is in no robot's group";
+  }
 }
 
 TEST(Fleet, CmdVelAndEStopStayWithTheirRobot) {
