@@ -76,7 +76,7 @@ target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)
 
 # sim.launch + description.launch: every link of the description on tf, wheel_states against odom.
-find_package(urdf REQUIRED)
+# (urdf: found in unit_tests.cmake, included first.)
 add_rostest_gtest(test_description test/rostest/description.test test/rostest/test_description.cpp)
 target_include_directories(test_description PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS})
 target_link_libraries(test_description srd_test_support ${urdf_LIBRARIES} ${catkin_LIBRARIES})
