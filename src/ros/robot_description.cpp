@@ -336,7 +336,7 @@ std::string makeRobotDescription(const DriverParams& params, const ServoBusJoint
     std::ostringstream limit;
     limit << "    <axis xyz=\"0 1 0\"/>\n    <limit lower=\"" << numbers({servo.lower})
           << "\" upper=\"" << numbers({servo.upper}) << "\" velocity=\"" << numbers({servo.velocity})
-          << "\" effort=\"1.0\"/>\n";  // effort: the servos report none; 1 N m as a placeholder
+          << "\" effort=\"1.0\"/>\n";  // URDF requires an effort; nothing here enforces it
     urdf.joint(servo.name, servo.key, "revolute", base_link, link,
                numbers({chassis_length / 4.0, y, chassis_top}), "0 0 0", limit.str());
   }

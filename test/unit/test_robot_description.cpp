@@ -140,7 +140,7 @@ TEST(RobotDescription, BadFilesAreRefusedNamingTheParameter) {
   };
   EXPECT_NE(refusal("base: {wheel_diameter: -0.1}\n").find("base/wheel_diameter"), std::string::npos);
   EXPECT_NE(refusal("base: {wheel_diameter: wide}\n").find("base/wheel_diameter"), std::string::npos);
-  EXPECT_NE(refusal("body: {encoder: 1}\nservo_bus: {joint_ids: [5], joint_names: [joint_1]}\n")
+  EXPECT_NE(refusal("servo_bus: {joint_ids: [5], joint_names: [joint_1]}\n")
                 .find("servo_bus/joint_names"),
             std::string::npos)
       << "a bus joint named like a body joint";
