@@ -24,3 +24,7 @@ catkin_add_gtest(ros_layer_tests
   test/unit/test_bag_replay.cpp)
 target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(ros_layer_tests srd_ros gtest_main)
+
+# The IMU's heading fused into odometry (~base/use_imu_heading), ROS-free.
+catkin_add_gtest(heading_fusion_tests test/unit/test_heading_fusion.cpp)
+target_link_libraries(heading_fusion_tests srd_core gtest_main)

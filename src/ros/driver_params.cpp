@@ -162,6 +162,7 @@ std::vector<ParamSpec> buildTable() {
       row("base/publish_tf", &P::base, &Base::publish_tf),
       row("base/left_wheel_direction", &P::base, &Base::left_wheel_direction, direction),
       row("base/right_wheel_direction", &P::base, &Base::right_wheel_direction, direction),
+      row("base/use_imu_heading", &P::base, &Base::use_imu_heading),
 
       row("body/enabled", &P::body, &Port::enabled),
       row("body/port", &P::body, &Port::port),
@@ -358,6 +359,12 @@ void DriverParams::validate() const {
                 std::to_string(base.battery_warn_percent) + ")");
     require(base.odom_frame != base.base_frame, "base/base_frame",
             "must differ from base/odom_frame ('" + base.odom_frame + "')");
+    if (base.use_imu_heading) {
+      require(body.enabled, "base/use_imu_heading",
+              "needs the servo controller board's IMU, but body/enabled is false");
+      require(imu.orientation_variance >= 0, "base/use_imu_heading",
+              "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
+    }
   }
   if (body.enabled) {
     const std::size_t n = body.servo_ids.size();

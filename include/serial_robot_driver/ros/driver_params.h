@@ -51,6 +51,8 @@ struct BaseParams : DevicePortParams {
   bool publish_tf = true;
   int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
   int right_wheel_direction = 1;
+  /// odom's heading from the body's IMU while its telemetry is fresh (device::BaseConfig).
+  bool use_imu_heading = false;
 };
 
 struct BodyParams : DevicePortParams {
