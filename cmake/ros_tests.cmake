@@ -74,3 +74,10 @@ add_rostest_gtest(test_odom test/rostest/odom.test test/rostest/test_odom.cpp)
 target_include_directories(test_odom PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# ~base/use_imu_heading end to end: odom's yaw against simulated robots whose base slips while
+# turning (sim::RobotSim in-process), with and without the IMU, and without telemetry.
+add_rostest_gtest(test_imu_heading test/rostest/imu_heading.test test/rostest/test_imu_heading.cpp)
+target_include_directories(test_imu_heading PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_imu_heading srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_imu_heading driver_node ${PROJECT_NAME}_generate_messages_cpp)
