@@ -339,7 +339,8 @@ OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const
   sample.position_variance = odometry_.positionVariance();
   sample.yaw_variance = odometry_.yawVariance();
   sample.travelled = odometry_.travelled();
-  sample.imu_heading = config_.use_imu_heading && heading_.source() == kinematics::HeadingSource::kImu;
+  sample.imu_heading =
+      config_.use_imu_heading && heading_.source() == kinematics::HeadingSource::kImu;
   return sample;
 }
 

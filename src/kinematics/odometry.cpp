@@ -61,7 +61,8 @@ double Odometry::positionVariance() const {
 }
 
 double Odometry::yawVariance() const {
-  return yaw_variance_origin_ + model_.yaw_variance_per_meter * (travelled_ - yaw_travelled_origin_);
+  return yaw_variance_origin_ +
+         model_.yaw_variance_per_meter * (travelled_ - yaw_travelled_origin_);
 }
 
 }  // namespace serial_robot_driver::kinematics

@@ -87,9 +87,10 @@ device::BaseEvents BaseInterface::events() {
     if (source == kinematics::HeadingSource::kImu) {
       ROS_INFO("odom heading: following the IMU's yaw (base/use_imu_heading)");
     } else if (source == kinematics::HeadingSource::kImuStale) {
-      ROS_WARN("odom heading: no IMU yaw for %.2f s (is the body's telemetry flowing?); integrating "
-               "the commanded turn from the last fused heading until it returns",
-               std::chrono::duration<double>(kinematics::kImuHeadingStaleAfter).count());
+      ROS_WARN(
+          "odom heading: no IMU yaw for %.2f s (is the body's telemetry flowing?); integrating "
+          "the commanded turn from the last fused heading until it returns",
+          std::chrono::duration<double>(kinematics::kImuHeadingStaleAfter).count());
     }
   };
   events.on_unknown_reply = [](const protocol::base::Frame& frame) {

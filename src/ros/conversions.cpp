@@ -108,8 +108,9 @@ namespace {
 Eigen::Quaterniond imuOrientation(const body::Telemetry& telemetry, double angle_scale,
                                   const Eigen::Matrix3d& map) {
   const auto& raw = telemetry.imu;
-  const geometry_msgs::Quaternion sensor = quaternionFromRollPitchYaw(
-      raw[body::kRoll] * angle_scale, raw[body::kPitch] * angle_scale, raw[body::kYaw] * angle_scale);
+  const geometry_msgs::Quaternion sensor =
+      quaternionFromRollPitchYaw(raw[body::kRoll] * angle_scale, raw[body::kPitch] * angle_scale,
+                                 raw[body::kYaw] * angle_scale);
   return Eigen::Quaterniond(sensor.w, sensor.x, sensor.y, sensor.z) *
          Eigen::Quaterniond(map.transpose());
 }
@@ -119,7 +120,8 @@ double imuYaw(const body::Telemetry& telemetry, const ImuParams& params) {
   const Eigen::Quaterniond q =
       imuOrientation(telemetry, params.angle_scale, axisMapMatrix(params.axis_map));
   // The Z (yaw) angle of a Z-Y-X decomposition.
-  return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()), 1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+  return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()),
+                    1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
 }
 
 sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params,

@@ -147,7 +147,8 @@ DriverNode::~DriverNode() { shutdown(); }
 void DriverNode::connectImuHeading() {
   // ~base/use_imu_heading (validate() made sure the body is enabled): the body's reader thread
   // hands each frame's IMU yaw straight to the base controller, which only stores it (see
-  // kinematics::HeadingFusion). Both interfaces live in devices_, which outlives the links' threads.
+  // kinematics::HeadingFusion). Both interfaces live in devices_, which outlives the links'
+  // threads.
   BaseInterface* base = nullptr;
   BodyInterface* body = nullptr;
   for (auto& device : devices_) {

@@ -362,8 +362,9 @@ void DriverParams::validate() const {
     if (base.use_imu_heading) {
       require(body.enabled, "base/use_imu_heading",
               "needs the servo controller board's IMU, but body/enabled is false");
-      require(imu.orientation_variance >= 0, "base/use_imu_heading",
-              "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
+      require(
+          imu.orientation_variance >= 0, "base/use_imu_heading",
+          "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
     }
   }
   if (body.enabled) {

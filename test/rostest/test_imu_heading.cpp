@@ -166,8 +166,8 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   // Position: integrated along the IMU's heading, the fused pose stays near the true one; the
   // commanded pose curves off with the heading it believes.
   const auto fused_pose = fused_->odom.last()->pose;
-  const double fused_position_error = positionError(fused_start, fused_->robot->stats().base,
-                                                    fused_pose.pose.position);
+  const double fused_position_error =
+      positionError(fused_start, fused_->robot->stats().base, fused_pose.pose.position);
   const double commanded_position_error =
       positionError(commanded_start, commanded_->robot->stats().base,
                     commanded_->odom.last()->pose.pose.position);

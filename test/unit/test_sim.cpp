@@ -282,8 +282,7 @@ TEST(RobotSimBodyDevice, ImuReportsTheChassisHeadingAndYawRate) {
   out.clear();
   body.tick(t0 + milliseconds(40), ChassisMotion{4.0, 0.0}, &out);
   ASSERT_EQ(out.size(), 1u);
-  const auto wrapped =
-      protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+  const auto wrapped = protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
   ASSERT_TRUE(wrapped.ok());
   EXPECT_EQ(wrapped->imu[protocol::body::kYaw], -23814);  // -2.2832 rad * 32768 / pi
 }

@@ -160,7 +160,8 @@ class BaseController : public LinkListener {
   /// Engaged: a zero-speed frame goes out at once (no ramp) and zero is held; frames keep flowing.
   /// Released: the wheels stay still until the next cmd_vel.
   void setEStop(bool engaged);
-  /// Puts the odometry pose (and its covariance) back to zero; a fused heading restarts at zero too.
+  /// Puts the odometry pose (and its covariance) back to zero; a fused heading restarts at zero
+  /// too.
   void resetOdometry();
   /// Any thread (the body port's reader): the yaw (rad) of the IMU on the base, measured at
   /// `stamp`. Used only with use_imu_heading.

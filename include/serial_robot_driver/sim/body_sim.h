@@ -53,7 +53,7 @@ struct BodySimStats {
   uint64_t sync_writes_ok = 0;
   uint64_t sync_writes_malformed = 0;   ///< verified CRC but a layout decodeSyncWrite rejected
   uint64_t sync_write_unknown_ids = 0;  ///< targets for ids the board does not have
-  double yaw_rad = 0.0;  ///< the heading the IMU reports (the chassis')
+  double yaw_rad = 0.0;                 ///< the heading the IMU reports (the chassis')
   std::vector<BodySimServoState> servos;
 };
 
