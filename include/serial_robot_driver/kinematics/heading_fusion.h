@@ -7,9 +7,10 @@
 // keeps the heading from jumping when the IMU comes or goes. Without a fresh sample the caller
 // integrates the commanded turn on from the last fused heading.
 //
-// Threading: addSample() runs on the body port's reader thread, everything else on the base loop's
-// thread (under the base controller's lock). The newest sample is handed over under sample_mutex_,
-// held only to copy two values, so the reader never waits on the base loop or its port writes.
+// Threading: addSample() runs on the body port's reader thread; everything else is called by the
+// base controller with its own lock held (from the 50 Hz loop, the reset service, stats()). The
+// newest sample is handed over under sample_mutex_, held only to copy two values, so the reader
+// never waits on the base loop or its port writes.
 #pragma once
 
 #include <chrono>
@@ -43,12 +44,12 @@ class HeadingFusion {
   /// older than the stored one is ignored.
   void addSample(double imu_yaw, SteadyClock::time_point stamp);
 
-  /// Loop thread: the heading odometry has at `now` (wrapped to [-pi, pi]), or nullopt when no
+  /// The heading odometry has at `now` (wrapped to [-pi, pi]), or nullopt when no
   /// fresh IMU sample exists and the caller integrates the commanded turn instead. `odom_yaw` is
   /// odometry's heading before this step: a (re)anchor makes it the fused heading's start.
   std::optional<double> heading(SteadyClock::time_point now, double odom_yaw);
 
-  /// Loop thread: odometry was reset. The next heading() re-anchors, so the fused heading starts
+  /// Odometry was reset. The next heading() re-anchors, so the fused heading starts
   /// from the reset heading (the IMU's yaw now counts as zero).
   void restart() { anchored_ = false; }
 
@@ -68,7 +69,7 @@ class HeadingFusion {
   const SteadyClock::duration stale_after_;
   mutable std::mutex sample_mutex_;  // guards newest_ only
   std::optional<Sample> newest_;
-  // Loop thread only.
+  // Guarded by the caller (the base controller's lock).
   bool anchored_ = false;
   double offset_ = 0;  ///< IMU yaw minus odometry heading at the anchor
   HeadingSource source_ = HeadingSource::kWaitingForImu;
