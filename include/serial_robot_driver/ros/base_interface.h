@@ -34,6 +34,8 @@ class BaseInterface : public DeviceInterface {
   /// Stops the loop and writes a zero-speed frame (before the port closes).
   void shutdown() override { controller_.stop(); }
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
+  void onImuYaw(double yaw, device::Clock::time_point stamp) { controller_.onImuYaw(yaw, stamp); }
 
  private:
   device::BaseEvents events();
