@@ -24,3 +24,9 @@ catkin_add_gtest(ros_layer_tests
   test/unit/test_bag_replay.cpp)
 target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(ros_layer_tests srd_ros gtest_main)
+
+# follow_joint_trajectory keeps control_msgs' md5 sums.
+catkin_add_gtest(trajectory_action_definition_tests test/unit/test_trajectory_action_definition.cpp)
+target_include_directories(trajectory_action_definition_tests PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(trajectory_action_definition_tests ${catkin_LIBRARIES} gtest_main)
+add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_messages_cpp)
