@@ -30,3 +30,7 @@ catkin_add_gtest(trajectory_action_definition_tests test/unit/test_trajectory_ac
 target_include_directories(trajectory_action_definition_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(trajectory_action_definition_tests ${catkin_LIBRARIES} gtest_main)
 add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_messages_cpp)
+
+# The ROS-free trajectory core: interpolation, replacement, goal validation, tolerances.
+catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp)
+target_link_libraries(trajectory_tests srd_core gtest_main)

@@ -61,8 +61,10 @@ JointSample Segment::evaluate(double t) const {
 }
 
 JointSample Segment::sample(double time) const {
-  if (time <= start_time_) return atRest(evaluate(0.0));
-  if (time >= end_time_) return atRest(evaluate(end_time_ - start_time_));
+  // At its very ends the polynomial still holds (with its boundary velocity), so a spline sampled
+  // where one segment hands over to the next sees no step in velocity.
+  if (time < start_time_) return atRest(evaluate(0.0));
+  if (time > end_time_) return atRest(evaluate(end_time_ - start_time_));
   return evaluate(time - start_time_);
 }
 
@@ -101,6 +103,13 @@ void JointSpline::splice(double from, const std::vector<Waypoint>& waypoints) {
     segments_.emplace_back(a.time, a.sample, b.time, b.sample, lesser(a.order, b.order));
   }
   hold_ = atRest(waypoints.back().sample);
+}
+
+void JointSpline::prune(double time) {
+  auto first_kept = std::find_if(segments_.begin(), segments_.end(),
+                                 [&](const Segment& s) { return s.endTime() >= time; });
+  if (first_kept == segments_.end() && !segments_.empty()) hold_ = atRest(segments_.back().sample(time));
+  segments_.erase(segments_.begin(), first_kept);
 }
 
 }  // namespace serial_robot_driver::trajectory

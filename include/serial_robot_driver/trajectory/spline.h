@@ -62,6 +62,8 @@ class JointSpline {
   /// `waypoints` must be in increasing time, none before `from` (a waypoint at `from` is a zero
   /// length bridge: the joint goes there at once). Empty `waypoints`: hold the state at `from`.
   void splice(double from, const std::vector<Waypoint>& waypoints);
+  /// Forgets segments that ended before `time` (sampling at or after `time` is unchanged).
+  void prune(double time);
 
  private:
   JointSample hold_;
