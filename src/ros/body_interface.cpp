@@ -8,6 +8,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/trajectory_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -34,11 +35,17 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   // tcpNoDelay: a joint command must not wait in Nagle's buffer.
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());
+  trajectory_ = std::make_unique<TrajectoryServer>(nh, params, bodyTrajectoryJoints(controller_));
   link.addListener(&controller_);
   diagnostics.add("body", this, &BodyInterface::diagnose);
 }
 
-void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
+void BodyInterface::start() { trajectory_->start(); }
+
+void BodyInterface::shutdown() {
+  joint_commands_sub_.shutdown();
+  trajectory_->shutdown();
+}
 
 void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
                                      device::Clock::time_point arrival) {
@@ -47,11 +54,14 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   telemetry_rate_.tick();
   const ros::Time stamp = arrival_stamps_(arrival);
   const auto& joints = controller_.joints();
+  // The trajectory server needs every frame: its goals are checked against it.
+  const auto joint_state =
+      boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
+  trajectory_->updateActual(*joint_state);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
   // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(
-        boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp)));
+    joint_states_pub_.publish(joint_state);
   }
   if (imu_pub_.getNumSubscribers() > 0) {
     imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, imu_params_, stamp)));
@@ -66,8 +76,12 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
 
 void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
   const JointCommand command = fromJointState(*msg);
-  const device::JointCommandResult result =
-      controller_.sendJointCommand(command.names, command.positions);
+  device::JointCommandResult result;
+  // A joint under a trajectory is taken over by this command, and its goal aborted.
+  trajectory_->takeOver(command.names, "joint_commands", [&] {
+    result = controller_.sendJointCommand(command.names, command.positions);
+    return result.ok();
+  });
   if (!result.ok() || !result.out_of_range.empty()) {
     ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
   }

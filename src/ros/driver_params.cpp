@@ -254,6 +254,15 @@ std::vector<ParamSpec> buildTable() {
           [](const int& v, const std::string& key) {
             require(v >= 0 && v <= 65535, key, "must be 0..65535 ms");
           }),
+      // Trajectory defaults (follow_joint_trajectory, joint_trajectory).
+      row("trajectory/goal_tolerance", &P::trajectory, &TrajectoryParams::goal_tolerance,
+          nonNegative<double>),
+      row("trajectory/goal_time_tolerance", &P::trajectory,
+          &TrajectoryParams::goal_time_tolerance, nonNegative<double>),
+      row("trajectory/path_tolerance", &P::trajectory, &TrajectoryParams::path_tolerance,
+          nonNegative<double>),
+      row("trajectory/max_velocity", &P::trajectory, &TrajectoryParams::max_velocity,
+          nonNegative<double>),
   };
 }
 

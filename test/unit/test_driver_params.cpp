@@ -258,5 +258,26 @@ TEST(ParameterTable, WrongTypeNamesTheParameter) {
   }
 }
 
+TEST(DriverParams, TrajectoryDefaultsMustNotBeNegative) {
+  const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
+      {"trajectory/goal_tolerance", [](DriverParams& p) { p.trajectory.goal_tolerance = -0.1; }},
+      {"trajectory/goal_time_tolerance",
+       [](DriverParams& p) { p.trajectory.goal_time_tolerance = -1; }},
+      {"trajectory/path_tolerance", [](DriverParams& p) { p.trajectory.path_tolerance = -1; }},
+      {"trajectory/max_velocity", [](DriverParams& p) { p.trajectory.max_velocity = -2; }},
+  };
+  for (const auto& [key, spoil] : cases) {
+    DriverParams params;
+    spoil(params);
+    try {
+      params.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), key);
+    }
+  }
+  EXPECT_NO_THROW(DriverParams().validate());
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::ros_layer

@@ -14,6 +14,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -24,13 +25,15 @@ class BodyInterface : public DeviceInterface {
   BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
                 diagnostic_updater::Updater& diagnostics);
 
-  /// Nothing to start: the body speaks when the link's reader hands it a frame.
-  void start() override {}
+  /// The body speaks when the link's reader hands it a frame; only the trajectory server starts.
+  void start() override;
   /// Stops taking joint commands. Frames that still arrive before the link stops are published.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
 
   const device::BodyController& controller() const { return controller_; }
+  /// The e-stop's hook: trajectory goals abort, joints hold.
+  TrajectoryServer& trajectories() { return *trajectory_; }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -52,6 +55,8 @@ class BodyInterface : public DeviceInterface {
   ros::Publisher foot_pressure_pub_;
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
+  // follow_joint_trajectory / joint_trajectory for the body's joints (its own threading comment).
+  std::unique_ptr<TrajectoryServer> trajectory_;
   // Diagnostics timer thread only.
   uint64_t frames_at_last_diagnose_ = 0;
   bool telemetry_stop_logged_ = false;

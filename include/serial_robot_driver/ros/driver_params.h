@@ -95,6 +95,14 @@ struct ServoBusParams : DevicePortParams {
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
 };
 
+/// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override them).
+struct TrajectoryParams {
+  double goal_tolerance = 0.05;      ///< rad, per joint
+  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
+  double path_tolerance = 0.0;       ///< rad; 0: not checked
+  double max_velocity = 0.0;         ///< rad/s per joint; a faster trajectory is refused; 0: no limit
+};
+
 /// Below this loop rate the base's 1 s heartbeat is at risk (validate() says so).
 constexpr double kMinBaseLoopRate = 5.0;
 
@@ -110,6 +118,7 @@ struct DriverParams {
   BodyParams body;
   ImuParams imu;
   ServoBusParams servo_bus;
+  TrajectoryParams trajectory;
 
   /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
   void validate() const;
