@@ -74,3 +74,10 @@ add_rostest_gtest(test_odom test/rostest/odom.test test/rostest/test_odom.cpp)
 target_include_directories(test_odom PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# follow_joint_trajectory (every result code, cancel, preemption, take-over, telemetry lost) and
+# joint_trajectory against the simulated body (sim::RobotSim in-process).
+add_rostest_gtest(test_trajectory test/rostest/trajectory.test test/rostest/test_trajectory.cpp)
+target_include_directories(test_trajectory PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_trajectory srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_trajectory driver_node ${PROJECT_NAME}_generate_messages_cpp)

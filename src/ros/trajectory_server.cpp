@@ -331,6 +331,7 @@ bool TrajectoryServer::superviseGoal(ActiveGoal& goal, double now,
         "they follow";
     static_assert(kTelemetryTimeout == 0.5, "the message says 0.5 s");
     ROS_WARN("follow_joint_trajectory: %s", message.c_str());
+    hold(goal.joints, now);  // at the desired position: there is no measurement to stop at
     goal.handle.setAborted(result(Result::PATH_TOLERANCE_VIOLATED, message), message);
     return true;
   }
