@@ -176,6 +176,10 @@ ParamValue changed(const ParamValue& value) {
       v.push_back("changed");
       return v;
     }
+    ParamValue operator()(std::vector<double> v) const {
+      v.push_back(0.25);
+      return v;
+    }
   };
   return std::visit(Change{}, value);
 }
@@ -277,6 +281,39 @@ TEST(DriverParams, TrajectoryDefaultsMustNotBeNegative) {
     }
   }
   EXPECT_NO_THROW(DriverParams().validate());
+}
+
+TEST(DriverParams, BusJointsAreCheckedAndNamed) {
+  const auto withJoints = [] {
+    DriverParams p;
+    p.servo_bus.joint_ids = {3, 4};
+    p.servo_bus.joint_names = {"pan", "tilt"};
+    return p;
+  };
+  EXPECT_NO_THROW(withJoints().validate());
+  const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
+      {"servo_bus/joint_ids", [](DriverParams& p) { p.servo_bus.joint_ids = {3, 3}; }},
+      {"servo_bus/joint_ids", [](DriverParams& p) { p.servo_bus.joint_ids = {3, 255}; }},
+      {"servo_bus/joint_names", [](DriverParams& p) { p.servo_bus.joint_names = {"pan"}; }},
+      {"servo_bus/joint_names", [](DriverParams& p) { p.servo_bus.joint_names = {"pan", "pan"}; }},
+      {"servo_bus/joint_names",
+       [](DriverParams& p) { p.servo_bus.joint_names = {"pan", "joint_1"}; }},  // a body joint
+      {"servo_bus/joint_zero_deg", [](DriverParams& p) { p.servo_bus.joint_zero_deg = {0}; }},
+      {"servo_bus/joint_zero_deg",
+       [](DriverParams& p) { p.servo_bus.joint_zero_deg = {0, 200}; }},
+      {"servo_bus/joint_directions",
+       [](DriverParams& p) { p.servo_bus.joint_directions = {1, 0}; }},
+  };
+  for (const auto& [key, spoil] : cases) {
+    DriverParams params = withJoints();
+    spoil(params);
+    try {
+      params.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), key) << e.what();
+    }
+  }
 }
 
 }  // namespace
