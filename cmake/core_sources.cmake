@@ -17,6 +17,7 @@ set(SRD_CORE_SOURCES
   src/trajectory/spline.cpp
   src/trajectory/command.cpp
   src/trajectory/tolerances.cpp
+  src/trajectory/bus_joint.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

@@ -79,6 +79,15 @@ JointSample JointSpline::sample(double time) const {
   return std::prev(it)->sample(time);
 }
 
+std::optional<SegmentSpan> JointSpline::segmentAt(double time) const {
+  for (const Segment& segment : segments_) {
+    if (segment.startTime() <= time && time < segment.endTime()) {
+      return SegmentSpan{segment.startTime(), segment.endTime(), segment.sample(segment.endTime())};
+    }
+  }
+  return std::nullopt;
+}
+
 double JointSpline::endTime() const {
   return segments_.empty() ? -std::numeric_limits<double>::infinity() : segments_.back().endTime();
 }

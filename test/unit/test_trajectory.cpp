@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/command.h"
 #include "serial_robot_driver/trajectory/spline.h"
 #include "serial_robot_driver/trajectory/tolerances.h"
@@ -263,6 +264,34 @@ TEST(Tolerances, FirstViolationNamesJointAndAmount) {
   EXPECT_EQ(violation->joint, 1u);
   EXPECT_EQ(violation->message,
             "joint 'b': position error 0.2500 rad is beyond the path tolerance 0.1000 rad");
+}
+
+// --- bus servo joints -----------------------------------------------------------------------
+
+TEST(BusJoint, MapsJointRadiansToServoDegrees) {
+  const BusJoint joint{7, "pan", 30.0, -1};
+  EXPECT_NEAR(joint.toServoDegrees(M_PI / 2), 30.0 - 90.0, kEps);
+  EXPECT_NEAR(joint.toRadians(-60.0), M_PI / 2, kEps);
+  // -180 .. 180 deg of the servo: joint -150 deg .. 210 deg, flipped by the direction.
+  const JointRange range = joint.range();
+  EXPECT_NEAR(range.min_position, -150.0 * M_PI / 180.0, kEps);
+  EXPECT_NEAR(range.max_position, 210.0 * M_PI / 180.0, kEps);
+}
+
+TEST(BusJoint, EachSegmentIsOneMoveAtItsStart) {
+  JointSpline spline(0.0);
+  spline.splice(10.0, {point(11.0, 0.5), point(13.0, 1.5)});
+  EXPECT_FALSE(segmentMoveAt(spline, 9.0, NAN)) << "not started";
+  auto move = segmentMoveAt(spline, 10.02, NAN);
+  ASSERT_TRUE(move);
+  EXPECT_NEAR(move->position, 0.5, kEps);
+  EXPECT_NEAR(move->duration, 0.98, kEps);  // the time left to the segment's end
+  EXPECT_FALSE(segmentMoveAt(spline, 10.5, 10.0)) << "its move went out already";
+  move = segmentMoveAt(spline, 11.0, 10.0);
+  ASSERT_TRUE(move);
+  EXPECT_NEAR(move->position, 1.5, kEps);
+  EXPECT_NEAR(move->duration, 2.0, kEps);
+  EXPECT_FALSE(segmentMoveAt(spline, 13.0, 11.0)) << "over";
 }
 
 }  // namespace

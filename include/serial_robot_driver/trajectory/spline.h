@@ -4,6 +4,7 @@
 // whatever clock the caller samples with (the ROS layer uses ROS time).
 #pragma once
 
+#include <optional>
 #include <vector>
 
 namespace serial_robot_driver::trajectory {
@@ -44,6 +45,13 @@ class Segment {
   double coefficients_[6] = {0, 0, 0, 0, 0, 0};  ///< p(t) = sum c_i t^i, t from start_time_
 };
 
+/// Where a segment runs and where it ends.
+struct SegmentSpan {
+  double start_time = 0.0;
+  double end_time = 0.0;
+  JointSample end;
+};
+
 /// Segments back to back, or a position held when there are none.
 class JointSpline {
  public:
@@ -56,6 +64,8 @@ class JointSpline {
   /// The time of the last waypoint, or -infinity when only holding.
   double endTime() const;
   bool holding() const { return segments_.empty(); }
+  /// The segment that runs at `time` (start <= time < end); nothing when none does.
+  std::optional<SegmentSpan> segmentAt(double time) const;
 
   /// Replaces what follows `from` by a bridge from this spline's own state at `from` to the first
   /// waypoint, then the waypoints' segments: what already ran is kept, so there is no jump.
