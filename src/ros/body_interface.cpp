@@ -35,16 +35,14 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   // tcpNoDelay: a joint command must not wait in Nagle's buffer.
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());
-  trajectory_ = std::make_unique<TrajectoryServer>(nh, params, bodyTrajectoryJoints(controller_));
   link.addListener(&controller_);
   diagnostics.add("body", this, &BodyInterface::diagnose);
 }
 
-void BodyInterface::start() { trajectory_->start(); }
+void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
 
-void BodyInterface::shutdown() {
-  joint_commands_sub_.shutdown();
-  trajectory_->shutdown();
+std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
+  return {bodyTrajectoryJoints(controller_)};
 }
 
 void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -57,7 +55,7 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   // The trajectory server needs every frame: its goals are checked against it.
   const auto joint_state =
       boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
-  trajectory_->updateActual(*joint_state);
+  if (trajectory_) trajectory_->updateActual(*joint_state);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
   // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
@@ -77,11 +75,16 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
 void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
   const JointCommand command = fromJointState(*msg);
   device::JointCommandResult result;
-  // A joint under a trajectory is taken over by this command, and its goal aborted.
-  trajectory_->takeOver(command.names, "joint_commands", [&] {
+  const auto send = [&] {
     result = controller_.sendJointCommand(command.names, command.positions);
     return result.ok();
-  });
+  };
+  // A joint under a trajectory is taken over by this command, and its goal aborted.
+  if (trajectory_) {
+    trajectory_->takeOver(command.names, "joint_commands", send);
+  } else {
+    send();
+  }
   if (!result.ok() || !result.out_of_range.empty()) {
     ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
   }

@@ -1,15 +1,16 @@
 #include "serial_robot_driver/ros/trajectory_server.h"
 
+#include "serial_robot_driver/ros/device_interface.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+
+#include "serial_robot_driver/trajectory/bus_joint.h"
 
 namespace serial_robot_driver::ros_layer {
 
 namespace {
-
-/// A goal whose joints have not been measured for this long is aborted: the driver can no longer
-/// tell whether they follow.
-constexpr double kTelemetryTimeout = 0.5;  // s
 
 using trajectory::CommandError;
 using trajectory::JointSample;
@@ -43,6 +44,8 @@ bool overlaps(const std::vector<std::size_t>& a, const std::vector<std::size_t>&
 
 }  // namespace
 
+std::vector<TrajectoryJoints> DeviceInterface::trajectoryJoints() { return {}; }
+
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg) {
   trajectory::TrajectoryCommand command;
   command.joint_names = msg.joint_names;
@@ -54,16 +57,27 @@ trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTr
 }
 
 TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
-                                   TrajectoryJoints joints)
+                                   std::vector<TrajectoryJoints> groups)
     : defaults_(params.trajectory),
-      joints_(std::move(joints)),
+      groups_(std::move(groups)),
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),
-      actual_(joints_.joints.size()),
-      tracks_(joints_.joints.size()),
       action_server_(nh, "follow_joint_trajectory",
                      [this](GoalHandle handle) { onGoal(handle); },
-                     [this](GoalHandle handle) { onCancel(handle); }, false) {}
+                     [this](GoalHandle handle) { onCancel(handle); }, false) {
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    for (std::size_t local = 0; local < groups_[g].joints.size(); ++local) {
+      index_[groups_[g].joints[local].name] = ranges_.size();
+      ranges_.push_back(groups_[g].joints[local]);
+      Track track;
+      track.group = g;
+      track.local = local;
+      track.state_timeout = groups_[g].state_timeout;
+      tracks_.push_back(track);
+    }
+  }
+  actual_.resize(ranges_.size());
+}
 
 TrajectoryServer::~TrajectoryServer() { shutdown(); }
 
@@ -92,23 +106,34 @@ void TrajectoryServer::shutdown() {
 }
 
 void TrajectoryServer::updateActual(const sensor_msgs::JointState& state) {
+  const std::size_t count = std::min(state.name.size(), state.position.size());
+  const bool velocity_known = state.velocity.size() >= count;
+  const ros::Time stamp = state.header.stamp.isZero() ? ros::Time::now() : state.header.stamp;
   std::lock_guard<std::mutex> lock(actual_mutex_);
-  const std::size_t count = std::min(state.position.size(), actual_.size());
-  velocity_known_ = state.velocity.size() >= count;
-  // Telemetry lists the joints in the order TrajectoryJoints has them.
-  for (std::size_t j = 0; j < count; ++j) {
-    actual_[j].position = state.position[j];
-    actual_[j].velocity = velocity_known_ ? state.velocity[j] : 0.0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto joint = index_.find(state.name[i]);
+    if (joint == index_.end()) continue;
+    Measured& m = actual_[joint->second];
+    m.sample.position = state.position[i];
+    m.sample.velocity = velocity_known ? state.velocity[i] : 0.0;
+    m.velocity_known = velocity_known;
+    m.stamp = stamp;
   }
-  actual_stamp_ = state.header.stamp.isZero() ? ros::Time::now() : state.header.stamp;
 }
 
-bool TrajectoryServer::actualState(std::vector<JointSample>* actual, double now,
-                                   bool* velocity_known) const {
+std::vector<TrajectoryServer::Measured> TrajectoryServer::measured() const {
   std::lock_guard<std::mutex> lock(actual_mutex_);
-  *actual = actual_;
-  if (velocity_known) *velocity_known = velocity_known_;
-  return !actual_stamp_.isZero() && now - actual_stamp_.toSec() <= kTelemetryTimeout;
+  return actual_;
+}
+
+long TrajectoryServer::staleJoint(const std::vector<Measured>& measured,
+                                  const std::vector<std::size_t>& joints, double now) const {
+  for (std::size_t j : joints) {
+    if (measured[j].stamp.isZero() || now - measured[j].stamp.toSec() > tracks_[j].state_timeout) {
+      return static_cast<long>(j);
+    }
+  }
+  return -1;
 }
 
 TrajectoryServer::Result TrajectoryServer::result(int code, const std::string& message) {
@@ -121,13 +146,15 @@ TrajectoryServer::Result TrajectoryServer::result(int code, const std::string& m
 trajectory::CommandCheck TrajectoryServer::check(const trajectory::TrajectoryCommand& command,
                                                  double start, double now) {
   trajectory::CommandCheck result =
-      trajectory::validate(command, joints_.joints, defaults_.max_velocity, start - now);
+      trajectory::validate(command, ranges_, defaults_.max_velocity, start - now);
   if (!result.ok()) return result;
-  std::vector<JointSample> actual;
-  if (!actualState(&actual, now) && !command.points.empty()) {
+  const std::vector<Measured> actual = measured();
+  const long stale = staleJoint(actual, result.joint_indices, now);
+  if (stale >= 0 && !command.points.empty()) {
     result.error = CommandError::kInvalidGoal;
-    result.message = "no recent state of the joints (is telemetry arriving?): cannot start from "
-                     "where they are";
+    result.message = "joint '" + ranges_[stale].name +
+                     "': no recent measurement (is its telemetry or poll arriving?), so the "
+                     "trajectory cannot start from where it is";
     return result;
   }
   if (defaults_.max_velocity > 0.0) {
@@ -135,10 +162,9 @@ trajectory::CommandCheck TrajectoryServer::check(const trajectory::TrajectoryCom
     std::vector<double> current;
     for (std::size_t j : result.joint_indices) {
       current.push_back(tracks_[j].writing ? tracks_[j].spline.sample(now).position
-                                           : actual[j].position);
+                                           : actual[j].sample.position);
     }
-    result = trajectory::validate(command, joints_.joints, defaults_.max_velocity, start - now,
-                                  current);
+    result = trajectory::validate(command, ranges_, defaults_.max_velocity, start - now, current);
   }
   return result;
 }
@@ -161,24 +187,29 @@ void TrajectoryServer::endGoalsOn(const std::vector<std::size_t>& joints, bool p
 
 void TrajectoryServer::apply(const trajectory::TrajectoryCommand& command,
                              const std::vector<std::size_t>& joints, double start, double now) {
-  std::vector<JointSample> actual;
-  actualState(&actual, now);
+  const std::vector<Measured> actual = measured();
   for (std::size_t column = 0; column < joints.size(); ++column) {
     Track& track = tracks_[joints[column]];
     // A joint nobody drives starts from where it is; a driven one from where it is meant to be.
-    if (!track.writing) track.spline = trajectory::JointSpline(actual[joints[column]].position);
+    if (!track.writing) {
+      track.spline = trajectory::JointSpline(actual[joints[column]].sample.position);
+    }
     track.spline.splice(std::max(start, now), trajectory::waypointsFor(command, column, start, now));
     track.writing = true;
+    track.hold_pending = false;
+    track.sent_segment = -1.0;  // no segment starts before the epoch
   }
 }
 
 void TrajectoryServer::hold(const std::vector<std::size_t>& joints, double now) {
-  std::vector<JointSample> actual;
-  const bool measured = actualState(&actual, now);
+  const std::vector<Measured> actual = measured();
   for (std::size_t j : joints) {
-    const double position = measured ? actual[j].position : tracks_[j].spline.sample(now).position;
+    const std::vector<std::size_t> one{j};
+    const double position = staleJoint(actual, one, now) < 0 ? actual[j].sample.position
+                                                              : tracks_[j].spline.sample(now).position;
     tracks_[j].spline = trajectory::JointSpline(position);
     tracks_[j].writing = true;  // written once, then the servo keeps it
+    tracks_[j].hold_pending = true;
   }
 }
 
@@ -265,14 +296,13 @@ void TrajectoryServer::takeOver(const std::vector<std::string>& names, const std
   if (!write()) return;
   std::vector<std::size_t> taken;
   for (const std::string& name : names) {
-    for (std::size_t j = 0; j < joints_.joints.size(); ++j) {
-      if (joints_.joints[j].name != name || !tracks_[j].writing) continue;
-      tracks_[j].writing = false;
-      taken.push_back(j);
-    }
+    const auto joint = index_.find(name);
+    if (joint == index_.end() || !tracks_[joint->second].writing) continue;
+    tracks_[joint->second].writing = false;
+    taken.push_back(joint->second);
   }
   if (taken.empty()) return;
-  const std::string message = "joint '" + joints_.joints[taken.front()].name + "' taken over by " +
+  const std::string message = "joint '" + ranges_[taken.front()].name + "' taken over by " +
                               source + ": trajectory stopped";
   ROS_WARN("%s", message.c_str());
   endGoalsOn(taken, false, Result::INVALID_GOAL, message);
@@ -293,43 +323,60 @@ void TrajectoryServer::onTick(const ros::TimerEvent&) {
   const double now = ros::Time::now().toSec();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return;
-  std::vector<JointSample> actual;
-  bool velocity_known = false;
-  const bool actual_fresh = actualState(&actual, now, &velocity_known);
-
+  const std::vector<Measured> actual = measured();
   for (auto it = goals_.begin(); it != goals_.end();) {
-    const bool over = superviseGoal(*it, now, actual, actual_fresh, velocity_known);
-    it = over ? goals_.erase(it) : std::next(it);
+    it = superviseGoal(*it, now, actual) ? goals_.erase(it) : std::next(it);
   }
+  writeTracks(now);
+}
 
-  // One frame for every joint a trajectory drives; a joint whose spline has ended is written
-  // once more at its final position, then left to its servo.
-  std::vector<std::string> names;
-  std::vector<double> positions;
+void TrajectoryServer::writeTracks(double now) {
+  // Streamed groups: one frame for every joint a trajectory drives. Per-segment groups: a move at
+  // each segment's start. A joint whose spline has ended is written once more at its final
+  // position (streamed), then left to its servo.
+  std::vector<std::vector<std::string>> names(groups_.size());
+  std::vector<std::vector<double>> positions(groups_.size());
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
     Track& track = tracks_[j];
     if (!track.writing) continue;
-    names.push_back(joints_.joints[j].name);
-    positions.push_back(track.spline.sample(now).position);
+    const TrajectoryJoints& group = groups_[track.group];
+    if (group.move) {
+      std::string error;
+      if (track.hold_pending) {
+        error = group.move(track.local, track.spline.sample(now).position, 0.0);
+      } else if (const auto move = trajectory::segmentMoveAt(track.spline, now, track.sent_segment)) {
+        error = group.move(track.local, move->position, move->duration);
+        track.sent_segment = move->segment_start;
+      }
+      if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
+    } else {
+      names[track.group].push_back(ranges_[j].name);
+      positions[track.group].push_back(track.spline.sample(now).position);
+    }
+    track.hold_pending = false;
     const bool owned = std::any_of(goals_.begin(), goals_.end(), [&](const ActiveGoal& goal) {
       return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
     });
     if (!owned && now > track.spline.endTime()) track.writing = false;
     track.spline.prune(now);
   }
-  if (names.empty()) return;
-  const std::string error = joints_.write(names, positions);
-  if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    if (names[g].empty() || !groups_[g].write) continue;
+    const std::string error = groups_[g].write(names[g], positions[g]);
+    if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
+  }
 }
 
 bool TrajectoryServer::superviseGoal(ActiveGoal& goal, double now,
-                                     const std::vector<JointSample>& actual, bool actual_fresh,
-                                     bool velocity_known) {
-  if (!actual_fresh) {
-    const std::string message =
-        "telemetry lost: no state of the joints for more than 0.5 s, so nobody can tell whether "
-        "they follow";
-    static_assert(kTelemetryTimeout == 0.5, "the message says 0.5 s");
+                                     const std::vector<Measured>& actual) {
+  const long stale = staleJoint(actual, goal.joints, now);
+  if (stale >= 0) {
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "telemetry lost: no state of joint '%s' for more than %.1f s, so nobody can tell "
+                  "whether it follows",
+                  ranges_[stale].name.c_str(), tracks_[stale].state_timeout);
+    const std::string message = text;
     ROS_WARN("follow_joint_trajectory: %s", message.c_str());
     hold(goal.joints, now);  // at the desired position: there is no measurement to stop at
     goal.handle.setAborted(result(Result::PATH_TOLERANCE_VIOLATED, message), message);
@@ -342,10 +389,12 @@ bool TrajectoryServer::superviseGoal(ActiveGoal& goal, double now,
   const ros::Duration since_start(std::max(0.0, now - goal.start_time));
   feedback.desired.time_from_start = feedback.actual.time_from_start =
       feedback.error.time_from_start = since_start;
+  const bool velocity_known = std::all_of(goal.joints.begin(), goal.joints.end(),
+                                          [&](std::size_t j) { return actual[j].velocity_known; });
   for (std::size_t j : goal.joints) {
     const JointSample d = tracks_[j].spline.sample(now);
-    JointSample a = actual[j];
-    if (!velocity_known) a.velocity = d.velocity;  // unmeasured: never a violation
+    JointSample a = actual[j].sample;
+    if (!actual[j].velocity_known) a.velocity = d.velocity;  // unmeasured: never a violation
     desired.push_back(d);
     measured.push_back(a);
     feedback.desired.positions.push_back(d.position);

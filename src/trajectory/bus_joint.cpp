@@ -28,7 +28,7 @@ std::optional<SegmentMove> segmentMoveAt(const JointSpline& spline, double now,
                                          double already_sent) {
   const std::optional<SegmentSpan> span = spline.segmentAt(now);
   if (!span || span->start_time == already_sent) return std::nullopt;
-  return SegmentMove{span->end.position, span->end_time - now};
+  return SegmentMove{span->end.position, span->end_time - now, span->start_time};
 }
 
 }  // namespace serial_robot_driver::trajectory

@@ -25,15 +25,16 @@ class BodyInterface : public DeviceInterface {
   BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
                 diagnostic_updater::Updater& diagnostics);
 
-  /// The body speaks when the link's reader hands it a frame; only the trajectory server starts.
-  void start() override;
+  /// Nothing to start: the body speaks when the link's reader hands it a frame.
+  void start() override {}
   /// Stops taking joint commands. Frames that still arrive before the link stops are published.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
 
   const device::BodyController& controller() const { return controller_; }
-  /// The e-stop's hook: trajectory goals abort, joints hold.
-  TrajectoryServer& trajectories() { return *trajectory_; }
+  /// The body's joints, streamed: one sync-write frame per loop tick.
+  std::vector<TrajectoryJoints> trajectoryJoints() override;
+  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -55,8 +56,8 @@ class BodyInterface : public DeviceInterface {
   ros::Publisher foot_pressure_pub_;
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
-  // follow_joint_trajectory / joint_trajectory for the body's joints (its own threading comment).
-  std::unique_ptr<TrajectoryServer> trajectory_;
+  // The node's trajectory server (its own threading comment); set before the link starts.
+  TrajectoryServer* trajectory_ = nullptr;
   // Diagnostics timer thread only.
   uint64_t frames_at_last_diagnose_ = 0;
   bool telemetry_stop_logged_ = false;

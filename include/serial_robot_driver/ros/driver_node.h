@@ -38,6 +38,7 @@ namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface;
 class PortMonitor;
+class TrajectoryServer;
 class WireCapture;
 
 class DriverNode {
@@ -72,6 +73,9 @@ class DriverNode {
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
   std::map<std::string, Port> ports_;
+  /// follow_joint_trajectory / joint_trajectory over every device's joints; null when none has
+  /// any. Outlives the devices, which hold a pointer to it.
+  std::unique_ptr<TrajectoryServer> trajectory_;
   /// In start and shutdown order: base, body, servo bus.
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up

@@ -1,4 +1,4 @@
-// follow_joint_trajectory (action) and joint_trajectory (topic) for one device's joints, with the
+// follow_joint_trajectory (action) and joint_trajectory (topic) for the node's joints, with the
 // semantics of ros_control's joint_trajectory_controller: goals checked whole before anything
 // moves, one spline per joint sampled at the loop rate, path and goal tolerances, cancel holds the
 // joints where they are, a new goal or message for the same joints preempts from the current
@@ -6,9 +6,9 @@
 //
 // Threading: the goal, cancel and topic callbacks and the loop timer run on the node's global
 // callback queue and share the state below under mutex_. Callbacks only check and splice; the
-// timer writes one frame per tick (a short write, as joint_commands does). updateActual() is
-// called on the port's reader thread and only takes actual_mutex_, so a reader never waits for a
-// tick. takeOver() runs another command's write under mutex_ so no trajectory frame can follow it.
+// timer writes one frame per tick for streamed joints (a short write, as joint_commands does) and
+// hands segment moves to the bus's own queue. updateActual() is called on a port's reader thread
+// or the bus worker and only takes actual_mutex_, so neither ever waits for a tick. takeOver() runs another command's write under mutex_ so no trajectory frame can follow it.
 #pragma once
 
 #include <actionlib/server/action_server.h>
@@ -19,6 +19,7 @@
 #include <functional>
 #include <mutex>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
@@ -29,13 +30,19 @@
 
 namespace serial_robot_driver::ros_layer {
 
-/// What a device gives the trajectory server: its joints and how to set their positions.
+/// What a device gives the trajectory server: its joints and how to set their positions, either
+/// streamed (`write` every loop tick: the body) or one move per segment (`move`: bus servos).
 struct TrajectoryJoints {
   std::vector<trajectory::JointRange> joints;
+  /// A goal aborts when one of its joints has had no measurement for this long (s).
+  double state_timeout = 0.5;
   /// Writes one frame setting these joints (rad); returns an error text, empty when written.
   std::function<std::string(const std::vector<std::string>& names,
                             const std::vector<double>& positions)>
       write;
+  /// Instead of `write`: moves joint `index` (into `joints`) to `position` (rad) in `duration` s;
+  /// must not block (queue the frame). Returns an error text, empty when queued.
+  std::function<std::string(std::size_t index, double position, double duration)> move;
 };
 
 /// A ROS-free command from a JointTrajectory message (stamps are left to the caller).
@@ -48,15 +55,16 @@ class TrajectoryServer {
 
   /// Advertises follow_joint_trajectory and joint_trajectory in `nh`'s namespace (started by
   /// start()).
-  TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params, TrajectoryJoints joints);
+  TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
+                   std::vector<TrajectoryJoints> groups);
   ~TrajectoryServer();
 
   void start();
   /// Aborts every goal and stops the timer. Idempotent.
   void shutdown();
 
-  /// The measured state of the joints (names as in TrajectoryJoints; an empty velocity: unknown).
-  /// Any thread.
+  /// The measured state of some joints (names as in TrajectoryJoints; other names are ignored;
+  /// an empty velocity: unknown). Any thread.
   void updateActual(const sensor_msgs::JointState& state);
 
   /// Another command (`source`, e.g. "joint_commands") for `names`: runs `write` under the lock
@@ -70,8 +78,18 @@ class TrajectoryServer {
 
  private:
   struct Track {
+    std::size_t group = 0;  ///< index into groups_
+    std::size_t local = 0;  ///< index into that group's joints
+    double state_timeout = 0.5;
     trajectory::JointSpline spline;
     bool writing = false;  ///< the timer writes this joint (until its spline's end is written)
+    bool hold_pending = false;  ///< per-segment joints: the hold move is still to go out
+    double sent_segment = 0.0;  ///< per-segment joints: start of the segment whose move went out
+  };
+  struct Measured {
+    trajectory::JointSample sample;
+    bool velocity_known = false;
+    ros::Time stamp;  ///< zero: never measured
   };
   struct ActiveGoal {
     GoalHandle handle;
@@ -103,24 +121,26 @@ class TrajectoryServer {
              double start, double now);
   /// Holds `joints` where they are measured (desired where there is no measurement). mutex_ held.
   void hold(const std::vector<std::size_t>& joints, double now);
-  /// Measured state of every joint and whether it is fresh enough to run a goal on; whether the
-  /// velocities were measured in `velocity_known`.
-  bool actualState(std::vector<trajectory::JointSample>* actual, double now,
-                   bool* velocity_known = nullptr) const;
+  /// The latest measurement of every joint.
+  std::vector<Measured> measured() const;
+  /// The first of `joints` whose measurement is older than its timeout at `now`, or -1.
+  long staleJoint(const std::vector<Measured>& measured, const std::vector<std::size_t>& joints,
+                  double now) const;
+  /// Writes (streamed groups) or queues (per-segment groups) what the tracks ask for. mutex_ held.
+  void writeTracks(double now);
   /// Ends a goal when its tolerances say so; publishes its feedback otherwise. mutex_ held.
-  bool superviseGoal(ActiveGoal& goal, double now, const std::vector<trajectory::JointSample>& actual,
-                     bool actual_fresh, bool velocity_known);
+  bool superviseGoal(ActiveGoal& goal, double now, const std::vector<Measured>& measured);
   static Result result(int code, const std::string& message);
 
   const TrajectoryParams defaults_;
-  const TrajectoryJoints joints_;
+  const std::vector<TrajectoryJoints> groups_;
+  std::vector<trajectory::JointRange> ranges_;  ///< every joint, in track order
+  std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track
   const double loop_period_;
   ros::NodeHandle nh_;
 
-  mutable std::mutex actual_mutex_;  // guards the measurement below
-  std::vector<trajectory::JointSample> actual_;
-  bool velocity_known_ = false;
-  ros::Time actual_stamp_;  ///< zero: no measurement yet
+  mutable std::mutex actual_mutex_;  // guards the measurements below
+  std::vector<Measured> actual_;
 
   std::mutex mutex_;  // guards everything below
   std::vector<Track> tracks_;

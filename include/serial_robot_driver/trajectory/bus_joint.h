@@ -30,6 +30,7 @@ struct BusJoint {
 struct SegmentMove {
   double position = 0.0;
   double duration = 0.0;
+  double segment_start = 0.0;  ///< which segment it is (pass it back as `already_sent`)
 };
 
 /// The move a bus servo gets at `now` for the segment of `spline` that runs then: to the segment's
