@@ -41,6 +41,14 @@ double simJoint(std::size_t index) {
 }
 uint64_t syncWrites() { return g_robot->stats().body.sync_writes_ok; }
 
+/// The bus joint "pan": servo 2, zero at 30 deg, direction -1 (trajectory.test).
+double simPan() {
+  for (const auto& servo : g_robot->stats().servo_bus.servos) {
+    if (servo.id == 2) return -(servo.angle_deg - 30.0) * M_PI / 180.0;
+  }
+  return std::nan("");
+}
+
 trajectory_msgs::JointTrajectoryPoint point(std::vector<double> positions, double time) {
   trajectory_msgs::JointTrajectoryPoint p;
   p.positions = std::move(positions);
@@ -256,6 +264,33 @@ TEST_F(TrajectoryTest, JointCommandTakesOverAndAbortsTheGoal) {
   ASSERT_TRUE(waitFor([] { return std::abs(simJoint(1) + 0.3) < 0.01; }, 30));
 }
 
+TEST_F(TrajectoryTest, BusServoJointFollowsOneMovePerSegment) {
+  waitStill();
+  sensor_msgs::JointState pan_state;
+  test_support::TopicCounter<sensor_msgs::JointState> servo_states(nh_, "servo_states", 50);
+  ASSERT_TRUE(servo_states.waitForCount(3, 30)) << "no servo_states";
+  bool pan_named = false;
+  for (const auto& msg : servo_states.since(0)) pan_named |= !msg.name.empty() && msg.name[0] == "pan";
+  EXPECT_TRUE(pan_named) << "servo_states does not name servo 2 'pan'";
+
+  FollowJointTrajectoryGoal goal = goalTo({0.4}, 1.0, {"pan"});
+  goal.trajectory.points.push_back(point({-0.5}, 2.5));
+  EXPECT_EQ(run(goal, State::SUCCEEDED), FollowJointTrajectoryResult::SUCCESSFUL) << errorString();
+  EXPECT_NEAR(simPan(), -0.5, 0.02);
+
+  // One goal across a body joint and the bus joint.
+  EXPECT_EQ(run(goalTo({0.2, 0.3}, 1.5, {"joint_1", "pan"}), State::SUCCEEDED),
+            FollowJointTrajectoryResult::SUCCESSFUL)
+      << errorString();
+  EXPECT_NEAR(simJoint(0), 0.2, 0.05);
+  EXPECT_NEAR(simPan(), 0.3, 0.02);
+
+  // Beyond the servo's -180..180 deg: 30 deg - (-3.5 rad) is past 180 deg.
+  EXPECT_EQ(run(goalTo({-3.5}, 5.0, {"pan"}), State::REJECTED),
+            FollowJointTrajectoryResult::INVALID_GOAL);
+  EXPECT_NE(errorString().find("joint 'pan', point 0"), std::string::npos) << errorString();
+}
+
 // Last: it stops the simulator.
 TEST_F(TrajectoryTest, TelemetryLostAbortsTheGoal) {
   waitStill();
@@ -275,7 +310,7 @@ int main(int argc, char** argv) {
   sim::SimOptions options;
   options.link = test_support::nodeParam(kNode, "port");
   options.enable_base = false;
-  options.enable_servo_bus = false;
+  options.enable_servo_bus = true;
   auto robot = std::make_unique<sim::RobotSim>(options);
   robot->start();
   g_robot = robot.get();
