@@ -221,6 +221,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                   request.accel_ms = req.accel_ms;
                                   request.decel_ms = req.decel_ms;
                                   request.power_mw = req.power_mw;
+                                  yieldJoint(req.id, "servo/move");
                                   return client_.move(request);
                                 }),
       advertiseServo<ServoScan>(nh_, "servo/scan",
@@ -235,6 +236,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                     request.interval_ms = req.interval_ms;
                                     request.power_mw = req.power_mw;
                                     request.wait = req.wait;
+                                    yieldJoint(req.id, "servo/rotate");
                                     return client_.rotate(request);
                                   }),
       advertiseServo<ServoSpin>(nh_, "servo/spin",
@@ -246,10 +248,12 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                   request.speed_dps = req.speed_dps;
                                   request.value = req.value;
                                   request.wait = req.wait;
+                                  yieldJoint(req.id, "servo/spin");
                                   return client_.spin(request);
                                 }),
       advertiseServo<ServoDamping>(nh_, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
+                                     yieldJoint(req.id, "servo/damping");
                                      return client_.damping(req.id, req.power_mw, req.wait);
                                    }),
       advertiseServo<ServoReadAll>(nh_, "servo/read_all",
@@ -343,6 +347,19 @@ void ServoBusInterface::queueMoveLocked(const device::MoveRequest& move) {
     queued_moves_.push_back(move);
   }
   worker_cv_.notify_all();
+}
+
+void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
+  const trajectory::BusJoint* joint = findBusJoint(bus_joints_, id);
+  if (!trajectory_ || !joint) return;
+  trajectory_->takeOver({joint->name}, source, [&] {
+    // A trajectory move still queued must not follow the service's command.
+    std::lock_guard<std::mutex> lock(worker_mutex_);
+    queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
+                                       [id](const device::MoveRequest& m) { return m.id == id; }),
+                        queued_moves_.end());
+    return true;
+  });
 }
 
 std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
+#include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -284,6 +285,20 @@ TEST_F(TrajectoryTest, BusServoJointFollowsOneMovePerSegment) {
       << errorString();
   EXPECT_NEAR(simJoint(0), 0.2, 0.05);
   EXPECT_NEAR(simPan(), 0.3, 0.02);
+
+  // A motion service for the joint's servo takes it over: the goal aborts, saying by what.
+  client_.sendGoal(goalTo({-1.0}, 4.0, {"pan"}));
+  ASSERT_TRUE(waitFor([&] { return client_.getState() == State::ACTIVE; }, 30));
+  serial_robot_driver::ServoRotate rotate;
+  rotate.request.id = 2;
+  rotate.request.angle_deg = 0.0;
+  rotate.request.interval_ms = 200;
+  ASSERT_TRUE(ros::service::call("servo/rotate", rotate));
+  ASSERT_TRUE(client_.waitForResult(ros::Duration(30)));
+  EXPECT_EQ(client_.getState(), State::ABORTED);
+  EXPECT_NE(errorString().find("servo/rotate"), std::string::npos) << errorString();
+  ASSERT_TRUE(waitFor([] { return std::abs(simPan() - 30.0 * M_PI / 180.0) < 0.02; }, 30))
+      << "the trajectory went on after servo/rotate";
 
   // Beyond the servo's -180..180 deg: 30 deg - (-3.5 rad) is past 180 deg.
   EXPECT_EQ(run(goalTo({-3.5}, 5.0, {"pan"}), State::REJECTED),

@@ -94,6 +94,9 @@ class ServoBusInterface : public DeviceInterface {
   /// Queues a move for the worker; the latest target of a servo replaces a queued one.
   /// worker_mutex_ held.
   void queueMoveLocked(const device::MoveRequest& move);
+  /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
+  /// trajectory stops (its goal aborts) and its queued move is dropped.
+  void yieldJoint(uint8_t id, const char* source);
   void workerLoop();
   void pollOnce(PolledServo& servo);
 
