@@ -278,7 +278,8 @@ void TrajectoryServer::onTrajectory(const trajectory_msgs::JointTrajectory::Cons
   if (!running_) return;
   const trajectory::CommandCheck checked = check(command, start, now);
   if (!checked.ok()) {
-    ROS_WARN("joint_trajectory: message ignored, nothing moves: %s", checked.message.c_str());
+    ROS_WARN_THROTTLE(1.0, "joint_trajectory: message ignored, nothing moves: %s",
+                      checked.message.c_str());
     return;
   }
   endGoalsOn(checked.joint_indices, true, Result::SUCCESSFUL,
@@ -323,6 +324,10 @@ void TrajectoryServer::onTick(const ros::TimerEvent&) {
   const double now = ros::Time::now().toSec();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return;
+  // Idle (the usual case) costs one scan of the tracks.
+  const bool busy = !goals_.empty() || std::any_of(tracks_.begin(), tracks_.end(),
+                                                   [](const Track& t) { return t.writing; });
+  if (!busy) return;
   const std::vector<Measured> actual = measured();
   for (auto it = goals_.begin(); it != goals_.end();) {
     it = superviseGoal(*it, now, actual) ? goals_.erase(it) : std::next(it);
