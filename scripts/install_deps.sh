@@ -15,6 +15,8 @@ PACKAGES=(
   python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs
   libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev catkin-lint catkin-tools
+  libactionlib-dev libactionlib-msgs-dev libtrajectory-msgs-dev
+  python3-actionlib python3-actionlib-msgs python3-trajectory-msgs
 )
 # The robot description (robot_description, description.launch, view.launch) and its tests.
 PACKAGES+=(libyaml-cpp-dev liburdf-dev liburdfdom-tools ros-robot-state-publisher

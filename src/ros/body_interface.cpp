@@ -8,6 +8,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/trajectory_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -40,6 +41,10 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
 
 void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
 
+std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
+  return {bodyTrajectoryJoints(controller_)};
+}
+
 void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
                                      device::Clock::time_point arrival) {
   // Runs on the link's reader thread; ros::Publisher::publish is thread-safe. A message nobody
@@ -47,11 +52,14 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   telemetry_rate_.tick();
   const ros::Time stamp = arrival_stamps_(arrival);
   const auto& joints = controller_.joints();
+  // The trajectory server needs every frame: its goals are checked against it.
+  const auto joint_state =
+      boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
+  if (trajectory_) trajectory_->updateActual(*joint_state);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
   // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(
-        boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp)));
+    joint_states_pub_.publish(joint_state);
   }
   if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, imu_params_), arrival);
   if (imu_pub_.getNumSubscribers() > 0) {
@@ -67,8 +75,17 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
 
 void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
   const JointCommand command = fromJointState(*msg);
-  const device::JointCommandResult result =
-      controller_.sendJointCommand(command.names, command.positions);
+  device::JointCommandResult result;
+  const auto send = [&] {
+    result = controller_.sendJointCommand(command.names, command.positions);
+    return result.ok();
+  };
+  // A joint under a trajectory is taken over by this command, and its goal aborted.
+  if (trajectory_) {
+    trajectory_->takeOver(command.names, "joint_commands", send);
+  } else {
+    send();
+  }
   if (!result.ok() || !result.out_of_range.empty()) {
     ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
   }

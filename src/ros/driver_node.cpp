@@ -6,6 +6,7 @@
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
 #include "serial_robot_driver/ros/servo_bus_interface.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/ros/wire_capture.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -134,6 +135,17 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     if (entry.enabled) devices_.push_back(entry.make(nh_, params_, portFor(entry.port), diagnostics_));
   }
   if (params_.base.use_imu_heading) connectImuHeading();
+  // One trajectory server for the joints of every device, so one goal may span them.
+  std::vector<TrajectoryJoints> trajectory_joints;
+  for (auto& device : devices_) {
+    for (TrajectoryJoints& group : device->trajectoryJoints()) {
+      if (!group.joints.empty()) trajectory_joints.push_back(std::move(group));
+    }
+  }
+  if (!trajectory_joints.empty()) {
+    trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, std::move(trajectory_joints));
+    for (auto& device : devices_) device->attachTrajectories(trajectory_.get());
+  }
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
@@ -168,6 +180,7 @@ device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports
 void DriverNode::start() {
   for (auto& [path, port] : ports_) port.link->start();
   for (auto& device : devices_) device->start();
+  if (trajectory_) trajectory_->start();
   ROS_INFO("%s", startupSummary().c_str());
 }
 
@@ -200,6 +213,7 @@ void DriverNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   diagnostics_timer_.stop();
+  if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop
   // Base first: its zero-speed frame goes out while the port is still open.
   for (auto& device : devices_) device->shutdown();
   for (auto& [path, port] : ports_) port.link->stop();

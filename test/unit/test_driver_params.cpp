@@ -197,6 +197,10 @@ ParamValue changed(const ParamValue& value) {
       v.push_back("changed");
       return v;
     }
+    ParamValue operator()(std::vector<double> v) const {
+      v.push_back(0.25);
+      return v;
+    }
   };
   return std::visit(Change{}, value);
 }
@@ -334,6 +338,60 @@ TEST(DriverParamsFrames, BadPrefixOrFrameIsNamed) {
     FAIL() << "base/base_frame '/' passed";
   } catch (const ParameterError& e) {
     EXPECT_EQ(e.name(), "base/base_frame");
+  }
+}
+
+TEST(DriverParams, TrajectoryDefaultsMustNotBeNegative) {
+  const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
+      {"trajectory/goal_tolerance", [](DriverParams& p) { p.trajectory.goal_tolerance = -0.1; }},
+      {"trajectory/goal_time_tolerance",
+       [](DriverParams& p) { p.trajectory.goal_time_tolerance = -1; }},
+      {"trajectory/path_tolerance", [](DriverParams& p) { p.trajectory.path_tolerance = -1; }},
+      {"trajectory/max_velocity", [](DriverParams& p) { p.trajectory.max_velocity = -2; }},
+  };
+  for (const auto& [key, spoil] : cases) {
+    DriverParams params;
+    spoil(params);
+    try {
+      params.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), key);
+    }
+  }
+  EXPECT_NO_THROW(DriverParams().validate());
+}
+
+TEST(DriverParams, BusJointsAreCheckedAndNamed) {
+  const auto withJoints = [] {
+    DriverParams p;
+    p.servo_bus.joint_ids = {3, 4};
+    p.servo_bus.joint_names = {"pan", "tilt"};
+    return p;
+  };
+  EXPECT_NO_THROW(withJoints().validate());
+  const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
+      {"servo_bus/joint_ids", [](DriverParams& p) { p.servo_bus.joint_ids = {3, 3}; }},
+      {"servo_bus/joint_ids", [](DriverParams& p) { p.servo_bus.joint_ids = {3, 255}; }},
+      {"servo_bus/joint_names", [](DriverParams& p) { p.servo_bus.joint_names = {"pan"}; }},
+      {"servo_bus/joint_names", [](DriverParams& p) { p.servo_bus.joint_names = {"pan", "pan"}; }},
+      {"servo_bus/joint_names",
+       [](DriverParams& p) { p.servo_bus.joint_names = {"pan", "joint_1"}; }},  // a body joint
+      {"servo_bus/joint_zero_deg", [](DriverParams& p) { p.servo_bus.joint_zero_deg = {0}; }},
+      {"servo_bus/joint_zero_deg",
+       [](DriverParams& p) { p.servo_bus.joint_zero_deg = {0, 200}; }},
+      {"servo_bus/joint_directions",
+       [](DriverParams& p) { p.servo_bus.joint_directions = {1, 0}; }},
+  };
+  for (const auto& [key, spoil] : cases) {
+    DriverParams params = withJoints();
+    spoil(params);
+    try {
+      params.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), key) << e.what();
+    }
   }
 }
 

@@ -5,7 +5,12 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 
+#include <vector>
+
 namespace serial_robot_driver::ros_layer {
+
+class TrajectoryServer;
+struct TrajectoryJoints;
 
 class DeviceInterface {
  public:
@@ -16,6 +21,11 @@ class DeviceInterface {
   virtual void shutdown() = 0;
   /// Fills the device's diagnostic status (called from the diagnostics timer).
   virtual void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) = 0;
+  /// The joints trajectories may drive on this device (none by default).
+  virtual std::vector<TrajectoryJoints> trajectoryJoints();
+  /// The node's trajectory server, given before start() when trajectoryJoints() had joints: the
+  /// device reports their measurements to it and lets it know when another command takes them.
+  virtual void attachTrajectories(TrajectoryServer* /*server*/) {}
 };
 
 }  // namespace serial_robot_driver::ros_layer

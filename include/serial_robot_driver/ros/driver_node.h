@@ -8,6 +8,7 @@
 //        /diagnostics, serial_raw (serial_robot_driver/SerialChunk, with ~capture)
 // Services: base/reset, base/clear_encoders (std_srvs/Trigger); servo/ping, servo/read, servo/write,
 //   servo/read_angle, servo/rotate, servo/spin, servo/damping, servo/read_all, servo/reset_user_data.
+// Action: follow_joint_trajectory (control_msgs-compatible); topic joint_trajectory (in).
 // Parameters: see ros/driver_params.h and config/robot.yaml.
 //
 // Threading model:
@@ -18,6 +19,8 @@
 //    in main, or the nodelet manager's threads); servo/* services have their own queue and
 //    spinner because they wait on the bus;
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
+//  - trajectory goals, cancels, joint_trajectory and the trajectory timer (one sync-write per loop
+//    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once
 
 #include <map>
@@ -35,6 +38,7 @@ namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface;
 class PortMonitor;
+class TrajectoryServer;
 class WireCapture;
 
 class DriverNode {
@@ -71,6 +75,9 @@ class DriverNode {
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
   std::map<std::string, Port> ports_;
+  /// follow_joint_trajectory / joint_trajectory over every device's joints; null when none has
+  /// any. Outlives the devices, which hold a pointer to it.
+  std::unique_ptr<TrajectoryServer> trajectory_;
   /// In start and shutdown order: base, body, servo bus.
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
