@@ -60,7 +60,10 @@ class StaleParams : public testing::Test {
     const bool driving = odom.waitForCount(3, 90.0);
     EXPECT_TRUE(driving) << "no odom: the driver does not drive the base; roslaunch said:\n"
                          << (launch_ ? launch_->output() : "");
-    EXPECT_FALSE(ros::param::has(std::string(kNode) + "/replay_bag"));
+    // Absent, or the empty value of the launch's own parameter file: no replay.
+    std::string replay_bag;
+    ros::param::get(std::string(kNode) + "/replay_bag", replay_bag);
+    EXPECT_EQ(replay_bag, "");
     EXPECT_FALSE(ros::param::has(std::string(kNode) + "/left_over_by_a_bench_run"));
     bool base_enabled = false;
     EXPECT_TRUE(ros::param::get(std::string(kNode) + "/base/enabled", base_enabled));
@@ -87,6 +90,12 @@ TEST_F(StaleParams, DriverLaunchClearsThem) {
   startSimulator();
   roslaunch({"driver.launch", "port:=" + link_, "respawn:=false"});
   expectTheLaunchIgnoresTheLeftovers();
+  // A clean shutdown (the robot's end still there) closes the port; it does not lose it.
+  launch_->signal(SIGINT);
+  ASSERT_TRUE(launch_->waitExit(60.0).has_value());
+  const std::string output = launch_->output();
+  EXPECT_NE(output.find("shutting down"), std::string::npos) << output;
+  EXPECT_EQ(output.find("reopening"), std::string::npos) << output;
 }
 
 TEST_F(StaleParams, DriverLaunchInNodeletModeClearsThem) {

@@ -20,6 +20,7 @@
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <string>
@@ -73,7 +74,7 @@ class DriverNode {
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
-  bool shut_down_ = false;
+  std::atomic<bool> shut_down_{false};  // read by the ports' monitors on the reader threads
 };
 
 }  // namespace serial_robot_driver::ros_layer
