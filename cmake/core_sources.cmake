@@ -9,6 +9,7 @@ set(SRD_CORE_SOURCES
   src/kinematics/diff_drive.cpp
   src/kinematics/odometry.cpp
   src/transport/serial_port.cpp
+  src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp
   src/device/base_controller.cpp
