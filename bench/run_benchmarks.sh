@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs the driver_node benchmarks (bench/driver_bench.cpp): a private roscore, driver_node and
-# robot_sim over pseudo-terminals, about 3 minutes. Prints a table and writes it to
-# bench/results/latest.md (or $SRD_BENCH_OUTPUT).
+# robot_sim over pseudo-terminals, about 3 minutes; then the framer's (bench/bench_framer.cpp,
+# Google Benchmark, a few seconds). Prints the tables and writes them to bench/results/latest.md
+# (or $SRD_BENCH_OUTPUT).
 #
 # usage: bench/run_benchmarks.sh [--build] [--long] [driver_bench options, see --help]
 #   --build             build driver_bench (and driver_node, robot_sim, floor_node,
@@ -44,6 +45,9 @@ if [[ -n "${SRD_BENCH_WS:-}" ]]; then
     else
       (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DSRD_BUILD_BENCHMARKS=ON "${launcher[@]}" --make-args -j2 driver_bench)
     fi
+    # bench_framer exists only where Google Benchmark is installed (libbenchmark-dev).
+    (cd "${SRD_BENCH_WS}/build" && make -j2 bench_framer) ||
+      echo "run_benchmarks.sh: bench_framer not built (no Google Benchmark); its section is skipped" >&2
   fi
   load_workspace() {  # a function, so setup.bash does not see this script's arguments
     set +u  # ROS's setup scripts read unset variables
@@ -81,4 +85,19 @@ status=0
 wait "${bench_pid}" || status=$?
 # A signal interrupts the first wait; wait again for the cleanup to finish.
 if kill -0 "${bench_pid}" 2>/dev/null; then wait "${bench_pid}" || status=$?; fi
+# The framer's throughput (Google Benchmark), appended to the same file, when it is built.
+framer="$(dirname "${bench}")/bench_framer"
+if [[ "${status}" -eq 0 && -x "${framer}" ]]; then
+  framer_out=$(mktemp)
+  "${framer}" --benchmark_min_time=0.2 | tee "${framer_out}"
+  {
+    echo
+    echo "### Framer and decoders (bench_framer, Google Benchmark, 0.2 s per benchmark)"
+    echo
+    echo '```'
+    cat "${framer_out}"
+    echo '```'
+  } >> "${output}"
+  rm -f "${framer_out}"
+fi
 exit "${status}"

@@ -44,7 +44,11 @@ SteadyTime RecordedStream::now() const {
   const RecordedPort& port = *port_;
   if (port.pacing_->paced()) return port.pacing_->now();
   if (port.next_ < port.chunks_.size()) {
-    return port.pacing_->onTimeline(port.chunks_[port.next_].recorded);
+    const RecordedChunk& next = port.chunks_[port.next_];
+    // Before a recorded reopen the port was lost right after its last bytes (read() throws at
+    // once, as the live read did), not after a silence that a stale-frame timer could count.
+    if (next.data.empty() && arrival_) return *arrival_;
+    return port.pacing_->onTimeline(next.recorded);
   }
   return port.pacing_->end();
 }

@@ -111,7 +111,7 @@ class RecordedStream : public ByteStream {
   /// The chunk's recorded stamp on the replay's timeline.
   std::optional<SteadyTime> arrivalTime() const override { return arrival_; }
   /// The timeline's present; at rate 0, the next chunk's time (or the end), as if the recorded
-  /// silence before it had passed.
+  /// silence before it had passed (before a recorded reopen: the last chunk's time).
   SteadyTime now() const override;
 
  private:
