@@ -30,6 +30,7 @@ class StaleParams : public testing::Test {
  protected:
   void SetUp() override {
     ASSERT_TRUE(ros::param::get("~link", link_)) << "missing test parameter ~link";
+    ASSERT_TRUE(ros::param::get("~config", config_)) << "missing test parameter ~config";
     test_support::removeStaleLink(link_);
   }
 
@@ -53,21 +54,17 @@ class StaleParams : public testing::Test {
     ASSERT_TRUE(launch_->started());
   }
 
-  /// The leftovers are gone and the driver drives the base on the real (simulated) port.
+  /// The leftovers are gone (the launch's file sets none of them) and the driver drives the base on
+  /// the real (simulated) port.
   void expectTheLaunchIgnoresTheLeftovers() {
     ros::NodeHandle nh;
     test_support::TopicCounter<nav_msgs::Odometry> odom(nh, "/odom", 1);
     const bool driving = odom.waitForCount(3, 90.0);
     EXPECT_TRUE(driving) << "no odom: the driver does not drive the base; roslaunch said:\n"
                          << (launch_ ? launch_->output() : "");
-    // Absent, or the empty value of the launch's own parameter file: no replay.
-    std::string replay_bag;
-    ros::param::get(std::string(kNode) + "/replay_bag", replay_bag);
-    EXPECT_EQ(replay_bag, "");
+    EXPECT_FALSE(ros::param::has(std::string(kNode) + "/replay_bag"));
     EXPECT_FALSE(ros::param::has(std::string(kNode) + "/left_over_by_a_bench_run"));
-    bool base_enabled = false;
-    EXPECT_TRUE(ros::param::get(std::string(kNode) + "/base/enabled", base_enabled));
-    EXPECT_TRUE(base_enabled);
+    EXPECT_FALSE(ros::param::has(std::string(kNode) + "/base/enabled"));
     EXPECT_TRUE(launch_->running()) << launch_->output();
   }
 
@@ -81,6 +78,7 @@ class StaleParams : public testing::Test {
   }
 
   std::string link_;
+  std::string config_;  // sets neither replay_bag nor base/enabled: the leftovers would decide
   std::unique_ptr<test_support::ChildProcess> sim_;
   std::unique_ptr<test_support::ChildProcess> launch_;
 };
@@ -88,7 +86,7 @@ class StaleParams : public testing::Test {
 TEST_F(StaleParams, DriverLaunchClearsThem) {
   leaveStaleParameters();
   startSimulator();
-  roslaunch({"driver.launch", "port:=" + link_, "respawn:=false"});
+  roslaunch({"driver.launch", "config:=" + config_, "port:=" + link_, "respawn:=false"});
   expectTheLaunchIgnoresTheLeftovers();
   // A clean shutdown (the robot's end still there) closes the port; it does not lose it.
   launch_->signal(SIGINT);
@@ -101,13 +99,14 @@ TEST_F(StaleParams, DriverLaunchClearsThem) {
 TEST_F(StaleParams, DriverLaunchInNodeletModeClearsThem) {
   leaveStaleParameters();
   startSimulator();
-  roslaunch({"driver.launch", "port:=" + link_, "respawn:=false", "nodelet:=true"});
+  roslaunch({"driver.launch", "config:=" + config_, "port:=" + link_, "respawn:=false",
+             "nodelet:=true"});
   expectTheLaunchIgnoresTheLeftovers();
 }
 
 TEST_F(StaleParams, SimLaunchClearsThem) {
   leaveStaleParameters();
-  roslaunch({"sim.launch", "link:=" + link_});
+  roslaunch({"sim.launch", "config:=" + config_, "link:=" + link_});
   expectTheLaunchIgnoresTheLeftovers();
 }
 
