@@ -10,6 +10,7 @@ set(SRD_CORE_SOURCES
   src/kinematics/odometry.cpp
   src/kinematics/heading_fusion.cpp
   src/transport/serial_port.cpp
+  src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp
   src/device/base_controller.cpp

@@ -102,3 +102,10 @@ add_rostest_gtest(test_trajectory test/rostest/trajectory.test test/rostest/test
 target_include_directories(test_trajectory PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_trajectory srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_trajectory driver_node ${PROJECT_NAME}_generate_messages_cpp)
+# Parameters an earlier launch left on the master (a ~replay_bag, a disabled device) do not steer
+# driver.launch (node and nodelet) or sim.launch: each clears its private namespace first.
+add_rostest_gtest(test_stale_params test/rostest/stale_params.test
+  test/rostest/test_stale_params.cpp)
+target_include_directories(test_stale_params PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_stale_params srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_stale_params driver_node robot_sim srd_nodelet)

@@ -115,9 +115,11 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
                         "port " + link_.options().path + " not connected");
   } else if (stats.frames_decoded == 0) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "no telemetry received yet");
+    // ERROR, as the frequency check's "No events recorded." already is: a board streaming
+    // nothing is a fault a robot monitor must show red, not a warning.
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR, "no telemetry received yet");
   } else if (stats.frames_decoded == frames_at_last_diagnose_) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "telemetry stopped");
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR, "telemetry stopped");
   }
   logTelemetryFlow(connected, stats.frames_decoded);
   status.hardware_id = link_.options().path;

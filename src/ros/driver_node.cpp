@@ -1,5 +1,6 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
+#include <atomic>
 #include <functional>
 #include <sstream>
 
@@ -12,9 +13,12 @@
 namespace serial_robot_driver::ros_layer {
 
 /// Logs a port's comings and goings once per event (reader thread), and the USB latency hint.
+/// Once the node shuts down, a port going down is the node closing it (or the robot's end going
+/// at the same moment): stopping is not losing, so nothing is logged as lost.
 class PortMonitor : public device::LinkListener {
  public:
-  explicit PortMonitor(const device::SerialLink& link) : link_(link) {}
+  PortMonitor(const device::SerialLink& link, const std::atomic<bool>& shutting_down)
+      : link_(link), shutting_down_(shutting_down) {}
 
   void onLinkUp() override {
     waiting_logged_ = false;
@@ -28,12 +32,16 @@ class PortMonitor : public device::LinkListener {
     }
   }
   void onLinkDown() override {
+    if (shutting_down_) {
+      ROS_DEBUG("port %s closed", link_.options().path.c_str());
+      return;
+    }
     ROS_WARN("port %s lost (%s); reopening every %.1f s", link_.options().path.c_str(),
              link_.stats().last_error.c_str(), link_.options().reconnect_interval);
     waiting_logged_ = true;  // the retries that follow need no message of their own
   }
   void onOpenFailed(const std::string& error) override {
-    if (waiting_logged_) return;  // once per outage, not once per retry
+    if (waiting_logged_ || shutting_down_) return;  // once per outage, not once per retry
     waiting_logged_ = true;
     ROS_WARN("waiting for port %s (%s); retrying every %.1f s", link_.options().path.c_str(),
              error.c_str(), link_.options().reconnect_interval);
@@ -42,6 +50,7 @@ class PortMonitor : public device::LinkListener {
 
  private:
   const device::SerialLink& link_;
+  const std::atomic<bool>& shutting_down_;
   bool waiting_logged_ = false;  // reader thread only
 };
 
@@ -122,7 +131,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     }
     Port port;
     port.link = std::make_unique<device::SerialLink>(options, stream_factory);
-    port.monitor = std::make_unique<PortMonitor>(*port.link);
+    port.monitor = std::make_unique<PortMonitor>(*port.link, shut_down_);
     port.link->addListener(port.monitor.get());
     port.link->setChunkObserver(capture_.get());
     Port& stored = ports_[path] = std::move(port);

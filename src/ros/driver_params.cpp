@@ -10,6 +10,7 @@
 #include <ros/param.h>
 
 #include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/transport/serial_port.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -32,12 +33,11 @@ void requireNonNegative(double value, const std::string& name) {
 }
 
 void requireBaud(int baud, const std::string& name, bool zero_means_inherit) {
-  static const std::set<int> kRates = {1200,   2400,   4800,   9600,    19200,   38400,  57600,
-                                       115200, 230400, 250000, 460800,  500000,  576000, 921600,
-                                       1000000, 1500000, 2000000, 3000000, 4000000};
   if (zero_means_inherit && baud == 0) return;
-  require(kRates.count(baud) > 0, name,
-          "unsupported baud rate " + std::to_string(baud) + " (e.g. 9600, 115200, 1000000)");
+  // The port's own table: a rate passes here exactly when the port can open at it.
+  require(baud > 0 && transport::isSupportedBaud(static_cast<unsigned>(baud)), name,
+          "unsupported baud rate " + std::to_string(baud) + " (supported: " +
+              transport::supportedBaudRatesText() + ")");
 }
 
 // --- the table -------------------------------------------------------------------------------

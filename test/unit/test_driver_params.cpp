@@ -8,6 +8,7 @@
 #include <set>
 
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/transport/serial_port.h"
 
 namespace serial_robot_driver::ros_layer {
 namespace {
@@ -127,6 +128,25 @@ TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
   DriverParams no_orientation = params;
   no_orientation.imu.orientation_variance = -1;
   expectRefused(no_orientation, "imu/orientation_variance is negative");
+}
+
+// Every rate the port opens at passes the check, and only those: the servos' 250000 and the large
+// standard rates included (one table decides both).
+TEST(DriverParams, EveryRateThePortOpensAtPasses) {
+  for (unsigned rate : transport::supportedBaudRates()) {
+    DriverParams params;
+    params.baud = static_cast<int>(rate);
+    EXPECT_NO_THROW(params.validate()) << rate;
+  }
+  for (int rate : {9600, 19200, 38400, 57600, 115200, 250000, 500000, 1152000, 2500000, 3500000}) {
+    DriverParams params;
+    params.servo_bus.port = "/dev/ttyUSB1";
+    params.servo_bus.baud = rate;
+    EXPECT_NO_THROW(params.validate()) << rate;
+  }
+  DriverParams params;
+  params.baud = 5000000;
+  EXPECT_THROW(params.validate(), ParameterError);
 }
 
 TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {

@@ -23,6 +23,7 @@
 //    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <string>
@@ -82,7 +83,7 @@ class DriverNode {
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
-  bool shut_down_ = false;
+  std::atomic<bool> shut_down_{false};  // read by the ports' monitors on the reader threads
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -5,11 +5,14 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
+
+#include "serial_robot_driver/transport/recorded_stream.h"
 
 namespace ros {
 class NodeHandle;
@@ -129,6 +132,9 @@ struct DriverParams {
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
   double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
+  /// Not a parameter: the running replay's timeline (set by the node once the bag is read), which
+  /// maps the frames' arrival times back to their recorded stamps.
+  std::shared_ptr<const transport::ReplayPacing> replay_timeline;
   BaseParams base;
   BodyParams body;
   ImuParams imu;
