@@ -3,6 +3,7 @@ catkin_add_gtest(core_tests
   test/unit/test_base_codec.cpp
   test/unit/test_body_codec.cpp
   test/unit/test_servo_bus_codec.cpp
+  test/unit/test_servo_commands.cpp
   test/unit/test_servo_params.cpp
   test/unit/test_stream_framer.cpp
   test/unit/test_diff_drive.cpp
