@@ -88,30 +88,24 @@ ServoStatus ServoBusClient::move(const MoveRequest& request) {
   const auto angle = static_cast<int32_t>(std::trunc(request.angle_deg * kDecidegreesPerDegree));
   const auto velocity =
       static_cast<uint16_t>(std::trunc(request.velocity_dps * kDecidegreesPerDegree));
-  std::vector<uint8_t> frame;
-  Command cmd = Command::kRotate;
+  servo::MoveCommand command;
+  command.id = request.id;
+  command.angle_decidegrees = angle;
+  command.interval_ms = request.interval_ms;
+  command.velocity_decidegrees_per_s = velocity;
+  command.ramps = ramps;
   if (by_velocity) {
-    cmd = request.multi_turn ? Command::kMultiTurnMoveByVelocity : Command::kMoveByVelocity;
-    frame =
-        request.multi_turn
-            ? servo::encodeMultiTurnMoveByVelocity(request.id, angle, velocity, ramps)
-            : servo::encodeMoveByVelocity(request.id, static_cast<int16_t>(angle), velocity, ramps);
+    command.cmd =
+        request.multi_turn ? Command::kMultiTurnMoveByVelocity : Command::kMoveByVelocity;
   } else if (with_ramps) {
-    cmd = request.multi_turn ? Command::kMultiTurnMoveByInterval : Command::kMoveByInterval;
-    frame =
-        request.multi_turn
-            ? servo::encodeMultiTurnMoveByInterval(request.id, angle, request.interval_ms, ramps)
-            : servo::encodeMoveByInterval(request.id, static_cast<int16_t>(angle),
-                                          static_cast<uint16_t>(request.interval_ms), ramps);
-  } else if (request.multi_turn) {
-    cmd = Command::kMultiTurnMove;
-    frame = servo::encodeMultiTurnMove(request.id, angle, request.interval_ms, request.power_mw);
+    command.cmd =
+        request.multi_turn ? Command::kMultiTurnMoveByInterval : Command::kMoveByInterval;
   } else {
-    frame = servo::encodeRotate(request.id, static_cast<int16_t>(angle),
-                                static_cast<uint16_t>(request.interval_ms), request.power_mw);
+    command.cmd = request.multi_turn ? Command::kMultiTurnMove : Command::kRotate;
   }
+  const std::vector<uint8_t> frame = servo::encodeMove(command);
   std::lock_guard<BusMutex> bus(bus_mutex_);
-  return sendCommand(frame, cmd, request.id);
+  return sendCommand(frame, command.cmd, request.id);
 }
 
 ServoStatus ServoBusClient::rotate(const RotateRequest& request) {

@@ -189,6 +189,12 @@ MoveCommand moveOf(Command cmd, uint8_t id, int32_t angle, uint32_t interval_ms,
 
 }  // namespace
 
+std::vector<uint8_t> encodeMove(const MoveCommand& move) { return buildMove(move); }
+
+std::vector<uint8_t> encodeSpin(const SpinCommand& spin) {
+  return encodeSpin(spin.id, spin.clockwise, spin.mode, spin.speed_dps, spin.value);
+}
+
 bool isMove(Command cmd) {
   return cmd == Command::kRotate ||
          (cmd >= Command::kMoveByInterval && cmd <= Command::kMultiTurnMoveByVelocity);

@@ -151,6 +151,8 @@ bool isMove(Command cmd);
 bool isMultiTurn(Command cmd);
 bool isByVelocity(Command cmd);
 bool hasRamps(Command cmd);
+/// The request of `move.cmd` (fields the command does not carry are ignored).
+std::vector<uint8_t> encodeMove(const MoveCommand& move);
 Decoded<MoveCommand> decodeMove(const Packet& request);
 
 /// A SPIN request: id, method (bit 7 clockwise, bits 1..0 mode), speed u16 deg/s, value u16.
@@ -161,6 +163,7 @@ struct SpinCommand {
   uint16_t speed_dps = 0;
   uint16_t value = 0;
 };
+std::vector<uint8_t> encodeSpin(const SpinCommand& spin);
 Decoded<SpinCommand> decodeSpin(const Packet& request);
 
 }  // namespace serial_robot_driver::protocol::servo
