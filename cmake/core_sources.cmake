@@ -13,6 +13,7 @@ set(SRD_CORE_SOURCES
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp
   src/device/loop_clock.cpp
+  src/device/device_set.cpp
   src/device/base_controller.cpp
   src/device/body_controller.cpp
   src/device/servo_bus_client.cpp

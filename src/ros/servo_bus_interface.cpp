@@ -184,12 +184,10 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
 }
 
 ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params,
-                                     device::SerialLink& link,
-                                     diagnostic_updater::Updater& diagnostics)
+                                     device::SerialLink& link)
     : link_(link),
       bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
       client_(bus_.client()),
-      diagnostics_(diagnostics),
       nh_(nh),
       topics_nh_(nh),
       command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
@@ -301,8 +299,6 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
           Announce::kInfo),
   };
 
-  diagnostics_.add("servo_bus", this, &ServoBusInterface::diagnose);
-
   if (params.servo_bus.allow_dangerous_writes) {
     ROS_WARN(
         "servo_bus: dangerous writes (servo_id, baudrate, response_switch, reserved cells, "
@@ -343,7 +339,6 @@ void ServoBusInterface::shutdown() {
   bus_.shutdown();  // fails a call waiting on the bus, so the spinner can stop quickly
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
-  diagnostics_.removeByName("servo_bus");
 }
 
 void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

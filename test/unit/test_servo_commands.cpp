@@ -71,7 +71,9 @@ TEST(ServoCommandTable, EveryGoldenAnswerFitsItsRowAndItsResultByteSaysOk) {
     const Packet packet = response(*frame);
     const CommandInfo& info = commandInfo(static_cast<Command>(packet.cmd));
     EXPECT_TRUE(info.answer.fits(packet.content_size)) << info.name;
-    if (info.result_index != kNoResult) EXPECT_EQ(packet.content[info.result_index], 1);
+    if (info.result_index != kNoResult) {
+      EXPECT_EQ(packet.content[info.result_index], 1);
+    }
   }
 }
 

@@ -11,6 +11,8 @@
 #include <variant>
 #include <vector>
 
+#include "serial_robot_driver/device/device_set.h"
+
 namespace ros {
 class NodeHandle;
 }
@@ -114,12 +116,18 @@ struct DriverParams {
   /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
   void validate() const;
 
-  std::string basePort() const { return base.port.empty() ? port : base.port; }
-  std::string bodyPort() const { return body.port.empty() ? port : body.port; }
-  std::string servoBusPort() const { return servo_bus.port.empty() ? port : servo_bus.port; }
-  int baseBaud() const { return base.baud > 0 ? base.baud : baud; }
-  int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
-  int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
+  /// The port parameters (~<name>/enabled, port, baud) of a device of the set.
+  const DevicePortParams& portParams(device::DeviceKind kind) const;
+  bool enabled(device::DeviceKind kind) const { return portParams(kind).enabled; }
+  /// The device's own port or baud, or the node-wide one it inherits.
+  std::string portOf(device::DeviceKind kind) const;
+  int baudOf(device::DeviceKind kind) const;
+  std::string basePort() const { return portOf(device::DeviceKind::kBase); }
+  std::string bodyPort() const { return portOf(device::DeviceKind::kBody); }
+  std::string servoBusPort() const { return portOf(device::DeviceKind::kServoBus); }
+  int baseBaud() const { return baudOf(device::DeviceKind::kBase); }
+  int bodyBaud() const { return baudOf(device::DeviceKind::kBody); }
+  int servoBusBaud() const { return baudOf(device::DeviceKind::kServoBus); }
   /// A topic's publisher queue: `live` frames (a slow subscriber drops old ones), but unbounded
   /// while replaying, where a full-speed replay must not lose what subscribers have not read yet.
   int publisherQueue(int live) const { return replay_bag.empty() ? live : 0; }

@@ -65,8 +65,7 @@ class ServoBusInterface : public DeviceInterface {
  public:
   /// Registers the client with `link` and advertises servo/* in `nh`'s namespace. Must be
   /// constructed before the link is started.
-  ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                    diagnostic_updater::Updater& diagnostics);
+  ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
   ~ServoBusInterface();
   ServoBusInterface(const ServoBusInterface&) = delete;
   ServoBusInterface& operator=(const ServoBusInterface&) = delete;
@@ -84,7 +83,6 @@ class ServoBusInterface : public DeviceInterface {
   device::SerialLink& link_;
   device::ServoBus bus_;
   device::ServoBusClient& client_;  // bus_'s
-  diagnostic_updater::Updater& diagnostics_;
   ros::CallbackQueue queue_;
   ros::NodeHandle nh_;  // the caller's namespace, bound to queue_
   std::vector<ros::ServiceServer> services_;
