@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/base_controller.h"
+#include "support/golden_frames.h"
 #include "support/manual_clock.h"
 
 namespace serial_robot_driver::device {
@@ -83,9 +84,9 @@ TEST_F(BaseControllerTest, FirstSpeedFrameIsPrecededByReset) {
   clock_->tick(1);
   ASSERT_EQ(frames_.size(), 2u);
   // Reset, SEQ 00: 55^AA^02^00^05^00 = F8
-  EXPECT_EQ(frames_[0], (Bytes{0x55, 0xAA, 0x02, 0x00, 0x05, 0x00, 0xF8}));
+  EXPECT_EQ(frames_[0], golden::base::kResetSeq0);
   // zero speed, SEQ 01: XOR = 55^AA^09^01^01 = F6
-  EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0, 0, 0, 0, 0, 0, 0, 0, 0xF6}));
+  EXPECT_EQ(frames_[1], golden::base::kBoth0Seq1);
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_TRUE(sent_[0].reset_before);
   EXPECT_EQ(sent_[0].seq, 1);
@@ -106,7 +107,7 @@ TEST_F(BaseControllerTest, NewCommandGoesOutAtOnceWithEqualPositiveTicksWhenStra
   clock_->step([&] { controller_.setCommand(0.1, 0.0); });
   ASSERT_EQ(frames_.size(), 2u) << "sent before the first tick is due";
   // 0.1 m/s = 4.07 ticks per period -> 4 on the first frame; SEQ 01: XOR = F7 ^ 01 = F6
-  EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0x00, 0x04, 0x00, 0x04, 0, 0, 0, 0, 0xF6}));
+  EXPECT_EQ(frames_[1], golden::base::kBoth4Seq1);
   EXPECT_EQ(controller_.stats().immediate_frames, 1u);
 }
 
@@ -153,7 +154,7 @@ TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
   clock_->tick(2);
   frames_.clear();
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
-  const Bytes error = {0x55, 0xAA, 0x02, 0x07, 0xFF, 0x00, 0x05};
+  const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->step([&] {
     controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
   });
@@ -196,8 +197,8 @@ TEST_F(BaseControllerTest, ResetAndClearEncodersServicesWriteTheirFrames) {
   EXPECT_TRUE(controller_.sendClearEncoders());
   EXPECT_TRUE(controller_.sendReset());
   ASSERT_EQ(frames_.size(), 2u);
-  EXPECT_EQ(frames_[0], (Bytes{0x55, 0xAA, 0x02, 0x00, 0x06, 0x00, 0xFB}));  // clear, SEQ 00
-  EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x02, 0x01, 0x05, 0x00, 0xF9}));  // Reset, SEQ 01
+  EXPECT_EQ(frames_[0], golden::base::kClearEncodersSeq0);  // clear, SEQ 00
+  EXPECT_EQ(frames_[1], golden::base::kResetSeq1);  // Reset, SEQ 01
   port_up_ = false;
   EXPECT_FALSE(controller_.sendReset());
 }
@@ -396,7 +397,7 @@ TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
   // 0.1 m/s = 4.07 -> 4 ticks; left flipped: FF FC, right 00 04; XOR 55^AA^09^01^01^FF^FC^04 = F1
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[1],
-            (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0xFF, 0xFC, 0x00, 0x04, 0, 0, 0, 0, 0xF1}));
+            golden::base::kLeftMinus4Right4Seq1);
   clock->tick(1);
   ASSERT_FALSE(samples.empty());
   EXPECT_GT(samples.back().pose.x, 0.0) << "the robot drives forward whatever the wire says";
@@ -424,7 +425,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   clock->tick(100);
   EXPECT_EQ(silent_events, 1) << "reported once, not every tick";
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
-  const Bytes reply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
+  const Bytes& reply = golden::base::kBattery87ReplySeq0;
   controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), clock->now());
   EXPECT_FALSE(controller.stats().base_silent);
   controller.stop();
@@ -432,7 +433,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
 
 TEST_F(BaseControllerTest, TimeoutErrorWhileRunningIsCountedButNotTheOneAtStart) {
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
-  const Bytes error = {0x55, 0xAA, 0x02, 0x07, 0xFF, 0x00, 0x05};
+  const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->tick(1);  // Reset + first frame
   clock_->step([&] {
     controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
@@ -463,7 +464,7 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   EXPECT_EQ(requests, 2);
   EXPECT_EQ(controller.stats().battery_requests, 2u);
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
-  const Bytes reply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
+  const Bytes& reply = golden::base::kBattery87ReplySeq0;
   controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), Clock::now());
   ASSERT_EQ(percents.size(), 1u);
   EXPECT_EQ(percents[0], 87);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -11,7 +12,9 @@
 #include <variant>
 #include <vector>
 
+#include "serial_robot_driver/device/base_controller.h"
 #include "serial_robot_driver/device/device_set.h"
+#include "serial_robot_driver/device/servo_bus.h"
 
 namespace ros {
 class NodeHandle;
@@ -36,23 +39,29 @@ struct DevicePortParams {
   int baud = 0;      ///< 0: the node-wide ~baud
 };
 
+/// The defaults of the core classes' configurations. The parameters that configure a core class
+/// start from its values, so each default is written once (in the core config), never copied.
+inline const device::BaseConfig kBaseDefaults{};
+inline const device::ServoBusConfig kServoBusDefaults{};
+
 struct BaseParams : DevicePortParams {
-  double wheel_diameter = 0.25;
-  int encoder_resolution = 1600;
-  double pid_rate = 50;
-  double wheel_separation = 0.40;
-  double max_wheel_speed = 1.0;
-  double max_wheel_accel = 0.0;
-  double cmd_vel_timeout = 0.5;
-  bool speed_dithering = true;
-  double battery_poll_rate = 1.0;
+  double wheel_diameter = kBaseDefaults.geometry.wheel_diameter;
+  int encoder_resolution = static_cast<int>(kBaseDefaults.geometry.encoder_resolution);
+  double pid_rate = kBaseDefaults.geometry.pid_rate;
+  double wheel_separation = kBaseDefaults.geometry.wheel_separation;
+  double max_wheel_speed = kBaseDefaults.max_wheel_speed;
+  double max_wheel_accel = kBaseDefaults.max_wheel_accel;
+  double cmd_vel_timeout = kBaseDefaults.cmd_vel_timeout;
+  bool speed_dithering = kBaseDefaults.speed_dithering;
+  double battery_poll_rate = kBaseDefaults.battery_poll_rate;
   int battery_warn_percent = 20;   ///< below: diagnostics WARN
   int battery_error_percent = 10;  ///< below: diagnostics ERROR
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
   bool publish_tf = true;
-  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
-  int right_wheel_direction = 1;
+  /// 1 or -1: sign between forward motion and the wire's ticks
+  int left_wheel_direction = kBaseDefaults.left_wheel_direction;
+  int right_wheel_direction = kBaseDefaults.right_wheel_direction;
 };
 
 struct BodyParams : DevicePortParams {
@@ -89,11 +98,11 @@ struct ImuParams {
 };
 
 struct ServoBusParams : DevicePortParams {
-  double timeout = 0.05;
-  int retries = 1;
-  bool allow_dangerous_writes = false;
+  double timeout = std::chrono::duration<double>(kServoBusDefaults.client.timeout).count();  ///< s
+  int retries = kServoBusDefaults.client.retries;
+  bool allow_dangerous_writes = kServoBusDefaults.client.allow_dangerous_writes;
   std::vector<int> state_ids;     ///< bus servos polled for servo_states (empty: no poll)
-  double state_rate = 10.0;       ///< Hz, polls of every state_ids servo
+  double state_rate = kServoBusDefaults.poll_rate;  ///< Hz, polls of every state_ids servo
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
 };
 
@@ -103,7 +112,7 @@ constexpr double kMinBaseLoopRate = 5.0;
 struct DriverParams {
   std::string port = "/dev/ttyUSB0";
   int baud = 115200;
-  double loop_rate = 50.0;
+  double loop_rate = kBaseDefaults.loop_rate;
   double reconnect_interval = 1.0;
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
