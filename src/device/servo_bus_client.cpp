@@ -1,24 +1,19 @@
+// ServoBusClient's transactions on the wire: matching answers to the pending request, timeouts
+// and retries, the half-duplex echo. The operations built on them are in servo_bus_queries.cpp
+// (ping, scan, angles), servo_bus_settings.cpp (parameters) and servo_bus_motion.cpp (motions).
 #include "serial_robot_driver/device/servo_bus_client.h"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <limits>
+#include <chrono>
 #include <utility>
 
-#include "serial_robot_driver/protocol/byte_order.h"
 #include "servo_bus_text.h"
 
 namespace serial_robot_driver::device {
 
 namespace servo = protocol::servo;
 using servo::Command;
-using servo::ParamInfo;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
-
-// The transactions on the wire: matching answers to the pending request, timeouts and retries,
-// the half-duplex echo. The operations are in servo_bus_queries.cpp (ping, scan, angles),
-// servo_bus_settings.cpp (parameters) and servo_bus_motion.cpp (motions).
 
 namespace {
 
@@ -201,9 +196,9 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
       return ok("answered in " + formatMs(latency_ms));
     }
     if (link_lost_) {
-      return fail(ServoError::kNotConnected,
-                  "servo bus port was lost while waiting for " + servoName(expect.id) + "'s " +
-                      commandName(expect.cmd) + " answer");
+      return fail(ServoError::kNotConnected, "servo bus port was lost while waiting for " +
+                                                 servoName(expect.id) + "'s " +
+                                                 commandName(expect.cmd) + " answer");
     }
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
     if (pending_.garbled) {
@@ -222,10 +217,9 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.timeouts;
   }
-  return fail(ServoError::kTimeout, servoName(expect.id) + " did not answer " +
-                                        commandName(expect.cmd) + " within " +
-                                        std::to_string(timeout.count()) + " ms (" +
-                                        attemptsText(attempts) + ")");
+  return fail(ServoError::kTimeout,
+              servoName(expect.id) + " did not answer " + commandName(expect.cmd) + " within " +
+                  std::to_string(timeout.count()) + " ms (" + attemptsText(attempts) + ")");
 }
 
 ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
@@ -261,8 +255,8 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
   servo::Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
-  ServoStatus status = transact(request, Expectation(cmd, id),
-                                motion_time + options_.timeout, 1, &answer);
+  ServoStatus status =
+      transact(request, Expectation(cmd, id), motion_time + options_.timeout, 1, &answer);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";
@@ -276,6 +270,5 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
   return ok(std::string(commandName(cmd)) + " completed by " + servoName(id) + ", " +
             status.message);
 }
-
 
 }  // namespace serial_robot_driver::device

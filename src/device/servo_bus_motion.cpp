@@ -1,23 +1,21 @@
-#include "serial_robot_driver/device/servo_bus_client.h"
-
+// ServoBusClient's motions: servo/move (CMD 8, 11..15), ROTATE, SPIN and DAMPING, checked before
+// anything is written.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
 #include <utility>
+#include <vector>
 
-#include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/device/servo_bus_client.h"
 #include "servo_bus_text.h"
 
 namespace serial_robot_driver::device {
 
 namespace servo = protocol::servo;
 using servo::Command;
-using servo::ParamInfo;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
-
-// The motions: servo/move (CMD 8, 11..15), ROTATE, SPIN and DAMPING, checked before anything
-// is written.
 
 namespace {
 
@@ -95,11 +93,9 @@ ServoStatus ServoBusClient::move(const MoveRequest& request) {
   command.velocity_decidegrees_per_s = velocity;
   command.ramps = ramps;
   if (by_velocity) {
-    command.cmd =
-        request.multi_turn ? Command::kMultiTurnMoveByVelocity : Command::kMoveByVelocity;
+    command.cmd = request.multi_turn ? Command::kMultiTurnMoveByVelocity : Command::kMoveByVelocity;
   } else if (with_ramps) {
-    command.cmd =
-        request.multi_turn ? Command::kMultiTurnMoveByInterval : Command::kMoveByInterval;
+    command.cmd = request.multi_turn ? Command::kMultiTurnMoveByInterval : Command::kMoveByInterval;
   } else {
     command.cmd = request.multi_turn ? Command::kMultiTurnMove : Command::kRotate;
   }
@@ -123,9 +119,8 @@ ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
   if (request.wait) {
     if (auto rejection = rejectBroadcast(request.id, Command::kRotate)) return *rejection;
   }
-  const std::vector<uint8_t> frame =
-      servo::encodeRotate(request.id, static_cast<int16_t>(decidegrees), request.interval_ms,
-                          request.power_mw);
+  const std::vector<uint8_t> frame = servo::encodeRotate(
+      request.id, static_cast<int16_t>(decidegrees), request.interval_ms, request.power_mw);
   std::lock_guard<BusMutex> bus(bus_mutex_);
   return sendMotion(frame, Command::kRotate, request.id, request.wait,
                     std::chrono::milliseconds(request.interval_ms));
@@ -158,8 +153,8 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request) {
     }
     motion_time = std::chrono::milliseconds(std::llround(expected_ms));
   }
-  const std::vector<uint8_t> frame = servo::encodeSpin(request.id, request.clockwise, mode,
-                                                       request.speed_dps, request.value);
+  const std::vector<uint8_t> frame =
+      servo::encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
   std::lock_guard<BusMutex> bus(bus_mutex_);
   return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time);
 }

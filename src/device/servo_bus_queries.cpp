@@ -1,27 +1,21 @@
-#include "serial_robot_driver/device/servo_bus_client.h"
-
-#include <algorithm>
-#include <cmath>
+// ServoBusClient's queries: PING, scan, READ_ANGLE and the multi-turn angle.
 #include <cstdio>
-#include <limits>
-#include <utility>
+#include <string>
+#include <vector>
 
-#include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/device/servo_bus_client.h"
 #include "servo_bus_text.h"
 
 namespace serial_robot_driver::device {
 
 namespace servo = protocol::servo;
 using servo::Command;
-using servo::ParamInfo;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
-
-// The queries: PING, scan, READ_ANGLE and the multi-turn angle.
 
 ServoStatus ServoBusClient::pingLocked(uint8_t id) {
   servo::Packet answer;
-  const ServoStatus status = exchangeLocked(
-      servo::encodePing(id), Expectation(Command::kPing, id), &answer);
+  const ServoStatus status =
+      exchangeLocked(servo::encodePing(id), Expectation(Command::kPing, id), &answer);
   if (!status.ok()) return status;
   return ok(servoName(id) + " is online (" + status.message + ")");
 }
@@ -66,12 +60,10 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
 ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* reading) {
   if (auto rejection = rejectBroadcast(id, Command::kReadMultiTurnAngle)) return *rejection;
   servo::Packet answer;
-  const ServoStatus status = exchange(
-      servo::encodeReadMultiTurnAngle(id),
-      Expectation(Command::kReadMultiTurnAngle, id), &answer);
+  const ServoStatus status = exchange(servo::encodeReadMultiTurnAngle(id),
+                                      Expectation(Command::kReadMultiTurnAngle, id), &answer);
   if (!status.ok()) return status;
-  const protocol::Decoded<servo::MultiTurnAngle> decoded =
-      servo::decodeMultiTurnAngle(answer);
+  const protocol::Decoded<servo::MultiTurnAngle> decoded = servo::decodeMultiTurnAngle(answer);
   if (!decoded) {
     return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable multi-turn angle");
   }
@@ -84,8 +76,8 @@ ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* rea
 
 ServoStatus ServoBusClient::pingOnceLocked(uint8_t id) {
   servo::Packet answer;
-  return transact(servo::encodePing(id), Expectation(Command::kPing, id),
-                  options_.timeout, 1, &answer);
+  return transact(servo::encodePing(id), Expectation(Command::kPing, id), options_.timeout, 1,
+                  &answer);
 }
 
 ServoStatus ServoBusClient::scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids) {

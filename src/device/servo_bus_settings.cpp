@@ -1,12 +1,11 @@
-#include "serial_robot_driver/device/servo_bus_client.h"
-
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <limits>
+// ServoBusClient's parameter operations: READ_DATA / WRITE_DATA with their checks and read-back,
+// READ_BATCH_DATA and RESET_USER_DATA.
+#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
-#include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/device/servo_bus_client.h"
 #include "servo_bus_text.h"
 
 namespace serial_robot_driver::device {
@@ -15,9 +14,6 @@ namespace servo = protocol::servo;
 using servo::Command;
 using servo::ParamInfo;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
-
-// The servo's parameters: READ_DATA / WRITE_DATA with its checks and read-back, READ_BATCH_DATA
-// and RESET_USER_DATA.
 
 namespace {
 
@@ -69,8 +65,8 @@ ServoStatus ServoBusClient::readParamLocked(uint8_t id, const ParamInfo& param,
   if (!status.ok()) return status;
   const protocol::Decoded<int64_t> raw = servo::decodeReadDataAnswer(answer, param);
   if (!raw) {
-    return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable value for " +
-                                            quoted(param.name));
+    return fail(ServoError::kBadAnswer,
+                servoName(id) + " sent an unreadable value for " + quoted(param.name));
   }
   *value = toParamValue(param, *raw);
   return ok(servoName(id) + " " + quoted(param.name) + " = " + valueText(*value));
@@ -139,9 +135,9 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
                                        " but the read-back failed: " + read_status.message);
   }
   if (read_back.value != value) {
-    return fail(ServoError::kReadBackMismatch,
-                "wrote " + assignment + " to " + servoName(id) + " but it reads back " +
-                    std::to_string(read_back.value));
+    return fail(ServoError::kReadBackMismatch, "wrote " + assignment + " to " + servoName(id) +
+                                                   " but it reads back " +
+                                                   std::to_string(read_back.value));
   }
   if (id_change) {
     return ok(servoName(id) + " is now " + servoName(new_id) + " (read back at the new id)");
@@ -154,8 +150,7 @@ ServoStatus ServoBusClient::readAll(uint8_t id, std::vector<ServoParamValue>* va
   if (auto rejection = rejectBroadcast(id, Command::kReadBatchData)) return *rejection;
   servo::Packet answer;
   const ServoStatus status =
-      exchange(servo::encodeReadBatchData(id),
-               Expectation(Command::kReadBatchData, id), &answer);
+      exchange(servo::encodeReadBatchData(id), Expectation(Command::kReadBatchData, id), &answer);
   if (!status.ok()) return status;
 
   const uint8_t* block = answer.content.data() + 1;
@@ -164,12 +159,12 @@ ServoStatus ServoBusClient::readAll(uint8_t id, std::vector<ServoParamValue>* va
     const std::optional<std::size_t> offset = servo::userBlockOffset(param);
     if (!offset) continue;  // read-only parameters are not in the user block
     const std::size_t size = servo::typeSize(param.type);
-    const std::optional<int64_t> raw =
-        *offset + size <= servo::kUserBlockSize ? servo::readValue(param, block + *offset, size)
-                                                : std::nullopt;
+    const std::optional<int64_t> raw = *offset + size <= servo::kUserBlockSize
+                                           ? servo::readValue(param, block + *offset, size)
+                                           : std::nullopt;
     if (!raw) {
-      return fail(ServoError::kBadAnswer, servoName(id) + " sent a user block without " +
-                                              quoted(param.name));
+      return fail(ServoError::kBadAnswer,
+                  servoName(id) + " sent a user block without " + quoted(param.name));
     }
     result.push_back(toParamValue(param, *raw));
   }

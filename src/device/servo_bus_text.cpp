@@ -41,9 +41,9 @@ ServoStatus notConnected() {
 
 std::optional<ServoStatus> rejectBroadcast(uint8_t id, servo::Command cmd) {
   if (id != servo::kBroadcastId) return std::nullopt;
-  return fail(ServoError::kInvalidArgument,
-              std::string("id 255 is the broadcast address; ") + commandName(cmd) +
-                  " needs the answer of one servo (ids 0..254)");
+  return fail(ServoError::kInvalidArgument, std::string("id 255 is the broadcast address; ") +
+                                                commandName(cmd) +
+                                                " needs the answer of one servo (ids 0..254)");
 }
 
 bool refused(const servo::Packet& answer) {

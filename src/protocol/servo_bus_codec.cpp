@@ -175,8 +175,8 @@ std::vector<uint8_t> buildMove(const MoveCommand& move) {
   return buildRequest(move.cmd, content.data(), size);
 }
 
-MoveCommand moveOf(Command cmd, uint8_t id, int32_t angle, uint32_t interval_ms,
-                   uint16_t velocity, const MoveRamps& ramps) {
+MoveCommand moveOf(Command cmd, uint8_t id, int32_t angle, uint32_t interval_ms, uint16_t velocity,
+                   const MoveRamps& ramps) {
   MoveCommand move;
   move.cmd = cmd;
   move.id = id;
@@ -207,8 +207,7 @@ Decoded<MoveCommand> decodeMove(const Packet& request) {
   const auto cmd = static_cast<Command>(request.cmd);
   if (!isMove(cmd)) return DecodeError::kUnknownCommand;
   const MoveLayout layout = moveLayout(cmd);
-  const std::size_t size =
-      1 + layout.angle_size + layout.second_size + (layout.ramps ? 4 : 0) + 2;
+  const std::size_t size = 1 + layout.angle_size + layout.second_size + (layout.ramps ? 4 : 0) + 2;
   if (request.content_size != size) return DecodeError::kBadLength;
   const uint8_t* at = request.content.data() + 1;
   MoveCommand move;

@@ -171,10 +171,9 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
   };
   events.on_servo_silent = [](uint8_t id, const device::ServoStatus& status,
                               std::chrono::milliseconds backoff) {
-    ROS_WARN_THROTTLE(kWarnThrottleS,
-                      "servo_states: %s does not answer (%s); asked again in %.1f s",
-                      servoJointName(id).c_str(), status.message.c_str(),
-                      backoff.count() / kMsPerSecond);
+    ROS_WARN_THROTTLE(
+        kWarnThrottleS, "servo_states: %s does not answer (%s); asked again in %.1f s",
+        servoJointName(id).c_str(), status.message.c_str(), backoff.count() / kMsPerSecond);
   };
   events.on_move_failed = [](const device::MoveRequest& move, const device::ServoStatus& status) {
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",

@@ -89,5 +89,4 @@ class ManualClock : public LoopClock {
   bool waiting_ = false;
 };
 
-
 }  // namespace serial_robot_driver::device

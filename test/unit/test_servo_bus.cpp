@@ -55,8 +55,7 @@ class ServoBusTest : public ::testing::Test {
       if (it == answers_.end()) return true;
       reply = it->second;
     }
-    bus_->onFrame(protocol::FrameFamily::kServoResponse, reply.data(), reply.size(),
-                  Clock::now());
+    bus_->onFrame(protocol::FrameFamily::kServoResponse, reply.data(), reply.size(), Clock::now());
     return true;
   }
 

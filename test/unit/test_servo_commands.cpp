@@ -41,12 +41,12 @@ TEST(ServoCommandTable, HasOneRowPerCommandInCmdOrder) {
 }
 
 TEST(ServoCommandTable, MotionsAnswerOnlyWithResponseSwitch) {
-  for (Command cmd : {Command::kSpin, Command::kRotate, Command::kDamping,
-                      Command::kMoveByInterval, Command::kMultiTurnMoveByVelocity}) {
+  for (Command cmd : {Command::kSpin, Command::kRotate, Command::kDamping, Command::kMoveByInterval,
+                      Command::kMultiTurnMoveByVelocity}) {
     EXPECT_EQ(commandInfo(cmd).answers, Answers::kWhenResponseSwitch) << commandInfo(cmd).name;
   }
-  for (Command cmd : {Command::kPing, Command::kReadData, Command::kWriteData,
-                      Command::kReadAngle, Command::kReadMultiTurnAngle}) {
+  for (Command cmd : {Command::kPing, Command::kReadData, Command::kWriteData, Command::kReadAngle,
+                      Command::kReadMultiTurnAngle}) {
     EXPECT_EQ(commandInfo(cmd).answers, Answers::kAlways) << commandInfo(cmd).name;
   }
 }
@@ -56,8 +56,7 @@ TEST(ServoCommandTable, EveryGoldenRequestFitsItsRow) {
        {&kPing3, &kReadAngle0, &kReadVoltage3, &kWriteSoftStart3, &kWriteServoId3To5,
         &kResetUserData3, &kRotate2To90In500, &kDamping0At500, &kReadBatch3, &kSpin0Cw5Turns,
         &kMoveByInterval1To90, &kMoveByVelocity1ToMinus90, &kMultiTurnMove1To720,
-        &kMultiTurnMoveByInterval1ToMinus360, &kMultiTurnMoveByVelocity1To3600,
-        &kReadMultiTurn1}) {
+        &kMultiTurnMoveByInterval1ToMinus360, &kMultiTurnMoveByVelocity1To3600, &kReadMultiTurn1}) {
     const Packet packet = request(*frame);
     const CommandInfo& info = commandInfo(static_cast<Command>(packet.cmd));
     EXPECT_TRUE(info.request.fits(packet.content_size)) << info.name;

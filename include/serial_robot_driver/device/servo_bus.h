@@ -55,10 +55,10 @@ struct ServoBusEvents {
 };
 
 struct ServoBusWorkerStats {
-  uint64_t angles_polled = 0;   ///< on_angle reports
-  uint64_t moves_sent = 0;      ///< queued moves written
-  uint64_t moves_failed = 0;    ///< queued moves the client refused or could not write
-  uint64_t moves_replaced = 0;  ///< queued moves replaced by a newer target of the same servo
+  uint64_t angles_polled = 0;        ///< on_angle reports
+  uint64_t moves_sent = 0;           ///< queued moves written
+  uint64_t moves_failed = 0;         ///< queued moves the client refused or could not write
+  uint64_t moves_replaced = 0;       ///< queued moves replaced by a newer target of the same servo
   std::vector<uint8_t> offline_ids;  ///< polled servos in back-off
 };
 

@@ -62,9 +62,12 @@ std::vector<uint8_t> encodeReadData(uint8_t id, uint8_t data_id);
 /// `value` must have passed checkWrite for `param`.
 std::vector<uint8_t> encodeWriteData(uint8_t id, const ParamInfo& param, int64_t value);
 std::vector<uint8_t> encodeReadBatchData(uint8_t id);
-std::vector<uint8_t> encodeWriteBatchData(uint8_t id, const std::array<uint8_t, kUserBlockSize>& block);
-std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint16_t speed_dps, uint16_t value);
-std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms, uint16_t power_mw);
+std::vector<uint8_t> encodeWriteBatchData(uint8_t id,
+                                          const std::array<uint8_t, kUserBlockSize>& block);
+std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint16_t speed_dps,
+                                uint16_t value);
+std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms,
+                                  uint16_t power_mw);
 std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw);
 std::vector<uint8_t> encodeReadAngle(uint8_t id);
 
@@ -142,9 +145,9 @@ struct MoveCommand {
   Command cmd = Command::kRotate;
   uint8_t id = 0;
   int32_t angle_decidegrees = 0;
-  uint32_t interval_ms = 0;            ///< the by-interval moves (8, 11, 13, 14)
+  uint32_t interval_ms = 0;                 ///< the by-interval moves (8, 11, 13, 14)
   uint16_t velocity_decidegrees_per_s = 0;  ///< the by-velocity moves (12, 15)
-  MoveRamps ramps;                     ///< power_mw always; accel/decel for 11, 12, 14, 15
+  MoveRamps ramps;                          ///< power_mw always; accel/decel for 11, 12, 14, 15
 };
 /// Whether `cmd` is one of the moves MoveCommand describes.
 bool isMove(Command cmd);
