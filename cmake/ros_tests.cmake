@@ -74,3 +74,25 @@ add_rostest_gtest(test_odom test/rostest/odom.test test/rostest/test_odom.cpp)
 target_include_directories(test_odom PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# sim.launch + description.launch: every link of the description on tf, wheel_states against odom.
+# (urdf: found in unit_tests.cmake, included first.)
+add_rostest_gtest(test_description test/rostest/description.test test/rostest/test_description.cpp)
+target_include_directories(test_description PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS})
+target_link_libraries(test_description srd_test_support ${urdf_LIBRARIES} ${catkin_LIBRARIES})
+add_dependencies(test_description driver_node robot_sim robot_description)
+
+# fleet_sim.launch: two robots in namespaces on one master, apart in topics, services and tf.
+add_rostest_gtest(test_fleet_sim test/rostest/fleet_sim.test test/rostest/test_fleet_sim.cpp)
+target_include_directories(test_fleet_sim PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS}
+  ${diagnostic_aggregator_INCLUDE_DIRS})
+target_link_libraries(test_fleet_sim srd_test_support ${urdf_LIBRARIES}
+  ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
+add_dependencies(test_fleet_sim driver_node robot_sim robot_description
+  ${PROJECT_NAME}_generate_messages_cpp)
+# ~base/use_imu_heading end to end: odom's yaw against simulated robots whose base slips while
+# turning (sim::RobotSim in-process), with and without the IMU, and without telemetry.
+add_rostest_gtest(test_imu_heading test/rostest/imu_heading.test test/rostest/test_imu_heading.cpp)
+target_include_directories(test_imu_heading PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_imu_heading srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_imu_heading driver_node ${PROJECT_NAME}_generate_messages_cpp)

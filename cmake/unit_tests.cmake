@@ -29,3 +29,15 @@ catkin_add_gtest(ros_layer_tests
   test/unit/test_bag_replay.cpp)
 target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(ros_layer_tests srd_ros gtest_main)
+
+# The robot description: robot_description's URDF through check_urdf and urdf::Model.
+find_package(urdf REQUIRED)
+catkin_add_gtest(description_tests test/unit/test_robot_description.cpp)
+target_include_directories(description_tests PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS})
+target_link_libraries(description_tests srd_description ${urdf_LIBRARIES} gtest_main)
+target_compile_definitions(description_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+  SRD_ROBOT_DESCRIPTION="$<TARGET_FILE:robot_description>")
+add_dependencies(description_tests robot_description)
+# The IMU's heading fused into odometry (~base/use_imu_heading), ROS-free.
+catkin_add_gtest(heading_fusion_tests test/unit/test_heading_fusion.cpp)
+target_link_libraries(heading_fusion_tests srd_core gtest_main)

@@ -16,6 +16,11 @@ PACKAGES=(
   libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev catkin-lint catkin-tools
 )
+# The robot description (robot_description, description.launch, view.launch) and its tests.
+PACKAGES+=(libyaml-cpp-dev liburdf-dev liburdfdom-tools ros-robot-state-publisher
+           joint-state-publisher topic-tools rviz)
+# --dev: what scripts/screenshot_view.sh needs to remake docs/images/ (a virtual display, a grab).
+[ "${1:-}" != "--dev" ] || PACKAGES+=(xvfb imagemagick)
 
 missing=()
 for package in "${PACKAGES[@]}"; do

@@ -5,7 +5,9 @@
 #   - executables, libsrd_nodelet, launch/, config/ (parameters, analyzers, udev rule), msg/srv,
 #     the nodelet plugin description, srd_core's headers; no srd_ros/srd_sim headers, no benchmarks;
 #   - rospack finds the package and its nodelet plugin; every launch file passes roslaunch's check;
-#   - sim.launch runs (joint_states flow, the servo/ping service exists), and driver.launch nodelet:=true
+#   - sim.launch runs (joint_states flow, the servo/ping service exists), description.launch puts
+#     the robot's links on /tf, fleet_sim.launch runs two robots under their prefixes, and
+#     driver.launch nodelet:=true
 #     loads serial_robot_driver/DriverNodelet against robot_sim.
 # Usage: scripts/test_install.sh [build dir]. Prints "install test passed" or what failed.
 set -euo pipefail
@@ -37,6 +39,9 @@ rm -f "$prefix.install.log"
 
 share="$prefix/share/serial_robot_driver"
 for f in lib/serial_robot_driver/driver_node lib/serial_robot_driver/robot_sim lib/libsrd_nodelet.so \
+         lib/serial_robot_driver/robot_description share/serial_robot_driver/launch/description.launch \
+         share/serial_robot_driver/launch/view.launch share/serial_robot_driver/config/view.rviz \
+         share/serial_robot_driver/launch/fleet_sim.launch share/serial_robot_driver/config/fleet.rviz \
          lib/libsrd_core.a share/serial_robot_driver/package.xml \
          share/serial_robot_driver/nodelet_plugins.xml share/serial_robot_driver/launch/driver.launch \
          share/serial_robot_driver/launch/sim.launch share/serial_robot_driver/launch/record.launch \
@@ -95,7 +100,27 @@ wait_for 60 'rosservice list | grep -q "^/servo/ping$"' ||
   { tail -n 30 "$prefix/sim.log"; fail "sim.launch: no /servo/ping"; }
 wait_for 30 'timeout 6 rostopic bw -w 3 /joint_states 2>&1 | grep -q average' ||
   { tail -n 30 "$prefix/sim.log"; fail "sim.launch: no joint_states"; }
+
+# description.launch next to it: the robot's links on /tf (the wheels need wheel_states merged).
+run "exec roslaunch serial_robot_driver description.launch" > "$prefix/description.log" 2>&1 &
+started_pids="$! $started_pids"
+description_launch=$!
+wait_for 60 'timeout 10 rostopic echo -n 50 /tf 2>&1 | grep -q "child_frame_id: \"left_wheel_link\""' ||
+  { tail -n 30 "$prefix/description.log"; fail "description.launch: no left_wheel_link on /tf"; }
+stop_group "$description_launch"
 stop_group "$sim_launch"
+
+# fleet_sim.launch: two robots in namespaces, each robot's links under its tf_prefix.
+run "exec roslaunch serial_robot_driver fleet_sim.launch link_prefix:=$prefix/fleet_" > "$prefix/fleet.log" 2>&1 &
+started_pids="$! $started_pids"
+fleet_launch=$!
+for robot in robot1 robot2; do
+  wait_for 60 "rosservice list | grep -q '^/$robot/servo/ping$'" ||
+    { tail -n 30 "$prefix/fleet.log"; fail "fleet_sim.launch: no /$robot/servo/ping"; }
+  wait_for 60 "timeout 10 rostopic echo -n 50 /tf 2>&1 | grep -q 'child_frame_id: \"$robot/left_wheel_link\"'" ||
+    { tail -n 30 "$prefix/fleet.log"; fail "fleet_sim.launch: no $robot/left_wheel_link on /tf"; }
+done
+stop_group "$fleet_launch"
 
 # The nodelet from the install space: robot_sim alone, and driver.launch nodelet:=true on its pty.
 run "exec rosrun serial_robot_driver robot_sim --link $link" > "$prefix/robot_sim.log" 2>&1 &

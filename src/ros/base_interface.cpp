@@ -3,7 +3,9 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/BatteryState.h>
+#include <sensor_msgs/JointState.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "serial_robot_driver/WheelCommand.h"
@@ -35,6 +37,8 @@ device::BaseConfig makeBaseConfig(const DriverParams& params) {
   config.baud = params.baseBaud();
   config.left_wheel_direction = params.base.left_wheel_direction;
   config.right_wheel_direction = params.base.right_wheel_direction;
+  config.use_imu_heading = params.base.use_imu_heading;
+  config.imu_yaw_variance = params.imu.orientation_variance;
   return config;
 }
 
@@ -80,6 +84,16 @@ device::BaseEvents BaseInterface::events() {
   events.on_timeout_error = [] {
     ROS_WARN_THROTTLE(5.0, "base reported a connection-timeout error (FF): sending Reset");
   };
+  events.on_heading_source = [this](kinematics::HeadingSource source) {
+    if (source == kinematics::HeadingSource::kImu) {
+      ROS_INFO("odom heading: following the IMU's yaw (base/use_imu_heading)");
+    } else if (source == kinematics::HeadingSource::kImuStale) {
+      ROS_WARN(
+          "odom heading: no IMU yaw for %.2f s (is the body's telemetry flowing?); integrating "
+          "the commanded turn from the last fused heading until it returns",
+          std::chrono::duration<double>(kinematics::kImuHeadingStaleAfter).count());
+    }
+  };
   events.on_unknown_reply = [](const protocol::base::Frame& frame) {
     ROS_DEBUG_THROTTLE(5.0, "base sent a frame with unknown MSGID 0x%02X", frame.msg_id);
   };
@@ -97,6 +111,7 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
       controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
   battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
+  wheel_states_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
 
   link.addListener(&controller_);
 
@@ -146,7 +161,8 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom.twist.twist.linear.x = sample.linear;
   odom.twist.twist.angular.z = sample.angular;
   // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
-  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all.
+  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
+  // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
   constexpr double kNotEstimated = 1e6;
   odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
   odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
@@ -158,6 +174,7 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
   odom.twist.covariance[35] = kTwistAngularVariance;
   odom_pub_.publish(odom);
+  publishWheelStates(sample, stamp);
 
   if (!tf_broadcaster_) return;
   geometry_msgs::TransformStamped transform;
@@ -167,6 +184,18 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   transform.transform.translation.y = sample.pose.y;
   transform.transform.rotation = orientation;
   tf_broadcaster_->sendTransform(transform);
+}
+
+void BaseInterface::publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp) {
+  // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
+  const double radius = params_.wheel_diameter / 2.0;
+  sensor_msgs::JointState wheels;
+  wheels.header.stamp = stamp;
+  wheels.header.frame_id = params_.base_frame;
+  wheels.name = {params_.left_wheel_joint, params_.right_wheel_joint};
+  wheels.position = {sample.wheel_travel.x() / radius, sample.wheel_travel.y() / radius};
+  wheels.velocity = {sample.wheel_speeds.x() / radius, sample.wheel_speeds.y() / radius};
+  wheel_states_pub_.publish(wheels);
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -221,6 +250,17 @@ void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     }
   }
   if (s.e_stop) status.mergeSummary(DiagnosticStatus::WARN, "e-stop engaged: holding zero speed");
+  if (s.heading_source) {
+    // ~base/use_imu_heading: odom without the IMU is worth a warning, the driving goes on.
+    if (*s.heading_source != kinematics::HeadingSource::kImu) {
+      status.mergeSummaryf(DiagnosticStatus::WARN, "odom heading: %s",
+                           kinematics::toString(*s.heading_source));
+    }
+    status.add("odom heading source", kinematics::toString(*s.heading_source));
+    status.add("odom heading IMU fallbacks", s.imu_heading_fallbacks);
+    status.add("odom heading IMU yaw age (s)",
+               s.imu_yaw_age ? std::to_string(*s.imu_yaw_age) : std::string("none yet"));
+  }
   status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);

@@ -52,6 +52,7 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
     joint_states_pub_.publish(
         boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp)));
   }
+  if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, imu_params_), arrival);
   if (imu_pub_.getNumSubscribers() > 0) {
     imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, imu_params_, stamp)));
   }

@@ -123,6 +123,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
       device->diagnose(s);
     });
   }
+  if (params_.base.use_imu_heading) connectImuHeading();
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
@@ -132,6 +133,25 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
 }
 
 DriverNode::~DriverNode() { shutdown(); }
+
+void DriverNode::connectImuHeading() {
+  // ~base/use_imu_heading (validate() made sure the body is enabled): the body's reader thread
+  // hands each frame's IMU yaw straight to the base controller, which only stores it (see
+  // kinematics::HeadingFusion). Both interfaces live in devices_, which outlives the links'
+  // threads.
+  BaseInterface* base = nullptr;
+  BodyInterface* body = nullptr;
+  for (auto& device : devices_) {
+    if (!base) base = dynamic_cast<BaseInterface*>(device.get());
+    if (!body) body = dynamic_cast<BodyInterface*>(device.get());
+  }
+  if (!base || !body) return;
+  const bool replaying = !params_.replay_bag.empty();
+  body->setImuYawListener([base, replaying](double yaw, device::Clock::time_point arrival) {
+    // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
+    base->onImuYaw(yaw, replaying ? device::Clock::now() : arrival);
+  });
+}
 
 device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }
 

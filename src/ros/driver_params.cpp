@@ -162,6 +162,9 @@ std::vector<ParamSpec> buildTable() {
       row("base/publish_tf", &P::base, &Base::publish_tf),
       row("base/left_wheel_direction", &P::base, &Base::left_wheel_direction, direction),
       row("base/right_wheel_direction", &P::base, &Base::right_wheel_direction, direction),
+      row("base/left_wheel_joint", &P::base, &Base::left_wheel_joint, frameId),
+      row("base/right_wheel_joint", &P::base, &Base::right_wheel_joint, frameId),
+      row("base/use_imu_heading", &P::base, &Base::use_imu_heading),
 
       row("body/enabled", &P::body, &Port::enabled),
       row("body/port", &P::body, &Port::port),
@@ -329,6 +332,20 @@ std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std
   return map;
 }
 
+std::string resolveFrame(const std::string& tf_prefix, const std::string& frame) {
+  if (!frame.empty() && frame[0] == '/') return frame.substr(1);
+  const std::size_t first = tf_prefix.find_first_not_of('/');
+  if (first == std::string::npos) return frame;  // empty, or nothing but slashes
+  const std::size_t last = tf_prefix.find_last_not_of('/');
+  return tf_prefix.substr(first, last - first + 1) + "/" + frame;
+}
+
+void DriverParams::resolveFrames() {
+  base.odom_frame = resolveFrame(tf_prefix, base.odom_frame);
+  base.base_frame = resolveFrame(tf_prefix, base.base_frame);
+  imu.frame_id = resolveFrame(tf_prefix, imu.frame_id);
+}
+
 const std::vector<ParamSpec>& parameterTable() {
   static const std::vector<ParamSpec> table = buildTable();
   return table;
@@ -338,6 +355,7 @@ void DriverParams::validate() const {
   // Single values first (the table), then what relates several parameters.
   for (const auto& spec : parameterTable()) spec.check(*this);
 
+  require(tf_prefix.find(' ') == std::string::npos, "tf_prefix", "must not contain spaces");
   require(!capture || replay_bag.empty(), "capture",
           "cannot be combined with ~replay_bag: a replay reads a capture and writes nothing");
   std::string all_devices;
@@ -364,6 +382,15 @@ void DriverParams::validate() const {
                 std::to_string(base.battery_warn_percent) + ")");
     require(base.odom_frame != base.base_frame, "base/base_frame",
             "must differ from base/odom_frame ('" + base.odom_frame + "')");
+    require(base.left_wheel_joint != base.right_wheel_joint, "base/right_wheel_joint",
+            "must differ from base/left_wheel_joint ('" + base.left_wheel_joint + "')");
+    if (base.use_imu_heading) {
+      require(body.enabled, "base/use_imu_heading",
+              "needs the servo controller board's IMU, but body/enabled is false");
+      require(
+          imu.orientation_variance >= 0, "base/use_imu_heading",
+          "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
+    }
   }
   if (body.enabled) {
     const std::size_t n = body.servo_ids.size();
@@ -418,7 +445,8 @@ int DriverParams::baudOf(device::DeviceKind kind) const {
 
 DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unknown_keys) {
   DriverParams params;
-  std::set<std::string> known = {"diagnostic_period"};  // read by diagnostic_updater itself
+  // diagnostic_period: read by diagnostic_updater itself; tf_prefix: searched for, may be private.
+  std::set<std::string> known = {"diagnostic_period", "tf_prefix"};
   for (const auto& spec : parameterTable()) {
     known.insert(spec.key);
     if (!source.has(spec.key)) continue;
@@ -437,7 +465,14 @@ DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unk
 }
 
 DriverParams loadParams(const ros::NodeHandle& nh, std::vector<std::string>* unknown_keys) {
-  return loadParams(NodeHandleSource(nh), unknown_keys);
+  DriverParams params = loadParams(NodeHandleSource(nh), unknown_keys);
+  // ~tf_prefix, then tf_prefix in each enclosing namespace up to the root.
+  std::string key;
+  if (nh.searchParam("tf_prefix", key) && !nh.getParam(key, params.tf_prefix)) {
+    throw ParameterError("tf_prefix", "must be a string (found " + key + ")");
+  }
+  params.resolveFrames();
+  return params;
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -108,6 +108,27 @@ INSTANTIATE_TEST_SUITE_P(
                   p.base.enabled = p.body.enabled = p.servo_bus.enabled = false;
                 }}));
 
+TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
+  DriverParams params;
+  params.base.use_imu_heading = true;
+  EXPECT_NO_THROW(params.validate());
+  const auto expectRefused = [](const DriverParams& p, const std::string& reason) {
+    try {
+      p.validate();
+      FAIL() << "no error for " << reason;
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), "base/use_imu_heading");
+      EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+    }
+  };
+  DriverParams no_body = params;
+  no_body.body.enabled = false;
+  expectRefused(no_body, "body/enabled is false");
+  DriverParams no_orientation = params;
+  no_orientation.imu.orientation_variance = -1;
+  expectRefused(no_orientation, "imu/orientation_variance is negative");
+}
+
 TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
   DriverParams params;
   params.servo_bus.port = "/dev/ttyUSB1";
@@ -255,6 +276,64 @@ TEST(ParameterTable, WrongTypeNamesTheParameter) {
   } catch (const ParameterError& e) {
     EXPECT_EQ(e.name(), "base/encoder_resolution");
     EXPECT_NE(std::string(e.what()).find("an integer"), std::string::npos) << e.what();
+  }
+}
+
+// --- tf_prefix ---------------------------------------------------------------------------------
+
+TEST(ResolveFrame, PrefixGoesInFrontWithOneSlash) {
+  EXPECT_EQ(resolveFrame("robot1", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("robot1", "base_link"), "robot1/base_link");
+}
+
+TEST(ResolveFrame, EmptyPrefixLeavesTheFrameAsConfigured) {
+  EXPECT_EQ(resolveFrame("", "odom"), "odom");
+  EXPECT_EQ(resolveFrame("", "some/frame"), "some/frame");
+  EXPECT_EQ(resolveFrame("/", "odom"), "odom") << "a prefix of slashes only is no prefix";
+}
+
+TEST(ResolveFrame, LeadingSlashFrameIsTakenAsItIsWithoutTheSlash) {
+  EXPECT_EQ(resolveFrame("robot1", "/map"), "map");
+  EXPECT_EQ(resolveFrame("", "/odom"), "odom");
+  EXPECT_EQ(resolveFrame("robot1", "/shared/odom"), "shared/odom");
+}
+
+TEST(ResolveFrame, PrefixSlashesAreTrimmedInnerOnesKept) {
+  EXPECT_EQ(resolveFrame("/robot1", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("robot1/", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("//robot1//", "odom"), "robot1/odom");
+  EXPECT_EQ(resolveFrame("fleet/robot1", "imu_link"), "fleet/robot1/imu_link");
+}
+
+TEST(DriverParamsFrames, ResolveFramesPrefixesEveryFrameParameter) {
+  DriverParams params;
+  params.tf_prefix = "robot2";
+  params.imu.frame_id = "/imu_shared";
+  params.resolveFrames();
+  EXPECT_EQ(params.base.odom_frame, "robot2/odom");
+  EXPECT_EQ(params.base.base_frame, "robot2/base_link");
+  EXPECT_EQ(params.imu.frame_id, "imu_shared");
+  EXPECT_NO_THROW(params.validate());
+}
+
+TEST(DriverParamsFrames, BadPrefixOrFrameIsNamed) {
+  DriverParams spaced;
+  spaced.tf_prefix = "robot 1";
+  try {
+    spaced.validate();
+    FAIL() << "a tf_prefix with a space passed";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "tf_prefix");
+  }
+  DriverParams slash_only;
+  slash_only.base.base_frame = "/";
+  slash_only.tf_prefix = "robot1";
+  slash_only.resolveFrames();
+  try {
+    slash_only.validate();
+    FAIL() << "base/base_frame '/' passed";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "base/base_frame");
   }
 }
 

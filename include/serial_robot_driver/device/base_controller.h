@@ -20,6 +20,9 @@
 //  - Odometry (mutex_) integrates the wheel speeds of each speed frame the base accepted, from its
 //    write until the next accepted frame, the base's own 1 s timeout, or an FF error, whichever
 //    comes first. The loop reports a sample after every scheduled tick (on_odometry).
+//  - With use_imu_heading, onImuYaw() runs on the body port's reader thread and only hands the
+//    sample to kinematics::HeadingFusion (its own short lock, never mutex_, so telemetry never
+//    waits for a base write); the loop reads the newest sample when it advances the odometry.
 #pragma once
 
 #include <condition_variable>
@@ -34,6 +37,7 @@
 #include "serial_robot_driver/device/loop_clock.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
+#include "serial_robot_driver/kinematics/heading_fusion.h"
 #include "serial_robot_driver/kinematics/odometry.h"
 #include "serial_robot_driver/protocol/base_codec.h"
 
@@ -56,6 +60,11 @@ struct BaseConfig {
   /// With battery polling on, this many poll periods without any reply mean the base is silent.
   double silent_after_polls = 3.0;
   kinematics::PoseCovarianceModel odometry_covariance;
+  /// Odometry's heading from the IMU yaw given to onImuYaw() while it is fresh (see
+  /// kinematics::HeadingFusion); the commanded turn otherwise.
+  bool use_imu_heading = false;
+  double imu_yaw_variance = 0.0003;  ///< rad^2, odom's yaw variance while the IMU heading is used
+  Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
 };
 
 /// Where the odometry stood after a scheduled tick.
@@ -67,6 +76,13 @@ struct OdometrySample {
   double position_variance = 0;  ///< m^2, x and y
   double yaw_variance = 0;       ///< rad^2
   double travelled = 0;          ///< m since the last reset
+  /// Each wheel's signed path (left, right; m) since the controller started, from the same
+  /// accepted speeds as the pose; reset_odometry leaves it alone (wheel angles do not jump).
+  kinematics::WheelSpeeds wheel_travel = kinematics::WheelSpeeds::Zero();
+  /// Each wheel's speed (left, right; m/s) the base runs at now (0 once its timeout stopped it).
+  kinematics::WheelSpeeds wheel_speeds = kinematics::WheelSpeeds::Zero();
+  /// Where the heading came from (kImu only with use_imu_heading).
+  bool imu_heading = false;
 };
 
 /// One wheel frame as written.
@@ -103,6 +119,11 @@ struct BaseStats {
   double last_period_ms = 0;
   double worst_period_ms = 0;
   std::optional<uint8_t> battery_percent;
+  /// use_imu_heading only: where the heading comes from, how often the IMU went stale, and the
+  /// age of the newest IMU yaw (s).
+  std::optional<kinematics::HeadingSource> heading_source;
+  uint64_t imu_heading_fallbacks = 0;
+  std::optional<double> imu_yaw_age;
 };
 
 /// What the base reports; every hook may be empty. Called without the controller's lock held.
@@ -115,6 +136,8 @@ struct BaseEvents {
   std::function<void(const OdometrySample&)> on_odometry;  ///< after every scheduled tick
   std::function<void()> on_cmd_vel_timeout;                ///< once per timeout, when it starts
   std::function<void(double seconds)> on_silent;           ///< once, when the base goes silent
+  /// use_imu_heading: the heading's source changed (IMU fused, or the IMU went stale); loop thread.
+  std::function<void(kinematics::HeadingSource)> on_heading_source;
 };
 
 class BaseController : public LinkListener {
@@ -130,8 +153,12 @@ class BaseController : public LinkListener {
   /// Engaged: a zero-speed frame goes out at once (no ramp) and zero is held; frames keep flowing.
   /// Released: the wheels stay still until the next cmd_vel.
   void setEStop(bool engaged);
-  /// Puts the odometry pose (and its covariance) back to zero.
+  /// Puts the odometry pose (and its covariance) back to zero; a fused heading restarts at zero
+  /// too.
   void resetOdometry();
+  /// Any thread (the body port's reader): the yaw (rad) of the IMU on the base, measured at
+  /// `stamp`. Used only with use_imu_heading.
+  void onImuYaw(double yaw, Clock::time_point stamp);
   /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
   /// the port's baud (10 bits per byte) divided by immediate_line_share.
   Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
@@ -196,7 +223,10 @@ class BaseController : public LinkListener {
   Clock::time_point next_battery_poll_{};
   bool e_stop_ = false;
   kinematics::Odometry odometry_;
+  kinematics::HeadingFusion heading_;  ///< used with use_imu_heading only
+  kinematics::HeadingSource reported_heading_source_ = kinematics::HeadingSource::kWaitingForImu;
   kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
+  kinematics::WheelSpeeds wheel_travel_ = kinematics::WheelSpeeds::Zero();  ///< see OdometrySample
   std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
   Clock::time_point integrated_until_{};
   std::optional<Clock::time_point> last_reset_sent_;

@@ -1,4 +1,4 @@
-// ROS face of the AP1 base: cmd_vel and e_stop in; wheel_command, odom (+ tf), battery and
+// ROS face of the AP1 base: cmd_vel and e_stop in; wheel_command, odom (+ tf), wheel_states, battery and
 // diagnostics out; base/reset, base/clear_encoders and base/reset_odometry services. The control
 // loop itself is device::BaseController's thread; odom and tf are published from it, once per tick.
 // odom is the motion the base was commanded and accepted, not a measurement: the AP1 reports no
@@ -33,12 +33,15 @@ class BaseInterface : public DeviceInterface {
   /// Stops the loop and writes a zero-speed frame (before the port closes).
   void shutdown() override { controller_.stop(); }
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
+  void onImuYaw(double yaw, device::Clock::time_point stamp) { controller_.onImuYaw(yaw, stamp); }
 
  private:
   device::BaseEvents events();
   void onCmdVel(const geometry_msgs::Twist::ConstPtr& msg);
   void onEStop(const std_msgs::Bool::ConstPtr& msg);
   void publishOdometry(const device::OdometrySample& sample);
+  void publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp);
   bool onResetOdometry(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
@@ -49,6 +52,7 @@ class BaseInterface : public DeviceInterface {
   // Before the controller: its loop publishes through them until it stops.
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
   ros::Publisher odom_pub_;
+  ros::Publisher wheel_states_pub_;  // advertised in the constructor's body
   device::BaseController controller_;
   ros::Publisher wheel_command_pub_;
   ros::Publisher battery_pub_;

@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
+#include <functional>
 #include <memory>
 
 #include "serial_robot_driver/device/body_controller.h"
@@ -30,6 +31,10 @@ class BodyInterface : public DeviceInterface {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
 
   const device::BodyController& controller() const { return controller_; }
+  /// Called on the reader thread with every frame's IMU yaw (imuYaw()) and arrival time. Set it
+  /// before the link starts (~base/use_imu_heading: the base's odometry).
+  using ImuYawListener = std::function<void(double yaw, device::Clock::time_point arrival)>;
+  void setImuYawListener(ImuYawListener listener) { imu_yaw_listener_ = std::move(listener); }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -51,6 +56,7 @@ class BodyInterface : public DeviceInterface {
   ros::Publisher foot_pressure_pub_;
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
+  ImuYawListener imu_yaw_listener_;
   // Diagnostics timer thread only.
   uint64_t frames_at_last_diagnose_ = 0;
   bool telemetry_stop_logged_ = false;

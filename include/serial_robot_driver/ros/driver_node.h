@@ -60,6 +60,8 @@ class DriverNode {
     std::unique_ptr<PortMonitor> monitor;
   };
   device::SerialLink& portFor(const std::string& path);
+  /// ~base/use_imu_heading: feeds the body's IMU yaw to the base's odometry.
+  void connectImuHeading();
   /// One line for the log: ports, the devices on each, rates.
   std::string startupSummary() const;
   void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);

@@ -62,6 +62,10 @@ struct BaseParams : DevicePortParams {
   /// 1 or -1: sign between forward motion and the wire's ticks
   int left_wheel_direction = kBaseDefaults.left_wheel_direction;
   int right_wheel_direction = kBaseDefaults.right_wheel_direction;
+  std::string left_wheel_joint = "left_wheel_joint";  ///< wheel_states and robot description names
+  std::string right_wheel_joint = "right_wheel_joint";
+  /// odom's heading from the body's IMU while its telemetry is fresh (device::BaseConfig).
+  bool use_imu_heading = kBaseDefaults.use_imu_heading;
 };
 
 struct BodyParams : DevicePortParams {
@@ -106,6 +110,12 @@ struct ServoBusParams : DevicePortParams {
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
 };
 
+/// The tf frame name of a frame parameter under `tf_prefix`, as robot_state_publisher resolves its
+/// links: "<prefix>/<frame>" with the prefix's own leading and trailing slashes dropped
+/// ("/robot1/" and "robot1" alike); a frame written with a leading '/' is taken as it is, without
+/// the slash; an empty prefix leaves the frame as configured. The one place a frame name is made.
+std::string resolveFrame(const std::string& tf_prefix, const std::string& frame);
+
 /// Below this loop rate the base's 1 s heartbeat is at risk (validate() says so).
 constexpr double kMinBaseLoopRate = 5.0;
 
@@ -121,6 +131,13 @@ struct DriverParams {
   BodyParams body;
   ImuParams imu;
   ServoBusParams servo_bus;
+  /// Not a ~ parameter: `tf_prefix` searched upward from the node's namespace (as
+  /// robot_state_publisher does), so one value in a robot's namespace serves all its nodes.
+  std::string tf_prefix;
+
+  /// Puts every frame parameter (base/odom_frame, base/base_frame, imu/frame_id) under tf_prefix
+  /// (resolveFrame). loadParams(NodeHandle) calls it once, after reading tf_prefix.
+  void resolveFrames();
 
   /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
   void validate() const;
