@@ -81,10 +81,11 @@ void baudOrInherit(const int& value, const std::string& key) { requireBaud(value
 /// Whether a key's range check applies: a device's keys (and the IMU's, which the body reports)
 /// are checked only while that device is enabled.
 bool checked(const DriverParams& p, const std::string& key) {
-  const std::string device = key.substr(0, key.find('/'));
-  if (device == "base") return p.base.enabled;
-  if (device == "body" || device == "imu") return p.body.enabled;
-  if (device == "servo_bus") return p.servo_bus.enabled;
+  const std::string prefix = key.substr(0, key.find('/'));
+  if (prefix == "imu") return p.enabled(device::DeviceKind::kBody);
+  for (const device::DeviceDescription& device : device::deviceSet()) {
+    if (prefix == device.name) return p.enabled(device.kind);
+  }
   return true;
 }
 
