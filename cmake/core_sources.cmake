@@ -28,6 +28,8 @@ set(SRD_CORE_SOURCES
   src/device/servo_bus_motion.cpp
   src/device/servo_bus_text.cpp
   src/device/servo_bus.cpp
+  src/device/e_stop.cpp
+  src/device/servo_bus_safety.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

@@ -34,6 +34,7 @@ void ServoBus::onFrame(protocol::FrameFamily family, const uint8_t* data, std::s
 void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (motion_locked_) return;  // the e-stop holds: the caller refused (and counted) it already
     for (const MoveRequest& move : moves) {
       auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
                                  [&move](const MoveRequest& m) { return m.id == move.id; });
@@ -63,13 +64,15 @@ void ServoBus::start() {
 }
 
 void ServoBus::shutdown() {
-  client_.shutdown();  // wakes a call waiting on the bus, so the worker stops quickly
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
   }
   wake_.notify_all();
+  // The worker's poll is one background transaction at most.
   if (worker_.joinable()) worker_.join();
+  finalWords();
+  client_.shutdown();  // every later call fails at once
 }
 
 ServoBusWorkerStats ServoBus::stats() const {
@@ -113,6 +116,7 @@ void ServoBus::workerLoop() {
 
 void ServoBus::sendMove(const MoveRequest& move) {
   const ServoStatus status = client_.move(move);
+  if (status.ok()) noteMotion(move.id, true);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (status.ok()) {

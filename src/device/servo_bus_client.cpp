@@ -41,6 +41,8 @@ const char* toString(ServoError error) {
       return "port not connected";
     case ServoError::kIdInUse:
       return "servo id in use";
+    case ServoError::kMotionRefused:
+      return "motion refused";
     case ServoError::kTimeout:
       return "timeout";
     case ServoError::kBadAnswer:

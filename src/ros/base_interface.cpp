@@ -118,9 +118,6 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
   // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.
   cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &BaseInterface::onCmdVel, this,
                               ros::TransportHints().tcpNoDelay());
-  // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
-  e_stop_sub_ =
-      nh.subscribe("e_stop", 10, &BaseInterface::onEStop, this, ros::TransportHints().tcpNoDelay());
   reset_srv_ = nh.advertiseService("base/reset", &BaseInterface::onReset, this);
   reset_odometry_srv_ =
       nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
@@ -128,19 +125,17 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
 }
 
 void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {
+  // Counted with the other refused commands; the controller ignores it (and counts it) itself.
+  if (e_stop_) e_stop_->refuse("cmd_vel");
   if (!controller_.setCommand(msg->linear.x, msg->angular.z)) {
     ROS_WARN_THROTTLE(1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
                       msg->linear.x, msg->angular.z);
   }
 }
 
-void BaseInterface::onEStop(const std_msgs::Bool::ConstPtr& msg) {
-  controller_.setEStop(msg->data);
-  if (msg->data) {
-    ROS_WARN("e_stop engaged: holding zero speed, cmd_vel ignored until e_stop is false");
-  } else {
-    ROS_INFO("e_stop released: obeying cmd_vel from the next message");
-  }
+void BaseInterface::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  e_stop.addListener([this](bool engaged) { controller_.setEStop(engaged); });
 }
 
 void BaseInterface::publishOdometry(const device::OdometrySample& sample) {

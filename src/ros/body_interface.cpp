@@ -73,6 +73,10 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
 }
 
 void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
+  if (e_stop_ && e_stop_->refuse("joint_commands")) {
+    ROS_WARN_THROTTLE(1.0, "joint_commands refused: e_stop is engaged");
+    return;
+  }
   const JointCommand command = fromJointState(*msg);
   device::JointCommandResult result;
   const auto send = [&] {

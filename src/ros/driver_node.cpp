@@ -145,6 +145,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, std::move(trajectory_joints));
     for (auto& device : devices_) device->attachTrajectories(trajectory_.get());
   }
+  connectEStop();
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
@@ -172,6 +173,46 @@ void DriverNode::connectImuHeading() {
     // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
     base->onImuYaw(yaw, replaying ? device::Clock::now() : arrival);
   });
+}
+
+void DriverNode::connectEStop() {
+  // The trajectories stop first, so no trajectory move follows a device's stop.
+  if (trajectory_) trajectory_->attachEStop(e_stop_);
+  for (auto& device : devices_) device->attachEStop(e_stop_);
+  // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
+  e_stop_sub_ = nh_.subscribe("e_stop", 10, &DriverNode::onEStop, this,
+                              ros::TransportHints().tcpNoDelay());
+  diagnostics_.add("e_stop", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
+    diagnoseEStop(s);
+  });
+}
+
+void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
+  if (!e_stop_.set(msg->data)) return;
+  if (msg->data) {
+    ROS_WARN("e_stop engaged: every actuator stopped (base at zero speed, trajectories aborted, "
+             "bus servos stopped); motion commands refused until e_stop is false");
+  } else {
+    ROS_INFO("e_stop released: motion commands obeyed from the next one");
+  }
+}
+
+void DriverNode::diagnoseEStop(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const device::EStopStats stats = e_stop_.stats();
+  if (stats.engaged) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "engaged: every actuator stopped, motion commands refused");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "released");
+  }
+  status.add("engaged", stats.engaged);
+  status.add("engagements", stats.engagements);
+  uint64_t refused = 0;
+  for (const auto& [source, count] : stats.refused) {
+    status.add("refused: " + source, count);
+    refused += count;
+  }
+  status.add("commands refused", refused);
 }
 
 device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }
@@ -212,6 +253,7 @@ void DriverNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   diagnostics_timer_.stop();
+  e_stop_sub_.shutdown();
   if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop
   // Base first: its zero-speed frame goes out while the port is still open.
   for (auto& device : devices_) device->shutdown();

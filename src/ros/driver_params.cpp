@@ -297,6 +297,16 @@ std::vector<ParamSpec> buildTable() {
           [](const std::vector<int>& directions, const std::string& key) {
             for (int d : directions) require(d == 1 || d == -1, key, "entries must be 1 or -1");
           }),
+      // Safe motion.
+      row("servo_bus/relax_power_mw", &P::servo_bus, &Bus::relax_power_mw,
+          [](const int& v, const std::string& key) {
+            require(v >= 0 && v <= 65535, key, "must be 0..65535 mW");
+          }),
+      row("servo_bus/on_shutdown", &P::servo_bus, &Bus::on_shutdown,
+          [](const std::string& v, const std::string& key) {
+            require(device::shutdownActionFromString(v).has_value(), key,
+                    "must be stop, relax or none, got '" + v + "'");
+          }),
   };
 }
 

@@ -164,6 +164,10 @@ device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
     }
   }
   config.poll_rate = params.servo_bus.state_rate;
+  config.relax_power_mw = static_cast<uint16_t>(params.servo_bus.relax_power_mw);
+  // validate() accepted only the names shutdownActionFromString() knows.
+  config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
+                           .value_or(device::ShutdownAction::kStop);
   return config;
 }
 
@@ -198,7 +202,8 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
       client_(bus_.client()),
       nh_(nh),
       topics_nh_(nh),
-      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
+      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)),
+      on_shutdown_(params.servo_bus.on_shutdown) {
   link_.addListener(&bus_);
 
   // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
@@ -255,8 +260,10 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                   request.accel_ms = req.accel_ms;
                                   request.decel_ms = req.decel_ms;
                                   request.power_mw = req.power_mw;
+                                  device::ServoStatus refused = refuseWhileEStopped("servo/move");
+                                  if (!refused.ok()) return refused;
                                   yieldJoint(req.id, "servo/move");
-                                  return client_.move(request);
+                                  return bus_.move(request);
                                 }),
       advertiseServo<ServoScan>(nh_, "servo/scan",
                                 [this](ServoScan::Request& req, ServoScan::Response& res) {
@@ -270,8 +277,11 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                     request.interval_ms = req.interval_ms;
                                     request.power_mw = req.power_mw;
                                     request.wait = req.wait;
+                                    device::ServoStatus refused =
+                                        refuseWhileEStopped("servo/rotate");
+                                    if (!refused.ok()) return refused;
                                     yieldJoint(req.id, "servo/rotate");
-                                    return client_.rotate(request);
+                                    return bus_.rotate(request);
                                   }),
       advertiseServo<ServoSpin>(nh_, "servo/spin",
                                 [this](ServoSpin::Request& req, ServoSpin::Response&) {
@@ -282,14 +292,36 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                   request.speed_dps = req.speed_dps;
                                   request.value = req.value;
                                   request.wait = req.wait;
+                                  // A SPIN stop is no motion: it works while the e-stop holds.
+                                  if (req.mode != 0) {
+                                    device::ServoStatus refused = refuseWhileEStopped("servo/spin");
+                                    if (!refused.ok()) return refused;
+                                  }
                                   yieldJoint(req.id, "servo/spin");
-                                  return client_.spin(request);
+                                  return bus_.spin(request);
                                 }),
       advertiseServo<ServoDamping>(nh_, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
+                                     device::ServoStatus refused =
+                                         refuseWhileEStopped("servo/damping");
+                                     if (!refused.ok()) return refused;
                                      yieldJoint(req.id, "servo/damping");
-                                     return client_.damping(req.id, req.power_mw, req.wait);
+                                     return bus_.damping(req.id, req.power_mw, req.wait);
                                    }),
+      advertiseServo<ServoRelax>(nh_, "servo/relax",
+                                 [this](ServoRelax::Request& req, ServoRelax::Response&) {
+                                   device::ServoStatus refused = refuseWhileEStopped("servo/relax");
+                                   if (!refused.ok()) return refused;
+                                   for (uint8_t id : req.ids) yieldJoint(id, "servo/relax");
+                                   return bus_.relax(req.ids);
+                                 }),
+      advertiseServo<ServoHold>(nh_, "servo/hold",
+                                [this](ServoHold::Request& req, ServoHold::Response&) {
+                                  device::ServoStatus refused = refuseWhileEStopped("servo/hold");
+                                  if (!refused.ok()) return refused;
+                                  for (uint8_t id : req.ids) yieldJoint(id, "servo/hold");
+                                  return bus_.hold(req.ids);
+                                }),
       advertiseServo<ServoReadAll>(nh_, "servo/read_all",
                                    [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
                                      std::vector<device::ServoParamValue> values;
@@ -323,6 +355,10 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
 }
 
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
+  if (!refuseWhileEStopped("servo_commands").ok()) {
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands refused, nothing sent: e_stop is engaged");
+    return;
+  }
   const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
   if (!batch.error.empty()) {
     commands_rejected_.fetch_add(1);
@@ -346,6 +382,26 @@ void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr&
   } else {
     queue();
   }
+}
+
+device::ServoStatus ServoBusInterface::refuseWhileEStopped(const std::string& source) {
+  if (!e_stop_ || !e_stop_->refuse(source)) return {};
+  return {device::ServoError::kMotionRefused,
+          "e_stop is engaged: no servo moves until it is released (publish false on e_stop)"};
+}
+
+void ServoBusInterface::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  // On the e_stop subscriber's thread: the SPIN stops take the bus as a caller, ahead of the poll.
+  e_stop.addListener([this](bool engaged) {
+    const std::vector<uint8_t> moving = bus_.movingIds();
+    bus_.setMotionLocked(engaged);
+    if (engaged && !moving.empty()) {
+      std::string ids;
+      for (uint8_t id : moving) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+      ROS_WARN("e_stop: SPIN stop sent to bus servo(s) %s", ids.c_str());
+    }
+  });
 }
 
 void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
@@ -425,6 +481,11 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("servo_commands moves sent", worker.moves_sent);
   status.add("servo_commands rejected", commands_rejected_.load());
   status.add("servo_commands moves failed", worker.moves_failed);
+  std::string moving;
+  for (uint8_t id : bus_.movingIds()) moving += (moving.empty() ? "" : ", ") + std::to_string(id);
+  status.add("servos set moving", moving.empty() ? std::string("none") : moving);
+  status.add("motion locked (e_stop)", bus_.motionLocked());
+  status.add("on shutdown", on_shutdown_);
   if (!offline.empty() && link_.connected()) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                         "polled servos not answering: " + offline);

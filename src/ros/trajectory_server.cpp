@@ -225,6 +225,11 @@ void TrajectoryServer::onGoal(GoalHandle handle) {
                        "the driver is not running");
     return;
   }
+  if (e_stop_ && e_stop_->refuse("follow_joint_trajectory")) {
+    ROS_WARN("follow_joint_trajectory: goal rejected: e_stop is engaged");
+    handle.setRejected(result(Result::INVALID_GOAL, "e_stop is engaged"), "e_stop is engaged");
+    return;
+  }
   const trajectory::CommandCheck checked = check(command, start, now);
   if (!checked.ok()) {
     ROS_WARN("follow_joint_trajectory: goal rejected: %s", checked.message.c_str());
@@ -276,6 +281,10 @@ void TrajectoryServer::onTrajectory(const trajectory_msgs::JointTrajectory::Cons
   const double start = msg->header.stamp.isZero() ? now : msg->header.stamp.toSec();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return;
+  if (e_stop_ && e_stop_->refuse("joint_trajectory")) {
+    ROS_WARN_THROTTLE(1.0, "joint_trajectory: message ignored, nothing moves: e_stop is engaged");
+    return;
+  }
   const trajectory::CommandCheck checked = check(command, start, now);
   if (!checked.ok()) {
     ROS_WARN_THROTTLE(1.0, "joint_trajectory: message ignored, nothing moves: %s",
@@ -318,6 +327,13 @@ void TrajectoryServer::stopAll(const std::string& reason) {
   for (const ActiveGoal& goal : goals_) all.insert(all.end(), goal.joints.begin(), goal.joints.end());
   endGoalsOn(all, false, Result::INVALID_GOAL, reason);
   hold(all, ros::Time::now().toSec());
+}
+
+void TrajectoryServer::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  e_stop.addListener([this](bool engaged) {
+    if (engaged) stopAll("e_stop engaged");
+  });
 }
 
 void TrajectoryServer::onTick(const ros::TimerEvent&) {

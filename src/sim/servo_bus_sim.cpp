@@ -342,6 +342,7 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
           return;
         case servo::SpinMode::kContinuous:
           stopAll(s);
+          s->relaxed = false;
           s->spin_rate_dps = rate;
           reply({id, 1});
           return;
@@ -370,6 +371,7 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
 
     case Command::kDamping:
       stopAll(s);  // damping releases the holding torque: nothing keeps moving
+      s->relaxed = true;
       reply({id, 1});
       break;
 
@@ -391,6 +393,7 @@ void ServoBusSim::stopAll(Servo* s) {
 void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
   if (!motion.answer) stopAll(s);  // response_switch 0: the new command interrupts
   s->spin_rate_dps = 0.0;
+  s->relaxed = false;
   s->motions.push_back(motion);
   runMotions(s, now);
 }
@@ -481,6 +484,7 @@ ServoBusSimStats ServoBusSim::stats() const {
     snapshot.id = static_cast<uint8_t>(param(s, kServoId));
     snapshot.angle_deg = s.angle_deg;
     snapshot.moving = !s.motions.empty() || s.spin_rate_dps != 0.0;
+    snapshot.relaxed = s.relaxed;
     snapshot.params = s.params;
     copy.servos.push_back(std::move(snapshot));
   }

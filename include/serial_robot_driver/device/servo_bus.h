@@ -22,6 +22,8 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,10 +34,18 @@
 
 namespace serial_robot_driver::device {
 
+/// What servos set moving get when the bus shuts down (before its port closes).
+enum class ShutdownAction { kStop, kRelax, kNone };
+/// "stop", "relax", "none"; nullopt for anything else.
+std::optional<ShutdownAction> shutdownActionFromString(const std::string& text);
+
 struct ServoBusConfig {
   ServoBusOptions client;
   std::vector<uint8_t> polled_ids;  ///< servos whose angle is polled (servo_states)
   double poll_rate = 10.0;          ///< polls per second of each polled servo, > 0
+  uint16_t relax_power_mw = 50;     ///< DAMPING power of relax()
+  /// For each servo set spinning or moving: kStop a SPIN stop, kRelax relax(), kNone nothing.
+  ShutdownAction on_shutdown = ShutdownAction::kStop;
 };
 
 /// One polled angle.
@@ -85,9 +95,32 @@ class ServoBus : public LinkListener {
   /// Drops a move of servo `id` still waiting in the queue (another command took the servo over).
   void dropQueuedMoves(uint8_t id);
 
+  // Motion through the device: the client's operations, refused (kMotionRefused) while
+  // setMotionLocked(true) holds, and noted so the device knows which servos it set moving
+  // (stopMotion(), the shutdown). Any thread.
+  ServoStatus move(const MoveRequest& request);
+  ServoStatus rotate(const RotateRequest& request);
+  ServoStatus spin(const SpinRequest& request);
+  ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait);
+  /// DAMPING at config().relax_power_mw for each of `ids` (empty: every polled servo): the
+  /// servos can be turned by hand. Stops at the first failure.
+  ServoStatus relax(const std::vector<uint8_t>& ids);
+  /// Each of `ids` (empty: every polled servo) holds the angle it is at now: READ_ANGLE, then a
+  /// ROTATE there. Stops at the first failure.
+  ServoStatus hold(const std::vector<uint8_t>& ids);
+
+  /// The e-stop: true drops the queued moves, refuses motion (queueMoves() included) and sends a
+  /// SPIN stop to every servo set spinning or moving; false lets motion through again.
+  void setMotionLocked(bool locked);
+  bool motionLocked() const;
+  /// Servos set spinning or moving and not stopped or relaxed since (the broadcast id 255 too).
+  std::vector<uint8_t> movingIds() const;
+
   /// Starts the worker thread. Idempotent.
   void start();
-  /// Fails a call in progress (kShutdown), stops and joins the worker. Idempotent.
+  /// Stops and joins the worker, gives the servos set moving what config().on_shutdown says
+  /// (while the port is still open; after a service call in progress), then fails every later
+  /// call (kShutdown). Idempotent.
   void shutdown();
 
   ServoBusWorkerStats stats() const;
@@ -107,6 +140,12 @@ class ServoBus : public LinkListener {
   };
 
   void workerLoop();
+  /// Notes the outcome of a motion command of servo `id`: moving or at rest.
+  void noteMotion(uint8_t id, bool moving);
+  /// SPIN stop to each servo set moving; the last failure (ok when every stop went out).
+  ServoStatus stopMoving();
+  ServoStatus refuseWhileLocked(uint8_t id) const;
+  void finalWords();
   void sendMove(const MoveRequest& move);
   void pollOnce(PolledServo& servo);
 
@@ -122,6 +161,9 @@ class ServoBus : public LinkListener {
   bool started_ = false;
   std::deque<MoveRequest> queued_moves_;
   std::vector<PolledServo> polled_;  // schedule changed by the worker only
+  std::set<uint8_t> moving_;          // servos set moving and not stopped since
+  bool motion_locked_ = false;
+  bool final_words_said_ = false;
   ServoBusWorkerStats stats_;
   std::thread worker_;
 };

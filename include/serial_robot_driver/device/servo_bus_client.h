@@ -43,6 +43,7 @@ enum class ServoError {
   kDangerous,         ///< servo_id / baudrate / reset_user_data without allow_dangerous_writes
   kNotConnected,      ///< the port is down (or was lost while waiting)
   kIdInUse,           ///< servo_id change refused: a servo already answers at the new id
+  kMotionRefused,     ///< a motion command while the e-stop holds or the servo is protected
   kTimeout,           ///< no answer in any attempt
   kBadAnswer,         ///< an answer with the right CMD and id whose content does not fit
   kRefused,           ///< the servo answered with result 0

@@ -1,4 +1,4 @@
-// ROS face of the AP1 base: cmd_vel and e_stop in; wheel_command, odom (+ tf), wheel_states, battery and
+// ROS face of the AP1 base: cmd_vel in (and the node's e-stop); wheel_command, odom (+ tf), wheel_states, battery and
 // diagnostics out; base/reset, base/clear_encoders and base/reset_odometry services. The control
 // loop itself is device::BaseController's thread; odom and tf are published from it, once per tick.
 // odom is the motion the base was commanded and accepted, not a measurement: the AP1 reports no
@@ -8,7 +8,6 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
-#include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -33,13 +32,14 @@ class BaseInterface : public DeviceInterface {
   /// Stops the loop and writes a zero-speed frame (before the port closes).
   void shutdown() override { controller_.stop(); }
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// Engaged: zero speed held at once (frames keep flowing as the heartbeat), cmd_vel ignored.
+  void attachEStop(device::EStop& e_stop) override;
   /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
   void onImuYaw(double yaw, device::Clock::time_point stamp) { controller_.onImuYaw(yaw, stamp); }
 
  private:
   device::BaseEvents events();
   void onCmdVel(const geometry_msgs::Twist::ConstPtr& msg);
-  void onEStop(const std_msgs::Bool::ConstPtr& msg);
   void publishOdometry(const device::OdometrySample& sample);
   void publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp);
   bool onResetOdometry(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
@@ -57,7 +57,7 @@ class BaseInterface : public DeviceInterface {
   ros::Publisher wheel_command_pub_;
   ros::Publisher battery_pub_;
   ros::Subscriber cmd_vel_sub_;
-  ros::Subscriber e_stop_sub_;
+  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
   ros::ServiceServer reset_odometry_srv_;
   ros::ServiceServer reset_srv_;
   ros::ServiceServer clear_encoders_srv_;

@@ -39,6 +39,8 @@ class BodyInterface : public DeviceInterface {
   /// The body's joints, streamed: one sync-write frame per loop tick.
   std::vector<TrajectoryJoints> trajectoryJoints() override;
   void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
+  /// joint_commands are refused while it holds.
+  void attachEStop(device::EStop& e_stop) override { e_stop_ = &e_stop; }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -63,6 +65,7 @@ class BodyInterface : public DeviceInterface {
   ImuYawListener imu_yaw_listener_;
   // The node's trajectory server (its own threading comment); set before the link starts.
   TrajectoryServer* trajectory_ = nullptr;
+  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
   // Diagnostics timer thread only.
   uint64_t frames_at_last_diagnose_ = 0;
   bool telemetry_stop_logged_ = false;

@@ -8,6 +8,8 @@
 
 #include <vector>
 
+#include "serial_robot_driver/device/e_stop.h"
+
 namespace serial_robot_driver::ros_layer {
 
 class TrajectoryServer;
@@ -28,6 +30,9 @@ class DeviceInterface {
   /// The node's trajectory server, given before start() when trajectoryJoints() had joints: the
   /// device reports their measurements to it and lets it know when another command takes them.
   virtual void attachTrajectories(TrajectoryServer* /*server*/) {}
+  /// The node's one e-stop, given before start(): the device registers what engaging it means
+  /// for its actuators and refuses motion commands while it holds. It outlives the device.
+  virtual void attachEStop(device::EStop& /*e_stop*/) {}
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -2,12 +2,13 @@
 //
 // The devices it drives are the device set (device/device_set.h); each has a ROS interface of its
 // own (ros/*_interface.h) with its topics and services, listed in full in docs/node_api.md:
-//   base      in cmd_vel, e_stop; out odom (+ tf), wheel_command, battery;
+//   base      in cmd_vel; out odom (+ tf), wheel_command, battery;
 //             base/reset, base/reset_odometry, base/clear_encoders
 //   body      in joint_commands; out joint_states, imu/data, foot_pressure, telemetry
 //   servo_bus in servo_commands; out servo_states; servo/ping, read, write, read_angle, move,
 //             scan, rotate, spin, damping, read_all, reset_user_data
-// and the node itself: /diagnostics (one status per port and per device), serial_raw (with
+// and the node itself: e_stop (one device::EStop handed to every device and the trajectories),
+// /diagnostics (one status per port and per device), serial_raw (with
 // ~capture), the follow_joint_trajectory action and joint_trajectory topic for the joints of every
 // device (ros/trajectory_server.h). Parameters: see ros/driver_params.h and config/robot.yaml.
 //
@@ -31,7 +32,9 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
+#include <std_msgs/Bool.h>
 
+#include "serial_robot_driver/device/e_stop.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -70,9 +73,16 @@ class DriverNode {
   /// One line for the log: ports, the devices on each, rates.
   std::string startupSummary() const;
   void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// Hands the e-stop to the trajectories and the devices and subscribes e_stop.
+  void connectEStop();
+  void onEStop(const std_msgs::Bool::ConstPtr& msg);
+  void diagnoseEStop(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_;
   DriverParams params_;
+  /// The one e-stop of every actuator; outlives the devices and the trajectory server.
+  device::EStop e_stop_;
+  ros::Subscriber e_stop_sub_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
   std::map<std::string, Port> ports_;

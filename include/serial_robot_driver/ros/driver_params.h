@@ -115,6 +115,9 @@ struct ServoBusParams : DevicePortParams {
   std::vector<std::string> joint_names;
   std::vector<double> joint_zero_deg;  ///< servo angle at joint position 0; empty: all 0
   std::vector<int> joint_directions;   ///< 1 or -1; empty: all 1
+  // Safe motion: servo/relax's DAMPING power; what servos set moving get when the node stops.
+  int relax_power_mw = kServoBusDefaults.relax_power_mw;  ///< mW
+  std::string on_shutdown = "stop";                       ///< stop | relax | none
 };
 
 /// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override them).

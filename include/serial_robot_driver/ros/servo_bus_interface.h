@@ -23,11 +23,13 @@
 #include <vector>
 
 #include "serial_robot_driver/ServoDamping.h"
+#include "serial_robot_driver/ServoHold.h"
 #include "serial_robot_driver/ServoMove.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoReadAll.h"
 #include "serial_robot_driver/ServoReadAngle.h"
+#include "serial_robot_driver/ServoRelax.h"
 #include "serial_robot_driver/ServoResetUserData.h"
 #include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/ServoScan.h"
@@ -80,6 +82,9 @@ class ServoBusInterface : public DeviceInterface {
   /// ~servo_bus/joint_ids as trajectory joints: one queued move per segment.
   std::vector<TrajectoryJoints> trajectoryJoints() override;
   void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
+  /// Engaged: queued moves dropped, a SPIN stop to every servo the driver set moving; motion
+  /// services and servo_commands refused until it is released (reads, pings, scans still work).
+  void attachEStop(device::EStop& e_stop) override;
 
  private:
   device::ServoBusEvents makeEvents();
@@ -87,6 +92,8 @@ class ServoBusInterface : public DeviceInterface {
   /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
   /// trajectory stops (its goal aborts) and its queued move is dropped.
   void yieldJoint(uint8_t id, const char* source);
+  /// A motion service or topic while the e-stop holds: counted, and its refusal (else ok).
+  device::ServoStatus refuseWhileEStopped(const std::string& source);
 
   // Bus servos as joints (trajectories): fixed before the bus starts, read on the worker thread.
   const std::vector<trajectory::BusJoint> bus_joints_;
@@ -108,6 +115,8 @@ class ServoBusInterface : public DeviceInterface {
   ros::Subscriber commands_sub_;
   const uint16_t command_interval_ms_;
   std::atomic<uint64_t> commands_rejected_{0};
+  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
+  const std::string on_shutdown_;
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
+#include "serial_robot_driver/device/e_stop.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/trajectory/command.h"
 #include "serial_robot_driver/trajectory/spline.h"
@@ -75,6 +76,9 @@ class TrajectoryServer {
 
   /// Aborts every goal and holds every joint where it is, with `reason` (the e-stop's hook).
   void stopAll(const std::string& reason);
+  /// The node's e-stop (before start()): engaging it calls stopAll(); while it holds, goals are
+  /// rejected and joint_trajectory messages ignored, both counted.
+  void attachEStop(device::EStop& e_stop);
 
  private:
   struct Track {
@@ -146,6 +150,7 @@ class TrajectoryServer {
   std::vector<Track> tracks_;
   std::vector<ActiveGoal> goals_;
   bool running_ = false;
+  device::EStop* e_stop_ = nullptr;
   actionlib::ActionServer<Action> action_server_;
   ros::Subscriber trajectory_sub_;
   ros::Timer timer_;

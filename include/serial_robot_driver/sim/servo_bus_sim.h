@@ -36,6 +36,7 @@ struct BusServoSnapshot {
   uint8_t id = 0;
   double angle_deg = 0.0;
   bool moving = false;
+  bool relaxed = false;  ///< DAMPING since the last motion command: no holding torque
   /// Every parameter by data_id (read-only ones included).
   std::map<uint8_t, int64_t> params;
 };
@@ -88,6 +89,7 @@ class ServoBusSim {
     std::map<uint8_t, int64_t> params;
     std::deque<Motion> motions;  ///< front runs; the rest are queued (response_switch 1)
     TimePoint last_step;
+    bool relaxed = false;  ///< DAMPING since the last motion command
   };
   struct PendingAnswer {
     TimePoint due;
