@@ -29,7 +29,7 @@ class DriverNodelet : public nodelet::Nodelet {
     replay_start_.stop();
     replay_watch_.stop();
     if (!driver_) return;
-    NODELET_INFO("shutting down: stopping the wheels");
+    NODELET_INFO("shutting down: stopping the wheels and the bus servos");
     driver_->shutdown();
   }
 

@@ -110,7 +110,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
     ROS_INFO("%s", replay->summary().c_str());
     std::this_thread::sleep_for(kReplayLinger);
   }
-  ROS_INFO("shutting down: stopping the wheels");
+  ROS_INFO("shutting down: stopping the wheels and the bus servos");
   node.shutdown();
   spinner.stop();
   ros::shutdown();

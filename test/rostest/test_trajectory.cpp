@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
+#include <std_msgs/Bool.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
 #include <cmath>
@@ -263,6 +264,44 @@ TEST_F(TrajectoryTest, JointCommandTakesOverAndAbortsTheGoal) {
   EXPECT_EQ(client_.getState(), State::ABORTED);
   EXPECT_NE(errorString().find("joint_commands"), std::string::npos) << errorString();
   ASSERT_TRUE(waitFor([] { return std::abs(simJoint(1) + 0.3) < 0.01; }, 30));
+}
+
+// The node's e-stop: the running goal aborts, and while it holds new goals are rejected and
+// joint_trajectory and joint_commands move nothing; released, goals run again.
+TEST_F(TrajectoryTest, EStopAbortsTheGoalAndRefusesMotionUntilReleased) {
+  ros::Publisher e_stop = nh_.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true);
+  ASSERT_TRUE(waitFor([&] { return e_stop.getNumSubscribers() > 0; }, 20));
+  waitStill();
+  client_.sendGoal(goalTo({1.0, 0.5}, 4.0));
+  ASSERT_TRUE(waitFor([&] { return client_.getState() == State::ACTIVE; }, 30));
+  std_msgs::Bool engaged;
+  engaged.data = true;
+  e_stop.publish(engaged);
+  ASSERT_TRUE(client_.waitForResult(ros::Duration(30)));
+  EXPECT_EQ(client_.getState(), State::ABORTED);
+  EXPECT_NE(errorString().find("e_stop"), std::string::npos) << errorString();
+  waitStill();
+
+  client_.sendGoal(goalTo({-0.5, -0.5}, 1.0));
+  ASSERT_TRUE(client_.waitForResult(ros::Duration(30)));
+  EXPECT_EQ(client_.getState(), State::REJECTED);
+  const uint64_t writes = syncWrites();
+  trajectory_msgs::JointTrajectory msg;
+  msg.joint_names = {"joint_1"};
+  msg.points = {point({0.2}, 1.0)};
+  topic_.publish(msg);
+  sensor_msgs::JointState command;
+  command.name = {"joint_2"};
+  command.position = {-0.3};
+  joint_commands_.publish(command);
+  test_support::sleepSeconds(1.0);
+  EXPECT_EQ(syncWrites(), writes) << "a joint moved while the e-stop held";
+
+  std_msgs::Bool released;
+  released.data = false;
+  e_stop.publish(released);
+  test_support::sleepSeconds(0.5);
+  EXPECT_EQ(run(goalTo({-0.2, 0.1}, 1.0), State::SUCCEEDED), 0) << errorString();
 }
 
 TEST_F(TrajectoryTest, BusServoJointFollowsOneMovePerSegment) {
