@@ -31,6 +31,7 @@ set(SRD_CORE_SOURCES
   src/device/e_stop.cpp
   src/device/servo_bus_safety.cpp
   src/device/servo_health.cpp
+  src/device/servo_bus_health.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

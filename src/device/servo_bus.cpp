@@ -20,6 +20,16 @@ ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents eve
     servo.next_poll = now;
     polled_.push_back(servo);
   }
+  if (config_.health_rate > 0.0) {
+    health_period_ = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(1.0 / config_.health_rate));
+    for (uint8_t id : config_.polled_ids) {
+      HealthServo servo;
+      servo.report.id = id;
+      servo.next_poll = now;
+      health_.push_back(servo);
+    }
+  }
 }
 
 ServoBus::~ServoBus() { shutdown(); }
@@ -103,8 +113,20 @@ void ServoBus::workerLoop() {
       wake_.wait(lock, [this] { return stop_ || !queued_moves_.empty(); });
       continue;
     }
+    // Health polls are background work of a second kind, due at their own (lower) rate.
+    const Clock::time_point health_due = nextHealthPoll();
+    if (health_due <= clock_->now()) {
+      const auto first = std::min_element(
+          health_.begin(), health_.end(),
+          [](const HealthServo& a, const HealthServo& b) { return a.next_poll < b.next_poll; });
+      const auto index = static_cast<std::size_t>(first - health_.begin());
+      lock.unlock();
+      pollHealthOnce(index);
+      lock.lock();
+      continue;
+    }
     if (clock_->now() < due->next_poll) {
-      clock_->waitUntil(lock, wake_, due->next_poll);
+      clock_->waitUntil(lock, wake_, std::min(due->next_poll, health_due));
       continue;
     }
     PolledServo& servo = *due;
@@ -115,7 +137,8 @@ void ServoBus::workerLoop() {
 }
 
 void ServoBus::sendMove(const MoveRequest& move) {
-  const ServoStatus status = client_.move(move);
+  ServoStatus status = refuseWhileLocked(move.id);  // an overheated servo (protect)
+  if (status.ok()) status = client_.move(move);
   if (status.ok()) noteMotion(move.id, true);
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -35,9 +35,22 @@ void ServoBus::noteMotion(uint8_t id, bool moving) {
 
 ServoStatus ServoBus::refuseWhileLocked(uint8_t id) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!motion_locked_) return {};
-  return {ServoError::kMotionRefused,
-          "e_stop is engaged: " + servoLabel(id) + " does not move until it is released"};
+  if (motion_locked_) {
+    return {ServoError::kMotionRefused,
+            "e_stop is engaged: " + servoLabel(id) + " does not move until it is released"};
+  }
+  for (const HealthServo& servo : health_) {
+    if (servo.report.id != id || !servo.report.overheated) continue;
+    const ServoHealthReport& report = servo.report;
+    return {ServoError::kMotionRefused,
+            servoLabel(id) + " is relaxed: its temperature reached its over_temperature limit (" +
+                std::to_string(report.readings.temperature_c) + " degC, limit " +
+                std::to_string(report.limits.over_temperature_c) + " degC); moves are refused " +
+                "until it has cooled to " +
+                std::to_string(report.limits.over_temperature_c - OverheatGuard::kCoolDownC) +
+                " degC"};
+  }
+  return {};
 }
 
 ServoStatus ServoBus::move(const MoveRequest& request) {

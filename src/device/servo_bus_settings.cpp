@@ -73,7 +73,7 @@ ServoStatus ServoBusClient::readParamLocked(uint8_t id, const ParamInfo& param,
 }
 
 ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
-                                      ServoParamValue* value) {
+                                      ServoParamValue* value, BusPriority priority) {
   const ParamInfo* param = servo::findParam(param_name);
   if (param == nullptr) {
     return fail(ServoError::kUnknownParam,
@@ -81,6 +81,11 @@ ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
                     " (use a name such as 'voltage' or a data_id such as '51')");
   }
   if (auto rejection = rejectBroadcast(id, Command::kReadData)) return *rejection;
+  if (priority == BusPriority::kBackground) {
+    bus_mutex_.lockBackground();
+    std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
+    return readParamLocked(id, *param, value);
+  }
   std::lock_guard<BusMutex> bus(bus_mutex_);
   return readParamLocked(id, *param, value);
 }

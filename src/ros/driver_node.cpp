@@ -132,6 +132,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     diagnostics_.add(description.name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
       device->diagnose(s);
     });
+    device->addDiagnostics(diagnostics_);
   }
   if (params_.base.use_imu_heading) connectImuHeading();
   // One trajectory server for the joints of every device, so one goal may span them.

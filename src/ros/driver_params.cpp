@@ -307,6 +307,11 @@ std::vector<ParamSpec> buildTable() {
             require(device::shutdownActionFromString(v).has_value(), key,
                     "must be stop, relax or none, got '" + v + "'");
           }),
+      row("servo_bus/health_rate", &P::servo_bus, &Bus::health_rate,
+          [](const double& v, const std::string& key) {
+            require(std::isfinite(v) && v >= 0.0 && v <= 10.0, key, "must be 0..10 Hz (0: off)");
+          }),
+      row("servo_bus/protect", &P::servo_bus, &Bus::protect),
   };
 }
 

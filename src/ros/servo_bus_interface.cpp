@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -168,6 +169,8 @@ device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
   // validate() accepted only the names shutdownActionFromString() knows.
   config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
                            .value_or(device::ShutdownAction::kStop);
+  config.health_rate = params.servo_bus.health_rate;
+  config.protect = params.servo_bus.protect;
   return config;
 }
 
@@ -185,6 +188,18 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
     ROS_WARN_THROTTLE(
         kWarnThrottleS, "servo_states: %s does not answer (%s); asked again in %.1f s",
         servoJointName(id).c_str(), status.message.c_str(), backoff.count() / kMsPerSecond);
+  };
+  events.on_overheat = [](const device::ServoHealthReport& report) {
+    if (report.overheated) {
+      ROS_ERROR("servo_bus: %s at %ld degC reached its over_temperature limit (%ld degC): relaxed, "
+                "its moves refused until it has cooled %ld degC (~servo_bus/protect)",
+                servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c),
+                static_cast<long>(report.limits.over_temperature_c),
+                static_cast<long>(device::OverheatGuard::kCoolDownC));
+    } else {
+      ROS_INFO("servo_bus: %s has cooled to %ld degC: its moves are obeyed again",
+               servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c));
+    }
   };
   events.on_move_failed = [](const device::MoveRequest& move, const device::ServoStatus& status) {
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",
@@ -404,6 +419,64 @@ void ServoBusInterface::attachEStop(device::EStop& e_stop) {
   });
 }
 
+void ServoBusInterface::addDiagnostics(diagnostic_updater::Updater& updater) {
+  if (bus_.config().health_rate <= 0.0) return;
+  for (uint8_t id : bus_.config().polled_ids) {
+    updater.add("servo_bus servo " + std::to_string(id),
+                [this, id](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseServo(id, s); });
+  }
+}
+
+void ServoBusInterface::diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  status.hardware_id = link_.options().path;
+  const std::string name = "servo " + std::to_string(id);
+  std::optional<device::ServoHealthReport> found;
+  for (const device::ServoHealthReport& report : bus_.health()) {
+    if (report.id == id) found = report;
+  }
+  if (!found || !found->polled) {
+    status.summary(DiagnosticStatus::OK, name + ": no health poll yet");
+    return;
+  }
+  const device::ServoHealthReport& report = *found;
+  status.add("online", report.online);
+  if (!report.online) {
+    status.summary(DiagnosticStatus::ERROR, name + " does not answer: " + report.last_error);
+    return;
+  }
+  const device::ServoReadings& r = report.readings;
+  status.add("voltage (mV)", r.voltage_mv);
+  status.add("current (mA)", r.current_ma);
+  status.add("power (mW)", r.power_mw);
+  status.add("temperature (degC)", r.temperature_c);
+  status.add("servo_status", r.status);
+  if (report.limits_known) {
+    status.add("over_volt_low (mV)", report.limits.over_volt_low_mv);
+    status.add("over_volt_high (mV)", report.limits.over_volt_high_mv);
+    status.add("over_temperature (degC)", report.limits.over_temperature_c);
+    status.add("over_power (mW)", report.limits.over_power_mw);
+    status.add("over_current (mA)", report.limits.over_current_ma);
+  } else {
+    status.add("limits", "not read yet");
+  }
+  status.add("relaxed for its temperature (protect)", report.overheated);
+  switch (report.assessment.level) {
+    case device::HealthLevel::kOk:
+      status.summary(DiagnosticStatus::OK, name + " ok");
+      break;
+    case device::HealthLevel::kWarn:
+      status.summary(DiagnosticStatus::WARN, report.assessment.message);
+      break;
+    case device::HealthLevel::kError:
+      status.summary(DiagnosticStatus::ERROR, report.assessment.message);
+      break;
+  }
+  if (report.overheated) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "relaxed, moves refused until it has cooled");
+  }
+}
+
 void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
   const trajectory::BusJoint* joint = findBusJoint(bus_joints_, id);
   if (!trajectory_ || !joint) return;
@@ -486,6 +559,8 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("servos set moving", moving.empty() ? std::string("none") : moving);
   status.add("motion locked (e_stop)", bus_.motionLocked());
   status.add("on shutdown", on_shutdown_);
+  status.add("health polls per second", bus_.config().health_rate);
+  status.add("protect", bus_.config().protect);
   if (!offline.empty() && link_.connected()) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                         "polled servos not answering: " + offline);

@@ -22,9 +22,11 @@ using namespace golden::servo;  // NOLINT: the shared golden frames
 
 class ServoBusTest : public ::testing::Test {
  protected:
-  /// A bus polling `polled_ids` at 10 Hz (every 100 ms) on the manual clock.
+  /// A bus polling `polled_ids` at 10 Hz (every 100 ms) on the manual clock, without the health
+  /// poll (these tests count the frames of the moves and the angle polls).
   void makeBus(std::vector<uint8_t> polled_ids) {
     ServoBusConfig config;
+    config.health_rate = 0.0;
     config.client.timeout = milliseconds(5);  // a silent servo costs 5 ms of real time
     config.client.retries = 0;
     config.polled_ids = std::move(polled_ids);

@@ -31,6 +31,7 @@
 #include "serial_robot_driver/device/loop_clock.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/device/servo_bus_client.h"
+#include "serial_robot_driver/device/servo_health.h"
 
 namespace serial_robot_driver::device {
 
@@ -46,6 +47,25 @@ struct ServoBusConfig {
   uint16_t relax_power_mw = 50;     ///< DAMPING power of relax()
   /// For each servo set spinning or moving: kStop a SPIN stop, kRelax relax(), kNone nothing.
   ShutdownAction on_shutdown = ShutdownAction::kStop;
+  /// Health polls (voltage, current, power, temperature, status) per second of each polled
+  /// servo, as background work between the angle polls; 0: none.
+  double health_rate = 1.0;
+  /// A servo at its own temperature limit is relaxed and its moves refused until it has cooled
+  /// OverheatGuard::kCoolDownC below it.
+  bool protect = false;
+};
+
+/// The health of one polled servo (health_rate > 0).
+struct ServoHealthReport {
+  uint8_t id = 0;
+  bool polled = false;        ///< at least one health poll finished (answered or not)
+  bool online = false;        ///< the last health poll was answered
+  std::string last_error;     ///< why the last poll failed
+  bool limits_known = false;  ///< the servo's limits, read once when it first answered
+  ServoLimits limits;
+  ServoReadings readings;     ///< valid once a poll was answered
+  HealthAssessment assessment;
+  bool overheated = false;    ///< protect: relaxed, its moves refused
 };
 
 /// One polled angle.
@@ -62,6 +82,8 @@ struct ServoBusEvents {
   std::function<void(uint8_t id, const ServoStatus& status, std::chrono::milliseconds backoff)>
       on_servo_silent;
   std::function<void(const MoveRequest& move, const ServoStatus& status)> on_move_failed;
+  /// protect: servo `report.id` was relaxed for its temperature (`overheated`), or has cooled.
+  std::function<void(const ServoHealthReport& report)> on_overheat;
 };
 
 struct ServoBusWorkerStats {
@@ -115,6 +137,8 @@ class ServoBus : public LinkListener {
   bool motionLocked() const;
   /// Servos set spinning or moving and not stopped or relaxed since (the broadcast id 255 too).
   std::vector<uint8_t> movingIds() const;
+  /// One report per polled servo (empty when health_rate is 0).
+  std::vector<ServoHealthReport> health() const;
 
   /// Starts the worker thread. Idempotent.
   void start();
@@ -146,6 +170,12 @@ class ServoBus : public LinkListener {
   ServoStatus stopMoving();
   ServoStatus refuseWhileLocked(uint8_t id) const;
   void finalWords();
+  /// The health poll's schedule: the servo due first, and when (max when none).
+  Clock::time_point nextHealthPoll() const;  // mutex_ held
+  void pollHealthOnce(std::size_t index);
+  /// Reads `names` in order into `values`; the first failure.
+  ServoStatus readHealthParams(uint8_t id, const std::vector<const char*>& names,
+                               std::vector<int64_t>* values);
   void sendMove(const MoveRequest& move);
   void pollOnce(PolledServo& servo);
 
@@ -164,6 +194,14 @@ class ServoBus : public LinkListener {
   std::set<uint8_t> moving_;          // servos set moving and not stopped since
   bool motion_locked_ = false;
   bool final_words_said_ = false;
+  // Health polls: one entry per polled servo, changed by the worker only (read under mutex_).
+  struct HealthServo {
+    ServoHealthReport report;
+    Clock::time_point next_poll;
+    OverheatGuard guard;
+  };
+  std::vector<HealthServo> health_;
+  Clock::duration health_period_{0};
   ServoBusWorkerStats stats_;
   std::thread worker_;
 };

@@ -156,7 +156,9 @@ class ServoBusClient : public LinkListener {
   /// PING: ok when the servo answered.
   ServoStatus ping(uint8_t id);
   /// READ_DATA of a parameter given by name or data_id as text ("51").
-  ServoStatus readParam(uint8_t id, std::string_view param, ServoParamValue* value);
+  /// kBackground (the health poll): the bus is taken only while no other caller waits for it.
+  ServoStatus readParam(uint8_t id, std::string_view param, ServoParamValue* value,
+                        BusPriority priority = BusPriority::kCaller);
   /// WRITE_DATA after checkWrite, then a read-back to confirm. A servo_id change first pings the
   /// new id and is refused if a servo answers there; a baudrate write is not read back (it takes
   /// effect at once).

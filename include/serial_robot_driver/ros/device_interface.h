@@ -33,6 +33,9 @@ class DeviceInterface {
   /// The node's one e-stop, given before start(): the device registers what engaging it means
   /// for its actuators and refuses motion commands while it holds. It outlives the device.
   virtual void attachEStop(device::EStop& /*e_stop*/) {}
+  /// Statuses of its own beyond the device's one (e.g. one per bus servo), added to `updater`
+  /// once, at construction of the node.
+  virtual void addDiagnostics(diagnostic_updater::Updater& /*updater*/) {}
 };
 
 }  // namespace serial_robot_driver::ros_layer

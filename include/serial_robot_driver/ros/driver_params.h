@@ -118,6 +118,8 @@ struct ServoBusParams : DevicePortParams {
   // Safe motion: servo/relax's DAMPING power; what servos set moving get when the node stops.
   int relax_power_mw = kServoBusDefaults.relax_power_mw;  ///< mW
   std::string on_shutdown = "stop";                       ///< stop | relax | none
+  double health_rate = kServoBusDefaults.health_rate;  ///< Hz of the health poll; 0: off
+  bool protect = kServoBusDefaults.protect;  ///< relax a servo at its temperature limit
 };
 
 /// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override them).

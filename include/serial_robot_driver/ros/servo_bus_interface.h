@@ -85,6 +85,9 @@ class ServoBusInterface : public DeviceInterface {
   /// Engaged: queued moves dropped, a SPIN stop to every servo the driver set moving; motion
   /// services and servo_commands refused until it is released (reads, pings, scans still work).
   void attachEStop(device::EStop& e_stop) override;
+  /// With ~servo_bus/health_rate > 0: "servo_bus servo <id>", one status per polled servo (its
+  /// readings against its own limits; an offline servo is an ERROR).
+  void addDiagnostics(diagnostic_updater::Updater& updater) override;
 
  private:
   device::ServoBusEvents makeEvents();
@@ -94,6 +97,7 @@ class ServoBusInterface : public DeviceInterface {
   void yieldJoint(uint8_t id, const char* source);
   /// A motion service or topic while the e-stop holds: counted, and its refusal (else ok).
   device::ServoStatus refuseWhileEStopped(const std::string& source);
+  void diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status);
 
   // Bus servos as joints (trajectories): fixed before the bus starts, read on the worker thread.
   const std::vector<trajectory::BusJoint> bus_joints_;
