@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <functional>
 #include <iomanip>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <vector>
@@ -164,6 +165,25 @@ Flag idList(const std::string& name, const std::string& value_name, const std::s
               shown};
 }
 
+/// "ID:VALUE" into a per-servo map (a bus servo's held temperature or voltage); repeatable.
+Flag heldValue(const std::string& name, const std::string& value_name, const std::string& help,
+               std::function<std::map<uint8_t, int64_t>&(SimOptions&)> field) {
+  return Flag{name, value_name, help,
+              [name, field](const std::string& value, SimOptions& options) {
+                const std::size_t colon = value.find(':');
+                std::vector<uint8_t> ids;
+                double number = 0;
+                if (colon == std::string::npos || !parseIdList(value.substr(0, colon), &ids) ||
+                    ids.size() != 1 || !parseDouble(value.substr(colon + 1), &number) ||
+                    number < 0 || number > 65535) {
+                  return badValue(name, value) + " (ID:VALUE, id 0..254, value 0..65535)";
+                }
+                field(options)[ids.front()] = static_cast<int64_t>(number);
+                return std::string();
+              },
+              {}};
+}
+
 /// Every flag of robot_sim, in --help order.
 const std::vector<Flag>& flags() {
   static const std::vector<Flag> table = {
@@ -212,6 +232,13 @@ const std::vector<Flag>& flags() {
       idList(
           "--offline-ids", "7", "ids that never answer", SIZE_MAX,
           [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.offline_ids; }, false),
+      heldValue("--servo-temperature", "ID:DEGC",
+                "hold a bus servo's temperature at DEGC (repeatable)",
+                [](SimOptions& o) -> std::map<uint8_t, int64_t>& {
+                  return o.servo_bus.temperature_c;
+                }),
+      heldValue("--servo-voltage", "ID:MV", "hold a bus servo's voltage at MV (repeatable)",
+                [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.voltage_mv; }),
       Flag{"--servo-latency-ms", "MS", "servo bus answer latency",
            [](const std::string& value, SimOptions& o) {
              double ms = 0;

@@ -109,6 +109,12 @@ ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
     s.params[kSerialNumber] = 0x53520000 + id;
     resetUserData(&s);
     s.params[kServoId] = id;  // configured on this chain
+    if (auto held = config_.temperature_c.find(id); held != config_.temperature_c.end()) {
+      s.params[kTemperature] = held->second;
+    }
+    if (auto held = config_.voltage_mv.find(id); held != config_.voltage_mv.end()) {
+      s.params[kVoltage] = held->second;
+    }
     servos_.push_back(std::move(s));
   }
 }
@@ -437,11 +443,16 @@ void ServoBusSim::runMotions(Servo* s, TimePoint now) {
 void ServoBusSim::driftReadOnly(Servo* s) {
   std::uniform_int_distribution<int> step(-1, 1);
   const bool moving = !s->motions.empty() || s->spin_rate_dps != 0.0;
+  const auto id = static_cast<uint8_t>(param(*s, kServoId));
+  const bool voltage_held = config_.voltage_mv.count(id) > 0;
+  const bool temperature_held = config_.temperature_c.count(id) > 0;
   int64_t& voltage = s->params[kVoltage];
-  voltage =
-      std::clamp<int64_t>(voltage + 5 * step(rng_), kNominalVoltage - 60, kNominalVoltage + 60);
+  if (!voltage_held) {
+    voltage =
+        std::clamp<int64_t>(voltage + 5 * step(rng_), kNominalVoltage - 60, kNominalVoltage + 60);
+  }
   int64_t& temperature = s->params[kTemperature];
-  if (std::uniform_int_distribution<int>(0, 49)(rng_) == 0) {
+  if (!temperature_held && std::uniform_int_distribution<int>(0, 49)(rng_) == 0) {
     temperature = std::clamp<int64_t>(temperature + step(rng_), kNominalTemperature - 1,
                                       kNominalTemperature + 2);
   }

@@ -1,8 +1,10 @@
 // Safe motion end to end (safe_motion.test): the e-stop stops a spinning bus servo and refuses
 // motion until released while reads still work; servo/relax and servo/hold; a servo set spinning
 // is stopped when the node gets SIGINT and relaxed (~servo_bus/on_shutdown: relax) when its
-// nodelet is unloaded. Checked through the simulator's servos (sim::RobotSim in this process),
+// nodelet is unloaded; a hot servo reported in /diagnostics and, with ~servo_bus/protect, relaxed
+// and refused. Checked through the simulator's servos (sim::RobotSim in this process),
 // the services' answers and /diagnostics. No timing assertions: every wait has a generous deadline.
+#include <diagnostic_msgs/DiagnosticStatus.h>
 #include <gtest/gtest.h>
 #include <nodelet/NodeletLoad.h>
 #include <nodelet/NodeletUnload.h>
@@ -42,10 +44,12 @@ constexpr double kWaitSeconds = 20.0;
 sim::RobotSim* g_robot = nullptr;
 std::string g_port;
 
-std::unique_ptr<sim::RobotSim> makeBus(const std::string& port) {
+std::unique_ptr<sim::RobotSim> makeBus(const std::string& port,
+                                        const sim::ServoBusSimConfig& bus = {}) {
   sim::SimOptions options;
   options.enable_base = false;
   options.enable_body = false;
+  options.servo_bus = bus;
   options.servo_bus.servo_ids = {0, 1, 2, 3};
   options.servo_link = port;
   auto robot = std::make_unique<sim::RobotSim>(options);
@@ -78,6 +82,11 @@ srd::ServoSpin spin(const std::string& ns, uint8_t id, uint8_t mode = 1) {
   EXPECT_TRUE(ros::service::waitForService(ns + "/servo/spin", 30000));
   EXPECT_TRUE(ros::service::call(ns + "/servo/spin", call));
   return call;
+}
+
+/// spin() once the node's port is open (its services come up before the port does).
+bool spinOnceConnected(const std::string& ns, uint8_t id) {
+  return waitFor([&] { return spin(ns, id).response.success; }, kWaitSeconds);
 }
 
 class SafeMotion : public ::testing::Test {
@@ -204,7 +213,7 @@ TEST(SafeMotionProcess, SigintStopsASpinningServo) {
                                    "_reconnect_interval:=0.2", "_base/enabled:=false",
                                    "_body/enabled:=false"});
   ASSERT_TRUE(node.started());
-  ASSERT_TRUE(spin("/sig", 3).response.success) << node.output();
+  ASSERT_TRUE(spinOnceConnected("/sig", 3)) << node.output();
   ASSERT_TRUE(waitMoving(*robot, 3, true)) << node.output();
 
   node.signal(SIGINT);
@@ -234,7 +243,7 @@ TEST(SafeMotionProcess, NodeletUnloadRelaxesASpinningServo) {
   ASSERT_TRUE(ros::service::call("/unl_manager/load_nodelet", load)) << manager.output();
   ASSERT_TRUE(load.response.success) << manager.output();
 
-  ASSERT_TRUE(spin("/unl", 0).response.success) << manager.output();
+  ASSERT_TRUE(spinOnceConnected("/unl", 0)) << manager.output();
   ASSERT_TRUE(waitMoving(*robot, 0, true)) << manager.output();
 
   nodelet::NodeletUnload unload;
@@ -246,6 +255,70 @@ TEST(SafeMotionProcess, NodeletUnloadRelaxesASpinningServo) {
 
   manager.signal(SIGINT);
   manager.waitExit(20.0);
+}
+
+// Health: servo 1 hot (70 degC, its limit 65), servo 2's voltage near its lower limit (4900 mV,
+// limit 4500), servo 7 absent; with ~servo_bus/protect the hot servo is relaxed and its moves
+// refused, while servo 2 still moves.
+TEST(SafeMotionProcess, AHotServoIsReportedRelaxedAndRefused) {
+  const std::string port = g_port + "_hot";
+  sim::ServoBusSimConfig bus;
+  bus.temperature_c[1] = 70;
+  bus.voltage_mv[2] = 4900;
+  auto robot = makeBus(port, bus);
+  ros::param::set("/hot/driver_hot/servo_bus/state_ids", std::vector<int>{1, 2, 7});
+  ros::param::set("/hot/driver_hot/servo_bus/health_rate", 5.0);
+  ros::param::set("/hot/driver_hot/servo_bus/protect", true);
+  ros::param::set("/hot/driver_hot/servo_bus/timeout", 0.1);
+  ros::param::set("/hot/driver_hot/diagnostic_period", 0.2);
+  ros::NodeHandle nh;
+  test_support::DiagnosticsWatch diagnostics(nh, "hot/driver_hot");
+  test_support::ChildProcess node(test_support::findDriverNode(),
+                                  {"__ns:=/hot", "__name:=driver_hot", "_port:=" + port,
+                                   "_reconnect_interval:=0.2", "_base/enabled:=false",
+                                   "_body/enabled:=false"});
+  ASSERT_TRUE(node.started());
+  using Status = test_support::DiagnosticsWatch::Status;
+  const auto keep_waiting = [] { return ros::ok(); };
+  const auto hot = diagnostics.waitFor(
+      "servo_bus servo 1", 0,
+      [](const Status& s) { return s.level == diagnostic_msgs::DiagnosticStatus::ERROR; },
+      keep_waiting, kWaitSeconds);
+  ASSERT_TRUE(hot.has_value()) << node.output();
+  EXPECT_NE(hot->message.find("servo 1"), std::string::npos) << hot->message;
+  EXPECT_NE(hot->message.find("over_temperature 65 degC"), std::string::npos) << hot->message;
+  EXPECT_EQ(hot->value("temperature (degC)"), "70");
+  const auto low = diagnostics.waitFor(
+      "servo_bus servo 2", 0,
+      [](const Status& s) { return s.level == diagnostic_msgs::DiagnosticStatus::WARN; },
+      keep_waiting, kWaitSeconds);
+  ASSERT_TRUE(low.has_value()) << node.output();
+  EXPECT_NE(low->message.find("over_volt_low 4500 mV"), std::string::npos) << low->message;
+  const auto offline = diagnostics.waitFor(
+      "servo_bus servo 7", 0,
+      [](const Status& s) { return s.level == diagnostic_msgs::DiagnosticStatus::ERROR; },
+      keep_waiting, kWaitSeconds);
+  ASSERT_TRUE(offline.has_value()) << node.output();
+  EXPECT_NE(offline->message.find("does not answer"), std::string::npos) << offline->message;
+
+  // protect: relaxed, and its moves refused; the other servo still moves.
+  EXPECT_TRUE(waitFor([&] { return simServo(*robot, 1)->relaxed; }, kWaitSeconds));
+  srd::ServoRotate rotate;
+  rotate.request.id = 1;
+  rotate.request.angle_deg = 45.0;
+  ASSERT_TRUE(ros::service::call("/hot/servo/rotate", rotate));
+  EXPECT_FALSE(rotate.response.success);
+  EXPECT_NE(rotate.response.message.find("over_temperature"), std::string::npos)
+      << rotate.response.message;
+  rotate.request.id = 2;
+  ASSERT_TRUE(ros::service::call("/hot/servo/rotate", rotate));
+  EXPECT_TRUE(rotate.response.success) << rotate.response.message;
+  EXPECT_TRUE(waitFor([&] { return std::fabs(simServo(*robot, 2)->angle_deg - 45.0) < 1e-6; },
+                      kWaitSeconds));
+  EXPECT_TRUE(simServo(*robot, 1)->relaxed);
+
+  node.signal(SIGINT);
+  node.waitExit(20.0);
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 //             base/reset, base/reset_odometry, base/clear_encoders
 //   body      in joint_commands; out joint_states, imu/data, foot_pressure, telemetry
 //   servo_bus in servo_commands; out servo_states; servo/ping, read, write, read_angle, move,
-//             scan, rotate, spin, damping, read_all, reset_user_data
+//             scan, rotate, spin, damping, relax, hold, read_all, reset_user_data
 // and the node itself: e_stop (one device::EStop handed to every device and the trajectories),
 // /diagnostics (one status per port and per device), serial_raw (with
 // ~capture), the follow_joint_trajectory action and joint_trajectory topic for the joints of every

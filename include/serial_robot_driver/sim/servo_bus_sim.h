@@ -28,6 +28,9 @@ namespace serial_robot_driver::sim {
 struct ServoBusSimConfig {
   std::vector<uint8_t> servo_ids = {0, 1, 2};
   std::vector<uint8_t> offline_ids;  ///< listed servos that never answer
+  /// Servos whose temperature (degC) or voltage (mV) is held at a value instead of drifting.
+  std::map<uint8_t, int64_t> temperature_c;
+  std::map<uint8_t, int64_t> voltage_mv;
   double answer_latency_s = 0.0015;
   uint32_t seed = 1;
 };
