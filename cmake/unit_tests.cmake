@@ -17,7 +17,8 @@ catkin_add_gtest(core_tests
   test/unit/test_servo_bus.cpp
   test/unit/test_sim.cpp
   test/unit/test_device_set.cpp
-  test/unit/test_servo_health.cpp)
+  test/unit/test_servo_health.cpp
+  test/unit/test_e_stop.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
 # test_device_set.cpp reads config/analyzers.yaml from the sources.

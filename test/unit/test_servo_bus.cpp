@@ -180,5 +180,62 @@ TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
   EXPECT_TRUE(written().empty());
 }
 
+// SPIN stop at speed 0 (the e-stop's and the shutdown's): 12 4C 07 06 | id 0, mode 0, speed 0,
+// value 0 | sum 0x6B.
+const Bytes kSpin0StopSpeed0 = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x6B};
+
+SpinRequest continuousSpin0() {
+  SpinRequest spin;
+  spin.id = 0;
+  spin.mode = 1;
+  spin.speed_dps = 100;
+  return spin;
+}
+
+TEST_F(ServoBusTest, MotionLockStopsTheServosSetSpinningAndRefusesMotionUntilReleased) {
+  makeBus({});
+  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
+  EXPECT_EQ(bus_->movingIds(), std::vector<uint8_t>{0});
+  bus_->setMotionLocked(true);
+  EXPECT_EQ(countWritten(kSpin0StopSpeed0), 1u);
+  EXPECT_TRUE(bus_->movingIds().empty());
+
+  const ServoStatus refused = bus_->spin(continuousSpin0());
+  EXPECT_EQ(refused.error, ServoError::kMotionRefused);
+  EXPECT_NE(refused.message.find("e_stop"), std::string::npos) << refused.message;
+  EXPECT_EQ(bus_->damping(0, 500, false).error, ServoError::kMotionRefused);
+  EXPECT_EQ(countWritten(kSpin0CcwContinuous), 1u) << "a refused command reached the bus";
+  double angle = 0.0;
+  EXPECT_TRUE(bus_->client().readAngle(0, &angle).ok()) << "reads still work";
+
+  bus_->setMotionLocked(false);
+  EXPECT_TRUE(bus_->spin(continuousSpin0()).ok());
+  EXPECT_EQ(countWritten(kSpin0CcwContinuous), 2u);
+}
+
+TEST_F(ServoBusTest, ShutdownStopsOnlyTheServosSetMoving) {
+  makeBus({});
+  bus_->start();
+  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
+  bus_->shutdown();
+  EXPECT_EQ(written().back(), kSpin0StopSpeed0);
+  EXPECT_EQ(countWritten(kSpin0StopSpeed0), 1u);
+  EXPECT_EQ(bus_->spin(continuousSpin0()).error, ServoError::kShutdown);
+}
+
+TEST_F(ServoBusTest, ShutdownSaysNothingWhenNoServoWasSetMoving) {
+  makeBus({});
+  bus_->start();
+  SpinRequest stop = continuousSpin0();
+  stop.mode = 0;
+  stop.speed_dps = 0;
+  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
+  ASSERT_TRUE(bus_->spin(stop).ok());  // stopped by hand: nothing moves any more
+  const std::size_t before = written().size();
+  bus_->shutdown();
+  EXPECT_EQ(written().size(), before);
+}
+
 }  // namespace
+
 }  // namespace serial_robot_driver::device

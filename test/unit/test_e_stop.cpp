@@ -1,0 +1,43 @@
+// The node's one e-stop: listeners run once per change in registration order, refusals are
+// counted by source only while it is engaged.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/device/e_stop.h"
+
+namespace {
+
+using serial_robot_driver::device::EStop;
+
+TEST(EStop, ListenersRunOncePerChangeInOrder) {
+  EStop e_stop;
+  std::vector<std::string> calls;
+  e_stop.addListener([&](bool engaged) { calls.push_back(engaged ? "a on" : "a off"); });
+  e_stop.addListener([&](bool engaged) { calls.push_back(engaged ? "b on" : "b off"); });
+  EXPECT_FALSE(e_stop.set(false)) << "starts released";
+  EXPECT_TRUE(e_stop.set(true));
+  EXPECT_FALSE(e_stop.set(true)) << "a repeated message changes nothing";
+  EXPECT_TRUE(e_stop.set(false));
+  EXPECT_EQ(calls, (std::vector<std::string>{"a on", "b on", "a off", "b off"}));
+  EXPECT_EQ(e_stop.stats().engagements, 1u);
+  EXPECT_FALSE(e_stop.stats().engaged);
+}
+
+TEST(EStop, RefusesAndCountsOnlyWhileEngaged) {
+  EStop e_stop;
+  EXPECT_FALSE(e_stop.refuse("cmd_vel"));
+  e_stop.set(true);
+  EXPECT_TRUE(e_stop.engaged());
+  EXPECT_TRUE(e_stop.refuse("cmd_vel"));
+  EXPECT_TRUE(e_stop.refuse("cmd_vel"));
+  EXPECT_TRUE(e_stop.refuse("servo/spin"));
+  e_stop.set(false);
+  EXPECT_FALSE(e_stop.refuse("cmd_vel"));
+  const auto stats = e_stop.stats();
+  EXPECT_EQ(stats.refused.at("cmd_vel"), 2u);
+  EXPECT_EQ(stats.refused.at("servo/spin"), 1u);
+}
+
+}  // namespace
