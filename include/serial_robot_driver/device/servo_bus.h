@@ -12,6 +12,11 @@
 //  - The operations of client() (the services) run on their caller's thread, serialized with the
 //    worker by the client's bus lock.
 //  - The ServoBusEvents hooks run on the worker thread without mutex_ held.
+//  - With health_rate > 0 the worker also polls each servo's health (five READ_DATA, each as
+//    background work, so a caller still waits for one transaction at most) when it falls due.
+//  - The motion operations (move, rotate, spin, damping, relax, hold) run on their caller's thread
+//    like the client's; setMotionLocked() (the e-stop) writes its SPIN stops on its caller's.
+//  - shutdown() joins the worker first, then says the last words (on_shutdown) on its caller's.
 //  - Stats are one struct under mutex_; stats() returns a snapshot.
 #pragma once
 

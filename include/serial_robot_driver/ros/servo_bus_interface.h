@@ -65,6 +65,11 @@ struct ServoCommandBatch {
 };
 ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms);
 
+/// The status of servo `id` from its health report (null: not polled yet): its readings and
+/// limits, WARN within 10 % of a limit, ERROR beyond it or when the servo does not answer.
+void diagnoseServoHealth(uint8_t id, const device::ServoHealthReport* report,
+                         diagnostic_updater::DiagnosticStatusWrapper& status);
+
 class ServoBusInterface : public DeviceInterface {
  public:
   /// Registers the client with `link` and advertises servo/* in `nh`'s namespace. Must be
