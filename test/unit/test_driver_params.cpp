@@ -105,6 +105,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 1000; }},
         BadCase{"servo_bus/command_interval_ms",
                 [](DriverParams& p) { p.servo_bus.command_interval_ms = 70000; }},
+        BadCase{"servo_bus/on_shutdown", [](DriverParams& p) { p.servo_bus.on_shutdown = "halt"; }},
+        BadCase{"servo_bus/relax_power_mw",
+                [](DriverParams& p) { p.servo_bus.relax_power_mw = -1; }},
+        BadCase{"servo_bus/health_rate", [](DriverParams& p) { p.servo_bus.health_rate = -1.0; }},
         BadCase{"base/enabled", [](DriverParams& p) {
                   p.base.enabled = p.body.enabled = p.servo_bus.enabled = false;
                 }}));
