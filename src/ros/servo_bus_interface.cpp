@@ -327,14 +327,14 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                  [this](ServoRelax::Request& req, ServoRelax::Response&) {
                                    device::ServoStatus refused = refuseWhileEStopped("servo/relax");
                                    if (!refused.ok()) return refused;
-                                   for (uint8_t id : req.ids) yieldJoint(id, "servo/relax");
+                                   yieldJoints(req.ids, "servo/relax");
                                    return bus_.relax(req.ids);
                                  }),
       advertiseServo<ServoHold>(nh_, "servo/hold",
                                 [this](ServoHold::Request& req, ServoHold::Response&) {
                                   device::ServoStatus refused = refuseWhileEStopped("servo/hold");
                                   if (!refused.ok()) return refused;
-                                  for (uint8_t id : req.ids) yieldJoint(id, "servo/hold");
+                                  yieldJoints(req.ids, "servo/hold");
                                   return bus_.hold(req.ids);
                                 }),
       advertiseServo<ServoReadAll>(nh_, "servo/read_all",
@@ -434,6 +434,10 @@ void ServoBusInterface::diagnoseServo(uint8_t id, diagnostic_updater::Diagnostic
     if (report.id == id) found = report;
   }
   diagnoseServoHealth(id, found ? &*found : nullptr, status);
+}
+
+void ServoBusInterface::yieldJoints(const std::vector<uint8_t>& ids, const char* source) {
+  for (uint8_t id : ids.empty() ? bus_.config().polled_ids : ids) yieldJoint(id, source);
 }
 
 void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {

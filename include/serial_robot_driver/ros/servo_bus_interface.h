@@ -100,6 +100,8 @@ class ServoBusInterface : public DeviceInterface {
   /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
   /// trajectory stops (its goal aborts) and its queued move is dropped.
   void yieldJoint(uint8_t id, const char* source);
+  /// yieldJoint() for each of `ids`; empty: every configured servo (servo/relax, servo/hold).
+  void yieldJoints(const std::vector<uint8_t>& ids, const char* source);
   /// A motion service or topic while the e-stop holds: counted, and its refusal (else ok).
   device::ServoStatus refuseWhileEStopped(const std::string& source);
   void diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status);
