@@ -135,24 +135,29 @@ void ServoBusClient::onFrame(protocol::FrameFamily family, const uint8_t* data, 
   if (family != protocol::FrameFamily::kServoResponse) return;  // another device on this port
 
   const protocol::Decoded<servo::Packet> packet = servo::decodeResponse(data, size);
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  if (!packet.ok()) {
-    ++stats_.garbled;
-    return;
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    if (!packet.ok()) {
+      ++stats_.garbled;
+      return;
+    }
+    if (!pending_.active || pending_.answered || pending_.garbled || !matches(*packet)) {
+      ++stats_.mismatched;
+      return;
+    }
+    if (packet->content_size != pending_.expect.content_size) {
+      ++stats_.garbled;
+      pending_.garbled = true;
+    } else {
+      pending_.answered = true;
+    }
+    pending_.answer = *packet;
+    pending_.arrival = arrival;
   }
-  if (!pending_.active || pending_.answered || pending_.garbled || !matches(*packet)) {
-    ++stats_.mismatched;
-    return;
-  }
-  if (packet->content_size != pending_.expect.content_size) {
-    ++stats_.garbled;
-    pending_.garbled = true;
-  } else {
-    pending_.answered = true;
-  }
-  pending_.answer = *packet;
-  pending_.arrival = arrival;
-  answer_cv_.notify_all();
+  // Notified after the unlock: a caller woken while this thread still held state_mutex_ would
+  // only block on it again (one more sleep and wake-up per transaction on a busy bus). Only the
+  // transaction's own caller waits, and it cannot leave before its predicate holds.
+  answer_cv_.notify_one();
 }
 
 ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const Expectation& expect,

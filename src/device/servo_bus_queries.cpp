@@ -52,6 +52,8 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
   if (!decoded) return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable angle");
   if (arrival != nullptr) *arrival = answered_at;
   *angle_deg = decoded->angle_decidegrees / kDecidegreesPerDegree;
+  // The poll reads no message: it would cost a formatted string on every transaction.
+  if (priority == BusPriority::kBackground) return ok({});
   char text[32];
   std::snprintf(text, sizeof(text), "%.1f deg", *angle_deg);
   return ok(servoName(id) + " is at " + text);

@@ -189,6 +189,8 @@ class ServoBusClient : public LinkListener {
 
   ServoBusStats stats() const;
   const ServoBusOptions& options() const { return options_; }
+  /// Callers (not background work) waiting for the bus right now (for tests and diagnostics).
+  int callersWaiting() { return bus_mutex_.foregroundWaiting(); }
 
   // LinkListener (reader thread).
   void onLinkDown() override;

@@ -17,6 +17,7 @@
 #include <sensor_msgs/JointState.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -108,6 +109,10 @@ class ServoBusInterface : public DeviceInterface {
   ros::Subscriber commands_sub_;
   const uint16_t command_interval_ms_;
   std::atomic<uint64_t> commands_rejected_{0};
+
+  // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
+  uint64_t polls_at_last_check_ = 0;
+  std::chrono::steady_clock::time_point last_rate_check_{};
 };
 
 }  // namespace serial_robot_driver::ros_layer
