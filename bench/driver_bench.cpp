@@ -842,14 +842,51 @@ BusRun runServoFloor(Context& context, const std::string& tag, double latency_ms
   return {transactions / seconds, cpu / transactions * 1e6, cpu / seconds, mean_ms};
 }
 
-/// driver_node polling 20 servos at `state_rate` each; servo_states messages counted (one per
-/// answered READ_ANGLE), the node's CPU from its process clock.
+/// robot_sim's counters of the servo bus as its stats file last had them.
+struct SimBusCounters {
+  double uptime_s = -1;
+  double answers = 0;
+};
+
+SimBusCounters readSimBusCounters(const std::string& path) {
+  SimBusCounters counters;
+  std::ifstream in(path);
+  std::string key;
+  double value = 0;
+  while (in >> key >> value) {
+    if (key == "uptime_s") counters.uptime_s = value;
+    if (key == "servo_answers") counters.answers = value;
+  }
+  return counters;
+}
+
+/// Waits for robot_sim's next stats write (once a second) and returns it with the node's CPU at
+/// that moment, so both windows line up within the 5 ms of polling.
+std::pair<SimBusCounters, double> nextSimBusCounters(const std::string& path, pid_t node) {
+  const double previous = readSimBusCounters(path).uptime_s;
+  SimBusCounters counters;
+  require(waitUntil(
+              [&] {
+                counters = readSimBusCounters(path);
+                return counters.uptime_s != previous && counters.uptime_s >= 0;
+              },
+              5s),
+          "robot_sim's stats file " + path + " is not rewritten");
+  return {counters, processCpuSeconds(node)};
+}
+
+/// driver_node polling 20 servos at `state_rate` each, the node's CPU from its process clock.
+/// `subscribed`: servo_states messages counted (one per answered READ_ANGLE); else nobody
+/// subscribes and robot_sim's answers are counted: the transaction path without roscpp's cost of
+/// sending each message.
 BusRun runServoStates(Context& context, const std::string& tag, double latency_ms, bool paced,
-                      double state_rate) {
+                      double state_rate, bool subscribed = true) {
   const std::string ns = "bus_node_" + tag;
   const std::string link = context.paths.link(ns);
-  const auto sim =
-      startRobotSim(context.paths, "robot_sim_" + ns, busSimFlags(link, latency_ms, paced));
+  const std::string stats_file = context.paths.work_dir + "/" + ns + ".stats";
+  std::vector<std::string> sim_flags = busSimFlags(link, latency_ms, paced);
+  sim_flags.insert(sim_flags.end(), {"--stats-file", stats_file});
+  const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, sim_flags);
   std::vector<int> ids;
   for (int id = 0; id < kBusServos; ++id) ids.push_back(id);
   ParamList params = commonParams(link, kEventDriven);
@@ -858,6 +895,18 @@ BusRun runServoStates(Context& context, const std::string& tag, double latency_m
                                {"servo_bus/state_ids", toXmlRpc(ids)},
                                {"servo_bus/state_rate", state_rate}});
   DriverProcess driver(context.paths, ns, params);
+  if (!subscribed) {
+    require(waitUntil([&] { return readSimBusCounters(stats_file).answers > 0; }, 30s),
+            "driver_node never polled; see " + context.paths.log(ns));
+    const auto [first, cpu_start] = nextSimBusCounters(stats_file, driver.pid());
+    require(sleepUntil(Clock::now() + fromSeconds(context.options.bus_seconds - 0.5)), "stopped");
+    const auto [last, cpu_end] = nextSimBusCounters(stats_file, driver.pid());
+    const double seconds = last.uptime_s - first.uptime_s;
+    const double count = last.answers - first.answers;
+    require(count > 0 && seconds > 0, "driver_node stopped polling");
+    return {count / seconds, (cpu_end - cpu_start) / count * 1e6, (cpu_end - cpu_start) / seconds,
+            seconds * 1000.0 / count};
+  }
   std::atomic<std::size_t> messages{0};
   ros::Subscriber subscriber = context.nh.subscribe<sensor_msgs::JointState>(
       driver.topic("servo_states"), 10000, [&](const sensor_msgs::JointState::ConstPtr&) { ++messages; },
@@ -881,6 +930,7 @@ void runServoBusSection(Context& context) {
   // Side by side: each pair of runs back to back, so the machine's load is alike for both.
   const BusRun floor_fast = runServoFloor(context, "fast", 0.0, false);
   const BusRun node_fast = runServoStates(context, "fast", 0.0, false, 1000.0);
+  const BusRun node_quiet = runServoStates(context, "quiet", 0.0, false, 1000.0, false);
   const BusRun floor_paced = runServoFloor(context, "paced", kBusLatencyMs, true);
   const BusRun node_paced = runServoStates(context, "paced", kBusLatencyMs, true, 1000.0);
   const BusRun floor_unpaced = runServoFloor(context, "latency", kBusLatencyMs, false);
@@ -898,6 +948,9 @@ void runServoBusSection(Context& context) {
   add("driver_node, pty speed, latency 0, state_rate 1000", node_fast,
       format("%.2f of the rate, %.2f of the CPU", node_fast.per_second / floor_fast.per_second,
              node_fast.cpu_us / floor_fast.cpu_us));
+  add("driver_node, the same, nobody subscribed to servo_states", node_quiet,
+      format("%.2f of the rate, %.2f of the CPU", node_quiet.per_second / floor_fast.per_second,
+             node_quiet.cpu_us / floor_fast.cpu_us));
   add(format("servo_floor, --pace-baud %.0f, latency %.1f ms", kBusBaud, kBusLatencyMs),
       floor_paced, "");
   add(format("driver_node, --pace-baud %.0f, latency %.1f ms, state_rate 1000", kBusBaud,
