@@ -434,26 +434,34 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   // Asked vs achieved: state_rate of every answering polled servo, against the angles read since
   // the last update. A line too slow for what was asked (or service calls taking the bus) shows
   // here rather than as a silently lower rate.
+  // The achieved rate is measured over at least kRateWindowS, so one slow transaction (a silent
+  // servo's timeout, a long service call) does not flag a line that keeps up on average.
+  constexpr double kRateWindowS = 2.0;
   const auto now = std::chrono::steady_clock::now();
   const std::size_t answering = bus_.config().polled_ids.size() - worker.offline_ids.size();
   const double asked = state_rate_ * static_cast<double>(answering);
-  if (last_rate_check_ != std::chrono::steady_clock::time_point{} && now > last_rate_check_) {
-    const double seconds = std::chrono::duration<double>(now - last_rate_check_).count();
-    const double achieved = static_cast<double>(worker.angles_polled - polls_at_last_check_) / seconds;
-    status.addf("servo_states asked (per s)", "%.1f", asked);
-    status.addf("servo_states achieved (per s)", "%.1f", achieved);
-    // 10 % of slack for the update's own jitter; a saturated line falls far below it.
-    if (link_.connected() && asked > 0 && achieved < 0.9 * asked) {
-      char text[160];
-      std::snprintf(text, sizeof(text),
-                    "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
-                    "service calls are the limit: lower ~servo_bus/state_rate or raise the baud)",
-                    asked, achieved);
-      status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
-    }
+  if (last_rate_check_ == std::chrono::steady_clock::time_point{}) {
+    last_rate_check_ = now;
+    polls_at_last_check_ = worker.angles_polled;
   }
-  polls_at_last_check_ = worker.angles_polled;
-  last_rate_check_ = now;
+  const double seconds = std::chrono::duration<double>(now - last_rate_check_).count();
+  if (seconds >= kRateWindowS) {
+    achieved_rate_ = static_cast<double>(worker.angles_polled - polls_at_last_check_) / seconds;
+    polls_at_last_check_ = worker.angles_polled;
+    last_rate_check_ = now;
+  }
+  status.addf("servo_states asked (per s)", "%.1f", asked);
+  if (achieved_rate_ < 0) return;  // the first window is not over yet
+  status.addf("servo_states achieved (per s)", "%.1f", achieved_rate_);
+  // 10 % of slack for the window's own jitter; a saturated line falls far below it.
+  if (link_.connected() && asked > 0 && achieved_rate_ < 0.9 * asked) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
+                  "service calls are the limit: lower ~servo_bus/state_rate or raise the baud)",
+                  asked, achieved_rate_);
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
+  }
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -113,6 +113,7 @@ class ServoBusInterface : public DeviceInterface {
   // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
   uint64_t polls_at_last_check_ = 0;
   std::chrono::steady_clock::time_point last_rate_check_{};
+  double achieved_rate_ = -1.0;  ///< reads/s over the last window; < 0: none yet
 };
 
 }  // namespace serial_robot_driver::ros_layer
