@@ -280,10 +280,10 @@ void RobotSim::flush(Port* port) {
     std::size_t remaining = pending.bytes.size() - pending.offset;
     TimePoint line_start{};
     if (paced) {
-      // Paced: the bytes whose last bit is through the line by now (the line carries a frame
-      // from when it is ready, after what it carried before), at most the next slice's worth.
-      // A late wake-up delivers late but never stretches the line: tx_line_free follows the
-      // line's own clock, not this thread's.
+      // Paced: once the next slice (or the whole of a short frame) is through, the bytes whose
+      // last bit is through the line by now (the line carries a frame from when it is ready,
+      // after what it carried before). A late wake-up delivers late but never stretches the
+      // line: tx_line_free follows the line's own clock, not this thread's.
       if (now < nextSendAt(port)) return;
       line_start = std::max(port->tx_line_free, pending.ready_at);
       const auto through = static_cast<std::size_t>((now - line_start) / lineTime(1));
