@@ -8,6 +8,7 @@ set(SRD_CORE_SOURCES
   src/protocol/stream_framer.cpp
   src/kinematics/diff_drive.cpp
   src/kinematics/odometry.cpp
+  src/kinematics/heading_fusion.cpp
   src/transport/serial_port.cpp
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp

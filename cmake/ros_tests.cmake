@@ -90,3 +90,9 @@ target_link_libraries(test_fleet_sim srd_test_support ${urdf_LIBRARIES}
   ${diagnostic_aggregator_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(test_fleet_sim driver_node robot_sim robot_description
   ${PROJECT_NAME}_generate_messages_cpp)
+# ~base/use_imu_heading end to end: odom's yaw against simulated robots whose base slips while
+# turning (sim::RobotSim in-process), with and without the IMU, and without telemetry.
+add_rostest_gtest(test_imu_heading test/rostest/imu_heading.test test/rostest/test_imu_heading.cpp)
+target_include_directories(test_imu_heading PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_imu_heading srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_imu_heading driver_node ${PROJECT_NAME}_generate_messages_cpp)

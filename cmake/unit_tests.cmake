@@ -33,3 +33,13 @@ target_link_libraries(description_tests srd_description ${urdf_LIBRARIES} gtest_
 target_compile_definitions(description_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
   SRD_ROBOT_DESCRIPTION="$<TARGET_FILE:robot_description>")
 add_dependencies(description_tests robot_description)
+# The IMU's heading fused into odometry (~base/use_imu_heading), ROS-free.
+catkin_add_gtest(heading_fusion_tests test/unit/test_heading_fusion.cpp)
+target_link_libraries(heading_fusion_tests srd_core gtest_main)
+
+# Runtime tuning: the dynamic_reconfigure .cfg files agree with the parameter table, and what of a
+# change applies (no roscore needed).
+catkin_add_gtest(runtime_tuning_tests test/unit/test_runtime_tuning.cpp)
+target_include_directories(runtime_tuning_tests PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(runtime_tuning_tests srd_ros gtest_main)
+add_dependencies(runtime_tuning_tests ${PROJECT_NAME}_gencfg)

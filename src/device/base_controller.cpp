@@ -52,7 +52,8 @@ BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents
       min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
       limiter_(config.max_wheel_accel),
       quantizer_(config.geometry, config.speed_dithering),
-      odometry_(config.geometry.wheel_separation, config.odometry_covariance) {}
+      odometry_(config.geometry.wheel_separation, config.odometry_covariance),
+      heading_(config.imu_stale_after) {}
 
 BaseController::~BaseController() {
   {
@@ -103,6 +104,16 @@ void BaseController::resetOdometry() {
   const Clock::time_point now = clock_->now();
   advanceOdometryLocked(now);
   odometry_.reset();
+  if (config_.use_imu_heading) {
+    heading_.restart();
+    advanceOdometryLocked(now);  // anchors the IMU's yaw now at heading zero, if it is fresh
+  }
+}
+
+void BaseController::onImuYaw(double yaw, Clock::time_point stamp) {
+  // Stored even while use_imu_heading is off (addSample only copies two values under its own
+  // lock): config_ belongs to the loop's lock, and retune may switch the fusion on at any time.
+  heading_.addSample(yaw, stamp);
 }
 
 bool BaseController::sendReset() {
@@ -176,6 +187,12 @@ void BaseController::retune(const BaseConfig& next) {
   limiter_.setMaxAccel(next.max_wheel_accel);
   quantizer_.retune(geometry, next.speed_dithering);
   odometry_.setWheelSeparation(geometry.wheel_separation);
+  if (next.use_imu_heading != config_.use_imu_heading) {
+    // On: anchored where odometry stands now; off: the commanded turn goes on from the last fused
+    // heading. Either way the heading does not jump.
+    if (next.use_imu_heading) heading_.restart();
+    config_.use_imu_heading = next.use_imu_heading;
+  }
   if (next.battery_poll_rate != config_.battery_poll_rate) {
     if (next.battery_poll_rate > 0) {
       // A faster rate starts now, not after the slower period still pending.
@@ -197,6 +214,11 @@ BaseStats BaseController::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   const Clock::time_point now = clock_->now();
   BaseStats snapshot = stats_;
+  if (config_.use_imu_heading) {
+    snapshot.heading_source = heading_.source();
+    snapshot.imu_heading_fallbacks = heading_.fallbacks();
+    snapshot.imu_yaw_age = heading_.sampleAge(now);
+  }
   snapshot.min_immediate_interval_ms = seconds(min_immediate_interval_) * 1e3;
   if (last_running_timeout_error_) {
     snapshot.seconds_since_running_timeout_error = seconds(now - *last_running_timeout_error_);
@@ -324,13 +346,23 @@ kinematics::WheelTicks BaseController::onWire(const kinematics::WheelTicks& tick
 }
 
 void BaseController::advanceOdometryLocked(Clock::time_point now) {
-  if (!accepted_at_) return;
-  // The base runs the last accepted speeds until its heartbeat timeout stops it.
-  const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(config_.heartbeat_gap));
-  if (end > integrated_until_) {
-    odometry_.integrate(held_speeds_, seconds(end - integrated_until_));
-    wheel_travel_ += held_speeds_ * seconds(end - integrated_until_);
-    integrated_until_ = end;
+  double dt = 0;
+  if (accepted_at_) {
+    // The base runs the last accepted speeds until its heartbeat timeout stops it.
+    const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(config_.heartbeat_gap));
+    if (end > integrated_until_) {
+      dt = seconds(end - integrated_until_);
+      wheel_travel_ += held_speeds_ * dt;
+      integrated_until_ = end;
+    }
+  }
+  // The fused heading follows the IMU even while the wheels stand still (the robot was pushed).
+  const std::optional<double> heading =
+      config_.use_imu_heading ? heading_.heading(now, odometry_.pose().yaw) : std::nullopt;
+  if (heading) {
+    odometry_.integrate(held_speeds_, dt, *heading, config_.imu_yaw_variance);
+  } else if (dt > 0) {
+    odometry_.integrate(held_speeds_, dt);
   }
 }
 
@@ -360,6 +392,8 @@ OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const
   sample.position_variance = odometry_.positionVariance();
   sample.yaw_variance = odometry_.yawVariance();
   sample.travelled = odometry_.travelled();
+  sample.imu_heading =
+      config_.use_imu_heading && heading_.source() == kinematics::HeadingSource::kImu;
   return sample;
 }
 
@@ -429,6 +463,7 @@ void BaseController::tick(Clock::time_point now) {
   sendSpeed(now, false);
 
   std::optional<double> went_silent;
+  std::optional<kinematics::HeadingSource> heading_changed;
   OdometrySample sample;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -441,8 +476,13 @@ void BaseController::tick(Clock::time_point now) {
     }
     advanceOdometryLocked(now);
     sample = odometrySampleLocked(now);
+    if (config_.use_imu_heading && heading_.source() != reported_heading_source_) {
+      reported_heading_source_ = heading_.source();
+      heading_changed = reported_heading_source_;
+    }
   }
   if (went_silent && events_.on_silent) events_.on_silent(*went_silent);
+  if (heading_changed && events_.on_heading_source) events_.on_heading_source(*heading_changed);
   if (events_.on_odometry) events_.on_odometry(sample);
 }
 

@@ -5,6 +5,7 @@
 #include <sensor_msgs/BatteryState.h>
 #include <sensor_msgs/JointState.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "serial_robot_driver/WheelCommand.h"
@@ -36,6 +37,8 @@ device::BaseConfig makeBaseConfig(const DriverParams& params) {
   config.baud = params.baseBaud();
   config.left_wheel_direction = params.base.left_wheel_direction;
   config.right_wheel_direction = params.base.right_wheel_direction;
+  config.use_imu_heading = params.base.use_imu_heading;
+  config.imu_yaw_variance = params.imu.orientation_variance;
   return config;
 }
 
@@ -71,7 +74,7 @@ device::BaseEvents BaseInterface::events() {
   events.on_odometry = [this](const device::OdometrySample& sample) { publishOdometry(sample); };
   events.on_cmd_vel_timeout = [this] {
     ROS_INFO_THROTTLE(10.0, "no cmd_vel for %.2f s (base/cmd_vel_timeout): commanding zero speed",
-                      params_.cmd_vel_timeout);
+                      tuned().cmd_vel_timeout);
   };
   events.on_silent = [this](double seconds) {
     ROS_ERROR_THROTTLE(10.0,
@@ -80,6 +83,16 @@ device::BaseEvents BaseInterface::events() {
   };
   events.on_timeout_error = [] {
     ROS_WARN_THROTTLE(5.0, "base reported a connection-timeout error (FF): sending Reset");
+  };
+  events.on_heading_source = [this](kinematics::HeadingSource source) {
+    if (source == kinematics::HeadingSource::kImu) {
+      ROS_INFO("odom heading: following the IMU's yaw (base/use_imu_heading)");
+    } else if (source == kinematics::HeadingSource::kImuStale) {
+      ROS_WARN(
+          "odom heading: no IMU yaw for %.2f s (is the body's telemetry flowing?); integrating "
+          "the commanded turn from the last fused heading until it returns",
+          std::chrono::duration<double>(kinematics::kImuHeadingStaleAfter).count());
+    }
   };
   events.on_unknown_reply = [](const protocol::base::Frame& frame) {
     ROS_DEBUG_THROTTLE(5.0, "base sent a frame with unknown MSGID 0x%02X", frame.msg_id);
@@ -92,6 +105,8 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
     : link_(link),
       arrival_stamps_(params),
       params_(params.base),
+      tuned_{params.base.publish_tf, params.base.cmd_vel_timeout, params.base.battery_warn_percent,
+             params.base.battery_error_percent},
       tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
                                              : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
@@ -149,7 +164,8 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom.twist.twist.linear.x = sample.linear;
   odom.twist.twist.angular.z = sample.angular;
   // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
-  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all.
+  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
+  // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
   constexpr double kNotEstimated = 1e6;
   odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
   odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
@@ -163,7 +179,9 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom_pub_.publish(odom);
   publishWheelStates(sample, stamp);
 
-  if (!tf_broadcaster_) return;
+  if (!tuned().publish_tf) return;
+  // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
+  if (!tf_broadcaster_) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
   geometry_msgs::TransformStamped transform;
   transform.header = odom.header;
   transform.child_frame_id = odom.child_frame_id;
@@ -175,14 +193,26 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
 
 void BaseInterface::publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp) {
   // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
-  const double radius = params_.wheel_diameter / 2.0;
   sensor_msgs::JointState wheels;
   wheels.header.stamp = stamp;
   wheels.header.frame_id = params_.base_frame;
   wheels.name = {params_.left_wheel_joint, params_.right_wheel_joint};
-  wheels.position = {sample.wheel_travel.x() / radius, sample.wheel_travel.y() / radius};
-  wheels.velocity = {sample.wheel_speeds.x() / radius, sample.wheel_speeds.y() / radius};
+  // In rad, from the controller: with the diameter each stretch of travel ran under.
+  wheels.position = {sample.wheel_angles.x(), sample.wheel_angles.y()};
+  wheels.velocity = {sample.wheel_rates.x(), sample.wheel_rates.y()};
   wheel_states_pub_.publish(wheels);
+}
+
+BaseInterface::Tuned BaseInterface::tuned() const {
+  std::lock_guard<std::mutex> lock(tuned_mutex_);
+  return tuned_;
+}
+
+void BaseInterface::retune(const DriverParams& params) {
+  controller_.retune(makeBaseConfig(params));
+  std::lock_guard<std::mutex> lock(tuned_mutex_);
+  tuned_ = Tuned{params.base.publish_tf, params.base.cmd_vel_timeout,
+                 params.base.battery_warn_percent, params.base.battery_error_percent};
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -228,15 +258,27 @@ void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   }
   if (s.battery_percent) {
     const int percent = *s.battery_percent;
-    if (percent < params_.battery_error_percent) {
+    const Tuned limits = tuned();
+    if (percent < limits.battery_error_percent) {
       status.mergeSummaryf(DiagnosticStatus::ERROR, "battery %d %% (below %d %%)", percent,
-                           params_.battery_error_percent);
-    } else if (percent < params_.battery_warn_percent) {
+                           limits.battery_error_percent);
+    } else if (percent < limits.battery_warn_percent) {
       status.mergeSummaryf(DiagnosticStatus::WARN, "battery %d %% (below %d %%)", percent,
-                           params_.battery_warn_percent);
+                           limits.battery_warn_percent);
     }
   }
   if (s.e_stop) status.mergeSummary(DiagnosticStatus::WARN, "e-stop engaged: holding zero speed");
+  if (s.heading_source) {
+    // ~base/use_imu_heading: odom without the IMU is worth a warning, the driving goes on.
+    if (*s.heading_source != kinematics::HeadingSource::kImu) {
+      status.mergeSummaryf(DiagnosticStatus::WARN, "odom heading: %s",
+                           kinematics::toString(*s.heading_source));
+    }
+    status.add("odom heading source", kinematics::toString(*s.heading_source));
+    status.add("odom heading IMU fallbacks", s.imu_heading_fallbacks);
+    status.add("odom heading IMU yaw age (s)",
+               s.imu_yaw_age ? std::to_string(*s.imu_yaw_age) : std::string("none yet"));
+  }
   status.hardware_id = link_.options().path;
   status.add("port", link_.options().path);
   status.add("connected", connected);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 
 namespace serial_robot_driver::ros_layer {
 
@@ -102,6 +103,27 @@ sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
   return msg;
 }
 
+namespace {
+/// R_world_imu from the board's attitude angles and the axis map M (v_imu = M v_sensor).
+Eigen::Quaterniond imuOrientation(const body::Telemetry& telemetry, double angle_scale,
+                                  const Eigen::Matrix3d& map) {
+  const auto& raw = telemetry.imu;
+  const geometry_msgs::Quaternion sensor =
+      quaternionFromRollPitchYaw(raw[body::kRoll] * angle_scale, raw[body::kPitch] * angle_scale,
+                                 raw[body::kYaw] * angle_scale);
+  return Eigen::Quaterniond(sensor.w, sensor.x, sensor.y, sensor.z) *
+         Eigen::Quaterniond(map.transpose());
+}
+}  // namespace
+
+double imuYaw(const body::Telemetry& telemetry, const ImuParams& params) {
+  const Eigen::Quaterniond q =
+      imuOrientation(telemetry, params.angle_scale, axisMapMatrix(params.axis_map));
+  // The Z (yaw) angle of a Z-Y-X decomposition.
+  return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()),
+                    1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+}
+
 sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params,
                        const ros::Time& stamp) {
   sensor_msgs::Imu msg;
@@ -123,11 +145,7 @@ sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params
   msg.angular_velocity.x = gyro.x();
   msg.angular_velocity.y = gyro.y();
   msg.angular_velocity.z = gyro.z();
-  const geometry_msgs::Quaternion sensor = quaternionFromRollPitchYaw(
-      raw[body::kRoll] * params.angle_scale, raw[body::kPitch] * params.angle_scale,
-      raw[body::kYaw] * params.angle_scale);
-  const Eigen::Quaterniond world_imu =
-      Eigen::Quaterniond(sensor.w, sensor.x, sensor.y, sensor.z) * Eigen::Quaterniond(map.transpose());
+  const Eigen::Quaterniond world_imu = imuOrientation(telemetry, params.angle_scale, map);
   msg.orientation.x = world_imu.x();
   msg.orientation.y = world_imu.y();
   msg.orientation.z = world_imu.z();

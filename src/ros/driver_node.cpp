@@ -5,6 +5,7 @@
 
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
+#include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/servo_bus_interface.h"
 #include "serial_robot_driver/ros/wire_capture.h"
 
@@ -133,15 +134,40 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   for (const DeviceEntry& entry : entries) {
     if (entry.enabled) devices_.push_back(entry.make(nh_, params_, portFor(entry.port), diagnostics_));
   }
+  // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
+  connectImuHeading();
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
+  // Runtime tuning: a server per group under ~ (~base, ~imu, ...), starting from params_.
+  std::vector<DeviceInterface*> tunable;
+  for (auto& device : devices_) tunable.push_back(device.get());
+  tuning_ = std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable));
   diagnostics_timer_ = nh_.createSteadyTimer(
       ros::WallDuration(diagnostics_period_),
       [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
 }
 
 DriverNode::~DriverNode() { shutdown(); }
+
+void DriverNode::connectImuHeading() {
+  // ~base/use_imu_heading (validate() made sure the body is enabled): the body's reader thread
+  // hands each frame's IMU yaw straight to the base controller, which only stores it (see
+  // kinematics::HeadingFusion). Both interfaces live in devices_, which outlives the links'
+  // threads.
+  BaseInterface* base = nullptr;
+  BodyInterface* body = nullptr;
+  for (auto& device : devices_) {
+    if (!base) base = dynamic_cast<BaseInterface*>(device.get());
+    if (!body) body = dynamic_cast<BodyInterface*>(device.get());
+  }
+  if (!base || !body) return;
+  const bool replaying = !params_.replay_bag.empty();
+  body->setImuYawListener([base, replaying](double yaw, device::Clock::time_point arrival) {
+    // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
+    base->onImuYaw(yaw, replaying ? device::Clock::now() : arrival);
+  });
+}
 
 device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }
 
@@ -179,6 +205,7 @@ std::string DriverNode::startupSummary() const {
 void DriverNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  if (tuning_) tuning_->stop();  // no retune while the devices stop
   diagnostics_timer_.stop();
   // Base first: its zero-speed frame goes out while the port is still open.
   for (auto& device : devices_) device->shutdown();

@@ -164,6 +164,7 @@ std::vector<ParamSpec> buildTable() {
       row("base/right_wheel_direction", &P::base, &Base::right_wheel_direction, direction),
       row("base/left_wheel_joint", &P::base, &Base::left_wheel_joint, frameId),
       row("base/right_wheel_joint", &P::base, &Base::right_wheel_joint, frameId),
+      row("base/use_imu_heading", &P::base, &Base::use_imu_heading),
 
       row("body/enabled", &P::body, &Port::enabled),
       row("body/port", &P::body, &Port::port),
@@ -377,6 +378,13 @@ void DriverParams::validate() const {
             "must differ from base/odom_frame ('" + base.odom_frame + "')");
     require(base.left_wheel_joint != base.right_wheel_joint, "base/right_wheel_joint",
             "must differ from base/left_wheel_joint ('" + base.left_wheel_joint + "')");
+    if (base.use_imu_heading) {
+      require(body.enabled, "base/use_imu_heading",
+              "needs the servo controller board's IMU, but body/enabled is false");
+      require(
+          imu.orientation_variance >= 0, "base/use_imu_heading",
+          "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
+    }
   }
   if (body.enabled) {
     const std::size_t n = body.servo_ids.size();

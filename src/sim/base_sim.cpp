@@ -115,7 +115,7 @@ void BaseSim::advancePose() {
   const double left = stats_.last_left_speed * meters_per_tick;
   const double right = stats_.last_right_speed * meters_per_tick;
   const double forward = (left + right) / 2.0;
-  const double turn = (right - left) / config_.wheel_separation_m;
+  const double turn = (right - left) / config_.wheel_separation_m * (1.0 - config_.turn_slip);
   const double heading = stats_.yaw_rad + turn / 2.0;
   stats_.x_m += forward * std::cos(heading);
   stats_.y_m += forward * std::sin(heading);
@@ -127,7 +127,7 @@ double BaseSim::yawRate() const {
   const double to_mps = config_.pid_rate_hz / ticks_per_meter;
   const double left = stats_.last_left_speed * to_mps;
   const double right = stats_.last_right_speed * to_mps;
-  return (right - left) / config_.wheel_separation_m;
+  return (right - left) / config_.wheel_separation_m * (1.0 - config_.turn_slip);
 }
 
 }  // namespace serial_robot_driver::sim

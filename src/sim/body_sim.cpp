@@ -62,7 +62,7 @@ void BodySim::handleSyncWrite(const uint8_t* data, std::size_t size) {
   }
 }
 
-void BodySim::advance(TimePoint now, double yaw_rate) {
+void BodySim::advance(TimePoint now) {
   const double dt = toSeconds(now - last_step_);
   if (dt <= 0) return;
   last_step_ = now;
@@ -73,7 +73,6 @@ void BodySim::advance(TimePoint now, double yaw_rate) {
     servo.position += step;
     servo.speed = clipToInt16(step / dt);
   }
-  stats_.yaw_rad = wrapAngle(stats_.yaw_rad + yaw_rate * dt);
 }
 
 int16_t BodySim::noise() {
@@ -81,7 +80,8 @@ int16_t BodySim::noise() {
   return static_cast<int16_t>(std::uniform_int_distribution<int>(-2, 2)(rng_));
 }
 
-std::vector<uint8_t> BodySim::buildTelemetry(double yaw_rate) {
+std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
+  stats_.yaw_rad = wrapAngle(chassis.yaw_rad);
   body::Telemetry telemetry;
   telemetry.servo_count = stats_.servos.size();
   for (std::size_t i = 0; i < stats_.servos.size(); ++i) {
@@ -95,7 +95,7 @@ std::vector<uint8_t> BodySim::buildTelemetry(double yaw_rate) {
   telemetry.imu[body::kGyroX] = noise();
   telemetry.imu[body::kGyroY] = noise();
   telemetry.imu[body::kGyroZ] =
-      clipToInt16(yaw_rate * kRadToDeg * config_.gyro_lsb_per_dps + noise());
+      clipToInt16(chassis.yaw_rate * kRadToDeg * config_.gyro_lsb_per_dps + noise());
   telemetry.imu[body::kRoll] = noise();
   telemetry.imu[body::kPitch] = noise();
   telemetry.imu[body::kYaw] = clipToInt16(stats_.yaw_rad * kRadToDeg * config_.angle_lsb_per_deg);
@@ -124,18 +124,18 @@ std::vector<uint8_t> BodySim::buildTelemetry(double yaw_rate) {
   return body::encodeTelemetry(telemetry);
 }
 
-void BodySim::tick(TimePoint now, double yaw_rate, Outbox* out) {
+void BodySim::tick(TimePoint now, const ChassisMotion& chassis, Outbox* out) {
   if (config_.telemetry_rate_hz <= 0) {
-    advance(now, yaw_rate);
+    advance(now);
     return;
   }
   if (now - next_telemetry_ > std::chrono::seconds(1)) next_telemetry_ = now;  // after a stall
   while (next_telemetry_ <= now) {
-    advance(next_telemetry_, yaw_rate);
-    out->push_back(Outgoing{OutputKind::kTelemetry, buildTelemetry(yaw_rate)});
+    advance(next_telemetry_);
+    out->push_back(Outgoing{OutputKind::kTelemetry, buildTelemetry(chassis)});
     next_telemetry_ += telemetry_period_;
   }
-  advance(now, yaw_rate);
+  advance(now);
 }
 
 TimePoint BodySim::nextEvent() const {

@@ -201,6 +201,11 @@ const std::vector<Flag>& flags() {
           [](SimOptions& o) -> double& { return o.body.servo_speed; }, true),
       toggle("--imu-noise", "+-2 LSB noise on the IMU values",
              [](SimOptions& o) { o.body.imu_noise = true; }),
+      number(
+          "--turn-slip", "FRACTION",
+          "wheel slip: the base turns by (1 - FRACTION) of the commanded yaw rate (0..1); the IMU "
+          "reports the true turn",
+          0.0, 1.0, [](SimOptions& o) -> double& { return o.base.turn_slip; }),
       idList(
           "--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX,
           [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.servo_ids; }, true),

@@ -341,7 +341,12 @@ void RobotSim::step(TimePoint now) {
   }
   Outbox outbox;
   if (base_) base_->tick(now, &outbox);
-  if (body_) body_->tick(now, base_ ? base_->yawRate() : 0.0, &outbox);
+  if (body_) {
+    // The board rides on the base: its IMU reports the base's true heading (slip included).
+    ChassisMotion chassis;
+    if (base_) chassis = ChassisMotion{base_->stats().yaw_rad, base_->yawRate()};
+    body_->tick(now, chassis, &outbox);
+  }
   if (servo_bus_) servo_bus_->tick(now, &outbox);
   for (Outgoing& frame : outbox) route(std::move(frame));
 

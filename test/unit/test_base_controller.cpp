@@ -637,6 +637,84 @@ TEST(BaseControllerLoop, NewCommandGoesOutBeforeTheNextTick) {
 }  // namespace
 }  // namespace serial_robot_driver::device
 
+// --- the IMU's heading in the odometry (use_imu_heading) -------------------------------------
+
+namespace serial_robot_driver::device {
+namespace {
+
+TEST(BaseControllerImuHeading, FollowsTheImuFallsBackWithoutAJumpAndResumesWithoutOne) {
+  std::vector<OdometrySample> odometry;
+  std::vector<kinematics::HeadingSource> sources;
+  BaseEvents events;
+  events.on_odometry = [&](const OdometrySample& sample) { odometry.push_back(sample); };
+  events.on_heading_source = [&](kinematics::HeadingSource s) { sources.push_back(s); };
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  config.cmd_vel_timeout = 100;  // one command turns for the whole test
+  config.use_imu_heading = true;
+  config.imu_yaw_variance = 0.0003;
+  const Clock::time_point t0 = Clock::now();
+  auto clock = std::make_shared<ManualClock>(t0);
+  auto controller = startOnManualClock(config, events, clock);
+
+  // The IMU starts at an arbitrary yaw (2.0 rad): odom's heading is relative to it.
+  double imu_yaw = 2.0;
+  const auto feed = [&] { controller->onImuYaw(imu_yaw, clock->now()); };
+  feed();
+  clock->tick(1);
+  ASSERT_FALSE(odometry.empty());
+  EXPECT_TRUE(odometry.back().imu_heading);
+  EXPECT_NEAR(odometry.back().pose.yaw, 0.0, 1e-12);
+  ASSERT_EQ(sources, std::vector<kinematics::HeadingSource>{kinematics::HeadingSource::kImu});
+
+  // Commanded 0.5 rad/s; the IMU says the base turns at 0.35 rad/s (slip): odom follows the IMU.
+  clock->step([&] { controller->setCommand(0.0, 0.5); });
+  for (int i = 0; i < 50; ++i) {
+    imu_yaw += 0.35 * 0.02;
+    feed();
+    clock->tick(1);
+  }
+  EXPECT_NEAR(odometry.back().pose.yaw, 0.35, 1e-9);
+  EXPECT_NEAR(odometry.back().yaw_variance, 0.0003, 1e-12);
+  EXPECT_NEAR(odometry.back().pose.x, 0.0, 1e-9) << "turning on the spot";
+
+  // The IMU goes quiet: after 0.25 s odom integrates the commanded turn from the fused heading.
+  const std::size_t before_outage = odometry.size();
+  clock->tick(40);  // 0.8 s
+  EXPECT_FALSE(odometry.back().imu_heading);
+  ASSERT_EQ(sources.size(), 2u);
+  EXPECT_EQ(sources.back(), kinematics::HeadingSource::kImuStale);
+  EXPECT_GT(odometry.back().pose.yaw, 0.35 + 0.2) << "the commanded turn goes on";
+  EXPECT_GT(odometry.back().yaw_variance, 0.0003) << "and the yaw variance grows again";
+  EXPECT_EQ(controller->stats().imu_heading_fallbacks, 1u);
+  // The IMU returns at a yaw far from where odom stands: odom carries on from its own heading.
+  imu_yaw = -3.0;
+  feed();
+  clock->tick(1);
+  const double resumed_at = odometry.back().pose.yaw;
+  EXPECT_TRUE(odometry.back().imu_heading);
+  for (int i = 0; i < 10; ++i) {
+    imu_yaw += 0.35 * 0.02;
+    feed();
+    clock->tick(1);
+  }
+  EXPECT_NEAR(odometry.back().pose.yaw, resumed_at + 0.07, 1e-9);
+  // No jump anywhere: no step turned more than the commanded 0.5 rad/s allows in one period
+  // (0.01 rad; 0.0123 when dithering puts a fifth tick on each wheel).
+  for (std::size_t i = before_outage; i < odometry.size(); ++i) {
+    const double step = std::remainder(odometry[i].pose.yaw - odometry[i - 1].pose.yaw, 2 * M_PI);
+    EXPECT_LE(std::abs(step), 0.015) << "step " << i;
+  }
+
+  // base/reset_odometry: the fused heading restarts at zero where the IMU stands now.
+  controller->resetOdometry();
+  imu_yaw += 0.05;
+  feed();
+  clock->tick(1);
+  EXPECT_NEAR(odometry.back().pose.yaw, 0.05, 1e-9);
+  EXPECT_NEAR(odometry.back().yaw_variance, 0.0003, 1e-12);
+  controller->stop();
+
 // --- retune: the tunable part of the configuration changed while the loop runs ----------------
 namespace serial_robot_driver::device {
 namespace {

@@ -232,6 +232,23 @@ TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {
   EXPECT_EQ(msg.orientation_covariance[4], 0.0);
 }
 
+// imuYaw (~base/use_imu_heading) is the yaw of the orientation imu/data carries, axis map included.
+TEST(ConversionsImu, ImuYawIsTheHeadingOfThePublishedOrientation) {
+  ImuParams params;
+  params.angle_scale = M_PI / 32768.0;
+  EXPECT_NEAR(imuYaw(goldenTelemetry(), params), -M_PI / 2, 1e-9);  // raw yaw -16384: -90 deg
+  // Board turned +90 deg about z ([-y, x, z]): the imu frame's heading is -180 deg.
+  params.axis_map = {"-y", "x", "z"};
+  EXPECT_NEAR(std::abs(imuYaw(goldenTelemetry(), params)), M_PI, 1e-9);
+  // Upside down ([x, -y, -z]) is a roll of 180 deg: the heading stays -90 deg.
+  params.axis_map = {"x", "-y", "-z"};
+  EXPECT_NEAR(imuYaw(goldenTelemetry(), params), -M_PI / 2, 1e-9);
+  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
+  const auto& q = msg.orientation;
+  EXPECT_NEAR(imuYaw(goldenTelemetry(), params),
+              std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z)), 1e-9);
+}
+
 // --- FootPressure and Telemetry ------------------------------------------------------------------
 
 TEST(ConversionsFootPressure, OnlyForFramesWithTheFootBlock) {

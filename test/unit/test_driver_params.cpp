@@ -108,6 +108,27 @@ INSTANTIATE_TEST_SUITE_P(
                   p.base.enabled = p.body.enabled = p.servo_bus.enabled = false;
                 }}));
 
+TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
+  DriverParams params;
+  params.base.use_imu_heading = true;
+  EXPECT_NO_THROW(params.validate());
+  const auto expectRefused = [](const DriverParams& p, const std::string& reason) {
+    try {
+      p.validate();
+      FAIL() << "no error for " << reason;
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), "base/use_imu_heading");
+      EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+    }
+  };
+  DriverParams no_body = params;
+  no_body.body.enabled = false;
+  expectRefused(no_body, "body/enabled is false");
+  DriverParams no_orientation = params;
+  no_orientation.imu.orientation_variance = -1;
+  expectRefused(no_orientation, "imu/orientation_variance is negative");
+}
+
 TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
   DriverParams params;
   params.servo_bus.port = "/dev/ttyUSB1";

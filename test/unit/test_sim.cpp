@@ -247,6 +247,46 @@ TEST(RobotSimBaseDevice, YawRateFollowsTheWheelDifference) {
   EXPECT_GT(base.yawRate(), 0.0);  // right wheel faster: counter-clockwise
 }
 
+TEST(RobotSimBaseDevice, TurnSlipTurnsTheChassisLessThanItsWheelsCommand) {
+  const TimePoint t0{};
+  BaseSimConfig config;
+  config.turn_slip = 0.3;
+  BaseSim base(config, t0);
+  Outbox out;
+  const Bytes right4 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x00,
+                        0x00, 0x04, 0x00, 0x00, 0x00, 0x00, 0xF3};
+  base.handleFrame(right4.data(), right4.size(), t0, &out);
+  base.tick(t0 + milliseconds(105), &out);  // 5 PID periods
+  // The encoders count every tick; the chassis turns by 70 % of what the ticks command:
+  // 5 periods * 4 ticks * (0.25 pi / 1600) m / 0.40 m = 0.0245437 rad commanded.
+  EXPECT_EQ(base.stats().right_ticks, 20);
+  EXPECT_NEAR(base.stats().yaw_rad, 0.7 * 0.0245437, 1e-6);
+  EXPECT_NEAR(base.yawRate(), 0.7 * (4 * 50 / (1600 / (0.25 * M_PI))) / 0.40, 1e-9);
+}
+
+TEST(RobotSimBodyDevice, ImuReportsTheChassisHeadingAndYawRate) {
+  const TimePoint t0{};
+  BodySimConfig config;
+  config.telemetry_rate_hz = 50;
+  BodySim body(config, t0);
+  Outbox out;
+  body.tick(t0 + milliseconds(20), ChassisMotion{1.0, 0.5}, &out);
+  ASSERT_EQ(out.size(), 1u);
+  const auto telemetry =
+      protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+  ASSERT_TRUE(telemetry.ok());
+  // 1 rad at 180 deg / 32768 per LSB: 10430.4 LSB; 0.5 rad/s at 2000 deg/s / 32768: 469.4 LSB.
+  EXPECT_EQ(telemetry->imu[protocol::body::kYaw], 10430);
+  EXPECT_EQ(telemetry->imu[protocol::body::kGyroZ], 469);
+  // A heading beyond pi is reported wrapped, as an attitude module does: 4 rad = 4 - 2 pi.
+  out.clear();
+  body.tick(t0 + milliseconds(40), ChassisMotion{4.0, 0.0}, &out);
+  ASSERT_EQ(out.size(), 1u);
+  const auto wrapped = protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+  ASSERT_TRUE(wrapped.ok());
+  EXPECT_EQ(wrapped->imu[protocol::body::kYaw], -23814);  // -2.2832 rad * 32768 / pi
+}
+
 TEST(RobotSimBodyDevice, ServoMovesAtTheBoundedSpeed) {
   const TimePoint t0{};
   BodySimConfig config;
@@ -256,12 +296,12 @@ TEST(RobotSimBodyDevice, ServoMovesAtTheBoundedSpeed) {
   BodySim body(config, t0);
   body.handleSyncWrite(kSyncWrite2And3.data(), kSyncWrite2And3.size());
   Outbox out;
-  body.tick(t0 + milliseconds(500), 0.0, &out);
+  body.tick(t0 + milliseconds(500), ChassisMotion{}, &out);
   EXPECT_TRUE(out.empty());  // telemetry off
   EXPECT_NEAR(body.stats().servos[1].position, 2048 - 500, 1e-6);
   EXPECT_EQ(body.stats().servos[1].speed, -1000);
   EXPECT_EQ(body.stats().servos[0].speed, 0);
-  body.tick(t0 + milliseconds(2000), 0.0, &out);
+  body.tick(t0 + milliseconds(2000), ChassisMotion{}, &out);
   EXPECT_NEAR(body.stats().servos[1].position, 1024, 1e-6);
 }
 

@@ -20,6 +20,9 @@
 //  - Odometry (mutex_) integrates the wheel speeds of each speed frame the base accepted, from its
 //    write until the next accepted frame, the base's own 1 s timeout, or an FF error, whichever
 //    comes first. The loop reports a sample after every scheduled tick (on_odometry).
+//  - With use_imu_heading, onImuYaw() runs on the body port's reader thread and only hands the
+//    sample to kinematics::HeadingFusion (its own short lock, never mutex_, so telemetry never
+//    waits for a base write); the loop reads the newest sample when it advances the odometry.
 #pragma once
 
 #include <condition_variable>
@@ -33,6 +36,7 @@
 
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
+#include "serial_robot_driver/kinematics/heading_fusion.h"
 #include "serial_robot_driver/kinematics/odometry.h"
 #include "serial_robot_driver/protocol/base_codec.h"
 
@@ -55,6 +59,11 @@ struct BaseConfig {
   /// With battery polling on, this many poll periods without any reply mean the base is silent.
   double silent_after_polls = 3.0;
   kinematics::PoseCovarianceModel odometry_covariance;
+  /// Odometry's heading from the IMU yaw given to onImuYaw() while it is fresh (see
+  /// kinematics::HeadingFusion); the commanded turn otherwise.
+  bool use_imu_heading = false;
+  double imu_yaw_variance = 0.0003;  ///< rad^2, odom's yaw variance while the IMU heading is used
+  Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
 };
 
 /// Where the odometry stood after a scheduled tick.
@@ -76,6 +85,8 @@ struct OdometrySample {
   kinematics::WheelSpeeds wheel_angles = kinematics::WheelSpeeds::Zero();
   /// wheel_speeds as the wheels' angular speeds (rad/s) with the diameter in force.
   kinematics::WheelSpeeds wheel_rates = kinematics::WheelSpeeds::Zero();
+  /// Where the heading came from (kImu only with use_imu_heading).
+  bool imu_heading = false;
 };
 
 /// One wheel frame as written.
@@ -112,6 +123,11 @@ struct BaseStats {
   double last_period_ms = 0;
   double worst_period_ms = 0;
   std::optional<uint8_t> battery_percent;
+  /// use_imu_heading only: where the heading comes from, how often the IMU went stale, and the
+  /// age of the newest IMU yaw (s).
+  std::optional<kinematics::HeadingSource> heading_source;
+  uint64_t imu_heading_fallbacks = 0;
+  std::optional<double> imu_yaw_age;
 };
 
 /// Where the base loop reads the time and waits for its next tick. The default is the steady
@@ -137,6 +153,8 @@ struct BaseEvents {
   std::function<void(const OdometrySample&)> on_odometry;  ///< after every scheduled tick
   std::function<void()> on_cmd_vel_timeout;                ///< once per timeout, when it starts
   std::function<void(double seconds)> on_silent;           ///< once, when the base goes silent
+  /// use_imu_heading: the heading's source changed (IMU fused, or the IMU went stale); loop thread.
+  std::function<void(kinematics::HeadingSource)> on_heading_source;
 };
 
 class BaseController : public LinkListener {
@@ -152,8 +170,12 @@ class BaseController : public LinkListener {
   /// Engaged: a zero-speed frame goes out at once (no ramp) and zero is held; frames keep flowing.
   /// Released: the wheels stay still until the next cmd_vel.
   void setEStop(bool engaged);
-  /// Puts the odometry pose (and its covariance) back to zero.
+  /// Puts the odometry pose (and its covariance) back to zero; a fused heading restarts at zero
+  /// too.
   void resetOdometry();
+  /// Any thread (the body port's reader): the yaw (rad) of the IMU on the base, measured at
+  /// `stamp`. Used only with use_imu_heading.
+  void onImuYaw(double yaw, Clock::time_point stamp);
   /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
   /// the port's baud (10 bits per byte) divided by immediate_line_share.
   Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
@@ -164,7 +186,7 @@ class BaseController : public LinkListener {
 
   /// Applies the tunable part of `next` from the next frame on, all at once (under the loop's
   /// lock): geometry.wheel_diameter and .wheel_separation, max_wheel_speed, max_wheel_accel,
-  /// cmd_vel_timeout, speed_dithering, battery_poll_rate. Everything else in `next` is ignored
+  /// cmd_vel_timeout, speed_dithering, battery_poll_rate, use_imu_heading. Everything else in `next` is ignored
   /// (it needs a new controller). No Reset, the sequence goes on, the odometry keeps its pose:
   /// the motion up to now is integrated with the geometry it ran under, from now on with the new
   /// one. Expects validated values.
@@ -228,6 +250,8 @@ class BaseController : public LinkListener {
   Clock::time_point next_battery_poll_{};
   bool e_stop_ = false;
   kinematics::Odometry odometry_;
+  kinematics::HeadingFusion heading_;  ///< used with use_imu_heading only
+  kinematics::HeadingSource reported_heading_source_ = kinematics::HeadingSource::kWaitingForImu;
   kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
   kinematics::WheelSpeeds wheel_travel_ = kinematics::WheelSpeeds::Zero();  ///< see OdometrySample
   /// Wheel angles and travel when the diameter last changed (see OdometrySample::wheel_angles).

@@ -21,6 +21,8 @@ struct Pose2D {
 /// turn on the spot counts too.
 ///   var(x) = var(y) = initial_position_variance + position_variance_per_meter * travelled
 ///   var(yaw)        = initial_yaw_variance + yaw_variance_per_meter * travelled
+/// A measured heading (Odometry::integrate with measured_yaw) restarts var(yaw) from the
+/// measurement's variance; it grows per metre again from there once measurements stop.
 struct PoseCovarianceModel {
   double initial_position_variance = 1e-6;      ///< m^2
   double position_variance_per_meter = 0.0025;  ///< m^2 per m: std 5 cm after 1 m, 16 cm after 10 m
@@ -37,6 +39,13 @@ class Odometry {
   /// the second-order Runge-Kutta (midpoint) step, as ros_controllers' diff_drive_controller does.
   /// Non-finite or negative `dt`, or non-finite speeds, leave the pose unchanged.
   void integrate(const WheelSpeeds& speeds, double dt);
+  /// Like integrate(), but the heading at the end of the step is `measured_yaw` (an IMU's) rather
+  /// than the commanded turn: the path is the arc through the measured turn, as long as the
+  /// commanded distance. The yaw variance becomes `measured_yaw_variance` and grows from there
+  /// again (per metre, as the model says) over the steps that follow without a measurement.
+  /// dt = 0 only sets the heading. A non-finite argument leaves the pose unchanged.
+  void integrate(const WheelSpeeds& speeds, double dt, double measured_yaw,
+                 double measured_yaw_variance);
   /// Pose, distance travelled and twist back to zero.
   void reset();
   /// A corrected wheel separation for the steps from now on; the pose reached so far is kept.
@@ -53,12 +62,18 @@ class Odometry {
   double yawVariance() const;
 
  private:
+  /// Moves `distance` along the arc that turns the heading by `turn` (rad).
+  void step(double distance, double turn);
+
   double wheel_separation_;
   PoseCovarianceModel model_;
   Pose2D pose_;
   double linear_ = 0;
   double angular_ = 0;
   double travelled_ = 0;
+  // The yaw variance grows from this value at this distance travelled (the last measured heading).
+  double yaw_variance_origin_;
+  double yaw_travelled_origin_ = 0;
 };
 
 }  // namespace serial_robot_driver::kinematics

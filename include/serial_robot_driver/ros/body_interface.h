@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
+#include <functional>
 #include <memory>
 
 #include "serial_robot_driver/device/body_controller.h"
@@ -29,8 +30,14 @@ class BodyInterface : public DeviceInterface {
   /// Stops taking joint commands. Frames that still arrive before the link stops are published.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~imu tunables (accel_scale, gyro_scale, angle_scale) from the next telemetry frame on.
+  void retune(const DriverParams& params) override;
 
   const device::BodyController& controller() const { return controller_; }
+  /// Called on the reader thread with every frame's IMU yaw (imuYaw()) and arrival time. Set it
+  /// before the link starts (~base/use_imu_heading: the base's odometry).
+  using ImuYawListener = std::function<void(double yaw, device::Clock::time_point arrival)>;
+  void setImuYawListener(ImuYawListener listener) { imu_yaw_listener_ = std::move(listener); }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -41,7 +48,9 @@ class BodyInterface : public DeviceInterface {
 
   device::SerialLink& link_;
   const ArrivalStamps arrival_stamps_;
-  const ImuParams imu_params_;
+  /// Swapped whole by retune() (~imu scales) and loaded once per frame by the reader thread, so
+  /// a frame is converted with one set of scales (std::atomic_load / atomic_store).
+  std::shared_ptr<const ImuParams> imu_params_;
   device::BodyController controller_;
   // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
   double min_rate_ = 1.0;
@@ -52,6 +61,7 @@ class BodyInterface : public DeviceInterface {
   ros::Publisher foot_pressure_pub_;
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
+  ImuYawListener imu_yaw_listener_;
   // Diagnostics timer thread only.
   uint64_t frames_at_last_diagnose_ = 0;
   bool telemetry_stop_logged_ = false;

@@ -70,6 +70,10 @@ sensor_msgs::JointState toJointState(const protocol::body::Telemetry& telemetry,
 sensor_msgs::Imu toImu(const protocol::body::Telemetry& telemetry, const ImuParams& params,
                        const ros::Time& stamp);
 
+/// The yaw (rad, [-pi, pi]) of the orientation toImu() publishes: the board's attitude through
+/// ~imu/axis_map, i.e. the heading of the imu frame (~base/use_imu_heading feeds it to odometry).
+double imuYaw(const protocol::body::Telemetry& telemetry, const ImuParams& params);
+
 /// The 8 raw foot readings, or nothing when the frame did not carry the foot block.
 std::optional<serial_robot_driver::FootPressure> toFootPressure(
     const protocol::body::Telemetry& telemetry, const ros::Time& stamp,

@@ -5,6 +5,8 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 
+#include "serial_robot_driver/ros/driver_params.h"
+
 namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface {
@@ -16,6 +18,10 @@ class DeviceInterface {
   virtual void shutdown() = 0;
   /// Fills the device's diagnostic status (called from the diagnostics timer).
   virtual void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) = 0;
+  /// Takes the runtime-tunable parameters of `params` (validated; the rest is what the device
+  /// was built with) from its next loop tick or transaction on (dynamic_reconfigure, see
+  /// ros/runtime_tuning.h). Devices without tunables ignore it.
+  virtual void retune(const DriverParams& /*params*/) {}
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -34,6 +34,7 @@
 namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface;
+class RuntimeTuning;
 class PortMonitor;
 class WireCapture;
 
@@ -60,6 +61,8 @@ class DriverNode {
     std::unique_ptr<PortMonitor> monitor;
   };
   device::SerialLink& portFor(const std::string& path);
+  /// ~base/use_imu_heading: feeds the body's IMU yaw to the base's odometry.
+  void connectImuHeading();
   /// One line for the log: ports, the devices on each, rates.
   std::string startupSummary() const;
   void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -73,6 +76,8 @@ class DriverNode {
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
+  /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after devices_, destroyed first.
+  std::unique_ptr<RuntimeTuning> tuning_;
   bool shut_down_ = false;
 };
 

@@ -53,6 +53,8 @@ struct BaseParams : DevicePortParams {
   int right_wheel_direction = 1;
   std::string left_wheel_joint = "left_wheel_joint";  ///< wheel_states and robot description names
   std::string right_wheel_joint = "right_wheel_joint";
+  /// odom's heading from the body's IMU while its telemetry is fresh (device::BaseConfig).
+  bool use_imu_heading = false;
 };
 
 struct BodyParams : DevicePortParams {

@@ -24,6 +24,10 @@ struct BaseSimConfig {
   double wheel_diameter_m = 0.25;
   double encoder_resolution = 1600.0;
   double wheel_separation_m = 0.40;
+  /// Wheel slip while turning: the chassis turns by (1 - turn_slip) of the turn its wheel ticks
+  /// command (0..1). The encoders still count every tick: odometry from the ticks overestimates
+  /// the turn, as it does on a slippery floor.
+  double turn_slip = 0.0;
 };
 
 struct BaseSimStats {
@@ -40,7 +44,7 @@ struct BaseSimStats {
   int64_t left_ticks = 0;
   int64_t right_ticks = 0;
   /// The chassis pose from the speeds applied, one midpoint step per PID period (m, m, rad): the
-  /// reference the driver's commanded-motion odometry is checked against.
+  /// reference the driver's odometry is checked against. Slip included: the true pose.
   double x_m = 0;
   double y_m = 0;
   double yaw_rad = 0;
@@ -61,7 +65,8 @@ class BaseSim {
   TimePoint nextEvent() const;
 
   const BaseSimStats& stats() const { return stats_; }
-  /// Yaw rate of the chassis (rad/s, counter-clockwise positive) from the speeds in force.
+  /// True yaw rate of the chassis (rad/s, counter-clockwise positive) from the speeds in force,
+  /// slip included.
   double yawRate() const;
   void setBatteryPercent(uint8_t percent) { config_.battery_percent = percent; }
 

@@ -2,7 +2,8 @@
 //
 // Streams telemetry frames at a fixed rate: every configured servo moves toward its last
 // sync-write target at a bounded speed and reports that speed; the IMU sees gravity on z and the
-// yaw rate of the wheeled base; the optional foot block carries plausible pressure readings.
+// wheeled base's true heading and yaw rate (the board sits on the base); the optional foot block
+// carries plausible pressure readings.
 #pragma once
 
 #include <cstddef>
@@ -33,6 +34,12 @@ struct BodySimConfig {
   uint32_t seed = 1;
 };
 
+/// How the chassis the board is mounted on moves (the base's true motion; zero without a base).
+struct ChassisMotion {
+  double yaw_rad = 0.0;   ///< heading, counter-clockwise
+  double yaw_rate = 0.0;  ///< rad/s
+};
+
 struct BodySimServoState {
   uint8_t id = 0;
   double position = 0.0;  ///< ticks
@@ -46,7 +53,7 @@ struct BodySimStats {
   uint64_t sync_writes_ok = 0;
   uint64_t sync_writes_malformed = 0;   ///< verified CRC but a layout decodeSyncWrite rejected
   uint64_t sync_write_unknown_ids = 0;  ///< targets for ids the board does not have
-  double yaw_rad = 0.0;
+  double yaw_rad = 0.0;                 ///< the heading the IMU reports (the chassis')
   std::vector<BodySimServoState> servos;
 };
 
@@ -56,16 +63,16 @@ class BodySim {
 
   /// A CRC-verified FF FF FD 00 frame from the host.
   void handleSyncWrite(const uint8_t* data, std::size_t size);
-  /// Moves the servos and integrates the yaw up to `now`; emits the telemetry frames that are due.
-  /// `yaw_rate` is the chassis turn rate in rad/s (from the base).
-  void tick(TimePoint now, double yaw_rate, Outbox* out);
+  /// Moves the servos up to `now`; emits the telemetry frames that are due, their IMU reporting
+  /// `chassis` (the base's true heading and yaw rate now).
+  void tick(TimePoint now, const ChassisMotion& chassis, Outbox* out);
   TimePoint nextEvent() const;
 
   const BodySimStats& stats() const { return stats_; }
 
  private:
-  void advance(TimePoint now, double yaw_rate);
-  std::vector<uint8_t> buildTelemetry(double yaw_rate);
+  void advance(TimePoint now);
+  std::vector<uint8_t> buildTelemetry(const ChassisMotion& chassis);
   int16_t noise();
 
   BodySimConfig config_;
