@@ -714,6 +714,10 @@ TEST(BaseControllerImuHeading, FollowsTheImuFallsBackWithoutAJumpAndResumesWitho
   EXPECT_NEAR(odometry.back().pose.yaw, 0.05, 1e-9);
   EXPECT_NEAR(odometry.back().yaw_variance, 0.0003, 1e-12);
   controller->stop();
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::device
 
 // --- retune: the tunable part of the configuration changed while the loop runs ----------------
 namespace serial_robot_driver::device {
