@@ -96,3 +96,7 @@ add_rostest_gtest(test_imu_heading test/rostest/imu_heading.test test/rostest/te
 target_include_directories(test_imu_heading PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_imu_heading srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_imu_heading driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# Runtime tuning through dynamic_reconfigure's Python client against robot_sim.
+add_rostest(test/rostest/runtime_tuning.test
+  DEPENDENCIES driver_node robot_sim ${PROJECT_NAME}_generate_messages_py ${PROJECT_NAME}_gencfg)

@@ -105,7 +105,7 @@ template <typename Config>
 class GroupServer : public RuntimeTuning::Server {
  public:
   GroupServer(RuntimeTuning& owner, const ros::NodeHandle& private_nh, const std::string& group)
-      : owner_(owner), group_(group), server_(ros::NodeHandle(private_nh, group)) {
+      : owner_(owner), group_(group), server_(server_mutex_, ros::NodeHandle(private_nh, group)) {
     // The server starts from the parameter server and the .cfg defaults; what applies is what
     // the node was started with (the parameter server may lack a key the node took as default).
     Config initial = Config::__getDefault__();
@@ -155,6 +155,7 @@ class GroupServer : public RuntimeTuning::Server {
 
   RuntimeTuning& owner_;
   const std::string group_;
+  boost::recursive_mutex server_mutex_;  // the server's; ours, so updateConfig() may use it
   dynamic_reconfigure::Server<Config> server_;
 };
 
