@@ -18,6 +18,9 @@
 //    in main, or the nodelet manager's threads); servo/* services have their own queue and
 //    spinner because they wait on the bus;
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
+//  - the dynamic_reconfigure servers (~base, ~imu; ros/runtime_tuning.h) answer on the global
+//    queue too; a change reaches each device under the device's own lock (the base loop's mutex,
+//    the IMU scales swapped whole), from its next tick or frame on.
 #pragma once
 
 #include <map>
