@@ -832,5 +832,48 @@ TEST(BaseControllerRetune, FasterBatteryPollStartsWithoutWaitingForTheSlowPeriod
   controller.stop();
 }
 
+
+TEST(BaseControllerRetune, ImuHeadingSwitchedOnAndOffWithoutAJump) {
+  std::vector<OdometrySample> odometry;
+  BaseEvents events;
+  events.on_odometry = [&](const OdometrySample& sample) { odometry.push_back(sample); };
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  config.cmd_vel_timeout = 100;  // one command turns for the whole test
+  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto controller = startOnManualClock(config, events, clock);
+  double imu_yaw = 2.0;  // far from odom's heading: fusion must anchor, not jump to it
+  const auto feed = [&] { controller->onImuYaw(imu_yaw, clock->now()); };
+  clock->step([&] { controller->setCommand(0.0, 0.5); });
+  for (int i = 0; i < 20; ++i) {
+    imu_yaw += 0.35 * 0.02;  // the IMU says 0.35 rad/s
+    feed();
+    clock->tick(1);
+  }
+  EXPECT_FALSE(odometry.back().imu_heading) << "off as started";
+  const double commanded = odometry.back().pose.yaw;
+  EXPECT_NEAR(commanded, 0.2, 0.03);  // 0.5 rad/s for 0.4 s
+
+  BaseConfig fused = controller->config();
+  fused.use_imu_heading = true;
+  controller->retune(fused);
+  for (int i = 0; i < 20; ++i) {
+    imu_yaw += 0.35 * 0.02;
+    feed();
+    clock->tick(1);
+  }
+  EXPECT_TRUE(odometry.back().imu_heading);
+  // From where odom stood, at the IMU's rate: 0.4 s at 0.35 rad/s (within one period's turn).
+  EXPECT_NEAR(odometry.back().pose.yaw - commanded, 0.14, 0.011);
+
+  const double fused_yaw = odometry.back().pose.yaw;
+  fused.use_imu_heading = false;
+  controller->retune(fused);
+  clock->tick(1);
+  EXPECT_FALSE(odometry.back().imu_heading);
+  EXPECT_NEAR(odometry.back().pose.yaw - fused_yaw, 0.01, 0.003) << "the commanded turn goes on";
+  controller->stop();
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::device
