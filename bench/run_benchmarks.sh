@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # Runs the driver_node benchmarks (bench/driver_bench.cpp): a private roscore, driver_node and
-# robot_sim over pseudo-terminals, about 3 minutes. Prints a table and writes it to
-# bench/results/latest.md (or $SRD_BENCH_OUTPUT).
+# robot_sim over pseudo-terminals, about 3 minutes; then the framer's (bench/bench_framer.cpp,
+# Google Benchmark, a few seconds). Prints the tables and writes them to bench/results/latest.md
+# (or $SRD_BENCH_OUTPUT).
 #
 # usage: bench/run_benchmarks.sh [--build] [--long] [driver_bench options, see --help]
-#   --build             catkin_make driver_bench (and driver_node, robot_sim, floor_node) first,
-#                       -j2, with -DSRD_BUILD_BENCHMARKS=ON (benchmarks are off by default)
+#   --build             build driver_bench (and driver_node, robot_sim, floor_node,
+#                       polling_driver_node) first, -j2, with -DSRD_BUILD_BENCHMARKS=ON (benchmarks
+#                       are off by default): in SRD_BENCH_WS, or else in the clone's own .ws/ with
+#                       scripts/build.sh, so `bench/run_benchmarks.sh --build` works on a fresh clone
 #   --long              longer runs (about 15 minutes); also SRD_BENCH_LONG=1
-#   SRD_BENCH_WS=DIR    the catkin workspace to use (default: the sourced one, or the one this
-#                       script was installed into)
+#   SRD_BENCH_WS=DIR    the catkin workspace to use (default: the clone's .ws/ when it holds
+#                       driver_bench or --build is given, else the sourced one)
 set -euo pipefail
 export PATH="/usr/bin:$PATH"  # Debian's python3 for the ROS tools
 
@@ -25,9 +28,26 @@ for arg in "$@"; do
 done
 if [[ "${SRD_BENCH_LONG:-0}" == "1" ]]; then args+=(--long); fi
 
+own_ws="${package_dir}/.ws"
+if [[ -z "${SRD_BENCH_WS:-}" && -f "${package_dir}/scripts/build.sh" ]]; then
+  if (( build )) || [[ -x "${own_ws}/devel/lib/serial_robot_driver/driver_bench" ]]; then
+    SRD_BENCH_WS="${own_ws}"
+  fi
+fi
+# ccache, when installed, makes a rebuild on a fresh clone mostly cache hits.
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+
 if [[ -n "${SRD_BENCH_WS:-}" ]]; then
   if (( build )); then
-    (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DSRD_BUILD_BENCHMARKS=ON --make-args -j2 driver_bench)
+    if [[ "${SRD_BENCH_WS}" == "${own_ws}" ]]; then
+      bash "${package_dir}/scripts/build.sh" -DSRD_BUILD_BENCHMARKS=ON "${launcher[@]}" -j2 driver_bench
+    else
+      (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DSRD_BUILD_BENCHMARKS=ON "${launcher[@]}" --make-args -j2 driver_bench)
+    fi
+    # bench_framer exists only where Google Benchmark is installed (libbenchmark-dev).
+    (cd "${SRD_BENCH_WS}/build" && make -j2 bench_framer) ||
+      echo "run_benchmarks.sh: bench_framer not built (no Google Benchmark); its section is skipped" >&2
   fi
   load_workspace() {  # a function, so setup.bash does not see this script's arguments
     set +u  # ROS's setup scripts read unset variables
@@ -43,8 +63,8 @@ else
   bench=""
 fi
 if [[ -z "${bench}" || ! -x "${bench}" ]]; then
-  echo "run_benchmarks.sh: driver_bench not found. Build it (catkin_make driver_bench) and set" \
-       "SRD_BENCH_WS=<workspace>, or source the workspace's setup.bash." >&2
+  echo "run_benchmarks.sh: driver_bench not found. Run bench/run_benchmarks.sh --build (builds it" \
+       "in ${own_ws}), or set SRD_BENCH_WS=<workspace> where it is built." >&2
   exit 2
 fi
 
@@ -65,4 +85,19 @@ status=0
 wait "${bench_pid}" || status=$?
 # A signal interrupts the first wait; wait again for the cleanup to finish.
 if kill -0 "${bench_pid}" 2>/dev/null; then wait "${bench_pid}" || status=$?; fi
+# The framer's throughput (Google Benchmark), appended to the same file, when it is built.
+framer="$(dirname "${bench}")/bench_framer"
+if [[ "${status}" -eq 0 && -x "${framer}" ]]; then
+  framer_out=$(mktemp)
+  "${framer}" --benchmark_min_time=0.2 | tee "${framer_out}"
+  {
+    echo
+    echo "### Framer and decoders (bench_framer, Google Benchmark, 0.2 s per benchmark)"
+    echo
+    echo '```'
+    cat "${framer_out}"
+    echo '```'
+  } >> "${output}"
+  rm -f "${framer_out}"
+fi
 exit "${status}"

@@ -10,11 +10,16 @@ set(SRD_CORE_SOURCES
   src/kinematics/odometry.cpp
   src/kinematics/heading_fusion.cpp
   src/transport/serial_port.cpp
+  src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp
   src/device/base_controller.cpp
   src/device/body_controller.cpp
   src/device/servo_bus_client.cpp
+  src/trajectory/spline.cpp
+  src/trajectory/command.cpp
+  src/trajectory/tolerances.cpp
+  src/trajectory/bus_joint.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

@@ -96,6 +96,19 @@ add_rostest_gtest(test_imu_heading test/rostest/imu_heading.test test/rostest/te
 target_include_directories(test_imu_heading PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_imu_heading srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_imu_heading driver_node ${PROJECT_NAME}_generate_messages_cpp)
+# follow_joint_trajectory (every result code, cancel, preemption, take-over, telemetry lost) and
+# joint_trajectory against the simulated body (sim::RobotSim in-process).
+add_rostest_gtest(test_trajectory test/rostest/trajectory.test test/rostest/test_trajectory.cpp)
+target_include_directories(test_trajectory PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_trajectory srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_trajectory driver_node ${PROJECT_NAME}_generate_messages_cpp)
+# Parameters an earlier launch left on the master (a ~replay_bag, a disabled device) do not steer
+# driver.launch (node and nodelet) or sim.launch: each clears its private namespace first.
+add_rostest_gtest(test_stale_params test/rostest/stale_params.test
+  test/rostest/test_stale_params.cpp)
+target_include_directories(test_stale_params PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_stale_params srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_stale_params driver_node robot_sim srd_nodelet)
 
 # Runtime tuning through dynamic_reconfigure's Python client against robot_sim.
 add_rostest(test/rostest/runtime_tuning.test

@@ -36,6 +36,20 @@ add_dependencies(description_tests robot_description)
 # The IMU's heading fused into odometry (~base/use_imu_heading), ROS-free.
 catkin_add_gtest(heading_fusion_tests test/unit/test_heading_fusion.cpp)
 target_link_libraries(heading_fusion_tests srd_core gtest_main)
+# follow_joint_trajectory keeps control_msgs' md5 sums.
+catkin_add_gtest(trajectory_action_definition_tests test/unit/test_trajectory_action_definition.cpp)
+target_include_directories(trajectory_action_definition_tests PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(trajectory_action_definition_tests ${catkin_LIBRARIES} gtest_main)
+add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_messages_cpp)
+
+# The ROS-free trajectory core: interpolation, replacement, goal validation, tolerances.
+catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp)
+target_link_libraries(trajectory_tests srd_core gtest_main)
+
+# Trajectories' ROS-side pure functions (messages, bus joints); no roscore.
+catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp)
+target_include_directories(trajectory_ros_tests PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(trajectory_ros_tests srd_ros gtest_main)
 
 # Runtime tuning: the dynamic_reconfigure .cfg files agree with the parameter table, and what of a
 # change applies (no roscore needed).

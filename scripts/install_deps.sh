@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs what a fresh Debian 12 machine lacks to build, run and test serial_robot_driver
 # (ROS 1 from Debian's packages). Idempotent and quiet: apt-get runs only when something is missing.
+# The python3-*-msgs/-srvs packages are what `rostopic echo` and `rosservice call` need to load the
+# types the node publishes and serves ("Cannot load message class" without them).
 set -euo pipefail
 
 PACKAGES=(
@@ -13,8 +15,12 @@ PACKAGES=(
   librosbag-dev librosbag-storage-dev libdiagnostic-aggregator-dev
   librostest-dev python3-rostest python3-rosbag rosbash
   python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs
+  python3-diagnostic-msgs python3-tf2-msgs python3-std-srvs python3-trajectory-msgs
+  python3-actionlib-msgs python3-rostopic python3-rosservice libdiagnostic-aggregator-tools
   libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev catkin-lint catkin-tools
+  libactionlib-dev libactionlib-msgs-dev libtrajectory-msgs-dev
+  python3-actionlib python3-actionlib-msgs python3-trajectory-msgs
 )
 # The robot description (robot_description, description.launch, view.launch) and its tests.
 PACKAGES+=(libyaml-cpp-dev liburdf-dev liburdfdom-tools ros-robot-state-publisher

@@ -5,9 +5,10 @@
 #   - executables, libsrd_nodelet, launch/, config/ (parameters, analyzers, udev rule), msg/srv,
 #     the nodelet plugin description, srd_core's headers; no srd_ros/srd_sim headers, no benchmarks;
 #   - rospack finds the package and its nodelet plugin; every launch file passes roslaunch's check;
-#   - sim.launch runs (joint_states flow, the servo/ping service exists), description.launch puts
-#     the robot's links on /tf, fleet_sim.launch runs two robots under their prefixes, and
-#     driver.launch nodelet:=true
+#   - sim.launch runs (joint_states flow, the servo/ping service exists), `rostopic echo` prints a
+#     message of every topic the node publishes and every service's type loads (the Python message
+#     packages of install_deps.sh), description.launch puts the robot's links on /tf,
+#     fleet_sim.launch runs two robots under their prefixes, and driver.launch nodelet:=true
 #     loads serial_robot_driver/DriverNodelet against robot_sim.
 # Usage: scripts/test_install.sh [build dir]. Prints "install test passed" or what failed.
 set -euo pipefail
@@ -57,8 +58,7 @@ for f in include/serial_robot_driver/ros include/serial_robot_driver/sim \
   [ ! -e "$prefix/$f" ] || fail "$f is installed but should not be"
 done
 
-# Everything below runs with the install space alone. (Debian ships no Python classes for
-# sensor_msgs, so data flow is checked with `rostopic bw`, which needs none.)
+# Everything below runs with the install space alone.
 master_port=$((20000 + RANDOM % 20000))
 # Debian's catkin installs no setup.bash into a prefix; these are the variables it would set.
 run() {
@@ -93,7 +93,11 @@ wait_for() {  # wait_for <seconds> <command run in the install environment>
 wait_for 30 'rostopic list' || fail "roscore did not start"
 
 link="$prefix/sim_pty"
-run "exec roslaunch serial_robot_driver sim.launch link:=$link" > "$prefix/sim.log" 2>&1 &
+# capture, foot and polled servo angles: serial_raw, foot_pressure and servo_states flow too, so
+# every topic can be echoed. (The later servo_bus mapping replaces robot.yaml's; its other keys
+# take the node's defaults.)
+{ cat "$share/config/robot.yaml"; printf 'servo_bus:\n  state_ids: [1]\n'; } > "$prefix/all_topics.yaml"
+run "exec roslaunch serial_robot_driver sim.launch link:=$link capture:=true foot:=true config:=$prefix/all_topics.yaml" > "$prefix/sim.log" 2>&1 &
 started_pids="$! $started_pids"
 sim_launch=$!
 wait_for 60 'rosservice list | grep -q "^/servo/ping$"' ||
@@ -108,6 +112,36 @@ description_launch=$!
 wait_for 60 'timeout 10 rostopic echo -n 50 /tf 2>&1 | grep -q "child_frame_id: \"left_wheel_link\""' ||
   { tail -n 30 "$prefix/description.log"; fail "description.launch: no left_wheel_link on /tf"; }
 stop_group "$description_launch"
+# `rostopic echo` of every topic the node publishes (a moving base: wheel_command flows), and the
+# request type of every service it serves, with the Python message classes the set-up installs.
+run "exec rostopic pub -r 10 /cmd_vel geometry_msgs/Twist '{linear: {x: 0.1}}'" > "$prefix/cmd_vel.log" 2>&1 &
+started_pids="$! $started_pids"
+cmd_vel_pub=$!
+node_info="$(run 'rosnode info /driver_node 2>/dev/null')"
+publications="$(echo "$node_info" | sed -n '/^Publications:/,/^$/p' | sed -nE 's/^ \* ([^ ]+) .*/\1/p' | grep -v '^/rosout$')"
+services="$(echo "$node_info" | sed -n '/^Services:/,/^$/p' | sed -nE 's/^ \* ([^ ]+).*/\1/p' | grep -vE '/(get_loggers|set_logger_level)$')"
+[ "$(echo "$publications" | wc -w)" -ge 10 ] || fail "rosnode info lists too few publications: $publications"
+for topic in $publications; do
+  case "$topic" in
+    # An action's feedback and result flow only while a goal runs (trajectory.test covers them):
+    # here their Python message classes must load, which is what `rostopic echo` needs.
+    */feedback|*/result)
+      type="$(run "rostopic type $topic")"
+      run "python3 -c 'import ${type%%/*}.msg as m; m.${type##*/}'" ||
+        fail "the Python message class of $topic ($type) does not load"
+      echo "loaded $type"
+      continue ;;
+  esac
+  out="$(run "timeout 20 rostopic echo -n 1 --noarr $topic 2>&1")" ||
+    fail "rostopic echo $topic: $(echo "$out" | tail -n 3)"
+  echo "$out" | grep -q "^---$" || fail "rostopic echo $topic printed no message: $(echo "$out" | tail -n 3)"
+  echo "echoed $topic"
+done
+for service in $services; do
+  out="$(run "rosservice args $service 2>&1")" || fail "rosservice args $service: $out"
+  echo "service $service: $(run "rosservice type $service")"
+done
+stop_group "$cmd_vel_pub"
 stop_group "$sim_launch"
 
 # fleet_sim.launch: two robots in namespaces, each robot's links under its tf_prefix.

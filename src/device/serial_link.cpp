@@ -190,7 +190,8 @@ void SerialLink::readerLoop() {
     const int longest_read_ms = stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs;
     int read_timeout_ms = longest_read_ms;
     if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
-      const auto quiet = Clock::now() - chunk_arrival_;
+      // The stream's clock: a replay measures the recorded silence on its own timeline.
+      const auto quiet = stream_->now() - chunk_arrival_;
       if (quiet >= options_.stale_frame_timeout) {
         // No byte for a whole timeout: what is buffered will not complete. Frames found behind
         // the stale candidate keep the arrival time of their bytes.
@@ -202,7 +203,10 @@ void SerialLink::readerLoop() {
       }
       const auto left = std::chrono::ceil<std::chrono::milliseconds>(
           options_.stale_frame_timeout - quiet);
-      read_timeout_ms = std::clamp<int>(static_cast<int>(left.count()), 1, longest_read_ms);
+      // Clamped as a duration first: the int conversion never sees more than longest_read_ms.
+      read_timeout_ms = static_cast<int>(
+          std::clamp(left, std::chrono::milliseconds(1), std::chrono::milliseconds(longest_read_ms))
+              .count());
     }
     std::size_t n = 0;
     try {

@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     const srd::YamlParamSource source(config);
     const srd::DriverParams params = srd::loadParams(source, nullptr);
     params.validate();
-    std::cout << srd::makeRobotDescription(params, srd::loadServoBusJoints(source), imu, name);
+    std::cout << srd::makeRobotDescription(params, imu, name);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "robot_description: " << config << ": " << e.what() << "\n";

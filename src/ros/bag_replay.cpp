@@ -58,6 +58,8 @@ Recording readRecording(const std::string& path) {
                         joined(raw_topics) + "); replay one with a bag filtered to one topic");
     }
     recording.topic = *raw_topics.begin();
+    // The recording lasts as long as the bag: a silence on the ports at its end counts too.
+    recording.end = transport::RecordedStamp(static_cast<int64_t>(everything.getEndTime().toNSec()));
     rosbag::View view(bag, rosbag::TopicQuery(recording.topic));
     for (const rosbag::MessageInstance& message : view) {
       const auto chunk = message.instantiate<serial_robot_driver::SerialChunk>();
@@ -69,8 +71,9 @@ Recording readRecording(const std::string& path) {
         ++recording.outbound_chunks;
         continue;
       }
-      recording.ports[chunk->port].push_back(
-          {arrivalOfRecordedStamp(chunk->header.stamp), chunk->data});
+      const transport::RecordedStamp stamp(static_cast<int64_t>(chunk->header.stamp.toNSec()));
+      recording.ports[chunk->port].push_back({stamp, chunk->data});
+      recording.end = std::max(recording.end, stamp);
     }
   } catch (const rosbag::BagException& e) {
     throw ReplayError("replay bag " + path + " is damaged: " + e.what());
@@ -93,16 +96,16 @@ std::set<std::string> configuredPorts(const DriverParams& params) {
 BagReplay::BagReplay(const DriverParams& params)
     : path_(params.replay_bag), recording_(readRecording(params.replay_bag)) {
   const std::set<std::string> configured = configuredPorts(params);
-  transport::SteadyTime first = transport::SteadyTime::max();
+  transport::RecordedStamp first = transport::RecordedStamp::max();
   for (const auto& [port, chunks] : recording_.ports) {
     if (!configured.count(port)) {
       throw ReplayError("replay bag " + path_ + " has chunks of port " + port +
                         ", which the configuration does not have (configured: " +
                         joined(configured) + "); load the configuration the bag was recorded with");
     }
-    first = std::min(first, chunks.front().arrival);
+    first = std::min(first, chunks.front().recorded);
   }
-  pacing_ = std::make_shared<transport::ReplayPacing>(params.replay_rate, first);
+  pacing_ = std::make_shared<transport::ReplayPacing>(params.replay_rate, first, recording_.end);
   for (const std::string& port : configured) {
     auto found = recording_.ports.find(port);
     std::vector<transport::RecordedChunk> chunks;

@@ -8,6 +8,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/trajectory_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -44,6 +45,10 @@ void BodyInterface::retune(const DriverParams& params) {
 
 void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
 
+std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
+  return {bodyTrajectoryJoints(controller_)};
+}
+
 void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
                                      device::Clock::time_point arrival) {
   // Runs on the link's reader thread; ros::Publisher::publish is thread-safe. A message nobody
@@ -51,11 +56,14 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   telemetry_rate_.tick();
   const ros::Time stamp = arrival_stamps_(arrival);
   const auto& joints = controller_.joints();
+  // The trajectory server needs every frame: its goals are checked against it.
+  const auto joint_state =
+      boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
+  if (trajectory_) trajectory_->updateActual(*joint_state);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
   // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(
-        boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp)));
+    joint_states_pub_.publish(joint_state);
   }
   const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
   if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, *imu), arrival);
@@ -72,8 +80,17 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
 
 void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
   const JointCommand command = fromJointState(*msg);
-  const device::JointCommandResult result =
-      controller_.sendJointCommand(command.names, command.positions);
+  device::JointCommandResult result;
+  const auto send = [&] {
+    result = controller_.sendJointCommand(command.names, command.positions);
+    return result.ok();
+  };
+  // A joint under a trajectory is taken over by this command, and its goal aborted.
+  if (trajectory_) {
+    trajectory_->takeOver(command.names, "joint_commands", send);
+  } else {
+    send();
+  }
   if (!result.ok() || !result.out_of_range.empty()) {
     ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
   }
@@ -103,9 +120,11 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
                         "port " + link_.options().path + " not connected");
   } else if (stats.frames_decoded == 0) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "no telemetry received yet");
+    // ERROR, as the frequency check's "No events recorded." already is: a board streaming
+    // nothing is a fault a robot monitor must show red, not a warning.
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR, "no telemetry received yet");
   } else if (stats.frames_decoded == frames_at_last_diagnose_) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "telemetry stopped");
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR, "telemetry stopped");
   }
   logTelemetryFlow(connected, stats.frames_decoded);
   status.hardware_id = link_.options().path;

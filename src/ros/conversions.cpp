@@ -25,16 +25,11 @@ ros::Time toRosTime(std::chrono::steady_clock::time_point event) {
   return toRosTime(event, ros_now, steady_now);
 }
 
-std::chrono::steady_clock::time_point arrivalOfRecordedStamp(const ros::Time& recorded) {
-  return std::chrono::steady_clock::time_point(
-      std::chrono::nanoseconds(static_cast<int64_t>(recorded.toNSec())));
-}
-
 ros::Time ArrivalStamps::operator()(std::chrono::steady_clock::time_point arrival) const {
-  if (replaying_) {
+  if (replay_timeline_) {
+    const int64_t recorded_ns = replay_timeline_->recordedAt(arrival).count();
     ros::Time stamp;
-    stamp.fromNSec(static_cast<uint64_t>(
-        std::chrono::duration_cast<std::chrono::nanoseconds>(arrival.time_since_epoch()).count()));
+    stamp.fromNSec(static_cast<uint64_t>(std::max<int64_t>(recorded_ns, 0)));
     return stamp;
   }
   thread_local std::chrono::steady_clock::time_point last_arrival{};

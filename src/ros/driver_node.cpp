@@ -1,5 +1,6 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
+#include <atomic>
 #include <functional>
 #include <sstream>
 
@@ -7,14 +8,18 @@
 #include "serial_robot_driver/ros/body_interface.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/servo_bus_interface.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/ros/wire_capture.h"
 
 namespace serial_robot_driver::ros_layer {
 
 /// Logs a port's comings and goings once per event (reader thread), and the USB latency hint.
+/// Once the node shuts down, a port going down is the node closing it (or the robot's end going
+/// at the same moment): stopping is not losing, so nothing is logged as lost.
 class PortMonitor : public device::LinkListener {
  public:
-  explicit PortMonitor(const device::SerialLink& link) : link_(link) {}
+  PortMonitor(const device::SerialLink& link, const std::atomic<bool>& shutting_down)
+      : link_(link), shutting_down_(shutting_down) {}
 
   void onLinkUp() override {
     waiting_logged_ = false;
@@ -28,12 +33,16 @@ class PortMonitor : public device::LinkListener {
     }
   }
   void onLinkDown() override {
+    if (shutting_down_) {
+      ROS_DEBUG("port %s closed", link_.options().path.c_str());
+      return;
+    }
     ROS_WARN("port %s lost (%s); reopening every %.1f s", link_.options().path.c_str(),
              link_.stats().last_error.c_str(), link_.options().reconnect_interval);
     waiting_logged_ = true;  // the retries that follow need no message of their own
   }
   void onOpenFailed(const std::string& error) override {
-    if (waiting_logged_) return;  // once per outage, not once per retry
+    if (waiting_logged_ || shutting_down_) return;  // once per outage, not once per retry
     waiting_logged_ = true;
     ROS_WARN("waiting for port %s (%s); retrying every %.1f s", link_.options().path.c_str(),
              error.c_str(), link_.options().reconnect_interval);
@@ -42,6 +51,7 @@ class PortMonitor : public device::LinkListener {
 
  private:
   const device::SerialLink& link_;
+  const std::atomic<bool>& shutting_down_;
   bool waiting_logged_ = false;  // reader thread only
 };
 
@@ -122,7 +132,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     }
     Port port;
     port.link = std::make_unique<device::SerialLink>(options, stream_factory);
-    port.monitor = std::make_unique<PortMonitor>(*port.link);
+    port.monitor = std::make_unique<PortMonitor>(*port.link, shut_down_);
     port.link->addListener(port.monitor.get());
     port.link->setChunkObserver(capture_.get());
     Port& stored = ports_[path] = std::move(port);
@@ -136,6 +146,17 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   }
   // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
   connectImuHeading();
+  // One trajectory server for the joints of every device, so one goal may span them.
+  std::vector<TrajectoryJoints> trajectory_joints;
+  for (auto& device : devices_) {
+    for (TrajectoryJoints& group : device->trajectoryJoints()) {
+      if (!group.joints.empty()) trajectory_joints.push_back(std::move(group));
+    }
+  }
+  if (!trajectory_joints.empty()) {
+    trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, std::move(trajectory_joints));
+    for (auto& device : devices_) device->attachTrajectories(trajectory_.get());
+  }
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
@@ -174,6 +195,7 @@ device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports
 void DriverNode::start() {
   for (auto& [path, port] : ports_) port.link->start();
   for (auto& device : devices_) device->start();
+  if (trajectory_) trajectory_->start();
   ROS_INFO("%s", startupSummary().c_str());
 }
 
@@ -207,6 +229,7 @@ void DriverNode::shutdown() {
   shut_down_ = true;
   if (tuning_) tuning_->stop();  // no retune while the devices stop
   diagnostics_timer_.stop();
+  if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop
   // Base first: its zero-speed frame goes out while the port is still open.
   for (auto& device : devices_) device->shutdown();
   for (auto& [path, port] : ports_) port.link->stop();

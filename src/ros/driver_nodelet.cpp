@@ -7,11 +7,17 @@
 // service queue are the driver's own, as in driver_node. Unloading the nodelet, or stopping the
 // manager, destroys it: the destructor shuts the driver down, which writes the last zero-speed
 // frame before the ports close.
+//
+// ~replay_bag works as in driver_node: the ports' bytes come from the bag and the real ports are
+// never opened. A nodelet cannot end its manager, so at the end of the bag it logs the summary and
+// stays loaded, idle; a bag that cannot be replayed is refused with the reason, and nothing starts.
 #include <nodelet/nodelet.h>
 
 #include <memory>
 #include <pluginlib/class_list_macros.hpp>
+#include <string>
 
+#include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
 #include "serial_robot_driver/ros/run_driver_node.h"
 
@@ -20,6 +26,8 @@ namespace serial_robot_driver::ros_layer {
 class DriverNodelet : public nodelet::Nodelet {
  public:
   ~DriverNodelet() override {
+    replay_start_.stop();
+    replay_watch_.stop();
     if (!driver_) return;
     NODELET_INFO("shutting down: stopping the wheels");
     driver_->shutdown();
@@ -36,11 +44,49 @@ class DriverNodelet : public nodelet::Nodelet {
       NODELET_FATAL("%s; the driver does not start", e.what());
       return;
     }
-    driver_ = std::make_unique<DriverNode>(getNodeHandle(), private_nh, params);
-    driver_->start();
+    device::SerialLink::StreamFactory stream_factory;
+    if (!params.replay_bag.empty()) {
+      try {
+        replay_ = std::make_unique<BagReplay>(params);
+      } catch (const ReplayError& e) {
+        NODELET_FATAL("%s; the driver does not start (no port is opened)", e.what());
+        return;
+      }
+      stream_factory = replay_->streamFactory();
+      params.replay_timeline = replay_->timeline();
+      params.reconnect_interval = 0.0;  // the recording paces its reopens
+      NODELET_INFO("replaying %s from %s (rate %g; 0: full speed)",
+                   replay_->recording().topic.c_str(), params.replay_bag.c_str(),
+                   params.replay_rate);
+    }
+    driver_ = std::make_unique<DriverNode>(getNodeHandle(), private_nh, params, stream_factory);
+    if (!replay_) {
+      driver_->start();
+      return;
+    }
+    // As driver_node: give subscribers time to connect before the first chunk, then watch for the
+    // end of the bag. Both on wall timers, so onInit() does not hold the manager up.
+    ros::NodeHandle nh = getNodeHandle();
+    replay_start_ = nh.createWallTimer(
+        kReplaySettle,
+        [this](const ros::WallTimerEvent&) {
+          replay_->startClock();
+          driver_->start();
+        },
+        true);
+    replay_watch_ = nh.createWallTimer(ros::WallDuration(0.05), [this](const ros::WallTimerEvent&) {
+      if (!replay_->finished()) return;
+      replay_watch_.stop();
+      driver_->updateDiagnostics();
+      NODELET_INFO("%s; the replay is over, the nodelet stays loaded", replay_->summary().c_str());
+    });
   }
 
+  static inline const ros::WallDuration kReplaySettle{1.5};
+  // Declared first, destroyed last: the driver's links read from the replay's ports.
+  std::unique_ptr<BagReplay> replay_;
   std::unique_ptr<DriverNode> driver_;
+  ros::WallTimer replay_start_, replay_watch_;
 };
 
 }  // namespace serial_robot_driver::ros_layer

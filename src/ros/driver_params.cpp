@@ -1,5 +1,6 @@
 #include "serial_robot_driver/ros/driver_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include <ros/param.h>
 
 #include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/transport/serial_port.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -31,12 +33,11 @@ void requireNonNegative(double value, const std::string& name) {
 }
 
 void requireBaud(int baud, const std::string& name, bool zero_means_inherit) {
-  static const std::set<int> kRates = {1200,   2400,   4800,   9600,    19200,   38400,  57600,
-                                       115200, 230400, 250000, 460800,  500000,  576000, 921600,
-                                       1000000, 1500000, 2000000, 3000000, 4000000};
   if (zero_means_inherit && baud == 0) return;
-  require(kRates.count(baud) > 0, name,
-          "unsupported baud rate " + std::to_string(baud) + " (e.g. 9600, 115200, 1000000)");
+  // The port's own table: a rate passes here exactly when the port can open at it.
+  require(baud > 0 && transport::isSupportedBaud(static_cast<unsigned>(baud)), name,
+          "unsupported baud rate " + std::to_string(baud) + " (supported: " +
+              transport::supportedBaudRatesText() + ")");
 }
 
 // --- the table -------------------------------------------------------------------------------
@@ -257,13 +258,52 @@ std::vector<ParamSpec> buildTable() {
           [](const int& v, const std::string& key) {
             require(v >= 0 && v <= 65535, key, "must be 0..65535 ms");
           }),
+      // Trajectory defaults (follow_joint_trajectory, joint_trajectory).
+      row("trajectory/goal_tolerance", &P::trajectory, &TrajectoryParams::goal_tolerance,
+          nonNegative<double>),
+      row("trajectory/goal_time_tolerance", &P::trajectory,
+          &TrajectoryParams::goal_time_tolerance, nonNegative<double>),
+      row("trajectory/path_tolerance", &P::trajectory, &TrajectoryParams::path_tolerance,
+          nonNegative<double>),
+      row("trajectory/max_velocity", &P::trajectory, &TrajectoryParams::max_velocity,
+          nonNegative<double>),
+      // Bus servos as named joints; lengths and names are checked in validate().
+      row("servo_bus/joint_ids", &P::servo_bus, &Bus::joint_ids,
+          [](const std::vector<int>& ids, const std::string& key) {
+            std::set<int> seen;
+            for (int id : ids) {
+              require(id >= 0 && id <= 254, key,
+                      "ids must be 0..254 (255 is broadcast), got " + std::to_string(id));
+              require(seen.insert(id).second, key, "id " + std::to_string(id) + " is listed twice");
+            }
+          }),
+      row("servo_bus/joint_names", &P::servo_bus, &Bus::joint_names,
+          [](const std::vector<std::string>& names, const std::string& key) {
+            std::set<std::string> seen;
+            for (const std::string& name : names) {
+              require(!name.empty(), key, "a joint name is empty");
+              require(seen.insert(name).second, key, "joint '" + name + "' is listed twice");
+            }
+          }),
+      row("servo_bus/joint_zero_deg", &P::servo_bus, &Bus::joint_zero_deg,
+          [](const std::vector<double>& zeros, const std::string& key) {
+            for (double zero : zeros) {
+              require(std::isfinite(zero) && zero >= -180.0 && zero <= 180.0, key,
+                      "must be servo angles within -180..180 deg");
+            }
+          }),
+      row("servo_bus/joint_directions", &P::servo_bus, &Bus::joint_directions,
+          [](const std::vector<int>& directions, const std::string& key) {
+            for (int d : directions) require(d == 1 || d == -1, key, "entries must be 1 or -1");
+          }),
   };
 }
 
 /// How a parameter's expected type reads in an error message.
 std::string typeName(const ParamValue& value) {
   static const char* const kNames[] = {"true or false", "an integer",          "a number",
-                                       "a string",      "a list of integers", "a list of strings"};
+                                       "a string",      "a list of integers", "a list of strings",
+                                       "a list of numbers"};
   return kNames[value.index()];
 }
 
@@ -395,6 +435,24 @@ void DriverParams::validate() const {
     requireOnePerServo(body.joint_names.size(), "body/joint_names");
     requireOnePerServo(body.zero_ticks.size(), "body/zero_ticks");
     requireOnePerServo(body.directions.size(), "body/directions");
+  }
+  if (servo_bus.enabled) {
+    const std::size_t n = servo_bus.joint_ids.size();
+    const auto requireOnePerJoint = [n](std::size_t size, const std::string& name, bool may_be_empty) {
+      require(size == n || (may_be_empty && size == 0), name,
+              "has " + std::to_string(size) + " entries but servo_bus/joint_ids has " +
+                  std::to_string(n));
+    };
+    requireOnePerJoint(servo_bus.joint_names.size(), "servo_bus/joint_names", false);
+    requireOnePerJoint(servo_bus.joint_zero_deg.size(), "servo_bus/joint_zero_deg", true);
+    requireOnePerJoint(servo_bus.joint_directions.size(), "servo_bus/joint_directions", true);
+    for (const std::string& name : servo_bus.joint_names) {
+      const bool body_has_it = body.enabled && std::find(body.joint_names.begin(),
+                                                         body.joint_names.end(),
+                                                         name) != body.joint_names.end();
+      require(!body_has_it, "servo_bus/joint_names",
+              "joint '" + name + "' is also a body joint (body/joint_names)");
+    }
   }
 
   // Devices sharing a path share one port, so they must agree on its baud rate.

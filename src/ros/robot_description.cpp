@@ -1,4 +1,5 @@
 #include "serial_robot_driver/ros/robot_description.h"
+#include "serial_robot_driver/ros/trajectory_bus_joints.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -94,6 +95,7 @@ bool YamlParamSource::get(const std::string& key, ParamValue* value) const {
         [&node](auto& typed) {
           using T = std::decay_t<decltype(typed)>;
           if constexpr (std::is_same_v<T, std::vector<int>> ||
+                        std::is_same_v<T, std::vector<double>> ||
                         std::is_same_v<T, std::vector<std::string>>) {
             return readList(node, &typed);
           } else {
@@ -110,52 +112,6 @@ std::vector<std::string> YamlParamSource::keys() const {
   std::vector<std::string> keys;
   if (root_->IsMap()) collectKeys(*root_, "", &keys);
   return keys;
-}
-
-ServoBusJoints loadServoBusJoints(const ParamSource& source) {
-  ServoBusJoints joints;
-  const auto read = [&source](const std::string& key, ParamValue value) {
-    if (source.has(key) && !source.get(key, &value)) {
-      throw ParameterError(key, "must be a list of " +
-                                    std::string(value.index() == 4 ? "integers" : "strings"));
-    }
-    return value;
-  };
-  joints.ids = std::get<std::vector<int>>(read("servo_bus/joint_ids", std::vector<int>{}));
-  joints.names =
-      std::get<std::vector<std::string>>(read("servo_bus/joint_names", std::vector<std::string>{}));
-  joints.directions =
-      std::get<std::vector<int>>(read("servo_bus/joint_directions", std::vector<int>{}));
-  // Zero angles may be written as integers or numbers: read them as text and parse.
-  const auto zeros = std::get<std::vector<std::string>>(
-      read("servo_bus/joint_zero_deg", std::vector<std::string>{}));
-  for (const auto& text : zeros) {
-    std::size_t used = 0;
-    double value = 0;
-    try {
-      value = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != text.size() || !std::isfinite(value)) {
-      throw ParameterError("servo_bus/joint_zero_deg", "'" + text + "' is not a number of degrees");
-    }
-    joints.zero_deg.push_back(value);
-  }
-  const std::size_t n = joints.ids.size();
-  const auto onePerJoint = [n](std::size_t size, const std::string& key, bool may_be_empty) {
-    if (size != n && !(may_be_empty && size == 0)) {
-      throw ParameterError(key, "has " + std::to_string(size) +
-                                    " entries but servo_bus/joint_ids has " + std::to_string(n));
-    }
-  };
-  onePerJoint(joints.names.size(), "servo_bus/joint_names", false);
-  onePerJoint(joints.zero_deg.size(), "servo_bus/joint_zero_deg", true);
-  onePerJoint(joints.directions.size(), "servo_bus/joint_directions", true);
-  for (int d : joints.directions) {
-    if (d != 1 && d != -1) throw ParameterError("servo_bus/joint_directions", "entries must be 1 or -1");
-  }
-  return joints;
 }
 
 // --- the URDF --------------------------------------------------------------------------------
@@ -266,8 +222,8 @@ std::string linkName(const std::string& frame) {
   return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
 }
 
-std::string makeRobotDescription(const DriverParams& params, const ServoBusJoints& bus_joints,
-                                 const ImuMount& imu, const std::string& robot_name) {
+std::string makeRobotDescription(const DriverParams& params, const ImuMount& imu,
+                                 const std::string& robot_name) {
   // Simple shapes sized from the wheel geometry: base_link on the ground between the wheels
   // (REP-105), the axle at the wheel radius, a box chassis and a rear caster ball.
   const BaseParams& base = params.base;
@@ -317,13 +273,10 @@ std::string makeRobotDescription(const DriverParams& params, const ServoBusJoint
   }
   if (params.servo_bus.enabled) {
     constexpr double kMaxBusServoSpeedDps = 750.0;  // servo/move's velocity limit
-    for (std::size_t i = 0; i < bus_joints.ids.size(); ++i) {
-      const double zero = i < bus_joints.zero_deg.size() ? bus_joints.zero_deg[i] : 0.0;
-      const int direction = i < bus_joints.directions.size() ? bus_joints.directions[i] : 1;
-      const double a = direction * (-kBusServoSingleTurnDeg - zero) * M_PI / 180.0;
-      const double b = direction * (kBusServoSingleTurnDeg - zero) * M_PI / 180.0;
-      servos.push_back({bus_joints.names[i], "servo_bus/joint_names", std::min(a, b),
-                        std::max(a, b), kMaxBusServoSpeedDps * M_PI / 180.0});
+    for (const trajectory::BusJoint& joint : makeBusJoints(params.servo_bus)) {
+      const trajectory::JointRange range = joint.range();
+      servos.push_back({joint.name, "servo_bus/joint_names", range.min_position,
+                        range.max_position, kMaxBusServoSpeedDps * M_PI / 180.0});
     }
   }
   const double arm_length = std::max(0.05, 0.8 * radius);

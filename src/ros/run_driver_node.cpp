@@ -81,6 +81,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
       return 1;
     }
     stream_factory = replay->streamFactory();
+    params.replay_timeline = replay->timeline();
     // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
     params.reconnect_interval = 0.0;
     ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(),

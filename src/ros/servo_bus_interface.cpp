@@ -221,6 +221,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                   request.accel_ms = req.accel_ms;
                                   request.decel_ms = req.decel_ms;
                                   request.power_mw = req.power_mw;
+                                  yieldJoint(req.id, "servo/move");
                                   return client_.move(request);
                                 }),
       advertiseServo<ServoScan>(nh_, "servo/scan",
@@ -235,6 +236,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                     request.interval_ms = req.interval_ms;
                                     request.power_mw = req.power_mw;
                                     request.wait = req.wait;
+                                    yieldJoint(req.id, "servo/rotate");
                                     return client_.rotate(request);
                                   }),
       advertiseServo<ServoSpin>(nh_, "servo/spin",
@@ -246,10 +248,12 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                   request.speed_dps = req.speed_dps;
                                   request.value = req.value;
                                   request.wait = req.wait;
+                                  yieldJoint(req.id, "servo/spin");
                                   return client_.spin(request);
                                 }),
       advertiseServo<ServoDamping>(nh_, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
+                                     yieldJoint(req.id, "servo/damping");
                                      return client_.damping(req.id, req.power_mw, req.wait);
                                    }),
       advertiseServo<ServoReadAll>(nh_, "servo/read_all",
@@ -288,6 +292,18 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
     servo.next_poll = now;
     polled_.push_back(servo);
   }
+  // Joint servos are polled too: their angles are the trajectories' measurements.
+  bus_joints_ = makeBusJoints(params.servo_bus);
+  state_rate_ = params.servo_bus.state_rate;
+  for (const trajectory::BusJoint& joint : bus_joints_) {
+    const bool polled = std::any_of(polled_.begin(), polled_.end(),
+                                    [&](const PolledServo& s) { return s.id == joint.id; });
+    if (polled) continue;
+    PolledServo servo;
+    servo.id = joint.id;
+    servo.next_poll = now;
+    polled_.push_back(servo);
+  }
   states_pub_ = topics_nh_.advertise<sensor_msgs::JointState>("servo_states", 10);
   commands_sub_ = topics_nh_.subscribe("servo_commands", 10, &ServoBusInterface::onServoCommands,
                                        this, ros::TransportHints().tcpNoDelay());
@@ -295,25 +311,68 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
 
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
   ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
-  std::lock_guard<std::mutex> lock(worker_mutex_);
-  if (!batch.error.empty()) {
-    ++commands_rejected_;
-    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
-                      batch.error.c_str());
-    return;
-  }
+  const auto queueBatch = [&] {
+    std::lock_guard<std::mutex> lock(worker_mutex_);
+    if (!batch.error.empty()) {
+      ++commands_rejected_;
+      ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
+                        batch.error.c_str());
+      return false;
+    }
+    for (const device::MoveRequest& move : batch.moves) queueMoveLocked(move);
+    return true;
+  };
+  // A joint servo under a trajectory is taken over by this command, and its goal aborted.
+  std::vector<std::string> joints;
   for (const device::MoveRequest& move : batch.moves) {
-    // The latest target of a servo replaces a queued one: the queue stays bounded (one entry per
-    // servo) when a long service call holds the bus.
-    auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
-                               [&move](const device::MoveRequest& m) { return m.id == move.id; });
-    if (queued != queued_moves_.end()) {
-      *queued = move;
-    } else {
-      queued_moves_.push_back(move);
+    if (const trajectory::BusJoint* joint = findBusJoint(bus_joints_, move.id)) {
+      joints.push_back(joint->name);
     }
   }
+  if (trajectory_ && !joints.empty()) {
+    trajectory_->takeOver(joints, "servo_commands", queueBatch);
+  } else {
+    queueBatch();
+  }
+}
+
+void ServoBusInterface::queueMoveLocked(const device::MoveRequest& move) {
+  // The latest target of a servo replaces a queued one: the queue stays bounded (one entry per
+  // servo) when a long service call holds the bus.
+  auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
+                             [&move](const device::MoveRequest& m) { return m.id == move.id; });
+  if (queued != queued_moves_.end()) {
+    *queued = move;
+  } else {
+    queued_moves_.push_back(move);
+  }
   worker_cv_.notify_all();
+}
+
+void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
+  const trajectory::BusJoint* joint = findBusJoint(bus_joints_, id);
+  if (!trajectory_ || !joint) return;
+  trajectory_->takeOver({joint->name}, source, [&] {
+    // A trajectory move still queued must not follow the service's command.
+    std::lock_guard<std::mutex> lock(worker_mutex_);
+    queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
+                                       [id](const device::MoveRequest& m) { return m.id == id; }),
+                        queued_moves_.end());
+    return true;
+  });
+}
+
+std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
+  const auto queue_move = [this](uint8_t id, double angle_deg, uint32_t interval_ms) {
+    device::MoveRequest move;
+    move.id = id;
+    move.angle_deg = angle_deg;
+    move.interval_ms = interval_ms;
+    std::lock_guard<std::mutex> lock(worker_mutex_);
+    queueMoveLocked(move);
+    return std::string();
+  };
+  return {busTrajectoryJoints(bus_joints_, queue_move, state_rate_)};
 }
 
 void ServoBusInterface::workerLoop() {
@@ -383,11 +442,10 @@ void ServoBusInterface::pollOnce(PolledServo& servo) {
   servo.backoff = std::chrono::milliseconds(0);
   // Keep the rate without drifting; after a stall, start again from now.
   servo.next_poll = std::max(servo.next_poll + period, now);
-  sensor_msgs::JointState msg;
-  msg.header.stamp = toRosTime(arrival);
-  msg.name.push_back(servoJointName(servo.id));
-  msg.position.push_back(angle_deg / kDegreesPerRadian);
+  const sensor_msgs::JointState msg =
+      busJointState(bus_joints_, servo.id, angle_deg, toRosTime(arrival));
   states_pub_.publish(msg);
+  if (trajectory_) trajectory_->updateActual(msg);
   ++states_published_;
 }
 

@@ -6,14 +6,17 @@
 
 namespace serial_robot_driver::transport {
 
-ReplayPacing::ReplayPacing(double rate, SteadyTime first_arrival)
-    : rate_(rate), first_arrival_(first_arrival), start_(std::chrono::steady_clock::now()) {}
+ReplayPacing::ReplayPacing(double rate, RecordedStamp first, RecordedStamp end)
+    : rate_(rate), first_(first), end_(std::max(first, end)), start_(std::chrono::steady_clock::now()) {}
 
-SteadyTime ReplayPacing::dueAt(SteadyTime arrival) const {
-  if (rate_ <= 0) return start_;
-  const std::chrono::duration<double> recorded_offset = arrival - first_arrival_;
-  return start_ +
-         std::chrono::duration_cast<std::chrono::steady_clock::duration>(recorded_offset / rate_);
+SteadyTime ReplayPacing::now() const {
+  const auto since_start = std::chrono::steady_clock::now() - start_;
+  return start_ + std::chrono::duration_cast<std::chrono::nanoseconds>(since_start * rate_);
+}
+
+std::chrono::nanoseconds ReplayPacing::steadyWait(std::chrono::nanoseconds span) const {
+  if (rate_ <= 0 || span.count() <= 0) return std::chrono::nanoseconds(0);
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(span / rate_);
 }
 
 RecordedPort::RecordedPort(std::string name, std::vector<RecordedChunk> chunks,
@@ -37,12 +40,32 @@ void RecordedStream::open() {
   open_ = true;
 }
 
+SteadyTime RecordedStream::now() const {
+  const RecordedPort& port = *port_;
+  if (port.pacing_->paced()) return port.pacing_->now();
+  if (port.next_ < port.chunks_.size()) {
+    const RecordedChunk& next = port.chunks_[port.next_];
+    // Before a recorded reopen the port was lost right after its last bytes (read() throws at
+    // once, as the live read did), not after a silence that a stale-frame timer could count.
+    if (next.data.empty() && arrival_) return *arrival_;
+    return port.pacing_->onTimeline(next.recorded);
+  }
+  return port.pacing_->end();
+}
+
 std::size_t RecordedStream::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {
   RecordedPort& port = *port_;
-  const auto timeout = std::chrono::milliseconds(timeout_ms);
+  const ReplayPacing& pacing = *port.pacing_;
+  const std::chrono::nanoseconds timeout = std::chrono::milliseconds(std::max(timeout_ms, 0));
   if (port.next_ >= port.chunks_.size()) {
+    // The recording may go on in silence after the last chunk: the replay ends with it.
+    const SteadyTime now_on_timeline = now();
+    if (now_on_timeline < pacing.end()) {
+      std::this_thread::sleep_for(pacing.steadyWait(std::min(timeout, pacing.end() - now_on_timeline)));
+      return 0;
+    }
     port.finished_ = true;
-    std::this_thread::sleep_for(timeout);
+    std::this_thread::sleep_for(pacing.paced() ? pacing.steadyWait(timeout) : timeout);
     return 0;
   }
   const RecordedChunk& chunk = port.chunks_[port.next_];
@@ -50,15 +73,18 @@ std::size_t RecordedStream::read(uint8_t* buffer, std::size_t capacity, int time
     throw TransportError(TransportErrorKind::kDisconnected,
                          "the recording reopens port " + port.name_ + " here");
   }
-  const SteadyTime due = port.pacing_->dueAt(chunk.arrival);
-  if (due > std::chrono::steady_clock::now() + timeout) {
-    std::this_thread::sleep_for(timeout);
-    return 0;
+  const SteadyTime arrival = pacing.onTimeline(chunk.recorded);
+  if (pacing.paced()) {
+    const SteadyTime now_on_timeline = pacing.now();
+    if (arrival > now_on_timeline + timeout) {
+      std::this_thread::sleep_for(pacing.steadyWait(timeout));
+      return 0;
+    }
+    std::this_thread::sleep_for(pacing.steadyWait(arrival - now_on_timeline));
   }
-  std::this_thread::sleep_until(due);
   const std::size_t n = std::min(capacity, chunk.data.size() - port.offset_);
   std::memcpy(buffer, chunk.data.data() + port.offset_, n);
-  arrival_ = chunk.arrival;
+  arrival_ = arrival;
   port.offset_ += n;
   port.bytes_fed_ += n;
   if (port.offset_ == chunk.data.size()) {

@@ -1,4 +1,5 @@
 #include "serial_robot_driver/transport/serial_port.h"
+#include "serial_robot_driver/transport/termios2_baud.h"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -15,6 +16,7 @@
 #include <linux/serial.h>
 #endif
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
@@ -85,6 +87,35 @@ void configureRaw8N1(int fd, speed_t speed, const std::string& path) {
 }
 
 }  // namespace
+
+const std::vector<unsigned>& supportedBaudRates() {
+  static const std::vector<unsigned> kRates = {
+      1200,   2400,   4800,   9600,    19200,   38400,   57600,   115200,  230400,  250000, 460800,
+      500000, 576000, 921600, 1000000, 1152000, 1500000, 2000000, 2500000, 3000000, 3500000, 4000000};
+  return kRates;
+}
+
+bool isSupportedBaud(unsigned baud) {
+  const auto& rates = supportedBaudRates();
+  return std::binary_search(rates.begin(), rates.end(), baud);
+}
+
+std::string supportedBaudRatesText() {
+  std::string text;
+  for (unsigned rate : supportedBaudRates()) text += (text.empty() ? "" : ", ") + std::to_string(rate);
+  return text;
+}
+
+std::optional<unsigned> readBaudRate(int fd) {
+  if (const std::optional<unsigned> baud = readBaudWithTermios2(fd)) return baud;
+  termios settings{};
+  if (::tcgetattr(fd, &settings) != 0) return std::nullopt;
+  const speed_t speed = ::cfgetospeed(&settings);
+  for (unsigned rate : supportedBaudRates()) {
+    if (baudToSpeed(rate) == std::optional<unsigned>(speed)) return rate;
+  }
+  return std::nullopt;
+}
 
 std::optional<unsigned> baudToSpeed(unsigned baud) {
   switch (baud) {
@@ -309,12 +340,13 @@ void SerialPort::wakeRead() {
 
 void SerialPort::open() {
   close();
-  const std::optional<unsigned> speed = baudToSpeed(options_.baud);
-  if (!speed) {
-    throw TransportError(
-        TransportErrorKind::kConfigureFailed,
-        "unsupported baud rate " + std::to_string(options_.baud) + " for " + options_.path);
+  if (!isSupportedBaud(options_.baud)) {
+    throw TransportError(TransportErrorKind::kConfigureFailed,
+                         "unsupported baud rate " + std::to_string(options_.baud) + " for " +
+                             options_.path + " (supported: " + supportedBaudRatesText() + ")");
   }
+  // A rate without a Bxxx constant: configured at B38400 first, then set by number.
+  const std::optional<unsigned> speed = baudToSpeed(options_.baud);
 
   const int fd = ::open(options_.path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0 && errno == EBUSY) throwPortBusy(options_.path, "opened exclusively");
@@ -322,7 +354,15 @@ void SerialPort::open() {
   takeExclusively(fd, options_.path);  // closes fd when it throws
 
   try {
-    configureRaw8N1(fd, *speed, options_.path);
+    configureRaw8N1(fd, speed.value_or(B38400), options_.path);
+    if (!speed) {
+      const int error = setBaudWithTermios2(fd, options_.baud);
+      if (error != 0) {
+        throwErrno(TransportErrorKind::kConfigureFailed,
+                   "cannot set the baud rate " + std::to_string(options_.baud) + " of " + options_.path,
+                   error);
+      }
+    }
   } catch (...) {
     ::close(fd);
     throw;

@@ -15,7 +15,12 @@
 #include <thread>
 #include <vector>
 
+#include <rosbag/bag.h>
+
+#include "serial_robot_driver/SerialChunk.h"
+#include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/golden_frames.h"
 #include "support/fake_device.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
@@ -183,6 +188,97 @@ TEST(DriverNodelet, ManagerSigintStopsTheWheels) {
   const auto status = manager.waitExit(20.0);
   ASSERT_TRUE(status.has_value()) << "the manager did not exit on SIGINT\n" << manager.output();
   expectLastFrameIsZero(*base);
+}
+
+// 3. ~replay_bag in the nodelet: the bag's chunks are replayed (telemetry with the recorded
+// stamps), and the real port, though it exists and a base is configured on it, is never opened:
+// nothing is written to it. A bag that cannot be replayed is refused, naming the bag, and again
+// nothing touches the port.
+class NodeletReplay : public testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(ros::param::get("/driver_node/port", port_));
+    port_ += "_replay";
+    base_ = makeBase(port_);
+  }
+
+  /// Loads a DriverNodelet named `name` into a manager of its own, replaying `bag`.
+  void load(const std::string& name, const std::string& bag) {
+    ros::param::set(name + "/port", port_);
+    ros::param::set(name + "/replay_bag", bag);
+    ros::param::set(name + "/replay_rate", 0.0);
+    ros::param::set(name + "/base/battery_poll_rate", 0.0);
+    ros::param::set(name + "/servo_bus/enabled", false);
+    ros::param::set(name + "/body/servo_ids", std::vector<int>{1, 2});
+    ros::param::set(name + "/body/joint_names", std::vector<std::string>{"a", "b"});
+    ros::param::set(name + "/body/zero_ticks", std::vector<int>{2048, 2048});
+    ros::param::set(name + "/body/directions", std::vector<int>{1, 1});
+    manager_ = std::make_unique<test_support::ChildProcess>(
+        "rosrun", std::vector<std::string>{"nodelet", "nodelet", "manager", "__name:=replay_manager"});
+    ASSERT_TRUE(ros::service::waitForService("/replay_manager/load_nodelet", 30000))
+        << manager_->output();
+    nodelet::NodeletLoad request;
+    request.request.name = name;
+    request.request.type = "serial_robot_driver/DriverNodelet";
+    ASSERT_TRUE(ros::service::call("/replay_manager/load_nodelet", request)) << manager_->output();
+    ASSERT_TRUE(request.response.success) << manager_->output();
+  }
+
+  void TearDown() override {
+    if (manager_ && manager_->running()) {
+      manager_->signal(SIGINT);
+      manager_->waitExit(20.0);
+    }
+    std::remove(bag_.c_str());
+  }
+
+  std::string port_;
+  std::string bag_ = "/tmp/srd_test_nodelet_replay_" + std::to_string(::getpid()) + ".bag";
+  std::unique_ptr<FakeDevice> base_;
+  std::unique_ptr<test_support::ChildProcess> manager_;
+};
+
+TEST_F(NodeletReplay, ReplaysTheBagWithoutOpeningThePort) {
+  constexpr int kFrames = 10;
+  {
+    rosbag::Bag bag(bag_, rosbag::bagmode::Write);
+    serial_robot_driver::SerialChunk chunk;
+    chunk.port = port_;
+    chunk.header.stamp = ros::Time(100.0);
+    bag.write("/serial_raw", chunk.header.stamp, chunk);  // the "port opened" mark
+    for (int i = 0; i < kFrames; ++i) {
+      chunk.header.stamp = ros::Time(100.0 + 0.02 * (i + 1));
+      chunk.data = golden::body::kTelemetryTwoServos;
+      bag.write("/serial_raw", chunk.header.stamp, chunk);
+    }
+  }
+  ros::NodeHandle nh;
+  test_support::TopicCounter<serial_robot_driver::Telemetry> telemetry(nh, "/replaying/telemetry");
+  load("/replaying/driver_node", bag_);
+  ASSERT_TRUE(telemetry.waitForCount(kFrames, 30.0)) << telemetry.count() << " telemetry\n"
+                                                    << manager_->output();
+  const auto replayed = telemetry.since(0);
+  EXPECT_EQ(replayed.front().header.stamp, ros::Time(100.02));
+  EXPECT_EQ(replayed.back().header.stamp, ros::Time(100.0 + 0.02 * kFrames));
+  // A live base would have sent its Reset by now.
+  test_support::sleepSeconds(1.0);
+  EXPECT_TRUE(base_->frames().empty()) << "the replaying nodelet wrote to the real port";
+}
+
+TEST_F(NodeletReplay, RefusesABagItCannotReplayNamingIt) {
+  const std::string missing = "/tmp/srd_test_nodelet_no_such_" + std::to_string(::getpid()) + ".bag";
+  load("/refusing/driver_node", missing);
+  // The manager's own output (its console log) carries the refusal.
+  const bool refused = waitFor(
+      [&] {
+        const std::string output = manager_->output();
+        const std::size_t line = output.find("replay bag " + missing);
+        return line != std::string::npos && output.find("does not start", line) != std::string::npos;
+      },
+      30.0);
+  EXPECT_TRUE(refused) << manager_->output();
+  test_support::sleepSeconds(1.0);
+  EXPECT_TRUE(base_->frames().empty()) << "the refused nodelet wrote to the real port";
 }
 
 }  // namespace

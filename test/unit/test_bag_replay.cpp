@@ -80,10 +80,19 @@ TEST_F(BagReplayTest, ReadsTheInboundChunksPerPortInOrder) {
   EXPECT_TRUE(a[0].data.empty());  // the "port opened" mark
   EXPECT_EQ(a[1].data, (std::vector<uint8_t>{0xAA, 0x55}));
   EXPECT_EQ(a[2].data, (std::vector<uint8_t>{0x7E}));
-  // The arrival handed to the link maps back to the recorded stamp exactly.
+  EXPECT_EQ(a[2].recorded, std::chrono::nanoseconds(101250000000LL));
+  // The bag ends with its last message (of any topic).
+  EXPECT_EQ(recording.end, std::chrono::nanoseconds(101250000000LL));
+  // The arrival handed to the link lies on the replay's timeline and maps back to the recorded
+  // stamp exactly.
   DriverParams replaying;
   replaying.replay_bag = path;
-  EXPECT_EQ(ArrivalStamps(replaying)(a[2].arrival), ros::Time(101.25));
+  replaying.replay_timeline =
+      std::make_shared<transport::ReplayPacing>(1.0, a[0].recorded, recording.end);
+  const auto arrival = replaying.replay_timeline->onTimeline(a[2].recorded);
+  EXPECT_EQ(arrival - replaying.replay_timeline->onTimeline(a[0].recorded),
+            std::chrono::milliseconds(1250));
+  EXPECT_EQ(ArrivalStamps(replaying)(arrival), ros::Time(101.25));
   EXPECT_EQ(recording.ports.at("/dev/ttyB").at(0).data, (std::vector<uint8_t>{0x1F}));
 }
 

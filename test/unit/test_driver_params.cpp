@@ -8,6 +8,7 @@
 #include <set>
 
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/transport/serial_port.h"
 
 namespace serial_robot_driver::ros_layer {
 namespace {
@@ -129,6 +130,25 @@ TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
   expectRefused(no_orientation, "imu/orientation_variance is negative");
 }
 
+// Every rate the port opens at passes the check, and only those: the servos' 250000 and the large
+// standard rates included (one table decides both).
+TEST(DriverParams, EveryRateThePortOpensAtPasses) {
+  for (unsigned rate : transport::supportedBaudRates()) {
+    DriverParams params;
+    params.baud = static_cast<int>(rate);
+    EXPECT_NO_THROW(params.validate()) << rate;
+  }
+  for (int rate : {9600, 19200, 38400, 57600, 115200, 250000, 500000, 1152000, 2500000, 3500000}) {
+    DriverParams params;
+    params.servo_bus.port = "/dev/ttyUSB1";
+    params.servo_bus.baud = rate;
+    EXPECT_NO_THROW(params.validate()) << rate;
+  }
+  DriverParams params;
+  params.baud = 5000000;
+  EXPECT_THROW(params.validate(), ParameterError);
+}
+
 TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
   DriverParams params;
   params.servo_bus.port = "/dev/ttyUSB1";
@@ -195,6 +215,10 @@ ParamValue changed(const ParamValue& value) {
     }
     ParamValue operator()(std::vector<std::string> v) const {
       v.push_back("changed");
+      return v;
+    }
+    ParamValue operator()(std::vector<double> v) const {
+      v.push_back(0.25);
       return v;
     }
   };
@@ -334,6 +358,60 @@ TEST(DriverParamsFrames, BadPrefixOrFrameIsNamed) {
     FAIL() << "base/base_frame '/' passed";
   } catch (const ParameterError& e) {
     EXPECT_EQ(e.name(), "base/base_frame");
+  }
+}
+
+TEST(DriverParams, TrajectoryDefaultsMustNotBeNegative) {
+  const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
+      {"trajectory/goal_tolerance", [](DriverParams& p) { p.trajectory.goal_tolerance = -0.1; }},
+      {"trajectory/goal_time_tolerance",
+       [](DriverParams& p) { p.trajectory.goal_time_tolerance = -1; }},
+      {"trajectory/path_tolerance", [](DriverParams& p) { p.trajectory.path_tolerance = -1; }},
+      {"trajectory/max_velocity", [](DriverParams& p) { p.trajectory.max_velocity = -2; }},
+  };
+  for (const auto& [key, spoil] : cases) {
+    DriverParams params;
+    spoil(params);
+    try {
+      params.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), key);
+    }
+  }
+  EXPECT_NO_THROW(DriverParams().validate());
+}
+
+TEST(DriverParams, BusJointsAreCheckedAndNamed) {
+  const auto withJoints = [] {
+    DriverParams p;
+    p.servo_bus.joint_ids = {3, 4};
+    p.servo_bus.joint_names = {"pan", "tilt"};
+    return p;
+  };
+  EXPECT_NO_THROW(withJoints().validate());
+  const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
+      {"servo_bus/joint_ids", [](DriverParams& p) { p.servo_bus.joint_ids = {3, 3}; }},
+      {"servo_bus/joint_ids", [](DriverParams& p) { p.servo_bus.joint_ids = {3, 255}; }},
+      {"servo_bus/joint_names", [](DriverParams& p) { p.servo_bus.joint_names = {"pan"}; }},
+      {"servo_bus/joint_names", [](DriverParams& p) { p.servo_bus.joint_names = {"pan", "pan"}; }},
+      {"servo_bus/joint_names",
+       [](DriverParams& p) { p.servo_bus.joint_names = {"pan", "joint_1"}; }},  // a body joint
+      {"servo_bus/joint_zero_deg", [](DriverParams& p) { p.servo_bus.joint_zero_deg = {0}; }},
+      {"servo_bus/joint_zero_deg",
+       [](DriverParams& p) { p.servo_bus.joint_zero_deg = {0, 200}; }},
+      {"servo_bus/joint_directions",
+       [](DriverParams& p) { p.servo_bus.joint_directions = {1, 0}; }},
+  };
+  for (const auto& [key, spoil] : cases) {
+    DriverParams params = withJoints();
+    spoil(params);
+    try {
+      params.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.name(), key) << e.what();
+    }
   }
 }
 

@@ -13,11 +13,17 @@ namespace {
 
 using std::chrono::milliseconds;
 
-SteadyTime at(int ms) { return SteadyTime(milliseconds(1000000 + ms)); }
+// A wall-clock stamp of 2026, as recorded: far beyond any steady clock's reading.
+RecordedStamp at(int ms) { return RecordedStamp(std::chrono::seconds(1795000000)) + milliseconds(ms); }
+
+std::shared_ptr<ReplayPacing> pacingOf(const std::vector<RecordedChunk>& chunks, double rate) {
+  const RecordedStamp first = chunks.empty() ? at(0) : chunks.front().recorded;
+  const RecordedStamp last = chunks.empty() ? at(0) : chunks.back().recorded;
+  return std::make_shared<ReplayPacing>(rate, first, last);
+}
 
 std::shared_ptr<RecordedPort> portOf(std::vector<RecordedChunk> chunks, double rate = 0.0) {
-  auto pacing =
-      std::make_shared<ReplayPacing>(rate, chunks.empty() ? at(0) : chunks.front().arrival);
+  auto pacing = pacingOf(chunks, rate);
   return std::make_shared<RecordedPort>("/dev/ttyTEST", std::move(chunks), pacing);
 }
 
@@ -32,9 +38,11 @@ TEST(RecordedStream, HandsOutOneChunkPerReadWithItsArrival) {
   RecordedStream stream(port);
   stream.open();  // takes the recorded "opened" mark
   EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0xAA, 0x55}));
-  EXPECT_EQ(stream.arrivalTime(), at(5));
+  ASSERT_TRUE(stream.arrivalTime());
+  const SteadyTime first_arrival = *stream.arrivalTime();
   EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x01}));
-  EXPECT_EQ(stream.arrivalTime(), at(9));
+  // On the replay's timeline the recorded gap keeps its length.
+  EXPECT_EQ(*stream.arrivalTime() - first_arrival, milliseconds(4));
   EXPECT_FALSE(port->finished());
   EXPECT_TRUE(readOnce(stream).empty());
   EXPECT_TRUE(port->finished());
@@ -72,8 +80,9 @@ TEST(RecordedStream, AChunkLargerThanTheBufferComesInPiecesWithTheSameArrival) {
   RecordedStream stream(port);
   stream.open();
   EXPECT_EQ(readOnce(stream, 3), (std::vector<uint8_t>{1, 2, 3}));
+  const auto first_piece = stream.arrivalTime();
   EXPECT_EQ(readOnce(stream, 3), (std::vector<uint8_t>{4, 5}));
-  EXPECT_EQ(stream.arrivalTime(), at(7));
+  EXPECT_EQ(stream.arrivalTime(), first_piece);
   EXPECT_EQ(port->stats().chunks_fed, 1u);
 }
 
@@ -99,11 +108,52 @@ TEST(RecordedStream, AChunkNotYetDueIsNotHandedOut) {
   EXPECT_FALSE(port->finished());
 }
 
-TEST(ReplayPacing, ScalesTheRecordedOffsets) {
-  ReplayPacing twice(2.0, at(0));
-  ReplayPacing flat_out(0.0, at(0));
-  EXPECT_EQ(twice.dueAt(at(1000)) - twice.dueAt(at(0)), milliseconds(500));
-  EXPECT_EQ(flat_out.dueAt(at(1000)), flat_out.dueAt(at(0)));
+TEST(ReplayPacing, MapsRecordedStampsOntoTheSteadyTimelineAndBackExactly) {
+  ReplayPacing pacing(1.0, at(0), at(1000));
+  const auto now = std::chrono::steady_clock::now();
+  // The first chunk lies at the replay's start, near the steady clock's present (not at a
+  // wall-clock reading decades away from it).
+  EXPECT_LT(std::chrono::abs(pacing.onTimeline(at(0)) - now), std::chrono::seconds(60));
+  EXPECT_EQ(pacing.onTimeline(at(250)) - pacing.onTimeline(at(0)), milliseconds(250));
+  EXPECT_EQ(pacing.recordedAt(pacing.onTimeline(at(123))), at(123));
+  EXPECT_EQ(pacing.end() - pacing.onTimeline(at(0)), milliseconds(1000));
+}
+
+TEST(ReplayPacing, ScalesTheWaitsNotTheTimeline) {
+  ReplayPacing twice(2.0, at(0), at(1000));
+  EXPECT_EQ(twice.steadyWait(milliseconds(1000)), milliseconds(500));
+  EXPECT_EQ(twice.onTimeline(at(1000)) - twice.onTimeline(at(0)), milliseconds(1000));
+  ReplayPacing flat_out(0.0, at(0), at(1000));
+  EXPECT_EQ(flat_out.steadyWait(milliseconds(1000)), milliseconds(0));
+}
+
+// Rate 0: each port's clock stands at its next chunk, so the silence before it has passed by the
+// time the link looks; after the last chunk it stands at the recording's end.
+TEST(RecordedStream, AtFullSpeedTheClockJumpsToTheNextChunkThenToTheEnd) {
+  std::vector<RecordedChunk> chunks = {{at(0), {0x01}}, {at(400), {0x02}}};
+  auto pacing = std::make_shared<ReplayPacing>(0.0, at(0), at(900));
+  auto port = std::make_shared<RecordedPort>("/dev/ttyTEST", chunks, pacing);
+  RecordedStream stream(port);
+  stream.open();
+  EXPECT_EQ(stream.now(), pacing->onTimeline(at(0)));
+  readOnce(stream);
+  EXPECT_EQ(stream.now(), pacing->onTimeline(at(400)));
+  readOnce(stream);
+  EXPECT_EQ(stream.now(), pacing->onTimeline(at(900)));
+  EXPECT_TRUE(readOnce(stream).empty());
+  EXPECT_TRUE(port->finished());
+}
+
+// Paced: the port is finished only once the recording's end has been reached, silence included.
+TEST(RecordedStream, APacedReplayRunsOnThroughTheSilenceAtTheEnd) {
+  std::vector<RecordedChunk> chunks = {{at(0), {0x01}}};
+  auto pacing = std::make_shared<ReplayPacing>(1.0, at(0), at(3600000));
+  auto port = std::make_shared<RecordedPort>("/dev/ttyTEST", chunks, pacing);
+  RecordedStream stream(port);
+  stream.open();
+  EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x01}));
+  EXPECT_TRUE(readOnce(stream).empty());
+  EXPECT_FALSE(port->finished());
 }
 
 }  // namespace

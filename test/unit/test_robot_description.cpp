@@ -162,11 +162,10 @@ TEST(YamlParamSource, ReadsTheDriversParametersWithTheirDefaults) {
   EXPECT_EQ(params.body.directions, (std::vector<int>{1, -1}));
   EXPECT_EQ(params.loop_rate, DriverParams().loop_rate) << "absent: the driver's default";
   EXPECT_TRUE(params.base.publish_tf);
-  const ServoBusJoints bus = loadServoBusJoints(source);
-  EXPECT_EQ(bus.ids, (std::vector<int>{5}));
-  EXPECT_EQ(bus.names, (std::vector<std::string>{"gripper"}));
-  EXPECT_EQ(bus.zero_deg, (std::vector<double>{90.0}));
-  EXPECT_EQ(bus.directions, (std::vector<int>{-1}));
+  EXPECT_EQ(params.servo_bus.joint_ids, (std::vector<int>{5}));
+  EXPECT_EQ(params.servo_bus.joint_names, (std::vector<std::string>{"gripper"}));
+  EXPECT_EQ(params.servo_bus.joint_zero_deg, (std::vector<double>{90.0}));
+  EXPECT_EQ(params.servo_bus.joint_directions, (std::vector<int>{-1}));
 }
 
 TEST(RobotDescription, LinkNamesDropALeadingSlash) {

@@ -9,6 +9,7 @@
 
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
+#include "serial_robot_driver/transport/recorded_stream.h"
 #include "support/test_helpers.h"
 #include "support/golden_frames.h"
 
@@ -76,6 +77,89 @@ TEST(SerialLink, GivesUpOnAStalePartialFrameAndDeliversTheFrameBehindIt) {
   EXPECT_EQ(listener.frames[0].second, kPingReply);
   EXPECT_EQ(link.stats().framer.stale_candidates, 1u);
   link.stop();
+}
+
+// What a wire capture keeps of a live link: its inbound chunks with their times.
+class InboundCapture : public ChunkObserver {
+ public:
+  void onChunk(const WireChunk& chunk) override {
+    if (chunk.outbound) return;
+    std::lock_guard<std::mutex> lock(mutex);
+    // As a bag holds them: wall-clock stamps (a 2026 date plus the steady reading).
+    const auto stamp = std::chrono::duration_cast<std::chrono::nanoseconds>(
+        chunk.time.time_since_epoch() + std::chrono::seconds(1795000000));
+    chunks.push_back({stamp, Bytes(chunk.data, chunk.data + chunk.size)});
+  }
+  std::vector<transport::RecordedChunk> taken() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return chunks;
+  }
+  std::mutex mutex;
+  std::vector<transport::RecordedChunk> chunks;
+};
+
+void expectSameCounters(const protocol::FramerStats& replayed, const protocol::FramerStats& live) {
+  EXPECT_EQ(replayed.bytes_in, live.bytes_in);
+  EXPECT_EQ(replayed.bytes_skipped, live.bytes_skipped);
+  EXPECT_EQ(replayed.checksum_errors, live.checksum_errors);
+  EXPECT_EQ(replayed.unknown_commands, live.unknown_commands);
+  EXPECT_EQ(replayed.stale_candidates, live.stale_candidates);
+  EXPECT_EQ(replayed.frames, live.frames);
+}
+
+// A partial frame followed by silence, live on a pty and captured; then that capture replayed at
+// full speed and at the recorded pace: the stale-frame timer must fire in the replay just as it
+// did live (the recorded silence counts on the replay's timeline), with the same counters. Two
+// silences: one before the next frame, one at the end of the capture.
+TEST(SerialLink, ACapturedSilenceReplaysWithTheLiveCounters) {
+  const std::string path = uniqueLinkPath("capture");
+  SerialLinkOptions options = optionsFor(path);
+  options.stale_frame_timeout = milliseconds(100);
+  const Bytes stray_header = {0x05, 0x1C, 0x01, 0x21};  // a PING answer claiming N = 33
+
+  InboundCapture capture;
+  protocol::FramerStats live;
+  std::chrono::nanoseconds capture_end{};
+  {
+    sim::PseudoTerminal pty(path);
+    SerialLink link(options);
+    RecordingListener listener;
+    link.addListener(&listener);
+    link.setChunkObserver(&capture);
+    link.start();
+    ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+    pty.write(stray_header.data(), stray_header.size());
+    ASSERT_TRUE(waitFor([&] { return link.stats().framer.stale_candidates == 1; }, kWaitSeconds));
+    pty.write(kPingReply.data(), kPingReply.size());
+    ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
+    pty.write(stray_header.data(), 2);  // half a header, and nothing after it
+    ASSERT_TRUE(waitFor([&] { return link.stats().framer.stale_candidates == 2; }, kWaitSeconds));
+    capture_end = std::chrono::duration_cast<std::chrono::nanoseconds>(
+        Clock::now().time_since_epoch() + std::chrono::seconds(1795000000));
+    live = link.stats().framer;
+    link.stop();
+  }
+  const std::vector<transport::RecordedChunk> chunks = capture.taken();
+  ASSERT_GE(chunks.size(), 4u);  // the open mark and three writes (a write may split)
+
+  for (double rate : {0.0, 1.0}) {
+    SCOPED_TRACE("rate " + std::to_string(rate));
+    auto pacing =
+        std::make_shared<transport::ReplayPacing>(rate, chunks.front().recorded, capture_end);
+    auto port = std::make_shared<transport::RecordedPort>(path, chunks, pacing);
+    SerialLink link(options, [port](const SerialLinkOptions&) {
+      return std::make_unique<transport::RecordedStream>(port);
+    });
+    RecordingListener listener;
+    link.addListener(&listener);
+    pacing->restart();
+    link.start();
+    ASSERT_TRUE(waitFor([&] { return port->finished(); }, 10.0));
+    const protocol::FramerStats replayed = link.stats().framer;
+    link.stop();
+    EXPECT_EQ(listener.frameCount(), 1u);
+    expectSameCounters(replayed, live);
+  }
 }
 
 TEST(SerialLink, DeliversFramesAndWritesBytes) {

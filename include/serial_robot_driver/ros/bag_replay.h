@@ -1,7 +1,9 @@
 // ~replay_bag: the ports' bytes come from a bag's serial_raw (recorded with ~capture) instead of
 // the wire. The bag is read whole at start-up with the rosbag C++ API; each configured port then
-// gets a transport::RecordedStream, so the very same links, framers, devices and publishers run,
-// and the frames carry their recorded arrival stamps (conversions.h, ArrivalStamps).
+// gets a transport::RecordedStream, so the very same links, framers, devices and publishers run.
+// Recorded stamps are placed on the replay's own steady timeline (transport::ReplayPacing), where
+// the links' timers see the recorded silences; the published frames carry the recorded stamps
+// again (conversions.h, ArrivalStamps).
 #pragma once
 
 #include <map>
@@ -28,6 +30,7 @@ struct Recording {
   std::string topic;  ///< the serial_raw topic found, e.g. /serial_raw or /robot1/serial_raw
   std::map<std::string, std::vector<transport::RecordedChunk>> ports;
   std::size_t outbound_chunks = 0;  ///< recorded writes: not replayed
+  transport::RecordedStamp end{0};  ///< the bag's latest stamp (any topic)
 };
 
 /// Reads every serial_raw chunk of the bag at `path`. Throws ReplayError when the file is missing
@@ -49,6 +52,8 @@ class BagReplay {
   device::SerialLink::StreamFactory streamFactory() const;
   /// The recorded pace counts from now (call just before the links start).
   void startClock() { pacing_->restart(); }
+  /// The replay's timeline, for the stamps of what the replay publishes (DriverParams).
+  std::shared_ptr<const transport::ReplayPacing> timeline() const { return pacing_; }
   /// Every port has handed out its last chunk.
   bool finished() const;
   /// One line for the log: chunks and bytes fed, writes discarded.

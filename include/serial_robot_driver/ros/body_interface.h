@@ -15,6 +15,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -38,6 +39,9 @@ class BodyInterface : public DeviceInterface {
   /// before the link starts (~base/use_imu_heading: the base's odometry).
   using ImuYawListener = std::function<void(double yaw, device::Clock::time_point arrival)>;
   void setImuYawListener(ImuYawListener listener) { imu_yaw_listener_ = std::move(listener); }
+  /// The body's joints, streamed: one sync-write frame per loop tick.
+  std::vector<TrajectoryJoints> trajectoryJoints() override;
+  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
@@ -62,6 +66,8 @@ class BodyInterface : public DeviceInterface {
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
   ImuYawListener imu_yaw_listener_;
+  // The node's trajectory server (its own threading comment); set before the link starts.
+  TrajectoryServer* trajectory_ = nullptr;
   // Diagnostics timer thread only.
   uint64_t frames_at_last_diagnose_ = 0;
   bool telemetry_stop_logged_ = false;

@@ -29,22 +29,18 @@ ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time
 /// The same, against the current ros::Time::now() and steady_clock::now().
 ros::Time toRosTime(std::chrono::steady_clock::time_point event);
 
-/// The steady time point a replayed chunk stamped `recorded` arrives at (transport::RecordedStream
-/// hands it to the link): the stamp's nanoseconds since the epoch, so the way back is exact.
-std::chrono::steady_clock::time_point arrivalOfRecordedStamp(const ros::Time& recorded);
-
 /// Header stamps of frames from their arrival time in the core (steady clock).
 /// Live: toRosTime(), with the last conversion remembered per thread, so the users of one chunk
 /// (its wire capture and the frames it completes, all on the port's reader thread) give it the
-/// very same stamp. Replaying (~replay_bag set): the inverse of arrivalOfRecordedStamp(), so a
-/// replay publishes the recorded stamps.
+/// very same stamp. Replaying (params.replay_timeline set): the recorded stamp the arrival stands
+/// for on the replay's timeline, exactly, so a replay publishes the recorded stamps.
 class ArrivalStamps {
  public:
-  explicit ArrivalStamps(const DriverParams& params) : replaying_(!params.replay_bag.empty()) {}
+  explicit ArrivalStamps(const DriverParams& params) : replay_timeline_(params.replay_timeline) {}
   ros::Time operator()(std::chrono::steady_clock::time_point arrival) const;
 
  private:
-  bool replaying_;
+  std::shared_ptr<const transport::ReplayPacing> replay_timeline_;
 };
 
 /// The joints configured from ~body (servo_ids, joint_names, zero_ticks, directions,

@@ -6,8 +6,12 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 
 #include "serial_robot_driver/ros/driver_params.h"
+#include <vector>
 
 namespace serial_robot_driver::ros_layer {
+
+class TrajectoryServer;
+struct TrajectoryJoints;
 
 class DeviceInterface {
  public:
@@ -22,6 +26,11 @@ class DeviceInterface {
   /// was built with) from its next loop tick or transaction on (dynamic_reconfigure, see
   /// ros/runtime_tuning.h). Devices without tunables ignore it.
   virtual void retune(const DriverParams& /*params*/) {}
+  /// The joints trajectories may drive on this device (none by default).
+  virtual std::vector<TrajectoryJoints> trajectoryJoints();
+  /// The node's trajectory server, given before start() when trajectoryJoints() had joints: the
+  /// device reports their measurements to it and lets it know when another command takes them.
+  virtual void attachTrajectories(TrajectoryServer* /*server*/) {}
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -8,6 +8,7 @@
 //        /diagnostics, serial_raw (serial_robot_driver/SerialChunk, with ~capture)
 // Services: base/reset, base/clear_encoders (std_srvs/Trigger); servo/ping, servo/read, servo/write,
 //   servo/read_angle, servo/rotate, servo/spin, servo/damping, servo/read_all, servo/reset_user_data.
+// Action: follow_joint_trajectory (control_msgs-compatible); topic joint_trajectory (in).
 // Parameters: see ros/driver_params.h and config/robot.yaml.
 //
 // Threading model:
@@ -21,8 +22,11 @@
 //  - the dynamic_reconfigure servers (~base, ~imu; ros/runtime_tuning.h) answer on the global
 //    queue too; a change reaches each device under the device's own lock (the base loop's mutex,
 //    the IMU scales swapped whole), from its next tick or frame on.
+//  - trajectory goals, cancels, joint_trajectory and the trajectory timer (one sync-write per loop
+//    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <string>
@@ -39,6 +43,7 @@ namespace serial_robot_driver::ros_layer {
 class DeviceInterface;
 class RuntimeTuning;
 class PortMonitor;
+class TrajectoryServer;
 class WireCapture;
 
 class DriverNode {
@@ -75,13 +80,17 @@ class DriverNode {
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
   std::map<std::string, Port> ports_;
+  /// follow_joint_trajectory / joint_trajectory over every device's joints; null when none has
+  /// any. Outlives the devices, which hold a pointer to it.
+  std::unique_ptr<TrajectoryServer> trajectory_;
   /// In start and shutdown order: base, body, servo bus.
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
-  /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after devices_, destroyed first.
+  /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after devices_ and
+  /// trajectory_, destroyed first.
   std::unique_ptr<RuntimeTuning> tuning_;
-  bool shut_down_ = false;
+  std::atomic<bool> shut_down_{false};  // read by the ports' monitors on the reader threads
 };
 
 }  // namespace serial_robot_driver::ros_layer

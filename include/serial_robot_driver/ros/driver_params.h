@@ -5,11 +5,14 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
+
+#include "serial_robot_driver/transport/recorded_stream.h"
 
 namespace ros {
 class NodeHandle;
@@ -97,6 +100,19 @@ struct ServoBusParams : DevicePortParams {
   std::vector<int> state_ids;     ///< bus servos polled for servo_states (empty: no poll)
   double state_rate = 10.0;       ///< Hz, polls of every state_ids servo
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
+  // Bus servos used as named joints (trajectories, servo_states); one entry per joint_ids.
+  std::vector<int> joint_ids;
+  std::vector<std::string> joint_names;
+  std::vector<double> joint_zero_deg;  ///< servo angle at joint position 0; empty: all 0
+  std::vector<int> joint_directions;   ///< 1 or -1; empty: all 1
+};
+
+/// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override them).
+struct TrajectoryParams {
+  double goal_tolerance = 0.05;      ///< rad, per joint
+  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
+  double path_tolerance = 0.0;       ///< rad; 0: not checked
+  double max_velocity = 0.0;         ///< rad/s per joint; a faster trajectory is refused; 0: no limit
 };
 
 /// The tf frame name of a frame parameter under `tf_prefix`, as robot_state_publisher resolves its
@@ -116,6 +132,9 @@ struct DriverParams {
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
   double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
+  /// Not a parameter: the running replay's timeline (set by the node once the bag is read), which
+  /// maps the frames' arrival times back to their recorded stamps.
+  std::shared_ptr<const transport::ReplayPacing> replay_timeline;
   BaseParams base;
   BodyParams body;
   ImuParams imu;
@@ -127,6 +146,7 @@ struct DriverParams {
   /// Puts every frame parameter (base/odom_frame, base/base_frame, imu/frame_id) under tf_prefix
   /// (resolveFrame). loadParams(NodeHandle) calls it once, after reading tf_prefix.
   void resolveFrames();
+  TrajectoryParams trajectory;
 
   /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
   void validate() const;
@@ -144,7 +164,8 @@ struct DriverParams {
 
 /// One parameter's value; the alternative held says the parameter's type.
 using ParamValue =
-    std::variant<bool, int, double, std::string, std::vector<int>, std::vector<std::string>>;
+    std::variant<bool, int, double, std::string, std::vector<int>, std::vector<std::string>,
+                 std::vector<double>>;
 
 /// One row of the parameter table: the key under ~ and how it reaches its DriverParams field.
 /// The table (parameterTable()) is the only place a key is spelled: loading, the unknown-key

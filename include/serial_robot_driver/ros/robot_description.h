@@ -33,27 +33,11 @@ class YamlParamSource : public ParamSource {
   std::unique_ptr<YAML::Node> root_;
 };
 
-/// The bus servos used as named joints (~servo_bus/joint_ids, joint_names, joint_zero_deg,
-/// joint_directions). Read from the source here as they are optional in the file.
-struct ServoBusJoints {
-  std::vector<int> ids;
-  std::vector<std::string> names;
-  std::vector<double> zero_deg;  ///< empty: all 0
-  std::vector<int> directions;   ///< empty: all 1
-};
-
-/// Reads ServoBusJoints from `source`; throws ParameterError naming a key of the wrong type or
-/// lists of different lengths.
-ServoBusJoints loadServoBusJoints(const ParamSource& source);
-
 /// Where the IMU sits on the base (the `imu_xyz` / `imu_rpy` args of the launch files).
 struct ImuMount {
   std::array<double, 3> xyz{0, 0, 0};  ///< m in the base frame
   std::array<double, 3> rpy{0, 0, 0};  ///< rad, URDF order (roll, pitch, yaw)
 };
-
-/// The bus servos' single-turn range (deg), as servo/move checks it.
-constexpr double kBusServoSingleTurnDeg = 180.0;
 
 /// A frame parameter as a URDF link name: robot_state_publisher adds the tf_prefix itself, so a
 /// leading '/' (which keeps the driver from prefixing) is dropped.
@@ -61,7 +45,7 @@ std::string linkName(const std::string& frame);
 
 /// The URDF document. `params` must have passed validate(). Throws ParameterError when two joints
 /// or links would share a name.
-std::string makeRobotDescription(const DriverParams& params, const ServoBusJoints& bus_joints,
-                                 const ImuMount& imu, const std::string& robot_name);
+std::string makeRobotDescription(const DriverParams& params, const ImuMount& imu,
+                                 const std::string& robot_name);
 
 }  // namespace serial_robot_driver::ros_layer

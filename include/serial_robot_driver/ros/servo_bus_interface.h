@@ -41,6 +41,7 @@
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
+#include "serial_robot_driver/ros/trajectory_bus_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -76,6 +77,9 @@ class ServoBusInterface : public DeviceInterface {
   /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// ~servo_bus/joint_ids as trajectory joints: one queued move per segment.
+  std::vector<TrajectoryJoints> trajectoryJoints() override;
+  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
 
  private:
   /// One servo of ~servo_bus/state_ids and its poll schedule.
@@ -87,6 +91,12 @@ class ServoBusInterface : public DeviceInterface {
   };
 
   void onServoCommands(const sensor_msgs::JointState::ConstPtr& msg);
+  /// Queues a move for the worker; the latest target of a servo replaces a queued one.
+  /// worker_mutex_ held.
+  void queueMoveLocked(const device::MoveRequest& move);
+  /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
+  /// trajectory stops (its goal aborts) and its queued move is dropped.
+  void yieldJoint(uint8_t id, const char* source);
   void workerLoop();
   void pollOnce(PolledServo& servo);
 
@@ -115,6 +125,11 @@ class ServoBusInterface : public DeviceInterface {
   uint64_t commands_sent_ = 0;
   uint64_t commands_rejected_ = 0;
   uint64_t command_failures_ = 0;
+
+  // Bus servos as joints (trajectories); set before start().
+  std::vector<trajectory::BusJoint> bus_joints_;
+  double state_rate_ = 10.0;
+  TrajectoryServer* trajectory_ = nullptr;
 };
 
 }  // namespace serial_robot_driver::ros_layer

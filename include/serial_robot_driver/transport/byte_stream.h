@@ -49,6 +49,11 @@ class ByteStream {
   /// When the bytes of the last read() arrived, for a stream that knows it better than the
   /// reader's clock (a replayed recording); nothing: they arrived when read() returned.
   virtual std::optional<std::chrono::steady_clock::time_point> arrivalTime() const { return {}; }
+  /// The clock arrivalTime() and the reader's timers (the stale partial frame) run on: the steady
+  /// clock, or a replay's own timeline.
+  virtual std::chrono::steady_clock::time_point now() const {
+    return std::chrono::steady_clock::now();
+  }
   /// Whether wakeRead() works. A reader of a stream that cannot be woken must use short read
   /// timeouts to notice a stop request; one that can sleeps until data or a wake-up comes.
   virtual bool wakeable() const { return false; }

@@ -4,7 +4,8 @@
 // behind SerialLink: the framers, the devices and the publishers run unchanged.
 //
 // Threading model: a port's chunks are read by that port's reader thread only (the link opens a
-// new RecordedStream on the same RecordedPort after each recorded reopen); writes come from any
+// new RecordedStream on the same RecordedPort after each recorded reopen), and now() is asked on
+// that thread too; writes come from any
 // thread and only touch atomic counters; finished() and stats() may be called from anywhere.
 #pragma once
 
@@ -20,25 +21,44 @@
 namespace serial_robot_driver::transport {
 
 using SteadyTime = std::chrono::steady_clock::time_point;
+/// A recorded stamp: nanoseconds since the Unix epoch (a ROS wall-clock stamp).
+using RecordedStamp = std::chrono::nanoseconds;
 
 struct RecordedChunk {
-  SteadyTime arrival;         ///< when it was read, as the link hands it on to the frames
+  RecordedStamp recorded;     ///< when it was read on the recorded run
   std::vector<uint8_t> data;  ///< empty: the port was (re)opened here
 };
 
-/// When recorded chunks are due: `rate` times the recorded pace from the moment it is built (or
-/// restarted), the earliest recorded arrival being due at once. Rate 0: everything is due at once.
+/// The replay's own timeline. Recorded stamps are wall-clock times; the link's timers (the stale
+/// partial frame) run on the steady clock. Each recorded stamp therefore gets a steady time point:
+/// the replay's start plus its offset from the first recorded chunk, so recorded gaps keep their
+/// length in the link's terms at any rate, and stamps map back exactly.
+/// Rate r > 0: the timeline runs r times as fast as the steady clock from the start (rate 1: it
+/// is the steady clock), and a chunk is due when the timeline reaches it. Rate 0: nothing waits;
+/// each port's clock jumps to its next chunk (RecordedStream::now()).
 class ReplayPacing {
  public:
-  ReplayPacing(double rate, SteadyTime first_arrival);
-  SteadyTime dueAt(SteadyTime arrival) const;
+  /// `first`: the earliest recorded chunk; `end`: the end of the recording (its latest stamp, of
+  /// any topic), until which the replay keeps running so that a silence at the end counts too.
+  ReplayPacing(double rate, RecordedStamp first, RecordedStamp end);
   bool paced() const { return rate_ > 0; }
-  /// The replay begins now. Call before the readers start (it is not synchronized with dueAt).
+  double rate() const { return rate_; }
+  /// The replay begins now. Call before the readers start (it is not synchronized with readers).
   void restart() { start_ = std::chrono::steady_clock::now(); }
+
+  /// Where a recorded stamp lies on the timeline, and back (exact: whole nanoseconds).
+  SteadyTime onTimeline(RecordedStamp recorded) const { return start_ + (recorded - first_); }
+  RecordedStamp recordedAt(SteadyTime on_timeline) const { return first_ + (on_timeline - start_); }
+  SteadyTime end() const { return onTimeline(end_); }
+  /// The timeline's present (paced replays; a rate-0 port keeps a clock of its own).
+  SteadyTime now() const;
+  /// How long to wait on the steady clock for `span` of the timeline to pass (paced replays).
+  std::chrono::nanoseconds steadyWait(std::chrono::nanoseconds span) const;
 
  private:
   double rate_;
-  SteadyTime first_arrival_;
+  RecordedStamp first_;
+  RecordedStamp end_;
   SteadyTime start_;
 };
 
@@ -81,13 +101,18 @@ class RecordedStream : public ByteStream {
   void open() override;
   void close() override { open_ = false; }
   bool isOpen() const override { return open_; }
-  /// The next chunk once it is due (0 while none is due within `timeout_ms`, and forever after
-  /// the last one). Throws TransportError(kDisconnected) where the recording reopened the port.
+  /// The next chunk once it is due (0 while none is due within `timeout_ms` of the timeline, and
+  /// forever after the last one). Throws TransportError(kDisconnected) where the recording
+  /// reopened the port. The port is finished once the timeline has reached the recording's end.
   std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms) override;
   /// Counts and drops the bytes.
   void write(const uint8_t* data, std::size_t size) override;
   std::string name() const override { return port_->name(); }
+  /// The chunk's recorded stamp on the replay's timeline.
   std::optional<SteadyTime> arrivalTime() const override { return arrival_; }
+  /// The timeline's present; at rate 0, the next chunk's time (or the end), as if the recorded
+  /// silence before it had passed (before a recorded reopen: the last chunk's time).
+  SteadyTime now() const override;
 
  private:
   std::shared_ptr<RecordedPort> port_;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "serial_robot_driver/transport/byte_stream.h"
 
@@ -73,8 +74,20 @@ struct PortHolder {
 /// when none can be seen.
 std::optional<PortHolder> findPortHolder(const std::string& device_path);
 
-/// termios speed constant for a baud rate; nullopt when unsupported.
+/// The baud rates a port opens at, ascending: the standard Linux rates and the servos' 250000. The
+/// one table behind both the parameter check and open().
+const std::vector<unsigned>& supportedBaudRates();
+bool isSupportedBaud(unsigned baud);
+/// supportedBaudRates() as "1200, 2400, ..." for messages.
+std::string supportedBaudRatesText();
+
+/// termios speed constant for a baud rate; nullopt when it has none. A supported rate without one
+/// (250000) is set by number with termios2 (BOTHER) on Linux.
 std::optional<unsigned> baudToSpeed(unsigned baud);
+
+/// The speed an open tty runs at in bits/s (its output speed), read back from the kernel; nullopt
+/// when the device refuses to tell.
+std::optional<unsigned> readBaudRate(int fd);
 
 /// Reads /sys/bus/usb-serial/devices/<ttyX>/latency_timer for a device path (symlinks resolved).
 std::optional<int> readLatencyTimerMs(const std::string& device_path);

@@ -1,0 +1,154 @@
+// follow_joint_trajectory (action) and joint_trajectory (topic) for the node's joints, with the
+// semantics of ros_control's joint_trajectory_controller: goals checked whole before anything
+// moves, one spline per joint sampled at the loop rate, path and goal tolerances, cancel holds the
+// joints where they are, a new goal or message for the same joints preempts from the current
+// desired state.
+//
+// Threading: the goal, cancel and topic callbacks and the loop timer run on the node's global
+// callback queue and share the state below under mutex_. Callbacks only check and splice; the
+// timer writes one frame per tick for streamed joints (a short write, as joint_commands does) and
+// hands segment moves to the bus's own queue. updateActual() is called on a port's reader thread
+// or the bus worker and only takes actual_mutex_, so neither ever waits for a tick. takeOver() runs another command's write under mutex_ so no trajectory frame can follow it.
+#pragma once
+
+#include <actionlib/server/action_server.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <trajectory_msgs/JointTrajectory.h>
+
+#include <functional>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "serial_robot_driver/FollowJointTrajectoryAction.h"
+#include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/trajectory/command.h"
+#include "serial_robot_driver/trajectory/spline.h"
+#include "serial_robot_driver/trajectory/tolerances.h"
+
+namespace serial_robot_driver::ros_layer {
+
+/// What a device gives the trajectory server: its joints and how to set their positions, either
+/// streamed (`write` every loop tick: the body) or one move per segment (`move`: bus servos).
+struct TrajectoryJoints {
+  std::vector<trajectory::JointRange> joints;
+  /// A goal aborts when one of its joints has had no measurement for this long (s).
+  double state_timeout = 0.5;
+  /// Writes one frame setting these joints (rad); returns an error text, empty when written.
+  std::function<std::string(const std::vector<std::string>& names,
+                            const std::vector<double>& positions)>
+      write;
+  /// Instead of `write`: moves joint `index` (into `joints`) to `position` (rad) in `duration` s;
+  /// must not block (queue the frame). Returns an error text, empty when queued.
+  std::function<std::string(std::size_t index, double position, double duration)> move;
+};
+
+/// A ROS-free command from a JointTrajectory message (stamps are left to the caller).
+trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg);
+
+class TrajectoryServer {
+ public:
+  using Action = serial_robot_driver::FollowJointTrajectoryAction;
+  using GoalHandle = actionlib::ServerGoalHandle<Action>;
+
+  /// Advertises follow_joint_trajectory and joint_trajectory in `nh`'s namespace (started by
+  /// start()).
+  TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
+                   std::vector<TrajectoryJoints> groups);
+  ~TrajectoryServer();
+
+  void start();
+  /// Aborts every goal and stops the timer. Idempotent.
+  void shutdown();
+
+  /// The measured state of some joints (names as in TrajectoryJoints; other names are ignored;
+  /// an empty velocity: unknown). Any thread.
+  void updateActual(const sensor_msgs::JointState& state);
+
+  /// Another command (`source`, e.g. "joint_commands") for `names`: runs `write` under the lock
+  /// and, when it wrote (returns true), stops the trajectories of those joints and aborts the
+  /// goals that ran them, saying so.
+  void takeOver(const std::vector<std::string>& names, const std::string& source,
+                const std::function<bool()>& write);
+
+  /// Aborts every goal and holds every joint where it is, with `reason` (the e-stop's hook).
+  void stopAll(const std::string& reason);
+
+ private:
+  struct Track {
+    std::size_t group = 0;  ///< index into groups_
+    std::size_t local = 0;  ///< index into that group's joints
+    double state_timeout = 0.5;
+    trajectory::JointSpline spline;
+    bool writing = false;  ///< the timer writes this joint (until its spline's end is written)
+    bool hold_pending = false;  ///< per-segment joints: the hold move is still to go out
+    double sent_segment = 0.0;  ///< per-segment joints: start of the segment whose move went out
+  };
+  struct Measured {
+    trajectory::JointSample sample;
+    bool velocity_known = false;
+    ros::Time stamp;  ///< zero: never measured
+  };
+  struct ActiveGoal {
+    GoalHandle handle;
+    std::vector<std::size_t> joints;
+    std::vector<std::string> names;
+    std::vector<trajectory::JointTolerance> path_tolerances;
+    std::vector<trajectory::JointTolerance> goal_tolerances;
+    double start_time = 0.0;
+    double end_time = 0.0;
+    double goal_time_tolerance = 0.0;
+  };
+  using Result = serial_robot_driver::FollowJointTrajectoryResult;
+
+  void onGoal(GoalHandle handle);
+  void onCancel(GoalHandle handle);
+  void onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg);
+  void onTick(const ros::TimerEvent& event);
+
+  /// Checks `command` (starting at `start`, now `now`) against the joints and where they are;
+  /// the indices of its joints in `check`. mutex_ held.
+  trajectory::CommandCheck check(const trajectory::TrajectoryCommand& command, double start,
+                                 double now);
+  /// Ends the goals that drive any of `joints` (cancelled when `preempted`, else aborted with
+  /// `code`), with `message`. mutex_ held.
+  void endGoalsOn(const std::vector<std::size_t>& joints, bool preempted, int code,
+                  const std::string& message);
+  /// Splices the command into the joints' splines. mutex_ held.
+  void apply(const trajectory::TrajectoryCommand& command, const std::vector<std::size_t>& joints,
+             double start, double now);
+  /// Holds `joints` where they are measured (desired where there is no measurement). mutex_ held.
+  void hold(const std::vector<std::size_t>& joints, double now);
+  /// The latest measurement of every joint.
+  std::vector<Measured> measured() const;
+  /// The first of `joints` whose measurement is older than its timeout at `now`, or -1.
+  long staleJoint(const std::vector<Measured>& measured, const std::vector<std::size_t>& joints,
+                  double now) const;
+  /// Writes (streamed groups) or queues (per-segment groups) what the tracks ask for. mutex_ held.
+  void writeTracks(double now);
+  /// Ends a goal when its tolerances say so; publishes its feedback otherwise. mutex_ held.
+  bool superviseGoal(ActiveGoal& goal, double now, const std::vector<Measured>& measured);
+  static Result result(int code, const std::string& message);
+
+  const TrajectoryParams defaults_;
+  const std::vector<TrajectoryJoints> groups_;
+  std::vector<trajectory::JointRange> ranges_;  ///< every joint, in track order
+  std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track
+  const double loop_period_;
+  ros::NodeHandle nh_;
+
+  mutable std::mutex actual_mutex_;  // guards the measurements below
+  std::vector<Measured> actual_;
+
+  std::mutex mutex_;  // guards everything below
+  std::vector<Track> tracks_;
+  std::vector<ActiveGoal> goals_;
+  bool running_ = false;
+  actionlib::ActionServer<Action> action_server_;
+  ros::Subscriber trajectory_sub_;
+  ros::Timer timer_;
+};
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,19 @@
+#include "serial_robot_driver/ros/trajectory_joints.h"
+
+namespace serial_robot_driver::ros_layer {
+
+TrajectoryJoints bodyTrajectoryJoints(device::BodyController& controller) {
+  TrajectoryJoints result;
+  for (const device::BodyJoint& joint : controller.joints()) {
+    const auto [low, high] = joint.calibration.reachableRadians();
+    result.joints.push_back({joint.name, low, high});
+  }
+  result.write = [&controller](const std::vector<std::string>& names,
+                               const std::vector<double>& positions) {
+    const device::JointCommandResult sent = controller.sendJointCommand(names, positions);
+    return sent.ok() && sent.out_of_range.empty() ? std::string() : sent.message();
+  };
+  return result;
+}
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,84 @@
+// The ROS-side pieces of trajectories that need no roscore: messages to commands, bus joints from
+// parameters, polled angles to joint measurements, and one ROTATE per bus segment.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "serial_robot_driver/ros/trajectory_bus_joints.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
+
+namespace serial_robot_driver::ros_layer {
+namespace {
+
+TEST(TrajectoryRos, CommandFromMessageKeepsEveryField) {
+  trajectory_msgs::JointTrajectory msg;
+  msg.joint_names = {"a", "b"};
+  msg.points.resize(1);
+  msg.points[0].positions = {0.1, 0.2};
+  msg.points[0].velocities = {0.3, 0.4};
+  msg.points[0].time_from_start = ros::Duration(1.25);
+  const trajectory::TrajectoryCommand command = toTrajectoryCommand(msg);
+  EXPECT_EQ(command.joint_names, msg.joint_names);
+  ASSERT_EQ(command.points.size(), 1u);
+  EXPECT_EQ(command.points[0].time_from_start, 1.25);
+  EXPECT_EQ(command.points[0].velocities, (std::vector<double>{0.3, 0.4}));
+  EXPECT_TRUE(command.points[0].accelerations.empty());
+}
+
+TEST(TrajectoryRos, BusJointsFromParametersWithDefaults) {
+  ServoBusParams params;
+  params.joint_ids = {5, 9};
+  params.joint_names = {"pan", "tilt"};
+  std::vector<trajectory::BusJoint> joints = makeBusJoints(params);
+  ASSERT_EQ(joints.size(), 2u);
+  EXPECT_EQ(joints[1].id, 9);
+  EXPECT_EQ(joints[1].name, "tilt");
+  EXPECT_EQ(joints[1].zero_deg, 0.0);
+  EXPECT_EQ(joints[1].direction, 1);
+  params.joint_zero_deg = {10.0, -20.0};
+  params.joint_directions = {1, -1};
+  joints = makeBusJoints(params);
+  EXPECT_EQ(joints[1].zero_deg, -20.0);
+  EXPECT_EQ(joints[1].direction, -1);
+}
+
+TEST(TrajectoryRos, PolledAngleBecomesTheJointsPosition) {
+  const std::vector<trajectory::BusJoint> joints = {{9, "tilt", -20.0, -1}};
+  // tilt = -(70 - (-20)) deg = -90 deg.
+  sensor_msgs::JointState state = busJointState(joints, 9, 70.0, ros::Time(3.0));
+  ASSERT_EQ(state.name.size(), 1u);
+  EXPECT_EQ(state.name[0], "tilt");
+  EXPECT_NEAR(state.position[0], -M_PI / 2, 1e-12);
+  EXPECT_EQ(state.header.stamp, ros::Time(3.0));
+  state = busJointState(joints, 4, 90.0, ros::Time(3.0));
+  EXPECT_EQ(state.name[0], "servo_4");
+  EXPECT_NEAR(state.position[0], M_PI / 2, 1e-12);
+}
+
+TEST(TrajectoryRos, BusSegmentIsOneRotateInTheServosDegrees) {
+  const std::vector<trajectory::BusJoint> joints = {{9, "tilt", -20.0, -1}};
+  std::vector<std::tuple<uint8_t, double, uint32_t>> queued;
+  const TrajectoryJoints group = busTrajectoryJoints(
+      joints,
+      [&](uint8_t id, double angle_deg, uint32_t interval_ms) {
+        queued.emplace_back(id, angle_deg, interval_ms);
+        return std::string();
+      },
+      20.0);
+  ASSERT_EQ(group.joints.size(), 1u);
+  EXPECT_EQ(group.joints[0].name, "tilt");
+  EXPECT_FALSE(group.write);
+  EXPECT_EQ(group.state_timeout, 0.5);  // three polls at 20 Hz are less
+  EXPECT_TRUE(group.move(0, M_PI / 2, 0.7504).empty());
+  ASSERT_EQ(queued.size(), 1u);
+  EXPECT_EQ(std::get<0>(queued[0]), 9);
+  EXPECT_NEAR(std::get<1>(queued[0]), -110.0, 1e-9);  // -20 - 90
+  EXPECT_EQ(std::get<2>(queued[0]), 750u);
+  EXPECT_EQ(busTrajectoryJoints(joints, {}, 2.0).state_timeout, 1.5);
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::ros_layer
