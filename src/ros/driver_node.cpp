@@ -163,7 +163,8 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   // Runtime tuning: a server per group under ~ (~base, ~imu, ...), starting from params_.
   std::vector<DeviceInterface*> tunable;
   for (auto& device : devices_) tunable.push_back(device.get());
-  tuning_ = std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable));
+  tuning_ =
+      std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable), trajectory_.get());
   diagnostics_timer_ = nh_.createSteadyTimer(
       ros::WallDuration(diagnostics_period_),
       [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });

@@ -10,7 +10,9 @@
 
 #include "serial_robot_driver/BaseTuningConfig.h"
 #include "serial_robot_driver/ImuTuningConfig.h"
+#include "serial_robot_driver/TrajectoryTuningConfig.h"
 #include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -162,13 +164,17 @@ class GroupServer : public RuntimeTuning::Server {
 }  // namespace
 
 RuntimeTuning::RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
-                             std::vector<DeviceInterface*> devices)
-    : in_force_(params), devices_(std::move(devices)) {
+                             std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory)
+    : in_force_(params), devices_(std::move(devices)), trajectory_(trajectory) {
   if (params.base.enabled) {
     servers_.push_back(std::make_unique<GroupServer<BaseTuningConfig>>(*this, private_nh, "base"));
   }
   if (params.body.enabled) {
     servers_.push_back(std::make_unique<GroupServer<ImuTuningConfig>>(*this, private_nh, "imu"));
+  }
+  if (trajectory_) {
+    servers_.push_back(
+        std::make_unique<GroupServer<TrajectoryTuningConfig>>(*this, private_nh, "trajectory"));
   }
 }
 
@@ -207,6 +213,7 @@ DriverParams RuntimeTuning::apply(const std::string& group,
   if (!changed) return in_force_;
   in_force_ = result.applied;
   for (DeviceInterface* device : devices_) device->retune(in_force_);
+  if (trajectory_) trajectory_->retune(in_force_.trajectory);
   return in_force_;
 }
 

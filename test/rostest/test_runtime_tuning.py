@@ -7,13 +7,16 @@ import threading
 import time
 import unittest
 
+import actionlib
 import rospy
 import rostest
 from dynamic_reconfigure.client import Client
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
-from serial_robot_driver.msg import WheelCommand
+from serial_robot_driver.msg import (FollowJointTrajectoryAction, FollowJointTrajectoryGoal,
+                                     FollowJointTrajectoryResult, WheelCommand)
+from trajectory_msgs.msg import JointTrajectoryPoint
 
 NODE = "/driver_node"
 TIMEOUT = 30.0  # s: generous, the machine is shared
@@ -91,6 +94,10 @@ class RuntimeTuningTest(unittest.TestCase):
         rospy.init_node("test_runtime_tuning")
         cls.base = Client(NODE + "/base", timeout=TIMEOUT)
         cls.imu = Client(NODE + "/imu", timeout=TIMEOUT)
+        cls.trajectory = Client(NODE + "/trajectory", timeout=TIMEOUT)
+        cls.follow = actionlib.SimpleActionClient("/follow_joint_trajectory",
+                                                  FollowJointTrajectoryAction)
+        assert cls.follow.wait_for_server(rospy.Duration(TIMEOUT))
         cls.frames = Recorder("/wheel_command", WheelCommand)
         cls.odom = Recorder("/odom", Odometry)
         cls.imu_data = Recorder("/imu/data", Imu)
@@ -112,6 +119,9 @@ class RuntimeTuningTest(unittest.TestCase):
         imu = self.imu.get_configuration(timeout=TIMEOUT)
         self.assertAlmostEqual(imu["accel_scale"], 0.005)
         self.assertAlmostEqual(imu["gyro_scale"], 0.0010653)
+        trajectory = self.trajectory.get_configuration(timeout=TIMEOUT)
+        self.assertAlmostEqual(trajectory["goal_tolerance"], 0.07)  # the .cfg says 0.05
+        self.assertAlmostEqual(trajectory["max_velocity"], 0.0)
         # The parameter server holds the same.
         self.assertAlmostEqual(rospy.get_param(NODE + "/base/max_wheel_speed"), 0.8)
         self.assertAlmostEqual(rospy.get_param(NODE + "/base/wheel_diameter"), 0.25)
@@ -203,6 +213,42 @@ class RuntimeTuningTest(unittest.TestCase):
         self.assertGreater(abs(a), 1.0)
         self.assertAlmostEqual(b / a, 2.0, delta=0.05)
         self.tune(self.imu, accel_scale=0.005)
+
+
+    def follow_joint_1(self, position, seconds):
+        self.feedback = 0
+        goal = FollowJointTrajectoryGoal()
+        goal.trajectory.joint_names = ["joint_1"]
+        point = JointTrajectoryPoint()
+        point.positions = [position]
+        point.time_from_start = rospy.Duration(seconds)
+        goal.trajectory.points = [point]
+        self.follow.send_goal(goal, feedback_cb=self.on_feedback)
+
+    def on_feedback(self, _):
+        self.feedback += 1
+
+    def finish(self):
+        self.assertTrue(self.follow.wait_for_result(rospy.Duration(TIMEOUT)))
+        return self.follow.get_result().error_code
+
+    def test_g_trajectory_speed_limit_and_a_running_goal_goes_on(self):
+        # 0.3 rad in 1 s is faster than 0.1 rad/s: refused before anything moves.
+        self.assertAlmostEqual(self.tune(self.trajectory, max_velocity=0.1)["max_velocity"], 0.1)
+        self.follow_joint_1(0.3, 1.0)
+        self.assertEqual(self.finish(), FollowJointTrajectoryResult.INVALID_GOAL)
+        # Raised: the same goal runs; retuning while it runs does not stop it.
+        self.tune(self.trajectory, max_velocity=1.0)
+        self.follow_joint_1(0.3, 2.0)
+        wait_for(lambda: self.feedback >= 5, what="the goal running")  # changes fall mid-goal
+        self.tune(self.trajectory, goal_tolerance=0.1, max_velocity=0.5)
+        self.tune(self.base, max_wheel_speed=0.7)
+        self.assertEqual(self.finish(), FollowJointTrajectoryResult.SUCCESSFUL)
+        # Back where it started, under the new limit (0.3 rad in 1 s = 0.3 rad/s).
+        self.follow_joint_1(0.0, 1.0)
+        self.assertEqual(self.finish(), FollowJointTrajectoryResult.SUCCESSFUL)
+        self.tune(self.trajectory, goal_tolerance=0.07, max_velocity=0.0)
+        self.tune(self.base, max_wheel_speed=0.8)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@
 
 #include "serial_robot_driver/BaseTuningConfig.h"
 #include "serial_robot_driver/ImuTuningConfig.h"
+#include "serial_robot_driver/TrajectoryTuningConfig.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -99,6 +100,11 @@ TEST(RuntimeTuningTable, BaseServerHasEveryBaseTunableAsTheTableHasIt) {
 TEST(RuntimeTuningTable, ImuServerHasTheScalesAsTheTableHasThem) {
   expectAgreesWithTheTable<serial_robot_driver::ImuTuningConfig>(
       "imu", {"accel_scale", "gyro_scale", "angle_scale"});
+}
+
+TEST(RuntimeTuningTable, TrajectoryServerHasTheGoalDefaultsAsTheTableHasThem) {
+  expectAgreesWithTheTable<serial_robot_driver::TrajectoryTuningConfig>(
+      "trajectory", {"goal_tolerance", "goal_time_tolerance", "path_tolerance", "max_velocity"});
 }
 
 TEST(TuneParams, AValidChangeApplies) {

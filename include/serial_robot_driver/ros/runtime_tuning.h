@@ -27,6 +27,7 @@
 namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface;
+class TrajectoryServer;
 
 /// One requested value: the parameter's key as in the table ("base/max_wheel_speed") and the value.
 using ParamAssignment = std::pair<std::string, ParamValue>;
@@ -50,10 +51,11 @@ std::string toText(const ParamValue& value);
 class RuntimeTuning {
  public:
   /// Starts the servers of the enabled groups under `private_nh`: ~base (base enabled), ~imu
-  /// (body enabled). `params` are the parameters in force; `devices` get every accepted change and
-  /// must outlive this object.
+  /// (body enabled), ~trajectory (`trajectory` not null: some device has joints). `params` are the
+  /// parameters in force; `devices` and `trajectory` get every accepted change and must outlive
+  /// this object.
   RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
-                std::vector<DeviceInterface*> devices);
+                std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory = nullptr);
   ~RuntimeTuning();
   RuntimeTuning(const RuntimeTuning&) = delete;
   RuntimeTuning& operator=(const RuntimeTuning&) = delete;
@@ -76,6 +78,7 @@ class RuntimeTuning {
   DriverParams in_force_;
   bool stopped_ = false;
   const std::vector<DeviceInterface*> devices_;
+  TrajectoryServer* const trajectory_;
   std::vector<std::unique_ptr<Server>> servers_;  // last: destroyed first
 };
 
