@@ -5,6 +5,7 @@ set(SRD_CORE_SOURCES
   src/protocol/body_codec.cpp
   src/protocol/servo_params.cpp
   src/protocol/servo_bus_codec.cpp
+  src/protocol/servo_commands.cpp
   src/protocol/stream_framer.cpp
   src/kinematics/diff_drive.cpp
   src/kinematics/odometry.cpp
@@ -13,6 +14,8 @@ set(SRD_CORE_SOURCES
   src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp
+  src/device/loop_clock.cpp
+  src/device/device_set.cpp
   src/device/base_controller.cpp
   src/device/body_controller.cpp
   src/device/servo_bus_client.cpp
@@ -20,6 +23,11 @@ set(SRD_CORE_SOURCES
   src/trajectory/command.cpp
   src/trajectory/tolerances.cpp
   src/trajectory/bus_joint.cpp
+  src/device/servo_bus_queries.cpp
+  src/device/servo_bus_settings.cpp
+  src/device/servo_bus_motion.cpp
+  src/device/servo_bus_text.cpp
+  src/device/servo_bus.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

@@ -3,6 +3,7 @@ catkin_add_gtest(core_tests
   test/unit/test_base_codec.cpp
   test/unit/test_body_codec.cpp
   test/unit/test_servo_bus_codec.cpp
+  test/unit/test_servo_commands.cpp
   test/unit/test_servo_params.cpp
   test/unit/test_stream_framer.cpp
   test/unit/test_diff_drive.cpp
@@ -13,9 +14,13 @@ catkin_add_gtest(core_tests
   test/unit/test_base_controller.cpp
   test/unit/test_body_controller.cpp
   test/unit/test_servo_bus_client.cpp
-  test/unit/test_sim.cpp)
+  test/unit/test_servo_bus.cpp
+  test/unit/test_sim.cpp
+  test/unit/test_device_set.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
+# test_device_set.cpp reads config/analyzers.yaml from the sources.
+target_compile_definitions(core_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 
 # Conversions and parameter validation of the ROS layer (pure functions, no roscore needed).
 catkin_add_gtest(ros_layer_tests

@@ -22,6 +22,7 @@
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/protocol/servo_commands.h"
 #include "serial_robot_driver/protocol/servo_params.h"
 
 namespace {
@@ -132,6 +133,20 @@ void runServoResponse(const uint8_t* d, std::size_t n) {
                                      packet->content.begin() + packet->content_size);
   check(sameBytes(servo::encodeResponse(static_cast<servo::Command>(packet->cmd), content), d, n));
   runServoParams(*packet);
+  // The typed answers of the command table: an answer of the size its row says decodes and
+  // re-encodes to the same CONTENT.
+  const auto cmd = static_cast<servo::Command>(packet->cmd);
+  const servo::CommandInfo& info = servo::commandInfo(cmd);
+  if (!info.answer.fits(packet->content_size)) return;
+  if (info.result_index != servo::kNoResult) check(info.result_index < packet->content_size);
+  if (cmd == servo::Command::kReadAngle) {
+    const auto angle = servo::decodeAngleAnswer(*packet);
+    check(angle.ok() && servo::angleAnswerContent(*angle) == content);
+  }
+  if (cmd == servo::Command::kReadMultiTurnAngle) {
+    const auto angle = servo::decodeMultiTurnAngle(*packet);
+    check(angle.ok() && servo::multiTurnAngleContent(*angle) == content);
+  }
 }
 
 void runServoRequest(const uint8_t* d, std::size_t n) {
@@ -139,6 +154,20 @@ void runServoRequest(const uint8_t* d, std::size_t n) {
   if (!packet.ok()) return;
   check(packet->content_size + servo::kOverhead == n);
   check(packet->cmd >= servo::kMinCommand && packet->cmd <= servo::kMaxCommand);
+  // The typed requests of the command table (what the simulator reads): a request of the size
+  // its row says decodes, and the moves and SPIN re-encode to the same bytes.
+  const auto cmd = static_cast<servo::Command>(packet->cmd);
+  if (!servo::commandInfo(cmd).request.fits(packet->content_size)) return;
+  if (servo::isMove(cmd)) {
+    const auto move = servo::decodeMove(*packet);
+    check(move.ok() && sameBytes(servo::encodeMove(*move), d, n));
+  }
+  if (cmd == servo::Command::kSpin) {
+    const auto spin = servo::decodeSpin(*packet);
+    check(spin.ok());
+    // Bits 6..2 of the method byte are not part of SPIN: only the frames without them re-encode.
+    if ((packet->content[1] & 0x7C) == 0) check(sameBytes(servo::encodeSpin(*spin), d, n));
+  }
 }
 
 void runSyncWrite(const uint8_t* d, std::size_t n) {

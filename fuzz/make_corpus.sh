@@ -75,6 +75,15 @@ write "$d/servo_read_batch_fixall" "0C 00 05 1C 05 21 01 00 01 01 00 05 01 88 13
   50 00 B8 0B E8 03 01 00 00 00 00 01 F4 01 84 03 7C FC 00 00 00"
 write "$d/servo_request_raw" "03 00 $servo_rotate"
 write "$d/servo_request_fixsum" "08 00 $servo_spin_ms"
+# One seed per move of the command table (CMD 11..16), so each typed request is reached at once.
+write "$d/servo_move_by_interval_raw" "03 00 12 4C 0B 0B 01 84 03 E8 03 64 00 64 00 00 00 AF"
+write "$d/servo_move_by_velocity_raw" "03 00 12 4C 0C 0B 01 7C FC 10 0E 64 00 64 00 00 00 D4"
+write "$d/servo_multi_turn_move_raw" "03 00 12 4C 0D 0B 01 20 1C 00 00 D0 07 00 00 00 00 8A"
+write "$d/servo_multi_turn_by_interval_raw" "03 00 12 4C 0E 0F 01 F0 F1 FF FF E8 03 00 00 C8 00 C8
+  00 00 00 D6"
+write "$d/servo_multi_turn_by_velocity_raw" "03 00 12 4C 0F 0D 01 A0 8C 00 00 10 0E 64 00 64 00 00
+  00 8D"
+write "$d/servo_read_multi_turn_reply_raw" "02 00 05 1C 10 07 01 20 1C 00 00 02 00 77"
 write "$d/sync_write_raw" "04 00 $sync_write"
 write "$d/sync_write_fixcrc" "09 00 $sync_write"
 write "$d/sync_write_fixall" "0E 00 $sync_write 05 00 08"

@@ -32,14 +32,6 @@ int16_t withDirection(int16_t ticks, int direction) {
                                                       : static_cast<int16_t>(-ticks);
 }
 
-class SteadyLoopClock : public LoopClock {
- public:
-  Clock::time_point now() const override { return Clock::now(); }
-  void waitUntil(std::unique_lock<std::mutex>& lock, std::condition_variable& wake,
-                 Clock::time_point deadline) override {
-    wake.wait_until(lock, deadline);
-  }
-};
 }  // namespace
 
 BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents events,
@@ -47,7 +39,7 @@ BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents
     : config_(config),
       writer_(std::move(writer)),
       events_(std::move(events)),
-      clock_(clock ? std::move(clock) : std::make_shared<SteadyLoopClock>()),
+      clock_(clock ? std::move(clock) : steadyLoopClock()),
       period_(fromSeconds(1.0 / config.loop_rate)),
       min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
       limiter_(config.max_wheel_accel),

@@ -48,8 +48,8 @@ void SerialLink::stop() {
   }
   state_cv_.notify_all();
   wakeReader();
+  // The reader closes the port on its way out, so onLinkDown stays on the reader thread.
   if (reader_.joinable()) reader_.join();
-  if (stream_) closeStream("stopped");
 }
 
 bool SerialLink::write(const std::vector<uint8_t>& frame) { return write(frame.data(), frame.size()); }
@@ -224,6 +224,7 @@ void SerialLink::readerLoop() {
     std::lock_guard<std::mutex> lock(state_mutex_);
     stats_.framer = framer_.stats();
   }
+  if (stream_) closeStream("stopped");
 }
 
 }  // namespace serial_robot_driver::device

@@ -107,15 +107,6 @@ std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint1
   return buildRequest(Command::kSpin, content.data(), content.size());
 }
 
-std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms,
-                                  uint16_t power_mw) {
-  std::array<uint8_t, 7> content = {id};
-  writeLE16(&content[1], static_cast<uint16_t>(angle_decidegrees));
-  writeLE16(&content[3], interval_ms);
-  writeLE16(&content[5], power_mw);
-  return buildRequest(Command::kRotate, content.data(), content.size());
-}
-
 std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw) {
   std::array<uint8_t, 3> content = {id};
   writeLE16(&content[1], power_mw);
@@ -128,71 +119,202 @@ std::vector<uint8_t> encodeReadAngle(uint8_t id) {
 
 namespace {
 
-constexpr std::size_t kAngle16Size = 2;
-constexpr std::size_t kAngle32Size = 4;
+// The layout of each move after the id: angle (i16 / i32), interval or velocity (u16 / u32),
+// the ramps (accel, decel u16) or not, then power (u16). One description for encode and decode.
+struct MoveLayout {
+  std::size_t angle_size;
+  std::size_t second_size;
+  bool by_velocity;
+  bool ramps;
+};
 
-// id | angle (i16 or i32) | u16 or u32 | the ramps (accel, decel, power), all little-endian.
-std::vector<uint8_t> buildMove(Command cmd, uint8_t id, int32_t angle, std::size_t angle_size,
-                               uint32_t interval_or_velocity, std::size_t second_size,
-                               const MoveRamps* ramps, uint16_t power_mw) {
+MoveLayout moveLayout(Command cmd) {
+  switch (cmd) {
+    case Command::kMoveByInterval:
+      return {2, 2, false, true};
+    case Command::kMoveByVelocity:
+      return {2, 2, true, true};
+    case Command::kMultiTurnMove:
+      return {4, 4, false, false};
+    case Command::kMultiTurnMoveByInterval:
+      return {4, 4, false, true};
+    case Command::kMultiTurnMoveByVelocity:
+      return {4, 2, true, true};
+    default:  // ROTATE
+      return {2, 2, false, false};
+  }
+}
+
+void writeField(uint8_t* at, std::size_t size, uint32_t value) {
+  if (size == 2) {
+    writeLE16(at, static_cast<uint16_t>(value));
+  } else {
+    writeLE32(at, value);
+  }
+}
+
+std::vector<uint8_t> buildMove(const MoveCommand& move) {
+  const MoveLayout layout = moveLayout(move.cmd);
   std::array<uint8_t, 1 + 4 + 4 + 3 * 2> content{};
   std::size_t size = 0;
-  content[size++] = id;
-  if (angle_size == kAngle16Size) {
-    writeLE16(&content[size], static_cast<uint16_t>(static_cast<int16_t>(angle)));
-  } else {
-    writeLE32(&content[size], static_cast<uint32_t>(angle));
-  }
-  size += angle_size;
-  if (second_size == 2) {
-    writeLE16(&content[size], static_cast<uint16_t>(interval_or_velocity));
-  } else {
-    writeLE32(&content[size], interval_or_velocity);
-  }
-  size += second_size;
-  if (ramps != nullptr) {
-    writeLE16(&content[size], ramps->accel_ms);
-    writeLE16(&content[size + 2], ramps->decel_ms);
+  content[size++] = move.id;
+  const auto angle = static_cast<uint32_t>(move.angle_decidegrees);
+  writeField(&content[size], layout.angle_size,
+             layout.angle_size == 2 ? static_cast<uint16_t>(static_cast<int16_t>(angle)) : angle);
+  size += layout.angle_size;
+  writeField(&content[size], layout.second_size,
+             layout.by_velocity ? move.velocity_decidegrees_per_s : move.interval_ms);
+  size += layout.second_size;
+  if (layout.ramps) {
+    writeLE16(&content[size], move.ramps.accel_ms);
+    writeLE16(&content[size + 2], move.ramps.decel_ms);
     size += 4;
-    power_mw = ramps->power_mw;
   }
-  writeLE16(&content[size], power_mw);
+  writeLE16(&content[size], move.ramps.power_mw);
   size += 2;
-  return buildRequest(cmd, content.data(), size);
+  return buildRequest(move.cmd, content.data(), size);
+}
+
+MoveCommand moveOf(Command cmd, uint8_t id, int32_t angle, uint32_t interval_ms, uint16_t velocity,
+                   const MoveRamps& ramps) {
+  MoveCommand move;
+  move.cmd = cmd;
+  move.id = id;
+  move.angle_decidegrees = angle;
+  move.interval_ms = interval_ms;
+  move.velocity_decidegrees_per_s = velocity;
+  move.ramps = ramps;
+  return move;
 }
 
 }  // namespace
 
+std::vector<uint8_t> encodeMove(const MoveCommand& move) { return buildMove(move); }
+
+std::vector<uint8_t> encodeSpin(const SpinCommand& spin) {
+  return encodeSpin(spin.id, spin.clockwise, spin.mode, spin.speed_dps, spin.value);
+}
+
+bool isMove(Command cmd) {
+  return cmd == Command::kRotate ||
+         (cmd >= Command::kMoveByInterval && cmd <= Command::kMultiTurnMoveByVelocity);
+}
+bool isMultiTurn(Command cmd) { return moveLayout(cmd).angle_size == 4; }
+bool isByVelocity(Command cmd) { return moveLayout(cmd).by_velocity; }
+bool hasRamps(Command cmd) { return moveLayout(cmd).ramps; }
+
+Decoded<MoveCommand> decodeMove(const Packet& request) {
+  const auto cmd = static_cast<Command>(request.cmd);
+  if (!isMove(cmd)) return DecodeError::kUnknownCommand;
+  const MoveLayout layout = moveLayout(cmd);
+  const std::size_t size = 1 + layout.angle_size + layout.second_size + (layout.ramps ? 4 : 0) + 2;
+  if (request.content_size != size) return DecodeError::kBadLength;
+  const uint8_t* at = request.content.data() + 1;
+  MoveCommand move;
+  move.cmd = cmd;
+  move.id = request.id();
+  move.angle_decidegrees =
+      layout.angle_size == 2 ? readLE16Signed(at) : static_cast<int32_t>(readLE32(at));
+  at += layout.angle_size;
+  const uint32_t second = layout.second_size == 2 ? readLE16(at) : readLE32(at);
+  if (layout.by_velocity) {
+    move.velocity_decidegrees_per_s = static_cast<uint16_t>(second);
+  } else {
+    move.interval_ms = second;
+  }
+  at += layout.second_size;
+  if (layout.ramps) {
+    move.ramps.accel_ms = readLE16(at);
+    move.ramps.decel_ms = readLE16(at + 2);
+    at += 4;
+  }
+  move.ramps.power_mw = readLE16(at);
+  return move;
+}
+
+Decoded<SpinCommand> decodeSpin(const Packet& request) {
+  if (request.cmd != static_cast<uint8_t>(Command::kSpin)) return DecodeError::kUnknownCommand;
+  if (request.content_size != 6) return DecodeError::kBadLength;
+  SpinCommand spin;
+  spin.id = request.id();
+  const uint8_t method = request.content[1];
+  spin.clockwise = (method & kSpinDirectionBit) != 0;
+  spin.mode = static_cast<SpinMode>(method & kSpinModeMask);
+  spin.speed_dps = readLE16(&request.content[2]);
+  spin.value = readLE16(&request.content[4]);
+  return spin;
+}
+
+std::vector<uint8_t> angleAnswerContent(const AngleAnswer& answer) {
+  std::vector<uint8_t> content(3);
+  content[0] = answer.id;
+  writeLE16(&content[1], static_cast<uint16_t>(answer.angle_decidegrees));
+  return content;
+}
+
+Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer) {
+  if (answer.content_size != 3) return DecodeError::kBadLength;
+  return AngleAnswer{answer.content[0], readLE16Signed(&answer.content[1])};
+}
+
+Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer) {
+  return decodeMultiTurnAngle(answer.content.data(), answer.content_size);
+}
+
+std::vector<uint8_t> readDataAnswerContent(uint8_t id, const ParamInfo& param, int64_t value) {
+  std::vector<uint8_t> content = {id, param.data_id};
+  uint8_t bytes[8] = {};
+  const std::size_t size = writeValue(param, value, bytes);
+  content.insert(content.end(), bytes, bytes + size);
+  return content;
+}
+
+Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param) {
+  constexpr std::size_t kHeader = 2;  // id, data_id
+  if (answer.content_size < kHeader) return DecodeError::kBadLength;
+  const std::optional<int64_t> value =
+      readValue(param, answer.content.data() + kHeader, answer.content_size - kHeader);
+  if (!value) return DecodeError::kBadLength;
+  return *value;
+}
+
+std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms,
+                                  uint16_t power_mw) {
+  MoveRamps ramps;
+  ramps.power_mw = power_mw;
+  return buildMove(moveOf(Command::kRotate, id, angle_decidegrees, interval_ms, 0, ramps));
+}
+
 std::vector<uint8_t> encodeMoveByInterval(uint8_t id, int16_t angle_decidegrees,
                                           uint16_t interval_ms, const MoveRamps& ramps) {
-  return buildMove(Command::kMoveByInterval, id, angle_decidegrees, kAngle16Size, interval_ms, 2,
-                   &ramps, 0);
+  return buildMove(moveOf(Command::kMoveByInterval, id, angle_decidegrees, interval_ms, 0, ramps));
 }
 
 std::vector<uint8_t> encodeMoveByVelocity(uint8_t id, int16_t angle_decidegrees,
                                           uint16_t velocity_decidegrees_per_s,
                                           const MoveRamps& ramps) {
-  return buildMove(Command::kMoveByVelocity, id, angle_decidegrees, kAngle16Size,
-                   velocity_decidegrees_per_s, 2, &ramps, 0);
+  return buildMove(moveOf(Command::kMoveByVelocity, id, angle_decidegrees, 0,
+                          velocity_decidegrees_per_s, ramps));
 }
 
 std::vector<uint8_t> encodeMultiTurnMove(uint8_t id, int32_t angle_decidegrees,
                                          uint32_t interval_ms, uint16_t power_mw) {
-  return buildMove(Command::kMultiTurnMove, id, angle_decidegrees, kAngle32Size, interval_ms, 4,
-                   nullptr, power_mw);
+  MoveRamps ramps;
+  ramps.power_mw = power_mw;
+  return buildMove(moveOf(Command::kMultiTurnMove, id, angle_decidegrees, interval_ms, 0, ramps));
 }
 
 std::vector<uint8_t> encodeMultiTurnMoveByInterval(uint8_t id, int32_t angle_decidegrees,
                                                    uint32_t interval_ms, const MoveRamps& ramps) {
-  return buildMove(Command::kMultiTurnMoveByInterval, id, angle_decidegrees, kAngle32Size,
-                   interval_ms, 4, &ramps, 0);
+  return buildMove(
+      moveOf(Command::kMultiTurnMoveByInterval, id, angle_decidegrees, interval_ms, 0, ramps));
 }
 
 std::vector<uint8_t> encodeMultiTurnMoveByVelocity(uint8_t id, int32_t angle_decidegrees,
                                                    uint16_t velocity_decidegrees_per_s,
                                                    const MoveRamps& ramps) {
-  return buildMove(Command::kMultiTurnMoveByVelocity, id, angle_decidegrees, kAngle32Size,
-                   velocity_decidegrees_per_s, 2, &ramps, 0);
+  return buildMove(moveOf(Command::kMultiTurnMoveByVelocity, id, angle_decidegrees, 0,
+                          velocity_decidegrees_per_s, ramps));
 }
 
 std::vector<uint8_t> encodeReadMultiTurnAngle(uint8_t id) {

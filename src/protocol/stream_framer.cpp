@@ -53,6 +53,26 @@ FramerConfig FramerConfig::forDriver(bool base, bool body, bool servo_bus,
   return config;
 }
 
+void FramerConfig::accept(FrameFamily family) {
+  switch (family) {
+    case FrameFamily::kBase:
+      base = true;
+      break;
+    case FrameFamily::kTelemetry:
+      telemetry = true;
+      break;
+    case FrameFamily::kServoResponse:
+      servo_response = true;
+      break;
+    case FrameFamily::kServoRequest:
+      servo_request = true;
+      break;
+    case FrameFamily::kSyncWrite:
+      sync_write = true;
+      break;
+  }
+}
+
 FramerConfig FramerConfig::forSimulator() {
   FramerConfig config;
   config.base = true;

@@ -87,9 +87,9 @@ Recording readRecording(const std::string& path) {
 
 std::set<std::string> configuredPorts(const DriverParams& params) {
   std::set<std::string> ports;
-  if (params.base.enabled) ports.insert(params.basePort());
-  if (params.body.enabled) ports.insert(params.bodyPort());
-  if (params.servo_bus.enabled) ports.insert(params.servoBusPort());
+  for (const device::DeviceDescription& device : device::deviceSet()) {
+    if (params.enabled(device.kind)) ports.insert(params.portOf(device.kind));
+  }
   return ports;
 }
 

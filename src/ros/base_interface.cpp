@@ -101,7 +101,7 @@ device::BaseEvents BaseInterface::events() {
 }
 
 BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
-                             device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
+                             device::SerialLink& link)
     : link_(link),
       arrival_stamps_(params),
       params_(params.base),
@@ -127,7 +127,6 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
   reset_odometry_srv_ =
       nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
   clear_encoders_srv_ = nh.advertiseService("base/clear_encoders", &BaseInterface::onClearEncoders, this);
-  diagnostics.add("base", this, &BaseInterface::diagnose);
 }
 
 void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {

@@ -13,7 +13,7 @@
 namespace serial_robot_driver::ros_layer {
 
 BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
-                             device::SerialLink& link, diagnostic_updater::Updater& diagnostics)
+                             device::SerialLink& link)
     : link_(link),
       arrival_stamps_(params),
       imu_params_(std::make_shared<const ImuParams>(params.imu)),
@@ -36,7 +36,6 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());
   link.addListener(&controller_);
-  diagnostics.add("body", this, &BodyInterface::diagnose);
 }
 
 void BodyInterface::retune(const DriverParams& params) {

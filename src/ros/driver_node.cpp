@@ -1,6 +1,7 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
 #include <atomic>
+#include <algorithm>
 #include <functional>
 #include <sstream>
 
@@ -57,34 +58,26 @@ class PortMonitor : public device::LinkListener {
 
 namespace {
 
-/// One kind of device the node can drive: whether it is enabled, where it is, and how its ROS
-/// interface is built. A new device is one more row in devices().
-struct DeviceEntry {
-  const char* name;  ///< as in its parameters and its diagnostic status
-  bool enabled;
-  std::string port;
-  int baud;
-  bool base, body, servo_bus;  ///< the frame families its port's framer must accept
-  std::function<std::unique_ptr<DeviceInterface>(ros::NodeHandle&, const DriverParams&,
-                                                 device::SerialLink&, diagnostic_updater::Updater&)>
-      make;
-};
+/// How the ROS interface of each device of the set is built.
+using InterfaceFactory = std::function<std::unique_ptr<DeviceInterface>(
+    ros::NodeHandle&, const DriverParams&, device::SerialLink&)>;
 
 template <typename Interface>
 std::unique_ptr<DeviceInterface> make(ros::NodeHandle& nh, const DriverParams& params,
-                                      device::SerialLink& link, diagnostic_updater::Updater& diagnostics) {
-  return std::make_unique<Interface>(nh, params, link, diagnostics);
+                                      device::SerialLink& link) {
+  return std::make_unique<Interface>(nh, params, link);
 }
 
-/// In start and shutdown order: the base first, so its zero-speed frame goes out before anything
-/// else stops.
-std::vector<DeviceEntry> devices(const DriverParams& p) {
-  return {
-      {"base", p.base.enabled, p.basePort(), p.baseBaud(), true, false, false, make<BaseInterface>},
-      {"body", p.body.enabled, p.bodyPort(), p.bodyBaud(), false, true, false, make<BodyInterface>},
-      {"servo_bus", p.servo_bus.enabled, p.servoBusPort(), p.servoBusBaud(), false, false, true,
-       make<ServoBusInterface>},
-  };
+InterfaceFactory interfaceFor(device::DeviceKind kind) {
+  switch (kind) {
+    case device::DeviceKind::kBase:
+      return make<BaseInterface>;
+    case device::DeviceKind::kBody:
+      return make<BodyInterface>;
+    case device::DeviceKind::kServoBus:
+      break;
+  }
+  return make<ServoBusInterface>;
 }
 
 }  // namespace
@@ -98,19 +91,9 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   diagnostics_.setHardwareID(params_.port);
 
   // Devices naming the same path share one port, one reader thread and one framer.
-  struct Users {
-    bool base = false, body = false, servo_bus = false;
-    int baud = 0;
-  };
-  const std::vector<DeviceEntry> entries = devices(params_);
-  std::map<std::string, Users> users;
-  for (const DeviceEntry& entry : entries) {
-    if (!entry.enabled) continue;
-    Users& use = users[entry.port];
-    use.base |= entry.base;
-    use.body |= entry.body;
-    use.servo_bus |= entry.servo_bus;
-    use.baud = entry.baud;
+  std::map<std::string, std::vector<device::DeviceKind>> users;
+  for (const device::DeviceDescription& device : device::deviceSet()) {
+    if (params_.enabled(device.kind)) users[params_.portOf(device.kind)].push_back(device.kind);
   }
   if (params_.capture) {
     capture_ = std::make_unique<WireCapture>(nh_, params_);
@@ -121,11 +104,11 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   for (const auto& [path, use] : users) {
     device::SerialLinkOptions options;
     options.path = path;
-    options.baud = static_cast<unsigned>(use.baud);
+    // validate() made every device on a shared port agree on the baud rate.
+    options.baud = static_cast<unsigned>(params_.baudOf(use.front()));
     options.reconnect_interval = params_.reconnect_interval;
-    options.framer = protocol::FramerConfig::forDriver(use.base, use.body, use.servo_bus,
-                                                       params_.body.servo_ids.size());
-    if (use.servo_bus) {
+    options.framer = device::framerFor(use, params_.body.servo_ids.size());
+    if (std::count(use.begin(), use.end(), device::DeviceKind::kServoBus) > 0) {
       // A servo answer must not wait behind a stray header longer than an answer may take.
       options.stale_frame_timeout = std::chrono::milliseconds(
           std::max<long>(1, std::lround(params_.servo_bus.timeout * 1000.0)));
@@ -141,8 +124,15 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     });
   }
 
-  for (const DeviceEntry& entry : entries) {
-    if (entry.enabled) devices_.push_back(entry.make(nh_, params_, portFor(entry.port), diagnostics_));
+  for (const device::DeviceDescription& description : device::deviceSet()) {
+    if (!params_.enabled(description.kind)) continue;
+    devices_.push_back(
+        interfaceFor(description.kind)(nh_, params_, portFor(params_.portOf(description.kind))));
+    // The device's status carries its name from the set.
+    DeviceInterface* device = devices_.back().get();
+    diagnostics_.add(description.name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
+      device->diagnose(s);
+    });
   }
   // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
   connectImuHeading();
@@ -209,9 +199,9 @@ std::string DriverNode::startupSummary() const {
   for (const auto& [path, port] : ports_) {
     text << separator << path << " (" << port.link->options().baud << " baud:";
     const char* comma = " ";
-    for (const DeviceEntry& entry : devices(params_)) {
-      if (!entry.enabled || entry.port != path) continue;
-      text << comma << entry.name;
+    for (const device::DeviceDescription& device : device::deviceSet()) {
+      if (!params_.enabled(device.kind) || params_.portOf(device.kind) != path) continue;
+      text << comma << device.name;
       comma = ", ";
     }
     text << ")";

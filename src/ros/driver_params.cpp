@@ -82,10 +82,11 @@ void baudOrInherit(const int& value, const std::string& key) { requireBaud(value
 /// Whether a key's range check applies: a device's keys (and the IMU's, which the body reports)
 /// are checked only while that device is enabled.
 bool checked(const DriverParams& p, const std::string& key) {
-  const std::string device = key.substr(0, key.find('/'));
-  if (device == "base") return p.base.enabled;
-  if (device == "body" || device == "imu") return p.body.enabled;
-  if (device == "servo_bus") return p.servo_bus.enabled;
+  const std::string prefix = key.substr(0, key.find('/'));
+  if (prefix == "imu") return p.enabled(device::DeviceKind::kBody);
+  for (const device::DeviceDescription& device : device::deviceSet()) {
+    if (prefix == device.name) return p.enabled(device.kind);
+  }
   return true;
 }
 
@@ -398,8 +399,14 @@ void DriverParams::validate() const {
   require(tf_prefix.find(' ') == std::string::npos, "tf_prefix", "must not contain spaces");
   require(!capture || replay_bag.empty(), "capture",
           "cannot be combined with ~replay_bag: a replay reads a capture and writes nothing");
-  require(base.enabled || body.enabled || servo_bus.enabled, "base/enabled",
-          "every device is disabled (base, body, servo_bus): nothing to drive");
+  std::string all_devices;
+  bool any_enabled = false;
+  for (const device::DeviceDescription& device : device::deviceSet()) {
+    all_devices += (all_devices.empty() ? "" : ", ") + std::string(device.name);
+    any_enabled |= enabled(device.kind);
+  }
+  require(any_enabled, std::string(device::deviceSet().front().name) + "/enabled",
+          "every device is disabled (" + all_devices + "): nothing to drive");
   if (base.enabled) {
     // Every tick's wheel frame is the base's heartbeat; it stops with a timeout error after 1 s
     // without one. 5 Hz leaves five frames in that second, so one lost frame is harmless.
@@ -461,15 +468,38 @@ void DriverParams::validate() const {
     int baud;
   };
   std::vector<Use> uses;
-  if (base.enabled) uses.push_back({"base", basePort(), baseBaud()});
-  if (body.enabled) uses.push_back({"body", bodyPort(), bodyBaud()});
-  if (servo_bus.enabled) uses.push_back({"servo_bus", servoBusPort(), servoBusBaud()});
+  for (const device::DeviceDescription& device : device::deviceSet()) {
+    if (!enabled(device.kind)) continue;
+    uses.push_back({device.name, portOf(device.kind), baudOf(device.kind)});
+  }
   for (std::size_t i = 0; i < uses.size(); ++i) {
     for (std::size_t j = i + 1; j < uses.size(); ++j) {
       require(uses[i].path != uses[j].path || uses[i].baud == uses[j].baud, uses[j].name + "/baud",
               "differs from " + uses[i].name + "'s baud on the shared port " + uses[i].path);
     }
   }
+}
+
+const DevicePortParams& DriverParams::portParams(device::DeviceKind kind) const {
+  switch (kind) {
+    case device::DeviceKind::kBase:
+      return base;
+    case device::DeviceKind::kBody:
+      return body;
+    case device::DeviceKind::kServoBus:
+      break;
+  }
+  return servo_bus;
+}
+
+std::string DriverParams::portOf(device::DeviceKind kind) const {
+  const DevicePortParams& own = portParams(kind);
+  return own.port.empty() ? port : own.port;
+}
+
+int DriverParams::baudOf(device::DeviceKind kind) const {
+  const DevicePortParams& own = portParams(kind);
+  return own.baud > 0 ? own.baud : baud;
 }
 
 DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unknown_keys) {

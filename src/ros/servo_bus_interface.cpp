@@ -18,10 +18,6 @@ constexpr double kMsPerSecond = 1000.0;
 constexpr double kDegreesPerRadian = 180.0 / M_PI;
 constexpr int kMaxBusId = 254;  // 255 is the broadcast address
 constexpr double kWarnThrottleS = 5.0;
-// A servo that stops answering the poll is asked again after a back-off that doubles up to the
-// maximum, so a dead servo costs one timeout per back-off period, not one per poll.
-constexpr std::chrono::milliseconds kFirstBackoff{500};
-constexpr std::chrono::milliseconds kMaxBackoff{8000};
 
 void logOutcome(const std::string& service, const device::ServoStatus& status) {
   if (status.ok()) {
@@ -155,17 +151,55 @@ device::ServoBusOptions makeServoBusOptions(const DriverParams& params) {
   return options;
 }
 
+device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
+  device::ServoBusConfig config;
+  config.client = makeServoBusOptions(params);
+  for (int id : params.servo_bus.state_ids) config.polled_ids.push_back(static_cast<uint8_t>(id));
+  // Joint servos are polled too: their angles are the trajectories' measurements.
+  for (int id : params.servo_bus.joint_ids) {
+    const auto joint_id = static_cast<uint8_t>(id);
+    if (std::find(config.polled_ids.begin(), config.polled_ids.end(), joint_id) ==
+        config.polled_ids.end()) {
+      config.polled_ids.push_back(joint_id);
+    }
+  }
+  config.poll_rate = params.servo_bus.state_rate;
+  return config;
+}
+
+device::ServoBusEvents ServoBusInterface::makeEvents() {
+  device::ServoBusEvents events;
+  // On the bus worker thread.
+  events.on_angle = [this](const device::ServoAngleSample& sample) {
+    const sensor_msgs::JointState msg =
+        busJointState(bus_joints_, sample.id, sample.angle_deg, toRosTime(sample.arrival));
+    states_pub_.publish(msg);
+    if (trajectory_) trajectory_->updateActual(msg);
+  };
+  events.on_servo_silent = [](uint8_t id, const device::ServoStatus& status,
+                              std::chrono::milliseconds backoff) {
+    ROS_WARN_THROTTLE(
+        kWarnThrottleS, "servo_states: %s does not answer (%s); asked again in %.1f s",
+        servoJointName(id).c_str(), status.message.c_str(), backoff.count() / kMsPerSecond);
+  };
+  events.on_move_failed = [](const device::MoveRequest& move, const device::ServoStatus& status) {
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",
+                      servoJointName(move.id).c_str(), messageFor(status).c_str());
+  };
+  return events;
+}
+
 ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params,
-                                     device::SerialLink& link,
-                                     diagnostic_updater::Updater& diagnostics)
-    : link_(link),
-      client_(makeServoBusOptions(params), link.writer()),
-      diagnostics_(diagnostics),
+                                     device::SerialLink& link)
+    : bus_joints_(makeBusJoints(params.servo_bus)),
+      state_rate_(params.servo_bus.state_rate),
+      link_(link),
+      bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
+      client_(bus_.client()),
       nh_(nh),
       topics_nh_(nh),
-      poll_period_(1.0 / params.servo_bus.state_rate),
       command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
-  link_.addListener(&client_);
+  link_.addListener(&bus_);
 
   // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
   // wait = true) and must never hold up cmd_vel or joint_commands on the global queue.
@@ -277,51 +311,25 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
           Announce::kInfo),
   };
 
-  diagnostics_.add("servo_bus", this, &ServoBusInterface::diagnose);
-
   if (params.servo_bus.allow_dangerous_writes) {
     ROS_WARN(
         "servo_bus: dangerous writes (servo_id, baudrate, response_switch, reserved cells, "
         "reset_user_data) are ARMED");
   }
 
-  const auto now = device::Clock::now();
-  for (int id : params.servo_bus.state_ids) {
-    PolledServo servo;
-    servo.id = static_cast<uint8_t>(id);
-    servo.next_poll = now;
-    polled_.push_back(servo);
-  }
-  // Joint servos are polled too: their angles are the trajectories' measurements.
-  bus_joints_ = makeBusJoints(params.servo_bus);
-  state_rate_ = params.servo_bus.state_rate;
-  for (const trajectory::BusJoint& joint : bus_joints_) {
-    const bool polled = std::any_of(polled_.begin(), polled_.end(),
-                                    [&](const PolledServo& s) { return s.id == joint.id; });
-    if (polled) continue;
-    PolledServo servo;
-    servo.id = joint.id;
-    servo.next_poll = now;
-    polled_.push_back(servo);
-  }
   states_pub_ = topics_nh_.advertise<sensor_msgs::JointState>("servo_states", 10);
   commands_sub_ = topics_nh_.subscribe("servo_commands", 10, &ServoBusInterface::onServoCommands,
                                        this, ros::TransportHints().tcpNoDelay());
 }
 
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
-  ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
-  const auto queueBatch = [&] {
-    std::lock_guard<std::mutex> lock(worker_mutex_);
-    if (!batch.error.empty()) {
-      ++commands_rejected_;
-      ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
-                        batch.error.c_str());
-      return false;
-    }
-    for (const device::MoveRequest& move : batch.moves) queueMoveLocked(move);
-    return true;
-  };
+  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
+  if (!batch.error.empty()) {
+    commands_rejected_.fetch_add(1);
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
+                      batch.error.c_str());
+    return;
+  }
   // A joint servo under a trajectory is taken over by this command, and its goal aborted.
   std::vector<std::string> joints;
   for (const device::MoveRequest& move : batch.moves) {
@@ -329,24 +337,15 @@ void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr&
       joints.push_back(joint->name);
     }
   }
+  const auto queue = [&] {
+    bus_.queueMoves(batch.moves);
+    return true;
+  };
   if (trajectory_ && !joints.empty()) {
-    trajectory_->takeOver(joints, "servo_commands", queueBatch);
+    trajectory_->takeOver(joints, "servo_commands", queue);
   } else {
-    queueBatch();
+    queue();
   }
-}
-
-void ServoBusInterface::queueMoveLocked(const device::MoveRequest& move) {
-  // The latest target of a servo replaces a queued one: the queue stays bounded (one entry per
-  // servo) when a long service call holds the bus.
-  auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
-                             [&move](const device::MoveRequest& m) { return m.id == move.id; });
-  if (queued != queued_moves_.end()) {
-    *queued = move;
-  } else {
-    queued_moves_.push_back(move);
-  }
-  worker_cv_.notify_all();
 }
 
 void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
@@ -354,10 +353,7 @@ void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
   if (!trajectory_ || !joint) return;
   trajectory_->takeOver({joint->name}, source, [&] {
     // A trajectory move still queued must not follow the service's command.
-    std::lock_guard<std::mutex> lock(worker_mutex_);
-    queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
-                                       [id](const device::MoveRequest& m) { return m.id == id; }),
-                        queued_moves_.end());
+    bus_.dropQueuedMoves(id);
     return true;
   });
 }
@@ -368,85 +364,10 @@ std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
     move.id = id;
     move.angle_deg = angle_deg;
     move.interval_ms = interval_ms;
-    std::lock_guard<std::mutex> lock(worker_mutex_);
-    queueMoveLocked(move);
+    bus_.queueMoves({move});
     return std::string();
   };
   return {busTrajectoryJoints(bus_joints_, queue_move, state_rate_)};
-}
-
-void ServoBusInterface::workerLoop() {
-  std::unique_lock<std::mutex> lock(worker_mutex_);
-  while (!worker_stop_) {
-    if (!queued_moves_.empty()) {
-      const device::MoveRequest move = queued_moves_.front();
-      queued_moves_.pop_front();
-      lock.unlock();
-      const device::ServoStatus status = client_.move(move);
-      if (!status.ok()) {
-        ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",
-                          servoJointName(move.id).c_str(), messageFor(status).c_str());
-      }
-      lock.lock();
-      if (status.ok()) {
-        ++commands_sent_;
-      } else {
-        ++command_failures_;
-      }
-      continue;
-    }
-    // The servo whose poll is due first.
-    auto due = std::min_element(
-        polled_.begin(), polled_.end(),
-        [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
-    if (due == polled_.end()) {
-      worker_cv_.wait(lock, [this] { return worker_stop_ || !queued_moves_.empty(); });
-      continue;
-    }
-    if (device::Clock::now() < due->next_poll) {
-      worker_cv_.wait_until(lock, due->next_poll);
-      continue;
-    }
-    PolledServo& servo = *due;
-    lock.unlock();
-    pollOnce(servo);  // polled_ is only changed by this thread; the counters under the lock
-    lock.lock();
-  }
-}
-
-void ServoBusInterface::pollOnce(PolledServo& servo) {
-  double angle_deg = 0.0;
-  device::Clock::time_point arrival;
-  const device::ServoStatus status = client_.pollAngle(servo.id, &angle_deg, &arrival);
-  const auto now = device::Clock::now();
-  const auto period = std::chrono::duration_cast<device::Clock::duration>(poll_period_);
-  std::lock_guard<std::mutex> lock(worker_mutex_);
-  if (status.error == device::ServoError::kNotConnected) {
-    // The port is down, not the servo: ask again at the poll rate once it is back.
-    servo.next_poll = now + period;
-    return;
-  }
-  if (!status.ok()) {
-    ++servo.failures;
-    const bool was_online = servo.backoff.count() == 0;
-    servo.backoff = was_online ? kFirstBackoff : std::min(servo.backoff * 2, kMaxBackoff);
-    servo.next_poll = now + servo.backoff;
-    if (was_online) {
-      ROS_WARN_THROTTLE(kWarnThrottleS,
-                        "servo_states: %s does not answer (%s); asked again in %.1f s",
-                        servoJointName(servo.id).c_str(), status.message.c_str(),
-                        servo.backoff.count() / kMsPerSecond);
-    }
-    return;
-  }
-  servo.backoff = std::chrono::milliseconds(0);
-  // Keep the rate without drifting; after a stall, start again from now.
-  servo.next_poll = std::max(servo.next_poll + period, now);
-  const sensor_msgs::JointState msg =
-      busJointState(bus_joints_, servo.id, angle_deg, toRosTime(arrival));
-  states_pub_.publish(msg);
-  if (trajectory_) trajectory_->updateActual(msg);
-  ++states_published_;
 }
 
 void ServoBusInterface::start() {
@@ -455,7 +376,7 @@ void ServoBusInterface::start() {
   // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
   spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
   spinner_->start();
-  worker_ = std::thread([this] { workerLoop(); });
+  bus_.start();
 }
 
 ServoBusInterface::~ServoBusInterface() { shutdown(); }
@@ -463,17 +384,10 @@ ServoBusInterface::~ServoBusInterface() { shutdown(); }
 void ServoBusInterface::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
-  client_.shutdown();  // wakes a call waiting on the bus, so the spinner can stop quickly
   commands_sub_.shutdown();
-  {
-    std::lock_guard<std::mutex> lock(worker_mutex_);
-    worker_stop_ = true;
-  }
-  worker_cv_.notify_all();
-  if (worker_.joinable()) worker_.join();
+  bus_.shutdown();  // fails a call waiting on the bus, so the spinner can stop quickly
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
-  diagnostics_.removeByName("servo_bus");
 }
 
 void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -501,17 +415,16 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("retries per transaction", client_.options().retries);
   status.add("dangerous writes armed", client_.options().allow_dangerous_writes);
 
-  std::lock_guard<std::mutex> lock(worker_mutex_);
+  const device::ServoBusWorkerStats worker = bus_.stats();
   std::string offline;
-  for (const PolledServo& servo : polled_) {
-    if (servo.backoff.count() > 0)
-      offline += (offline.empty() ? "" : ", ") + std::to_string(servo.id);
+  for (uint8_t id : worker.offline_ids) {
+    offline += (offline.empty() ? "" : ", ") + std::to_string(id);
   }
-  status.add("servo_states published", states_published_);
+  status.add("servo_states published", worker.angles_polled);
   status.add("polled servos offline", offline.empty() ? std::string("none") : offline);
-  status.add("servo_commands moves sent", commands_sent_);
-  status.add("servo_commands rejected", commands_rejected_);
-  status.add("servo_commands moves failed", command_failures_);
+  status.add("servo_commands moves sent", worker.moves_sent);
+  status.add("servo_commands rejected", commands_rejected_.load());
+  status.add("servo_commands moves failed", worker.moves_failed);
   if (!offline.empty() && link_.connected()) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                         "polled servos not answering: " + offline);

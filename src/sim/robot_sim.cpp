@@ -17,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "serial_robot_driver/device/device_set.h"
 #include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 
@@ -158,9 +159,13 @@ void RobotSim::start() {
     ports_.push_back(std::move(port));
     return raw;
   };
-  if (base_) base_port_ = portFor(options_.base_link, "base");
-  if (body_) body_port_ = portFor(options_.body_link, "body");
-  if (servo_bus_) servo_port_ = portFor(options_.servo_link, "servo_bus");
+  // The ports named as the driver names its devices (the device set).
+  using device::DeviceKind;
+  if (base_) base_port_ = portFor(options_.base_link, device::describe(DeviceKind::kBase).name);
+  if (body_) body_port_ = portFor(options_.body_link, device::describe(DeviceKind::kBody).name);
+  if (servo_bus_) {
+    servo_port_ = portFor(options_.servo_link, device::describe(DeviceKind::kServoBus).name);
+  }
 
   for (auto& port : ports_) {
     port->pty = std::make_unique<PseudoTerminal>(port->link);

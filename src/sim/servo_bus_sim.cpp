@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/protocol/servo_commands.h"
 #include "serial_robot_driver/protocol/servo_params.h"
 
 namespace serial_robot_driver::sim {
@@ -211,181 +212,151 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
   const uint8_t* content = packet.content.data();
   const std::size_t size = packet.content_size;
   const TimePoint due = now + fromSeconds(config_.answer_latency_s);
-  const auto reply = [&](Command cmd, const std::vector<uint8_t>& answer_content) {
-    if (!broadcast) answer(due, cmd, answer_content);
+  const auto cmd = static_cast<Command>(packet.cmd);
+  const servo::CommandInfo& info = servo::commandInfo(cmd);
+  if (!info.request.fits(size)) {
+    ++stats_.malformed;
+    return;
+  }
+  // Nobody answers the broadcast id; a motion answers (on completion) only with response_switch 1.
+  const bool answers = !broadcast && (info.answers == servo::Answers::kAlways ||
+                                      param(*s, kResponseSwitch) == 1);
+  const auto reply = [&](const std::vector<uint8_t>& answer_content) {
+    if (answers) answer(due, cmd, answer_content);
   };
   const auto malformed = [&]() { ++stats_.malformed; };
 
-  switch (static_cast<Command>(packet.cmd)) {
+  if (servo::isMove(cmd)) {
+    const protocol::Decoded<servo::MoveCommand> move = servo::decodeMove(packet);
+    if (!move) return malformed();
+    Motion motion;
+    motion.cmd = cmd;
+    motion.multi_turn = servo::isMultiTurn(cmd);
+    motion.target_angle = move->angle_decidegrees / 10.0;
+    if (servo::isByVelocity(cmd)) {
+      motion.velocity_dps = move->velocity_decidegrees_per_s / 10.0;
+      if (motion.velocity_dps <= 0) return malformed();
+    } else {
+      motion.duration_s = move->interval_ms / kMsPerSecond;
+    }
+    if (servo::hasRamps(cmd)) {
+      motion.accel_s = move->ramps.accel_ms / kMsPerSecond;
+      motion.decel_s = move->ramps.decel_ms / kMsPerSecond;
+    }
+    requestMove(s, motion, id, broadcast, now);
+    return;
+  }
+
+  switch (cmd) {
     case Command::kPing:
-      reply(Command::kPing, {id});
+      reply({id});
       break;
 
     case Command::kResetUserData:
       resetUserData(s);
       // The servo now has its factory id and answers from there.
-      reply(Command::kResetUserData, {kFactoryId, 1});
+      reply({kFactoryId, 1});
       break;
 
     case Command::kReadData: {
-      if (size != 2) return malformed();
-      const servo::ParamInfo* info = servo::findParamById(content[1]);
-      if (info == nullptr) {
+      const servo::ParamInfo* param_info = servo::findParamById(content[1]);
+      if (param_info == nullptr) {
         ++stats_.unknown_data_ids;
         return;
       }
-      std::vector<uint8_t> answer_content = {id, info->data_id};
-      uint8_t value[8] = {};
-      const std::size_t n = servo::writeValue(*info, param(*s, info->data_id), value);
-      answer_content.insert(answer_content.end(), value, value + n);
-      reply(Command::kReadData, answer_content);
+      reply(servo::readDataAnswerContent(id, *param_info, param(*s, param_info->data_id)));
       break;
     }
 
     case Command::kWriteData: {
-      if (size < 2) return malformed();
-      const servo::ParamInfo* info = servo::findParamById(content[1]);
-      if (info == nullptr) {
+      const servo::ParamInfo* param_info = servo::findParamById(content[1]);
+      if (param_info == nullptr) {
         ++stats_.unknown_data_ids;
         return;
       }
-      const auto value = servo::readValue(*info, content + 2, size - 2);
+      const auto value = servo::readValue(*param_info, content + 2, size - 2);
       if (!value) return malformed();
       // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
-      const bool ok = servo::checkWrite(*info, *value, true) == servo::WriteCheck::kOk;
+      const bool ok = servo::checkWrite(*param_info, *value, true) == servo::WriteCheck::kOk;
       if (ok) {
-        s->params[info->data_id] = *value;
+        s->params[param_info->data_id] = *value;
       } else {
         ++stats_.writes_rejected;
       }
-      reply(Command::kWriteData, {id, info->data_id, static_cast<uint8_t>(ok ? 1 : 0)});
+      reply({id, param_info->data_id, static_cast<uint8_t>(ok ? 1 : 0)});
       break;
     }
 
     case Command::kReadBatchData: {
-      if (size != 1) return malformed();
       std::vector<uint8_t> answer_content(1 + servo::kUserBlockSize, 0);
       answer_content[0] = id;
-      for (const servo::ParamInfo& info : servo::paramTable()) {
-        const auto offset = servo::userBlockOffset(info);
+      for (const servo::ParamInfo& param_info : servo::paramTable()) {
+        const auto offset = servo::userBlockOffset(param_info);
         if (!offset) continue;
-        servo::writeValue(info, param(*s, info.data_id), &answer_content[1 + *offset]);
+        servo::writeValue(param_info, param(*s, param_info.data_id),
+                          &answer_content[1 + *offset]);
       }
-      reply(Command::kReadBatchData, answer_content);
+      reply(answer_content);
       break;
     }
 
     case Command::kWriteBatchData: {
-      if (size != 1 + servo::kUserBlockSize) return malformed();
       // All or nothing: one bad cell rejects the block.
       std::map<uint8_t, int64_t> values;
       bool ok = true;
-      for (const servo::ParamInfo& info : servo::paramTable()) {
-        const auto offset = servo::userBlockOffset(info);
+      for (const servo::ParamInfo& param_info : servo::paramTable()) {
+        const auto offset = servo::userBlockOffset(param_info);
         if (!offset) continue;
-        const auto value =
-            servo::readValue(info, content + 1 + *offset, servo::typeSize(info.type));
-        if (!value || servo::checkWrite(info, *value, true) != servo::WriteCheck::kOk) {
+        const auto value = servo::readValue(param_info, content + 1 + *offset,
+                                            servo::typeSize(param_info.type));
+        if (!value || servo::checkWrite(param_info, *value, true) != servo::WriteCheck::kOk) {
           ok = false;
           break;
         }
-        values[info.data_id] = *value;
+        values[param_info.data_id] = *value;
       }
       if (ok) {
         for (const auto& [data_id, value] : values) s->params[data_id] = value;
       } else {
         ++stats_.writes_rejected;
       }
-      reply(Command::kWriteBatchData, {id, static_cast<uint8_t>(ok ? 1 : 0)});
+      reply({id, static_cast<uint8_t>(ok ? 1 : 0)});
       break;
     }
 
     case Command::kSpin: {
-      if (size != 6) return malformed();
-      const uint8_t method = content[1];
-      const double speed = protocol::readLE16(content + 2);
-      const uint16_t value = protocol::readLE16(content + 4);
-      const double rate = (method & 0x80) ? -speed : speed;  // clockwise is negative
+      const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(packet);
+      if (!spin) return malformed();
+      const double speed = spin->speed_dps;
+      const double rate = spin->clockwise ? -speed : speed;  // clockwise is negative
       Motion motion;
       motion.kind = Motion::Kind::kSpin;
       motion.cmd = Command::kSpin;
-      motion.answer = !broadcast && param(*s, kResponseSwitch) == 1;
+      motion.answer = answers;
       motion.answer_id = id;
       motion.rate_dps = rate;
-      switch (static_cast<servo::SpinMode>(method & 0x03)) {
+      switch (spin->mode) {
         case servo::SpinMode::kStop:
           stopAll(s);
-          if (motion.answer) answer(due, Command::kSpin, {id, 1});
+          reply({id, 1});
           return;
         case servo::SpinMode::kContinuous:
           stopAll(s);
           s->spin_rate_dps = rate;
-          if (motion.answer) answer(due, Command::kSpin, {id, 1});
+          reply({id, 1});
           return;
         case servo::SpinMode::kTurns:
-          motion.duration_s = speed > 0 ? value * 360.0 / speed : 0.0;
+          motion.duration_s = speed > 0 ? spin->value * 360.0 / speed : 0.0;
           break;
         case servo::SpinMode::kDurationMs:
-          motion.duration_s = value / 1000.0;
+          motion.duration_s = spin->value / 1000.0;
           break;
       }
       startMotion(s, motion, now);
       break;
     }
 
-    case Command::kRotate: {
-      if (size != 7) return malformed();
-      Motion motion;
-      motion.cmd = Command::kRotate;
-      motion.target_angle = protocol::readLE16Signed(content + 1) / 10.0;
-      motion.duration_s = protocol::readLE16(content + 3) / kMsPerSecond;
-      requestMove(s, motion, id, broadcast, now);
-      break;
-    }
-
-    // CMD 11..15: id, angle (i16 or i32, 0.1 deg), interval (u16 / u32 ms) or velocity
-    // (u16, 0.1 deg/s), [accel u16, decel u16], power u16.
-    case Command::kMoveByInterval:
-    case Command::kMoveByVelocity:
-    case Command::kMultiTurnMove:
-    case Command::kMultiTurnMoveByInterval:
-    case Command::kMultiTurnMoveByVelocity: {
-      const auto cmd = static_cast<Command>(packet.cmd);
-      const bool multi_turn = cmd == Command::kMultiTurnMove ||
-                              cmd == Command::kMultiTurnMoveByInterval ||
-                              cmd == Command::kMultiTurnMoveByVelocity;
-      const bool by_velocity =
-          cmd == Command::kMoveByVelocity || cmd == Command::kMultiTurnMoveByVelocity;
-      const bool has_ramps = cmd != Command::kMultiTurnMove;
-      const std::size_t angle_size = multi_turn ? 4 : 2;
-      const std::size_t second_size = multi_turn && !by_velocity ? 4 : 2;
-      const std::size_t expected = 1 + angle_size + second_size + (has_ramps ? 4 : 0) + 2;
-      if (size != expected) return malformed();
-      Motion motion;
-      motion.cmd = cmd;
-      motion.multi_turn = multi_turn;
-      motion.target_angle = (multi_turn ? static_cast<int32_t>(protocol::readLE32(content + 1))
-                                        : protocol::readLE16Signed(content + 1)) /
-                            10.0;
-      const uint8_t* second = content + 1 + angle_size;
-      const double second_value =
-          second_size == 4 ? protocol::readLE32(second) : protocol::readLE16(second);
-      if (by_velocity) {
-        motion.velocity_dps = second_value / 10.0;
-        if (motion.velocity_dps <= 0) return malformed();
-      } else {
-        motion.duration_s = second_value / kMsPerSecond;
-      }
-      if (has_ramps) {
-        motion.accel_s = protocol::readLE16(second + second_size) / kMsPerSecond;
-        motion.decel_s = protocol::readLE16(second + second_size + 2) / kMsPerSecond;
-      }
-      requestMove(s, motion, id, broadcast, now);
-      break;
-    }
-
     case Command::kReadMultiTurnAngle: {
-      if (size != 1) return malformed();
       servo::MultiTurnAngle reading;
       reading.id = id;
       const double decidegrees =
@@ -393,27 +364,21 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
                      double(std::numeric_limits<int32_t>::max()));
       reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
       reading.turns = static_cast<int16_t>(std::trunc(s->angle_deg / kDegreesPerTurn));
-      reply(Command::kReadMultiTurnAngle, servo::multiTurnAngleContent(reading));
+      reply(servo::multiTurnAngleContent(reading));
       break;
     }
 
     case Command::kDamping:
-      if (size != 3) return malformed();
       stopAll(s);  // damping releases the holding torque: nothing keeps moving
-      if (!broadcast && param(*s, kResponseSwitch) == 1) answer(due, Command::kDamping, {id, 1});
+      reply({id, 1});
       break;
 
-    case Command::kReadAngle: {
-      if (size != 1) return malformed();
-      std::vector<uint8_t> answer_content = {id, 0, 0};
-      protocol::writeLE16(&answer_content[1],
-                          static_cast<uint16_t>(toDecidegrees(foldDegrees(s->angle_deg))));
-      reply(Command::kReadAngle, answer_content);
+    case Command::kReadAngle:
+      reply(servo::angleAnswerContent(
+          servo::AngleAnswer{id, toDecidegrees(foldDegrees(s->angle_deg))}));
       break;
-    }
 
-    default:
-      malformed();
+    default:  // the moves, above
       break;
   }
 }

@@ -12,91 +12,14 @@
 #include <vector>
 
 #include "serial_robot_driver/device/base_controller.h"
+#include "support/golden_frames.h"
+#include "support/manual_clock.h"
 
 namespace serial_robot_driver::device {
 namespace {
 
 using Bytes = std::vector<uint8_t>;
 using std::chrono::milliseconds;
-
-/// A LoopClock the test moves: the controller's loop thread runs for real, but its time only
-/// passes when the test says so, and each step returns once the loop has done what fell due.
-class ManualClock : public LoopClock {
- public:
-  explicit ManualClock(Clock::time_point start) : now_(start) {}
-
-  Clock::time_point now() const override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return now_;
-  }
-
-  void waitUntil(std::unique_lock<std::mutex>& loop_lock, std::condition_variable& wake,
-                 Clock::time_point /*deadline*/) override {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      loop_mutex_ = loop_lock.mutex();
-      wake_ = &wake;
-      ++waits_;
-      waiting_ = true;
-    }
-    idle_.notify_all();
-    wake.wait(loop_lock);  // until advance() or the controller itself notifies
-    std::lock_guard<std::mutex> lock(mutex_);
-    waiting_ = false;
-  }
-
-  /// Returns once the loop thread waits for the first time (call after start()).
-  void waitForLoop() { settleAfter(0); }
-
-  /// Runs `action` (something that wakes the loop, e.g. a new command) and returns once the loop
-  /// has handled it and waits again.
-  template <typename Action>
-  void step(Action action) {
-    const uint64_t seen = waits();
-    action();
-    settleAfter(seen);
-  }
-
-  /// Moves time forward in one jump (a stalled machine, when `d` spans several periods).
-  void advance(Clock::duration d) {
-    step([&] {
-      std::mutex* loop_mutex = nullptr;
-      std::condition_variable* wake = nullptr;
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        now_ += d;
-        loop_mutex = loop_mutex_;
-        wake = wake_;
-      }
-      // Taking the loop's mutex first: the loop is either before its time check or waiting.
-      std::lock_guard<std::mutex> lock(*loop_mutex);
-      wake->notify_all();
-    });
-  }
-
-  /// Moves time forward one loop period at a time, `periods` times.
-  void tick(int periods, Clock::duration period = milliseconds(20)) {
-    for (int i = 0; i < periods; ++i) advance(period);
-  }
-
- private:
-  uint64_t waits() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return waits_;
-  }
-  void settleAfter(uint64_t seen) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    idle_.wait(lock, [&] { return waiting_ && waits_ > seen; });
-  }
-
-  mutable std::mutex mutex_;
-  std::condition_variable idle_;
-  Clock::time_point now_;
-  std::mutex* loop_mutex_ = nullptr;
-  std::condition_variable* wake_ = nullptr;
-  uint64_t waits_ = 0;
-  bool waiting_ = false;
-};
 
 /// A controller whose loop runs on `clock`, started and waiting for its first tick; the frames it
 /// writes go to `frames` when one is given (for tests with a configuration of their own).
@@ -161,9 +84,9 @@ TEST_F(BaseControllerTest, FirstSpeedFrameIsPrecededByReset) {
   clock_->tick(1);
   ASSERT_EQ(frames_.size(), 2u);
   // Reset, SEQ 00: 55^AA^02^00^05^00 = F8
-  EXPECT_EQ(frames_[0], (Bytes{0x55, 0xAA, 0x02, 0x00, 0x05, 0x00, 0xF8}));
+  EXPECT_EQ(frames_[0], golden::base::kResetSeq0);
   // zero speed, SEQ 01: XOR = 55^AA^09^01^01 = F6
-  EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0, 0, 0, 0, 0, 0, 0, 0, 0xF6}));
+  EXPECT_EQ(frames_[1], golden::base::kBoth0Seq1);
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_TRUE(sent_[0].reset_before);
   EXPECT_EQ(sent_[0].seq, 1);
@@ -184,7 +107,7 @@ TEST_F(BaseControllerTest, NewCommandGoesOutAtOnceWithEqualPositiveTicksWhenStra
   clock_->step([&] { controller_.setCommand(0.1, 0.0); });
   ASSERT_EQ(frames_.size(), 2u) << "sent before the first tick is due";
   // 0.1 m/s = 4.07 ticks per period -> 4 on the first frame; SEQ 01: XOR = F7 ^ 01 = F6
-  EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0x00, 0x04, 0x00, 0x04, 0, 0, 0, 0, 0xF6}));
+  EXPECT_EQ(frames_[1], golden::base::kBoth4Seq1);
   EXPECT_EQ(controller_.stats().immediate_frames, 1u);
 }
 
@@ -231,7 +154,7 @@ TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
   clock_->tick(2);
   frames_.clear();
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
-  const Bytes error = {0x55, 0xAA, 0x02, 0x07, 0xFF, 0x00, 0x05};
+  const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->step([&] {
     controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
   });
@@ -274,8 +197,8 @@ TEST_F(BaseControllerTest, ResetAndClearEncodersServicesWriteTheirFrames) {
   EXPECT_TRUE(controller_.sendClearEncoders());
   EXPECT_TRUE(controller_.sendReset());
   ASSERT_EQ(frames_.size(), 2u);
-  EXPECT_EQ(frames_[0], (Bytes{0x55, 0xAA, 0x02, 0x00, 0x06, 0x00, 0xFB}));  // clear, SEQ 00
-  EXPECT_EQ(frames_[1], (Bytes{0x55, 0xAA, 0x02, 0x01, 0x05, 0x00, 0xF9}));  // Reset, SEQ 01
+  EXPECT_EQ(frames_[0], golden::base::kClearEncodersSeq0);  // clear, SEQ 00
+  EXPECT_EQ(frames_[1], golden::base::kResetSeq1);  // Reset, SEQ 01
   port_up_ = false;
   EXPECT_FALSE(controller_.sendReset());
 }
@@ -501,7 +424,7 @@ TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
   // 0.1 m/s = 4.07 -> 4 ticks; left flipped: FF FC, right 00 04; XOR 55^AA^09^01^01^FF^FC^04 = F1
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[1],
-            (Bytes{0x55, 0xAA, 0x09, 0x01, 0x01, 0xFF, 0xFC, 0x00, 0x04, 0, 0, 0, 0, 0xF1}));
+            golden::base::kLeftMinus4Right4Seq1);
   clock->tick(1);
   ASSERT_FALSE(samples.empty());
   EXPECT_GT(samples.back().pose.x, 0.0) << "the robot drives forward whatever the wire says";
@@ -529,7 +452,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   clock->tick(100);
   EXPECT_EQ(silent_events, 1) << "reported once, not every tick";
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
-  const Bytes reply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
+  const Bytes& reply = golden::base::kBattery87ReplySeq0;
   controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), clock->now());
   EXPECT_FALSE(controller.stats().base_silent);
   controller.stop();
@@ -537,7 +460,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
 
 TEST_F(BaseControllerTest, TimeoutErrorWhileRunningIsCountedButNotTheOneAtStart) {
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
-  const Bytes error = {0x55, 0xAA, 0x02, 0x07, 0xFF, 0x00, 0x05};
+  const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->tick(1);  // Reset + first frame
   clock_->step([&] {
     controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
@@ -568,7 +491,7 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   EXPECT_EQ(requests, 2);
   EXPECT_EQ(controller.stats().battery_requests, 2u);
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
-  const Bytes reply = {0x55, 0xAA, 0x02, 0x00, 0x02, 0x57, 0xA8};
+  const Bytes& reply = golden::base::kBattery87ReplySeq0;
   controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), Clock::now());
   ASSERT_EQ(percents.size(), 1u);
   EXPECT_EQ(percents[0], 87);

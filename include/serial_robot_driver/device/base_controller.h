@@ -34,6 +34,7 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/device/loop_clock.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/kinematics/heading_fusion.h"
@@ -128,19 +129,6 @@ struct BaseStats {
   std::optional<kinematics::HeadingSource> heading_source;
   uint64_t imu_heading_fallbacks = 0;
   std::optional<double> imu_yaw_age;
-};
-
-/// Where the base loop reads the time and waits for its next tick. The default is the steady
-/// clock; tests pass a clock they move themselves.
-class LoopClock {
- public:
-  virtual ~LoopClock() = default;
-  virtual Clock::time_point now() const = 0;
-  /// Called by the loop with `lock` (the controller's mutex) held: waits on `wake` until
-  /// `deadline` on this clock or a notification, whichever comes first. May return early; the
-  /// loop checks again.
-  virtual void waitUntil(std::unique_lock<std::mutex>& lock, std::condition_variable& wake,
-                         Clock::time_point deadline) = 0;
 };
 
 /// What the base reports; every hook may be empty. Called without the controller's lock held.

@@ -11,8 +11,10 @@
 //    A failed write marks the port lost; the reader thread then closes and reopens it.
 //  - Only the reader thread opens and closes the stream, so a read never races a close.
 //  - A ChunkObserver (wire capture), when set, sees every chunk on the thread that moved it: reads
-//    on the reader thread, writes on the writer's thread. It must copy what it keeps and return
-//    at once; without one, the only cost is a null check per read and per write.
+//    on the reader thread, writes on the writer's thread INSIDE the per-port write lock, so the
+//    capture has the writes in the order they went on the wire. It must copy what it keeps and
+//    return at once (it holds up every writer of the port); without one, the only cost is a null
+//    check per read and per write.
 //  - An idle reader sleeps in its read until data comes; stop() and a writer that saw the port
 //    fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
 #pragma once
@@ -40,7 +42,8 @@ using Clock = std::chrono::steady_clock;
 /// port is down or the write failed (SerialLink::write). Tests pass a fake.
 using FrameWriter = std::function<bool(const std::vector<uint8_t>&)>;
 
-/// Implemented by the devices on a port. All calls come from the link's reader thread.
+/// Implemented by the devices on a port. All calls come from the link's reader thread, the last
+/// onLinkDown too (the reader closes the port on its way out of stop()).
 class LinkListener {
  public:
   virtual ~LinkListener() = default;

@@ -1,5 +1,6 @@
-// A client for the UART bus servos (docs/protocols.md, section 3). ROS-free: the ROS services
-// (ros/servo_bus_interface.h) are a thin layer that turns requests into calls of this class.
+// A client for the UART bus servos (docs/protocols.md, section 3): the transactions on the wire
+// and the operations built on them. ROS-free; device::ServoBus (servo_bus.h) owns one, with the
+// queue and the poll, and the ROS services (ros/servo_bus_interface.h) call its operations.
 //
 // Threading model:
 //  - Any thread may call the operations. The bus is half duplex, so they are serialized by one bus
@@ -11,7 +12,7 @@
 //    never state_mutex_, the only lock onFrame() takes: a fake in a test may answer synchronously
 //    by calling onFrame() from inside it.
 //  - Stats are kept in one struct under state_mutex_; stats() returns a snapshot.
-//  - Background work (pollAngle: the servo_states poll) takes the bus only when no foreground
+//  - Background work (readAngle with BusPriority::kBackground: the servo_states poll) takes the bus only when no foreground
 //    caller waits for it, so a service call waits at most for the one transaction in progress.
 #pragma once
 
@@ -124,6 +125,9 @@ struct ServoBusStats {
   double max_latency_ms = 0.0;
 };
 
+/// Who waits for the bus: a caller (a service) goes before background work (the poll).
+enum class BusPriority { kCaller, kBackground };
+
 /// The bus lock: foreground callers (lock()) go before background ones (lockBackground()), which
 /// take the bus only while nobody waits for it. Usable with std::lock_guard.
 class BusMutex {
@@ -157,7 +161,10 @@ class ServoBusClient : public LinkListener {
   /// effect at once).
   ServoStatus writeParam(uint8_t id, std::string_view param, int64_t value);
   /// READ_ANGLE in degrees. `arrival` (optional): when the answer's last byte was read.
-  ServoStatus readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival = nullptr);
+  /// kBackground (the servo_states poll): one attempt, and the bus is taken only while no other
+  /// caller waits for it.
+  ServoStatus readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival = nullptr,
+                        BusPriority priority = BusPriority::kCaller);
   /// CMD 16: the multi-turn angle and the turn count.
   ServoStatus readMultiTurnAngle(uint8_t id, MultiTurnReading* reading);
   /// CMD 8 or 11..15, chosen by the request (see MoveRequest); returns once the frame is written.
@@ -165,9 +172,6 @@ class ServoBusClient : public LinkListener {
   /// PINGs first_id..last_id, one attempt each (a silent id costs one timeout), and lists the ids
   /// that answered. The bus is taken per id, so other callers are served in between.
   ServoStatus scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids);
-  /// READ_ANGLE as background work: one attempt, and the bus is taken only while no other caller
-  /// waits for it (the servo_states poll).
-  ServoStatus pollAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival);
   /// ROTATE / SPIN / DAMPING return once the frame is written unless `wait` is set. Id 255
   /// (broadcast) is accepted only without wait.
   ServoStatus rotate(const RotateRequest& request);
@@ -195,6 +199,8 @@ class ServoBusClient : public LinkListener {
   /// What an answer must look like to complete the pending transaction.
   struct Expectation {
     Expectation() = default;
+    /// The answer of `answer_cmd` as the command table sizes it (commands of a fixed answer).
+    Expectation(protocol::servo::Command answer_cmd, uint8_t answer_id);
     Expectation(protocol::servo::Command answer_cmd, uint8_t answer_id, std::size_t size)
         : cmd(answer_cmd), id(answer_id), content_size(size) {}
 

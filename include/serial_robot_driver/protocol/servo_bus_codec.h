@@ -62,9 +62,12 @@ std::vector<uint8_t> encodeReadData(uint8_t id, uint8_t data_id);
 /// `value` must have passed checkWrite for `param`.
 std::vector<uint8_t> encodeWriteData(uint8_t id, const ParamInfo& param, int64_t value);
 std::vector<uint8_t> encodeReadBatchData(uint8_t id);
-std::vector<uint8_t> encodeWriteBatchData(uint8_t id, const std::array<uint8_t, kUserBlockSize>& block);
-std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint16_t speed_dps, uint16_t value);
-std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms, uint16_t power_mw);
+std::vector<uint8_t> encodeWriteBatchData(uint8_t id,
+                                          const std::array<uint8_t, kUserBlockSize>& block);
+std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint16_t speed_dps,
+                                uint16_t value);
+std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms,
+                                  uint16_t power_mw);
 std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw);
 std::vector<uint8_t> encodeReadAngle(uint8_t id);
 
@@ -120,5 +123,50 @@ Decoded<Packet> decodeRequest(const uint8_t* data, std::size_t size);
 
 /// Builds a response packet (simulator side).
 std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& content);
+
+// --- Typed requests and answers: the simulator encodes answers and decodes requests with the
+// same functions the client uses the other way round. Sizes and result bytes: servo_commands.h.
+
+/// A READ_ANGLE answer: id, i16 angle (0.1 deg).
+struct AngleAnswer {
+  uint8_t id = 0;
+  int16_t angle_decidegrees = 0;
+};
+std::vector<uint8_t> angleAnswerContent(const AngleAnswer& answer);
+Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer);
+/// A CMD 16 answer packet.
+Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer);
+/// A READ_DATA answer: id, data_id, then the value as `param`'s type lays it out.
+std::vector<uint8_t> readDataAnswerContent(uint8_t id, const ParamInfo& param, int64_t value);
+Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param);
+
+/// Any of the motions CMD 8 (ROTATE) and 11..15, as its request carries it.
+struct MoveCommand {
+  Command cmd = Command::kRotate;
+  uint8_t id = 0;
+  int32_t angle_decidegrees = 0;
+  uint32_t interval_ms = 0;                 ///< the by-interval moves (8, 11, 13, 14)
+  uint16_t velocity_decidegrees_per_s = 0;  ///< the by-velocity moves (12, 15)
+  MoveRamps ramps;                          ///< power_mw always; accel/decel for 11, 12, 14, 15
+};
+/// Whether `cmd` is one of the moves MoveCommand describes.
+bool isMove(Command cmd);
+bool isMultiTurn(Command cmd);
+bool isByVelocity(Command cmd);
+bool hasRamps(Command cmd);
+/// The request of `move.cmd` (fields the command does not carry are ignored).
+std::vector<uint8_t> encodeMove(const MoveCommand& move);
+Decoded<MoveCommand> decodeMove(const Packet& request);
+
+/// A SPIN request: id, method (bit 7 clockwise, bits 1..0 mode), speed u16 deg/s, value u16.
+struct SpinCommand {
+  uint8_t id = 0;
+  bool clockwise = false;
+  SpinMode mode = SpinMode::kStop;
+  uint16_t speed_dps = 0;
+  uint16_t value = 0;
+};
+std::vector<uint8_t> encodeSpin(const SpinCommand& spin);
+Decoded<SpinCommand> decodeSpin(const Packet& request);
 
 }  // namespace serial_robot_driver::protocol::servo

@@ -40,7 +40,10 @@ struct FramerConfig {
   /// Telemetry LEN must equal 24 + 4N or 40 + 4N for this N.
   std::size_t telemetry_servo_count = 0;
 
-  /// What the driver listens for on a port shared by the given devices.
+  /// Accept frames of `family` as well.
+  void accept(FrameFamily family);
+  /// What the driver listens for on a port shared by the given devices (tests and benchmarks;
+  /// the driver builds it from its device set, device/device_set.h).
   static FramerConfig forDriver(bool base, bool body, bool servo_bus, std::size_t servo_count);
   /// What the simulator listens for.
   static FramerConfig forSimulator();

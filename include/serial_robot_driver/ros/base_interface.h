@@ -25,10 +25,9 @@ device::BaseConfig makeBaseConfig(const DriverParams& params);
 
 class BaseInterface : public DeviceInterface {
  public:
-  /// Registers the controller on `link` (before the link starts), advertises the topics and
-  /// services and adds the "base" diagnostic task. `link` must outlive this object.
-  BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                diagnostic_updater::Updater& diagnostics);
+  /// Registers the controller on `link` (before the link starts) and advertises the topics and
+  /// services. `link` must outlive this object.
+  BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
   /// Starts the control loop (after the links are started).
   void start() override { controller_.start(); }
   /// Stops the loop and writes a zero-speed frame (before the port closes).

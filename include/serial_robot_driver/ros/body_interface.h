@@ -21,10 +21,9 @@ namespace serial_robot_driver::ros_layer {
 
 class BodyInterface : public DeviceInterface {
  public:
-  /// Registers the controller on `link` (before the link starts), advertises the topics and adds
-  /// the "body" diagnostic task. `link` and `diagnostics` must outlive this object.
-  BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link,
-                diagnostic_updater::Updater& diagnostics);
+  /// Registers the controller on `link` (before the link starts) and advertises the topics.
+  /// `link` must outlive this object.
+  BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
 
   /// Nothing to start: the body speaks when the link's reader hands it a frame.
   void start() override {}

@@ -1,6 +1,7 @@
 // The shape every ROS-side device (or input) has, so DriverNode handles them all one way: each is
-// constructed on its port before the ports start (it registers its listener, topics, services and
-// diagnostic task there), started once the ports run, and shut down before the ports close.
+// constructed on its port before the ports start (it registers its listener, topics and services
+// there), started once the ports run, and shut down before the ports close. DriverNode adds its
+// diagnostic status under the device's name from the device set (device/device_set.h).
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -20,7 +21,8 @@ class DeviceInterface {
   virtual void start() = 0;
   /// Stops taking requests and says its last words while the port is still open. Idempotent.
   virtual void shutdown() = 0;
-  /// Fills the device's diagnostic status (called from the diagnostics timer).
+  /// Fills the device's diagnostic status (called from the diagnostics timer, also after
+  /// shutdown() for a last report).
   virtual void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) = 0;
   /// Takes the runtime-tunable parameters of `params` (validated; the rest is what the device
   /// was built with) from its next loop tick or transaction on (dynamic_reconfigure, see

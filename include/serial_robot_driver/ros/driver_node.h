@@ -1,15 +1,15 @@
 // driver_node: one node that owns the robot's serial port(s).
 //
-// Topics (in the node's namespace):
-//   in : cmd_vel (geometry_msgs/Twist), joint_commands (sensor_msgs/JointState)
-//   out: wheel_command (serial_robot_driver/WheelCommand), battery (sensor_msgs/BatteryState),
-//        joint_states (sensor_msgs/JointState), imu/data (sensor_msgs/Imu),
-//        foot_pressure (serial_robot_driver/FootPressure), telemetry (serial_robot_driver/Telemetry),
-//        /diagnostics, serial_raw (serial_robot_driver/SerialChunk, with ~capture)
-// Services: base/reset, base/clear_encoders (std_srvs/Trigger); servo/ping, servo/read, servo/write,
-//   servo/read_angle, servo/rotate, servo/spin, servo/damping, servo/read_all, servo/reset_user_data.
-// Action: follow_joint_trajectory (control_msgs-compatible); topic joint_trajectory (in).
-// Parameters: see ros/driver_params.h and config/robot.yaml.
+// The devices it drives are the device set (device/device_set.h); each has a ROS interface of its
+// own (ros/*_interface.h) with its topics and services, listed in full in docs/node_api.md:
+//   base      in cmd_vel, e_stop; out odom (+ tf), wheel_command, battery;
+//             base/reset, base/reset_odometry, base/clear_encoders
+//   body      in joint_commands; out joint_states, imu/data, foot_pressure, telemetry
+//   servo_bus in servo_commands; out servo_states; servo/ping, read, write, read_angle, move,
+//             scan, rotate, spin, damping, read_all, reset_user_data
+// and the node itself: /diagnostics (one status per port and per device), serial_raw (with
+// ~capture), the follow_joint_trajectory action and joint_trajectory topic for the joints of every
+// device (ros/trajectory_server.h). Parameters: see ros/driver_params.h and config/robot.yaml.
 //
 // Threading model:
 //  - one reader thread per port (device::SerialLink) decodes and publishes telemetry and base replies

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -13,6 +14,9 @@
 #include <vector>
 
 #include "serial_robot_driver/transport/recorded_stream.h"
+#include "serial_robot_driver/device/base_controller.h"
+#include "serial_robot_driver/device/device_set.h"
+#include "serial_robot_driver/device/servo_bus.h"
 
 namespace ros {
 class NodeHandle;
@@ -37,27 +41,33 @@ struct DevicePortParams {
   int baud = 0;      ///< 0: the node-wide ~baud
 };
 
+/// The defaults of the core classes' configurations. The parameters that configure a core class
+/// start from its values, so each default is written once (in the core config), never copied.
+inline const device::BaseConfig kBaseDefaults{};
+inline const device::ServoBusConfig kServoBusDefaults{};
+
 struct BaseParams : DevicePortParams {
-  double wheel_diameter = 0.25;
-  int encoder_resolution = 1600;
-  double pid_rate = 50;
-  double wheel_separation = 0.40;
-  double max_wheel_speed = 1.0;
-  double max_wheel_accel = 0.0;
-  double cmd_vel_timeout = 0.5;
-  bool speed_dithering = true;
-  double battery_poll_rate = 1.0;
+  double wheel_diameter = kBaseDefaults.geometry.wheel_diameter;
+  int encoder_resolution = static_cast<int>(kBaseDefaults.geometry.encoder_resolution);
+  double pid_rate = kBaseDefaults.geometry.pid_rate;
+  double wheel_separation = kBaseDefaults.geometry.wheel_separation;
+  double max_wheel_speed = kBaseDefaults.max_wheel_speed;
+  double max_wheel_accel = kBaseDefaults.max_wheel_accel;
+  double cmd_vel_timeout = kBaseDefaults.cmd_vel_timeout;
+  bool speed_dithering = kBaseDefaults.speed_dithering;
+  double battery_poll_rate = kBaseDefaults.battery_poll_rate;
   int battery_warn_percent = 20;   ///< below: diagnostics WARN
   int battery_error_percent = 10;  ///< below: diagnostics ERROR
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
   bool publish_tf = true;
-  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
-  int right_wheel_direction = 1;
+  /// 1 or -1: sign between forward motion and the wire's ticks
+  int left_wheel_direction = kBaseDefaults.left_wheel_direction;
+  int right_wheel_direction = kBaseDefaults.right_wheel_direction;
   std::string left_wheel_joint = "left_wheel_joint";  ///< wheel_states and robot description names
   std::string right_wheel_joint = "right_wheel_joint";
   /// odom's heading from the body's IMU while its telemetry is fresh (device::BaseConfig).
-  bool use_imu_heading = false;
+  bool use_imu_heading = kBaseDefaults.use_imu_heading;
 };
 
 struct BodyParams : DevicePortParams {
@@ -94,11 +104,11 @@ struct ImuParams {
 };
 
 struct ServoBusParams : DevicePortParams {
-  double timeout = 0.05;
-  int retries = 1;
-  bool allow_dangerous_writes = false;
+  double timeout = std::chrono::duration<double>(kServoBusDefaults.client.timeout).count();  ///< s
+  int retries = kServoBusDefaults.client.retries;
+  bool allow_dangerous_writes = kServoBusDefaults.client.allow_dangerous_writes;
   std::vector<int> state_ids;     ///< bus servos polled for servo_states (empty: no poll)
-  double state_rate = 10.0;       ///< Hz, polls of every state_ids servo
+  double state_rate = kServoBusDefaults.poll_rate;  ///< Hz, polls of every state_ids servo
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
   // Bus servos used as named joints (trajectories, servo_states); one entry per joint_ids.
   std::vector<int> joint_ids;
@@ -127,7 +137,7 @@ constexpr double kMinBaseLoopRate = 5.0;
 struct DriverParams {
   std::string port = "/dev/ttyUSB0";
   int baud = 115200;
-  double loop_rate = 50.0;
+  double loop_rate = kBaseDefaults.loop_rate;
   double reconnect_interval = 1.0;
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
@@ -151,12 +161,18 @@ struct DriverParams {
   /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
   void validate() const;
 
-  std::string basePort() const { return base.port.empty() ? port : base.port; }
-  std::string bodyPort() const { return body.port.empty() ? port : body.port; }
-  std::string servoBusPort() const { return servo_bus.port.empty() ? port : servo_bus.port; }
-  int baseBaud() const { return base.baud > 0 ? base.baud : baud; }
-  int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
-  int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
+  /// The port parameters (~<name>/enabled, port, baud) of a device of the set.
+  const DevicePortParams& portParams(device::DeviceKind kind) const;
+  bool enabled(device::DeviceKind kind) const { return portParams(kind).enabled; }
+  /// The device's own port or baud, or the node-wide one it inherits.
+  std::string portOf(device::DeviceKind kind) const;
+  int baudOf(device::DeviceKind kind) const;
+  std::string basePort() const { return portOf(device::DeviceKind::kBase); }
+  std::string bodyPort() const { return portOf(device::DeviceKind::kBody); }
+  std::string servoBusPort() const { return portOf(device::DeviceKind::kServoBus); }
+  int baseBaud() const { return baudOf(device::DeviceKind::kBase); }
+  int bodyBaud() const { return baudOf(device::DeviceKind::kBody); }
+  int servoBusBaud() const { return baudOf(device::DeviceKind::kServoBus); }
   /// A topic's publisher queue: `live` frames (a slow subscriber drops old ones), but unbounded
   /// while replaying, where a full-speed replay must not lose what subscribers have not read yet.
   int publisherQueue(int live) const { return replay_bag.empty() ? live : 0; }

@@ -1,0 +1,161 @@
+#include "serial_robot_driver/device/servo_bus.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace serial_robot_driver::device {
+
+ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events,
+                   std::shared_ptr<LoopClock> clock)
+    : config_(std::move(config)),
+      events_(std::move(events)),
+      clock_(clock ? std::move(clock) : steadyLoopClock()),
+      poll_period_(std::chrono::duration_cast<Clock::duration>(
+          std::chrono::duration<double>(1.0 / config_.poll_rate))),
+      client_(config_.client, std::move(writer)) {
+  const Clock::time_point now = clock_->now();
+  for (uint8_t id : config_.polled_ids) {
+    PolledServo servo;
+    servo.id = id;
+    servo.next_poll = now;
+    polled_.push_back(servo);
+  }
+}
+
+ServoBus::~ServoBus() { shutdown(); }
+
+void ServoBus::onLinkDown() { client_.onLinkDown(); }
+
+void ServoBus::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+                       Clock::time_point arrival) {
+  client_.onFrame(family, data, size, arrival);
+}
+
+void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const MoveRequest& move : moves) {
+      auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
+                                 [&move](const MoveRequest& m) { return m.id == move.id; });
+      if (queued != queued_moves_.end()) {
+        *queued = move;
+        ++stats_.moves_replaced;
+      } else {
+        queued_moves_.push_back(move);
+      }
+    }
+  }
+  wake_.notify_all();
+}
+
+void ServoBus::dropQueuedMoves(uint8_t id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
+                                     [id](const MoveRequest& m) { return m.id == id; }),
+                      queued_moves_.end());
+}
+
+void ServoBus::start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (started_ || stop_) return;
+  started_ = true;
+  worker_ = std::thread([this] { workerLoop(); });
+}
+
+void ServoBus::shutdown() {
+  client_.shutdown();  // wakes a call waiting on the bus, so the worker stops quickly
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+ServoBusWorkerStats ServoBus::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ServoBusWorkerStats stats = stats_;
+  for (const PolledServo& servo : polled_) {
+    if (servo.backoff.count() > 0) stats.offline_ids.push_back(servo.id);
+  }
+  return stats;
+}
+
+void ServoBus::workerLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_) {
+    if (!queued_moves_.empty()) {
+      const MoveRequest move = queued_moves_.front();
+      queued_moves_.pop_front();
+      lock.unlock();
+      sendMove(move);
+      lock.lock();
+      continue;
+    }
+    // The servo whose poll is due first.
+    auto due = std::min_element(
+        polled_.begin(), polled_.end(),
+        [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
+    if (due == polled_.end()) {
+      wake_.wait(lock, [this] { return stop_ || !queued_moves_.empty(); });
+      continue;
+    }
+    if (clock_->now() < due->next_poll) {
+      clock_->waitUntil(lock, wake_, due->next_poll);
+      continue;
+    }
+    PolledServo& servo = *due;
+    lock.unlock();
+    pollOnce(servo);  // the schedule is only changed by this thread; mutex_ for stats() readers
+    lock.lock();
+  }
+}
+
+void ServoBus::sendMove(const MoveRequest& move) {
+  const ServoStatus status = client_.move(move);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (status.ok()) {
+      ++stats_.moves_sent;
+    } else {
+      ++stats_.moves_failed;
+    }
+  }
+  if (!status.ok() && events_.on_move_failed) events_.on_move_failed(move, status);
+}
+
+void ServoBus::pollOnce(PolledServo& servo) {
+  ServoAngleSample sample;
+  sample.id = servo.id;
+  const ServoStatus status =
+      client_.readAngle(servo.id, &sample.angle_deg, &sample.arrival, BusPriority::kBackground);
+  const Clock::time_point now = clock_->now();
+  bool went_silent = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (status.error == ServoError::kNotConnected || status.error == ServoError::kShutdown) {
+      // The port is down, not the servo: ask again at the poll rate once it is back.
+      servo.next_poll = now + poll_period_;
+      return;
+    }
+    if (!status.ok()) {
+      went_silent = servo.backoff.count() == 0;
+      servo.backoff = went_silent ? kFirstBackoff : std::min(servo.backoff * 2, kMaxBackoff);
+      servo.next_poll = now + servo.backoff;
+    } else {
+      servo.backoff = std::chrono::milliseconds(0);
+      // Keep the rate without drifting; after a stall, start again from now.
+      servo.next_poll = std::max(servo.next_poll + poll_period_, now);
+      ++stats_.angles_polled;
+    }
+  }
+  if (!status.ok()) {
+    if (went_silent && events_.on_servo_silent) {
+      events_.on_servo_silent(servo.id, status, servo.backoff);
+    }
+    return;
+  }
+  if (events_.on_angle) events_.on_angle(sample);
+}
+
+}  // namespace serial_robot_driver::device

@@ -1,0 +1,182 @@
+// ServoBus, the bus device without ROS: the move queue and the poll schedule with its back-off,
+// on a manual clock (the worker thread runs; the test moves time) and a fake bus that records
+// every frame and answers synchronously with golden frames.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "serial_robot_driver/device/servo_bus.h"
+#include "support/golden_frames.h"
+#include "support/manual_clock.h"
+
+namespace serial_robot_driver::device {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+using std::chrono::milliseconds;
+using namespace golden::servo;  // NOLINT: the shared golden frames
+
+class ServoBusTest : public ::testing::Test {
+ protected:
+  /// A bus polling `polled_ids` at 10 Hz (every 100 ms) on the manual clock.
+  void makeBus(std::vector<uint8_t> polled_ids) {
+    ServoBusConfig config;
+    config.client.timeout = milliseconds(5);  // a silent servo costs 5 ms of real time
+    config.client.retries = 0;
+    config.polled_ids = std::move(polled_ids);
+    config.poll_rate = 10.0;
+    ServoBusEvents events;
+    events.on_angle = [this](const ServoAngleSample& sample) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      angles_.push_back(sample);
+    };
+    events.on_servo_silent = [this](uint8_t id, const ServoStatus&, milliseconds backoff) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      silent_.push_back({id, backoff});
+    };
+    events.on_move_failed = [this](const MoveRequest& move, const ServoStatus& status) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      failed_moves_.push_back({move.id, status.error});
+    };
+    bus_ = std::make_unique<ServoBus>(
+        config, [this](const Bytes& frame) { return write(frame); }, events, clock_);
+  }
+
+  bool write(const Bytes& frame) {
+    Bytes reply;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      written_.push_back(frame);
+      auto it = answers_.find(frame);
+      if (it == answers_.end()) return true;
+      reply = it->second;
+    }
+    bus_->onFrame(protocol::FrameFamily::kServoResponse, reply.data(), reply.size(), Clock::now());
+    return true;
+  }
+
+  std::vector<Bytes> written() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return written_;
+  }
+  std::size_t countWritten(const Bytes& frame) {
+    std::size_t count = 0;
+    for (const Bytes& f : written()) count += f == frame ? 1 : 0;
+    return count;
+  }
+
+  const Clock::time_point t0_ = Clock::time_point() + std::chrono::hours(1);
+  std::shared_ptr<ManualClock> clock_ = std::make_shared<ManualClock>(t0_);
+  std::mutex mutex_;
+  std::map<Bytes, Bytes> answers_ = {{kReadAngle0, kReadAngle0Reply902}};
+  std::vector<Bytes> written_;
+  std::vector<ServoAngleSample> angles_;
+  std::vector<std::pair<uint8_t, milliseconds>> silent_;
+  std::vector<std::pair<uint8_t, ServoError>> failed_moves_;
+  std::unique_ptr<ServoBus> bus_;
+};
+
+TEST_F(ServoBusTest, PollsEachServoOncePerPeriod) {
+  makeBus({0});
+  bus_->start();
+  clock_->waitForLoop();  // the first poll falls due at once
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  clock_->advance(milliseconds(99));
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  clock_->advance(milliseconds(1));
+  EXPECT_EQ(countWritten(kReadAngle0), 2u);
+  bus_->shutdown();
+
+  ASSERT_EQ(angles_.size(), 2u);
+  EXPECT_EQ(angles_[0].id, 0);
+  EXPECT_DOUBLE_EQ(angles_[0].angle_deg, 90.2);
+  EXPECT_EQ(bus_->stats().angles_polled, 2u);
+  EXPECT_TRUE(bus_->stats().offline_ids.empty());
+  EXPECT_TRUE(silent_.empty());
+}
+
+TEST_F(ServoBusTest, SilentServoIsAskedAgainAfterADoublingBackoff) {
+  answers_.clear();
+  makeBus({0});
+  bus_->start();
+  clock_->waitForLoop();
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  ASSERT_EQ(silent_.size(), 1u);
+  EXPECT_EQ(silent_[0].first, 0);
+  EXPECT_EQ(silent_[0].second, ServoBus::kFirstBackoff);
+  EXPECT_EQ(bus_->stats().offline_ids, std::vector<uint8_t>{0});
+
+  // Not at the poll period: only after the back-off.
+  clock_->advance(milliseconds(499));
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  clock_->advance(milliseconds(1));
+  EXPECT_EQ(countWritten(kReadAngle0), 2u);
+  // Silent again: the back-off doubles, and the servo is reported once, not per poll.
+  clock_->advance(milliseconds(999));
+  EXPECT_EQ(countWritten(kReadAngle0), 2u);
+  EXPECT_EQ(silent_.size(), 1u);
+
+  // It answers again: back online and polled at the period.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    answers_[kReadAngle0] = kReadAngle0Reply902;
+  }
+  clock_->advance(milliseconds(1));
+  EXPECT_EQ(countWritten(kReadAngle0), 3u);
+  EXPECT_TRUE(bus_->stats().offline_ids.empty());
+  clock_->advance(milliseconds(100));
+  EXPECT_EQ(countWritten(kReadAngle0), 4u);
+  bus_->shutdown();
+  EXPECT_EQ(angles_.size(), 2u);
+}
+
+TEST_F(ServoBusTest, LatestTargetReplacesAQueuedOneAndMovesGoBeforeThePoll) {
+  makeBus({0});
+  MoveRequest first;
+  first.id = 2;
+  first.angle_deg = 10.0;
+  MoveRequest latest = first;
+  latest.angle_deg = 90.0;
+  latest.interval_ms = 500;
+  bus_->queueMoves({first});
+  bus_->queueMoves({latest});
+  EXPECT_EQ(bus_->stats().moves_replaced, 1u);
+
+  bus_->start();
+  clock_->waitForLoop();
+  EXPECT_EQ(written(), (std::vector<Bytes>{kRotate2To90In500, kReadAngle0}));
+  bus_->shutdown();
+  EXPECT_EQ(bus_->stats().moves_sent, 1u);
+}
+
+TEST_F(ServoBusTest, RefusedMoveIsReportedAndNothingIsWritten) {
+  makeBus({0});
+  MoveRequest move;
+  move.id = 2;
+  move.angle_deg = 200.0;  // beyond a single-turn move's +-180
+  bus_->queueMoves({move});
+  bus_->start();
+  clock_->waitForLoop();
+  bus_->shutdown();
+  EXPECT_EQ(written(), std::vector<Bytes>{kReadAngle0});
+  ASSERT_EQ(failed_moves_.size(), 1u);
+  EXPECT_EQ(failed_moves_[0].first, 2);
+  EXPECT_EQ(failed_moves_[0].second, ServoError::kInvalidArgument);
+  EXPECT_EQ(bus_->stats().moves_failed, 1u);
+}
+
+TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
+  makeBus({});
+  bus_->start();
+  bus_->shutdown();
+  bus_->shutdown();
+  EXPECT_EQ(bus_->client().ping(3).error, ServoError::kShutdown);
+  EXPECT_TRUE(written().empty());
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::device
