@@ -10,6 +10,7 @@
 
 #include "serial_robot_driver/BaseTuningConfig.h"
 #include "serial_robot_driver/ImuTuningConfig.h"
+#include "serial_robot_driver/ServoBusTuningConfig.h"
 #include "serial_robot_driver/TrajectoryTuningConfig.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
@@ -171,6 +172,10 @@ RuntimeTuning::RuntimeTuning(const ros::NodeHandle& private_nh, const DriverPara
   }
   if (params.body.enabled) {
     servers_.push_back(std::make_unique<GroupServer<ImuTuningConfig>>(*this, private_nh, "imu"));
+  }
+  if (params.servo_bus.enabled) {
+    servers_.push_back(
+        std::make_unique<GroupServer<ServoBusTuningConfig>>(*this, private_nh, "servo_bus"));
   }
   if (trajectory_) {
     servers_.push_back(

@@ -13,7 +13,7 @@ import rostest
 from dynamic_reconfigure.client import Client
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu
+from sensor_msgs.msg import Imu, JointState
 from serial_robot_driver.msg import (FollowJointTrajectoryAction, FollowJointTrajectoryGoal,
                                      FollowJointTrajectoryResult, WheelCommand)
 from trajectory_msgs.msg import JointTrajectoryPoint
@@ -95,6 +95,8 @@ class RuntimeTuningTest(unittest.TestCase):
         cls.base = Client(NODE + "/base", timeout=TIMEOUT)
         cls.imu = Client(NODE + "/imu", timeout=TIMEOUT)
         cls.trajectory = Client(NODE + "/trajectory", timeout=TIMEOUT)
+        cls.servo_bus = Client(NODE + "/servo_bus", timeout=TIMEOUT)
+        cls.servo_states = Recorder("/servo_states", JointState)
         cls.follow = actionlib.SimpleActionClient("/follow_joint_trajectory",
                                                   FollowJointTrajectoryAction)
         assert cls.follow.wait_for_server(rospy.Duration(TIMEOUT))
@@ -122,6 +124,9 @@ class RuntimeTuningTest(unittest.TestCase):
         trajectory = self.trajectory.get_configuration(timeout=TIMEOUT)
         self.assertAlmostEqual(trajectory["goal_tolerance"], 0.07)  # the .cfg says 0.05
         self.assertAlmostEqual(trajectory["max_velocity"], 0.0)
+        servo_bus = self.servo_bus.get_configuration(timeout=TIMEOUT)
+        self.assertAlmostEqual(servo_bus["state_rate"], 2.0)  # the .cfg says 10
+        self.assertAlmostEqual(servo_bus["timeout"], 0.05)
         # The parameter server holds the same.
         self.assertAlmostEqual(rospy.get_param(NODE + "/base/max_wheel_speed"), 0.8)
         self.assertAlmostEqual(rospy.get_param(NODE + "/base/wheel_diameter"), 0.25)
@@ -249,6 +254,27 @@ class RuntimeTuningTest(unittest.TestCase):
         self.assertEqual(self.finish(), FollowJointTrajectoryResult.SUCCESSFUL)
         self.tune(self.trajectory, goal_tolerance=0.07, max_velocity=0.0)
         self.tune(self.base, max_wheel_speed=0.8)
+
+
+    def test_h_servo_polling_rate_raised(self):
+        def median_interval(messages):
+            stamps = [m.header.stamp.to_sec() for m in messages]
+            gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+            return gaps[len(gaps) // 2]
+
+        start = self.servo_states.count()
+        slow = self.servo_states.wait_for_more(start, 4)
+        answer = self.tune(self.servo_bus, state_rate=20.0)
+        self.assertAlmostEqual(answer["state_rate"], 20.0)
+        after = self.servo_states.count()
+        fast = self.servo_states.wait_for_more(after, 12)[1:]
+        # 2 Hz polls 0.5 s apart, 20 Hz 0.05 s apart (the node's own stamps; wide margins).
+        self.assertGreater(median_interval(slow), 0.3)
+        self.assertLess(median_interval(fast), 0.25)
+        # A rate of 0 is refused (the rate in force stays); too many retries are clamped.
+        self.assertAlmostEqual(self.tune(self.servo_bus, state_rate=0.0)["state_rate"], 20.0)
+        self.assertEqual(self.tune(self.servo_bus, retries=50)["retries"], 10)
+        self.tune(self.servo_bus, state_rate=2.0, retries=1)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@
 
 #include "serial_robot_driver/BaseTuningConfig.h"
 #include "serial_robot_driver/ImuTuningConfig.h"
+#include "serial_robot_driver/ServoBusTuningConfig.h"
 #include "serial_robot_driver/TrajectoryTuningConfig.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 
@@ -100,6 +101,12 @@ TEST(RuntimeTuningTable, BaseServerHasEveryBaseTunableAsTheTableHasIt) {
 TEST(RuntimeTuningTable, ImuServerHasTheScalesAsTheTableHasThem) {
   expectAgreesWithTheTable<serial_robot_driver::ImuTuningConfig>(
       "imu", {"accel_scale", "gyro_scale", "angle_scale"});
+}
+
+TEST(RuntimeTuningTable, ServoBusServerHasTheBusTimingAsTheTableHasIt) {
+  // health_rate, protect, relax_power_mw and on_shutdown join when the table has them.
+  expectAgreesWithTheTable<serial_robot_driver::ServoBusTuningConfig>(
+      "servo_bus", {"timeout", "retries", "state_rate", "command_interval_ms"});
 }
 
 TEST(RuntimeTuningTable, TrajectoryServerHasTheGoalDefaultsAsTheTableHasThem) {

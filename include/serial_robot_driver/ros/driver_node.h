@@ -19,9 +19,10 @@
 //    in main, or the nodelet manager's threads); servo/* services have their own queue and
 //    spinner because they wait on the bus;
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
-//  - the dynamic_reconfigure servers (~base, ~imu, ~trajectory; ros/runtime_tuning.h) answer on the global
-//    queue too; a change reaches each device under the device's own lock (the base loop's mutex,
-//    the IMU scales swapped whole), from its next tick or frame on.
+//  - the dynamic_reconfigure servers (~base, ~imu, ~servo_bus, ~trajectory; ros/runtime_tuning.h)
+//    answer on the global queue too; a change reaches each device under the device's own lock
+//    (the base loop's mutex, the IMU scales swapped whole, the bus client's state lock, the
+//    trajectory server's mutex), from its next tick, frame or transaction on.
 //  - trajectory goals, cancels, joint_trajectory and the trajectory timer (one sync-write per loop
 //    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once

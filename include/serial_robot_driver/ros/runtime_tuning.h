@@ -51,7 +51,7 @@ std::string toText(const ParamValue& value);
 class RuntimeTuning {
  public:
   /// Starts the servers of the enabled groups under `private_nh`: ~base (base enabled), ~imu
-  /// (body enabled), ~trajectory (`trajectory` not null: some device has joints). `params` are the
+  /// (body enabled), ~servo_bus (servo_bus enabled), ~trajectory (`trajectory` not null: some device has joints). `params` are the
   /// parameters in force; `devices` and `trajectory` get every accepted change and must outlive
   /// this object.
   RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
