@@ -53,7 +53,8 @@ std::string toText(const ParamValue& value) {
   return text.str();
 }
 
-TuningResult tuneParams(const DriverParams& in_force, const std::vector<ParamAssignment>& requested) {
+TuningResult tuneParams(const DriverParams& in_force,
+                        const std::vector<ParamAssignment>& requested) {
   TuningResult result{in_force, {}};
   for (const auto& [key, value] : requested) {
     const ParamSpec& spec = specFor(key);
@@ -86,7 +87,8 @@ TuningResult tuneParams(const DriverParams& in_force, const std::vector<ParamAss
       }
       // A rule between several values, broken by the change: refuse all of it.
       for (const auto& [key, value] : requested) {
-        if (specFor(key).get(result.applied) != specFor(key).get(in_force)) refuse(key, error.what());
+        if (specFor(key).get(result.applied) != specFor(key).get(in_force))
+          refuse(key, error.what());
       }
     }
   }

@@ -79,10 +79,12 @@ void expectAgreesWithTheTable(const std::string& group, const std::set<std::stri
       ASSERT_TRUE(std::isfinite(min)) << "the table bounds every number below";
       const double up = std::nextafter(min, std::numeric_limits<double>::infinity());
       EXPECT_TRUE(tableAccepts(key, min) || tableAccepts(key, up));
-      EXPECT_FALSE(tableAccepts(key, std::nextafter(min, -std::numeric_limits<double>::infinity())));
+      EXPECT_FALSE(
+          tableAccepts(key, std::nextafter(min, -std::numeric_limits<double>::infinity())));
       if (std::isfinite(max)) {
         EXPECT_TRUE(tableAccepts(key, max));
-        EXPECT_FALSE(tableAccepts(key, std::nextafter(max, std::numeric_limits<double>::infinity())));
+        EXPECT_FALSE(
+            tableAccepts(key, std::nextafter(max, std::numeric_limits<double>::infinity())));
       } else {
         EXPECT_TRUE(tableAccepts(key, 1e9)) << "no maximum in the .cfg, none in the table";
       }
@@ -140,15 +142,15 @@ TEST(TuneParams, AValueTheStartUpCheckRefusesKeepsTheValueInForce) {
 
 TEST(TuneParams, ARuleBetweenValuesRefusesTheWholeChange) {
   const DriverParams in_force;  // warn 20, error 10
-  const TuningResult result = tuneParams(
-      in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 10}});
+  const TuningResult result =
+      tuneParams(in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 10}});
   EXPECT_EQ(result.applied.base.battery_warn_percent, 20);
   ASSERT_EQ(result.refusals.size(), 1u);
   EXPECT_NE(result.refusals[0].find("battery_warn_percent = 5 refused"), std::string::npos);
   EXPECT_NE(result.refusals[0].find("must not exceed"), std::string::npos) << result.refusals[0];
 
-  const TuningResult both = tuneParams(
-      in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 3}});
+  const TuningResult both =
+      tuneParams(in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 3}});
   EXPECT_TRUE(both.refusals.empty()) << "lowered together, both apply";
   EXPECT_EQ(both.applied.base.battery_warn_percent, 5);
   EXPECT_EQ(both.applied.base.battery_error_percent, 3);

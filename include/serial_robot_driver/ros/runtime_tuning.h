@@ -14,13 +14,13 @@
 // the nodelet manager's threads); mutex_ makes them one at a time.
 #pragma once
 
+#include <ros/node_handle.h>
+
 #include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <ros/node_handle.h>
 
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -43,7 +43,8 @@ struct TuningResult {
 /// was not changed (a rule between several values), every changed value of the request is
 /// refused. Throws std::invalid_argument for a key that is not in the table or a value of the wrong
 /// type (a programming error: the .cfg files and the table agree, see test_runtime_tuning.cpp).
-TuningResult tuneParams(const DriverParams& in_force, const std::vector<ParamAssignment>& requested);
+TuningResult tuneParams(const DriverParams& in_force,
+                        const std::vector<ParamAssignment>& requested);
 
 /// A parameter value as text for a log line: 0.5, true, 20, "odom".
 std::string toText(const ParamValue& value);
@@ -51,9 +52,9 @@ std::string toText(const ParamValue& value);
 class RuntimeTuning {
  public:
   /// Starts the servers of the enabled groups under `private_nh`: ~base (base enabled), ~imu
-  /// (body enabled), ~servo_bus (servo_bus enabled), ~trajectory (`trajectory` not null: some device has joints). `params` are the
-  /// parameters in force; `devices` and `trajectory` get every accepted change and must outlive
-  /// this object.
+  /// (body enabled), ~servo_bus (servo_bus enabled), ~trajectory (`trajectory` not null: some
+  /// device has joints). `params` are the parameters in force; `devices` and `trajectory` get
+  /// every accepted change and must outlive this object.
   RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
                 std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory = nullptr);
   ~RuntimeTuning();
