@@ -322,8 +322,13 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                        this, ros::TransportHints().tcpNoDelay());
 }
 
+void ServoBusInterface::retune(const DriverParams& params) {
+  bus_.retune(makeServoBusConfig(params));
+  command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
+}
+
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
-  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
+  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_.load());
   if (!batch.error.empty()) {
     commands_rejected_.fetch_add(1);
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
@@ -411,9 +416,10 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("echoes skipped", stats.echoes);
   status.addf("last latency (ms)", "%.2f", stats.last_latency_ms);
   status.addf("max latency (ms)", "%.2f", stats.max_latency_ms);
-  status.add("timeout (ms)", static_cast<int>(client_.options().timeout.count()));
-  status.add("retries per transaction", client_.options().retries);
-  status.add("dangerous writes armed", client_.options().allow_dangerous_writes);
+  const device::ServoBusOptions options = client_.options();
+  status.add("timeout (ms)", static_cast<int>(options.timeout.count()));
+  status.add("retries per transaction", options.retries);
+  status.add("dangerous writes armed", options.allow_dangerous_writes);
 
   const device::ServoBusWorkerStats worker = bus_.stats();
   std::string offline;

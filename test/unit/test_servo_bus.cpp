@@ -178,5 +178,28 @@ TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
   EXPECT_TRUE(written().empty());
 }
 
+
+TEST_F(ServoBusTest, RetunedPollRateAppliesFromTheNextPollAndTimingFromTheNextTransaction) {
+  makeBus({0});
+  bus_->start();
+  clock_->waitForLoop();  // the first poll at t0; the next falls due at t0 + 100 ms
+  clock_->advance(milliseconds(20));
+  ServoBusConfig faster = bus_->config();
+  faster.poll_rate = 50.0;  // every 20 ms
+  faster.client.timeout = milliseconds(7);
+  faster.client.retries = 2;
+  clock_->step([&] { bus_->retune(faster); });
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  // Due 20 ms after the change, not at the 100 ms the old rate had scheduled.
+  clock_->advance(milliseconds(20));
+  EXPECT_EQ(countWritten(kReadAngle0), 2u);
+  clock_->advance(milliseconds(20));
+  EXPECT_EQ(countWritten(kReadAngle0), 3u);
+  EXPECT_EQ(bus_->client().options().timeout, milliseconds(7));
+  EXPECT_EQ(bus_->client().options().retries, 2);
+  bus_->shutdown();
+  EXPECT_EQ(angles_.size(), 3u);
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::device

@@ -91,7 +91,12 @@ class ServoBus : public LinkListener {
   void shutdown();
 
   ServoBusWorkerStats stats() const;
+  /// The configuration it was built with (retune() changes only what its comment says).
   const ServoBusConfig& config() const { return config_; }
+  /// Applies the tunable part of `next`: client.timeout and client.retries from the next bus
+  /// transaction on, poll_rate from the next poll on (a faster rate does not wait out the slower
+  /// period still pending). Never waits for the bus. Expects validated values (poll_rate > 0).
+  void retune(const ServoBusConfig& next);
 
   // LinkListener (reader thread): handed on to the client.
   void onLinkDown() override;
@@ -113,7 +118,7 @@ class ServoBus : public LinkListener {
   const ServoBusConfig config_;
   const ServoBusEvents events_;
   const std::shared_ptr<LoopClock> clock_;
-  const Clock::duration poll_period_;
+  Clock::duration poll_period_;  // guarded by mutex_ (retune)
   ServoBusClient client_;
 
   mutable std::mutex mutex_;  // guards everything below
@@ -121,7 +126,7 @@ class ServoBus : public LinkListener {
   bool stop_ = false;
   bool started_ = false;
   std::deque<MoveRequest> queued_moves_;
-  std::vector<PolledServo> polled_;  // schedule changed by the worker only
+  std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   ServoBusWorkerStats stats_;
   std::thread worker_;
 };
