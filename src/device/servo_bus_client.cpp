@@ -227,9 +227,21 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
                   std::to_string(timeout.count()) + " ms (" + attemptsText(attempts) + ")");
 }
 
+ServoBusOptions ServoBusClient::options() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return options_;
+}
+
+void ServoBusClient::retune(std::chrono::milliseconds timeout, int retries) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  options_.timeout = timeout;
+  options_.retries = retries;
+}
+
 ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
                                            const Expectation& expect, servo::Packet* answer) {
-  return transact(request, expect, options_.timeout, options_.retries + 1, answer);
+  const ServoBusOptions options = this->options();  // one transaction, one set of options
+  return transact(request, expect, options.timeout, options.retries + 1, answer);
 }
 
 ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const Expectation& expect,
@@ -261,7 +273,7 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
   ServoStatus status =
-      transact(request, Expectation(cmd, id), motion_time + options_.timeout, 1, &answer);
+      transact(request, Expectation(cmd, id), motion_time + options().timeout, 1, &answer);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";

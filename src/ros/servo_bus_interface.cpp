@@ -323,8 +323,13 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                        this, ros::TransportHints().tcpNoDelay());
 }
 
+void ServoBusInterface::retune(const DriverParams& params) {
+  bus_.retune(makeServoBusConfig(params));
+  command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
+}
+
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
-  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
+  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_.load());
   if (!batch.error.empty()) {
     commands_rejected_.fetch_add(1);
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
@@ -412,9 +417,10 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("echoes skipped", stats.echoes);
   status.addf("last latency (ms)", "%.2f", stats.last_latency_ms);
   status.addf("max latency (ms)", "%.2f", stats.max_latency_ms);
-  status.add("timeout (ms)", static_cast<int>(client_.options().timeout.count()));
-  status.add("retries per transaction", client_.options().retries);
-  status.add("dangerous writes armed", client_.options().allow_dangerous_writes);
+  const device::ServoBusOptions options = client_.options();
+  status.add("timeout (ms)", static_cast<int>(options.timeout.count()));
+  status.add("retries per transaction", options.retries);
+  status.add("dangerous writes armed", options.allow_dangerous_writes);
 
   const device::ServoBusWorkerStats worker = bus_.stats();
   std::string offline;
@@ -431,15 +437,14 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
                         "polled servos not answering: " + offline);
   }
 
-  // Asked vs achieved: state_rate of every answering polled servo, against the angles read since
-  // the last update. A line too slow for what was asked (or service calls taking the bus) shows
-  // here rather than as a silently lower rate.
+  // Asked vs achieved: the state_rate in force for every answering polled servo, against the
+  // angles read over the window. A line too slow for what was asked (or service calls taking
+  // the bus) shows here rather than as a silently lower rate.
   // The achieved rate is measured over at least kRateWindowS, so one slow transaction (a silent
   // servo's timeout, a long service call) does not flag a line that keeps up on average.
   constexpr double kRateWindowS = 2.0;
   const auto now = std::chrono::steady_clock::now();
-  const std::size_t answering = bus_.config().polled_ids.size() - worker.offline_ids.size();
-  const double asked = state_rate_ * static_cast<double>(answering);
+  const double asked = worker.asked_poll_rate;
   if (last_rate_check_ == std::chrono::steady_clock::time_point{}) {
     last_rate_check_ = now;
     polls_at_last_check_ = worker.angles_polled;

@@ -217,6 +217,21 @@ TEST_F(ServoBusTest, AWaitingCallGoesBeforeAPollThatFellDue) {
   EXPECT_EQ(written(), (std::vector<Bytes>{kPing3, kPing5, kReadAngle0}));
 }
 
+TEST_F(ServoBusTest, AskedPollRateCountsTheServosNotInBackoffAtTheRateInForce) {
+  answers_.clear();  // neither servo answers
+  makeBus({0, 3});   // 10 Hz each
+  EXPECT_DOUBLE_EQ(bus_->stats().asked_poll_rate, 20.0);
+  ServoBusConfig faster = bus_->config();
+  faster.poll_rate = 50.0;
+  bus_->retune(faster);
+  EXPECT_DOUBLE_EQ(bus_->stats().asked_poll_rate, 100.0);
+  bus_->start();
+  // Both are silent: once in back-off they are not asked at the poll rate any more.
+  ASSERT_TRUE(waitFor([&] { return bus_->stats().offline_ids.size() == 2; }));
+  EXPECT_DOUBLE_EQ(bus_->stats().asked_poll_rate, 0.0);
+  bus_->shutdown();
+}
+
 TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
   makeBus({});
   bus_->start();
@@ -224,6 +239,29 @@ TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
   bus_->shutdown();
   EXPECT_EQ(bus_->client().ping(3).error, ServoError::kShutdown);
   EXPECT_TRUE(written().empty());
+}
+
+
+TEST_F(ServoBusTest, RetunedPollRateAppliesFromTheNextPollAndTimingFromTheNextTransaction) {
+  makeBus({0});
+  bus_->start();
+  clock_->waitForLoop();  // the first poll at t0; the next falls due at t0 + 100 ms
+  clock_->advance(milliseconds(20));
+  ServoBusConfig faster = bus_->config();
+  faster.poll_rate = 50.0;  // every 20 ms
+  faster.client.timeout = milliseconds(7);
+  faster.client.retries = 2;
+  clock_->step([&] { bus_->retune(faster); });
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  // Due 20 ms after the change, not at the 100 ms the old rate had scheduled.
+  clock_->advance(milliseconds(20));
+  EXPECT_EQ(countWritten(kReadAngle0), 2u);
+  clock_->advance(milliseconds(20));
+  EXPECT_EQ(countWritten(kReadAngle0), 3u);
+  EXPECT_EQ(bus_->client().options().timeout, milliseconds(7));
+  EXPECT_EQ(bus_->client().options().retries, 2);
+  bus_->shutdown();
+  EXPECT_EQ(angles_.size(), 3u);
 }
 
 }  // namespace

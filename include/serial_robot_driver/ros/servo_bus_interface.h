@@ -78,6 +78,9 @@ class ServoBusInterface : public DeviceInterface {
   /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~servo_bus tunables: timeout and retries from the next transaction, state_rate from the
+  /// next poll, command_interval_ms from the next servo_commands message.
+  void retune(const DriverParams& params) override;
   /// ~servo_bus/joint_ids as trajectory joints: one queued move per segment.
   std::vector<TrajectoryJoints> trajectoryJoints() override;
   void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
@@ -107,7 +110,7 @@ class ServoBusInterface : public DeviceInterface {
   ros::NodeHandle topics_nh_;  // the caller's namespace on the caller's queue
   ros::Publisher states_pub_;
   ros::Subscriber commands_sub_;
-  const uint16_t command_interval_ms_;
+  std::atomic<uint16_t> command_interval_ms_;  // retune() from the dynamic_reconfigure callback
   std::atomic<uint64_t> commands_rejected_{0};
 
   // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
