@@ -909,7 +909,8 @@ BusRun runServoStates(Context& context, const std::string& tag, double latency_m
   }
   std::atomic<std::size_t> messages{0};
   ros::Subscriber subscriber = context.nh.subscribe<sensor_msgs::JointState>(
-      driver.topic("servo_states"), 10000, [&](const sensor_msgs::JointState::ConstPtr&) { ++messages; },
+      driver.topic("servo_states"), 10000,
+      [&](const sensor_msgs::JointState::ConstPtr&) { ++messages; },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   require(waitUntil([&] { return messages > 0; }, 30s),
           "no servo_states received; see " + context.paths.log(ns));
@@ -1248,7 +1249,9 @@ void run(Context& context) {
         "With capture every chunk read and every frame written is copied, stamped and queued; "
         "a thread of its own publishes serial_raw, so the loop and the reader never wait for it.");
   }
-  if (o.runs(10)) attempt(context, "servo bus at the wire's pace (10)", [&] { runServoBusSection(context); });
+  if (o.runs(10)) {
+    attempt(context, "servo bus at the wire's pace (10)", [&] { runServoBusSection(context); });
+  }
 }
 
 std::string executableDirectory() {

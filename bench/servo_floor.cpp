@@ -97,7 +97,6 @@ int main(int argc, char** argv) {
   std::printf("transactions=%llu seconds=%.3f cpu_s=%.4f lost=%llu mean_ms=%.4f checksum=%ld\n",
               static_cast<unsigned long long>(transactions), seconds, cpu,
               static_cast<unsigned long long>(lost),
-              transactions ? seconds * 1000.0 / static_cast<double>(transactions) : 0.0,
-              angle_sum);
+              transactions ? seconds * 1000.0 / static_cast<double>(transactions) : 0.0, angle_sum);
   return 0;
 }

@@ -94,7 +94,8 @@ ServoBusWorkerStats ServoBus::stats() const {
     if (servo.backoff.count() > 0) stats.offline_ids.push_back(servo.id);
   }
   const double poll_rate = 1.0 / std::chrono::duration<double>(poll_period_).count();
-  stats.asked_poll_rate = poll_rate * static_cast<double>(polled_.size() - stats.offline_ids.size());
+  stats.asked_poll_rate =
+      poll_rate * static_cast<double>(polled_.size() - stats.offline_ids.size());
   return stats;
 }
 

@@ -241,7 +241,6 @@ TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
   EXPECT_TRUE(written().empty());
 }
 
-
 TEST_F(ServoBusTest, RetunedPollRateAppliesFromTheNextPollAndTimingFromTheNextTransaction) {
   makeBus({0});
   bus_->start();
