@@ -15,6 +15,10 @@
 //     processes' runs alternated in rounds, and the ratios node / floor
 //  9. ~capture on vs off: base loop period and CPU (2, 3), telemetry -> joint_states and CPU (4),
 //     with a subscriber on serial_raw as rosbag record would be
+// 10. the servo bus at the wire's pace: READ_ANGLE transactions per second and CPU per
+//     transaction of servo_states (20 servos) against servo_floor (bench/servo_floor.cpp, one
+//     blocking request/answer loop), on robot_sim at pty speed and paced at 115200 baud; and how
+//     closely the paced robot_sim keeps to the line's time
 // Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
@@ -62,7 +66,7 @@ using test_support::PtyFrameReader;
 
 struct Options {
   bool long_run = false;
-  std::set<int> sections{1, 2, 3, 4, 5, 6, 7, 8, 9};
+  std::set<int> sections{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
   std::string output;                   ///< Markdown copy of the results; "" = none
   std::string bin_dir;                  ///< "" = the directory of this executable
   int master_port = 0;                  ///< 0 = any free port
@@ -74,6 +78,7 @@ struct Options {
   std::size_t service_calls = 200;  ///< 6: calls timed per client kind
   double stress_seconds = 5;        ///< 6: idle and stress windows of the wheel loop
   std::size_t floor_rounds = 2;     ///< 8: alternated node/floor rounds
+  double bus_seconds = 5;           ///< 10: window of each servo bus run
 
   bool runs(int section) const { return sections.count(section) > 0; }
 };
@@ -85,6 +90,7 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           9 repeats 2, 3, 4 with ~capture, and runs 2-4 without it if
                           they did not run)
   --floor-rounds N        8: alternated node/floor rounds (default 2)
+  --bus-seconds S         10: window of each servo bus run (default 5)
   --output FILE           also write the results (Markdown) to FILE
   --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
   --master-port N         port of the private roscore (default: a free one)
@@ -102,7 +108,7 @@ std::set<int> parseSections(const std::string& text) {
   std::string item;
   while (std::getline(stream, item, ',')) {
     const int section = std::stoi(item);
-    if (section < 1 || section > 9) throw std::invalid_argument("no section " + item);
+    if (section < 1 || section > 10) throw std::invalid_argument("no section " + item);
     sections.insert(section);
   }
   return sections;
@@ -120,6 +126,7 @@ Options parseOptions(int argc, char** argv) {
       options.rate_step_seconds = 10;
       options.service_calls = 2000;
       options.stress_seconds = 30;
+      options.bus_seconds = 20;
     }
   }
   for (int i = 1; i < argc; ++i) {
@@ -151,6 +158,8 @@ Options parseOptions(int argc, char** argv) {
       options.service_calls = std::stoul(value);
     } else if (flag == "--floor-rounds") {
       options.floor_rounds = std::max<std::size_t>(1, std::stoul(value));
+    } else if (flag == "--bus-seconds") {
+      options.bus_seconds = std::stod(value);
     } else if (flag == "--stress-seconds") {
       options.stress_seconds = std::stod(value);
     } else {
@@ -779,6 +788,205 @@ ServoSessionResult runServoSession(Context& context) {
   return result;
 }
 
+// --- the servo bus at the wire's pace (10) ------------------------------------------------------
+
+constexpr int kBusServos = 20;
+constexpr double kBusBaud = 115200;
+constexpr double kBusLatencyMs = 0.5;
+/// READ_ANGLE: a 6-byte request and an 8-byte answer, 10 bits a byte on the line.
+constexpr double kBusLineMs = (6 + 8) * 10.0 / kBusBaud * 1000.0;
+
+/// One run of READ_ANGLE transactions: by whom, how many per second, at what cost.
+struct BusRun {
+  double per_second = 0;
+  double cpu_us = 0;      ///< CPU per transaction of the process doing them
+  double cpu_share = 0;   ///< CPU seconds per second
+  double turnaround_ms = 0;
+};
+
+std::vector<std::string> busSimFlags(const std::string& link, double latency_ms, bool paced) {
+  std::string ids;
+  for (int id = 0; id < kBusServos; ++id) ids += (id ? "," : "") + std::to_string(id);
+  std::vector<std::string> flags = {"--link", link, "--no-base", "--no-body", "--bus-servo-ids",
+                                    ids, "--servo-latency-ms", format("%.3f", latency_ms)};
+  if (paced) flags.insert(flags.end(), {"--pace-baud", format("%.0f", kBusBaud)});
+  return flags;
+}
+
+/// servo_floor against its own robot_sim for the window; parses the line it prints.
+BusRun runServoFloor(Context& context, const std::string& tag, double latency_ms, bool paced) {
+  const std::string link = context.paths.link("bus_floor_" + tag);
+  const auto sim = startRobotSim(context.paths, "robot_sim_bus_floor_" + tag,
+                                 busSimFlags(link, latency_ms, paced));
+  require(waitUntil([&] { return ::access(link.c_str(), F_OK) == 0; }, 20s),
+          "robot_sim did not create " + link);
+  const std::string log = context.paths.log("servo_floor_" + tag);
+  ChildProcess floor("servo_floor", {context.paths.bin_dir + "/servo_floor", link,
+                                     std::to_string(kBusServos),
+                                     format("%.1f", context.options.bus_seconds)},
+                     log);
+  require(waitUntil([&] { return !floor.running(); },
+                    fromSeconds(context.options.bus_seconds + 30)),
+          "servo_floor did not finish; see " + log);
+  std::ifstream in(log);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (line.rfind("transactions=", 0) == 0) last = line;
+  }
+  unsigned long long transactions = 0, lost = 0;
+  double seconds = 0, cpu = 0, mean_ms = 0;
+  require(std::sscanf(last.c_str(), "transactions=%llu seconds=%lf cpu_s=%lf lost=%llu mean_ms=%lf",
+                      &transactions, &seconds, &cpu, &lost, &mean_ms) == 5 &&
+              transactions > 0,
+          "servo_floor printed no result; see " + log);
+  return {transactions / seconds, cpu / transactions * 1e6, cpu / seconds, mean_ms};
+}
+
+/// robot_sim's counters of the servo bus as its stats file last had them.
+struct SimBusCounters {
+  double uptime_s = -1;
+  double answers = 0;
+};
+
+SimBusCounters readSimBusCounters(const std::string& path) {
+  SimBusCounters counters;
+  std::ifstream in(path);
+  std::string key;
+  double value = 0;
+  while (in >> key >> value) {
+    if (key == "uptime_s") counters.uptime_s = value;
+    if (key == "servo_answers") counters.answers = value;
+  }
+  return counters;
+}
+
+/// Waits for robot_sim's next stats write (once a second) and returns it with the node's CPU at
+/// that moment, so both windows line up within the 5 ms of polling.
+std::pair<SimBusCounters, double> nextSimBusCounters(const std::string& path, pid_t node) {
+  const double previous = readSimBusCounters(path).uptime_s;
+  SimBusCounters counters;
+  require(waitUntil(
+              [&] {
+                counters = readSimBusCounters(path);
+                return counters.uptime_s != previous && counters.uptime_s >= 0;
+              },
+              5s),
+          "robot_sim's stats file " + path + " is not rewritten");
+  return {counters, processCpuSeconds(node)};
+}
+
+/// driver_node polling 20 servos at `state_rate` each, the node's CPU from its process clock.
+/// `subscribed`: servo_states messages counted (one per answered READ_ANGLE); else nobody
+/// subscribes and robot_sim's answers are counted: the transaction path without roscpp's cost of
+/// sending each message.
+BusRun runServoStates(Context& context, const std::string& tag, double latency_ms, bool paced,
+                      double state_rate, bool subscribed = true) {
+  const std::string ns = "bus_node_" + tag;
+  const std::string link = context.paths.link(ns);
+  const std::string stats_file = context.paths.work_dir + "/" + ns + ".stats";
+  std::vector<std::string> sim_flags = busSimFlags(link, latency_ms, paced);
+  sim_flags.insert(sim_flags.end(), {"--stats-file", stats_file});
+  const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, sim_flags);
+  std::vector<int> ids;
+  for (int id = 0; id < kBusServos; ++id) ids.push_back(id);
+  ParamList params = commonParams(link, kEventDriven);
+  params.insert(params.end(), {{"base/enabled", false},
+                               {"body/enabled", false},
+                               {"servo_bus/state_ids", toXmlRpc(ids)},
+                               {"servo_bus/state_rate", state_rate}});
+  DriverProcess driver(context.paths, ns, params);
+  if (!subscribed) {
+    require(waitUntil([&] { return readSimBusCounters(stats_file).answers > 0; }, 30s),
+            "driver_node never polled; see " + context.paths.log(ns));
+    const auto [first, cpu_start] = nextSimBusCounters(stats_file, driver.pid());
+    require(sleepUntil(Clock::now() + fromSeconds(context.options.bus_seconds - 0.5)), "stopped");
+    const auto [last, cpu_end] = nextSimBusCounters(stats_file, driver.pid());
+    const double seconds = last.uptime_s - first.uptime_s;
+    const double count = last.answers - first.answers;
+    require(count > 0 && seconds > 0, "driver_node stopped polling");
+    return {count / seconds, (cpu_end - cpu_start) / count * 1e6, (cpu_end - cpu_start) / seconds,
+            seconds * 1000.0 / count};
+  }
+  std::atomic<std::size_t> messages{0};
+  ros::Subscriber subscriber = context.nh.subscribe<sensor_msgs::JointState>(
+      driver.topic("servo_states"), 10000,
+      [&](const sensor_msgs::JointState::ConstPtr&) { ++messages; },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  require(waitUntil([&] { return messages > 0; }, 30s),
+          "no servo_states received; see " + context.paths.log(ns));
+  require(sleepUntil(Clock::now() + 1s), "stopped");
+  const std::size_t first = messages;
+  const double cpu_start = processCpuSeconds(driver.pid());
+  const Clock::time_point start = Clock::now();
+  require(sleepUntil(start + fromSeconds(context.options.bus_seconds)), "stopped");
+  const double seconds = toSeconds(Clock::now() - start);
+  const double cpu = processCpuSeconds(driver.pid()) - cpu_start;
+  const double count = static_cast<double>(messages - first);
+  require(count > 0, "servo_states stopped; see " + context.paths.log(ns));
+  return {count / seconds, cpu / count * 1e6, cpu / seconds, seconds * 1000.0 / count};
+}
+
+void runServoBusSection(Context& context) {
+  ResultTable& table = context.results;
+  // Side by side: each pair of runs back to back, so the machine's load is alike for both.
+  const BusRun floor_fast = runServoFloor(context, "fast", 0.0, false);
+  const BusRun node_fast = runServoStates(context, "fast", 0.0, false, 1000.0);
+  const BusRun node_quiet = runServoStates(context, "quiet", 0.0, false, 1000.0, false);
+  const BusRun floor_paced = runServoFloor(context, "paced", kBusLatencyMs, true);
+  const BusRun node_paced = runServoStates(context, "paced", kBusLatencyMs, true, 1000.0);
+  const BusRun floor_unpaced = runServoFloor(context, "latency", kBusLatencyMs, false);
+  const double wire_rate = 1000.0 / (kBusLineMs + kBusLatencyMs);
+
+  table.section(format("10. The servo bus at the wire's pace: READ_ANGLE of %d servos, "
+                       "servo_states (driver_node) vs servo_floor", kBusServos),
+                {"run", "transactions/s", "per transaction", "CPU per transaction", "CPU",
+                 "node / floor"});
+  auto add = [&](const std::string& what, const BusRun& run, const std::string& ratio_text) {
+    table.row({what, format("%.0f", run.per_second), format("%.3f ms", run.turnaround_ms),
+               format("%.1f us", run.cpu_us), format("%.2f s per s", run.cpu_share), ratio_text});
+  };
+  add("servo_floor, pty speed, latency 0", floor_fast, "");
+  add("driver_node, pty speed, latency 0, state_rate 1000", node_fast,
+      format("%.2f of the rate, %.2f of the CPU", node_fast.per_second / floor_fast.per_second,
+             node_fast.cpu_us / floor_fast.cpu_us));
+  add("driver_node, the same, nobody subscribed to servo_states", node_quiet,
+      format("%.2f of the rate, %.2f of the CPU", node_quiet.per_second / floor_fast.per_second,
+             node_quiet.cpu_us / floor_fast.cpu_us));
+  add(format("servo_floor, --pace-baud %.0f, latency %.1f ms", kBusBaud, kBusLatencyMs),
+      floor_paced, "");
+  add(format("driver_node, --pace-baud %.0f, latency %.1f ms, state_rate 1000", kBusBaud,
+             kBusLatencyMs),
+      node_paced,
+      format("%.2f of the rate, %.2f of the CPU", node_paced.per_second / floor_paced.per_second,
+             node_paced.cpu_us / floor_paced.cpu_us));
+  table.row({format("the line at %.0f baud + %.1f ms latency", kBusBaud, kBusLatencyMs),
+             format("%.0f", wire_rate), format("%.3f ms", kBusLineMs + kBusLatencyMs), "", "", ""});
+  add(format("servo_floor, pty speed, latency %.1f ms", kBusLatencyMs), floor_unpaced, "");
+
+  table.section("10. Goals of the servo bus");
+  table.row("driver_node's turnaround over the floor's, pty speed",
+            format("+%.3f ms", node_fast.turnaround_ms - floor_fast.turnaround_ms),
+            "<= the floor's own", node_fast.turnaround_ms <= 2 * floor_fast.turnaround_ms);
+  table.row("driver_node's CPU per transaction, pty speed", format("%.1f us", node_fast.cpu_us),
+            "<= 38 us (half of 77)", node_fast.cpu_us <= 38.5);
+  table.row(format("servo_states at %.0f baud, share of the line's rate", kBusBaud),
+            format("%.0f of %.0f /s = %.0f %%", node_paced.per_second, wire_rate,
+                   100.0 * node_paced.per_second / wire_rate),
+            ">= 90 %", node_paced.per_second >= 0.9 * wire_rate);
+  const double paced_excess = floor_paced.turnaround_ms - floor_unpaced.turnaround_ms;
+  table.row("paced robot_sim: floor turnaround paced - unpaced (same latency)",
+            format("%.3f ms (the line: %.3f ms)", paced_excess, kBusLineMs),
+            "line +- 0.1 ms", std::abs(paced_excess - kBusLineMs) <= 0.1);
+  table.row("paced robot_sim: floor turnaround vs line + latency",
+            format("%.3f ms vs %.3f ms", floor_paced.turnaround_ms, kBusLineMs + kBusLatencyMs));
+  table.note(
+      "Each transaction is a READ_ANGLE of the next servo: servo_states asks for 1000 Hz of each "
+      "of 20 servos, more than either line carries, so both clients run back to back. CPU is the "
+      "process's own clock over the window. The paced robot_sim's excess is the difference of two "
+      "floor runs that differ only in --pace-baud, so the pty round trip (the same in both) "
+      "cancels; the last row includes it.");
+}
+
 // --- the run ------------------------------------------------------------------------------------
 
 /// Runs one measurement; a failure is reported in the table and the run goes on.
@@ -1041,6 +1249,9 @@ void run(Context& context) {
         "With capture every chunk read and every frame written is copied, stamped and queued; "
         "a thread of its own publishes serial_raw, so the loop and the reader never wait for it.");
   }
+  if (o.runs(10)) {
+    attempt(context, "servo bus at the wire's pace (10)", [&] { runServoBusSection(context); });
+  }
 }
 
 std::string executableDirectory() {
@@ -1078,7 +1289,8 @@ int main(int argc, char** argv) {
 
   bench::RunPaths paths;
   paths.bin_dir = options.bin_dir.empty() ? bench::executableDirectory() : options.bin_dir;
-  for (const char* program : {"driver_node", "polling_driver_node", "robot_sim", "floor_node"}) {
+  for (const char* program :
+       {"driver_node", "polling_driver_node", "robot_sim", "floor_node", "servo_floor"}) {
     if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
       std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
                 << " not found: build the driver_bench target first\n";

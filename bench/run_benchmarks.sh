@@ -5,7 +5,7 @@
 # (or $SRD_BENCH_OUTPUT).
 #
 # usage: bench/run_benchmarks.sh [--build] [--long] [driver_bench options, see --help]
-#   --build             build driver_bench (and driver_node, robot_sim, floor_node,
+#   --build             build driver_bench (and driver_node, robot_sim, floor_node, servo_floor,
 #                       polling_driver_node) first, -j2, with -DSRD_BUILD_BENCHMARKS=ON (benchmarks
 #                       are off by default): in SRD_BENCH_WS, or else in the clone's own .ws/ with
 #                       scripts/build.sh, so `bench/run_benchmarks.sh --build` works on a fresh clone

@@ -13,6 +13,10 @@ target_include_directories(floor_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(floor_node srd_core ${catkin_LIBRARIES})
 add_dependencies(floor_node ${catkin_EXPORTED_TARGETS})
 
+# The servo bus's floor: one blocking READ_ANGLE client, ROS-free (driver_bench section 10).
+add_executable(servo_floor bench/servo_floor.cpp)
+target_link_libraries(servo_floor srd_core)
+
 add_executable(driver_bench
   bench/bench_support.cpp
   bench/driver_bench.cpp
@@ -27,7 +31,7 @@ target_include_directories(polling_driver_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(polling_driver_node srd_ros)
 
 # The benchmark launches these executables, so building it builds them.
-add_dependencies(driver_bench driver_node polling_driver_node floor_node robot_sim
+add_dependencies(driver_bench driver_node polling_driver_node floor_node robot_sim servo_floor
   ${PROJECT_NAME}_generate_messages_cpp)
 # Benchmarks run from the build tree and are never installed (hence the catkin_lint pragmas).
 #catkin_lint: ignore uninstalled_target

@@ -109,6 +109,10 @@ add_rostest_gtest(test_stale_params test/rostest/stale_params.test
 target_include_directories(test_stale_params PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_stale_params srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_stale_params driver_node robot_sim srd_nodelet)
+
+# Runtime tuning through dynamic_reconfigure's Python client against robot_sim.
+add_rostest(test/rostest/runtime_tuning.test
+  DEPENDENCIES driver_node robot_sim ${PROJECT_NAME}_generate_messages_py ${PROJECT_NAME}_gencfg)
 # Safe motion: the e-stop with a spinning bus servo, servo/relax and servo/hold, the servos'
 # stop on SIGINT and on a nodelet unload (sim::RobotSim in-process).
 add_rostest_gtest(test_safe_motion test/rostest/safe_motion.test test/rostest/test_safe_motion.cpp)

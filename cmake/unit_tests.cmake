@@ -57,3 +57,10 @@ target_link_libraries(trajectory_tests srd_core gtest_main)
 catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp)
 target_include_directories(trajectory_ros_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(trajectory_ros_tests srd_ros gtest_main)
+
+# Runtime tuning: the dynamic_reconfigure .cfg files agree with the parameter table, and what of a
+# change applies (no roscore needed).
+catkin_add_gtest(runtime_tuning_tests test/unit/test_runtime_tuning.cpp)
+target_include_directories(runtime_tuning_tests PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(runtime_tuning_tests srd_ros gtest_main)
+add_dependencies(runtime_tuning_tests ${PROJECT_NAME}_gencfg)

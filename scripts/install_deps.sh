@@ -25,6 +25,8 @@ PACKAGES=(
 # The robot description (robot_description, description.launch, view.launch) and its tests.
 PACKAGES+=(libyaml-cpp-dev liburdf-dev liburdfdom-tools ros-robot-state-publisher
            joint-state-publisher topic-tools rviz)
+# Runtime tuning: the dynamic_reconfigure server, its .cfg generator, its Python client and dynparam.
+PACKAGES+=(libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure)
 # --dev: what scripts/screenshot_view.sh needs to remake docs/images/ (a virtual display, a grab).
 [ "${1:-}" != "--dev" ] || PACKAGES+=(xvfb imagemagick)
 

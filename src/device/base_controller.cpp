@@ -103,7 +103,9 @@ void BaseController::resetOdometry() {
 }
 
 void BaseController::onImuYaw(double yaw, Clock::time_point stamp) {
-  if (config_.use_imu_heading) heading_.addSample(yaw, stamp);
+  // Stored even while use_imu_heading is off (addSample only copies two values under its own
+  // lock): config_ belongs to the loop's lock, and retune may switch the fusion on at any time.
+  heading_.addSample(yaw, stamp);
 }
 
 bool BaseController::sendReset() {
@@ -153,6 +155,51 @@ void BaseController::stop() {
     }
   }
   if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
+}
+
+void BaseController::retune(const BaseConfig& next) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = clock_->now();
+  // The motion so far, and the wheel angles so far, with the geometry they ran under.
+  advanceOdometryLocked(now);
+  wheel_angles_at_retune_ +=
+      (wheel_travel_ - travel_at_retune_) / (config_.geometry.wheel_diameter / 2.0);
+  travel_at_retune_ = wheel_travel_;
+  kinematics::DiffDriveGeometry geometry = config_.geometry;
+  geometry.wheel_diameter = next.geometry.wheel_diameter;
+  geometry.wheel_separation = next.geometry.wheel_separation;
+  // The base goes on running the ticks it accepted last; with the new geometry they stand for
+  // other speeds (a corrected diameter is the truth about what the wheels did all along).
+  held_speeds_ *= config_.geometry.ticksPerPeriodPerMps() / geometry.ticksPerPeriodPerMps();
+  config_.geometry = geometry;
+  config_.max_wheel_speed = next.max_wheel_speed;
+  config_.max_wheel_accel = next.max_wheel_accel;
+  config_.cmd_vel_timeout = next.cmd_vel_timeout;
+  config_.speed_dithering = next.speed_dithering;
+  limiter_.setMaxAccel(next.max_wheel_accel);
+  quantizer_.retune(geometry, next.speed_dithering);
+  odometry_.setWheelSeparation(geometry.wheel_separation);
+  if (next.use_imu_heading != config_.use_imu_heading) {
+    // On: anchored where odometry stands now; off: the commanded turn goes on from the last fused
+    // heading. Either way the heading does not jump.
+    if (next.use_imu_heading) heading_.restart();
+    config_.use_imu_heading = next.use_imu_heading;
+  }
+  if (next.battery_poll_rate != config_.battery_poll_rate) {
+    if (next.battery_poll_rate > 0) {
+      // A faster rate starts now, not after the slower period still pending.
+      next_battery_poll_ = std::min(next_battery_poll_, now + fromSeconds(1.0 / next.battery_poll_rate));
+    } else {
+      unanswered_since_.reset();  // no requests, nothing unanswered
+      silent_reported_ = false;
+    }
+    config_.battery_poll_rate = next.battery_poll_rate;
+  }
+}
+
+BaseConfig BaseController::config() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return config_;
 }
 
 BaseStats BaseController::stats() const {
@@ -331,6 +378,9 @@ OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const
     sample.wheel_speeds = held_speeds_;
   }
   sample.wheel_travel = wheel_travel_;
+  const double radius = config_.geometry.wheel_diameter / 2.0;
+  sample.wheel_angles = wheel_angles_at_retune_ + (wheel_travel_ - travel_at_retune_) / radius;
+  sample.wheel_rates = sample.wheel_speeds / radius;
   sample.position_variance = odometry_.positionVariance();
   sample.yaw_variance = odometry_.yawVariance();
   sample.travelled = odometry_.travelled();

@@ -66,6 +66,21 @@ void ServoBus::dropQueuedMoves(uint8_t id) {
                       queued_moves_.end());
 }
 
+void ServoBus::retune(const ServoBusConfig& next) {
+  client_.retune(next.client.timeout, next.client.retries);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    poll_period_ = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(1.0 / next.poll_rate));
+    const Clock::time_point soonest = clock_->now() + poll_period_;
+    for (PolledServo& servo : polled_) {
+      // A servo in back-off keeps its back-off; the others are due within the new period.
+      if (servo.backoff.count() == 0) servo.next_poll = std::min(servo.next_poll, soonest);
+    }
+  }
+  wake_.notify_all();  // the worker may be waiting for a poll that is now due earlier
+}
+
 void ServoBus::start() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (started_ || stop_) return;
@@ -91,6 +106,9 @@ ServoBusWorkerStats ServoBus::stats() const {
   for (const PolledServo& servo : polled_) {
     if (servo.backoff.count() > 0) stats.offline_ids.push_back(servo.id);
   }
+  const double poll_rate = 1.0 / std::chrono::duration<double>(poll_period_).count();
+  stats.asked_poll_rate =
+      poll_rate * static_cast<double>(polled_.size() - stats.offline_ids.size());
   return stats;
 }
 

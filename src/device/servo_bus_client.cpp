@@ -137,24 +137,29 @@ void ServoBusClient::onFrame(protocol::FrameFamily family, const uint8_t* data, 
   if (family != protocol::FrameFamily::kServoResponse) return;  // another device on this port
 
   const protocol::Decoded<servo::Packet> packet = servo::decodeResponse(data, size);
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  if (!packet.ok()) {
-    ++stats_.garbled;
-    return;
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    if (!packet.ok()) {
+      ++stats_.garbled;
+      return;
+    }
+    if (!pending_.active || pending_.answered || pending_.garbled || !matches(*packet)) {
+      ++stats_.mismatched;
+      return;
+    }
+    if (packet->content_size != pending_.expect.content_size) {
+      ++stats_.garbled;
+      pending_.garbled = true;
+    } else {
+      pending_.answered = true;
+    }
+    pending_.answer = *packet;
+    pending_.arrival = arrival;
   }
-  if (!pending_.active || pending_.answered || pending_.garbled || !matches(*packet)) {
-    ++stats_.mismatched;
-    return;
-  }
-  if (packet->content_size != pending_.expect.content_size) {
-    ++stats_.garbled;
-    pending_.garbled = true;
-  } else {
-    pending_.answered = true;
-  }
-  pending_.answer = *packet;
-  pending_.arrival = arrival;
-  answer_cv_.notify_all();
+  // Notified after the unlock: a caller woken while this thread still held state_mutex_ would
+  // only block on it again (one more sleep and wake-up per transaction on a busy bus). Only the
+  // transaction's own caller waits, and it cannot leave before its predicate holds.
+  answer_cv_.notify_one();
 }
 
 ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const Expectation& expect,
@@ -224,9 +229,21 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
                   std::to_string(timeout.count()) + " ms (" + attemptsText(attempts) + ")");
 }
 
+ServoBusOptions ServoBusClient::options() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return options_;
+}
+
+void ServoBusClient::retune(std::chrono::milliseconds timeout, int retries) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  options_.timeout = timeout;
+  options_.retries = retries;
+}
+
 ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
                                            const Expectation& expect, servo::Packet* answer) {
-  return transact(request, expect, options_.timeout, options_.retries + 1, answer);
+  const ServoBusOptions options = this->options();  // one transaction, one set of options
+  return transact(request, expect, options.timeout, options.retries + 1, answer);
 }
 
 ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const Expectation& expect,
@@ -258,7 +275,7 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
   ServoStatus status =
-      transact(request, Expectation(cmd, id), motion_time + options_.timeout, 1, &answer);
+      transact(request, Expectation(cmd, id), motion_time + options().timeout, 1, &answer);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";

@@ -38,7 +38,7 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
     // Background work makes one attempt: the next poll is the retry.
     bus_mutex_.lockBackground();
     std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
-    status = transact(request, expect, options_.timeout, 1, &answer);
+    status = transact(request, expect, options().timeout, 1, &answer);
     std::lock_guard<std::mutex> lock(state_mutex_);
     answered_at = pending_.arrival;
   } else {
@@ -52,6 +52,8 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
   if (!decoded) return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable angle");
   if (arrival != nullptr) *arrival = answered_at;
   *angle_deg = decoded->angle_decidegrees / kDecidegreesPerDegree;
+  // The poll reads no message: it would cost a formatted string on every transaction.
+  if (priority == BusPriority::kBackground) return ok({});
   char text[32];
   std::snprintf(text, sizeof(text), "%.1f deg", *angle_deg);
   return ok(servoName(id) + " is at " + text);
@@ -76,7 +78,7 @@ ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* rea
 
 ServoStatus ServoBusClient::pingOnceLocked(uint8_t id) {
   servo::Packet answer;
-  return transact(servo::encodePing(id), Expectation(Command::kPing, id), options_.timeout, 1,
+  return transact(servo::encodePing(id), Expectation(Command::kPing, id), options().timeout, 1,
                   &answer);
 }
 

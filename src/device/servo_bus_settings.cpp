@@ -189,10 +189,11 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
   expect.alt_id = kDefaultServoId;  // the reset moves the servo to id 0 and it may answer there
   std::lock_guard<BusMutex> bus(bus_mutex_);
   ServoStatus last;
-  for (int attempt = 1; attempt <= options_.retries + 1; ++attempt) {
+  const ServoBusOptions options = this->options();  // the same for every attempt
+  for (int attempt = 1; attempt <= options.retries + 1; ++attempt) {
     servo::Packet answer;
     // One attempt at a time: a re-sent reset would go to an id the servo may have left already.
-    last = transact(servo::encodeResetUserData(id), expect, options_.timeout, 1, &answer);
+    last = transact(servo::encodeResetUserData(id), expect, options.timeout, 1, &answer);
     if (last.ok()) {
       if (refused(answer)) {
         return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");

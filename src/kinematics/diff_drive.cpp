@@ -68,6 +68,12 @@ WheelSpeeds AccelerationLimiter::step(const WheelSpeeds& target, double dt) {
 TickQuantizer::TickQuantizer(const DiffDriveGeometry& geometry, bool dithering)
     : ticks_per_period_per_mps_(geometry.ticksPerPeriodPerMps()), dithering_(dithering) {}
 
+void TickQuantizer::retune(const DiffDriveGeometry& geometry, bool dithering) {
+  ticks_per_period_per_mps_ = geometry.ticksPerPeriodPerMps();
+  dithering_ = dithering;
+  if (!dithering_) remainder_.setZero();
+}
+
 Eigen::Vector2d TickQuantizer::exactTicks(const WheelSpeeds& speeds) const {
   return sanitized(speeds) * ticks_per_period_per_mps_;
 }

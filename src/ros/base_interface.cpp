@@ -74,7 +74,7 @@ device::BaseEvents BaseInterface::events() {
   events.on_odometry = [this](const device::OdometrySample& sample) { publishOdometry(sample); };
   events.on_cmd_vel_timeout = [this] {
     ROS_INFO_THROTTLE(10.0, "no cmd_vel for %.2f s (base/cmd_vel_timeout): commanding zero speed",
-                      params_.cmd_vel_timeout);
+                      tuned().cmd_vel_timeout);
   };
   events.on_silent = [this](double seconds) {
     ROS_ERROR_THROTTLE(10.0,
@@ -105,6 +105,8 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
     : link_(link),
       arrival_stamps_(params),
       params_(params.base),
+      tuned_{params.base.publish_tf, params.base.cmd_vel_timeout, params.base.battery_warn_percent,
+             params.base.battery_error_percent},
       tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
                                              : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
@@ -171,7 +173,9 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom_pub_.publish(odom);
   publishWheelStates(sample, stamp);
 
-  if (!tf_broadcaster_) return;
+  if (!tuned().publish_tf) return;
+  // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
+  if (!tf_broadcaster_) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
   geometry_msgs::TransformStamped transform;
   transform.header = odom.header;
   transform.child_frame_id = odom.child_frame_id;
@@ -183,14 +187,26 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
 
 void BaseInterface::publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp) {
   // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
-  const double radius = params_.wheel_diameter / 2.0;
   sensor_msgs::JointState wheels;
   wheels.header.stamp = stamp;
   wheels.header.frame_id = params_.base_frame;
   wheels.name = {params_.left_wheel_joint, params_.right_wheel_joint};
-  wheels.position = {sample.wheel_travel.x() / radius, sample.wheel_travel.y() / radius};
-  wheels.velocity = {sample.wheel_speeds.x() / radius, sample.wheel_speeds.y() / radius};
+  // In rad, from the controller: with the diameter each stretch of travel ran under.
+  wheels.position = {sample.wheel_angles.x(), sample.wheel_angles.y()};
+  wheels.velocity = {sample.wheel_rates.x(), sample.wheel_rates.y()};
   wheel_states_pub_.publish(wheels);
+}
+
+BaseInterface::Tuned BaseInterface::tuned() const {
+  std::lock_guard<std::mutex> lock(tuned_mutex_);
+  return tuned_;
+}
+
+void BaseInterface::retune(const DriverParams& params) {
+  controller_.retune(makeBaseConfig(params));
+  std::lock_guard<std::mutex> lock(tuned_mutex_);
+  tuned_ = Tuned{params.base.publish_tf, params.base.cmd_vel_timeout,
+                 params.base.battery_warn_percent, params.base.battery_error_percent};
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -236,12 +252,13 @@ void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   }
   if (s.battery_percent) {
     const int percent = *s.battery_percent;
-    if (percent < params_.battery_error_percent) {
+    const Tuned limits = tuned();
+    if (percent < limits.battery_error_percent) {
       status.mergeSummaryf(DiagnosticStatus::ERROR, "battery %d %% (below %d %%)", percent,
-                           params_.battery_error_percent);
-    } else if (percent < params_.battery_warn_percent) {
+                           limits.battery_error_percent);
+    } else if (percent < limits.battery_warn_percent) {
       status.mergeSummaryf(DiagnosticStatus::WARN, "battery %d %% (below %d %%)", percent,
-                           params_.battery_warn_percent);
+                           limits.battery_warn_percent);
     }
   }
   if (s.e_stop) status.mergeSummary(DiagnosticStatus::WARN, "e-stop engaged: holding zero speed");

@@ -16,7 +16,7 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)
     : link_(link),
       arrival_stamps_(params),
-      imu_params_(params.imu),
+      imu_params_(std::make_shared<const ImuParams>(params.imu)),
       controller_(
           makeBodyJoints(params.body), link.writer(),
           {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
@@ -36,6 +36,10 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());
   link.addListener(&controller_);
+}
+
+void BodyInterface::retune(const DriverParams& params) {
+  std::atomic_store(&imu_params_, std::make_shared<const ImuParams>(params.imu));
 }
 
 void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
@@ -60,9 +64,10 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   if (joint_states_pub_.getNumSubscribers() > 0) {
     joint_states_pub_.publish(joint_state);
   }
-  if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, imu_params_), arrival);
+  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
+  if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, *imu), arrival);
   if (imu_pub_.getNumSubscribers() > 0) {
-    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, imu_params_, stamp)));
+    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp)));
   }
   if (foot_pressure_pub_.getNumSubscribers() > 0) {
     if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);

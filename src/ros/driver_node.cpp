@@ -7,6 +7,7 @@
 
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
+#include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/servo_bus_interface.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/ros/wire_capture.h"
@@ -134,7 +135,8 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     });
     device->addDiagnostics(diagnostics_);
   }
-  if (params_.base.use_imu_heading) connectImuHeading();
+  // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
+  connectImuHeading();
   // One trajectory server for the joints of every device, so one goal may span them.
   std::vector<TrajectoryJoints> trajectory_joints;
   for (auto& device : devices_) {
@@ -150,6 +152,11 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
+  // Runtime tuning: a server per group under ~ (~base, ~imu, ...), starting from params_.
+  std::vector<DeviceInterface*> tunable;
+  for (auto& device : devices_) tunable.push_back(device.get());
+  tuning_ =
+      std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable), trajectory_.get());
   diagnostics_timer_ = nh_.createSteadyTimer(
       ros::WallDuration(diagnostics_period_),
       [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
@@ -253,6 +260,7 @@ std::string DriverNode::startupSummary() const {
 void DriverNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  if (tuning_) tuning_->stop();  // no retune while the devices stop
   diagnostics_timer_.stop();
   e_stop_sub_.shutdown();
   if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <functional>
 #include <optional>
@@ -369,12 +370,17 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
                                        this, ros::TransportHints().tcpNoDelay());
 }
 
+void ServoBusInterface::retune(const DriverParams& params) {
+  bus_.retune(makeServoBusConfig(params));
+  command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
+}
+
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
   if (!refuseWhileEStopped("servo_commands").ok()) {
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands refused, nothing sent: e_stop is engaged");
     return;
   }
-  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_);
+  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_.load());
   if (!batch.error.empty()) {
     commands_rejected_.fetch_add(1);
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
@@ -503,9 +509,10 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("echoes skipped", stats.echoes);
   status.addf("last latency (ms)", "%.2f", stats.last_latency_ms);
   status.addf("max latency (ms)", "%.2f", stats.max_latency_ms);
-  status.add("timeout (ms)", static_cast<int>(client_.options().timeout.count()));
-  status.add("retries per transaction", client_.options().retries);
-  status.add("dangerous writes armed", client_.options().allow_dangerous_writes);
+  const device::ServoBusOptions options = client_.options();
+  status.add("timeout (ms)", static_cast<int>(options.timeout.count()));
+  status.add("retries per transaction", options.retries);
+  status.add("dangerous writes armed", options.allow_dangerous_writes);
 
   const device::ServoBusWorkerStats worker = bus_.stats();
   std::string offline;
@@ -527,6 +534,37 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   if (!offline.empty() && link_.connected()) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                         "polled servos not answering: " + offline);
+  }
+
+  // Asked vs achieved: the state_rate in force for every answering polled servo, against the
+  // angles read over the window. A line too slow for what was asked (or service calls taking
+  // the bus) shows here rather than as a silently lower rate.
+  // The achieved rate is measured over at least kRateWindowS, so one slow transaction (a silent
+  // servo's timeout, a long service call) does not flag a line that keeps up on average.
+  constexpr double kRateWindowS = 2.0;
+  const auto now = std::chrono::steady_clock::now();
+  const double asked = worker.asked_poll_rate;
+  if (last_rate_check_ == std::chrono::steady_clock::time_point{}) {
+    last_rate_check_ = now;
+    polls_at_last_check_ = worker.angles_polled;
+  }
+  const double seconds = std::chrono::duration<double>(now - last_rate_check_).count();
+  if (seconds >= kRateWindowS) {
+    achieved_rate_ = static_cast<double>(worker.angles_polled - polls_at_last_check_) / seconds;
+    polls_at_last_check_ = worker.angles_polled;
+    last_rate_check_ = now;
+  }
+  status.addf("servo_states asked (per s)", "%.1f", asked);
+  if (achieved_rate_ < 0) return;  // the first window is not over yet
+  status.addf("servo_states achieved (per s)", "%.1f", achieved_rate_);
+  // 10 % of slack for the window's own jitter; a saturated line falls far below it.
+  if (link_.connected() && asked > 0 && achieved_rate_ < 0.9 * asked) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
+                  "service calls are the limit: lower ~servo_bus/state_rate or raise the baud)",
+                  asked, achieved_rate_);
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
   }
 }
 

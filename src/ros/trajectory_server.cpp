@@ -136,6 +136,11 @@ long TrajectoryServer::staleJoint(const std::vector<Measured>& measured,
   return -1;
 }
 
+void TrajectoryServer::retune(const TrajectoryParams& defaults) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  defaults_ = defaults;
+}
+
 TrajectoryServer::Result TrajectoryServer::result(int code, const std::string& message) {
   Result result;
   result.error_code = code;

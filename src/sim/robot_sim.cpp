@@ -3,11 +3,11 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/ioctl.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <fstream>
@@ -33,8 +33,9 @@ constexpr std::size_t kMaxBacklogBytes = 16 * 1024;
 constexpr auto kDrainTimeout = std::chrono::milliseconds(250);
 constexpr auto kReplugRetry = std::chrono::seconds(1);
 constexpr std::size_t kMaxGarbageBurst = 24;
-/// With --pace-baud, what the line carries in this much time goes into the pty at once: a finer
-/// slice would only wake the simulator more often.
+/// With --pace-baud, a long frame goes into the pty in pieces of what the line carries in this
+/// much time: a finer slice would only wake the simulator more often. A shorter frame goes in
+/// whole once its last bit is through the line, as a UART reader would see it complete.
 constexpr auto kPaceSlice = std::chrono::milliseconds(2);
 
 void setNonBlocking(int fd) {
@@ -63,6 +64,7 @@ struct RobotSim::Port {
     bool is_frame = true;  ///< false for garbage bursts
     OutputKind kind = OutputKind::kBaseReply;
     bool damaged = false;
+    TimePoint ready_at{};  ///< --pace-baud: the line carries it from then on, not before
   };
 
   std::string link;
@@ -140,7 +142,9 @@ void RobotSim::start() {
     port->framer = std::make_unique<protocol::StreamFramer>(
         protocol::FramerConfig::forSimulator(),
         [this, raw](FrameFamily family, const uint8_t* data, std::size_t size) {
-          const TimePoint at = Clock::now();
+          // Paced: the request arrived when its last bit was through the line, not when this
+          // thread woke up to feed it.
+          const TimePoint at = rx_frame_end_ == TimePoint{} ? Clock::now() : rx_frame_end_;
           Outbox outbox;
           if (family == FrameFamily::kBase && base_port_ == raw) {
             base_->handleFrame(data, size, at, &outbox);
@@ -244,7 +248,9 @@ void RobotSim::send(Port* port, Outgoing frame) {
     return;
   }
   port->backlog_bytes += bytes.size();
-  port->backlog.push_back(Port::PendingWrite{std::move(bytes), 0, true, frame.kind, damaged});
+  const TimePoint ready_at = frame.ready_at == TimePoint{} ? Clock::now() : frame.ready_at;
+  port->backlog.push_back(
+      Port::PendingWrite{std::move(bytes), 0, true, frame.kind, damaged, ready_at});
   flush(port);
 }
 
@@ -253,39 +259,46 @@ Clock::duration RobotSim::lineTime(std::size_t bytes) const {
       std::chrono::duration<double>(10.0 * static_cast<double>(bytes) / options_.pace_baud));
 }
 
+TimePoint RobotSim::nextSendAt(const Port* port) const {
+  if (port->backlog.empty()) return TimePoint::max();
+  const Port::PendingWrite& pending = port->backlog.front();
+  const TimePoint line_start = std::max(port->tx_line_free, pending.ready_at);
+  const std::size_t slice_bytes = std::max<std::size_t>(
+      1, static_cast<std::size_t>(options_.pace_baud / 10.0 *
+                                  std::chrono::duration<double>(kPaceSlice).count()));
+  return line_start + lineTime(std::min(pending.bytes.size() - pending.offset, slice_bytes));
+}
+
 void RobotSim::flush(Port* port) {
   if (!port->pty || !port->pty->isOpen()) return;
   const int fd = port->pty->masterFd();
-  // Paced: nothing while the line still carries earlier bytes, then one slice's worth, plus what
-  // the line could have carried while this thread woke up late (at most another slice), so the
-  // average rate is the baud rate's, not less.
-  std::size_t allowance = SIZE_MAX;
-  TimePoint line_start{};
-  if (options_.pace_baud > 0) {
-    const TimePoint now = Clock::now();
-    if (now < port->tx_line_free) return;
-    line_start = std::max(port->tx_line_free, now - kPaceSlice);
-    const double seconds = std::chrono::duration<double>(now - line_start + kPaceSlice).count();
-    allowance =
-        std::max<std::size_t>(1, static_cast<std::size_t>(options_.pace_baud / 10.0 * seconds));
-  }
-  while (!port->backlog.empty() && allowance > 0) {
+  const bool paced = options_.pace_baud > 0;
+  const TimePoint now = paced ? Clock::now() : TimePoint{};
+  while (!port->backlog.empty()) {
     Port::PendingWrite& pending = port->backlog.front();
-    const std::size_t remaining = std::min(pending.bytes.size() - pending.offset, allowance);
+    std::size_t remaining = pending.bytes.size() - pending.offset;
+    TimePoint line_start{};
+    if (paced) {
+      // Paced: once the next slice (or the whole of a short frame) is through, the bytes whose
+      // last bit is through the line by now (the line carries a frame from when it is ready,
+      // after what it carried before). A late wake-up delivers late but never stretches the
+      // line: tx_line_free follows the line's own clock, not this thread's.
+      if (now < nextSendAt(port)) return;
+      line_start = std::max(port->tx_line_free, pending.ready_at);
+      const auto through = static_cast<std::size_t>((now - line_start) / lineTime(1));
+      remaining = std::min(remaining, through);
+      if (remaining == 0) return;
+    }
     const ssize_t written = ::write(fd, pending.bytes.data() + pending.offset, remaining);
     if (written < 0) {
       if (errno == EINTR) continue;
       return;  // EAGAIN: the host is not reading right now; retry when poll says writable
     }
-    if (options_.pace_baud > 0) {
-      allowance -= static_cast<std::size_t>(written);
-      line_start += lineTime(static_cast<std::size_t>(written));
-      port->tx_line_free = line_start;
-    }
+    if (paced) port->tx_line_free = line_start + lineTime(static_cast<std::size_t>(written));
     counters_.bytes_sent += static_cast<uint64_t>(written);
     port->backlog_bytes -= static_cast<std::size_t>(written);
     pending.offset += static_cast<std::size_t>(written);
-    if (pending.offset < pending.bytes.size()) return;
+    if (pending.offset < pending.bytes.size()) continue;
     if (pending.is_frame) {
       SendCounters& counters = counters_.sent[static_cast<std::size_t>(pending.kind)];
       ++(pending.damaged ? counters.damaged : counters.intact);
@@ -340,8 +353,10 @@ void RobotSim::step(TimePoint now) {
     Port* port = owned.get();
     while (!port->rx_in_flight.empty() && port->rx_in_flight.front().first <= now) {
       const std::vector<uint8_t> bytes = std::move(port->rx_in_flight.front().second);
+      rx_frame_end_ = port->rx_in_flight.front().first;
       port->rx_in_flight.pop_front();
       port->framer->feed(bytes.data(), bytes.size());
+      rx_frame_end_ = TimePoint{};
     }
   }
   Outbox outbox;
@@ -383,6 +398,7 @@ void RobotSim::step(TimePoint now) {
             std::uniform_int_distribution<std::size_t>(1, kMaxGarbageBurst)(port->rng);
         Port::PendingWrite junk;
         junk.is_frame = false;
+        junk.ready_at = now;
         for (std::size_t i = 0; i < length; ++i) {
           junk.bytes.push_back(
               static_cast<uint8_t>(std::uniform_int_distribution<int>(0, 255)(port->rng)));
@@ -405,10 +421,15 @@ void RobotSim::step(TimePoint now) {
 }
 
 void RobotSim::run() {
+  // Wake up on time: the kernel's default 50 us of timer slack would add to every paced byte and
+  // every answer latency.
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   std::vector<pollfd> fds;
   std::vector<Port*> fd_ports;
   std::array<uint8_t, 4096> buffer{};
-  int timeout_ms = 0;
+  // The wait to the next event in ns (ppoll): a poll timeout in whole ms would round every paced
+  // byte, answer latency and timer up to the next ms.
+  Clock::duration wait{0};
   while (!stop_requested_) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -420,13 +441,16 @@ void RobotSim::run() {
         if (!port->plugged || !port->pty) continue;
         // Paced: no POLLOUT while the line is busy, or poll would return at once until it frees.
         const bool may_send = !port->backlog.empty() &&
-                              (options_.pace_baud == 0 || Clock::now() >= port->tx_line_free);
+                              (options_.pace_baud == 0 || Clock::now() >= nextSendAt(port.get()));
         const short events = may_send ? (POLLIN | POLLOUT) : POLLIN;
         fds.push_back(pollfd{port->pty->masterFd(), events, 0});
         fd_ports.push_back(port.get());
       }
     }
-    ::poll(fds.data(), fds.size(), timeout_ms);
+    const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
+    const timespec timeout{static_cast<time_t>(wait_ns / 1000000000),
+                           static_cast<long>(wait_ns % 1000000000)};  // NOLINT: timespec's type
+    ::ppoll(fds.data(), fds.size(), &timeout, nullptr);
     if (stop_requested_) break;
 
     std::lock_guard<std::mutex> lock(mutex_);
@@ -460,12 +484,10 @@ void RobotSim::run() {
     for (auto& port : ports_) {
       next = std::min({next, port->next_unplug, port->replug_at, port->next_garbage});
       if (port->draining) next = std::min(next, now + std::chrono::milliseconds(5));
-      if (!port->backlog.empty() && options_.pace_baud > 0)
-        next = std::min(next, port->tx_line_free);
+      if (options_.pace_baud > 0) next = std::min(next, nextSendAt(port.get()));
       if (!port->rx_in_flight.empty()) next = std::min(next, port->rx_in_flight.front().first);
     }
-    const double wait_ms = std::chrono::duration<double, std::milli>(next - now).count();
-    timeout_ms = wait_ms <= 0 ? 0 : static_cast<int>(std::ceil(wait_ms));
+    wait = std::max(Clock::duration::zero(), next - Clock::now());
   }
 }
 

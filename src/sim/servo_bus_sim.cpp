@@ -470,7 +470,8 @@ void ServoBusSim::tick(TimePoint now, Outbox* out) {
     if (drift) driftReadOnly(&s);
   }
   while (!pending_.empty() && pending_.front().due <= now) {
-    out->push_back(Outgoing{OutputKind::kServoResponse, std::move(pending_.front().bytes)});
+    out->push_back(Outgoing{OutputKind::kServoResponse, std::move(pending_.front().bytes),
+                            pending_.front().due});
     pending_.pop_front();
     ++stats_.answers;
   }

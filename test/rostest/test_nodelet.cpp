@@ -1,6 +1,7 @@
 // DriverNodelet in a nodelet manager (nodelet.test): it drives the base like driver_node, names
 // its diagnostics after itself (not after the manager), and leaves a zero-speed frame as the last
 // frame on the wire both when it is unloaded and when its manager is stopped with SIGINT.
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <nodelet/NodeletLoad.h>
@@ -124,6 +125,23 @@ TEST(DriverNodelet, DrivesAndStopsTheWheelsOnUnload) {
   ASSERT_TRUE(waitFor([&] { return diagnostics.latest("base").received > 0; }, 10.0));
   EXPECT_GT(diagnostics.latest("port " + port).received, 0u);
   EXPECT_EQ(diagnostics.latest("port " + port).value("path"), port);
+
+  // The nodelet offers the node's runtime tuning: ~base's dynamic_reconfigure server.
+  dynamic_reconfigure::Reconfigure tune;
+  dynamic_reconfigure::DoubleParameter limit;
+  limit.name = "max_wheel_speed";
+  limit.value = 0.3;
+  tune.request.config.doubles.push_back(limit);
+  ASSERT_TRUE(ros::service::waitForService("/driver_node/base/set_parameters", 10000));
+  ASSERT_TRUE(ros::service::call("/driver_node/base/set_parameters", tune));
+  bool answered = false;
+  for (const auto& value : tune.response.config.doubles) {
+    if (value.name == "max_wheel_speed") answered = value.value == 0.3;
+  }
+  EXPECT_TRUE(answered) << "the answer shows the new limit";
+  double in_force = 0;
+  ASSERT_TRUE(ros::param::get("/driver_node/base/max_wheel_speed", in_force));
+  EXPECT_DOUBLE_EQ(in_force, 0.3);
 
   nodelet::NodeletUnload unload;
   unload.request.name = "/driver_node";

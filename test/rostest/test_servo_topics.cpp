@@ -131,6 +131,20 @@ TEST_F(ServoTopics, ABadMessageIsRejectedWholeAndNothingIsSent) {
       kWaitSeconds));
 }
 
+TEST_F(ServoTopics, DiagnosticsCompareTheAskedAndTheAchievedReadRate) {
+  ros::NodeHandle nh;
+  const test_support::DiagnosticsWatch diagnostics(nh, "driver_node");
+  // Servos 1 and 2 answer at 20 Hz each; servo 7 is silent, in back-off, and not asked for.
+  EXPECT_TRUE(waitFor(
+      [&] {
+        const auto status = diagnostics.latest(kServoBusStatus);
+        return status.number("servo_states asked (per s)") == 40.0 &&
+               status.number("servo_states achieved (per s)") > 0.0;
+      },
+      kWaitSeconds))
+      << "no servo_states asked/achieved rates in the diagnostics";
+}
+
 TEST_F(ServoTopics, AServoThatDoesNotAnswerIsSkippedAndReported) {
   ros::NodeHandle nh;
   const test_support::DiagnosticsWatch diagnostics(nh, "driver_node");

@@ -102,7 +102,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.servo_bus.state_ids = {1, 255}; }},
         BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.servo_bus.state_ids = {4, 4}; }},
         BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 0; }},
-        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 1000; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 1001; }},
         BadCase{"servo_bus/command_interval_ms",
                 [](DriverParams& p) { p.servo_bus.command_interval_ms = 70000; }},
         BadCase{"servo_bus/on_shutdown", [](DriverParams& p) { p.servo_bus.on_shutdown = "halt"; }},

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <condition_variable>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "serial_robot_driver/device/servo_bus.h"
@@ -19,6 +22,15 @@ namespace {
 using Bytes = std::vector<uint8_t>;
 using std::chrono::milliseconds;
 using namespace golden::servo;  // NOLINT: the shared golden frames
+
+/// Polls `condition` until it holds or a generous timeout passes (threads of the bus run on).
+bool waitFor(const std::function<bool()>& condition) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!condition() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(milliseconds(1));
+  }
+  return condition();
+}
 
 class ServoBusTest : public ::testing::Test {
  protected:
@@ -51,8 +63,10 @@ class ServoBusTest : public ::testing::Test {
   bool write(const Bytes& frame) {
     Bytes reply;
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::unique_lock<std::mutex> lock(mutex_);
       written_.push_back(frame);
+      // A gated frame stays "on the wire" (the writer does not return) until the test opens it.
+      gate_opened_.wait(lock, [&] { return frame != gated_frame_; });
       auto it = answers_.find(frame);
       if (it == answers_.end()) return true;
       reply = it->second;
@@ -80,6 +94,8 @@ class ServoBusTest : public ::testing::Test {
   std::vector<std::pair<uint8_t, milliseconds>> silent_;
   std::vector<std::pair<uint8_t, ServoError>> failed_moves_;
   std::unique_ptr<ServoBus> bus_;
+  std::condition_variable gate_opened_;
+  Bytes gated_frame_;  // guarded by mutex_
 };
 
 TEST_F(ServoBusTest, PollsEachServoOncePerPeriod) {
@@ -171,6 +187,53 @@ TEST_F(ServoBusTest, RefusedMoveIsReportedAndNothingIsWritten) {
   EXPECT_EQ(bus_->stats().moves_failed, 1u);
 }
 
+// A call waits for the one transaction in progress, never for the polls that fall due meanwhile:
+// while servo 3's PING holds the bus, servo 0's poll falls due and another call (PING 5) comes;
+// when the bus frees, the call goes first and the poll after it.
+TEST_F(ServoBusTest, AWaitingCallGoesBeforeAPollThatFellDue) {
+  const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
+  answers_[kPing3] = kPing3Reply;
+  answers_[kPing5] = kPing5Reply;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    gated_frame_ = kPing3;
+  }
+  makeBus({0});
+  ServoStatus first, second;
+  std::thread holder([&] { first = bus_->client().ping(3); });
+  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));  // the transaction in progress
+  bus_->start();  // servo 0's poll is due at once: the worker waits for the bus
+  std::thread caller([&] { second = bus_->client().ping(5); });
+  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    gated_frame_.clear();
+  }
+  gate_opened_.notify_all();
+  holder.join();
+  caller.join();
+  EXPECT_TRUE(first.ok()) << first.message;
+  EXPECT_TRUE(second.ok()) << second.message;
+  ASSERT_TRUE(waitFor([&] { return countWritten(kReadAngle0) == 1; }));  // the poll goes on
+  bus_->shutdown();
+  EXPECT_EQ(written(), (std::vector<Bytes>{kPing3, kPing5, kReadAngle0}));
+}
+
+TEST_F(ServoBusTest, AskedPollRateCountsTheServosNotInBackoffAtTheRateInForce) {
+  answers_.clear();  // neither servo answers
+  makeBus({0, 3});   // 10 Hz each
+  EXPECT_DOUBLE_EQ(bus_->stats().asked_poll_rate, 20.0);
+  ServoBusConfig faster = bus_->config();
+  faster.poll_rate = 50.0;
+  bus_->retune(faster);
+  EXPECT_DOUBLE_EQ(bus_->stats().asked_poll_rate, 100.0);
+  bus_->start();
+  // Both are silent: once in back-off they are not asked at the poll rate any more.
+  ASSERT_TRUE(waitFor([&] { return bus_->stats().offline_ids.size() == 2; }));
+  EXPECT_DOUBLE_EQ(bus_->stats().asked_poll_rate, 0.0);
+  bus_->shutdown();
+}
+
 TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
   makeBus({});
   bus_->start();
@@ -234,6 +297,28 @@ TEST_F(ServoBusTest, ShutdownSaysNothingWhenNoServoWasSetMoving) {
   const std::size_t before = written().size();
   bus_->shutdown();
   EXPECT_EQ(written().size(), before);
+}
+
+TEST_F(ServoBusTest, RetunedPollRateAppliesFromTheNextPollAndTimingFromTheNextTransaction) {
+  makeBus({0});
+  bus_->start();
+  clock_->waitForLoop();  // the first poll at t0; the next falls due at t0 + 100 ms
+  clock_->advance(milliseconds(20));
+  ServoBusConfig faster = bus_->config();
+  faster.poll_rate = 50.0;  // every 20 ms
+  faster.client.timeout = milliseconds(7);
+  faster.client.retries = 2;
+  clock_->step([&] { bus_->retune(faster); });
+  EXPECT_EQ(countWritten(kReadAngle0), 1u);
+  // Due 20 ms after the change, not at the 100 ms the old rate had scheduled.
+  clock_->advance(milliseconds(20));
+  EXPECT_EQ(countWritten(kReadAngle0), 2u);
+  clock_->advance(milliseconds(20));
+  EXPECT_EQ(countWritten(kReadAngle0), 3u);
+  EXPECT_EQ(bus_->client().options().timeout, milliseconds(7));
+  EXPECT_EQ(bus_->client().options().retries, 2);
+  bus_->shutdown();
+  EXPECT_EQ(angles_.size(), 3u);
 }
 
 }  // namespace

@@ -803,6 +803,28 @@ TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
   EXPECT_GE(elapsed_s, line_s - 0.001);
 }
 
+// The answer of a paced servo comes after the request's bits, the servo's latency and the
+// answer's bits, each on the line's clock: never sooner, and (checked by driver_bench, not here)
+// not later either.
+TEST(RobotSim, PacedServoAnswersAfterTheRequestTheLatencyAndTheAnswerOnTheLine) {
+  SimOptions options = onlyServoBus();
+  options.pace_baud = 9600;
+  options.servo_bus.answer_latency_s = 0.005;
+  RobotSim sim(options);
+  sim.start();
+  Host host(slaveOf(sim), servoHostConfig());
+  ASSERT_TRUE(host.ok());
+  for (int round = 0; round < 3; ++round) {
+    host.frames().clear();
+    const auto start = Clock::now();
+    host.send(kReadAngle0);
+    ASSERT_TRUE(host.waitForFrame(kReadAngle0ReplyZero, milliseconds(10000)));
+    const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+    const double line_s = (kReadAngle0.size() + kReadAngle0ReplyZero.size()) * 10.0 / 9600.0;
+    EXPECT_GE(elapsed_s, line_s + 0.005 - 0.0005);
+  }
+}
+
 TEST(RobotSim, ServoFaultsGarbleOrSuppressAnswers) {
   SimOptions options = onlyServoBus();
   options.faults.servo_fault_rate = 1.0;

@@ -81,6 +81,11 @@ struct OdometrySample {
   kinematics::WheelSpeeds wheel_travel = kinematics::WheelSpeeds::Zero();
   /// Each wheel's speed (left, right; m/s) the base runs at now (0 once its timeout stopped it).
   kinematics::WheelSpeeds wheel_speeds = kinematics::WheelSpeeds::Zero();
+  /// Each wheel's angle (left, right; rad): wheel_travel through the wheel radius, continuous
+  /// when the diameter is retuned (the travel before a change keeps the radius it had).
+  kinematics::WheelSpeeds wheel_angles = kinematics::WheelSpeeds::Zero();
+  /// wheel_speeds as the wheels' angular speeds (rad/s) with the diameter in force.
+  kinematics::WheelSpeeds wheel_rates = kinematics::WheelSpeeds::Zero();
   /// Where the heading came from (kImu only with use_imu_heading).
   bool imu_heading = false;
 };
@@ -167,6 +172,16 @@ class BaseController : public LinkListener {
   /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.
   bool sendClearEncoders();
 
+  /// Applies the tunable part of `next` from the next frame on, all at once (under the loop's
+  /// lock): geometry.wheel_diameter and .wheel_separation, max_wheel_speed, max_wheel_accel,
+  /// cmd_vel_timeout, speed_dithering, battery_poll_rate, use_imu_heading. Everything else in `next` is ignored
+  /// (it needs a new controller). No Reset, the sequence goes on, the odometry keeps its pose:
+  /// the motion up to now is integrated with the geometry it ran under, from now on with the new
+  /// one. Expects validated values.
+  void retune(const BaseConfig& next);
+  /// The configuration in force.
+  BaseConfig config() const;
+
   void start();
   /// Stops the loop and writes one zero-speed frame, so the robot stops before the port closes.
   void stop();
@@ -196,7 +211,7 @@ class BaseController : public LinkListener {
   OdometrySample odometrySampleLocked(Clock::time_point now) const;
   kinematics::WheelTicks onWire(const kinematics::WheelTicks& ticks) const;
 
-  const BaseConfig config_;
+  BaseConfig config_;  ///< its tunable part changes under mutex_ (retune)
   const FrameWriter writer_;
   const BaseEvents events_;
   const std::shared_ptr<LoopClock> clock_;
@@ -227,6 +242,9 @@ class BaseController : public LinkListener {
   kinematics::HeadingSource reported_heading_source_ = kinematics::HeadingSource::kWaitingForImu;
   kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
   kinematics::WheelSpeeds wheel_travel_ = kinematics::WheelSpeeds::Zero();  ///< see OdometrySample
+  /// Wheel angles and travel when the diameter last changed (see OdometrySample::wheel_angles).
+  kinematics::WheelSpeeds wheel_angles_at_retune_ = kinematics::WheelSpeeds::Zero();
+  kinematics::WheelSpeeds travel_at_retune_ = kinematics::WheelSpeeds::Zero();
   std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
   Clock::time_point integrated_until_{};
   std::optional<Clock::time_point> last_reset_sent_;

@@ -97,6 +97,9 @@ struct ServoBusWorkerStats {
   uint64_t moves_failed = 0;         ///< queued moves the client refused or could not write
   uint64_t moves_replaced = 0;       ///< queued moves replaced by a newer target of the same servo
   std::vector<uint8_t> offline_ids;  ///< polled servos in back-off
+  /// Angle reads per second the schedule asks for: the poll rate in force times the polled
+  /// servos not in back-off. What the line delivers is angles_polled over time.
+  double asked_poll_rate = 0.0;
 };
 
 class ServoBus : public LinkListener {
@@ -153,7 +156,12 @@ class ServoBus : public LinkListener {
   void shutdown();
 
   ServoBusWorkerStats stats() const;
+  /// The configuration it was built with (retune() changes only what its comment says).
   const ServoBusConfig& config() const { return config_; }
+  /// Applies the tunable part of `next`: client.timeout and client.retries from the next bus
+  /// transaction on, poll_rate from the next poll on (a faster rate does not wait out the slower
+  /// period still pending). Never waits for the bus. Expects validated values (poll_rate > 0).
+  void retune(const ServoBusConfig& next);
 
   // LinkListener (reader thread): handed on to the client.
   void onLinkDown() override;
@@ -187,7 +195,7 @@ class ServoBus : public LinkListener {
   const ServoBusConfig config_;
   const ServoBusEvents events_;
   const std::shared_ptr<LoopClock> clock_;
-  const Clock::duration poll_period_;
+  Clock::duration poll_period_;  // guarded by mutex_ (retune)
   ServoBusClient client_;
 
   mutable std::mutex mutex_;  // guards everything below
@@ -195,7 +203,7 @@ class ServoBus : public LinkListener {
   bool stop_ = false;
   bool started_ = false;
   std::deque<MoveRequest> queued_moves_;
-  std::vector<PolledServo> polled_;  // schedule changed by the worker only
+  std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   std::set<uint8_t> moving_;          // servos set moving and not stopped since
   bool motion_locked_ = false;
   bool final_words_said_ = false;

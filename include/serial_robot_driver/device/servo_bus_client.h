@@ -191,7 +191,13 @@ class ServoBusClient : public LinkListener {
   void shutdown();
 
   ServoBusStats stats() const;
-  const ServoBusOptions& options() const { return options_; }
+  /// The options in force (a copy: retune() may change timeout and retries meanwhile).
+  ServoBusOptions options() const;
+  /// A new timeout and retry count for the transactions that start from now on; one that runs
+  /// keeps what it started with. Never waits for the bus.
+  void retune(std::chrono::milliseconds timeout, int retries);
+  /// Callers (not background work) waiting for the bus right now (for tests and diagnostics).
+  int callersWaiting() { return bus_mutex_.foregroundWaiting(); }
 
   // LinkListener (reader thread).
   void onLinkDown() override;
@@ -245,7 +251,7 @@ class ServoBusClient : public LinkListener {
   ServoStatus exchange(const std::vector<uint8_t>& request, const Expectation& expect,
                        protocol::servo::Packet* answer);
 
-  const ServoBusOptions options_;
+  ServoBusOptions options_;  // timeout and retries guarded by state_mutex_ (retune), read via options()
   const FrameWriter writer_;
 
   BusMutex bus_mutex_;  // one transaction on the wire at a time

@@ -39,6 +39,8 @@ class AccelerationLimiter {
   WheelSpeeds step(const WheelSpeeds& target, double dt);
   void reset(const WheelSpeeds& current = WheelSpeeds::Zero()) { current_ = current; }
   const WheelSpeeds& current() const { return current_; }
+  /// A new limit from the next step on; the speeds reached so far are kept (no jump).
+  void setMaxAccel(double max_accel) { max_accel_ = max_accel; }
 
  private:
   double max_accel_;
@@ -66,6 +68,9 @@ class TickQuantizer {
   void reset() { remainder_.setZero(); }
   /// Exact ticks per period that `speeds` stand for (no rounding).
   Eigen::Vector2d exactTicks(const WheelSpeeds& speeds) const;
+  /// New geometry or dithering from the next quantize() on. The carried remainder (under one
+  /// tick) is kept while dithering stays on, forgotten when it is switched off.
+  void retune(const DiffDriveGeometry& geometry, bool dithering);
 
  private:
   double ticks_per_period_per_mps_;

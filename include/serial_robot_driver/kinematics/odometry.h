@@ -48,6 +48,9 @@ class Odometry {
                  double measured_yaw_variance);
   /// Pose, distance travelled and twist back to zero.
   void reset();
+  /// A corrected wheel separation for the steps from now on; the pose reached so far is kept.
+  void setWheelSeparation(double wheel_separation) { wheel_separation_ = wheel_separation; }
+  double wheelSeparation() const { return wheel_separation_; }
 
   const Pose2D& pose() const { return pose_; }
   /// Body twist of the speeds last given to integrate() (m/s, rad/s).

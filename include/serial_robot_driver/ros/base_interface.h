@@ -32,6 +32,8 @@ class BaseInterface : public DeviceInterface {
   /// Stops the loop and writes a zero-speed frame (before the port closes).
   void shutdown() override { controller_.stop(); }
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~base tunables: the controller's from its next tick on, and the interface's own.
+  void retune(const DriverParams& params) override;
   /// Engaged: zero speed held at once (frames keep flowing as the heartbeat), cmd_vel ignored.
   void attachEStop(device::EStop& e_stop) override;
   /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
@@ -48,9 +50,19 @@ class BaseInterface : public DeviceInterface {
 
   device::SerialLink& link_;
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
-  const BaseParams params_;
+  const BaseParams params_;  // as started: frames and joint names (the tunables: tuned())
+  /// The ~base tunables the interface itself uses, changed together by retune().
+  struct Tuned {
+    bool publish_tf = true;
+    double cmd_vel_timeout = 0;
+    int battery_warn_percent = 0;
+    int battery_error_percent = 0;
+  };
+  Tuned tuned() const;
+  mutable std::mutex tuned_mutex_;
+  Tuned tuned_;  // guarded by tuned_mutex_
   // Before the controller: its loop publishes through them until it stops.
-  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
   ros::Publisher odom_pub_;
   ros::Publisher wheel_states_pub_;  // advertised in the constructor's body
   device::BaseController controller_;

@@ -30,6 +30,8 @@ class BodyInterface : public DeviceInterface {
   /// Stops taking joint commands. Frames that still arrive before the link stops are published.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~imu tunables (accel_scale, gyro_scale, angle_scale) from the next telemetry frame on.
+  void retune(const DriverParams& params) override;
 
   const device::BodyController& controller() const { return controller_; }
   /// Called on the reader thread with every frame's IMU yaw (imuYaw()) and arrival time. Set it
@@ -51,7 +53,9 @@ class BodyInterface : public DeviceInterface {
 
   device::SerialLink& link_;
   const ArrivalStamps arrival_stamps_;
-  const ImuParams imu_params_;
+  /// Swapped whole by retune() (~imu scales) and loaded once per frame by the reader thread, so
+  /// a frame is converted with one set of scales (std::atomic_load / atomic_store).
+  std::shared_ptr<const ImuParams> imu_params_;
   device::BodyController controller_;
   // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
   double min_rate_ = 1.0;

@@ -6,6 +6,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 
+#include "serial_robot_driver/ros/driver_params.h"
 #include <vector>
 
 #include "serial_robot_driver/device/e_stop.h"
@@ -25,6 +26,10 @@ class DeviceInterface {
   /// Fills the device's diagnostic status (called from the diagnostics timer, also after
   /// shutdown() for a last report).
   virtual void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) = 0;
+  /// Takes the runtime-tunable parameters of `params` (validated; the rest is what the device
+  /// was built with) from its next loop tick or transaction on (dynamic_reconfigure, see
+  /// ros/runtime_tuning.h). Devices without tunables ignore it.
+  virtual void retune(const DriverParams& /*params*/) {}
   /// The joints trajectories may drive on this device (none by default).
   virtual std::vector<TrajectoryJoints> trajectoryJoints();
   /// The node's trajectory server, given before start() when trajectoryJoints() had joints: the

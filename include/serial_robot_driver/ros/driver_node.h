@@ -20,6 +20,10 @@
 //    in main, or the nodelet manager's threads); servo/* services have their own queue and
 //    spinner because they wait on the bus;
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
+//  - the dynamic_reconfigure servers (~base, ~imu, ~servo_bus, ~trajectory; ros/runtime_tuning.h)
+//    answer on the global queue too; a change reaches each device under the device's own lock
+//    (the base loop's mutex, the IMU scales swapped whole, the bus client's state lock, the
+//    trajectory server's mutex), from its next tick, frame or transaction on.
 //  - trajectory goals, cancels, joint_trajectory and the trajectory timer (one sync-write per loop
 //    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once
@@ -41,6 +45,7 @@
 namespace serial_robot_driver::ros_layer {
 
 class DeviceInterface;
+class RuntimeTuning;
 class PortMonitor;
 class TrajectoryServer;
 class WireCapture;
@@ -93,6 +98,9 @@ class DriverNode {
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
+  /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after devices_ and
+  /// trajectory_, destroyed first.
+  std::unique_ptr<RuntimeTuning> tuning_;
   std::atomic<bool> shut_down_{false};  // read by the ports' monitors on the reader threads
 };
 

@@ -17,6 +17,7 @@
 #include <sensor_msgs/JointState.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -84,6 +85,9 @@ class ServoBusInterface : public DeviceInterface {
   /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~servo_bus tunables: timeout and retries from the next transaction, state_rate from the
+  /// next poll, command_interval_ms from the next servo_commands message.
+  void retune(const DriverParams& params) override;
   /// ~servo_bus/joint_ids as trajectory joints: one queued move per segment.
   std::vector<TrajectoryJoints> trajectoryJoints() override;
   void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
@@ -124,10 +128,15 @@ class ServoBusInterface : public DeviceInterface {
   ros::NodeHandle topics_nh_;  // the caller's namespace on the caller's queue
   ros::Publisher states_pub_;
   ros::Subscriber commands_sub_;
-  const uint16_t command_interval_ms_;
+  std::atomic<uint16_t> command_interval_ms_;  // retune() from the dynamic_reconfigure callback
   std::atomic<uint64_t> commands_rejected_{0};
   device::EStop* e_stop_ = nullptr;  // the node's, set before start()
   const std::string on_shutdown_;
+
+  // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
+  uint64_t polls_at_last_check_ = 0;
+  std::chrono::steady_clock::time_point last_rate_check_{};
+  double achieved_rate_ = -1.0;  ///< reads/s over the last window; < 0: none yet
 };
 
 }  // namespace serial_robot_driver::ros_layer

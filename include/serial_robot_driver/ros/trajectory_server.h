@@ -59,6 +59,9 @@ class TrajectoryServer {
   TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
                    std::vector<TrajectoryJoints> groups);
   ~TrajectoryServer();
+  /// New defaults (~trajectory: tolerances, max_velocity) for the goals and messages accepted
+  /// from now on; a running goal goes on with the tolerances it was accepted with.
+  void retune(const TrajectoryParams& defaults);
 
   void start();
   /// Aborts every goal and stops the timer. Idempotent.
@@ -136,7 +139,7 @@ class TrajectoryServer {
   bool superviseGoal(ActiveGoal& goal, double now, const std::vector<Measured>& measured);
   static Result result(int code, const std::string& message);
 
-  const TrajectoryParams defaults_;
+  TrajectoryParams defaults_;  // guarded by mutex_; retune() changes it
   const std::vector<TrajectoryJoints> groups_;
   std::vector<trajectory::JointRange> ranges_;  ///< every joint, in track order
   std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track

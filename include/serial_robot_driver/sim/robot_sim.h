@@ -59,6 +59,8 @@ class RobotSim {
   void flush(Port* port);
   /// How long the line takes to carry `bytes` at pace_baud (10 bits a byte).
   Clock::duration lineTime(std::size_t bytes) const;
+  /// --pace-baud: when flush() has the next bytes of the backlog through the line (max: none).
+  TimePoint nextSendAt(const Port* port) const;
   void unplug(Port* port, TimePoint now);
   void replug(Port* port, TimePoint now);
   void writeStatsFile() const;
@@ -77,6 +79,8 @@ class RobotSim {
   SimStats counters_;  ///< the RobotSim-level fields only; devices keep their own
   TimePoint started_at_;
   TimePoint next_stats_write_;
+  /// --pace-baud: when the frame being fed to a framer had its last bit through the line ({}: now).
+  TimePoint rx_frame_end_{};
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_requested_{false};

@@ -30,6 +30,8 @@ constexpr std::size_t kOutputKindCount = 3;
 struct Outgoing {
   OutputKind kind = OutputKind::kBaseReply;
   std::vector<uint8_t> bytes;
+  /// When the device starts sending it (a paced line carries it from then on); {}: now.
+  TimePoint ready_at{};
 };
 
 /// Frames a device emits during one call, in order.

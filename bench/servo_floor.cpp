@@ -1,0 +1,102 @@
+// servo_floor: the least a host must do per servo bus transaction, the yardstick of the servo
+// section of driver_bench. Benchmark only, never installed, no ROS.
+//
+// One thread: write a READ_ANGLE request, block in poll() until the answer's bytes are readable,
+// read them, decode the answer, next servo. No second thread, no queue, no busy waiting.
+//
+// usage: servo_floor PORT SERVOS SECONDS
+// prints one line: transactions=N seconds=S cpu_s=C lost=L mean_ms=M
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
+
+namespace servo = serial_robot_driver::protocol::servo;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+/// A lost answer (a fault, a restart) costs this wait; robot_sim never loses one unless told to.
+constexpr int kAnswerTimeoutMs = 50;
+constexpr std::size_t kAngleAnswerSize = servo::kOverhead + 3;  // id, i16 angle
+
+double processCpuSeconds() {
+  timespec cpu{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu);
+  return static_cast<double>(cpu.tv_sec) + static_cast<double>(cpu.tv_nsec) * 1e-9;
+}
+
+/// Reads one answer of `size` bytes (blocking); false after a timeout or a bad answer.
+bool readAnswer(int fd, std::size_t size, servo::Packet* packet) {
+  uint8_t buffer[servo::kMaxFrameSize];
+  std::size_t have = 0;
+  while (have < size) {
+    pollfd pfd{fd, POLLIN, 0};
+    if (::poll(&pfd, 1, kAnswerTimeoutMs) <= 0) return false;
+    const ssize_t n = ::read(fd, buffer + have, size - have);
+    if (n <= 0) return false;
+    have += static_cast<std::size_t>(n);
+  }
+  const auto decoded = servo::decodeResponse(buffer, have);
+  if (!decoded.ok()) return false;
+  *packet = *decoded;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 4) {
+    std::fprintf(stderr, "usage: servo_floor PORT SERVOS SECONDS\n");
+    return 2;
+  }
+  const int fd = ::open(argv[1], O_RDWR | O_NOCTTY);
+  if (fd < 0) {
+    std::perror("servo_floor: open");
+    return 1;
+  }
+  termios tio{};
+  ::tcgetattr(fd, &tio);
+  ::cfmakeraw(&tio);
+  ::tcsetattr(fd, TCSANOW, &tio);
+  const int servos = std::atoi(argv[2]);
+  const auto window = std::chrono::duration<double>(std::atof(argv[3]));
+
+  std::vector<std::vector<uint8_t>> requests;
+  for (int id = 0; id < servos; ++id) requests.push_back(servo::encodeReadAngle(id));
+
+  uint64_t transactions = 0, lost = 0;
+  long angle_sum = 0;  // keeps the decode from being optimised away
+  const double cpu_start = processCpuSeconds();
+  const Clock::time_point start = Clock::now();
+  Clock::time_point now = start;
+  for (std::size_t next = 0; now - start < window; next = (next + 1) % requests.size()) {
+    const std::vector<uint8_t>& request = requests[next];
+    servo::Packet answer;
+    if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size()) ||
+        !readAnswer(fd, kAngleAnswerSize, &answer)) {
+      ++lost;
+      ::tcflush(fd, TCIFLUSH);  // a late answer must not pass for the next one
+    } else {
+      const auto angle = servo::decodeAngleAnswer(answer);
+      if (angle.ok()) angle_sum += angle->angle_decidegrees;
+      ++transactions;
+    }
+    now = Clock::now();
+  }
+  const double seconds = std::chrono::duration<double>(now - start).count();
+  const double cpu = processCpuSeconds() - cpu_start;
+  std::printf("transactions=%llu seconds=%.3f cpu_s=%.4f lost=%llu mean_ms=%.4f checksum=%ld\n",
+              static_cast<unsigned long long>(transactions), seconds, cpu,
+              static_cast<unsigned long long>(lost),
+              transactions ? seconds * 1000.0 / static_cast<double>(transactions) : 0.0, angle_sum);
+  return 0;
+}

@@ -1,0 +1,86 @@
+// Runtime tuning: one dynamic_reconfigure server per parameter group, in the group's own namespace
+// (~base, ~imu, ...), so `dynparam set /driver_node/base max_wheel_speed 0.5` changes
+// ~base/max_wheel_speed. The servers start with the values the node was started with (never the
+// .cfg defaults) and write every accepted change back to the parameter server, which therefore
+// always holds what is in force.
+//
+// A change is checked like the start-up parameters (DriverParams::validate()): a value the check
+// refuses is not applied, the value in force stays (logged once, with the reason) and the server's
+// answer shows it. dynamic_reconfigure itself clamps a value outside the .cfg range to the range.
+// An accepted change goes to every device's retune() at once; each device applies it from its next
+// loop tick or transaction under its own lock, so no thread sees half of it.
+//
+// Threading: the servers' callbacks run on the node's global callback queue (the node's spinner or
+// the nodelet manager's threads); mutex_ makes them one at a time.
+#pragma once
+
+#include <ros/node_handle.h>
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "serial_robot_driver/ros/driver_params.h"
+
+namespace serial_robot_driver::ros_layer {
+
+class DeviceInterface;
+class TrajectoryServer;
+
+/// One requested value: the parameter's key as in the table ("base/max_wheel_speed") and the value.
+using ParamAssignment = std::pair<std::string, ParamValue>;
+
+struct TuningResult {
+  DriverParams applied;  ///< the parameters in force after the change (they pass validate())
+  /// One line per refused value: which, why (validate()'s message) and the value kept instead.
+  std::vector<std::string> refusals;
+};
+
+/// The parameters `in_force` with `requested` applied, as far as validate() accepts them: a
+/// refused value is dropped (the value in force is kept). When validate() names a parameter that
+/// was not changed (a rule between several values), every changed value of the request is
+/// refused. Throws std::invalid_argument for a key that is not in the table or a value of the wrong
+/// type (a programming error: the .cfg files and the table agree, see test_runtime_tuning.cpp).
+TuningResult tuneParams(const DriverParams& in_force,
+                        const std::vector<ParamAssignment>& requested);
+
+/// A parameter value as text for a log line: 0.5, true, 20, "odom".
+std::string toText(const ParamValue& value);
+
+class RuntimeTuning {
+ public:
+  /// Starts the servers of the enabled groups under `private_nh`: ~base (base enabled), ~imu
+  /// (body enabled), ~servo_bus (servo_bus enabled), ~trajectory (`trajectory` not null: some
+  /// device has joints). `params` are the parameters in force; `devices` and `trajectory` get
+  /// every accepted change and must outlive this object.
+  RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
+                std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory = nullptr);
+  ~RuntimeTuning();
+  RuntimeTuning(const RuntimeTuning&) = delete;
+  RuntimeTuning& operator=(const RuntimeTuning&) = delete;
+
+  /// From now on every request is answered with the values in force, nothing is applied (the
+  /// devices are shutting down). Idempotent.
+  void stop();
+
+  /// The parameters in force.
+  DriverParams inForce() const;
+
+  /// Applies `requested` of the server `group` (tuneParams), logs refusals and changes, hands an
+  /// accepted change to the devices. Returns the parameters in force afterwards.
+  DriverParams apply(const std::string& group, const std::vector<ParamAssignment>& requested);
+
+  class Server;  // one group's dynamic_reconfigure server (runtime_tuning.cpp)
+
+ private:
+  mutable std::mutex mutex_;
+  DriverParams in_force_;
+  bool stopped_ = false;
+  const std::vector<DeviceInterface*> devices_;
+  TrajectoryServer* const trajectory_;
+  std::vector<std::unique_ptr<Server>> servers_;  // last: destroyed first
+};
+
+}  // namespace serial_robot_driver::ros_layer

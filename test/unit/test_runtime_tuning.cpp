@@ -1,0 +1,176 @@
+// Runtime tuning without a ROS master: the .cfg files (their generated Config classes) against the
+// parameter table (every tunable's default, minimum and maximum are the table's and validate()'s),
+// and tuneParams(), which decides what of a requested change applies.
+#include <gtest/gtest.h>
+
+#include <boost/any.hpp>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "serial_robot_driver/BaseTuningConfig.h"
+#include "serial_robot_driver/ImuTuningConfig.h"
+#include "serial_robot_driver/ServoBusTuningConfig.h"
+#include "serial_robot_driver/TrajectoryTuningConfig.h"
+#include "serial_robot_driver/ros/runtime_tuning.h"
+
+namespace serial_robot_driver::ros_layer {
+namespace {
+
+const ParamSpec& specFor(const std::string& key) {
+  for (const ParamSpec& spec : parameterTable()) {
+    if (spec.key == key) return spec;
+  }
+  throw std::invalid_argument(key);
+}
+
+/// Whether the table's own check of `key` accepts `value` (other parameters at their defaults).
+bool tableAccepts(const std::string& key, const ParamValue& value) {
+  DriverParams params;
+  specFor(key).set(params, value);
+  try {
+    specFor(key).check(params);
+    return true;
+  } catch (const ParameterError& error) {
+    EXPECT_EQ(error.name(), key);
+    return false;
+  }
+}
+
+/// The value of a Config's parameter as the table's type.
+template <typename Config, typename Description>
+ParamValue valueOf(const Config& config, const Description& description) {
+  boost::any any;
+  description->getValue(config, any);
+  if (description->type == "bool") return boost::any_cast<bool>(any);
+  if (description->type == "int") return boost::any_cast<int>(any);
+  if (description->type == "double") return boost::any_cast<double>(any);
+  return boost::any_cast<std::string>(any);
+}
+
+/// Every parameter of Config is the table's `<group>/<name>` with the table's type and default,
+/// and its range is the table's: the table accepts the minimum (or, for a bound that must be
+/// exceeded such as "> 0", the next value up) and the maximum, and refuses the values beyond.
+template <typename Config>
+void expectAgreesWithTheTable(const std::string& group, const std::set<std::string>& tunables) {
+  std::set<std::string> names;
+  const DriverParams defaults;
+  for (const auto& description : Config::__getParamDescriptions__()) {
+    const std::string key = group + "/" + description->name;
+    SCOPED_TRACE(key);
+    names.insert(description->name);
+    ASSERT_NO_THROW(specFor(key)) << "not a parameter of the table";
+    EXPECT_FALSE(description->description.empty());
+    const ParamValue table_default = specFor(key).get(defaults);
+    const ParamValue cfg_default = valueOf(Config::__getDefault__(), description);
+    EXPECT_EQ(cfg_default.index(), table_default.index()) << "type differs";
+    EXPECT_EQ(toText(cfg_default), toText(table_default)) << "default differs";
+    EXPECT_TRUE(tableAccepts(key, cfg_default));
+    if (description->type == "int") {
+      const int min = std::get<int>(valueOf(Config::__getMin__(), description));
+      const int max = std::get<int>(valueOf(Config::__getMax__(), description));
+      EXPECT_TRUE(tableAccepts(key, min));
+      EXPECT_FALSE(tableAccepts(key, min - 1));
+      EXPECT_TRUE(tableAccepts(key, max));
+      EXPECT_FALSE(tableAccepts(key, max + 1));
+    } else if (description->type == "double") {
+      const double min = std::get<double>(valueOf(Config::__getMin__(), description));
+      const double max = std::get<double>(valueOf(Config::__getMax__(), description));
+      ASSERT_TRUE(std::isfinite(min)) << "the table bounds every number below";
+      const double up = std::nextafter(min, std::numeric_limits<double>::infinity());
+      EXPECT_TRUE(tableAccepts(key, min) || tableAccepts(key, up));
+      EXPECT_FALSE(
+          tableAccepts(key, std::nextafter(min, -std::numeric_limits<double>::infinity())));
+      if (std::isfinite(max)) {
+        EXPECT_TRUE(tableAccepts(key, max));
+        EXPECT_FALSE(
+            tableAccepts(key, std::nextafter(max, std::numeric_limits<double>::infinity())));
+      } else {
+        EXPECT_TRUE(tableAccepts(key, 1e9)) << "no maximum in the .cfg, none in the table";
+      }
+    }
+  }
+  EXPECT_EQ(names, tunables);
+}
+
+TEST(RuntimeTuningTable, BaseServerHasEveryBaseTunableAsTheTableHasIt) {
+  expectAgreesWithTheTable<serial_robot_driver::BaseTuningConfig>(
+      "base", {"max_wheel_speed", "max_wheel_accel", "cmd_vel_timeout", "speed_dithering",
+               "wheel_diameter", "wheel_separation", "battery_poll_rate", "battery_warn_percent",
+               "battery_error_percent", "publish_tf", "use_imu_heading"});
+}
+
+TEST(RuntimeTuningTable, ImuServerHasTheScalesAsTheTableHasThem) {
+  expectAgreesWithTheTable<serial_robot_driver::ImuTuningConfig>(
+      "imu", {"accel_scale", "gyro_scale", "angle_scale"});
+}
+
+TEST(RuntimeTuningTable, ServoBusServerHasTheBusTimingAsTheTableHasIt) {
+  // health_rate, protect, relax_power_mw and on_shutdown join when the table has them.
+  expectAgreesWithTheTable<serial_robot_driver::ServoBusTuningConfig>(
+      "servo_bus", {"timeout", "retries", "state_rate", "command_interval_ms"});
+}
+
+TEST(RuntimeTuningTable, TrajectoryServerHasTheGoalDefaultsAsTheTableHasThem) {
+  expectAgreesWithTheTable<serial_robot_driver::TrajectoryTuningConfig>(
+      "trajectory", {"goal_tolerance", "goal_time_tolerance", "path_tolerance", "max_velocity"});
+}
+
+TEST(TuneParams, AValidChangeApplies) {
+  const DriverParams in_force;
+  const TuningResult result =
+      tuneParams(in_force, {{"base/max_wheel_speed", 0.5}, {"base/wheel_separation", 0.5}});
+  EXPECT_TRUE(result.refusals.empty());
+  EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.5);
+  EXPECT_DOUBLE_EQ(result.applied.base.wheel_separation, 0.5);
+  EXPECT_DOUBLE_EQ(result.applied.base.wheel_diameter, in_force.base.wheel_diameter);
+}
+
+TEST(TuneParams, AValueTheStartUpCheckRefusesKeepsTheValueInForce) {
+  DriverParams in_force;
+  in_force.base.cmd_vel_timeout = 0.8;
+  const TuningResult result =
+      tuneParams(in_force, {{"base/cmd_vel_timeout", 0.0}, {"base/max_wheel_speed", 0.3}});
+  EXPECT_DOUBLE_EQ(result.applied.base.cmd_vel_timeout, 0.8);
+  EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.3) << "the valid part applies";
+  ASSERT_EQ(result.refusals.size(), 1u);
+  EXPECT_NE(result.refusals[0].find("~base/cmd_vel_timeout = 0 refused"), std::string::npos)
+      << result.refusals[0];
+  EXPECT_NE(result.refusals[0].find("> 0"), std::string::npos) << "says why";
+  EXPECT_NE(result.refusals[0].find("keeping 0.8"), std::string::npos) << result.refusals[0];
+}
+
+TEST(TuneParams, ARuleBetweenValuesRefusesTheWholeChange) {
+  const DriverParams in_force;  // warn 20, error 10
+  const TuningResult result =
+      tuneParams(in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 10}});
+  EXPECT_EQ(result.applied.base.battery_warn_percent, 20);
+  ASSERT_EQ(result.refusals.size(), 1u);
+  EXPECT_NE(result.refusals[0].find("battery_warn_percent = 5 refused"), std::string::npos);
+  EXPECT_NE(result.refusals[0].find("must not exceed"), std::string::npos) << result.refusals[0];
+
+  const TuningResult both =
+      tuneParams(in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 3}});
+  EXPECT_TRUE(both.refusals.empty()) << "lowered together, both apply";
+  EXPECT_EQ(both.applied.base.battery_warn_percent, 5);
+  EXPECT_EQ(both.applied.base.battery_error_percent, 3);
+}
+
+TEST(TuneParams, PollRateAboveTheLoopRateAndImuHeadingWithoutTheBodyAreRefused) {
+  DriverParams in_force;
+  in_force.loop_rate = 20;
+  EXPECT_EQ(tuneParams(in_force, {{"base/battery_poll_rate", 25.0}}).applied.base.battery_poll_rate,
+            in_force.base.battery_poll_rate);
+  in_force.body.enabled = false;
+  const TuningResult result = tuneParams(in_force, {{"base/use_imu_heading", true}});
+  EXPECT_FALSE(result.applied.base.use_imu_heading);
+  EXPECT_EQ(result.refusals.size(), 1u);
+}
+
+TEST(TuneParams, UnknownKeysAndWrongTypesAreProgrammingErrors) {
+  EXPECT_THROW(tuneParams(DriverParams{}, {{"base/no_such", 1.0}}), std::invalid_argument);
+  EXPECT_THROW(tuneParams(DriverParams{}, {{"base/max_wheel_speed", 1}}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::ros_layer
