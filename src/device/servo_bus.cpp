@@ -5,9 +5,16 @@
 
 namespace serial_robot_driver::device {
 
+namespace {
+Clock::duration periodOf(double rate_hz) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));
+}
+}  // namespace
+
 ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events,
                    std::shared_ptr<LoopClock> clock)
     : config_(std::move(config)),
+      settings_(config_),
       events_(std::move(events)),
       clock_(clock ? std::move(clock) : steadyLoopClock()),
       poll_period_(std::chrono::duration_cast<Clock::duration>(
@@ -20,15 +27,13 @@ ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents eve
     servo.next_poll = now;
     polled_.push_back(servo);
   }
-  if (config_.health_rate > 0.0) {
-    health_period_ = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(1.0 / config_.health_rate));
-    for (uint8_t id : config_.polled_ids) {
-      HealthServo servo;
-      servo.report.id = id;
-      servo.next_poll = now;
-      health_.push_back(servo);
-    }
+  // Every polled servo has a health entry, so a health_rate turned on at runtime finds them.
+  if (config_.health_rate > 0.0) health_period_ = periodOf(config_.health_rate);
+  for (uint8_t id : config_.polled_ids) {
+    HealthServo servo;
+    servo.report.id = id;
+    servo.next_poll = now;
+    health_.push_back(servo);
   }
 }
 
@@ -70,12 +75,24 @@ void ServoBus::retune(const ServoBusConfig& next) {
   client_.retune(next.client.timeout, next.client.retries);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    poll_period_ = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(1.0 / next.poll_rate));
-    const Clock::time_point soonest = clock_->now() + poll_period_;
+    settings_.client.timeout = next.client.timeout;
+    settings_.client.retries = next.client.retries;
+    settings_.poll_rate = next.poll_rate;
+    settings_.health_rate = next.health_rate;
+    settings_.relax_power_mw = next.relax_power_mw;
+    settings_.protect = next.protect;
+    settings_.on_shutdown = next.on_shutdown;
+    poll_period_ = periodOf(next.poll_rate);
+    const Clock::time_point now = clock_->now();
+    const Clock::time_point soonest = now + poll_period_;
     for (PolledServo& servo : polled_) {
       // A servo in back-off keeps its back-off; the others are due within the new period.
       if (servo.backoff.count() == 0) servo.next_poll = std::min(servo.next_poll, soonest);
+    }
+    const bool health_was_off = health_period_.count() == 0;
+    health_period_ = next.health_rate > 0.0 ? periodOf(next.health_rate) : Clock::duration(0);
+    for (HealthServo& servo : health_) {
+      servo.next_poll = health_was_off ? now : std::min(servo.next_poll, now + health_period_);
     }
   }
   wake_.notify_all();  // the worker may be waiting for a poll that is now due earlier
@@ -98,6 +115,11 @@ void ServoBus::shutdown() {
   if (worker_.joinable()) worker_.join();
   finalWords();
   client_.shutdown();  // every later call fails at once
+}
+
+ServoBusConfig ServoBus::settings() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return settings_;
 }
 
 ServoBusWorkerStats ServoBus::stats() const {

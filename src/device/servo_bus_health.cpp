@@ -19,6 +19,7 @@ const std::vector<const char*> kLimitNames = {"over_volt_low", "over_volt_high",
 
 Clock::time_point ServoBus::nextHealthPoll() const {
   Clock::time_point next = Clock::time_point::max();
+  if (health_period_.count() == 0) return next;  // health_rate 0: off
   for (const HealthServo& servo : health_) next = std::min(next, servo.next_poll);
   return next;
 }
@@ -26,6 +27,7 @@ Clock::time_point ServoBus::nextHealthPoll() const {
 std::vector<ServoHealthReport> ServoBus::health() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<ServoHealthReport> reports;
+  if (health_period_.count() == 0) return reports;
   for (const HealthServo& servo : health_) reports.push_back(servo.report);
   return reports;
 }
@@ -76,16 +78,16 @@ void ServoBus::pollHealthOnce(std::size_t index) {
     servo.report.assessment = servo.report.limits_known
                                   ? assessHealth(id, servo.report.readings, servo.report.limits)
                                   : HealthAssessment{};
-    if (config_.protect && servo.report.limits_known) {
+    if (settings().protect && servo.report.limits_known) {
       const bool overheated = servo.guard.update(servo.report.readings.temperature_c,
                                                  servo.report.limits.over_temperature_c);
       overheat_changed = overheated != servo.report.overheated;
       servo.report.overheated = overheated;
     }
   }
-  servo.next_poll = std::max(servo.next_poll + health_period_, clock_->now());
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    servo.next_poll = std::max(servo.next_poll + health_period_, clock_->now());
     health_[index] = servo;
     if (servo.report.overheated) {
       // Its queued moves are dropped: none may follow the relax.
@@ -95,7 +97,7 @@ void ServoBus::pollHealthOnce(std::size_t index) {
     }
   }
   if (overheat_changed && servo.report.overheated) {
-    client_.damping(id, config_.relax_power_mw, false);
+    client_.damping(id, settings().relax_power_mw, false);
     noteMotion(id, false);
   }
   if (overheat_changed && events_.on_overheat) events_.on_overheat(servo.report);

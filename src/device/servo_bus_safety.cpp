@@ -22,6 +22,18 @@ std::optional<ShutdownAction> shutdownActionFromString(const std::string& text) 
   return std::nullopt;
 }
 
+const char* toString(ShutdownAction action) {
+  switch (action) {
+    case ShutdownAction::kStop:
+      return "stop";
+    case ShutdownAction::kRelax:
+      return "relax";
+    case ShutdownAction::kNone:
+      return "none";
+  }
+  return "?";
+}
+
 void ServoBus::noteMotion(uint8_t id, bool moving) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (moving) {
@@ -92,12 +104,13 @@ ServoStatus ServoBus::relax(const std::vector<uint8_t>& ids) {
   if (targets.empty()) {
     return {ServoError::kInvalidArgument, "no servo given and none configured (state_ids, joint_ids)"};
   }
+  const uint16_t power_mw = settings().relax_power_mw;
   for (uint8_t id : targets) {
-    const ServoStatus status = damping(id, config_.relax_power_mw, false);
+    const ServoStatus status = damping(id, power_mw, false);
     if (!status.ok()) return status;
   }
   return {ServoError::kOk, std::to_string(targets.size()) + " servo(s) relaxed (DAMPING " +
-                               std::to_string(config_.relax_power_mw) + " mW)"};
+                               std::to_string(power_mw) + " mW)"};
 }
 
 ServoStatus ServoBus::hold(const std::vector<uint8_t>& ids) {
@@ -162,12 +175,13 @@ void ServoBus::finalWords() {
     if (final_words_said_) return;
     final_words_said_ = true;
   }
-  switch (config_.on_shutdown) {
+  const ServoBusConfig in_force = settings();
+  switch (in_force.on_shutdown) {
     case ShutdownAction::kStop:
       stopMoving();
       break;
     case ShutdownAction::kRelax:
-      for (uint8_t id : movingIds()) client_.damping(id, config_.relax_power_mw, false);
+      for (uint8_t id : movingIds()) client_.damping(id, in_force.relax_power_mw, false);
       break;
     case ShutdownAction::kNone:
       break;

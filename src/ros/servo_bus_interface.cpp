@@ -218,8 +218,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
       client_(bus_.client()),
       nh_(nh),
       topics_nh_(nh),
-      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)),
-      on_shutdown_(params.servo_bus.on_shutdown) {
+      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
   link_.addListener(&bus_);
 
   // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
@@ -426,7 +425,7 @@ void ServoBusInterface::attachEStop(device::EStop& e_stop) {
 }
 
 void ServoBusInterface::addDiagnostics(diagnostic_updater::Updater& updater) {
-  if (bus_.config().health_rate <= 0.0) return;
+  // Every polled servo has its status, also while health_rate is 0 (it may be tuned on).
   for (uint8_t id : bus_.config().polled_ids) {
     updater.add("servo_bus servo " + std::to_string(id),
                 [this, id](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseServo(id, s); });
@@ -435,6 +434,11 @@ void ServoBusInterface::addDiagnostics(diagnostic_updater::Updater& updater) {
 
 void ServoBusInterface::diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.hardware_id = link_.options().path;
+  if (bus_.settings().health_rate <= 0.0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                   "servo " + std::to_string(id) + ": health poll off (~servo_bus/health_rate 0)");
+    return;
+  }
   std::optional<device::ServoHealthReport> found;
   for (const device::ServoHealthReport& report : bus_.health()) {
     if (report.id == id) found = report;
@@ -528,9 +532,10 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   for (uint8_t id : bus_.movingIds()) moving += (moving.empty() ? "" : ", ") + std::to_string(id);
   status.add("servos set moving", moving.empty() ? std::string("none") : moving);
   status.add("motion locked (e_stop)", bus_.motionLocked());
-  status.add("on shutdown", on_shutdown_);
-  status.add("health polls per second", bus_.config().health_rate);
-  status.add("protect", bus_.config().protect);
+  const device::ServoBusConfig in_force = bus_.settings();
+  status.add("on shutdown", device::toString(in_force.on_shutdown));
+  status.add("health polls per second", in_force.health_rate);
+  status.add("protect", in_force.protect);
   if (!offline.empty() && link_.connected()) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                         "polled servos not answering: " + offline);

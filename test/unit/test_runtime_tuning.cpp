@@ -105,10 +105,10 @@ TEST(RuntimeTuningTable, ImuServerHasTheScalesAsTheTableHasThem) {
       "imu", {"accel_scale", "gyro_scale", "angle_scale"});
 }
 
-TEST(RuntimeTuningTable, ServoBusServerHasTheBusTimingAsTheTableHasIt) {
-  // health_rate, protect, relax_power_mw and on_shutdown join when the table has them.
+TEST(RuntimeTuningTable, ServoBusServerHasEveryBusTunableAsTheTableHasIt) {
   expectAgreesWithTheTable<serial_robot_driver::ServoBusTuningConfig>(
-      "servo_bus", {"timeout", "retries", "state_rate", "command_interval_ms"});
+      "servo_bus", {"timeout", "retries", "state_rate", "command_interval_ms", "health_rate",
+                    "protect", "relax_power_mw", "on_shutdown"});
 }
 
 TEST(RuntimeTuningTable, TrajectoryServerHasTheGoalDefaultsAsTheTableHasThem) {

@@ -321,6 +321,26 @@ TEST_F(ServoBusTest, RetunedPollRateAppliesFromTheNextPollAndTimingFromTheNextTr
   EXPECT_EQ(angles_.size(), 3u);
 }
 
+TEST_F(ServoBusTest, RetunedSafetySettingsApplyFromTheirNextUse) {
+  makeBus({0});  // health poll off (health_rate 0)
+  EXPECT_TRUE(bus_->health().empty());
+  bus_->start();
+  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
+  ServoBusConfig next = bus_->settings();
+  next.on_shutdown = ShutdownAction::kRelax;
+  next.relax_power_mw = 500;
+  next.health_rate = 1.0;
+  next.protect = true;
+  bus_->retune(next);
+  EXPECT_EQ(bus_->config().on_shutdown, ShutdownAction::kStop) << "config() is the start-up one";
+  EXPECT_EQ(bus_->settings().on_shutdown, ShutdownAction::kRelax);
+  EXPECT_TRUE(bus_->settings().protect);
+  EXPECT_EQ(bus_->health().size(), 1u) << "the health poll is on for the polled servo";
+  bus_->shutdown();
+  EXPECT_EQ(written().back(), kDamping0At500) << "on_shutdown relax at the retuned power";
+  EXPECT_EQ(countWritten(kSpin0StopSpeed0), 0u);
+}
+
 }  // namespace
 
 }  // namespace serial_robot_driver::device

@@ -44,6 +44,7 @@ namespace serial_robot_driver::device {
 enum class ShutdownAction { kStop, kRelax, kNone };
 /// "stop", "relax", "none"; nullopt for anything else.
 std::optional<ShutdownAction> shutdownActionFromString(const std::string& text);
+const char* toString(ShutdownAction action);
 
 struct ServoBusConfig {
   ServoBusOptions client;
@@ -156,11 +157,15 @@ class ServoBus : public LinkListener {
   void shutdown();
 
   ServoBusWorkerStats stats() const;
-  /// The configuration it was built with (retune() changes only what its comment says).
+  /// The configuration it was built with; settings() is the one in force.
   const ServoBusConfig& config() const { return config_; }
+  /// The configuration in force: config() with what retune() changed since.
+  ServoBusConfig settings() const;
   /// Applies the tunable part of `next`: client.timeout and client.retries from the next bus
-  /// transaction on, poll_rate from the next poll on (a faster rate does not wait out the slower
-  /// period still pending). Never waits for the bus. Expects validated values (poll_rate > 0).
+  /// transaction on, poll_rate and health_rate from the next poll on (a faster rate does not wait
+  /// out the slower period still pending; health_rate 0 stops the health poll), relax_power_mw,
+  /// protect and on_shutdown from their next use. Never waits for the bus. Expects validated
+  /// values (poll_rate > 0).
   void retune(const ServoBusConfig& next);
 
   // LinkListener (reader thread): handed on to the client.
@@ -193,6 +198,7 @@ class ServoBus : public LinkListener {
   void pollOnce(PolledServo& servo);
 
   const ServoBusConfig config_;
+  ServoBusConfig settings_;  // guarded by mutex_: config_ as retune() left it
   const ServoBusEvents events_;
   const std::shared_ptr<LoopClock> clock_;
   Clock::duration poll_period_;  // guarded by mutex_ (retune)
@@ -213,7 +219,7 @@ class ServoBus : public LinkListener {
     Clock::time_point next_poll;
     OverheatGuard guard;
   };
-  std::vector<HealthServo> health_;
+  std::vector<HealthServo> health_;  // one per polled servo; polled while health_period_ > 0
   Clock::duration health_period_{0};
   ServoBusWorkerStats stats_;
   std::thread worker_;

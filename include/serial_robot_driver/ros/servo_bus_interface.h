@@ -131,7 +131,6 @@ class ServoBusInterface : public DeviceInterface {
   std::atomic<uint16_t> command_interval_ms_;  // retune() from the dynamic_reconfigure callback
   std::atomic<uint64_t> commands_rejected_{0};
   device::EStop* e_stop_ = nullptr;  // the node's, set before start()
-  const std::string on_shutdown_;
 
   // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
   uint64_t polls_at_last_check_ = 0;
