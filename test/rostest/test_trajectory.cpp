@@ -365,11 +365,5 @@ int main(int argc, char** argv) {
   options.link = test_support::nodeParam(kNode, "port");
   options.enable_base = false;
   options.enable_servo_bus = true;
-  auto robot = std::make_unique<sim::RobotSim>(options);
-  robot->start();
-  g_robot = robot.get();
-  const int result = RUN_ALL_TESTS();
-  g_robot = nullptr;
-  robot->stop();
-  return result;
+  return test_support::runAllTestsWithSim(options, &g_robot);
 }

@@ -1,6 +1,7 @@
 // ROS helpers shared by the rostests (see the header).
 #include "support/ros_test_support.h"
 
+#include <gtest/gtest.h>
 #include <ros/network.h>
 #include <unistd.h>
 #include <xmlrpcpp/XmlRpcClient.h>
@@ -112,6 +113,17 @@ std::vector<std::string> DiagnosticsWatch::names() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> result;
   for (const auto& [name, status] : statuses_) result.push_back(name);
+  return result;
+}
+
+int runAllTestsWithSim(const serial_robot_driver::sim::SimOptions& options,
+                       serial_robot_driver::sim::RobotSim** robot) {
+  serial_robot_driver::sim::RobotSim sim(options);
+  sim.start();
+  *robot = &sim;
+  const int result = RUN_ALL_TESTS();
+  *robot = nullptr;
+  sim.stop();
   return result;
 }
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/sim/robot_sim.h"
 #include "support/process_support.h"
 #include "support/test_helpers.h"
 
@@ -126,5 +127,10 @@ class DiagnosticsWatch {
   mutable std::mutex mutex_;
   std::map<std::string, Status> statuses_;
 };
+
+/// RUN_ALL_TESTS() against an in-process simulated robot on `options.link`: started before the
+/// tests, `*robot` pointing at it while they run, stopped after them. Returns RUN_ALL_TESTS()'s.
+int runAllTestsWithSim(const serial_robot_driver::sim::SimOptions& options,
+                       serial_robot_driver::sim::RobotSim** robot);
 
 }  // namespace test_support
