@@ -280,9 +280,14 @@ TEST(SafeMotionProcess, AHotServoIsReportedRelaxedAndRefused) {
   ASSERT_TRUE(node.started());
   using Status = test_support::DiagnosticsWatch::Status;
   const auto keep_waiting = [] { return ros::ok(); };
+  // The status of the reading past the limit (before the port connects, the servo's status is
+  // an ERROR of another kind: it does not answer).
   const auto hot = diagnostics.waitFor(
       "servo_bus servo 1", 0,
-      [](const Status& s) { return s.level == diagnostic_msgs::DiagnosticStatus::ERROR; },
+      [](const Status& s) {
+        return s.level == diagnostic_msgs::DiagnosticStatus::ERROR &&
+               s.message.find("over_temperature") != std::string::npos;
+      },
       keep_waiting, kWaitSeconds);
   ASSERT_TRUE(hot.has_value()) << node.output();
   EXPECT_NE(hot->message.find("servo 1"), std::string::npos) << hot->message;
