@@ -10,11 +10,8 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 ws="${SRD_CATKIN_TOOLS_WS:-$repo/.ws_catkin_tools}"
 export PATH="/usr/bin:/bin"
 set -m
-stop_group() {  # SIGINT to a job's process group, SIGKILL after 10 s
-  kill -INT -- "-$1" 2>/dev/null || return 0
-  for _ in $(seq 20); do kill -0 -- "-$1" 2>/dev/null || return 0; sleep 0.5; done
-  kill -KILL -- "-$1" 2>/dev/null || true
-}
+# stop_group, run, wait_for
+source "$repo/scripts/install_space_support.sh"
 started_pids=""
 cleanup() { for pid in $started_pids; do stop_group "$pid"; done; }
 trap cleanup EXIT
@@ -35,23 +32,9 @@ install="$ws/install"
 [ -f "$install/share/serial_robot_driver/launch/sim.launch" ] || fail "no sim.launch in $install"
 
 # The install space alone (with the system's ROS), as in scripts/test_install.sh.
-master_port=$((20000 + RANDOM % 20000))
-home="$ws/home"
-mkdir -p "$home"
-run() {
-  env -i HOME="$home" PATH="/usr/bin:/bin" ROS_HOME="$home/.ros" \
-    ROS_MASTER_URI="http://localhost:$master_port" CMAKE_PREFIX_PATH="$install" \
-    ROS_PACKAGE_PATH="$install/share" LD_LIBRARY_PATH="$install/lib" \
-    PYTHONPATH="$(ls -d "$install"/lib/python3*/dist-packages 2>/dev/null | head -n 1)" \
-    bash -c "$1"
-}
-wait_for() {  # wait_for <seconds> <command run in the install environment>
-  local deadline=$((SECONDS + $1))
-  until run "$2" > /dev/null 2>&1; do
-    [ $SECONDS -lt $deadline ] || return 1
-    sleep 1
-  done
-}
+install_prefix="$install"
+install_home="$ws/home"
+mkdir -p "$install_home"
 [ "$(run 'rospack find serial_robot_driver')" = "$install/share/serial_robot_driver" ] ||
   fail "rospack does not find the package in $install"
 

@@ -19,11 +19,8 @@ prefix="$(mktemp -d /tmp/srd_install.XXXXXX)"
 # Job control: each background job gets a process group of its own (so its children can be
 # stopped with it) and keeps SIGINT, which a non-interactive shell would otherwise ignore.
 set -m
-stop_group() {  # SIGINT to a job's process group, SIGKILL after 10 s
-  kill -INT -- "-$1" 2>/dev/null || return 0
-  for _ in $(seq 20); do kill -0 -- "-$1" 2>/dev/null || return 0; sleep 0.5; done
-  kill -KILL -- "-$1" 2>/dev/null || true
-}
+# stop_group, run, wait_for
+source "$repo/scripts/install_space_support.sh"
 cleanup() {
   # Only the process groups this script started, never by name; the newest first.
   for pid in ${started_pids:-}; do stop_group "$pid"; done
@@ -59,15 +56,8 @@ for f in include/serial_robot_driver/ros include/serial_robot_driver/sim \
 done
 
 # Everything below runs with the install space alone.
-master_port=$((20000 + RANDOM % 20000))
-# Debian's catkin installs no setup.bash into a prefix; these are the variables it would set.
-run() {
-  env -i HOME="$prefix/home" PATH="/usr/bin:/bin" ROS_HOME="$prefix/home/.ros" \
-    ROS_MASTER_URI="http://localhost:$master_port" CMAKE_PREFIX_PATH="$prefix" \
-    ROS_PACKAGE_PATH="$prefix/share" LD_LIBRARY_PATH="$prefix/lib" \
-    PYTHONPATH="$(ls -d "$prefix"/lib/python3*/dist-packages 2>/dev/null | head -n 1)" \
-    bash -c "$1"
-}
+install_prefix="$prefix"
+install_home="$prefix/home"
 mkdir -p "$prefix/home"
 
 [ "$(run 'rospack find serial_robot_driver')" = "$share" ] || fail "rospack does not find $share"
@@ -83,13 +73,6 @@ done
 
 run "exec roscore -p $master_port" > "$prefix/roscore.log" 2>&1 &
 started_pids="$! $started_pids"
-wait_for() {  # wait_for <seconds> <command run in the install environment>
-  local deadline=$((SECONDS + $1))
-  until run "$2" > /dev/null 2>&1; do
-    [ $SECONDS -lt $deadline ] || return 1
-    sleep 1
-  done
-}
 wait_for 30 'rostopic list' || fail "roscore did not start"
 
 link="$prefix/sim_pty"
