@@ -875,12 +875,52 @@ std::pair<SimBusCounters, double> nextSimBusCounters(const std::string& path, pi
   return {counters, processCpuSeconds(node)};
 }
 
+/// Subscribes to `topic` (servo_states of the process `pid`) and counts its messages over the
+/// window, one per answered READ_ANGLE, with the process's CPU over the same window.
+BusRun measureServoStates(Context& context, const std::string& topic, pid_t pid,
+                          const std::string& log) {
+  std::atomic<std::size_t> messages{0};
+  ros::Subscriber subscriber = context.nh.subscribe<sensor_msgs::JointState>(
+      topic, 10000, [&](const sensor_msgs::JointState::ConstPtr&) { ++messages; },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  require(waitUntil([&] { return messages > 0; }, 30s), "no servo_states received; see " + log);
+  require(sleepUntil(Clock::now() + 1s), "stopped");
+  const std::size_t first = messages;
+  const double cpu_start = processCpuSeconds(pid);
+  const Clock::time_point start = Clock::now();
+  require(sleepUntil(start + fromSeconds(context.options.bus_seconds)), "stopped");
+  const double seconds = toSeconds(Clock::now() - start);
+  const double cpu = processCpuSeconds(pid) - cpu_start;
+  const double count = static_cast<double>(messages - first);
+  require(count > 0, "servo_states stopped; see " + log);
+  return {count / seconds, cpu / count * 1e6, cpu / seconds, seconds * 1000.0 / count};
+}
+
+/// servo_floor --publish: the same blocking client, publishing each answer on servo_states.
+BusRun runPublishingServoFloor(Context& context, const std::string& tag, double latency_ms,
+                               bool paced) {
+  const std::string ns = "bus_floor_pub_" + tag;
+  const std::string link = context.paths.link(ns);
+  const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, busSimFlags(link, latency_ms, paced));
+  require(waitUntil([&] { return ::access(link.c_str(), F_OK) == 0; }, 20s),
+          "robot_sim did not create " + link);
+  const std::string log = context.paths.log("servo_floor_" + ns);
+  // It runs past the window (the subscription and a second of settling come first); the
+  // measurement is the subscriber's, like driver_node's, and the floor is stopped after it.
+  ChildProcess floor("servo_floor",
+                     {context.paths.bin_dir + "/servo_floor", link, std::to_string(kBusServos),
+                      format("%.1f", context.options.bus_seconds + 60), "--publish",
+                      "__ns:=/" + ns, "__name:=servo_floor"},
+                     log);
+  return measureServoStates(context, "/" + ns + "/servo_states", floor.pid(), log);
+}
+
 /// driver_node polling 20 servos at `state_rate` each, the node's CPU from its process clock.
 /// `subscribed`: servo_states messages counted (one per answered READ_ANGLE); else nobody
 /// subscribes and robot_sim's answers are counted: the transaction path without roscpp's cost of
 /// sending each message.
 BusRun runServoStates(Context& context, const std::string& tag, double latency_ms, bool paced,
-                      double state_rate, bool subscribed = true) {
+                      double state_rate, bool subscribed = true, double health_rate = 0.0) {
   const std::string ns = "bus_node_" + tag;
   const std::string link = context.paths.link(ns);
   const std::string stats_file = context.paths.work_dir + "/" + ns + ".stats";
@@ -893,7 +933,10 @@ BusRun runServoStates(Context& context, const std::string& tag, double latency_m
   params.insert(params.end(), {{"base/enabled", false},
                                {"body/enabled", false},
                                {"servo_bus/state_ids", toXmlRpc(ids)},
-                               {"servo_bus/state_rate", state_rate}});
+                               {"servo_bus/state_rate", state_rate},
+                               // The health poll shares the line (five READ_DATA per servo
+                               // and period); off unless asked, so the rows compare servo_states.
+                               {"servo_bus/health_rate", health_rate}});
   DriverProcess driver(context.paths, ns, params);
   if (!subscribed) {
     require(waitUntil([&] { return readSimBusCounters(stats_file).answers > 0; }, 30s),
@@ -907,23 +950,8 @@ BusRun runServoStates(Context& context, const std::string& tag, double latency_m
     return {count / seconds, (cpu_end - cpu_start) / count * 1e6, (cpu_end - cpu_start) / seconds,
             seconds * 1000.0 / count};
   }
-  std::atomic<std::size_t> messages{0};
-  ros::Subscriber subscriber = context.nh.subscribe<sensor_msgs::JointState>(
-      driver.topic("servo_states"), 10000,
-      [&](const sensor_msgs::JointState::ConstPtr&) { ++messages; },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  require(waitUntil([&] { return messages > 0; }, 30s),
-          "no servo_states received; see " + context.paths.log(ns));
-  require(sleepUntil(Clock::now() + 1s), "stopped");
-  const std::size_t first = messages;
-  const double cpu_start = processCpuSeconds(driver.pid());
-  const Clock::time_point start = Clock::now();
-  require(sleepUntil(start + fromSeconds(context.options.bus_seconds)), "stopped");
-  const double seconds = toSeconds(Clock::now() - start);
-  const double cpu = processCpuSeconds(driver.pid()) - cpu_start;
-  const double count = static_cast<double>(messages - first);
-  require(count > 0, "servo_states stopped; see " + context.paths.log(ns));
-  return {count / seconds, cpu / count * 1e6, cpu / seconds, seconds * 1000.0 / count};
+  return measureServoStates(context, driver.topic("servo_states"), driver.pid(),
+                            context.paths.log(ns));
 }
 
 void runServoBusSection(Context& context) {
@@ -931,9 +959,12 @@ void runServoBusSection(Context& context) {
   // Side by side: each pair of runs back to back, so the machine's load is alike for both.
   const BusRun floor_fast = runServoFloor(context, "fast", 0.0, false);
   const BusRun node_fast = runServoStates(context, "fast", 0.0, false, 1000.0);
+  const BusRun floor_pub_fast = runPublishingServoFloor(context, "fast", 0.0, false);
   const BusRun node_quiet = runServoStates(context, "quiet", 0.0, false, 1000.0, false);
   const BusRun floor_paced = runServoFloor(context, "paced", kBusLatencyMs, true);
   const BusRun node_paced = runServoStates(context, "paced", kBusLatencyMs, true, 1000.0);
+  const BusRun node_paced_health =
+      runServoStates(context, "paced_health", kBusLatencyMs, true, 1000.0, false, 1.0);
   const BusRun floor_unpaced = runServoFloor(context, "latency", kBusLatencyMs, false);
   const double wire_rate = 1000.0 / (kBusLineMs + kBusLatencyMs);
 
@@ -949,6 +980,11 @@ void runServoBusSection(Context& context) {
   add("driver_node, pty speed, latency 0, state_rate 1000", node_fast,
       format("%.2f of the rate, %.2f of the CPU", node_fast.per_second / floor_fast.per_second,
              node_fast.cpu_us / floor_fast.cpu_us));
+  add("servo_floor --publish (roscpp, one servo_states message per answer), pty speed",
+      floor_pub_fast, "");
+  add("driver_node against servo_floor --publish", node_fast,
+      format("%.2f of the rate, %.2f of the CPU", node_fast.per_second / floor_pub_fast.per_second,
+             node_fast.cpu_us / floor_pub_fast.cpu_us));
   add("driver_node, the same, nobody subscribed to servo_states", node_quiet,
       format("%.2f of the rate, %.2f of the CPU", node_quiet.per_second / floor_fast.per_second,
              node_quiet.cpu_us / floor_fast.cpu_us));
@@ -959,6 +995,10 @@ void runServoBusSection(Context& context) {
       node_paced,
       format("%.2f of the rate, %.2f of the CPU", node_paced.per_second / floor_paced.per_second,
              node_paced.cpu_us / floor_paced.cpu_us));
+  add(format("driver_node, the same with health_rate 1 (the default), every transaction counted "
+             "(READ_ANGLE and the health poll's READ_DATA)"),
+      node_paced_health,
+      format("%.2f of the floor's rate", node_paced_health.per_second / floor_paced.per_second));
   table.row({format("the line at %.0f baud + %.1f ms latency", kBusBaud, kBusLatencyMs),
              format("%.0f", wire_rate), format("%.3f ms", kBusLineMs + kBusLatencyMs), "", "", ""});
   add(format("servo_floor, pty speed, latency %.1f ms", kBusLatencyMs), floor_unpaced, "");
@@ -969,6 +1009,10 @@ void runServoBusSection(Context& context) {
             "<= the floor's own", node_fast.turnaround_ms <= 2 * floor_fast.turnaround_ms);
   table.row("driver_node's CPU per transaction, pty speed", format("%.1f us", node_fast.cpu_us),
             "<= 38 us (half of 77)", node_fast.cpu_us <= 38.5);
+  table.row("driver_node's CPU per transaction over servo_floor --publish's, pty speed",
+            format("%+.1f us (%.1f vs %.1f)", node_fast.cpu_us - floor_pub_fast.cpu_us,
+                   node_fast.cpu_us, floor_pub_fast.cpu_us),
+            "");
   table.row(format("servo_states at %.0f baud, share of the line's rate", kBusBaud),
             format("%.0f of %.0f /s = %.0f %%", node_paced.per_second, wire_rate,
                    100.0 * node_paced.per_second / wire_rate),

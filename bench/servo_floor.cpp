@@ -1,10 +1,15 @@
 // servo_floor: the least a host must do per servo bus transaction, the yardstick of the servo
-// section of driver_bench. Benchmark only, never installed, no ROS.
+// section of driver_bench. Benchmark only, never installed.
 //
 // One thread: write a READ_ANGLE request, block in poll() until the answer's bytes are readable,
 // read them, decode the answer, next servo. No second thread, no queue, no busy waiting.
 //
-// usage: servo_floor PORT SERVOS SECONDS
+// With --publish it is also the least any roscpp node doing servo_states' job must spend: each
+// answer becomes one sensor_msgs/JointState on `servo_states` (name servo_<id>, position in rad,
+// stamped on arrival), published from that same thread. It waits for its first subscriber before
+// the window starts. Without --publish nothing of ROS runs.
+//
+// usage: servo_floor PORT SERVOS SECONDS [--publish [ROS remapping args...]]
 // prints one line: transactions=N seconds=S cpu_s=C lost=L mean_ms=M
 #include <fcntl.h>
 #include <poll.h>
@@ -12,9 +17,16 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
 #include <chrono>
+#include <cmath>
+#include <memory>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
@@ -54,9 +66,18 @@ bool readAnswer(int fd, std::size_t size, servo::Packet* packet) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: servo_floor PORT SERVOS SECONDS\n");
+  const bool publish = argc >= 5 && std::strcmp(argv[4], "--publish") == 0;
+  if (argc < 4 || (argc > 4 && !publish)) {
+    std::fprintf(stderr, "usage: servo_floor PORT SERVOS SECONDS [--publish [ROS args]]\n");
     return 2;
+  }
+  std::unique_ptr<ros::NodeHandle> nh;
+  ros::Publisher states;
+  if (publish) {
+    ros::init(argc, argv, "servo_floor");
+    nh = std::make_unique<ros::NodeHandle>();
+    states = nh->advertise<sensor_msgs::JointState>("servo_states", 10);
+    while (ros::ok() && states.getNumSubscribers() == 0) ros::Duration(0.01).sleep();
   }
   const int fd = ::open(argv[1], O_RDWR | O_NOCTTY);
   if (fd < 0) {
@@ -71,7 +92,11 @@ int main(int argc, char** argv) {
   const auto window = std::chrono::duration<double>(std::atof(argv[3]));
 
   std::vector<std::vector<uint8_t>> requests;
-  for (int id = 0; id < servos; ++id) requests.push_back(servo::encodeReadAngle(id));
+  std::vector<std::string> names;
+  for (int id = 0; id < servos; ++id) {
+    requests.push_back(servo::encodeReadAngle(id));
+    names.push_back("servo_" + std::to_string(id));
+  }
 
   uint64_t transactions = 0, lost = 0;
   long angle_sum = 0;  // keeps the decode from being optimised away
@@ -87,7 +112,16 @@ int main(int argc, char** argv) {
       ::tcflush(fd, TCIFLUSH);  // a late answer must not pass for the next one
     } else {
       const auto angle = servo::decodeAngleAnswer(answer);
-      if (angle.ok()) angle_sum += angle->angle_decidegrees;
+      if (angle.ok()) {
+        angle_sum += angle->angle_decidegrees;
+        if (publish) {
+          sensor_msgs::JointState message;
+          message.header.stamp = ros::Time::now();
+          message.name.push_back(names[next]);
+          message.position.push_back(angle->angle_decidegrees * (M_PI / 1800.0));
+          states.publish(message);
+        }
+      }
       ++transactions;
     }
     now = Clock::now();

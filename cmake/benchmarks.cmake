@@ -13,9 +13,11 @@ target_include_directories(floor_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(floor_node srd_core ${catkin_LIBRARIES})
 add_dependencies(floor_node ${catkin_EXPORTED_TARGETS})
 
-# The servo bus's floor: one blocking READ_ANGLE client, ROS-free (driver_bench section 10).
+# The servo bus's floor: one blocking READ_ANGLE client (driver_bench section 10); with --publish
+# it also publishes each answer on servo_states through roscpp.
 add_executable(servo_floor bench/servo_floor.cpp)
-target_link_libraries(servo_floor srd_core)
+target_include_directories(servo_floor PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(servo_floor srd_core ${catkin_LIBRARIES})
 
 add_executable(driver_bench
   bench/bench_support.cpp

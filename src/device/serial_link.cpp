@@ -1,7 +1,6 @@
 #include "serial_robot_driver/device/serial_link.h"
 
 #include <algorithm>
-#include <array>
 
 #include "serial_robot_driver/transport/serial_port.h"
 
@@ -14,7 +13,8 @@ namespace {
 /// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here).
 constexpr int kReadTimeoutMs = 100;
 constexpr int kWakeableReadTimeoutMs = 5000;
-constexpr std::size_t kReadChunk = 4096;
+/// The longest a reader with nothing to do waits for its port to be reopened in one go.
+constexpr int kLongestIdleWaitS = 3600;
 
 std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& options) {
   return std::make_unique<transport::SerialPort>(transport::SerialPortOptions{options.path, options.baud});
@@ -150,6 +150,7 @@ void SerialLink::closeStream(const std::string& reason) {
     stream_.reset();
   }
   if (!was_connected) return;
+  next_open_attempt_ = Clock::now() + reconnectInterval();  // a lost port is reopened after a pause
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.disconnects;
@@ -163,17 +164,38 @@ void SerialLink::wakeReader() {
   if (stream_) stream_->wakeRead();
 }
 
-void SerialLink::sleepBeforeRetry() {
+void SerialLink::wake() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    wake_pending_ = true;
+  }
+  state_cv_.notify_all();  // a reader waiting to reopen the port
+  wakeReader();            // a reader in read()
+}
+
+bool SerialLink::onReaderThread() const { return std::this_thread::get_id() == reader_.get_id(); }
+
+void SerialLink::waitForRetry(Clock::time_point until) {
+  // Bounded: a far deadline (nothing to do) must not overflow the condition variable's clock.
+  until = std::min(until, Clock::now() + std::chrono::seconds(kLongestIdleWaitS));
   std::unique_lock<std::mutex> lock(state_mutex_);
-  state_cv_.wait_for(lock, std::chrono::duration<double>(options_.reconnect_interval),
-                     [this] { return stopping_.load(); });
+  state_cv_.wait_until(lock, until, [this] { return stopping_.load() || wake_pending_; });
+  wake_pending_ = false;
 }
 
 void SerialLink::readerLoop() {
-  std::array<uint8_t, kReadChunk> chunk{};
   while (!stopping_) {
+    const Clock::time_point work_due =
+        worker_ != nullptr ? worker_->nextWork() : Clock::time_point::max();
+    if (work_due <= Clock::now()) {
+      worker_->work();
+      continue;
+    }
     if (!connected_) {
-      if (!tryOpen()) sleepBeforeRetry();
+      if (Clock::now() >= next_open_attempt_ && !tryOpen()) {
+        next_open_attempt_ = Clock::now() + reconnectInterval();
+      }
+      if (!connected_) waitForRetry(std::min(next_open_attempt_, work_due));
       continue;
     }
     if (lost_) {
@@ -183,48 +205,65 @@ void SerialLink::readerLoop() {
         reason = stats_.last_error;
       }
       closeStream(reason);
-      sleepBeforeRetry();
       continue;
     }
-    // A wakeable stream sleeps until data, stop() or a failed write wakes it; the others poll.
-    const int longest_read_ms = stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs;
-    int read_timeout_ms = longest_read_ms;
-    if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
-      // The stream's clock: a replay measures the recorded silence on its own timeline.
-      const auto quiet = stream_->now() - chunk_arrival_;
-      if (quiet >= options_.stale_frame_timeout) {
-        // No byte for a whole timeout: what is buffered will not complete. Frames found behind
-        // the stale candidate keep the arrival time of their bytes.
-        while (framer_.dropStaleCandidate()) {
-        }
-        std::lock_guard<std::mutex> lock(state_mutex_);
-        stats_.framer = framer_.stats();
-        continue;
-      }
-      const auto left = std::chrono::ceil<std::chrono::milliseconds>(
-          options_.stale_frame_timeout - quiet);
-      // Clamped as a duration first: the int conversion never sees more than longest_read_ms.
-      read_timeout_ms = static_cast<int>(
-          std::clamp(left, std::chrono::milliseconds(1), std::chrono::milliseconds(longest_read_ms))
-              .count());
-    }
-    std::size_t n = 0;
-    try {
-      n = stream_->read(chunk.data(), chunk.size(), read_timeout_ms);
-    } catch (const transport::TransportError& e) {
-      closeStream(e.what());
-      sleepBeforeRetry();
-      continue;
-    }
-    if (n == 0) continue;
-    // A replayed recording knows when its bytes arrived; a live port's bytes arrived now.
-    chunk_arrival_ = stream_->arrivalTime().value_or(Clock::now());
-    if (observer_) observer_->onChunk({options_.path, false, chunk.data(), n, chunk_arrival_});
-    framer_.feed(chunk.data(), n);
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    stats_.framer = framer_.stats();
+    readOnce(work_due);
   }
   if (stream_) closeStream("stopped");
+}
+
+bool SerialLink::pump(Clock::time_point until) {
+  if (stopping_ || !connected_ || lost_) return false;
+  readOnce(until);
+  return connected_ && !lost_ && !stopping_;
+}
+
+Clock::duration SerialLink::reconnectInterval() const {
+  return std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(options_.reconnect_interval));
+}
+
+void SerialLink::readOnce(Clock::time_point until) {
+  // A wakeable stream sleeps until data, stop(), wake() or a failed write wakes it; the others poll.
+  const int longest_read_ms = stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs;
+  auto read_timeout = std::chrono::milliseconds(longest_read_ms);
+  if (until != Clock::time_point::max()) {
+    // Whole milliseconds, rounded up: poll() cannot wait less, and rounding down would spin.
+    read_timeout = std::min(read_timeout, std::max(std::chrono::milliseconds(0),
+                                                   std::chrono::ceil<std::chrono::milliseconds>(
+                                                       until - Clock::now())));
+  }
+  if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
+    // The stream's clock: a replay measures the recorded silence on its own timeline.
+    const auto quiet = stream_->now() - chunk_arrival_;
+    if (quiet >= options_.stale_frame_timeout) {
+      // No byte for a whole timeout: what is buffered will not complete. Frames found behind
+      // the stale candidate keep the arrival time of their bytes.
+      while (framer_.dropStaleCandidate()) {
+      }
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      stats_.framer = framer_.stats();
+      return;
+    }
+    const auto left =
+        std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet);
+    // Clamped as a duration first: the int conversion never sees more than longest_read_ms.
+    read_timeout = std::clamp(left, std::chrono::milliseconds(1), read_timeout);
+  }
+  std::size_t n = 0;
+  try {
+    n = stream_->read(chunk_.data(), chunk_.size(), static_cast<int>(read_timeout.count()));
+  } catch (const transport::TransportError& e) {
+    closeStream(e.what());
+    return;
+  }
+  if (n == 0) return;
+  // A replayed recording knows when its bytes arrived; a live port's bytes arrived now.
+  chunk_arrival_ = stream_->arrivalTime().value_or(Clock::now());
+  if (observer_) observer_->onChunk({options_.path, false, chunk_.data(), n, chunk_arrival_});
+  framer_.feed(chunk_.data(), n);
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  stats_.framer = framer_.stats();
 }
 
 }  // namespace serial_robot_driver::device

@@ -6,6 +6,10 @@
 namespace serial_robot_driver::device {
 
 namespace {
+/// How often a polled servo is asked again while its port is down (reopened every
+/// reconnect_interval, 1 s by default).
+constexpr std::chrono::milliseconds kPortDownRetry{100};
+
 Clock::duration periodOf(double rate_hz) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));
 }
@@ -61,7 +65,7 @@ void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
       }
     }
   }
-  wake_.notify_all();
+  wakeWorker();
 }
 
 void ServoBus::dropQueuedMoves(uint8_t id) {
@@ -95,14 +99,17 @@ void ServoBus::retune(const ServoBusConfig& next) {
       servo.next_poll = health_was_off ? now : std::min(servo.next_poll, now + health_period_);
     }
   }
-  wake_.notify_all();  // the worker may be waiting for a poll that is now due earlier
+  wakeWorker();  // the worker may be waiting for a poll that is now due earlier
 }
 
 void ServoBus::start() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (started_ || stop_) return;
-  started_ = true;
-  worker_ = std::thread([this] { workerLoop(); });
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (started_ || stop_) return;
+    started_ = true;
+    if (link_ == nullptr) worker_ = std::thread([this] { workerLoop(); });
+  }
+  if (link_ != nullptr) link_->wake();  // the reader thread takes the work from now on
 }
 
 void ServoBus::shutdown() {
@@ -110,9 +117,14 @@ void ServoBus::shutdown() {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
   }
-  wake_.notify_all();
+  wakeWorker();
   // The worker's poll is one background transaction at most.
   if (worker_.joinable()) worker_.join();
+  {
+    // Running on the link's reader thread: the piece of work in progress ends first.
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait(lock, [this] { return !working_; });
+  }
   finalWords();
   client_.shutdown();  // every later call fails at once
 }
@@ -134,46 +146,87 @@ ServoBusWorkerStats ServoBus::stats() const {
   return stats;
 }
 
+void ServoBus::runOn(SerialLink& link) {
+  link_ = &link;
+  link.addListener(this);
+  link.setWorker(this);
+  client_.setReaderPump({[&link] { return link.onReaderThread(); },
+                         [&link](Clock::time_point until) { return link.pump(until); },
+                         [&link] { link.wake(); }});
+}
+
+void ServoBus::wakeWorker() {
+  wake_.notify_all();
+  if (link_ != nullptr) link_->wake();
+}
+
+Clock::time_point ServoBus::nextWorkLocked() const {
+  if (!started_ || stop_) return Clock::time_point::max();
+  if (!queued_moves_.empty()) return Clock::time_point::min();
+  Clock::time_point next = nextHealthPoll();
+  for (const PolledServo& servo : polled_) next = std::min(next, servo.next_poll);
+  return next;
+}
+
+Clock::time_point ServoBus::nextWork() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return nextWorkLocked();
+}
+
+void ServoBus::work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (!started_ || stop_) return;
+  working_ = true;
+  workOnce(lock);
+  working_ = false;
+  lock.unlock();
+  wake_.notify_all();  // shutdown() waits for the piece of work in progress
+}
+
 void ServoBus::workerLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
-    if (!queued_moves_.empty()) {
-      const MoveRequest move = queued_moves_.front();
-      queued_moves_.pop_front();
-      lock.unlock();
-      sendMove(move);
-      lock.lock();
-      continue;
+    const Clock::time_point due = nextWorkLocked();
+    if (due == Clock::time_point::max()) {
+      wake_.wait(lock);
+    } else if (clock_->now() < due) {
+      clock_->waitUntil(lock, wake_, due);
+    } else {
+      workOnce(lock);
     }
-    // The servo whose poll is due first.
-    auto due = std::min_element(
-        polled_.begin(), polled_.end(),
-        [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
-    if (due == polled_.end()) {
-      wake_.wait(lock, [this] { return stop_ || !queued_moves_.empty(); });
-      continue;
-    }
-    // Health polls are background work of a second kind, due at their own (lower) rate.
-    const Clock::time_point health_due = nextHealthPoll();
-    if (health_due <= clock_->now()) {
-      const auto first = std::min_element(
-          health_.begin(), health_.end(),
-          [](const HealthServo& a, const HealthServo& b) { return a.next_poll < b.next_poll; });
-      const auto index = static_cast<std::size_t>(first - health_.begin());
-      lock.unlock();
-      pollHealthOnce(index);
-      lock.lock();
-      continue;
-    }
-    if (clock_->now() < due->next_poll) {
-      clock_->waitUntil(lock, wake_, std::min(due->next_poll, health_due));
-      continue;
-    }
-    PolledServo& servo = *due;
-    lock.unlock();
-    pollOnce(servo);  // the schedule is only changed by this thread; mutex_ for stats() readers
-    lock.lock();
   }
+}
+
+void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
+  if (!queued_moves_.empty()) {
+    const MoveRequest move = queued_moves_.front();
+    queued_moves_.pop_front();
+    lock.unlock();
+    sendMove(move);
+    lock.lock();
+    return;
+  }
+  const Clock::time_point now = clock_->now();
+  // Health polls are background work of a second kind, due at their own (lower) rate.
+  if (nextHealthPoll() <= now) {
+    const auto first = std::min_element(
+        health_.begin(), health_.end(),
+        [](const HealthServo& a, const HealthServo& b) { return a.next_poll < b.next_poll; });
+    const auto index = static_cast<std::size_t>(first - health_.begin());
+    lock.unlock();
+    pollHealthOnce(index);
+    lock.lock();
+    return;
+  }
+  // The servo whose poll is due first.
+  auto due = std::min_element(
+      polled_.begin(), polled_.end(),
+      [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
+  if (due == polled_.end() || now < due->next_poll) return;
+  PolledServo& servo = *due;
+  lock.unlock();
+  pollOnce(servo);  // the schedule is only changed by this thread; mutex_ for stats() readers
+  lock.lock();
 }
 
 void ServoBus::sendMove(const MoveRequest& move) {
@@ -201,8 +254,9 @@ void ServoBus::pollOnce(PolledServo& servo) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (status.error == ServoError::kNotConnected || status.error == ServoError::kShutdown) {
-      // The port is down, not the servo: ask again at the poll rate once it is back.
-      servo.next_poll = now + poll_period_;
+      // The port is down, not the servo: ask again at the poll rate, but no more often than
+      // kPortDownRetry, so a down port at a high state_rate does not keep the worker busy.
+      servo.next_poll = now + std::max<Clock::duration>(poll_period_, kPortDownRetry);
       return;
     }
     if (!status.ok()) {

@@ -17,6 +17,10 @@ using namespace servo_text;  // NOLINT: the shared sentences of every servo oper
 
 namespace {
 
+/// The longest a reader thread waiting for the bus pumps before it looks again; unlock() wakes it
+/// sooner.
+constexpr std::chrono::milliseconds kReaderWaitSlice{10};
+
 double toMs(Clock::duration duration) {
   return std::chrono::duration<double, std::milli>(duration).count();
 }
@@ -57,17 +61,35 @@ const char* toString(ServoError error) {
   return "unknown";
 }
 
+template <typename Predicate>
+void BusMutex::waitTurn(std::unique_lock<std::mutex>& lock, Predicate free) {
+  while (!free()) {
+    if (pump_ == nullptr || !pump_->on_reader_thread()) {
+      released_.wait(lock);
+      continue;
+    }
+    // The reader thread: whoever holds the bus may be waiting for an answer only it can read.
+    reader_waiting_ = true;
+    lock.unlock();
+    const bool port_up = pump_->pump(Clock::now() + kReaderWaitSlice);
+    lock.lock();
+    // A port that is down has nothing to read: the holder's write fails at once, so this wait
+    // is short, but it must not spin.
+    if (!port_up) released_.wait_for(lock, kReaderWaitSlice, free);
+  }
+}
+
 void BusMutex::lock() {
   std::unique_lock<std::mutex> lock(mutex_);
   ++waiting_;
-  released_.wait(lock, [this] { return !held_; });
+  waitTurn(lock, [this] { return !held_; });
   --waiting_;
   held_ = true;
 }
 
 void BusMutex::lockBackground() {
   std::unique_lock<std::mutex> lock(mutex_);
-  released_.wait(lock, [this] { return !held_ && waiting_ == 0; });
+  waitTurn(lock, [this] { return !held_ && waiting_ == 0; });
   held_ = true;
 }
 
@@ -77,11 +99,14 @@ int BusMutex::foregroundWaiting() {
 }
 
 void BusMutex::unlock() {
+  bool wake_reader = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     held_ = false;
+    wake_reader = std::exchange(reader_waiting_, false);
   }
   released_.notify_all();
+  if (wake_reader) pump_->wake();
 }
 
 ServoBusClient::Expectation::Expectation(Command answer_cmd, uint8_t answer_id)
@@ -162,6 +187,28 @@ void ServoBusClient::onFrame(protocol::FrameFamily family, const uint8_t* data, 
   answer_cv_.notify_one();
 }
 
+void ServoBusClient::setReaderPump(ReaderPump pump) {
+  pump_ = std::move(pump);
+  bus_mutex_.setReaderPump(pump_.pump ? &pump_ : nullptr);
+}
+
+void ServoBusClient::waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::time_point deadline) {
+  const auto settled = [this] {
+    return pending_.answered || pending_.garbled || link_lost_ || stopping_;
+  };
+  if (!pump_.pump || !pump_.on_reader_thread()) {
+    answer_cv_.wait_until(lock, deadline, settled);
+    return;
+  }
+  // The reader thread reads the answer itself: onFrame() runs inside pump(), on this thread.
+  while (!settled() && Clock::now() < deadline) {
+    lock.unlock();
+    const bool port_up = pump_.pump(deadline);
+    lock.lock();
+    if (!port_up && !settled()) link_lost_ = true;  // down, lost or stopping: no answer can come
+  }
+}
+
 ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const Expectation& expect,
                                      std::chrono::milliseconds timeout, int attempts,
                                      servo::Packet* answer) {
@@ -190,9 +237,7 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
     } else {
       ++stats_.retries;
     }
-    answer_cv_.wait_until(lock, sent_at + timeout, [this] {
-      return pending_.answered || pending_.garbled || link_lost_ || stopping_;
-    });
+    waitForAnswer(lock, sent_at + timeout);
     pending_.active = false;
 
     if (pending_.answered) {

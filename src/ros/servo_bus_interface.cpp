@@ -219,7 +219,9 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
       nh_(nh),
       topics_nh_(nh),
       command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
-  link_.addListener(&bus_);
+  // The bus's worker (the poll, the queued moves) runs on the port's reader thread: a poll writes
+  // its request and reads the answer itself, with no second thread to wake per transaction.
+  bus_.runOn(link_);
 
   // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
   // wait = true) and must never hold up cmd_vel or joint_commands on the global queue.

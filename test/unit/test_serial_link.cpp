@@ -1,5 +1,6 @@
 // SerialLink over a real pseudo-terminal: frames in through the reader thread, writes out,
-// unplug (EIO) and replug at the same symlink, and a port that appears only after start().
+// unplug (EIO) and replug at the same symlink, a port that appears only after start(), and a
+// LinkWorker that writes a request and reads its answer on the reader thread.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -224,6 +225,116 @@ TEST(SerialLink, RecoversAfterUnplugAtTheSameSymlink) {
   EXPECT_EQ(stats.connects, 2u);
   EXPECT_EQ(stats.disconnects, 1u);
   EXPECT_GE(stats.write_failures, 1u);
+  link.stop();
+}
+
+// A request/response worker as the servo bus runs on the link: armed from another thread, it
+// writes a PING on the reader thread and pumps the port there until the answer has reached the
+// listeners.
+class PingWorker : public LinkWorker {
+ public:
+  explicit PingWorker(SerialLink& link, RecordingListener& listener)
+      : link_(link), listener_(listener) {}
+  Clock::time_point nextWork() override {
+    return armed ? Clock::time_point::min() : Clock::time_point::max();
+  }
+  void work() override {
+    armed = false;
+    on_reader_thread = link_.onReaderThread();
+    const std::size_t before = listener_.frameCount();
+    ASSERT_TRUE(link_.write(golden::servo::kPing3));
+    const Clock::time_point deadline = Clock::now() + std::chrono::seconds(3);
+    while (listener_.frameCount() == before && Clock::now() < deadline) {
+      if (!link_.pump(deadline)) {
+        pump_failed = true;
+        break;
+      }
+    }
+    answered_inside_work = listener_.frameCount() > before;
+    ++done;
+  }
+
+  std::atomic<bool> armed{false};
+  std::atomic<int> done{0};
+  std::atomic<bool> on_reader_thread{false};
+  std::atomic<bool> answered_inside_work{false};
+  std::atomic<bool> pump_failed{false};
+
+ private:
+  SerialLink& link_;
+  RecordingListener& listener_;
+};
+
+TEST(SerialLink, AWorkerWritesAndReadsItsAnswerOnTheReaderThread) {
+  const std::string path = uniqueLinkPath("worker");
+  sim::PseudoTerminal pty(path);
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  PingWorker worker(link, listener);
+  link.addListener(&listener);
+  link.setWorker(&worker);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+  EXPECT_FALSE(link.onReaderThread());
+
+  // The idle reader sleeps in its read (seconds at a time); wake() makes it ask the worker now.
+  for (int round = 1; round <= 2; ++round) {
+    worker.armed = true;
+    link.wake();
+    Bytes request(golden::servo::kPing3.size());
+    std::size_t got = 0;
+    ASSERT_TRUE(waitFor(
+        [&] {
+          got += pty.read(request.data() + got, request.size() - got, 10);
+          return got == request.size();
+        },
+        kWaitSeconds));
+    EXPECT_EQ(request, golden::servo::kPing3);
+    // Junk, then the answer split in two writes: the pump frames it like the reader's own loop.
+    const Bytes junk = {0xAA, 0x05};
+    pty.write(junk.data(), junk.size());
+    pty.write(kPingReply.data(), 3);
+    pty.write(kPingReply.data() + 3, kPingReply.size() - 3);
+    ASSERT_TRUE(waitFor([&] { return worker.done == round; }, kWaitSeconds));
+    EXPECT_TRUE(worker.on_reader_thread);
+    EXPECT_TRUE(worker.answered_inside_work) << "the answer reached the listener during pump()";
+    EXPECT_FALSE(worker.pump_failed);
+  }
+  EXPECT_EQ(listener.frameCount(), 2u);
+  EXPECT_EQ(listener.frames[1].second, kPingReply);
+  link.stop();
+}
+
+TEST(SerialLink, APumpReportsAnUnpluggedPortAndTheLinkReopensIt) {
+  const std::string path = uniqueLinkPath("worker_unplug");
+  auto pty = std::make_unique<sim::PseudoTerminal>(path);
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  PingWorker worker(link, listener);
+  link.addListener(&listener);
+  link.setWorker(&worker);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+
+  worker.armed = true;
+  link.wake();
+  Bytes request(golden::servo::kPing3.size());
+  std::size_t got = 0;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        got += pty->read(request.data() + got, request.size() - got, 10);
+        return got == request.size();
+      },
+      kWaitSeconds));
+  pty->close();  // unplugged while the worker waits for its answer
+  ASSERT_TRUE(waitFor([&] { return worker.done == 1; }, kWaitSeconds));
+  EXPECT_TRUE(worker.pump_failed) << "the wait ends with the port, not at its deadline";
+  EXPECT_FALSE(worker.answered_inside_work);
+  EXPECT_EQ(listener.downs, 1);
+
+  pty = std::make_unique<sim::PseudoTerminal>(path);
+  ASSERT_TRUE(waitFor([&] { return link.connected(); }, kWaitSeconds));
+  EXPECT_EQ(listener.ups, 2);
   link.stop();
 }
 

@@ -15,10 +15,17 @@
 //    capture has the writes in the order they went on the wire. It must copy what it keeps and
 //    return at once (it holds up every writer of the port); without one, the only cost is a null
 //    check per read and per write.
-//  - An idle reader sleeps in its read until data comes; stop() and a writer that saw the port
-//    fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
+//  - An idle reader sleeps in its read until data comes; stop(), wake() and a writer that saw the
+//    port fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
+//  - A LinkWorker (setWorker: the servo bus, a request/response device) runs ON the reader thread,
+//    between reads, whenever its nextWork() falls due: it writes a request and waits for the
+//    answer by pump()ing the port itself, so an answer reaches the thread that waits for it
+//    without a second thread being woken. pump() hands every frame to every listener as the
+//    reader's own loop does, so the other devices of a shared port are served meanwhile. Other
+//    threads reach the worker through wake().
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -55,6 +62,18 @@ class LinkListener {
   /// A verified frame of one of the families the port's framer accepts.
   virtual void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                        Clock::time_point arrival) = 0;
+};
+
+/// Work that runs on a link's reader thread (see the threading model above).
+class LinkWorker {
+ public:
+  virtual ~LinkWorker() = default;
+  /// When work() has something to do next; Clock::time_point::max(): nothing until woken.
+  /// Called before every read, so it must be cheap.
+  virtual Clock::time_point nextWork() = 0;
+  /// Does one piece of the work due. It may write and pump() the link for an answer, for a
+  /// bounded time; it must not wait for other threads.
+  virtual void work() = 0;
 };
 
 /// One chunk as it crossed the port: what one read() returned, or one whole write().
@@ -113,6 +132,8 @@ class SerialLink {
   void addListener(LinkListener* listener);
   /// At most one; set before start(), it must outlive the link's threads. nullptr: none.
   void setChunkObserver(ChunkObserver* observer) { observer_ = observer; }
+  /// At most one; set before start(), it must outlive the reader thread (stop() the link first).
+  void setWorker(LinkWorker* worker) { worker_ = worker; }
   void start();
   /// Stops the reader thread and closes the port. Idempotent.
   void stop();
@@ -131,19 +152,34 @@ class SerialLink {
   /// Blocks until the link is connected or `timeout` elapses (start-up helpers and tests).
   bool waitConnected(std::chrono::milliseconds timeout) const;
 
+  /// Reader thread only (inside LinkWorker::work): reads once, waiting until `until` at most, and
+  /// hands the frames to the listeners. False when the port is down, lost or stopping.
+  bool pump(Clock::time_point until);
+  /// Whether the caller is the reader thread (the one that may pump()).
+  bool onReaderThread() const;
+  /// Any thread: the reader asks the worker's nextWork() again at once.
+  void wake();
+
  private:
   void readerLoop();
+  /// One read (up to `until`, the stale-frame and the stream's own limits) and its frames.
+  void readOnce(Clock::time_point until);
   bool tryOpen();
   void closeStream(const std::string& reason);
-  void sleepBeforeRetry();
+  /// Waits while the port is down: until `until`, stop() or wake().
+  void waitForRetry(Clock::time_point until);
+  Clock::duration reconnectInterval() const;
   void wakeReader();  // a read in progress returns at once (stop, loss seen by a writer)
 
   SerialLinkOptions options_;
   StreamFactory factory_;
   std::vector<LinkListener*> listeners_;
   ChunkObserver* observer_ = nullptr;
+  LinkWorker* worker_ = nullptr;
   protocol::StreamFramer framer_;
   Clock::time_point chunk_arrival_;
+  std::array<uint8_t, 4096> chunk_{};                // reader thread only: what one read returns
+  Clock::time_point next_open_attempt_{};            // reader thread only
 
   std::unique_ptr<transport::ByteStream> stream_;  // opened/closed by the reader thread only
   mutable std::mutex write_mutex_;                  // serializes writes and guards stream_ swaps
@@ -152,6 +188,7 @@ class SerialLink {
   std::atomic<bool> stopping_{false};
   mutable std::mutex state_mutex_;                  // guards stats_ and the stop condition
   mutable std::condition_variable state_cv_;
+  bool wake_pending_ = false;                       // guarded by state_mutex_: wake() came
   LinkStats stats_;
   std::thread reader_;
 };

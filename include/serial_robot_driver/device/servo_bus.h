@@ -4,10 +4,16 @@
 // converts messages to calls and events to messages.
 //
 // Threading model:
-//  - start() runs one worker thread. It writes the queued moves first, then polls the servo whose
-//    poll falls due first; it waits on the LoopClock (the steady clock unless a test passes its
-//    own) until the next poll or a new move. Both take the bus after any waiting caller (the poll
-//    as background work), so a service call waits for one transaction at most.
+//  - The worker writes the queued moves first, then polls the servo whose poll falls due first.
+//    Both take the bus after any waiting caller (the poll as background work), so a service call
+//    waits for one transaction at most. The worker is one of two threads:
+//      - runOn(link) (the driver): the link's reader thread. The link asks nextWork() before each
+//        read and calls work() when it is due; a transaction then writes its request and reads
+//        its answer on that same thread (SerialLink::pump), as a blocking client would, with no
+//        second thread to wake per transaction. Other threads wake it through the link.
+//      - otherwise (tests with a fake writer): a thread of its own started by start(), waiting on
+//        the LoopClock (the steady clock unless a test passes its own) until the next poll or a
+//        new move.
 //  - queueMoves() may be called from any thread: it only stores the targets and wakes the worker.
 //  - The operations of client() (the services) run on their caller's thread, serialized with the
 //    worker by the client's bus lock.
@@ -16,7 +22,8 @@
 //    background work, so a caller still waits for one transaction at most) when it falls due.
 //  - The motion operations (move, rotate, spin, damping, relax, hold) run on their caller's thread
 //    like the client's; setMotionLocked() (the e-stop) writes its SPIN stops on its caller's.
-//  - shutdown() joins the worker first, then says the last words (on_shutdown) on its caller's.
+//  - shutdown() stops the worker first (joins its thread, or waits for the piece of work the
+//    reader thread is doing), then says the last words (on_shutdown) on its caller's.
 //  - Stats are one struct under mutex_; stats() returns a snapshot.
 #pragma once
 
@@ -103,7 +110,7 @@ struct ServoBusWorkerStats {
   double asked_poll_rate = 0.0;
 };
 
-class ServoBus : public LinkListener {
+class ServoBus : public LinkListener, public LinkWorker {
  public:
   /// A servo that stops answering the poll is asked again after a back-off that doubles from the
   /// first to the longest, so a dead servo costs one timeout per back-off period, not per poll.
@@ -149,7 +156,11 @@ class ServoBus : public LinkListener {
   /// One report per polled servo (empty when health_rate is 0).
   std::vector<ServoHealthReport> health() const;
 
-  /// Starts the worker thread. Idempotent.
+  /// Before start(): the worker runs on `link`'s reader thread (see the threading model), which
+  /// the bus listens to. `link` must use the steady clock's time (no LoopClock of a test) and be
+  /// stopped before the bus is destroyed.
+  void runOn(SerialLink& link);
+  /// Starts the worker (its thread, or the work on the link's reader thread). Idempotent.
   void start();
   /// Stops and joins the worker, gives the servos set moving what config().on_shutdown says
   /// (while the port is still open; after a service call in progress), then fails every later
@@ -172,6 +183,9 @@ class ServoBus : public LinkListener {
   void onLinkDown() override;
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) override;
+  // LinkWorker (reader thread, after runOn()).
+  Clock::time_point nextWork() override;
+  void work() override;
 
  private:
   /// One polled servo and its schedule.
@@ -182,6 +196,13 @@ class ServoBus : public LinkListener {
   };
 
   void workerLoop();
+  /// When the worker has something to do next (mutex_ held): min() for a queued move, max()
+  /// before start(), after shutdown() or with nothing scheduled.
+  Clock::time_point nextWorkLocked() const;
+  /// One piece of the work due, if any (mutex_ held by `lock`; released around the bus).
+  void workOnce(std::unique_lock<std::mutex>& lock);
+  /// A change the worker must see: its own thread, or the link's reader thread.
+  void wakeWorker();
   /// Notes the outcome of a motion command of servo `id`: moving or at rest.
   void noteMotion(uint8_t id, bool moving);
   /// SPIN stop to each servo set moving; the last failure (ok when every stop went out).
@@ -208,6 +229,8 @@ class ServoBus : public LinkListener {
   std::condition_variable wake_;
   bool stop_ = false;
   bool started_ = false;
+  bool working_ = false;          // work() in progress on the link's reader thread
+  SerialLink* link_ = nullptr;    // runOn(): the worker is the link's reader thread
   std::deque<MoveRequest> queued_moves_;
   std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   std::set<uint8_t> moving_;          // servos set moving and not stopped since

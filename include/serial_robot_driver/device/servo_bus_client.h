@@ -12,8 +12,13 @@
 //    never state_mutex_, the only lock onFrame() takes: a fake in a test may answer synchronously
 //    by calling onFrame() from inside it.
 //  - Stats are kept in one struct under state_mutex_; stats() returns a snapshot.
-//  - Background work (readAngle with BusPriority::kBackground: the servo_states poll) takes the bus only when no foreground
-//    caller waits for it, so a service call waits at most for the one transaction in progress.
+//  - Background work (readAngle with BusPriority::kBackground: the servo_states poll) takes the
+//    bus only when no foreground caller waits for it, so a service call waits at most for the one
+//    transaction in progress.
+//  - With a ReaderPump (setReaderPump: device::ServoBus running on its link's reader thread), a
+//    wait on the link's reader thread never sleeps on another thread: waiting for an answer or for
+//    the bus, that thread reads the port itself (SerialLink::pump), so the answer it waits for,
+//    and a foreground caller's, still arrive. Callers on other threads wait as described above.
 #pragma once
 
 #include <chrono>
@@ -129,6 +134,15 @@ struct ServoBusStats {
 /// Who waits for the bus: a caller (a service) goes before background work (the poll).
 enum class BusPriority { kCaller, kBackground };
 
+/// How the link's reader thread waits without sleeping on another thread: it reads its port
+/// (SerialLink::pump) and is woken by wake() when what it waits for may have changed.
+struct ReaderPump {
+  std::function<bool()> on_reader_thread;
+  /// Reads once, up to `until`; false when the port is down or stopping.
+  std::function<bool(Clock::time_point until)> pump;
+  std::function<void()> wake;
+};
+
 /// The bus lock: foreground callers (lock()) go before background ones (lockBackground()), which
 /// take the bus only while nobody waits for it. Usable with std::lock_guard.
 class BusMutex {
@@ -138,12 +152,20 @@ class BusMutex {
   void lockBackground();
   /// Foreground callers waiting right now (for tests and diagnostics).
   int foregroundWaiting();
+  /// Set before any use: the reader thread pumps its port while it waits for the bus.
+  void setReaderPump(const ReaderPump* pump) { pump_ = pump; }
 
  private:
+  /// Waits (mutex_ held by `lock`) until `free` holds: on a condition variable, or pumping.
+  template <typename Predicate>
+  void waitTurn(std::unique_lock<std::mutex>& lock, Predicate free);
+
   std::mutex mutex_;
   std::condition_variable released_;
   bool held_ = false;
-  int waiting_ = 0;  ///< foreground callers waiting for the bus
+  int waiting_ = 0;               ///< foreground callers waiting for the bus
+  bool reader_waiting_ = false;   ///< the pumping reader thread waits: unlock() wakes it
+  const ReaderPump* pump_ = nullptr;
 };
 
 class ServoBusClient : public LinkListener {
@@ -198,6 +220,8 @@ class ServoBusClient : public LinkListener {
   void retune(std::chrono::milliseconds timeout, int retries);
   /// Callers (not background work) waiting for the bus right now (for tests and diagnostics).
   int callersWaiting() { return bus_mutex_.foregroundWaiting(); }
+  /// Before any call: waits on the pump's reader thread read the port (see the threading model).
+  void setReaderPump(ReaderPump pump);
 
   // LinkListener (reader thread).
   void onLinkDown() override;
@@ -247,12 +271,16 @@ class ServoBusClient : public LinkListener {
   /// One PING attempt, no retries (scan, and the check after a silent reset).
   ServoStatus pingOnceLocked(uint8_t id);
   bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
+  /// Waits (state_mutex_ held by `lock`) until the pending transaction is answered, garbled,
+  /// lost or shut down, or `deadline` passes.
+  void waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::time_point deadline);
   /// exchangeLocked() of a single request, taking bus_mutex_ itself.
   ServoStatus exchange(const std::vector<uint8_t>& request, const Expectation& expect,
                        protocol::servo::Packet* answer);
 
   ServoBusOptions options_;  // timeout and retries guarded by state_mutex_ (retune), read via options()
   const FrameWriter writer_;
+  ReaderPump pump_;  // set before any call; empty: every wait is on a condition variable
 
   BusMutex bus_mutex_;  // one transaction on the wire at a time
 
