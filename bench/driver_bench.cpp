@@ -1025,7 +1025,11 @@ void runServoBusSection(Context& context) {
             format("%.3f ms vs %.3f ms", floor_paced.turnaround_ms, kBusLineMs + kBusLatencyMs));
   table.note(
       "Each transaction is a READ_ANGLE of the next servo: servo_states asks for 1000 Hz of each "
-      "of 20 servos, more than either line carries, so both clients run back to back. CPU is the "
+      "of 20 servos, more than either line carries, so both clients run back to back. driver_node "
+      "runs with ~servo_bus/health_rate 0 except in the row that says otherwise, whose count is "
+      "robot_sim's answers (angles and health reads). servo_floor --publish is the least a roscpp "
+      "node doing servo_states' job must spend: the floor plus one JointState published per "
+      "answer, counted by the same subscriber as driver_node's. CPU is the "
       "process's own clock over the window. The paced robot_sim's excess is the difference of two "
       "floor runs that differ only in --pace-baud, so the pty round trip (the same in both) "
       "cancels; the last row includes it.");
