@@ -55,6 +55,20 @@ SerialLinkOptions optionsFor(const std::string& path) {
   return options;
 }
 
+/// What the driver wrote to the pty: `size` bytes, or fewer when they did not all come in time.
+Bytes readWritten(sim::PseudoTerminal& pty, std::size_t size) {
+  Bytes received(size);
+  std::size_t got = 0;
+  waitFor(
+      [&] {
+        got += pty.read(received.data() + got, size - got, 10);
+        return got == size;
+      },
+      kWaitSeconds);
+  received.resize(got);
+  return received;
+}
+
 // Battery reply, 87 %, SEQ 00 and PING reply id 3.
 const Bytes& kBatteryReply = golden::base::kBattery87ReplySeq0;
 const Bytes& kPingReply = golden::servo::kPing3Reply;
@@ -185,15 +199,7 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
 
   const Bytes& reset = golden::base::kResetSeq2;
   ASSERT_TRUE(link.write(reset));
-  Bytes received(reset.size());
-  std::size_t got = 0;
-  ASSERT_TRUE(waitFor(
-      [&] {
-        got += pty.read(received.data() + got, received.size() - got, 10);
-        return got == received.size();
-      },
-      kWaitSeconds));
-  EXPECT_EQ(received, reset);
+  EXPECT_EQ(readWritten(pty, reset.size()), reset);
 
   const LinkStats stats = link.stats();
   EXPECT_TRUE(stats.connected);
@@ -281,15 +287,7 @@ TEST(SerialLink, AWorkerWritesAndReadsItsAnswerOnTheReaderThread) {
   for (int round = 1; round <= 2; ++round) {
     worker.armed = true;
     link.wake();
-    Bytes request(golden::servo::kPing3.size());
-    std::size_t got = 0;
-    ASSERT_TRUE(waitFor(
-        [&] {
-          got += pty.read(request.data() + got, request.size() - got, 10);
-          return got == request.size();
-        },
-        kWaitSeconds));
-    EXPECT_EQ(request, golden::servo::kPing3);
+    ASSERT_EQ(readWritten(pty, golden::servo::kPing3.size()), golden::servo::kPing3);
     // Junk, then the answer split in two writes: the pump frames it like the reader's own loop.
     const Bytes junk = {0xAA, 0x05};
     pty.write(junk.data(), junk.size());
@@ -318,14 +316,7 @@ TEST(SerialLink, APumpReportsAnUnpluggedPortAndTheLinkReopensIt) {
 
   worker.armed = true;
   link.wake();
-  Bytes request(golden::servo::kPing3.size());
-  std::size_t got = 0;
-  ASSERT_TRUE(waitFor(
-      [&] {
-        got += pty->read(request.data() + got, request.size() - got, 10);
-        return got == request.size();
-      },
-      kWaitSeconds));
+  ASSERT_EQ(readWritten(*pty, golden::servo::kPing3.size()), golden::servo::kPing3);
   pty->close();  // unplugged while the worker waits for its answer
   ASSERT_TRUE(waitFor([&] { return worker.done == 1; }, kWaitSeconds));
   EXPECT_TRUE(worker.pump_failed) << "the wait ends with the port, not at its deadline";
