@@ -247,8 +247,8 @@ void SerialLink::readOnce(Clock::time_point until) {
     }
     const auto left =
         std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet);
-    // Clamped as a duration first: the int conversion never sees more than longest_read_ms.
-    read_timeout = std::clamp(left, std::chrono::milliseconds(1), read_timeout);
+    // Limited as a duration first: the int conversion never sees more than longest_read_ms.
+    read_timeout = std::min(read_timeout, std::max(left, std::chrono::milliseconds(1)));
   }
   std::size_t n = 0;
   try {
