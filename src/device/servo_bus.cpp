@@ -75,6 +75,15 @@ void ServoBus::dropQueuedMoves(uint8_t id) {
                       queued_moves_.end());
 }
 
+void ServoBus::stopServo(uint8_t id) {
+  dropQueuedMoves(id);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_requests_.insert(id);
+  }
+  wakeWorker();
+}
+
 void ServoBus::retune(const ServoBusConfig& next) {
   client_.retune(next.client.timeout, next.client.retries);
   {
@@ -162,7 +171,7 @@ void ServoBus::wakeWorker() {
 
 Clock::time_point ServoBus::nextWorkLocked() const {
   if (!started_ || stop_) return Clock::time_point::max();
-  if (!queued_moves_.empty()) return Clock::time_point::min();
+  if (!queued_moves_.empty() || !stop_requests_.empty()) return Clock::time_point::min();
   Clock::time_point next = nextHealthPoll();
   for (const PolledServo& servo : polled_) next = std::min(next, servo.next_poll);
   return next;
@@ -198,6 +207,16 @@ void ServoBus::workerLoop() {
 }
 
 void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
+  if (!stop_requests_.empty()) {
+    const uint8_t id = *stop_requests_.begin();
+    stop_requests_.erase(stop_requests_.begin());
+    lock.unlock();
+    SpinRequest stop;
+    stop.id = id;
+    spin(stop);
+    lock.lock();
+    return;
+  }
   if (!queued_moves_.empty()) {
     const MoveRequest move = queued_moves_.front();
     queued_moves_.pop_front();

@@ -132,6 +132,10 @@ class ServoBus : public LinkListener, public LinkWorker {
   void queueMoves(const std::vector<MoveRequest>& moves);
   /// Drops a move of servo `id` still waiting in the queue (another command took the servo over).
   void dropQueuedMoves(uint8_t id);
+  /// Stops servo `id` where it is (a SPIN stop, no position commanded) and drops its queued moves,
+  /// without waiting: the worker writes the stop ahead of queued moves, polls and waiting calls.
+  /// Allowed while the e-stop holds. Any thread.
+  void stopServo(uint8_t id);
 
   // Motion through the device: the client's operations, refused (kMotionRefused) while
   // setMotionLocked(true) holds, and noted so the device knows which servos it set moving
@@ -232,6 +236,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   bool working_ = false;          // work() in progress on the link's reader thread
   SerialLink* link_ = nullptr;    // runOn(): the worker is the link's reader thread
   std::deque<MoveRequest> queued_moves_;
+  std::set<uint8_t> stop_requests_;  // stopServo(): SPIN stops the worker writes first
   std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   std::set<uint8_t> moving_;          // servos set moving and not stopped since
   bool motion_locked_ = false;
