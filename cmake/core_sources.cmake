@@ -29,7 +29,9 @@ set(SRD_CORE_SOURCES
   src/device/servo_bus_text.cpp
   src/device/servo_bus.cpp
   src/device/e_stop.cpp
+  src/device/motion_gate.cpp
   src/device/servo_bus_safety.cpp
+  src/device/servo_bus_stops.cpp
   src/device/servo_health.cpp
   src/device/servo_bus_health.cpp
 )

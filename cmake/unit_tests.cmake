@@ -15,6 +15,7 @@ catkin_add_gtest(core_tests
   test/unit/test_body_controller.cpp
   test/unit/test_servo_bus_client.cpp
   test/unit/test_servo_bus.cpp
+  test/unit/test_servo_bus_stops.cpp
   test/unit/test_servo_bus_on_link.cpp
   test/unit/test_sim.cpp
   test/unit/test_device_set.cpp

@@ -24,6 +24,7 @@ ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents eve
       poll_period_(std::chrono::duration_cast<Clock::duration>(
           std::chrono::duration<double>(1.0 / config_.poll_rate))),
       client_(config_.client, std::move(writer)) {
+  client_.setMotionGate(&gate_, [this](uint8_t id) { noteCommanded(id); });
   const Clock::time_point now = clock_->now();
   for (uint8_t id : config_.polled_ids) {
     PolledServo servo;
@@ -75,15 +76,6 @@ void ServoBus::dropQueuedMoves(uint8_t id) {
                       queued_moves_.end());
 }
 
-void ServoBus::stopServo(uint8_t id) {
-  dropQueuedMoves(id);
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_requests_.insert(id);
-  }
-  wakeWorker();
-}
-
 void ServoBus::retune(const ServoBusConfig& next) {
   client_.retune(next.client.timeout, next.client.retries);
   {
@@ -122,6 +114,8 @@ void ServoBus::start() {
 }
 
 void ServoBus::shutdown() {
+  // The last words are decided from here on: no motion frame passes any more, whoever waited.
+  gate_.close();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
@@ -171,8 +165,8 @@ void ServoBus::wakeWorker() {
 
 Clock::time_point ServoBus::nextWorkLocked() const {
   if (!started_ || stop_) return Clock::time_point::max();
-  if (!queued_moves_.empty() || !stop_requests_.empty()) return Clock::time_point::min();
-  Clock::time_point next = nextHealthPoll();
+  if (!queued_moves_.empty()) return Clock::time_point::min();
+  Clock::time_point next = std::min(nextStopWork(), nextHealthPoll());
   for (const PolledServo& servo : polled_) next = std::min(next, servo.next_poll);
   return next;
 }
@@ -195,10 +189,10 @@ void ServoBus::work() {
 void ServoBus::workerLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
-    const Clock::time_point due = nextWorkLocked();
-    if (due == Clock::time_point::max()) {
-      wake_.wait(lock);
-    } else if (clock_->now() < due) {
+    Clock::time_point due = nextWorkLocked();
+    // Nothing scheduled: wait to be woken (bounded, so the clock's arithmetic cannot overflow).
+    if (due == Clock::time_point::max()) due = clock_->now() + std::chrono::hours(1);
+    if (clock_->now() < due) {
       clock_->waitUntil(lock, wake_, due);
     } else {
       workOnce(lock);
@@ -207,16 +201,8 @@ void ServoBus::workerLoop() {
 }
 
 void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
-  if (!stop_requests_.empty()) {
-    const uint8_t id = *stop_requests_.begin();
-    stop_requests_.erase(stop_requests_.begin());
-    lock.unlock();
-    SpinRequest stop;
-    stop.id = id;
-    spin(stop);
-    lock.lock();
-    return;
-  }
+  // Stops first: nothing else this bus does may go before them.
+  if (stopWorkOnce(lock, StopPace::kScheduled)) return;
   if (!queued_moves_.empty()) {
     const MoveRequest move = queued_moves_.front();
     queued_moves_.pop_front();
@@ -250,7 +236,18 @@ void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
 
 void ServoBus::sendMove(const MoveRequest& move) {
   ServoStatus status = refuseWhileLocked(move.id);  // an overheated servo (protect)
-  if (status.ok()) status = client_.move(move);
+  if (status.ok()) {
+    // Through the motion gate: refused if the e-stop came meanwhile.
+    status = client_.move(move, BusPriority::kWorker);
+  }
+  if (status.error == ServoError::kPreempted) {
+    // A stop goes first; the move goes after it unless a newer target or the e-stop replaced it.
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool replaced = std::any_of(queued_moves_.begin(), queued_moves_.end(),
+                                      [&move](const MoveRequest& m) { return m.id == move.id; });
+    if (!replaced && !motion_locked_ && stops_.count(move.id) == 0) queued_moves_.push_front(move);
+    return;
+  }
   if (status.ok()) noteMotion(move.id, true);
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -268,6 +265,7 @@ void ServoBus::pollOnce(PolledServo& servo) {
   sample.id = servo.id;
   const ServoStatus status =
       client_.readAngle(servo.id, &sample.angle_deg, &sample.arrival, BusPriority::kBackground);
+  if (status.error == ServoError::kPreempted) return;  // a stop went first: due again at once
   const Clock::time_point now = clock_->now();
   bool went_silent = false;
   {

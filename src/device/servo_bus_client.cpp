@@ -57,6 +57,8 @@ const char* toString(ServoError error) {
       return "read-back mismatch";
     case ServoError::kShutdown:
       return "shutting down";
+    case ServoError::kPreempted:
+      return "gave way to a stop";
   }
   return "unknown";
 }
@@ -82,14 +84,60 @@ void BusMutex::waitTurn(std::unique_lock<std::mutex>& lock, Predicate free) {
 void BusMutex::lock() {
   std::unique_lock<std::mutex> lock(mutex_);
   ++waiting_;
-  waitTurn(lock, [this] { return !held_; });
+  waitTurn(lock, [this] { return !held_ && !urgent_ && yielded_ == 0; });
   --waiting_;
   held_ = true;
 }
 
-void BusMutex::lockBackground() {
+bool BusMutex::lockBackground() {
   std::unique_lock<std::mutex> lock(mutex_);
-  waitTurn(lock, [this] { return !held_ && waiting_ == 0; });
+  waitTurn(lock, [this] { return urgent_ || (!held_ && waiting_ == 0 && yielded_ == 0); });
+  if (urgent_) return false;  // a stop is coming: the poll gives way and is due again at once
+  held_ = true;
+  return true;
+}
+
+bool BusMutex::lockUnlessUrgent() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  ++waiting_;
+  waitTurn(lock, [this] { return urgent_ || (!held_ && yielded_ == 0); });
+  --waiting_;
+  if (urgent_) return false;
+  held_ = true;
+  return true;
+}
+
+void BusMutex::lockUrgent() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  waitTurn(lock, [this] { return !held_; });
+  held_ = true;
+}
+
+void BusMutex::requestUrgent() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  urgent_ = true;
+  wakeWaiters(lock);  // a background wait gives up
+}
+
+void BusMutex::endUrgent() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  urgent_ = false;
+  wakeWaiters(lock);
+}
+
+bool BusMutex::urgentRequested() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return urgent_;
+}
+
+void BusMutex::yieldToUrgent() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (!urgent_) return;
+  held_ = false;
+  ++yielded_;
+  wakeWaiters(lock);
+  waitTurn(lock, [this] { return !held_ && !urgent_; });
+  --yielded_;
   held_ = true;
 }
 
@@ -99,12 +147,14 @@ int BusMutex::foregroundWaiting() {
 }
 
 void BusMutex::unlock() {
-  bool wake_reader = false;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    held_ = false;
-    wake_reader = std::exchange(reader_waiting_, false);
-  }
+  std::unique_lock<std::mutex> lock(mutex_);
+  held_ = false;
+  wakeWaiters(lock);
+}
+
+void BusMutex::wakeWaiters(std::unique_lock<std::mutex>& lock) {
+  const bool wake_reader = std::exchange(reader_waiting_, false);
+  lock.unlock();
   released_.notify_all();
   if (wake_reader) pump_->wake();
 }
@@ -194,7 +244,8 @@ void ServoBusClient::setReaderPump(ReaderPump pump) {
 
 void ServoBusClient::waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::time_point deadline) {
   const auto settled = [this] {
-    return pending_.answered || pending_.garbled || link_lost_ || stopping_;
+    return pending_.answered || pending_.garbled || link_lost_ || stopping_ ||
+           (motion_wait_ && urgent_);
   };
   if (!pump_.pump || !pump_.on_reader_thread()) {
     answer_cv_.wait_until(lock, deadline, settled);
@@ -209,12 +260,42 @@ void ServoBusClient::waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::ti
   }
 }
 
+std::optional<ServoStatus> ServoBusClient::writeRequest(const std::vector<uint8_t>& request,
+                                                        Command cmd, uint8_t id, FrameGate gate) {
+  bool written = false;
+  if (gate == FrameGate::kMotion && gate_ != nullptr) {
+    const GateState state = gate_->writeIfOpen(
+        [&] {
+          const bool out = writer_(request);
+          if (out && on_motion_written_) on_motion_written_(id);
+          return out;
+        },
+        &written);
+    if (state != GateState::kOpen) {
+      return fail(ServoError::kMotionRefused,
+                  std::string(toString(state)) + ": " + commandName(cmd) + " to " + servoName(id) +
+                      " was not written (refused when its turn on the bus came)");
+    }
+  } else {
+    written = writer_(request);
+  }
+  if (!written) return notConnected();
+  return std::nullopt;
+}
+
 ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const Expectation& expect,
                                      std::chrono::milliseconds timeout, int attempts,
-                                     servo::Packet* answer) {
+                                     servo::Packet* answer, FrameGate gate, bool give_way) {
   bool any_garbled = false;
   std::size_t garbled_size = 0;
   for (int attempt = 1; attempt <= attempts; ++attempt) {
+    // A stop asked during the last attempt goes out before this one: the worker that writes it
+    // ends here, a caller hands the bus over and goes on after it.
+    if (attempt > 1 && give_way && bus_mutex_.urgentRequested()) {
+      return fail(ServoError::kPreempted, servoName(expect.id) + "'s " + commandName(expect.cmd) +
+                                              " gave way to a stop");
+    }
+    if (attempt > 1) bus_mutex_.yieldToUrgent();
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
       if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
@@ -223,12 +304,14 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
       pending_.expect = expect;
       last_request_ = request;
       link_lost_ = false;
+      motion_wait_ = gate == FrameGate::kMotion;
     }
     const Clock::time_point sent_at = Clock::now();
-    if (!writer_(request)) {
+    if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate)) {
       std::lock_guard<std::mutex> lock(state_mutex_);
       pending_.active = false;
-      return notConnected();
+      motion_wait_ = false;
+      return *refusal;
     }
 
     std::unique_lock<std::mutex> lock(state_mutex_);
@@ -239,6 +322,8 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
     }
     waitForAnswer(lock, sent_at + timeout);
     pending_.active = false;
+    const bool cut_short = motion_wait_ && urgent_ && !pending_.answered;
+    motion_wait_ = false;
 
     if (pending_.answered) {
       const double latency_ms = toMs(pending_.arrival - sent_at);
@@ -253,6 +338,12 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
                                                  commandName(expect.cmd) + " answer");
     }
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
+    if (cut_short) {
+      return fail(ServoError::kPreempted,
+                  std::string(commandName(expect.cmd)) + " was written to " +
+                      servoName(expect.id) +
+                      ", but the wait for its completion was cut short by a stop");
+    }
     if (pending_.garbled) {
       any_garbled = true;
       garbled_size = pending_.answer.content_size;
@@ -291,6 +382,19 @@ ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
   return transact(request, expect, options.timeout, options.retries + 1, answer);
 }
 
+bool ServoBusClient::takeBus(BusPriority priority) {
+  switch (priority) {
+    case BusPriority::kCaller:
+      bus_mutex_.lock();
+      return true;
+    case BusPriority::kWorker:
+      return bus_mutex_.lockUnlessUrgent();
+    case BusPriority::kBackground:
+      return bus_mutex_.lockBackground();
+  }
+  return false;
+}
+
 ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const Expectation& expect,
                                      servo::Packet* answer) {
   std::lock_guard<BusMutex> bus(bus_mutex_);
@@ -298,13 +402,13 @@ ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const 
 }
 
 ServoStatus ServoBusClient::sendCommand(const std::vector<uint8_t>& request, Command cmd,
-                                        uint8_t id) {
+                                        uint8_t id, FrameGate gate) {
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
     last_request_ = request;
   }
-  if (!writer_(request)) return notConnected();
+  if (auto refusal = writeRequest(request, cmd, id, gate)) return *refusal;
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.commands;
@@ -314,13 +418,14 @@ ServoStatus ServoBusClient::sendCommand(const std::vector<uint8_t>& request, Com
 }
 
 ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
-                                       bool wait, std::chrono::milliseconds motion_time) {
-  if (!wait) return sendCommand(request, cmd, id);
+                                       bool wait, std::chrono::milliseconds motion_time,
+                                       FrameGate gate) {
+  if (!wait) return sendCommand(request, cmd, id, gate);
   servo::Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
   ServoStatus status =
-      transact(request, Expectation(cmd, id), motion_time + options().timeout, 1, &answer);
+      transact(request, Expectation(cmd, id), motion_time + options().timeout, 1, &answer, gate);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";
@@ -333,6 +438,34 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
   }
   return ok(std::string(commandName(cmd)) + " completed by " + servoName(id) + ", " +
             status.message);
+}
+
+void ServoBusClient::writeStops(const std::vector<uint8_t>& ids, std::vector<bool>* written) {
+  written->assign(ids.size(), false);
+  bus_mutex_.lockUrgent();
+  std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const std::vector<uint8_t> frame =
+        servo::encodeSpin(ids[i], false, servo::SpinMode::kStop, 0, 0);
+    (*written)[i] = sendCommand(frame, Command::kSpin, ids[i], FrameGate::kSafetyAction).ok();
+  }
+}
+
+void ServoBusClient::requestUrgent() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    urgent_ = true;
+  }
+  answer_cv_.notify_all();  // a motion wait gives way
+  bus_mutex_.requestUrgent();
+}
+
+void ServoBusClient::endUrgent() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    urgent_ = false;
+  }
+  bus_mutex_.endUrgent();
 }
 
 }  // namespace serial_robot_driver::device

@@ -61,7 +61,8 @@ void ServoBus::pollHealthOnce(std::size_t index) {
   std::vector<int64_t> values;
   ServoStatus status = silent ? ServoStatus{ServoError::kTimeout, "does not answer the angle poll"}
                               : readHealthParams(id, kReadingNames, &values);
-  if (status.error == ServoError::kShutdown) return;
+  // Shutting down, or a stop went first: the poll is due again as it was.
+  if (status.error == ServoError::kShutdown || status.error == ServoError::kPreempted) return;
   if (status.ok() && !servo.report.limits_known) {
     std::vector<int64_t> limits;
     if (readHealthParams(id, kLimitNames, &limits).ok()) {
@@ -97,7 +98,8 @@ void ServoBus::pollHealthOnce(std::size_t index) {
     }
   }
   if (overheat_changed && servo.report.overheated) {
-    client_.damping(id, settings().relax_power_mw, false);
+    // A safety action: let through whatever the gate says.
+    client_.damping(id, settings().relax_power_mw, false, FrameGate::kSafetyAction);
     noteMotion(id, false);
   }
   if (overheat_changed && events_.on_overheat) events_.on_overheat(servo.report);

@@ -31,7 +31,7 @@ constexpr uint16_t kMinRampMs = 20;      // the firmware's shortest ramp
 constexpr uint32_t kMaxMultiTurnIntervalMs = 4096000;
 }  // namespace
 
-ServoStatus ServoBusClient::move(const MoveRequest& request) {
+ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priority) {
   const auto invalid = [](const std::string& text) {
     return fail(ServoError::kInvalidArgument, text);
   };
@@ -100,8 +100,12 @@ ServoStatus ServoBusClient::move(const MoveRequest& request) {
     command.cmd = request.multi_turn ? Command::kMultiTurnMove : Command::kRotate;
   }
   const std::vector<uint8_t> frame = servo::encodeMove(command);
-  std::lock_guard<BusMutex> bus(bus_mutex_);
-  return sendCommand(frame, command.cmd, request.id);
+  if (!takeBus(priority)) {
+    return fail(ServoError::kPreempted, std::string(commandName(command.cmd)) + " to " +
+                                            servoName(request.id) + " gave way to a stop");
+  }
+  std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
+  return sendCommand(frame, command.cmd, request.id, FrameGate::kMotion);
 }
 
 ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
@@ -123,7 +127,7 @@ ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
       request.id, static_cast<int16_t>(decidegrees), request.interval_ms, request.power_mw);
   std::lock_guard<BusMutex> bus(bus_mutex_);
   return sendMotion(frame, Command::kRotate, request.id, request.wait,
-                    std::chrono::milliseconds(request.interval_ms));
+                    std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion);
 }
 
 ServoStatus ServoBusClient::spin(const SpinRequest& request) {
@@ -156,16 +160,18 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request) {
   const std::vector<uint8_t> frame =
       servo::encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
   std::lock_guard<BusMutex> bus(bus_mutex_);
-  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time);
+  // A SPIN stop is what the e-stop itself sends: never held back.
+  const FrameGate gate = mode == servo::SpinMode::kStop ? FrameGate::kSafetyAction : FrameGate::kMotion;
+  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time, gate);
 }
 
-ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait) {
+ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, FrameGate gate) {
   if (wait) {
     if (auto rejection = rejectBroadcast(id, Command::kDamping)) return *rejection;
   }
   const std::vector<uint8_t> frame = servo::encodeDamping(id, power_mw);
   std::lock_guard<BusMutex> bus(bus_mutex_);
-  return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0));
+  return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0), gate);
 }
 
 }  // namespace serial_robot_driver::device

@@ -34,16 +34,16 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
   ServoStatus status;
   const std::vector<uint8_t> request = servo::encodeReadAngle(id);
   const Expectation expect(Command::kReadAngle, id);
-  if (priority == BusPriority::kBackground) {
-    // Background work makes one attempt: the next poll is the retry.
-    bus_mutex_.lockBackground();
+  if (!takeBus(priority)) {
+    return fail(ServoError::kPreempted, servoName(id) + "'s READ_ANGLE gave way to a stop");
+  }
+  {
     std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
-    status = transact(request, expect, options().timeout, 1, &answer);
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    answered_at = pending_.arrival;
-  } else {
-    std::lock_guard<BusMutex> bus(bus_mutex_);
-    status = exchangeLocked(request, expect, &answer);
+    // Background work makes one attempt: the next poll is the retry.
+    const ServoBusOptions options = this->options();
+    const int attempts = priority == BusPriority::kBackground ? 1 : options.retries + 1;
+    status = transact(request, expect, options.timeout, attempts, &answer,
+                      FrameGate::kSafetyAction, priority == BusPriority::kWorker);
     std::lock_guard<std::mutex> lock(state_mutex_);
     answered_at = pending_.arrival;
   }

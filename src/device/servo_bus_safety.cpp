@@ -1,5 +1,6 @@
-// The ServoBus's motion operations with their bookkeeping: which servos the driver set moving, so
-// the e-stop and the shutdown can stop exactly those; relax and hold; the e-stop's lock.
+// The ServoBus's motion operations with their bookkeeping: which servos the driver set moving or
+// positioned, so the e-stop and the shutdown can stop exactly those; relax and hold. The stops
+// themselves are in servo_bus_stops.cpp.
 #include <algorithm>
 #include <cstdio>
 
@@ -15,23 +16,10 @@ std::string servoLabel(uint8_t id) { return "servo " + std::to_string(id); }
 
 }  // namespace
 
-std::optional<ShutdownAction> shutdownActionFromString(const std::string& text) {
-  if (text == "stop") return ShutdownAction::kStop;
-  if (text == "relax") return ShutdownAction::kRelax;
-  if (text == "none") return ShutdownAction::kNone;
-  return std::nullopt;
-}
-
-const char* toString(ShutdownAction action) {
-  switch (action) {
-    case ShutdownAction::kStop:
-      return "stop";
-    case ShutdownAction::kRelax:
-      return "relax";
-    case ShutdownAction::kNone:
-      return "none";
-  }
-  return "?";
+void ServoBus::noteCommanded(uint8_t id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  commanded_.insert(id);
+  stops_.erase(id);  // the gate was open: the e-stop is not engaged, this was a hold's stop
 }
 
 void ServoBus::noteMotion(uint8_t id, bool moving) {
@@ -95,7 +83,14 @@ ServoStatus ServoBus::damping(uint8_t id, uint16_t power_mw, bool wait) {
   ServoStatus status = refuseWhileLocked(id);
   if (!status.ok()) return status;
   status = client_.damping(id, power_mw, wait);
-  if (status.ok()) noteMotion(id, false);  // no holding torque: nothing keeps it moving
+  if (status.ok()) {
+    noteMotion(id, false);  // no holding torque: nothing keeps it moving or in place
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!motion_locked_) {
+      commanded_.erase(id);
+      stops_.erase(id);  // relaxed: there is nothing left to stop
+    }
+  }
   return status;
 }
 
@@ -138,15 +133,6 @@ ServoStatus ServoBus::hold(const std::vector<uint8_t>& ids) {
   return {ServoError::kOk, "holding servo(s) " + held};
 }
 
-void ServoBus::setMotionLocked(bool locked) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    motion_locked_ = locked;
-    if (locked) queued_moves_.clear();
-  }
-  if (locked) stopMoving();
-}
-
 bool ServoBus::motionLocked() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return motion_locked_;
@@ -157,35 +143,9 @@ std::vector<uint8_t> ServoBus::movingIds() const {
   return {moving_.begin(), moving_.end()};
 }
 
-ServoStatus ServoBus::stopMoving() {
-  ServoStatus last;
-  for (uint8_t id : movingIds()) {
-    SpinRequest stop;
-    stop.id = id;
-    stop.mode = 0;
-    const ServoStatus status = spin(stop);
-    if (!status.ok()) last = status;
-  }
-  return last;
-}
-
-void ServoBus::finalWords() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (final_words_said_) return;
-    final_words_said_ = true;
-  }
-  const ServoBusConfig in_force = settings();
-  switch (in_force.on_shutdown) {
-    case ShutdownAction::kStop:
-      stopMoving();
-      break;
-    case ShutdownAction::kRelax:
-      for (uint8_t id : movingIds()) client_.damping(id, in_force.relax_power_mw, false);
-      break;
-    case ShutdownAction::kNone:
-      break;
-  }
+std::vector<uint8_t> ServoBus::commandedIds() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return {commanded_.begin(), commanded_.end()};
 }
 
 }  // namespace serial_robot_driver::device

@@ -82,7 +82,9 @@ ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
   }
   if (auto rejection = rejectBroadcast(id, Command::kReadData)) return *rejection;
   if (priority == BusPriority::kBackground) {
-    bus_mutex_.lockBackground();
+    if (!takeBus(BusPriority::kBackground)) {
+      return fail(ServoError::kPreempted, servoName(id) + "'s health poll gave way to a stop");
+    }
     std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
     return readParamLocked(id, *param, value);
   }

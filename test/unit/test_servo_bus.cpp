@@ -14,89 +14,14 @@
 
 #include "serial_robot_driver/device/servo_bus.h"
 #include "support/golden_frames.h"
-#include "support/manual_clock.h"
+#include "support/servo_bus_rig.h"
 
 namespace serial_robot_driver::device {
 namespace {
 
-using Bytes = std::vector<uint8_t>;
 using std::chrono::milliseconds;
 using namespace golden::servo;  // NOLINT: the shared golden frames
 
-/// Polls `condition` until it holds or a generous timeout passes (threads of the bus run on).
-bool waitFor(const std::function<bool()>& condition) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!condition() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(milliseconds(1));
-  }
-  return condition();
-}
-
-class ServoBusTest : public ::testing::Test {
- protected:
-  /// A bus polling `polled_ids` at 10 Hz (every 100 ms) on the manual clock, without the health
-  /// poll (these tests count the frames of the moves and the angle polls).
-  void makeBus(std::vector<uint8_t> polled_ids) {
-    ServoBusConfig config;
-    config.health_rate = 0.0;
-    config.client.timeout = milliseconds(5);  // a silent servo costs 5 ms of real time
-    config.client.retries = 0;
-    config.polled_ids = std::move(polled_ids);
-    config.poll_rate = 10.0;
-    ServoBusEvents events;
-    events.on_angle = [this](const ServoAngleSample& sample) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      angles_.push_back(sample);
-    };
-    events.on_servo_silent = [this](uint8_t id, const ServoStatus&, milliseconds backoff) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      silent_.push_back({id, backoff});
-    };
-    events.on_move_failed = [this](const MoveRequest& move, const ServoStatus& status) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      failed_moves_.push_back({move.id, status.error});
-    };
-    bus_ = std::make_unique<ServoBus>(
-        config, [this](const Bytes& frame) { return write(frame); }, events, clock_);
-  }
-
-  bool write(const Bytes& frame) {
-    Bytes reply;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      written_.push_back(frame);
-      // A gated frame stays "on the wire" (the writer does not return) until the test opens it.
-      gate_opened_.wait(lock, [&] { return frame != gated_frame_; });
-      auto it = answers_.find(frame);
-      if (it == answers_.end()) return true;
-      reply = it->second;
-    }
-    bus_->onFrame(protocol::FrameFamily::kServoResponse, reply.data(), reply.size(), Clock::now());
-    return true;
-  }
-
-  std::vector<Bytes> written() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return written_;
-  }
-  std::size_t countWritten(const Bytes& frame) {
-    std::size_t count = 0;
-    for (const Bytes& f : written()) count += f == frame ? 1 : 0;
-    return count;
-  }
-
-  const Clock::time_point t0_ = Clock::time_point() + std::chrono::hours(1);
-  std::shared_ptr<ManualClock> clock_ = std::make_shared<ManualClock>(t0_);
-  std::mutex mutex_;
-  std::map<Bytes, Bytes> answers_ = {{kReadAngle0, kReadAngle0Reply902}};
-  std::vector<Bytes> written_;
-  std::vector<ServoAngleSample> angles_;
-  std::vector<std::pair<uint8_t, milliseconds>> silent_;
-  std::vector<std::pair<uint8_t, ServoError>> failed_moves_;
-  std::unique_ptr<ServoBus> bus_;
-  std::condition_variable gate_opened_;
-  Bytes gated_frame_;  // guarded by mutex_
-};
 
 TEST_F(ServoBusTest, PollsEachServoOncePerPeriod) {
   makeBus({0});
@@ -245,15 +170,7 @@ TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
 
 // SPIN stop at speed 0 (the e-stop's and the shutdown's): 12 4C 07 06 | id 0, mode 0, speed 0,
 // value 0 | sum 0x6B.
-const Bytes kSpin0StopSpeed0 = {0x12, 0x4C, 0x07, 0x06, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x6B};
 
-SpinRequest continuousSpin0() {
-  SpinRequest spin;
-  spin.id = 0;
-  spin.mode = 1;
-  spin.speed_dps = 100;
-  return spin;
-}
 
 TEST_F(ServoBusTest, MotionLockStopsTheServosSetSpinningAndRefusesMotionUntilReleased) {
   makeBus({});
@@ -276,27 +193,41 @@ TEST_F(ServoBusTest, MotionLockStopsTheServosSetSpinningAndRefusesMotionUntilRel
   EXPECT_EQ(countWritten(kSpin0CcwContinuous), 2u);
 }
 
-TEST_F(ServoBusTest, ShutdownStopsOnlyTheServosSetMoving) {
+// The last words: a stop to every servo set moving or positioned since start-up, then two looks at
+// its angle (the servo is at rest: confirmed); later calls fail.
+TEST_F(ServoBusTest, ShutdownStopsTheServosSetMovingAndLooksUntilTheyRest) {
   makeBus({});
   bus_->start();
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
   bus_->shutdown();
-  EXPECT_EQ(written().back(), kSpin0StopSpeed0);
-  EXPECT_EQ(countWritten(kSpin0StopSpeed0), 1u);
+  EXPECT_EQ(written(), (std::vector<Bytes>{kSpin0CcwContinuous, kSpin0StopSpeed0, kReadAngle0,
+                                           kReadAngle0}));
+  EXPECT_TRUE(bus_->pendingStops().empty());
   EXPECT_EQ(bus_->spin(continuousSpin0()).error, ServoError::kShutdown);
 }
 
-TEST_F(ServoBusTest, ShutdownSaysNothingWhenNoServoWasSetMoving) {
+// A servo stopped by hand was still positioned by the driver: it gets its stop at shutdown too.
+TEST_F(ServoBusTest, ShutdownStopsAServoStoppedByHandAgain) {
   makeBus({});
   bus_->start();
   SpinRequest stop = continuousSpin0();
   stop.mode = 0;
   stop.speed_dps = 0;
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
-  ASSERT_TRUE(bus_->spin(stop).ok());  // stopped by hand: nothing moves any more
-  const std::size_t before = written().size();
+  ASSERT_TRUE(bus_->spin(stop).ok());
+  EXPECT_TRUE(bus_->movingIds().empty());
+  EXPECT_EQ(bus_->commandedIds(), std::vector<uint8_t>{0});
   bus_->shutdown();
-  EXPECT_EQ(written().size(), before);
+  EXPECT_EQ(countWritten(kSpin0StopSpeed0), 2u);
+}
+
+TEST_F(ServoBusTest, ShutdownSaysNothingWhenNoServoWasCommanded) {
+  makeBus({});
+  bus_->start();
+  double angle = 0.0;
+  ASSERT_TRUE(bus_->client().readAngle(0, &angle).ok());
+  bus_->shutdown();
+  EXPECT_EQ(written(), std::vector<Bytes>{kReadAngle0});
 }
 
 TEST_F(ServoBusTest, RetunedPollRateAppliesFromTheNextPollAndTimingFromTheNextTransaction) {

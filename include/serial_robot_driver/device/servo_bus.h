@@ -21,9 +21,20 @@
 //  - With health_rate > 0 the worker also polls each servo's health (five READ_DATA, each as
 //    background work, so a caller still waits for one transaction at most) when it falls due.
 //  - The motion operations (move, rotate, spin, damping, relax, hold) run on their caller's thread
-//    like the client's; setMotionLocked() (the e-stop) writes its SPIN stops on its caller's.
-//  - shutdown() stops the worker first (joins its thread, or waits for the piece of work the
-//    reader thread is doing), then says the last words (on_shutdown) on its caller's.
+//    like the client's. Every motion frame, whoever writes it, passes the bus's MotionGate when it
+//    is written: the e-stop (setMotionLocked) and shutdown() take the gate's lock, so no motion
+//    frame goes out after they return, however long it waited for the bus.
+//  - Stops (the e-stop's, stopServo()'s) are the worker's first work: setMotionLocked() and
+//    stopServo() only note them, ask the bus for urgent work and wake the worker, so their caller
+//    never waits for the wire. The worker writes them as urgent work (after the one transaction
+//    attempt in flight, before every waiting call, scan id or poll), then reads the servo's angle
+//    twice, a moment apart, until it is seen at rest; a stop that could not be written, was not
+//    answered after, or left the servo moving is written again. After a reconnect (onLinkUp, on
+//    the reader thread before any write can succeed) every stop of the e-stop is written again
+//    first. Without a running worker (before start()) setMotionLocked() writes them itself.
+//  - shutdown() closes the gate, stops the worker (joins its thread, or waits for the piece of
+//    work the reader thread is doing), then says the last words (on_shutdown) on its caller's,
+//    each stop confirmed like the e-stop's for at most kShutdownStopBudget.
 //  - Stats are one struct under mutex_; stats() returns a snapshot.
 #pragma once
 
@@ -32,6 +43,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -41,6 +53,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/loop_clock.h"
+#include "serial_robot_driver/device/motion_gate.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/device/servo_bus_client.h"
 #include "serial_robot_driver/device/servo_health.h"
@@ -97,6 +110,16 @@ struct ServoBusEvents {
   std::function<void(const MoveRequest& move, const ServoStatus& status)> on_move_failed;
   /// protect: servo `report.id` was relaxed for its temperature (`overheated`), or has cooled.
   std::function<void(const ServoHealthReport& report)> on_overheat;
+  /// A stop of servo `id`: ok once the servo is seen at rest after it; an error when an attempt
+  /// failed (it is retried) or, at shutdown, when it could not be confirmed in time.
+  std::function<void(uint8_t id, const ServoStatus& status)> on_stop;
+};
+
+/// A stop not yet known to have reached its servo.
+struct PendingStopReport {
+  uint8_t id = 0;
+  int written = 0;  ///< times the stop went out so far
+  std::string why;  ///< what is still missing: written, answered, seen at rest
 };
 
 struct ServoBusWorkerStats {
@@ -116,6 +139,12 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// first to the longest, so a dead servo costs one timeout per back-off period, not per poll.
   static constexpr std::chrono::milliseconds kFirstBackoff{500};
   static constexpr std::chrono::milliseconds kMaxBackoff{8000};
+  /// A stopped servo's angle is read twice this far apart; it is at rest when it moved no more
+  /// than kRestToleranceDeg meanwhile.
+  static constexpr std::chrono::milliseconds kStopSettle{100};
+  static constexpr double kRestToleranceDeg = 0.5;
+  /// How long shutdown() keeps writing and confirming its stops, at most.
+  static constexpr std::chrono::milliseconds kShutdownStopBudget{1000};
 
   /// `clock` empty: the steady clock.
   ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events = {},
@@ -133,8 +162,9 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Drops a move of servo `id` still waiting in the queue (another command took the servo over).
   void dropQueuedMoves(uint8_t id);
   /// Stops servo `id` where it is (a SPIN stop, no position commanded) and drops its queued moves,
-  /// without waiting: the worker writes the stop ahead of queued moves, polls and waiting calls.
-  /// Allowed while the e-stop holds. Any thread.
+  /// without waiting: the worker writes the stop ahead of queued moves, polls and waiting calls
+  /// and confirms it like the e-stop's. A later motion of the servo supersedes it. Allowed while
+  /// the e-stop holds. Any thread.
   void stopServo(uint8_t id);
 
   // Motion through the device: the client's operations, refused (kMotionRefused) while
@@ -151,12 +181,21 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// ROTATE there. Stops at the first failure.
   ServoStatus hold(const std::vector<uint8_t>& ids);
 
-  /// The e-stop: true drops the queued moves, refuses motion (queueMoves() included) and sends a
-  /// SPIN stop to every servo set spinning or moving; false lets motion through again.
+  /// The e-stop: true locks the motion gate (no motion frame is written from its return on),
+  /// drops the queued moves, refuses motion (queueMoves() included) and has every servo set
+  /// moving or positioned since start-up (commandedIds()) stopped until each is seen at rest;
+  /// false lets motion through again. Never waits for the bus (see the threading model).
   void setMotionLocked(bool locked);
   bool motionLocked() const;
   /// Servos set spinning or moving and not stopped or relaxed since (the broadcast id 255 too).
   std::vector<uint8_t> movingIds() const;
+  /// Servos set moving or positioned since start-up and not relaxed since: what the e-stop and
+  /// the shutdown stop.
+  std::vector<uint8_t> commandedIds() const;
+  /// Stops not yet known to have reached their servo (for diagnostics).
+  std::vector<PendingStopReport> pendingStops() const;
+  /// Motion frames refused when their turn on the bus came (e-stop engaged or shutting down).
+  uint64_t motionRefusedAtWrite() const { return gate_.refusedAtWrite(); }
   /// One report per polled servo (empty when health_rate is 0).
   std::vector<ServoHealthReport> health() const;
 
@@ -183,7 +222,8 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// values (poll_rate > 0).
   void retune(const ServoBusConfig& next);
 
-  // LinkListener (reader thread): handed on to the client.
+  // LinkListener (reader thread): handed on to the client; a reconnect re-arms the stops.
+  void onLinkUp() override;
   void onLinkDown() override;
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) override;
@@ -207,11 +247,38 @@ class ServoBus : public LinkListener, public LinkWorker {
   void workOnce(std::unique_lock<std::mutex>& lock);
   /// A change the worker must see: its own thread, or the link's reader thread.
   void wakeWorker();
+  /// A stop until the servo is seen at rest (see the threading model).
+  struct PendingStop {
+    enum class Phase { kWrite, kFirstLook, kSecondLook } phase = Phase::kWrite;
+    Clock::time_point due;
+    double first_angle = 0.0;
+    int written = 0;
+    bool port_down = false;  ///< the last write failed
+    std::string why = "not written yet";
+  };
+  /// How stop work is paced: by the bus's clock (the worker), or back to back with real sleeps
+  /// for the settle (shutdown(), on its caller's thread, whatever clock the bus has).
+  enum class StopPace { kScheduled, kNow };
+
+  /// A motion frame of servo `id` went out (told by the client under the motion gate's lock, so
+  /// an e-stop engaged right after it finds the servo among those to stop). A pending stop of
+  /// the servo (a hold) is superseded.
+  void noteCommanded(uint8_t id);
   /// Notes the outcome of a motion command of servo `id`: moving or at rest.
   void noteMotion(uint8_t id, bool moving);
-  /// SPIN stop to each servo set moving; the last failure (ok when every stop went out).
-  ServoStatus stopMoving();
   ServoStatus refuseWhileLocked(uint8_t id) const;
+  /// Adds a stop of `id` to be written now (mutex_ held).
+  void armStopLocked(uint8_t id, Clock::time_point now);
+  /// Asks the client for urgent work and wakes the worker, or, without a running worker, writes
+  /// the stops itself.
+  void deliverStops();
+  /// When the stop work falls due next (mutex_ held); max() when none.
+  Clock::time_point nextStopWork() const;
+  /// One piece of stop work that is due (mutex_ held by `lock`, released around the bus): every
+  /// stop to be written, or one look at a stopped servo. False when nothing was due.
+  bool stopWorkOnce(std::unique_lock<std::mutex>& lock, StopPace pace);
+  void writeDueStops(std::unique_lock<std::mutex>& lock, StopPace pace);
+  void lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t id, StopPace pace);
   void finalWords();
   /// The health poll's schedule: the servo due first, and when (max when none).
   Clock::time_point nextHealthPoll() const;  // mutex_ held
@@ -236,7 +303,9 @@ class ServoBus : public LinkListener, public LinkWorker {
   bool working_ = false;          // work() in progress on the link's reader thread
   SerialLink* link_ = nullptr;    // runOn(): the worker is the link's reader thread
   std::deque<MoveRequest> queued_moves_;
-  std::set<uint8_t> stop_requests_;  // stopServo(): SPIN stops the worker writes first
+  std::map<uint8_t, PendingStop> stops_;  // not yet known to have reached their servo
+  std::set<uint8_t> commanded_;           // set moving or positioned since start-up
+  MotionGate gate_;                       // every motion frame passes it when written
   std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   std::set<uint8_t> moving_;          // servos set moving and not stopped since
   bool motion_locked_ = false;

@@ -32,6 +32,7 @@
 #include <string_view>
 #include <vector>
 
+#include "serial_robot_driver/device/motion_gate.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/servo_params.h"
@@ -54,6 +55,7 @@ enum class ServoError {
   kRefused,           ///< the servo answered with result 0
   kReadBackMismatch,  ///< the value read back after a write differs from the one written
   kShutdown,          ///< the client is shutting down
+  kPreempted,         ///< gave way to a stop: a poll that did not run, a motion wait cut short
 };
 const char* toString(ServoError error);
 
@@ -131,8 +133,10 @@ struct ServoBusStats {
   double max_latency_ms = 0.0;
 };
 
-/// Who waits for the bus: a caller (a service) goes before background work (the poll).
-enum class BusPriority { kCaller, kBackground };
+/// Who waits for the bus: a caller (a service) goes before background work (the poll). kWorker
+/// is the bus's own worker, which writes the stops: it waits like a caller, but gives way to urgent
+/// work (kPreempted) instead of waiting for it, before the bus is taken and between attempts.
+enum class BusPriority { kCaller, kWorker, kBackground };
 
 /// How the link's reader thread waits without sleeping on another thread: it reads its port
 /// (SerialLink::pump) and is woken by wake() when what it waits for may have changed.
@@ -143,13 +147,27 @@ struct ReaderPump {
   std::function<void()> wake;
 };
 
-/// The bus lock: foreground callers (lock()) go before background ones (lockBackground()), which
-/// take the bus only while nobody waits for it. Usable with std::lock_guard.
+/// The bus lock, by priority: urgent work (a stop) goes first and waits only for the holder;
+/// foreground callers (lock()) go next; background ones (lockBackground()) take the bus only while
+/// nobody else waits for it. Usable with std::lock_guard (lock()/unlock()).
 class BusMutex {
  public:
   void lock();
   void unlock();
-  void lockBackground();
+  /// False, without the bus, when urgent work is asked while it waits (the poll gives way).
+  bool lockBackground();
+  /// A caller that gives way: false, without the bus, when urgent work is asked while it waits.
+  bool lockUnlessUrgent();
+  /// A stop: waits for the holder only (one transaction attempt at most), never for a queue.
+  void lockUrgent();
+  /// Urgent work is coming: from now until endUrgent(), lock() and lockBackground() wait (a
+  /// background wait gives up) and a holder between two attempts hands the bus over.
+  void requestUrgent();
+  void endUrgent();
+  bool urgentRequested();
+  /// Between two attempts of one transaction: hands the bus to urgent work asked meanwhile and
+  /// takes it back before any other caller.
+  void yieldToUrgent();
   /// Foreground callers waiting right now (for tests and diagnostics).
   int foregroundWaiting();
   /// Set before any use: the reader thread pumps its port while it waits for the bus.
@@ -159,14 +177,21 @@ class BusMutex {
   /// Waits (mutex_ held by `lock`) until `free` holds: on a condition variable, or pumping.
   template <typename Predicate>
   void waitTurn(std::unique_lock<std::mutex>& lock, Predicate free);
+  void wakeWaiters(std::unique_lock<std::mutex>& lock);
 
   std::mutex mutex_;
   std::condition_variable released_;
   bool held_ = false;
   int waiting_ = 0;               ///< foreground callers waiting for the bus
+  bool urgent_ = false;           ///< requestUrgent() .. endUrgent()
+  int yielded_ = 0;               ///< holders that handed the bus to urgent work
   bool reader_waiting_ = false;   ///< the pumping reader thread waits: unlock() wakes it
   const ReaderPump* pump_ = nullptr;
 };
+
+/// Whether a motion frame waits for the motion gate (see motion_gate.h) or is a safety action
+/// (a stop, a relax at shutdown or for temperature) that is always let through.
+enum class FrameGate { kMotion, kSafetyAction };
 
 class ServoBusClient : public LinkListener {
  public:
@@ -193,15 +218,27 @@ class ServoBusClient : public LinkListener {
   /// CMD 16: the multi-turn angle and the turn count.
   ServoStatus readMultiTurnAngle(uint8_t id, MultiTurnReading* reading);
   /// CMD 8 or 11..15, chosen by the request (see MoveRequest); returns once the frame is written.
-  ServoStatus move(const MoveRequest& request);
+  ServoStatus move(const MoveRequest& request, BusPriority priority = BusPriority::kCaller);
   /// PINGs first_id..last_id, one attempt each (a silent id costs one timeout), and lists the ids
   /// that answered. The bus is taken per id, so other callers are served in between.
   ServoStatus scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids);
   /// ROTATE / SPIN / DAMPING return once the frame is written unless `wait` is set. Id 255
   /// (broadcast) is accepted only without wait.
+  /// Each motion frame is written through the motion gate (setMotionGate), decided when its turn
+  /// on the bus comes: refused then (kMotionRefused), nothing is written. A SPIN stop, and a
+  /// DAMPING with FrameGate::kSafetyAction, always pass.
   ServoStatus rotate(const RotateRequest& request);
   ServoStatus spin(const SpinRequest& request);
-  ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait);
+  ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait,
+                      FrameGate gate = FrameGate::kMotion);
+  /// SPIN stops to `ids` as urgent work (BusMutex::lockUrgent): written after the one transaction
+  /// attempt in flight, before every waiting caller. `written[i]`: whether the stop of ids[i]
+  /// went out. Fire and forget: whether the servo heard it is for the caller to find out.
+  void writeStops(const std::vector<uint8_t>& ids, std::vector<bool>* written);
+  /// Urgent work is coming (see BusMutex::requestUrgent); a caller waiting for a motion's
+  /// completion stops waiting (kPreempted: the motion went out, its end was not awaited).
+  void requestUrgent();
+  void endUrgent();
   /// READ_BATCH_DATA: the 22 user-block parameters (data_id 32..53) in table order.
   ServoStatus readAll(uint8_t id, std::vector<ServoParamValue>* values);
   /// RESET_USER_DATA (dangerous: refused unless allow_dangerous_writes). The reset also sets the
@@ -222,6 +259,12 @@ class ServoBusClient : public LinkListener {
   int callersWaiting() { return bus_mutex_.foregroundWaiting(); }
   /// Before any call: waits on the pump's reader thread read the port (see the threading model).
   void setReaderPump(ReaderPump pump);
+  /// Before any call: the gate every motion frame passes when it is written (nullptr: none), and
+  /// what is told, under the gate's lock, of each motion frame that went out (the servo's id).
+  void setMotionGate(MotionGate* gate, std::function<void(uint8_t id)> on_motion_written = {}) {
+    gate_ = gate;
+    on_motion_written_ = std::move(on_motion_written);
+  }
 
   // LinkListener (reader thread).
   void onLinkDown() override;
@@ -253,18 +296,30 @@ class ServoBusClient : public LinkListener {
   };
 
   // The helpers below expect bus_mutex_ to be held by the caller.
+  /// `gate` kMotion: the request is a motion frame (a wait for its completion, which a stop may
+  /// cut short); it is written through the motion gate.
+  /// `give_way` (BusPriority::kWorker): urgent work asked before a re-send ends it (kPreempted).
   ServoStatus transact(const std::vector<uint8_t>& request, const Expectation& expect,
                        std::chrono::milliseconds timeout, int attempts,
-                       protocol::servo::Packet* answer);
+                       protocol::servo::Packet* answer, FrameGate gate = FrameGate::kSafetyAction,
+                       bool give_way = false);
+  /// Takes the bus at `priority`; false (and nothing held) when it gave way to urgent work.
+  bool takeBus(BusPriority priority);
+  /// Writes one request, through the motion gate when `gate` is kMotion. nullopt when written;
+  /// else why not (the gate's refusal, or the port is down).
+  std::optional<ServoStatus> writeRequest(const std::vector<uint8_t>& request,
+                                          protocol::servo::Command cmd, uint8_t id,
+                                          FrameGate gate);
   /// transact() with the configured timeout and retries: the usual request/answer exchange.
   ServoStatus exchangeLocked(const std::vector<uint8_t>& request, const Expectation& expect,
                              protocol::servo::Packet* answer);
   /// Fire and forget: a motion command without wait.
   ServoStatus sendCommand(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
-                          uint8_t id);
+                          uint8_t id, FrameGate gate);
   /// The shared tail of ROTATE/SPIN/DAMPING: send, or transact and check the result byte.
   ServoStatus sendMotion(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
-                         uint8_t id, bool wait, std::chrono::milliseconds motion_time);
+                         uint8_t id, bool wait, std::chrono::milliseconds motion_time,
+                         FrameGate gate);
   ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
                               ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);
@@ -281,6 +336,8 @@ class ServoBusClient : public LinkListener {
   ServoBusOptions options_;  // timeout and retries guarded by state_mutex_ (retune), read via options()
   const FrameWriter writer_;
   ReaderPump pump_;  // set before any call; empty: every wait is on a condition variable
+  MotionGate* gate_ = nullptr;  // set before any call
+  std::function<void(uint8_t id)> on_motion_written_;
 
   BusMutex bus_mutex_;  // one transaction on the wire at a time
 
@@ -290,6 +347,8 @@ class ServoBusClient : public LinkListener {
   std::vector<uint8_t> last_request_;  // recognises the half-duplex echo
   bool link_lost_ = false;             // the port went down while a transaction was pending
   bool stopping_ = false;
+  bool urgent_ = false;       // requestUrgent() .. endUrgent(): a motion wait gives way
+  bool motion_wait_ = false;  // the pending transaction waits for a motion's completion
   ServoBusStats stats_;
 };
 

@@ -1,0 +1,54 @@
+#include "serial_robot_driver/device/motion_gate.h"
+
+namespace serial_robot_driver::device {
+
+const char* toString(GateState state) {
+  switch (state) {
+    case GateState::kOpen:
+      return "open";
+    case GateState::kLocked:
+      return "e_stop engaged";
+    case GateState::kClosed:
+      return "shutting down";
+  }
+  return "?";
+}
+
+void MotionGate::setLocked(bool locked) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  locked_ = locked;
+}
+
+void MotionGate::close() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  closed_ = true;
+}
+
+GateState MotionGate::stateLocked() const {
+  if (closed_) return GateState::kClosed;
+  return locked_ ? GateState::kLocked : GateState::kOpen;
+}
+
+GateState MotionGate::state() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stateLocked();
+}
+
+GateState MotionGate::writeIfOpen(const std::function<bool()>& write, bool* written) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const GateState state = stateLocked();
+  if (state != GateState::kOpen) {
+    ++refused_;
+    *written = false;
+    return state;
+  }
+  *written = write();
+  return state;
+}
+
+uint64_t MotionGate::refusedAtWrite() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return refused_;
+}
+
+}  // namespace serial_robot_driver::device
