@@ -78,6 +78,8 @@ std::string JointCommandResult::message() const {
              outOfRangeText() + ")";
     case JointCommandStatus::kWriteFailed:
       return "joint command not written: the body port is not connected";
+    case JointCommandStatus::kMotionRefused:
+      return "joint command not written: e_stop engaged or shutting down";
   }
   return "unknown joint command status";
 }
@@ -158,15 +160,26 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
   std::vector<protocol::body::ServoTarget> targets;
   targets.reserve(joints_.size());
   for (std::size_t i = 0; i < joints_.size(); ++i) {
-    if (requested[i]) last_commanded_ticks_[i] = requested[i];
-    if (last_commanded_ticks_[i])
-      targets.push_back({joints_[i].servo_id, *last_commanded_ticks_[i]});
+    const std::optional<uint16_t> ticks = requested[i] ? requested[i] : last_commanded_ticks_[i];
+    if (ticks) targets.push_back({joints_[i].servo_id, *ticks});
   }
-  // Writing under the lock keeps frames in the order their positions were stored.
-  if (!writer_ || !writer_(protocol::body::encodeSyncWrite(targets))) {
+  // Writing under the lock keeps frames in the order their positions were stored; through the
+  // gate, so a command that waited for this lock is refused if the e-stop came meanwhile.
+  bool written = false;
+  const GateState gate = gate_.writeIfOpen(
+      [&] { return writer_ && writer_(protocol::body::encodeSyncWrite(targets)); }, &written);
+  if (gate != GateState::kOpen) {
+    ++stats_.motion_refused;
+    result.status = JointCommandStatus::kMotionRefused;
+    return result;
+  }
+  if (!written) {
     ++stats_.write_failures;
     result.status = JointCommandStatus::kWriteFailed;
     return result;
+  }
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    if (requested[i]) last_commanded_ticks_[i] = requested[i];
   }
   ++stats_.commands_sent;
   return result;

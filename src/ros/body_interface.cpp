@@ -42,7 +42,15 @@ void BodyInterface::retune(const DriverParams& params) {
   std::atomic_store(&imu_params_, std::make_shared<const ImuParams>(params.imu));
 }
 
-void BodyInterface::shutdown() { joint_commands_sub_.shutdown(); }
+void BodyInterface::shutdown() {
+  joint_commands_sub_.shutdown();
+  controller_.gate().close();  // no position goes out once the node is shutting down
+}
+
+void BodyInterface::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  e_stop.addListener([this](bool engaged) { controller_.gate().setLocked(engaged); });
+}
 
 std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
   return {bodyTrajectoryJoints(controller_)};
@@ -141,6 +149,7 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("commands rejected", stats.commands_rejected);
   status.add("joint targets out of range", stats.joints_out_of_range);
   status.add("command write failures", stats.write_failures);
+  status.add("commands refused when written (e_stop)", stats.motion_refused);
   const device::LinkStats link_stats = link_.stats();
   status.add("port checksum errors", link_stats.framer.checksum_errors);
   status.add("port bad tails", link_stats.framer.bad_tails);

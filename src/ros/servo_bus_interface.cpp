@@ -206,6 +206,16 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",
                       servoJointName(move.id).c_str(), messageFor(status).c_str());
   };
+  events.on_stop = [](uint8_t id, const device::ServoStatus& status) {
+    if (status.ok()) {
+      ROS_INFO("servo_bus: %s stopped: %s", servoJointName(id).c_str(), status.message.c_str());
+    } else if (status.error == device::ServoError::kShutdown) {
+      ROS_ERROR("servo_bus: %s", status.message.c_str());
+    } else {
+      ROS_WARN_THROTTLE(kWarnThrottleS, "servo_bus: %s's stop not yet confirmed, writing it again: %s",
+                        servoJointName(id).c_str(), status.message.c_str());
+    }
+  };
   return events;
 }
 
@@ -415,13 +425,18 @@ device::ServoStatus ServoBusInterface::refuseWhileEStopped(const std::string& so
 void ServoBusInterface::attachEStop(device::EStop& e_stop) {
   e_stop_ = &e_stop;
   // On the e_stop subscriber's thread: the SPIN stops take the bus as a caller, ahead of the poll.
+  // On the e_stop subscriber's thread, and it never waits for the bus: the gate is locked (no
+  // motion frame from now on) and the stops are handed to the bus's worker, which writes them
+  // ahead of everything else and keeps writing them until each servo is seen at rest.
   e_stop.addListener([this](bool engaged) {
-    const std::vector<uint8_t> moving = bus_.movingIds();
     bus_.setMotionLocked(engaged);
-    if (engaged && !moving.empty()) {
+    const std::vector<uint8_t> commanded = bus_.commandedIds();
+    if (engaged && !commanded.empty()) {
       std::string ids;
-      for (uint8_t id : moving) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
-      ROS_WARN("e_stop: SPIN stop sent to bus servo(s) %s", ids.c_str());
+      for (uint8_t id : commanded) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+      ROS_WARN("e_stop: stopping bus servo(s) %s (each stop is written until the servo is seen at "
+               "rest)",
+               ids.c_str());
     }
   });
 }
@@ -534,6 +549,16 @@ void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   for (uint8_t id : bus_.movingIds()) moving += (moving.empty() ? "" : ", ") + std::to_string(id);
   status.add("servos set moving", moving.empty() ? std::string("none") : moving);
   status.add("motion locked (e_stop)", bus_.motionLocked());
+  status.add("motion frames refused when written", bus_.motionRefusedAtWrite());
+  std::string unconfirmed;
+  for (const device::PendingStopReport& stop : bus_.pendingStops()) {
+    unconfirmed += (unconfirmed.empty() ? "" : "; ") + servoJointName(stop.id) + ": " + stop.why;
+  }
+  status.add("stops not yet confirmed", unconfirmed.empty() ? std::string("none") : unconfirmed);
+  if (!unconfirmed.empty()) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                        "stop not yet known to have reached " + unconfirmed);
+  }
   const device::ServoBusConfig in_force = bus_.settings();
   status.add("on shutdown", device::toString(in_force.on_shutdown));
   status.add("health polls per second", in_force.health_rate);

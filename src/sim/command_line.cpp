@@ -272,6 +272,11 @@ const std::vector<Flag>& flags() {
           [](SimOptions& o) -> double& { return o.faults.unplug_duration_s; }, true),
       probability("--servo-fault-rate", "probability a servo answer is garbled or missing",
                   [](SimOptions& o) -> double& { return o.faults.servo_fault_rate; }),
+      whole(
+          "--lose-servo-stops", "N",
+          "the next N SPIN stops to a bus servo are lost on the line: the servo keeps moving", 1000000,
+          [](SimOptions& o, uint64_t v) { o.servo_bus.lost_stops = static_cast<uint32_t>(v); },
+          [](const SimOptions& o) { return show(o.servo_bus.lost_stops); }),
 
       section("Output:"),
       text("--stats-file", "PATH", "\"key value\" counters, rewritten every second and at exit",

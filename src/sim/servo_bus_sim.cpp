@@ -197,6 +197,12 @@ void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint
   const servo::Packet& packet = *decoded;
   ++stats_.requests;
   const uint8_t id = packet.id();
+  const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(packet);
+  if (spin && spin->mode == servo::SpinMode::kStop && config_.lost_stops > 0) {
+    --config_.lost_stops;
+    ++stats_.stops_lost;
+    return;
+  }
   if (id == servo::kBroadcastId) {
     ++stats_.broadcasts;
     for (Servo& s : servos_) execute(&s, packet, true, now);

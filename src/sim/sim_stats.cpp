@@ -58,6 +58,7 @@ std::string formatStats(const SimStats& stats) {
   line("servo_unknown_data_ids", bus.unknown_data_ids);
   line("servo_malformed", bus.malformed);
   line("servo_writes_rejected", bus.writes_rejected);
+  line("servo_stops_lost", bus.stops_lost);
   for (const BusServoSnapshot& servo : bus.servos) {
     line("bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg);
   }

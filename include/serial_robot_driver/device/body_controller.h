@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/device/motion_gate.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/decode_result.h"
@@ -55,6 +56,7 @@ struct BodyStats {
   uint64_t commands_sent = 0;
   uint64_t commands_rejected = 0;  ///< invalid commands: nothing was written
   uint64_t write_failures = 0;     ///< valid commands the link refused (port down)
+  uint64_t motion_refused = 0;     ///< valid commands the motion gate refused (e-stop, shutdown)
   uint64_t joints_out_of_range = 0;  ///< joint targets left out: beyond what the servo can reach
 };
 
@@ -67,6 +69,7 @@ enum class JointCommandStatus {
   kNotFinite,       ///< a NaN or infinite position
   kOutOfRange,      ///< every named joint was beyond its servo's reach: nothing written
   kWriteFailed,     ///< valid, but the link refused the frame (port down)
+  kMotionRefused,   ///< valid, but the motion gate was locked (e-stop) or closed when written
 };
 
 /// What became of one joint command: the ROS layer logs message() (throttled) when !ok().
@@ -111,6 +114,10 @@ class BodyController : public LinkListener {
   JointCommandResult sendJointCommand(const std::vector<std::string>& names,
                                       const std::vector<double>& positions);
 
+  /// The gate every sync-write passes when it is written (see motion_gate.h): the e-stop locks
+  /// it, the shutdown closes it.
+  MotionGate& gate() { return gate_; }
+
   const std::vector<BodyJoint>& joints() const { return joints_; }
   std::size_t servoCount() const { return joints_.size(); }
   BodyStats stats() const;
@@ -119,6 +126,8 @@ class BodyController : public LinkListener {
   const std::vector<BodyJoint> joints_;
   const FrameWriter writer_;
   const BodyEvents events_;
+
+  MotionGate gate_;
 
   mutable std::mutex mutex_;  // guards the fields below
   std::vector<std::optional<uint16_t>> last_commanded_ticks_;

@@ -42,7 +42,9 @@ class BodyInterface : public DeviceInterface {
   std::vector<TrajectoryJoints> trajectoryJoints() override;
   void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
   /// joint_commands are refused while it holds.
-  void attachEStop(device::EStop& e_stop) override { e_stop_ = &e_stop; }
+  /// Engaged: the controller's motion gate is locked, so no sync-write goes out from then on,
+  /// even one already waiting; joint_commands are refused and counted.
+  void attachEStop(device::EStop& e_stop) override;
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,

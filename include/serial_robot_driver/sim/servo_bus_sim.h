@@ -32,6 +32,9 @@ struct ServoBusSimConfig {
   std::map<uint8_t, int64_t> temperature_c;
   std::map<uint8_t, int64_t> voltage_mv;
   double answer_latency_s = 0.0015;
+  /// The next this many SPIN stops (mode 0) addressed to a servo never reach it, as if lost on
+  /// the line: the driver must notice the servo still moves and stop it again.
+  uint32_t lost_stops = 0;
   uint32_t seed = 1;
 };
 
@@ -52,6 +55,7 @@ struct ServoBusSimStats {
   uint64_t unknown_data_ids = 0;
   uint64_t malformed = 0;        ///< verified sum but content that does not fit the command
   uint64_t writes_rejected = 0;  ///< answered with result 0
+  uint64_t stops_lost = 0;       ///< SPIN stops dropped by lost_stops
   std::vector<BusServoSnapshot> servos;
 };
 
