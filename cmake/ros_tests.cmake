@@ -119,3 +119,10 @@ add_rostest_gtest(test_safe_motion test/rostest/safe_motion.test test/rostest/te
 target_include_directories(test_safe_motion PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_safe_motion srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_safe_motion driver_node srd_nodelet ${PROJECT_NAME}_generate_messages_cpp)
+# serial_raw with a subscriber that stops reading: bounded memory, the capture's drop counter in its
+# diagnostic status, and a true count (WireCapture in-process, a raw TCPROS subscriber).
+add_rostest_gtest(test_wire_capture test/rostest/wire_capture.test
+  test/rostest/test_wire_capture.cpp)
+target_include_directories(test_wire_capture PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_wire_capture srd_ros srd_test_support ${catkin_LIBRARIES})
+add_dependencies(test_wire_capture ${PROJECT_NAME}_generate_messages_cpp)

@@ -328,7 +328,6 @@ WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now, bool* time
   const double scale = std::max({1.0, std::abs(linear_x_), std::abs(angular_z_)});
   const WheelSpeeds unit =
       kinematics::wheelSpeedsFromTwist(config_.geometry, linear_x_ / scale, angular_z_ / scale);
-  if (!(config_.max_wheel_speed > 0)) return unit * scale;
   return kinematics::clampWheelSpeeds(unit, config_.max_wheel_speed / scale) * scale;
 }
 

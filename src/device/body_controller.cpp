@@ -118,6 +118,9 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
   } else if (names.size() != positions.size()) {
     result.status = JointCommandStatus::kLengthMismatch;
   } else {
+    // Every joint named so far, whatever its value: an out-of-range target leaves requested[]
+    // empty, so requested[] alone would let a second occurrence of that name through.
+    std::vector<bool> named(joints_.size(), false);
     for (std::size_t i = 0; i < names.size() && result.ok(); ++i) {
       const auto joint = std::find_if(joints_.begin(), joints_.end(),
                                       [&](const BodyJoint& j) { return j.name == names[i]; });
@@ -127,10 +130,11 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
         break;
       }
       const std::size_t index = static_cast<std::size_t>(joint - joints_.begin());
-      if (requested[index]) {
+      if (named[index]) {
         result.status = JointCommandStatus::kDuplicateJoint;
         break;
       }
+      named[index] = true;
       if (!std::isfinite(positions[i])) {
         result.status = JointCommandStatus::kNotFinite;
         break;

@@ -43,7 +43,7 @@ WheelSpeeds wheelSpeedsFromTwist(const DiffDriveGeometry& geometry, double linea
 
 WheelSpeeds clampWheelSpeeds(const WheelSpeeds& speeds, double max_wheel_speed) {
   const WheelSpeeds clean = sanitized(speeds);
-  if (!(max_wheel_speed > 0.0)) return clean;
+  if (!(max_wheel_speed > 0.0)) return WheelSpeeds::Zero();  // invalid: never "no limit"
   const double largest = clean.cwiseAbs().maxCoeff();
   if (largest <= max_wheel_speed) return clean;
   return clean * (max_wheel_speed / largest);

@@ -162,7 +162,9 @@ std::vector<ParamSpec> buildTable() {
       row("base/encoder_resolution", &P::base, &Base::encoder_resolution, positive<int>),
       row("base/pid_rate", &P::base, &Base::pid_rate, positive<double>),
       row("base/wheel_separation", &P::base, &Base::wheel_separation, positive<double>),
-      row("base/max_wheel_speed", &P::base, &Base::max_wheel_speed, nonNegative<double>),
+      // > 0: there is no "no limit" value. No maximum: the base's top speed is not documented, and
+      // the speed field's own range (int16 ticks per PID period) depends on tunable geometry.
+      row("base/max_wheel_speed", &P::base, &Base::max_wheel_speed, positive<double>),
       row("base/max_wheel_accel", &P::base, &Base::max_wheel_accel, nonNegative<double>),
       row("base/cmd_vel_timeout", &P::base, &Base::cmd_vel_timeout, positive<double>),
       row("base/speed_dithering", &P::base, &Base::speed_dithering),

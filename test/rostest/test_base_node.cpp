@@ -23,6 +23,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <geometry_msgs/Twist.h>
@@ -733,17 +734,27 @@ TEST(BaseNodeProcess, ConnectsWhenThePortAppearsLater) {
 }
 
 // 13. A bad parameter stops the node at start-up with a non-zero status and names the parameter.
+// A speed limit of 0 is one: it would not mean "no limit".
 TEST(BaseNodeProcess, BadParameterExitsNamingIt) {
   ASSERT_FALSE(g_driver_path.empty());
-  std::vector<std::string> args = driverArgs("/bad", "driver_bad", g_port + "_bad");
-  args.push_back("_base/wheel_diameter:=-1");
-  ChildProcess node(g_driver_path, args);
-  ASSERT_TRUE(node.started());
-  const auto status = node.waitExit(20.0);
-  ASSERT_TRUE(status.has_value()) << "driver_node kept running with a negative wheel diameter";
-  ASSERT_TRUE(WIFEXITED(*status)) << node.output();
-  EXPECT_EQ(WEXITSTATUS(*status), 2);
-  EXPECT_NE(node.output().find("base/wheel_diameter"), std::string::npos) << node.output();
+  const std::vector<std::pair<std::string, std::string>> cases = {{"base/wheel_diameter", "-1"},
+                                                                  {"base/max_wheel_speed", "0.0"},
+                                                                  {"base/max_wheel_speed", "-0.5"}};
+  int run = 0;
+  for (const auto& [name, value] : cases) {
+    SCOPED_TRACE(name + " " + value);
+    // A node name of its own each time: `_name:=value` stays on the parameter server.
+    std::vector<std::string> args =
+        driverArgs("/bad", "driver_bad" + std::to_string(run++), g_port + "_bad");
+    args.push_back("_" + name + ":=" + value);
+    ChildProcess node(g_driver_path, args);
+    ASSERT_TRUE(node.started());
+    const auto status = node.waitExit(20.0);
+    ASSERT_TRUE(status.has_value()) << "driver_node kept running with " << name << " " << value;
+    ASSERT_TRUE(WIFEXITED(*status)) << node.output();
+    EXPECT_EQ(WEXITSTATUS(*status), 2);
+    EXPECT_NE(node.output().find(name), std::string::npos) << node.output();
+  }
 }
 
 // 14. SIGINT while driving: the node's last frame before it closes the port is a zero-speed frame,

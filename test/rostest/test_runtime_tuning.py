@@ -277,5 +277,25 @@ class RuntimeTuningTest(unittest.TestCase):
         self.tune(self.servo_bus, state_rate=2.0, retries=1)
 
 
+    def test_i_speed_limit_cannot_be_switched_off(self):
+        # 0 (once "no limit") is refused like any value the start-up check refuses; -1 is clamped
+        # to the .cfg's minimum 0 first, then refused. The limit in force stays.
+        for requested in (0.0, -1.0):
+            answer = self.tune(self.base, max_wheel_speed=requested)
+            self.assertAlmostEqual(answer["max_wheel_speed"], 0.8)
+            self.assertAlmostEqual(rospy.get_param(NODE + "/base/max_wheel_speed"), 0.8)
+        # And motion is still limited: 2 m/s asked, 0.8 m/s sent.
+        driver = Driver(2.0, 0.0)
+        try:
+            start = self.frames.count()
+            wait_for(lambda: any(abs(f.left_speed - 0.8) < 1e-6 for f in self.frames.since(start)),
+                     what="frames at the 0.8 m/s limit")
+            for frame in self.frames.since(start):
+                self.assertLessEqual(frame.left_speed, 0.8 + 1e-6)
+                self.assertLessEqual(frame.right_speed, 0.8 + 1e-6)
+        finally:
+            driver.stop()
+
+
 if __name__ == "__main__":
     rostest.rosrun("serial_robot_driver", "test_runtime_tuning", RuntimeTuningTest)

@@ -322,6 +322,35 @@ TEST_F(BodyControllerCommand, EmptyAndDuplicateCommandsAreRejected) {
   EXPECT_TRUE(written_.empty());
 }
 
+// A name given twice is a duplicate whatever its values: an out-of-range (left out) or non-finite
+// first occurrence must not hide the second one.
+TEST_F(BodyControllerCommand, DuplicateIsRejectedWhateverTheValues) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    std::vector<std::string> names;
+    std::vector<double> positions;
+  };
+  const std::vector<Case> cases = {
+      {{"hip", "hip"}, {4.0, 0.0}},                // first out of range, second valid
+      {{"hip", "hip"}, {0.0, 4.0}},                // first valid, second out of range
+      {{"hip", "hip"}, {4.0, -4.0}},               // both out of range
+      {{"knee", "hip", "hip"}, {0.0, 4.0, nan}},   // out of range, then not finite
+      {{"hip", "knee", "hip"}, {-4.0, 0.0, 0.5}},  // another joint between them
+  };
+  std::size_t rejected = 0;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(::testing::PrintToString(c.names) + " " + ::testing::PrintToString(c.positions));
+    const JointCommandResult result = controller_.sendJointCommand(c.names, c.positions);
+    EXPECT_FALSE(result.ok());
+    EXPECT_EQ(result.status, JointCommandStatus::kDuplicateJoint);
+    EXPECT_EQ(result.joint, "hip");
+    EXPECT_NE(result.message().find("hip"), std::string::npos) << result.message();
+    EXPECT_EQ(controller_.stats().commands_rejected, ++rejected);
+  }
+  EXPECT_TRUE(written_.empty()) << "a rejected command wrote a frame";
+  EXPECT_EQ(controller_.stats().commands_sent, 0u);
+}
+
 TEST_F(BodyControllerCommand, RejectedCommandDoesNotChangeStoredPositions) {
   ASSERT_TRUE(controller_.sendJointCommand({"hip", "knee"}, {0.0, -M_PI / 2}).ok());
   // hip's valid value comes before the NaN: it must not be stored either.

@@ -72,10 +72,15 @@ TEST(DiffDriveClamp, LeavesSpeedsWithinTheLimitAlone) {
   EXPECT_NEAR(clamped.y(), 0.7, kTol);
 }
 
-TEST(DiffDriveClamp, NonPositiveMaximumDisablesTheClamp) {
-  const WheelSpeeds clamped = clampWheelSpeeds(WheelSpeeds(5.0, -7.0), 0.0);
-  EXPECT_NEAR(clamped.x(), 5.0, kTol);
-  EXPECT_NEAR(clamped.y(), -7.0, kTol);
+// A limit that is not > 0 is invalid (the parameter table refuses it): it never means "no limit";
+// the safe reading is a stop.
+TEST(DiffDriveClamp, InvalidMaximumStopsTheWheelsInsteadOfRemovingTheLimit) {
+  for (const double limit : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    SCOPED_TRACE(limit);
+    const WheelSpeeds clamped = clampWheelSpeeds(WheelSpeeds(5.0, -7.0), limit);
+    EXPECT_EQ(clamped.x(), 0.0);
+    EXPECT_EQ(clamped.y(), 0.0);
+  }
 }
 
 TEST(DiffDriveAccel, RampsTowardTheTargetKeepingTheRatio) {

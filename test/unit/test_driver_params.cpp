@@ -54,6 +54,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"base/pid_rate", [](DriverParams& p) { p.base.pid_rate = 0; }},
         BadCase{"base/wheel_separation", [](DriverParams& p) { p.base.wheel_separation = 0; }},
         BadCase{"base/max_wheel_speed", [](DriverParams& p) { p.base.max_wheel_speed = -1; }},
+        // 0 is no "no limit": the speed limit cannot be switched off.
+        BadCase{"base/max_wheel_speed", [](DriverParams& p) { p.base.max_wheel_speed = 0; }},
+        BadCase{"base/max_wheel_speed",
+                [](DriverParams& p) { p.base.max_wheel_speed = std::nan(""); }},
         BadCase{"base/max_wheel_accel", [](DriverParams& p) { p.base.max_wheel_accel = -1; }},
         BadCase{"base/cmd_vel_timeout", [](DriverParams& p) { p.base.cmd_vel_timeout = 0; }},
         BadCase{"base/battery_poll_rate", [](DriverParams& p) { p.base.battery_poll_rate = -1; }},

@@ -140,6 +140,34 @@ TEST(TuneParams, AValueTheStartUpCheckRefusesKeepsTheValueInForce) {
   EXPECT_NE(result.refusals[0].find("keeping 0.8"), std::string::npos) << result.refusals[0];
 }
 
+// The speed limit cannot be switched off: the .cfg's minimum (where dynamic_reconfigure clamps a
+// negative request) is 0, which the table refuses, so the limit in force stays.
+TEST(TuneParams, ASpeedLimitOfZeroOrLessIsRefusedAndTheLimitInForceStays) {
+  const auto& description = [] {
+    for (const auto& d : serial_robot_driver::BaseTuningConfig::__getParamDescriptions__()) {
+      if (d->name == "max_wheel_speed") return d;
+    }
+    throw std::invalid_argument("max_wheel_speed");
+  }();
+  const ParamValue cfg_min =
+      valueOf(serial_robot_driver::BaseTuningConfig::__getMin__(), description);
+  EXPECT_EQ(std::get<double>(cfg_min), 0.0);
+  EXPECT_FALSE(tableAccepts("base/max_wheel_speed", cfg_min));
+
+  DriverParams in_force;
+  in_force.base.max_wheel_speed = 0.8;
+  for (const double requested : {0.0, -1.0}) {
+    SCOPED_TRACE(requested);
+    const TuningResult result = tuneParams(in_force, {{"base/max_wheel_speed", requested}});
+    EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.8);
+    ASSERT_EQ(result.refusals.size(), 1u);
+    EXPECT_NE(result.refusals[0].find("~base/max_wheel_speed = "), std::string::npos)
+        << result.refusals[0];
+    EXPECT_NE(result.refusals[0].find("> 0"), std::string::npos) << result.refusals[0];
+    EXPECT_NE(result.refusals[0].find("keeping 0.8"), std::string::npos) << result.refusals[0];
+  }
+}
+
 TEST(TuneParams, ARuleBetweenValuesRefusesTheWholeChange) {
   const DriverParams in_force;  // warn 20, error 10
   const TuningResult result =

@@ -45,7 +45,7 @@ namespace serial_robot_driver::device {
 
 struct BaseConfig {
   kinematics::DiffDriveGeometry geometry;
-  double max_wheel_speed = 1.0;    ///< m/s; <= 0: no clamp
+  double max_wheel_speed = 1.0;    ///< m/s; must be > 0 (no "no limit" value)
   double max_wheel_accel = 0.0;    ///< m/s^2; 0: no limit
   double cmd_vel_timeout = 0.5;    ///< s without a command: zero speed
   bool speed_dithering = true;     ///< carry the tick remainder (false: vendor truncation)

@@ -26,7 +26,8 @@ WheelSpeeds wheelSpeedsFromTwist(const DiffDriveGeometry& geometry, double linea
                                  double angular_z);
 
 /// Scales both wheels by the same factor so that neither exceeds `max_wheel_speed`: the turn radius
-/// (the ratio between the wheels) is kept. `max_wheel_speed` <= 0 disables the clamp.
+/// (the ratio between the wheels) is kept. `max_wheel_speed` must be > 0: there is no "no limit"
+/// value, and a limit that is not > 0 (0, negative, NaN) stops both wheels.
 WheelSpeeds clampWheelSpeeds(const WheelSpeeds& speeds, double max_wheel_speed);
 
 /// Limits how fast each wheel's speed may change. Both wheels are scaled by the same fraction of
