@@ -111,6 +111,10 @@ class BodyController : public LinkListener {
   JointCommandResult sendJointCommand(const std::vector<std::string>& names,
                                       const std::vector<double>& positions);
 
+  /// The position (rad) joint `joint_index` (frame order) was last commanded, i.e. what the
+  /// board was last sent for it; nothing when it never was (or for an index beyond the joints).
+  std::optional<double> lastCommandedPosition(std::size_t joint_index) const;
+
   const std::vector<BodyJoint>& joints() const { return joints_; }
   std::size_t servoCount() const { return joints_.size(); }
   BodyStats stats() const;
