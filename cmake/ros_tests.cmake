@@ -7,7 +7,8 @@ add_library(srd_test_support STATIC
   test/support/pty_frame_reader.cpp
   test/support/fake_device.cpp
   test/support/process_support.cpp
-  test/support/ros_test_support.cpp)
+  test/support/ros_test_support.cpp
+  test/support/pty_tap.cpp)
 target_include_directories(srd_test_support PUBLIC ${PROJECT_SOURCE_DIR}/test
   PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(srd_test_support PUBLIC srd_core srd_sim ${catkin_LIBRARIES})
@@ -102,6 +103,21 @@ add_rostest_gtest(test_trajectory test/rostest/trajectory.test test/rostest/test
 target_include_directories(test_trajectory PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_trajectory srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_trajectory driver_node ${PROJECT_NAME}_generate_messages_cpp)
+# What trajectory stops write (an empty trajectory with and without telemetry, a cancel of a fast
+# bus joint) and a retune of the bus poll, on the wire: a fake board and the simulated bus behind a
+# tap (test_support::PtyTap).
+add_rostest_gtest(test_trajectory_stop test/rostest/trajectory_stop.test
+  test/rostest/test_trajectory_stop.cpp)
+target_include_directories(test_trajectory_stop PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_trajectory_stop srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_trajectory_stop driver_node ${PROJECT_NAME}_generate_messages_cpp)
+# A body goal while the ROS clock (use_sim_time, /clock from the test) steps forward and back: the
+# sync-writes on the wire progress smoothly and the goal succeeds.
+add_rostest_gtest(test_trajectory_clock test/rostest/trajectory_clock.test
+  test/rostest/test_trajectory_clock.cpp)
+target_include_directories(test_trajectory_clock PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_trajectory_clock srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_trajectory_clock driver_node ${PROJECT_NAME}_generate_messages_cpp)
 # Parameters an earlier launch left on the master (a ~replay_bag, a disabled device) do not steer
 # driver.launch (node and nodelet) or sim.launch: each clears its private namespace first.
 add_rostest_gtest(test_stale_params test/rostest/stale_params.test

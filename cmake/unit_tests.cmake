@@ -55,8 +55,9 @@ add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_mes
 catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp)
 target_link_libraries(trajectory_tests srd_core gtest_main)
 
-# Trajectories' ROS-side pure functions (messages, bus joints); no roscore.
-catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp)
+# Trajectories' ROS-side pure functions (messages, bus joints, what a stop holds); no roscore.
+catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp
+  test/unit/test_trajectory_stop.cpp)
 target_include_directories(trajectory_ros_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(trajectory_ros_tests srd_ros gtest_main)
 

@@ -189,6 +189,14 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
   return result;
 }
 
+std::optional<double> BodyController::lastCommandedPosition(std::size_t joint_index) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (joint_index >= last_commanded_ticks_.size() || !last_commanded_ticks_[joint_index]) {
+    return std::nullopt;
+  }
+  return joints_[joint_index].calibration.toRadians(*last_commanded_ticks_[joint_index]);
+}
+
 BodyStats BodyController::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return stats_;

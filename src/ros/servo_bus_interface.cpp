@@ -384,6 +384,12 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
 void ServoBusInterface::retune(const DriverParams& params) {
   bus_.retune(makeServoBusConfig(params));
   command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
+  // The joints' measurements come as often as the poll: their freshness limit follows it.
+  if (trajectory_ && !bus_joints_.empty()) {
+    std::vector<std::string> names;
+    for (const trajectory::BusJoint& joint : bus_joints_) names.push_back(joint.name);
+    trajectory_->setStateTimeout(names, busStateTimeout(params.servo_bus.state_rate));
+  }
 }
 
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
@@ -486,7 +492,13 @@ std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
     bus_.queueMoves({move});
     return std::string();
   };
-  return {busTrajectoryJoints(bus_joints_, queue_move, state_rate_)};
+  // A stop holds a joint with a SPIN stop: written ahead of queued moves, allowed while the
+  // e-stop holds, and never a move to an angle that may be a poll period old.
+  const auto stop_servo = [this](uint8_t id) {
+    bus_.stopServo(id);
+    return std::string();
+  };
+  return {busTrajectoryJoints(bus_joints_, queue_move, state_rate_, stop_servo)};
 }
 
 void ServoBusInterface::start() {

@@ -29,11 +29,19 @@ const trajectory::BusJoint* findBusJoint(const std::vector<trajectory::BusJoint>
   return it == joints.end() ? nullptr : &*it;
 }
 
+double busStateTimeout(double state_rate) { return std::max(0.5, 3.0 / state_rate); }
+
 TrajectoryJoints busTrajectoryJoints(const std::vector<trajectory::BusJoint>& joints,
-                                     QueueServoMove queue_move, double state_rate) {
+                                     QueueServoMove queue_move, double state_rate,
+                                     StopServo stop_servo) {
   TrajectoryJoints result;
   for (const trajectory::BusJoint& joint : joints) result.joints.push_back(joint.range());
-  result.state_timeout = std::max(0.5, 3.0 / state_rate);
+  result.state_timeout = busStateTimeout(state_rate);
+  if (stop_servo) {
+    result.stop = [joints, stop_servo](std::size_t index) {
+      return stop_servo(joints.at(index).id);
+    };
+  }
   result.move = [joints, queue_move](std::size_t index, double position, double duration) {
     const trajectory::BusJoint& joint = joints.at(index);
     // A segment longer than ROTATE can say is given its longest interval; the next segment's

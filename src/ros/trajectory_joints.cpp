@@ -13,6 +13,10 @@ TrajectoryJoints bodyTrajectoryJoints(device::BodyController& controller) {
     const device::JointCommandResult sent = controller.sendJointCommand(names, positions);
     return sent.ok() && sent.out_of_range.empty() ? std::string() : sent.message();
   };
+  // Where a stop holds a joint the trajectories never wrote: the board's last command for it.
+  result.last_commanded = [&controller](std::size_t index) {
+    return controller.lastCommandedPosition(index);
+  };
   return result;
 }
 

@@ -1,11 +1,12 @@
 #include "serial_robot_driver/ros/trajectory_server.h"
 
-#include "serial_robot_driver/ros/device_interface.h"
-
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
+#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/trajectory/bus_joint.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -42,7 +43,40 @@ bool overlaps(const std::vector<std::size_t>& a, const std::vector<std::size_t>&
                      [&](std::size_t j) { return std::find(b.begin(), b.end(), j) != b.end(); });
 }
 
+/// "; joint 'a', 'b' left alone: ..." for the joints a stop could not hold, "" when none.
+std::string leftAloneText(const std::vector<std::string>& names) {
+  if (names.empty()) return "";
+  std::string text = names.size() == 1 ? "joint " : "joints ";
+  for (std::size_t i = 0; i < names.size(); ++i) text += (i ? ", '" : "'") + names[i] + "'";
+  return text +
+         " left alone: never commanded by the driver nor recently measured, so there is no "
+         "position to hold";
+}
+
+/// `base`, then `; left_alone` when there is one.
+std::string withLeftAlone(const std::string& base, const std::string& left_alone) {
+  if (left_alone.empty()) return base;
+  return base.empty() ? left_alone : base + "; " + left_alone;
+}
+
 }  // namespace
+
+double steadyNow() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
+  if (stamp.isZero()) return steady_now;
+  return steady_now + (stamp - ros_now).toSec();
+}
+
+std::optional<double> streamedHoldPosition(std::optional<double> last_written,
+                                           std::optional<double> last_commanded,
+                                           std::optional<double> fresh_measurement) {
+  if (last_written) return last_written;
+  if (last_commanded) return last_commanded;
+  return fresh_measurement;
+}
 
 std::vector<TrajectoryJoints> DeviceInterface::trajectoryJoints() { return {}; }
 
@@ -50,8 +84,8 @@ trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTr
   trajectory::TrajectoryCommand command;
   command.joint_names = msg.joint_names;
   for (const auto& point : msg.points) {
-    command.points.push_back({point.time_from_start.toSec(), point.positions, point.velocities,
-                              point.accelerations});
+    command.points.push_back(
+        {point.time_from_start.toSec(), point.positions, point.velocities, point.accelerations});
   }
   return command;
 }
@@ -62,9 +96,9 @@ TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& para
       groups_(std::move(groups)),
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),
-      action_server_(nh, "follow_joint_trajectory",
-                     [this](GoalHandle handle) { onGoal(handle); },
-                     [this](GoalHandle handle) { onCancel(handle); }, false) {
+      action_server_(
+          nh, "follow_joint_trajectory", [this](GoalHandle handle) { onGoal(handle); },
+          [this](GoalHandle handle) { onCancel(handle); }, false) {
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     for (std::size_t local = 0; local < groups_[g].joints.size(); ++local) {
       index_[groups_[g].joints[local].name] = ranges_.size();
@@ -89,7 +123,8 @@ void TrajectoryServer::start() {
   // tcpNoDelay: a trajectory must not wait in Nagle's buffer.
   trajectory_sub_ = nh_.subscribe("joint_trajectory", 10, &TrajectoryServer::onTrajectory, this,
                                   ros::TransportHints().tcpNoDelay());
-  timer_ = nh_.createTimer(ros::Duration(loop_period_), &TrajectoryServer::onTick, this);
+  // Steady: a step of the ROS or wall clock must not skip or replay a trajectory.
+  timer_ = nh_.createSteadyTimer(ros::WallDuration(loop_period_), &TrajectoryServer::onTick, this);
 }
 
 void TrajectoryServer::shutdown() {
@@ -108,7 +143,8 @@ void TrajectoryServer::shutdown() {
 void TrajectoryServer::updateActual(const sensor_msgs::JointState& state) {
   const std::size_t count = std::min(state.name.size(), state.position.size());
   const bool velocity_known = state.velocity.size() >= count;
-  const ros::Time stamp = state.header.stamp.isZero() ? ros::Time::now() : state.header.stamp;
+  // Freshness is the steady time of receipt: the header's stamp is on a clock that may step.
+  const double received = steadyNow();
   std::lock_guard<std::mutex> lock(actual_mutex_);
   for (std::size_t i = 0; i < count; ++i) {
     const auto joint = index_.find(state.name[i]);
@@ -117,7 +153,7 @@ void TrajectoryServer::updateActual(const sensor_msgs::JointState& state) {
     m.sample.position = state.position[i];
     m.sample.velocity = velocity_known ? state.velocity[i] : 0.0;
     m.velocity_known = velocity_known;
-    m.stamp = stamp;
+    m.received = received;
   }
 }
 
@@ -129,7 +165,7 @@ std::vector<TrajectoryServer::Measured> TrajectoryServer::measured() const {
 long TrajectoryServer::staleJoint(const std::vector<Measured>& measured,
                                   const std::vector<std::size_t>& joints, double now) const {
   for (std::size_t j : joints) {
-    if (measured[j].stamp.isZero() || now - measured[j].stamp.toSec() > tracks_[j].state_timeout) {
+    if (!measured[j].received || now - *measured[j].received > tracks_[j].state_timeout) {
       return static_cast<long>(j);
     }
   }
@@ -139,6 +175,14 @@ long TrajectoryServer::staleJoint(const std::vector<Measured>& measured,
 void TrajectoryServer::retune(const TrajectoryParams& defaults) {
   std::lock_guard<std::mutex> lock(mutex_);
   defaults_ = defaults;
+}
+
+void TrajectoryServer::setStateTimeout(const std::vector<std::string>& names, double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const std::string& name : names) {
+    const auto joint = index_.find(name);
+    if (joint != index_.end()) tracks_[joint->second].state_timeout = seconds;
+  }
 }
 
 TrajectoryServer::Result TrajectoryServer::result(int code, const std::string& message) {
@@ -199,31 +243,54 @@ void TrajectoryServer::apply(const trajectory::TrajectoryCommand& command,
     if (!track.writing) {
       track.spline = trajectory::JointSpline(actual[joints[column]].sample.position);
     }
-    track.spline.splice(std::max(start, now), trajectory::waypointsFor(command, column, start, now));
+    track.spline.splice(std::max(start, now),
+                        trajectory::waypointsFor(command, column, start, now));
     track.writing = true;
-    track.hold_pending = false;
-    track.sent_segment = -1.0;  // no segment starts before the epoch
+    track.sent_segment = -std::numeric_limits<double>::infinity();  // no move went out yet
   }
 }
 
-void TrajectoryServer::hold(const std::vector<std::size_t>& joints, double now) {
+std::string TrajectoryServer::hold(const std::vector<std::size_t>& joints, double now) {
   const std::vector<Measured> actual = measured();
+  std::vector<std::string> left_alone;
   for (std::size_t j : joints) {
-    const std::vector<std::size_t> one{j};
-    const double position = staleJoint(actual, one, now) < 0 ? actual[j].sample.position
-                                                              : tracks_[j].spline.sample(now).position;
-    tracks_[j].spline = trajectory::JointSpline(position);
-    tracks_[j].writing = true;  // written once, then the servo keeps it
-    tracks_[j].hold_pending = true;
+    Track& track = tracks_[j];
+    const TrajectoryJoints& group = groups_[track.group];
+    if (group.move) {
+      // Per-segment: a stop where the servo is, never a move to an angle that may be stale. The
+      // desired state is the spline now (feedback, and where a later goal bridges from).
+      if (!track.writing && !track.moved) {
+        left_alone.push_back(ranges_[j].name);
+        continue;
+      }
+      track.spline = trajectory::JointSpline(track.spline.sample(now).position);
+      track.writing = true;  // until the next tick: it has nothing more to send
+      const std::string error = group.stop ? group.stop(track.local) : std::string();
+      if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
+      continue;
+    }
+    // Streamed: where it was last commanded, by this server, else by anyone; never commanded, where
+    // it is measured if that is fresh; else nothing is written for it.
+    const std::optional<double> position = streamedHoldPosition(
+        track.last_written, group.last_commanded ? group.last_commanded(track.local) : std::nullopt,
+        staleJoint(actual, {j}, now) < 0 ? std::optional<double>(actual[j].sample.position)
+                                         : std::nullopt);
+    if (!position) {
+      track.writing = false;
+      left_alone.push_back(ranges_[j].name);
+      continue;
+    }
+    track.spline = trajectory::JointSpline(*position);
+    track.writing = true;  // written once, then the servo keeps it
   }
+  return leftAloneText(left_alone);
 }
 
 void TrajectoryServer::onGoal(GoalHandle handle) {
   const auto goal = handle.getGoal();
   const trajectory::TrajectoryCommand command = toTrajectoryCommand(goal->trajectory);
-  const double now = ros::Time::now().toSec();
-  const double start =
-      goal->trajectory.header.stamp.isZero() ? now : goal->trajectory.header.stamp.toSec();
+  const double now = steadyNow();
+  const double start = steadyStart(goal->trajectory.header.stamp, now, ros::Time::now());
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) {
     handle.setRejected(result(Result::INVALID_GOAL, "the driver is not running"),
@@ -245,8 +312,10 @@ void TrajectoryServer::onGoal(GoalHandle handle) {
   endGoalsOn(checked.joint_indices, true, Result::SUCCESSFUL, "preempted by a new goal");
   if (command.points.empty()) {
     // joint_trajectory_controller's "stop": hold where they are, and that is done at once.
-    hold(checked.joint_indices, now);
-    handle.setSucceeded(result(Result::SUCCESSFUL, ""), "stopped where they are");
+    const std::string left_alone = hold(checked.joint_indices, now);
+    if (!left_alone.empty()) ROS_WARN("follow_joint_trajectory: stop: %s", left_alone.c_str());
+    handle.setSucceeded(result(Result::SUCCESSFUL, left_alone),
+                        withLeftAlone("stopped where they were last commanded", left_alone));
     return;
   }
   apply(command, checked.joint_indices, start, now);
@@ -274,16 +343,16 @@ void TrajectoryServer::onCancel(GoalHandle handle) {
   auto it = std::find_if(goals_.begin(), goals_.end(),
                          [&](const ActiveGoal& goal) { return goal.handle == handle; });
   if (it == goals_.end()) return;  // already over
-  hold(it->joints, ros::Time::now().toSec());
-  it->handle.setCanceled(result(Result::SUCCESSFUL, "cancelled: holding where they are"),
-                         "cancelled: holding where they are");
+  const std::string message = withLeftAlone("cancelled: holding where they were last commanded",
+                                            hold(it->joints, steadyNow()));
+  it->handle.setCanceled(result(Result::SUCCESSFUL, message), message);
   goals_.erase(it);
 }
 
 void TrajectoryServer::onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg) {
   const trajectory::TrajectoryCommand command = toTrajectoryCommand(*msg);
-  const double now = ros::Time::now().toSec();
-  const double start = msg->header.stamp.isZero() ? now : msg->header.stamp.toSec();
+  const double now = steadyNow();
+  const double start = steadyStart(msg->header.stamp, now, ros::Time::now());
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return;
   if (e_stop_ && e_stop_->refuse("joint_trajectory")) {
@@ -299,7 +368,8 @@ void TrajectoryServer::onTrajectory(const trajectory_msgs::JointTrajectory::Cons
   endGoalsOn(checked.joint_indices, true, Result::SUCCESSFUL,
              "preempted by a joint_trajectory message");
   if (command.points.empty()) {
-    hold(checked.joint_indices, now);
+    const std::string left_alone = hold(checked.joint_indices, now);
+    if (!left_alone.empty()) ROS_WARN("joint_trajectory: stop: %s", left_alone.c_str());
   } else {
     apply(command, checked.joint_indices, start, now);
   }
@@ -312,7 +382,10 @@ void TrajectoryServer::takeOver(const std::vector<std::string>& names, const std
   std::vector<std::size_t> taken;
   for (const std::string& name : names) {
     const auto joint = index_.find(name);
-    if (joint == index_.end() || !tracks_[joint->second].writing) continue;
+    if (joint == index_.end()) continue;
+    // What this server wrote is no longer the joint's last command.
+    tracks_[joint->second].last_written.reset();
+    if (!tracks_[joint->second].writing) continue;
     tracks_[joint->second].writing = false;
     taken.push_back(joint->second);
   }
@@ -329,9 +402,12 @@ void TrajectoryServer::stopAll(const std::string& reason) {
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
     if (tracks_[j].writing) all.push_back(j);
   }
-  for (const ActiveGoal& goal : goals_) all.insert(all.end(), goal.joints.begin(), goal.joints.end());
-  endGoalsOn(all, false, Result::INVALID_GOAL, reason);
-  hold(all, ros::Time::now().toSec());
+  for (const ActiveGoal& goal : goals_)
+    all.insert(all.end(), goal.joints.begin(), goal.joints.end());
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  const std::string left_alone = hold(all, steadyNow());
+  endGoalsOn(all, false, Result::INVALID_GOAL, withLeftAlone(reason, left_alone));
 }
 
 void TrajectoryServer::attachEStop(device::EStop& e_stop) {
@@ -341,8 +417,8 @@ void TrajectoryServer::attachEStop(device::EStop& e_stop) {
   });
 }
 
-void TrajectoryServer::onTick(const ros::TimerEvent&) {
-  const double now = ros::Time::now().toSec();
+void TrajectoryServer::onTick(const ros::SteadyTimerEvent&) {
+  const double now = steadyNow();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return;
   // Idle (the usual case) costs one scan of the tracks.
@@ -367,19 +443,16 @@ void TrajectoryServer::writeTracks(double now) {
     if (!track.writing) continue;
     const TrajectoryJoints& group = groups_[track.group];
     if (group.move) {
-      std::string error;
-      if (track.hold_pending) {
-        error = group.move(track.local, track.spline.sample(now).position, 0.0);
-      } else if (const auto move = trajectory::segmentMoveAt(track.spline, now, track.sent_segment)) {
-        error = group.move(track.local, move->position, move->duration);
+      if (const auto move = trajectory::segmentMoveAt(track.spline, now, track.sent_segment)) {
+        const std::string error = group.move(track.local, move->position, move->duration);
         track.sent_segment = move->segment_start;
+        if (error.empty()) track.moved = true;
+        if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
       }
-      if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
     } else {
       names[track.group].push_back(ranges_[j].name);
       positions[track.group].push_back(track.spline.sample(now).position);
     }
-    track.hold_pending = false;
     const bool owned = std::any_of(goals_.begin(), goals_.end(), [&](const ActiveGoal& goal) {
       return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
     });
@@ -389,7 +462,13 @@ void TrajectoryServer::writeTracks(double now) {
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     if (names[g].empty() || !groups_[g].write) continue;
     const std::string error = groups_[g].write(names[g], positions[g]);
-    if (!error.empty()) ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
+    if (!error.empty()) {
+      ROS_WARN_THROTTLE(1.0, "trajectory: %s", error.c_str());
+      continue;
+    }
+    for (std::size_t k = 0; k < names[g].size(); ++k) {
+      tracks_[index_.at(names[g][k])].last_written = positions[g][k];
+    }
   }
 }
 
@@ -402,15 +481,15 @@ bool TrajectoryServer::superviseGoal(ActiveGoal& goal, double now,
                   "telemetry lost: no state of joint '%s' for more than %.1f s, so nobody can tell "
                   "whether it follows",
                   ranges_[stale].name.c_str(), tracks_[stale].state_timeout);
-    const std::string message = text;
+    // Held where last commanded: there is no measurement to stop at.
+    const std::string message = withLeftAlone(text, hold(goal.joints, now));
     ROS_WARN("follow_joint_trajectory: %s", message.c_str());
-    hold(goal.joints, now);  // at the desired position: there is no measurement to stop at
     goal.handle.setAborted(result(Result::PATH_TOLERANCE_VIOLATED, message), message);
     return true;
   }
   std::vector<JointSample> desired, measured;
   serial_robot_driver::FollowJointTrajectoryFeedback feedback;
-  feedback.header.stamp = ros::Time(now);
+  feedback.header.stamp = ros::Time::now();  // ROS time, as every stamp; `now` is steady
   feedback.joint_names = goal.names;
   const ros::Duration since_start(std::max(0.0, now - goal.start_time));
   feedback.desired.time_from_start = feedback.actual.time_from_start =
@@ -437,10 +516,9 @@ bool TrajectoryServer::superviseGoal(ActiveGoal& goal, double now,
     const auto violation =
         trajectory::findViolation(goal.names, goal.path_tolerances, desired, measured, "path");
     if (!violation) return false;
-    ROS_WARN("follow_joint_trajectory: aborted: %s", violation->message.c_str());
-    hold(goal.joints, now);
-    goal.handle.setAborted(result(Result::PATH_TOLERANCE_VIOLATED, violation->message),
-                           violation->message);
+    const std::string message = withLeftAlone(violation->message, hold(goal.joints, now));
+    ROS_WARN("follow_joint_trajectory: aborted: %s", message.c_str());
+    goal.handle.setAborted(result(Result::PATH_TOLERANCE_VIOLATED, message), message);
     return true;
   }
   const auto violation =

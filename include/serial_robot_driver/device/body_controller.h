@@ -117,6 +117,9 @@ class BodyController : public LinkListener {
   /// The gate every sync-write passes when it is written (see motion_gate.h): the e-stop locks
   /// it, the shutdown closes it.
   MotionGate& gate() { return gate_; }
+  /// The position (rad) joint `joint_index` (frame order) was last commanded, i.e. what the
+  /// board was last sent for it; nothing when it never was (or for an index beyond the joints).
+  std::optional<double> lastCommandedPosition(std::size_t joint_index) const;
 
   const std::vector<BodyJoint>& joints() const { return joints_; }
   std::size_t servoCount() const { return joints_.size(); }

@@ -31,11 +31,20 @@ const trajectory::BusJoint* findBusJoint(const std::vector<trajectory::BusJoint>
 using QueueServoMove =
     std::function<std::string(uint8_t id, double angle_deg, uint32_t interval_ms)>;
 
+/// Stops servo `id` where it is (a SPIN stop, no position); must not block. Returns an error
+/// text, empty when queued.
+using StopServo = std::function<std::string(uint8_t id)>;
+
+/// How long a bus joint may go without a poll answer before its goal aborts: three poll periods at
+/// `state_rate` (Hz), at least 0.5 s.
+double busStateTimeout(double state_rate);
+
 /// The bus joints for the trajectory server: one ROTATE per segment, at its start, with the
-/// segment's remaining duration as interval. A goal aborts when a joint's poll answer is older
-/// than three poll periods (at least 0.5 s).
+/// segment's remaining duration as interval; a stop holds a joint with `stop_servo` (may be
+/// empty: nothing is sent). Its state_timeout is busStateTimeout(state_rate).
 TrajectoryJoints busTrajectoryJoints(const std::vector<trajectory::BusJoint>& joints,
-                                     QueueServoMove queue_move, double state_rate);
+                                     QueueServoMove queue_move, double state_rate,
+                                     StopServo stop_servo = {});
 
 /// One polled angle as a joint measurement: the joint's name and position (rad) where `id` is a
 /// joint, else servo_<id> and the servo's angle in rad.
