@@ -142,3 +142,9 @@ add_rostest_gtest(test_wire_capture test/rostest/wire_capture.test
 target_include_directories(test_wire_capture PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_wire_capture srd_ros srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_wire_capture ${PROJECT_NAME}_generate_messages_cpp)
+# The e-stop with the bus busy, the cable out and a stop lost: nothing moves after it, the stop
+# goes first after the replug and is written again until the servo rests, the base keeps its pace.
+add_rostest_gtest(test_estop_bus test/rostest/estop_bus.test test/rostest/test_estop_bus.cpp)
+target_include_directories(test_estop_bus PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_estop_bus srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_estop_bus driver_node ${PROJECT_NAME}_generate_messages_cpp)

@@ -153,10 +153,12 @@ void BusMutex::unlock() {
 }
 
 void BusMutex::wakeWaiters(std::unique_lock<std::mutex>& lock) {
-  const bool wake_reader = std::exchange(reader_waiting_, false);
-  lock.unlock();
+  // Returns with `lock` held, as it came: yieldToUrgent() goes on waiting with it.
   released_.notify_all();
-  if (wake_reader) pump_->wake();
+  if (!std::exchange(reader_waiting_, false)) return;
+  lock.unlock();
+  pump_->wake();  // the reader pumping its port: its read returns at once
+  lock.lock();
 }
 
 ServoBusClient::Expectation::Expectation(Command answer_cmd, uint8_t answer_id)
