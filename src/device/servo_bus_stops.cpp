@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <thread>
+#include <utility>
 
 #include "serial_robot_driver/device/servo_bus.h"
 
@@ -62,6 +63,7 @@ void ServoBus::setMotionLocked(bool locked) {
     motion_locked_ = locked;
     if (!locked) {
       stops_.clear();  // released: nothing is to be held back any more
+      endUrgentLocked();
       return;
     }
     queued_moves_.clear();
@@ -90,7 +92,7 @@ void ServoBus::deliverStops() {
     worker_running = started_ && !stop_;
   }
   if (worker_running) {
-    client_.requestUrgent();  // nobody takes the bus before the worker has written them
+    askUrgent();  // nobody takes the bus before the worker has written them
     wakeWorker();
     return;
   }
@@ -110,11 +112,26 @@ void ServoBus::onLinkUp() {
     for (auto& [id, stop] : stops_) armStopLocked(id, now);
     if (stops_.empty() || !started_ || stop_) return;
   }
-  client_.requestUrgent();
+  askUrgent();
   wakeWorker();  // a worker of its own; on the link, this thread is the worker
 }
 
+void ServoBus::askUrgent() {
+  // Under mutex_, so the flag and the client's reservation change together.
+  std::lock_guard<std::mutex> lock(mutex_);
+  urgent_asked_ = true;
+  client_.requestUrgent();
+}
+
+void ServoBus::endUrgentLocked() {
+  if (!std::exchange(urgent_asked_, false)) return;
+  client_.endUrgent();  // takes only the client's own locks
+}
+
 Clock::time_point ServoBus::nextStopWork() const {
+  // The bus is reserved for stops (askUrgent): the worker must see to it now, even when the stop
+  // it was asked for is gone meanwhile (released, superseded), or every caller would wait.
+  if (urgent_asked_) return Clock::time_point::min();
   Clock::time_point next = Clock::time_point::max();
   for (const auto& [id, stop] : stops_) next = std::min(next, stop.due);
   return next;
@@ -129,13 +146,17 @@ std::vector<PendingStopReport> ServoBus::pendingStops() const {
 
 bool ServoBus::stopWorkOnce(std::unique_lock<std::mutex>& lock, StopPace pace) {
   const Clock::time_point now = clock_->now();
-  const auto due = [&](const PendingStop& stop) { return pace == StopPace::kNow || stop.due <= now; };
+  const auto due = [&](const PendingStop& stop) {
+    return pace == StopPace::kNow || stop.due <= now;
+  };
   for (const auto& [id, stop] : stops_) {
     if (stop.phase == PendingStop::Phase::kWrite && due(stop)) {
       writeDueStops(lock, pace);
       return true;
     }
   }
+  // Nothing to write: the bus is no longer reserved.
+  endUrgentLocked();
   for (const auto& [id, stop] : stops_) {
     if (due(stop)) {
       lookAtStoppedServo(lock, id, pace);
@@ -185,7 +206,7 @@ void ServoBus::writeDueStops(std::unique_lock<std::mutex>& lock, StopPace pace) 
   const bool more = std::any_of(stops_.begin(), stops_.end(), [&](const auto& entry) {
     return entry.second.phase == PendingStop::Phase::kWrite && entry.second.due <= after;
   });
-  if (!more || pace == StopPace::kNow) client_.endUrgent();
+  if (!more || pace == StopPace::kNow) endUrgentLocked();
   lock.unlock();
   for (const auto& [id, status] : failures) {
     if (events_.on_stop) events_.on_stop(id, status);
@@ -240,7 +261,7 @@ void ServoBus::lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t id
   const bool rewrite = !outcome.ok() && outcome.error != ServoError::kTimeout &&
                        outcome.error != ServoError::kNotConnected;
   lock.unlock();
-  if (rewrite && pace == StopPace::kScheduled) client_.requestUrgent();  // still moving
+  if (rewrite && pace == StopPace::kScheduled) askUrgent();  // still moving: again, first
   if (events_.on_stop) events_.on_stop(id, outcome);
   lock.lock();
 }
@@ -260,8 +281,8 @@ void ServoBus::finalWords() {
       for (uint8_t id : commanded_) armStopLocked(id, now);
       // Back to back on this thread (the worker has stopped), until each is seen at rest.
       while (!stops_.empty() && std::chrono::steady_clock::now() < deadline) {
-        const bool port_down = std::all_of(stops_.begin(), stops_.end(),
-                                           [](const auto& entry) { return entry.second.port_down; });
+        const bool port_down = std::all_of(
+            stops_.begin(), stops_.end(), [](const auto& entry) { return entry.second.port_down; });
         if (port_down) {  // a port that is down has nothing to gain from a busy loop
           lock.unlock();
           std::this_thread::sleep_for(kStopRetry);
@@ -276,8 +297,9 @@ void ServoBus::finalWords() {
       lock.unlock();
       for (uint8_t id : ids) {
         // A write that failed (port down) is tried again until the budget is spent.
-        while (!client_.damping(id, in_force.relax_power_mw, false, FrameGate::kSafetyAction).ok() &&
-               std::chrono::steady_clock::now() < deadline) {
+        while (
+            !client_.damping(id, in_force.relax_power_mw, false, FrameGate::kSafetyAction).ok() &&
+            std::chrono::steady_clock::now() < deadline) {
           std::this_thread::sleep_for(kStopRetry);
         }
       }
@@ -289,6 +311,7 @@ void ServoBus::finalWords() {
   }
   std::vector<std::pair<uint8_t, std::string>> unconfirmed;
   for (const auto& [id, stop] : stops_) unconfirmed.push_back({id, stop.why});
+  endUrgentLocked();  // the callers still waiting get the bus (and kShutdown)
   lock.unlock();
   for (const auto& [id, why] : unconfirmed) {
     if (events_.on_stop) {

@@ -76,7 +76,8 @@ srd::ServoSpin spinCall(uint8_t id, uint8_t mode) {
   return call;
 }
 
-std::size_t count(const std::vector<PtyTap::Frame>& frames, const Bytes& bytes, std::size_t from = 0) {
+std::size_t count(const std::vector<PtyTap::Frame>& frames, const Bytes& bytes,
+                  std::size_t from = 0) {
   return static_cast<std::size_t>(
       std::count_if(frames.begin() + static_cast<long>(std::min(from, frames.size())), frames.end(),
                     [&](const PtyTap::Frame& f) { return f.bytes == bytes; }));
@@ -97,13 +98,7 @@ class EStopBus : public ::testing::Test {
     spinCall(1, 0);
   }
   void setEStop(bool engaged) {
-    std_msgs::Bool msg;
-    msg.data = engaged;
-    e_stop_.publish(msg);
-    const uint64_t seen = diagnostics_.latest("e_stop").received;
-    ASSERT_TRUE(diagnostics_.waitFor(
-        "e_stop", seen, [&](const auto& status) { return status.flag("engaged") == engaged; },
-        [] { return ros::ok(); }, kWaitSeconds));
+    ASSERT_TRUE(test_support::setEStopAndWait(e_stop_, diagnostics_, engaged, kWaitSeconds));
   }
   /// Spins servo 1 once the port is open (the services come up before it).
   void spinServo1() {
@@ -137,8 +132,8 @@ TEST_F(EStopBus, AStopEngagedWhileUnpluggedGoesFirstAfterTheReplugAndAgainWhenLo
   EXPECT_TRUE(simServo(1)->moving) << "nothing can reach the servo while the cable is out";
 
   *g_bus = plugBus();  // the cable is back
-  ASSERT_TRUE((*g_bus)->waitForFrames([](const auto& frames) { return !frames.empty(); },
-                                      kWaitSeconds));
+  ASSERT_TRUE(
+      (*g_bus)->waitForFrames([](const auto& frames) { return !frames.empty(); }, kWaitSeconds));
   EXPECT_EQ((*g_bus)->frames().front().bytes, kSpin1Stop) << "the stop is the first frame";
   ASSERT_TRUE(waitMoving(1, false)) << "the lost stop was never written again";
   EXPECT_EQ(g_robot->stats().servo_bus.stops_lost, 1u);
@@ -197,7 +192,8 @@ TEST_F(EStopBus, AStopDuringALongScanWaitsForOneTransactionAndTheBaseKeepsItsPac
   std::thread scanner([&] { ros::service::call("servo/scan", scan); });
   ASSERT_TRUE((*g_bus)->waitForFrames(
       [](const auto& frames) {
-        return !frames.empty() && frames.back().bytes[2] == kPingCmd && frames.back().bytes[4] >= 11;
+        return !frames.empty() && frames.back().bytes[2] == kPingCmd &&
+               frames.back().bytes[4] >= 11;
       },
       kWaitSeconds));
   const std::size_t at_e_stop = (*g_bus)->frameCount();
@@ -218,8 +214,9 @@ TEST_F(EStopBus, AStopDuringALongScanWaitsForOneTransactionAndTheBaseKeepsItsPac
   double longest_gap_s = 0.0;
   for (std::size_t i = 1; i < base.size(); ++i) {
     if (base[i].arrival < engaged_at - std::chrono::seconds(1)) continue;
-    longest_gap_s = std::max(
-        longest_gap_s, std::chrono::duration<double>(base[i].arrival - base[i - 1].arrival).count());
+    longest_gap_s =
+        std::max(longest_gap_s,
+                 std::chrono::duration<double>(base[i].arrival - base[i - 1].arrival).count());
   }
   EXPECT_LT(longest_gap_s, 0.5) << "the base's loop was held up";
   scanner.join();

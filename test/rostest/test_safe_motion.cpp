@@ -106,14 +106,7 @@ class SafeMotion : public ::testing::Test {
     spin("", 2, 0);
   }
   void setEStop(bool engaged) {
-    std_msgs::Bool msg;
-    msg.data = engaged;
-    e_stop_.publish(msg);
-    // The e-stop's state is in /diagnostics: wait until the node has it.
-    const uint64_t seen = diagnostics_.latest("e_stop").received;
-    ASSERT_TRUE(diagnostics_.waitFor(
-        "e_stop", seen, [&](const auto& status) { return status.flag("engaged") == engaged; },
-        [] { return ros::ok(); }, kWaitSeconds));
+    ASSERT_TRUE(test_support::setEStopAndWait(e_stop_, diagnostics_, engaged, kWaitSeconds));
   }
 
   ros::NodeHandle nh_;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 #include <ros/network.h>
+#include <std_msgs/Bool.h>
 #include <unistd.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 #include <xmlrpcpp/XmlRpcValue.h>
@@ -125,6 +126,20 @@ int runAllTestsWithSim(const serial_robot_driver::sim::SimOptions& options,
   *robot = nullptr;
   sim.stop();
   return result;
+}
+
+bool setEStopAndWait(ros::Publisher& e_stop, const DiagnosticsWatch& diagnostics, bool engaged,
+                     double timeout_s) {
+  std_msgs::Bool msg;
+  msg.data = engaged;
+  e_stop.publish(msg);
+  const uint64_t seen = diagnostics.latest("e_stop").received;
+  return diagnostics
+      .waitFor(
+          "e_stop", seen,
+          [&](const DiagnosticsWatch::Status& status) { return status.flag("engaged") == engaged; },
+          [] { return ros::ok(); }, timeout_s)
+      .has_value();
 }
 
 }  // namespace test_support

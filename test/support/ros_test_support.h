@@ -128,6 +128,11 @@ class DiagnosticsWatch {
   std::map<std::string, Status> statuses_;
 };
 
+/// Publishes `engaged` on `e_stop` and waits (up to `timeout_s`) until the node's "e_stop"
+/// diagnostic status reports that state; false when it never did.
+bool setEStopAndWait(ros::Publisher& e_stop, const DiagnosticsWatch& diagnostics, bool engaged,
+                     double timeout_s);
+
 /// RUN_ALL_TESTS() against an in-process simulated robot on `options.link`: started before the
 /// tests, `*robot` pointing at it while they run, stopped after them. Returns RUN_ALL_TESTS()'s.
 int runAllTestsWithSim(const serial_robot_driver::sim::SimOptions& options,

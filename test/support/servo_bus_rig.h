@@ -52,7 +52,8 @@ class ServoBusTest : public ::testing::Test {
       std::lock_guard<std::mutex> lock(mutex_);
       angles_.push_back(sample);
     };
-    events.on_servo_silent = [this](uint8_t id, const ServoStatus&, std::chrono::milliseconds backoff) {
+    events.on_servo_silent = [this](uint8_t id, const ServoStatus&,
+                                    std::chrono::milliseconds backoff) {
       std::lock_guard<std::mutex> lock(mutex_);
       silent_.push_back({id, backoff});
     };
@@ -123,7 +124,8 @@ class ServoBusTest : public ::testing::Test {
   const Clock::time_point t0_ = Clock::time_point() + std::chrono::hours(1);
   std::shared_ptr<ManualClock> clock_ = std::make_shared<ManualClock>(t0_);
   std::mutex mutex_;
-  std::map<Bytes, Bytes> answers_ = {{golden::servo::kReadAngle0, golden::servo::kReadAngle0Reply902}};
+  std::map<Bytes, Bytes> answers_ = {
+      {golden::servo::kReadAngle0, golden::servo::kReadAngle0Reply902}};
   std::vector<Bytes> written_;
   std::vector<ServoAngleSample> angles_;
   std::vector<std::pair<uint8_t, std::chrono::milliseconds>> silent_;
@@ -143,6 +145,5 @@ inline SpinRequest continuousSpin0() {
   spin.speed_dps = 100;
   return spin;
 }
-
 
 }  // namespace serial_robot_driver::device

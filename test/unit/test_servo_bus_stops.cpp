@@ -103,8 +103,8 @@ TEST_F(ServoBusTest, TheEStopsStopGoesBeforeTheCallsWaitingForTheBus) {
 // The stop is kept until the servo is seen at rest: an angle that still changes after it (the
 // servo did not hear it) has it written again; two equal angles confirm it.
 TEST_F(ServoBusTest, AStopAfterWhichTheServoStillMovesIsWrittenAgain) {
-  scripted_answers_[kReadAngle0] = {kReadAngle0Reply902, kReadAngle0Reply1000,
-                                    kReadAngle0Reply1000, kReadAngle0Reply1000};
+  scripted_answers_[kReadAngle0] = {kReadAngle0Reply902, kReadAngle0Reply1000, kReadAngle0Reply1000,
+                                    kReadAngle0Reply1000};
   makeBus({});
   bus_->start();
   clock_->waitForLoop();
@@ -186,12 +186,34 @@ TEST_F(ServoBusTest, AWaitForAMotionsCompletionGivesWayToTheStop) {
   rotate.wait = true;
   ServoStatus waited;
   std::thread caller([&] { waited = bus_->rotate(rotate); });
-  ASSERT_TRUE(waitFor([&] { return countWritten(kRotate2To90In500) == 0 && written().size() == 1; }));
+  ASSERT_TRUE(
+      waitFor([&] { return countWritten(kRotate2To90In500) == 0 && written().size() == 1; }));
   bus_->setMotionLocked(true);
   caller.join();
   EXPECT_EQ(waited.error, ServoError::kPreempted) << waited.message;
   ASSERT_TRUE(waitFor([&] { return countWritten(kSpin2StopSpeed0) >= 1; }));
   bus_->setMotionLocked(false);
+  bus_->shutdown();
+}
+
+// An e-stop released before its stop went out leaves nothing reserved: a call after it gets the
+// bus (it would wait for the stop's turn for ever otherwise).
+TEST_F(ServoBusTest, AReleaseBeforeTheStopWentOutLeavesTheBusFreeForCalls) {
+  const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
+  answers_[kPing3] = kPing3Reply;
+  answers_[kPing5] = kPing5Reply;
+  makeBus({});
+  bus_->start();
+  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
+  holdOnTheWire(kPing3);
+  std::thread holder([&] { bus_->client().ping(3); });
+  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));
+  bus_->setMotionLocked(true);
+  bus_->setMotionLocked(false);
+  releaseTheWire();
+  holder.join();
+  EXPECT_TRUE(bus_->client().ping(5).ok());
+  EXPECT_TRUE(bus_->pendingStops().empty());
   bus_->shutdown();
 }
 

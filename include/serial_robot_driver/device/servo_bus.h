@@ -272,6 +272,9 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Asks the client for urgent work and wakes the worker, or, without a running worker, writes
   /// the stops itself.
   void deliverStops();
+  /// Reserves the bus for the stops (ServoBusClient::requestUrgent) until endUrgentLocked().
+  void askUrgent();
+  void endUrgentLocked();  // mutex_ held
   /// When the stop work falls due next (mutex_ held); max() when none.
   Clock::time_point nextStopWork() const;
   /// One piece of stop work that is due (mutex_ held by `lock`, released around the bus): every
@@ -305,6 +308,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   std::deque<MoveRequest> queued_moves_;
   std::map<uint8_t, PendingStop> stops_;  // not yet known to have reached their servo
   std::set<uint8_t> commanded_;           // set moving or positioned since start-up
+  bool urgent_asked_ = false;             // askUrgent() .. endUrgentLocked()
   MotionGate gate_;                       // every motion frame passes it when written
   std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   std::set<uint8_t> moving_;          // servos set moving and not stopped since
