@@ -294,8 +294,8 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
     // A stop asked during the last attempt goes out before this one: the worker that writes it
     // ends here, a caller hands the bus over and goes on after it.
     if (attempt > 1 && give_way && bus_mutex_.urgentRequested()) {
-      return fail(ServoError::kPreempted, servoName(expect.id) + "'s " + commandName(expect.cmd) +
-                                              " gave way to a stop");
+      return fail(ServoError::kPreempted,
+                  servoName(expect.id) + "'s " + commandName(expect.cmd) + " gave way to a stop");
     }
     if (attempt > 1) bus_mutex_.yieldToUrgent();
     {
@@ -342,8 +342,7 @@ ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const 
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
     if (cut_short) {
       return fail(ServoError::kPreempted,
-                  std::string(commandName(expect.cmd)) + " was written to " +
-                      servoName(expect.id) +
+                  std::string(commandName(expect.cmd)) + " was written to " + servoName(expect.id) +
                       ", but the wait for its completion was cut short by a stop");
     }
     if (pending_.garbled) {

@@ -161,7 +161,8 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request) {
       servo::encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
   std::lock_guard<BusMutex> bus(bus_mutex_);
   // A SPIN stop is what the e-stop itself sends: never held back.
-  const FrameGate gate = mode == servo::SpinMode::kStop ? FrameGate::kSafetyAction : FrameGate::kMotion;
+  const FrameGate gate =
+      mode == servo::SpinMode::kStop ? FrameGate::kSafetyAction : FrameGate::kMotion;
   return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time, gate);
 }
 

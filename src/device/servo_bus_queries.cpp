@@ -42,8 +42,8 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
     // Background work makes one attempt: the next poll is the retry.
     const ServoBusOptions options = this->options();
     const int attempts = priority == BusPriority::kBackground ? 1 : options.retries + 1;
-    status = transact(request, expect, options.timeout, attempts, &answer,
-                      FrameGate::kSafetyAction, priority == BusPriority::kWorker);
+    status = transact(request, expect, options.timeout, attempts, &answer, FrameGate::kSafetyAction,
+                      priority == BusPriority::kWorker);
     std::lock_guard<std::mutex> lock(state_mutex_);
     answered_at = pending_.arrival;
   }

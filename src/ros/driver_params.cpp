@@ -253,8 +253,7 @@ std::vector<ParamSpec> buildTable() {
             require(v >= 0 && v <= 10, key, "must be 0..10");
           }),
       row("servo_bus/allow_dangerous_writes", &P::servo_bus, &Bus::allow_dangerous_writes),
-      row("servo_bus/state_ids", &P::servo_bus, &Bus::state_ids,
-          busServoIds),
+      row("servo_bus/state_ids", &P::servo_bus, &Bus::state_ids, busServoIds),
       row("servo_bus/state_rate", &P::servo_bus, &Bus::state_rate,
           [](const double& v, const std::string& key) {
             requirePositive(v, key);
@@ -269,15 +268,14 @@ std::vector<ParamSpec> buildTable() {
       // Trajectory defaults (follow_joint_trajectory, joint_trajectory).
       row("trajectory/goal_tolerance", &P::trajectory, &TrajectoryParams::goal_tolerance,
           nonNegative<double>),
-      row("trajectory/goal_time_tolerance", &P::trajectory,
-          &TrajectoryParams::goal_time_tolerance, nonNegative<double>),
+      row("trajectory/goal_time_tolerance", &P::trajectory, &TrajectoryParams::goal_time_tolerance,
+          nonNegative<double>),
       row("trajectory/path_tolerance", &P::trajectory, &TrajectoryParams::path_tolerance,
           nonNegative<double>),
       row("trajectory/max_velocity", &P::trajectory, &TrajectoryParams::max_velocity,
           nonNegative<double>),
       // Bus servos as named joints; lengths and names are checked in validate().
-      row("servo_bus/joint_ids", &P::servo_bus, &Bus::joint_ids,
-          busServoIds),
+      row("servo_bus/joint_ids", &P::servo_bus, &Bus::joint_ids, busServoIds),
       row("servo_bus/joint_names", &P::servo_bus, &Bus::joint_names,
           [](const std::vector<std::string>& names, const std::string& key) {
             std::set<std::string> seen;

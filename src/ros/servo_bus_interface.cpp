@@ -212,7 +212,8 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
     } else if (status.error == device::ServoError::kShutdown) {
       ROS_ERROR("servo_bus: %s", status.message.c_str());
     } else {
-      ROS_WARN_THROTTLE(kWarnThrottleS, "servo_bus: %s's stop not yet confirmed, writing it again: %s",
+      ROS_WARN_THROTTLE(kWarnThrottleS,
+                        "servo_bus: %s's stop not yet confirmed, writing it again: %s",
                         servoJointName(id).c_str(), status.message.c_str());
     }
   };
@@ -440,9 +441,10 @@ void ServoBusInterface::attachEStop(device::EStop& e_stop) {
     if (engaged && !commanded.empty()) {
       std::string ids;
       for (uint8_t id : commanded) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
-      ROS_WARN("e_stop: stopping bus servo(s) %s (each stop is written until the servo is seen at "
-               "rest)",
-               ids.c_str());
+      ROS_WARN(
+          "e_stop: stopping bus servo(s) %s (each stop is written until the servo is seen at "
+          "rest)",
+          ids.c_str());
     }
   });
 }

@@ -232,13 +232,12 @@ const std::vector<Flag>& flags() {
       idList(
           "--offline-ids", "7", "ids that never answer", SIZE_MAX,
           [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.offline_ids; }, false),
-      heldValue("--servo-temperature", "ID:DEGC",
-                "hold a bus servo's temperature at DEGC (repeatable)",
-                [](SimOptions& o) -> std::map<uint8_t, int64_t>& {
-                  return o.servo_bus.temperature_c;
-                }),
-      heldValue("--servo-voltage", "ID:MV", "hold a bus servo's voltage at MV (repeatable)",
-                [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.voltage_mv; }),
+      heldValue(
+          "--servo-temperature", "ID:DEGC", "hold a bus servo's temperature at DEGC (repeatable)",
+          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.temperature_c; }),
+      heldValue(
+          "--servo-voltage", "ID:MV", "hold a bus servo's voltage at MV (repeatable)",
+          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.voltage_mv; }),
       Flag{"--servo-latency-ms", "MS", "servo bus answer latency",
            [](const std::string& value, SimOptions& o) {
              double ms = 0;
@@ -274,7 +273,8 @@ const std::vector<Flag>& flags() {
                   [](SimOptions& o) -> double& { return o.faults.servo_fault_rate; }),
       whole(
           "--lose-servo-stops", "N",
-          "the next N SPIN stops to a bus servo are lost on the line: the servo keeps moving", 1000000,
+          "the next N SPIN stops to a bus servo are lost on the line: the servo keeps moving",
+          1000000,
           [](SimOptions& o, uint64_t v) { o.servo_bus.lost_stops = static_cast<uint32_t>(v); },
           [](const SimOptions& o) { return show(o.servo_bus.lost_stops); }),
 

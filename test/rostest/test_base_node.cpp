@@ -8,7 +8,12 @@
 //
 // Every TEST starts on a fresh pty, so the node reconnects and no state leaks between tests. The
 // machine may be busy: the tests count frames and use generous deadlines, never tight timing.
+#include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/BatteryState.h>
 #include <signal.h>
+#include <std_srvs/Trigger.h>
 #include <sys/wait.h>
 
 #include <chrono>
@@ -25,12 +30,6 @@
 #include <thread>
 #include <utility>
 #include <vector>
-
-#include <geometry_msgs/Twist.h>
-#include <gtest/gtest.h>
-#include <ros/ros.h>
-#include <sensor_msgs/BatteryState.h>
-#include <std_srvs/Trigger.h>
 
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/base_codec.h"

@@ -22,7 +22,6 @@ namespace {
 using std::chrono::milliseconds;
 using namespace golden::servo;  // NOLINT: the shared golden frames
 
-
 TEST_F(ServoBusTest, PollsEachServoOncePerPeriod) {
   makeBus({0});
   bus_->start();
@@ -171,7 +170,6 @@ TEST_F(ServoBusTest, ShutdownFailsLaterCallsAndIsIdempotent) {
 // SPIN stop at speed 0 (the e-stop's and the shutdown's): 12 4C 07 06 | id 0, mode 0, speed 0,
 // value 0 | sum 0x6B.
 
-
 TEST_F(ServoBusTest, MotionLockStopsTheServosSetSpinningAndRefusesMotionUntilReleased) {
   makeBus({});
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
@@ -200,8 +198,8 @@ TEST_F(ServoBusTest, ShutdownStopsTheServosSetMovingAndLooksUntilTheyRest) {
   bus_->start();
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
   bus_->shutdown();
-  EXPECT_EQ(written(), (std::vector<Bytes>{kSpin0CcwContinuous, kSpin0StopSpeed0, kReadAngle0,
-                                           kReadAngle0}));
+  EXPECT_EQ(written(),
+            (std::vector<Bytes>{kSpin0CcwContinuous, kSpin0StopSpeed0, kReadAngle0, kReadAngle0}));
   EXPECT_TRUE(bus_->pendingStops().empty());
   EXPECT_EQ(bus_->spin(continuousSpin0()).error, ServoError::kShutdown);
 }

@@ -308,8 +308,7 @@ class ServoBusClient : public LinkListener {
   /// Writes one request, through the motion gate when `gate` is kMotion. nullopt when written;
   /// else why not (the gate's refusal, or the port is down).
   std::optional<ServoStatus> writeRequest(const std::vector<uint8_t>& request,
-                                          protocol::servo::Command cmd, uint8_t id,
-                                          FrameGate gate);
+                                          protocol::servo::Command cmd, uint8_t id, FrameGate gate);
   /// transact() with the configured timeout and retries: the usual request/answer exchange.
   ServoStatus exchangeLocked(const std::vector<uint8_t>& request, const Expectation& expect,
                              protocol::servo::Packet* answer);
