@@ -449,28 +449,6 @@ void ServoBusInterface::attachEStop(device::EStop& e_stop) {
   });
 }
 
-void ServoBusInterface::addDiagnostics(diagnostic_updater::Updater& updater) {
-  // Every polled servo has its status, also while health_rate is 0 (it may be tuned on).
-  for (uint8_t id : bus_.config().polled_ids) {
-    updater.add("servo_bus servo " + std::to_string(id),
-                [this, id](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseServo(id, s); });
-  }
-}
-
-void ServoBusInterface::diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status) {
-  status.hardware_id = link_.options().path;
-  if (bus_.settings().health_rate <= 0.0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
-                   "servo " + std::to_string(id) + ": health poll off (~servo_bus/health_rate 0)");
-    return;
-  }
-  std::optional<device::ServoHealthReport> found;
-  for (const device::ServoHealthReport& report : bus_.health()) {
-    if (report.id == id) found = report;
-  }
-  diagnoseServoHealth(id, found ? &*found : nullptr, status);
-}
-
 void ServoBusInterface::yieldJoints(const std::vector<uint8_t>& ids, const char* source) {
   for (uint8_t id : ids.empty() ? bus_.config().polled_ids : ids) yieldJoint(id, source);
 }
@@ -521,97 +499,6 @@ void ServoBusInterface::shutdown() {
   bus_.shutdown();  // fails a call waiting on the bus, so the spinner can stop quickly
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
-}
-
-void ServoBusInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const device::ServoBusStats stats = client_.stats();
-  if (link_.connected()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
-                   std::to_string(stats.transactions) + " transactions, " +
-                       std::to_string(stats.timeouts) + " timeouts");
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "servo bus port is not connected");
-  }
-  status.hardware_id = link_.options().path;
-  status.add("port", link_.options().path);
-  status.add("connected", link_.connected());
-  status.add("transactions", stats.transactions);
-  status.add("commands without answer", stats.commands);
-  status.add("timeouts", stats.timeouts);
-  status.add("retries", stats.retries);
-  status.add("mismatched answers", stats.mismatched);
-  status.add("garbled answers", stats.garbled);
-  status.add("echoes skipped", stats.echoes);
-  status.addf("last latency (ms)", "%.2f", stats.last_latency_ms);
-  status.addf("max latency (ms)", "%.2f", stats.max_latency_ms);
-  const device::ServoBusOptions options = client_.options();
-  status.add("timeout (ms)", static_cast<int>(options.timeout.count()));
-  status.add("retries per transaction", options.retries);
-  status.add("dangerous writes armed", options.allow_dangerous_writes);
-
-  const device::ServoBusWorkerStats worker = bus_.stats();
-  std::string offline;
-  for (uint8_t id : worker.offline_ids) {
-    offline += (offline.empty() ? "" : ", ") + std::to_string(id);
-  }
-  status.add("servo_states published", worker.angles_polled);
-  status.add("polled servos offline", offline.empty() ? std::string("none") : offline);
-  status.add("servo_commands moves sent", worker.moves_sent);
-  status.add("servo_commands rejected", commands_rejected_.load());
-  status.add("servo_commands moves failed", worker.moves_failed);
-  std::string moving;
-  for (uint8_t id : bus_.movingIds()) moving += (moving.empty() ? "" : ", ") + std::to_string(id);
-  status.add("servos set moving", moving.empty() ? std::string("none") : moving);
-  status.add("motion locked (e_stop)", bus_.motionLocked());
-  status.add("motion frames refused when written", bus_.motionRefusedAtWrite());
-  std::string unconfirmed;
-  for (const device::PendingStopReport& stop : bus_.pendingStops()) {
-    unconfirmed += (unconfirmed.empty() ? "" : "; ") + servoJointName(stop.id) + ": " + stop.why;
-  }
-  status.add("stops not yet confirmed", unconfirmed.empty() ? std::string("none") : unconfirmed);
-  if (!unconfirmed.empty()) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
-                        "stop not yet known to have reached " + unconfirmed);
-  }
-  const device::ServoBusConfig in_force = bus_.settings();
-  status.add("on shutdown", device::toString(in_force.on_shutdown));
-  status.add("health polls per second", in_force.health_rate);
-  status.add("protect", in_force.protect);
-  if (!offline.empty() && link_.connected()) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
-                        "polled servos not answering: " + offline);
-  }
-
-  // Asked vs achieved: the state_rate in force for every answering polled servo, against the
-  // angles read over the window. A line too slow for what was asked (or service calls taking
-  // the bus) shows here rather than as a silently lower rate.
-  // The achieved rate is measured over at least kRateWindowS, so one slow transaction (a silent
-  // servo's timeout, a long service call) does not flag a line that keeps up on average.
-  constexpr double kRateWindowS = 2.0;
-  const auto now = std::chrono::steady_clock::now();
-  const double asked = worker.asked_poll_rate;
-  if (last_rate_check_ == std::chrono::steady_clock::time_point{}) {
-    last_rate_check_ = now;
-    polls_at_last_check_ = worker.angles_polled;
-  }
-  const double seconds = std::chrono::duration<double>(now - last_rate_check_).count();
-  if (seconds >= kRateWindowS) {
-    achieved_rate_ = static_cast<double>(worker.angles_polled - polls_at_last_check_) / seconds;
-    polls_at_last_check_ = worker.angles_polled;
-    last_rate_check_ = now;
-  }
-  status.addf("servo_states asked (per s)", "%.1f", asked);
-  if (achieved_rate_ < 0) return;  // the first window is not over yet
-  status.addf("servo_states achieved (per s)", "%.1f", achieved_rate_);
-  // 10 % of slack for the window's own jitter; a saturated line falls far below it.
-  if (link_.connected() && asked > 0 && achieved_rate_ < 0.9 * asked) {
-    char text[160];
-    std::snprintf(text, sizeof(text),
-                  "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
-                  "service calls are the limit: lower ~servo_bus/state_rate or raise the baud)",
-                  asked, achieved_rate_);
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
-  }
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -71,13 +71,15 @@ uint64_t DiagnosticsWatch::Status::number(const std::string& key) const {
 }
 
 DiagnosticsWatch::DiagnosticsWatch(ros::NodeHandle& nh, const std::string& node)
-    : prefix_(node + ": ") {
+    : state_(std::make_shared<State>()) {
+  state_->prefix = node + ": ";
   sub_ = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(mutex_);
+      "/diagnostics", 100,
+      [state = state_](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(state->mutex);
         for (const auto& status : msg->status) {
-          if (status.name.rfind(prefix_, 0) != 0) continue;
-          Status& stored = statuses_[status.name.substr(prefix_.size())];
+          if (status.name.rfind(state->prefix, 0) != 0) continue;
+          Status& stored = state->statuses[status.name.substr(state->prefix.size())];
           ++stored.received;
           stored.level = status.level;
           stored.message = status.message;
@@ -88,9 +90,9 @@ DiagnosticsWatch::DiagnosticsWatch(ros::NodeHandle& nh, const std::string& node)
 }
 
 DiagnosticsWatch::Status DiagnosticsWatch::latest(const std::string& name) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = statuses_.find(name);
-  return it == statuses_.end() ? Status{} : it->second;
+  std::lock_guard<std::mutex> lock(state_->mutex);
+  const auto it = state_->statuses.find(name);
+  return it == state_->statuses.end() ? Status{} : it->second;
 }
 
 std::optional<DiagnosticsWatch::Status> DiagnosticsWatch::waitFor(
@@ -111,9 +113,9 @@ std::optional<DiagnosticsWatch::Status> DiagnosticsWatch::waitFor(
 }
 
 std::vector<std::string> DiagnosticsWatch::names() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard<std::mutex> lock(state_->mutex);
   std::vector<std::string> result;
-  for (const auto& [name, status] : statuses_) result.push_back(name);
+  for (const auto& [name, status] : state_->statuses) result.push_back(name);
   return result;
 }
 

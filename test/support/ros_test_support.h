@@ -122,10 +122,15 @@ class DiagnosticsWatch {
   std::vector<std::string> names() const;
 
  private:
-  const std::string prefix_;
+  /// Shared with the subscriber's callback, so a watch destroyed while a message is being
+  /// handled on a spinner thread leaves that callback a live state to finish with.
+  struct State {
+    std::string prefix;
+    std::mutex mutex;
+    std::map<std::string, Status> statuses;
+  };
+  std::shared_ptr<State> state_;
   ros::Subscriber sub_;
-  mutable std::mutex mutex_;
-  std::map<std::string, Status> statuses_;
 };
 
 /// Publishes `engaged` on `e_stop` and waits (up to `timeout_s`) until the node's "e_stop"
