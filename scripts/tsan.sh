@@ -25,15 +25,23 @@ source "$ws/devel/setup.bash"
 set -u
 
 rm -f "$ws"/reports/tsan.*
-# second_deadlock_stack: lock-order reports name both stacks; halt_on_error=0: collect them all.
-export TSAN_OPTIONS="log_path=$ws/reports/tsan second_deadlock_stack=1 halt_on_error=0"
+# second_deadlock_stack: lock-order reports name both stacks; halt_on_error=0: collect them all;
+# exitcode=0: a process's exit status stays its own (the tests check the node's), the reports say
+# the rest.
+export TSAN_OPTIONS="log_path=$ws/reports/tsan second_deadlock_stack=1 halt_on_error=0 exitcode=0"
 status=0
 "$ws/devel/lib/serial_robot_driver/core_tests" --gtest_brief=1 > "$ws/core_tests.log" 2>&1 || status=1
 tail -n 3 "$ws/core_tests.log"
 if [ "${1:-}" != "--unit" ]; then
   for test in estop_bus.test safe_motion.test; do
-    rostest --text serial_robot_driver "$test" > "$ws/$test.log" 2>&1 || status=1
-    echo "$test: $(grep -cE '^\[       OK' "$ws/$test.log") passed, $(grep -cE '^\[  FAILED  \] [A-Z]' "$ws/$test.log") failed"
+    # An instrumented nodelet library cannot be loaded into the (uninstrumented) nodelet manager
+    # ("cannot allocate memory in static TLS block"): that one case runs in CI, not here.
+    GTEST_FILTER="-SafeMotionProcess.NodeletUnloadRelaxesASpinningServo" \
+      rostest --text serial_robot_driver "$test" > "$ws/$test.log" 2>&1 || status=1
+    passed=$(grep -cE '^\[       OK' "$ws/$test.log")
+    failed=$(grep -E '^\[  FAILED  \] [A-Za-z]+\.[A-Za-z]+ \(' "$ws/$test.log" | wc -l)
+    echo "$test: $passed passed, $failed failed"
+    [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ] || status=1
   done
 fi
 
