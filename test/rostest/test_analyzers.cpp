@@ -67,8 +67,11 @@ Grouping group(const std::vector<std::string>& names) {
 
 TEST(Analyzers, GroupEveryDriverStatus) {
   ros::NodeHandle nh;
-  diagnostic_aggregator::Aggregator aggregator;  // reads ~analyzers, subscribes to /diagnostics
-  AggregatedNames aggregated(nh);
+  // Both live as long as the process: their callbacks run on the spinner thread, and roscpp cannot
+  // wait for one already running, so destroying them at the end of the test could pull a mutex
+  // from under it (seen once: boost::lock_error, "mutex lock failed").
+  auto& aggregator = *new diagnostic_aggregator::Aggregator();  // reads ~analyzers
+  auto& aggregated = *new AggregatedNames(nh);
 
   // Until every group has a child (the sim connects, then the driver reports about once a second).
   Grouping grouping;
