@@ -104,6 +104,18 @@ class ServoBusTest : public ::testing::Test {
     std::lock_guard<std::mutex> lock(mutex_);
     gated_frame_ = frame;
   }
+  /// A PING of servo 3 that holds the bus (its frame held on the wire) until releaseTheWire():
+  /// the one transaction in flight. Returns its thread, once the frame is written.
+  std::thread holdTheBusWithPing3() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      answers_[golden::servo::kPing3] = golden::servo::kPing3Reply;
+    }
+    holdOnTheWire(golden::servo::kPing3);
+    std::thread holder([this] { bus_->client().ping(3); });
+    EXPECT_TRUE(waitFor([&] { return countWritten(golden::servo::kPing3) == 1; }));
+    return holder;
+  }
   void releaseTheWire() {
     {
       std::lock_guard<std::mutex> lock(mutex_);

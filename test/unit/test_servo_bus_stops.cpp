@@ -31,12 +31,9 @@ MoveRequest rotate2To90In500() {
 // The user's report: servo/spin waits for the bus behind a slow transaction, the e-stop comes, and
 // the SPIN went out after it. Now the frame is refused when its turn comes, and the call says so.
 TEST_F(ServoBusTest, ACallThatWaitedForTheBusIsRefusedWhenTheEStopCameMeanwhile) {
-  answers_[kPing3] = kPing3Reply;
-  holdOnTheWire(kPing3);
   makeBus({});
   bus_->start();
-  std::thread holder([&] { bus_->client().ping(3); });
-  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));
+  std::thread holder = holdTheBusWithPing3();
   ServoStatus spin;
   std::thread caller([&] { spin = bus_->spin(continuousSpin0()); });
   ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
@@ -56,11 +53,8 @@ TEST_F(ServoBusTest, ACallThatWaitedForTheBusIsRefusedWhenTheEStopCameMeanwhile)
 // A queued move (servo_commands, a trajectory segment) taken by the worker before the e-stop and
 // written after it: dropped at the write, reported as a failed move.
 TEST_F(ServoBusTest, AQueuedMoveThatWaitedForTheBusIsDroppedAtTheWrite) {
-  answers_[kPing3] = kPing3Reply;
-  holdOnTheWire(kPing3);
   makeBus({});
-  std::thread holder([&] { bus_->client().ping(3); });
-  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));
+  std::thread holder = holdTheBusWithPing3();
   bus_->start();
   bus_->queueMoves({rotate2To90In500()});
   ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }))
@@ -79,14 +73,11 @@ TEST_F(ServoBusTest, AQueuedMoveThatWaitedForTheBusIsDroppedAtTheWrite) {
 // it; the e-stop itself returns without waiting for the bus at all.
 TEST_F(ServoBusTest, TheEStopsStopGoesBeforeTheCallsWaitingForTheBus) {
   const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
-  answers_[kPing3] = kPing3Reply;
   answers_[kPing5] = kPing5Reply;
   makeBus({});
   bus_->start();
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
-  holdOnTheWire(kPing3);
-  std::thread holder([&] { bus_->client().ping(3); });
-  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));
+  std::thread holder = holdTheBusWithPing3();
   std::thread caller([&] { bus_->client().ping(5); });
   ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
   bus_->setMotionLocked(true);
@@ -200,14 +191,11 @@ TEST_F(ServoBusTest, AWaitForAMotionsCompletionGivesWayToTheStop) {
 // bus (it would wait for the stop's turn for ever otherwise).
 TEST_F(ServoBusTest, AReleaseBeforeTheStopWentOutLeavesTheBusFreeForCalls) {
   const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
-  answers_[kPing3] = kPing3Reply;
   answers_[kPing5] = kPing5Reply;
   makeBus({});
   bus_->start();
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
-  holdOnTheWire(kPing3);
-  std::thread holder([&] { bus_->client().ping(3); });
-  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));
+  std::thread holder = holdTheBusWithPing3();
   bus_->setMotionLocked(true);
   bus_->setMotionLocked(false);
   releaseTheWire();
@@ -219,11 +207,8 @@ TEST_F(ServoBusTest, AReleaseBeforeTheStopWentOutLeavesTheBusFreeForCalls) {
 
 // From the moment shutdown() decides the last words, a motion still waiting for the bus is refused.
 TEST_F(ServoBusTest, ShutdownRefusesACallThatWaitedForTheBus) {
-  answers_[kPing3] = kPing3Reply;
-  holdOnTheWire(kPing3);
   makeBus({});
-  std::thread holder([&] { bus_->client().ping(3); });
-  ASSERT_TRUE(waitFor([&] { return countWritten(kPing3) == 1; }));
+  std::thread holder = holdTheBusWithPing3();
   ServoStatus spin;
   std::thread caller([&] { spin = bus_->spin(continuousSpin0()); });
   ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
