@@ -71,6 +71,10 @@ void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
 
 void ServoBus::dropQueuedMoves(uint8_t id) {
   std::lock_guard<std::mutex> lock(mutex_);
+  dropQueuedMovesLocked(id);
+}
+
+void ServoBus::dropQueuedMovesLocked(uint8_t id) {
   queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
                                      [id](const MoveRequest& m) { return m.id == id; }),
                       queued_moves_.end());

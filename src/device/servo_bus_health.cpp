@@ -92,9 +92,7 @@ void ServoBus::pollHealthOnce(std::size_t index) {
     health_[index] = servo;
     if (servo.report.overheated) {
       // Its queued moves are dropped: none may follow the relax.
-      queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
-                                         [id](const MoveRequest& m) { return m.id == id; }),
-                          queued_moves_.end());
+      dropQueuedMovesLocked(id);
     }
   }
   if (overheat_changed && servo.report.overheated) {

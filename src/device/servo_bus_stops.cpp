@@ -10,18 +10,16 @@
 #include <utility>
 
 #include "serial_robot_driver/device/servo_bus.h"
+#include "servo_bus_text.h"
 
 namespace serial_robot_driver::device {
 
 namespace {
 
-constexpr uint8_t kBroadcastId = 255;
 /// A stop that could not be written is tried again after this; a reconnect tries it at once.
 constexpr std::chrono::milliseconds kStopRetry{100};
 /// A servo silent after its stop is asked again after a back-off doubling up to this.
 constexpr std::chrono::milliseconds kLongestStopBackoff{2000};
-
-std::string servoLabel(uint8_t id) { return "servo " + std::to_string(id); }
 
 std::chrono::milliseconds stopBackoff(int written) {
   const int doublings = std::clamp(written - 1, 0, 5);
@@ -77,9 +75,7 @@ void ServoBus::setMotionLocked(bool locked) {
 void ServoBus::stopServo(uint8_t id) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
-                                       [id](const MoveRequest& m) { return m.id == id; }),
-                        queued_moves_.end());
+    dropQueuedMovesLocked(id);
     armStopLocked(id, clock_->now());
   }
   deliverStops();
@@ -192,9 +188,9 @@ void ServoBus::writeDueStops(std::unique_lock<std::mutex>& lock, StopPace pace) 
       continue;
     }
     ++stop.written;
-    if (ids[i] == kBroadcastId) moving_.clear();
+    if (ids[i] == protocol::servo::kBroadcastId) moving_.clear();
     moving_.erase(ids[i]);
-    if (ids[i] == kBroadcastId) {
+    if (ids[i] == protocol::servo::kBroadcastId) {
       stops_.erase(it);  // nothing answers a broadcast: written is all that can be known
       continue;
     }
@@ -316,7 +312,7 @@ void ServoBus::finalWords() {
   for (const auto& [id, why] : unconfirmed) {
     if (events_.on_stop) {
       events_.on_stop(id, {ServoError::kShutdown,
-                           servoLabel(id) + "'s stop not confirmed at shutdown: " + why});
+                           servo_text::servoName(id) + "'s stop not confirmed at shutdown: " + why});
     }
   }
 }

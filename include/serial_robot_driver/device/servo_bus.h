@@ -267,6 +267,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Notes the outcome of a motion command of servo `id`: moving or at rest.
   void noteMotion(uint8_t id, bool moving);
   ServoStatus refuseWhileLocked(uint8_t id) const;
+  void dropQueuedMovesLocked(uint8_t id);  // mutex_ held
   /// Adds a stop of `id` to be written now (mutex_ held).
   void armStopLocked(uint8_t id, Clock::time_point now);
   /// Asks the client for urgent work and wakes the worker, or, without a running worker, writes
