@@ -311,8 +311,8 @@ void ServoBus::finalWords() {
   lock.unlock();
   for (const auto& [id, why] : unconfirmed) {
     if (events_.on_stop) {
-      events_.on_stop(id, {ServoError::kShutdown,
-                           servo_text::servoName(id) + "'s stop not confirmed at shutdown: " + why});
+      events_.on_stop(id, {ServoError::kShutdown, servo_text::servoName(id) +
+                                                      "'s stop not confirmed at shutdown: " + why});
     }
   }
 }
