@@ -149,19 +149,19 @@ void BM_FramerAndDecodeMixedStream(benchmark::State& state) {
                       [&](FrameFamily family, const uint8_t* data, std::size_t size) {
                         ++frames;
                         switch (family) {
-                          case FrameFamily::kTelemetry:
+                          case protocol::body::kTelemetryFrames:
                             decoded_ok += body::decodeTelemetry(data, size, kServoCount).ok();
                             break;
-                          case FrameFamily::kBase:
+                          case protocol::base::kFrames:
                             decoded_ok += base::decodeFrame(data, size).ok();
                             break;
-                          case FrameFamily::kServoResponse:
+                          case protocol::servo::kResponseFrames:
                             decoded_ok += servo::decodeResponse(data, size).ok();
                             break;
-                          case FrameFamily::kServoRequest:
+                          case protocol::servo::kRequestFrames:
                             decoded_ok += servo::decodeRequest(data, size).ok();
                             break;
-                          case FrameFamily::kSyncWrite:
+                          case protocol::body::kSyncWriteFrames:
                             break;
                         }
                       });

@@ -285,7 +285,7 @@ class SpeedFrameLog {
  public:
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) {
-    if (family != protocol::FrameFamily::kBase) return;
+    if (family != protocol::base::kFrames) return;
     const auto frame = base::decodeFrame(data, size);
     if (!frame || frame->msg_id != static_cast<uint8_t>(base::MsgId::kWheelSpeed)) return;
     const auto speed = base::interpretWheelSpeed(*frame);

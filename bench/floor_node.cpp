@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       const auto config = srd::protocol::FramerConfig::forDriver(false, true, false, ids.size());
       srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
                                                      std::size_t size) {
-        if (family != srd::protocol::FrameFamily::kTelemetry) return;
+        if (family != srd::protocol::body::kTelemetryFrames) return;
         const auto telemetry = srd::protocol::body::decodeTelemetry(data, size, ids.size());
         if (!telemetry) return;
         sensor_msgs::JointState msg;

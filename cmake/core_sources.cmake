@@ -1,4 +1,7 @@
 # Sources of the ROS-free core library, shared by the catkin build and the standalone fuzz build.
+# Paths are relative to the repository root (SRD_ROOT); the devices' own sources come from their
+# folders (cmake/devices.cmake), the device registry is generated (SRD_CORE_GENERATED_SOURCES).
+include(${SRD_ROOT}/cmake/devices.cmake)
 set(SRD_CORE_SOURCES
   src/protocol/decode_result.cpp
   src/protocol/base_codec.cpp
@@ -15,7 +18,9 @@ set(SRD_CORE_SOURCES
   src/transport/recorded_stream.cpp
   src/device/serial_link.cpp
   src/device/loop_clock.cpp
-  src/device/device_set.cpp
+  src/device/device_module.cpp
+  src/params/param_table.cpp
+  src/params/driver_params.cpp
   src/device/base_controller.cpp
   src/device/body_controller.cpp
   src/device/servo_bus_client.cpp
@@ -35,6 +40,13 @@ set(SRD_CORE_SOURCES
   src/device/servo_health.cpp
   src/device/servo_bus_health.cpp
 )
+
+srd_device_sources(core srd_device_core_sources)
+list(APPEND SRD_CORE_SOURCES ${srd_device_core_sources})
+srd_write_registry("${CMAKE_BINARY_DIR}/srd_generated/registered_devices.cpp"
+  "serial_robot_driver/device/device_module.h" "serial_robot_driver::device::DeviceModule" kModule
+  "serial_robot_driver::device::registeredDevices" "")
+set(SRD_CORE_GENERATED_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_devices.cpp")
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,
 # the tests and the benchmarks use them; the driver never does.

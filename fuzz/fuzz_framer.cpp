@@ -39,15 +39,15 @@ void check(bool condition) {
 
 bool enabled(const FramerConfig& config, FrameFamily family) {
   switch (family) {
-    case FrameFamily::kBase:
+    case protocol::base::kFrames:
       return config.base;
-    case FrameFamily::kTelemetry:
+    case protocol::body::kTelemetryFrames:
       return config.telemetry;
-    case FrameFamily::kServoResponse:
+    case protocol::servo::kResponseFrames:
       return config.servo_response;
-    case FrameFamily::kServoRequest:
+    case protocol::servo::kRequestFrames:
       return config.servo_request;
-    case FrameFamily::kSyncWrite:
+    case protocol::body::kSyncWriteFrames:
       return config.sync_write;
   }
   return false;
@@ -69,32 +69,32 @@ void decodeFrame(const FramerConfig& config, FrameFamily family, const uint8_t* 
   std::memcpy(copy.get(), frame, size);
   const uint8_t* data = copy.get();
   switch (family) {
-    case FrameFamily::kBase: {
+    case protocol::base::kFrames: {
       const auto decoded = base::decodeFrame(data, size);
       check(decoded.ok());
       (void)base::interpretReply(*decoded);
       (void)base::interpretWheelSpeed(*decoded);
       break;
     }
-    case FrameFamily::kTelemetry: {
+    case protocol::body::kTelemetryFrames: {
       const auto decoded = body::decodeTelemetry(data, size, config.telemetry_servo_count);
       check(decoded.ok());
       check(decoded->servo_count == config.telemetry_servo_count);
       break;
     }
-    case FrameFamily::kServoResponse: {
+    case protocol::servo::kResponseFrames: {
       const auto decoded = servo::decodeResponse(data, size);
       check(decoded.ok());
       check(decoded->content_size + servo::kOverhead == size);
       break;
     }
-    case FrameFamily::kServoRequest: {
+    case protocol::servo::kRequestFrames: {
       const auto decoded = servo::decodeRequest(data, size);
       check(decoded.ok());
       check(decoded->content_size + servo::kOverhead == size);
       break;
     }
-    case FrameFamily::kSyncWrite: {
+    case protocol::body::kSyncWriteFrames: {
       checkFramingAgrees(body::decodeSyncWrite(data, size));
       break;
     }

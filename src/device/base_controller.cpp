@@ -242,7 +242,7 @@ void BaseController::onLinkDown() {
 
 void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                              Clock::time_point arrival) {
-  if (family != protocol::FrameFamily::kBase) return;
+  if (family != protocol::base::kFrames) return;
   const auto frame = base::decodeFrame(data, size);
   if (!frame) {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -93,7 +93,7 @@ BodyController::BodyController(std::vector<BodyJoint> joints, FrameWriter writer
 void BodyController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                              Clock::time_point arrival) {
   // A shared port hands every listener every frame: only telemetry is ours.
-  if (family != protocol::FrameFamily::kTelemetry) return;
+  if (family != protocol::body::kTelemetryFrames) return;
   const auto telemetry = protocol::body::decodeTelemetry(data, size, joints_.size());
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -200,7 +200,7 @@ bool ServoBusClient::matches(const servo::Packet& packet) const {
 
 void ServoBusClient::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                              Clock::time_point arrival) {
-  if (family == protocol::FrameFamily::kServoRequest) {
+  if (family == protocol::servo::kRequestFrames) {
     // On a half-duplex adapter our own request comes back: recognise it, skip it.
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (!last_request_.empty() && size == last_request_.size() &&
@@ -211,7 +211,7 @@ void ServoBusClient::onFrame(protocol::FrameFamily family, const uint8_t* data, 
     }
     return;
   }
-  if (family != protocol::FrameFamily::kServoResponse) return;  // another device on this port
+  if (family != protocol::servo::kResponseFrames) return;  // another device on this port
 
   const protocol::Decoded<servo::Packet> packet = servo::decodeResponse(data, size);
   {

@@ -1,6 +1,7 @@
 #include "serial_robot_driver/protocol/base_codec.h"
 
 #include <algorithm>
+#include "serial_robot_driver/protocol/stream_framer.h"
 
 #include "serial_robot_driver/protocol/byte_order.h"
 
@@ -130,5 +131,14 @@ Decoded<WheelSpeed> interpretWheelSpeed(const Frame& frame) {
   speed.right_ticks = readBE16Signed(&frame.params[2]);
   return speed;
 }
+
+static_assert(kMaxFrameSize <= StreamFramer::kLongestFrame, "base frame too long for the framer");
+
+constexpr FrameFamily kFrames{
+    "base", kHeader0,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probeFrame(data, available);
+    },
+    0};
 
 }  // namespace serial_robot_driver::protocol::base

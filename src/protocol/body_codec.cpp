@@ -1,6 +1,7 @@
 #include "serial_robot_driver/protocol/body_codec.h"
 
 #include <algorithm>
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include <boost/crc.hpp>
 
 #include "serial_robot_driver/protocol/byte_order.h"
@@ -212,5 +213,18 @@ std::vector<uint8_t> encodeTelemetry(const Telemetry& telemetry) {
   frame[len - 1] = kTelemetryTail1;
   return frame;
 }
+
+static_assert(kSyncWritePrefix + syncWriteLen(kMaxSyncWriteServos) <= StreamFramer::kLongestFrame,
+              "sync write too long for the framer");
+
+constexpr FrameFamily kSyncWriteFrames{
+    "sync_write", kSyncWriteHeader[0],
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probeSyncWrite(data, available);
+    },
+    0};
+
+// Rank 0: asked before servo requests, which share the first byte 0x12.
+constexpr FrameFamily kTelemetryFrames{"telemetry", kTelemetryHeader0, probeTelemetry, 0};
 
 }  // namespace serial_robot_driver::protocol::body

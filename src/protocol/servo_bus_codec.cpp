@@ -1,6 +1,7 @@
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
 
 #include <algorithm>
+#include "serial_robot_driver/protocol/stream_framer.h"
 
 #include "serial_robot_driver/protocol/byte_order.h"
 
@@ -379,5 +380,22 @@ std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& con
   if (content.size() > kMaxContent) return {};
   return buildPacket(kResponseHeader0, kResponseHeader1, cmd, content.data(), content.size());
 }
+
+static_assert(kMaxFrameSize <= StreamFramer::kLongestFrame, "servo frame too long for the framer");
+
+constexpr FrameFamily kResponseFrames{
+    "servo_response", kResponseHeader0,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probeResponse(data, available);
+    },
+    0};
+
+// Rank 1: after the body's telemetry, which shares the first byte 0x12.
+constexpr FrameFamily kRequestFrames{
+    "servo_request", kRequestHeader0,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probeRequest(data, available);
+    },
+    1};
 
 }  // namespace serial_robot_driver::protocol::servo

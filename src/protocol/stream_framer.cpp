@@ -2,117 +2,85 @@
 
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
-#include "serial_robot_driver/protocol/base_codec.h"
-#include "serial_robot_driver/protocol/body_codec.h"
-#include "serial_robot_driver/protocol/byte_order.h"
-#include "serial_robot_driver/protocol/servo_bus_codec.h"
-
 namespace serial_robot_driver::protocol {
-namespace {
 
-constexpr std::size_t kLongestSyncWrite =
-    body::kSyncWritePrefix + body::syncWriteLen(body::kMaxSyncWriteServos);
-static_assert(base::kMaxFrameSize <= StreamFramer::kLongestFrame, "base frame too long");
-static_assert(servo::kMaxFrameSize <= StreamFramer::kLongestFrame, "servo frame too long");
-static_assert(kLongestSyncWrite <= StreamFramer::kLongestFrame, "sync write too long");
 // feed() keeps an incomplete candidate (< kLongestFrame bytes) and appends up to kLongestFrame.
 static_assert(2 * StreamFramer::kLongestFrame <= StreamFramer::kBufferSize, "buffer too small");
 
-std::size_t familyIndex(FrameFamily family) { return static_cast<std::size_t>(family); }
-
-}  // namespace
-
-const char* toString(FrameFamily family) {
-  switch (family) {
-    case FrameFamily::kBase:
-      return "base";
-    case FrameFamily::kTelemetry:
-      return "telemetry";
-    case FrameFamily::kServoResponse:
-      return "servo_response";
-    case FrameFamily::kServoRequest:
-      return "servo_request";
-    case FrameFamily::kSyncWrite:
-      return "sync_write";
+void FramerConfig::accept(const FrameFamily& family, std::size_t expected) {
+  for (std::size_t i = 0; i < family_count; ++i) {
+    if (families[i].family == family) {
+      families[i].expected = expected;
+      return;
+    }
   }
-  return "unknown";
-}
-
-FramerConfig FramerConfig::forDriver(bool base, bool body, bool servo_bus,
-                                     std::size_t servo_count) {
-  FramerConfig config;
-  config.base = base;
-  config.telemetry = body;
-  config.servo_response = servo_bus;
-  // The bus is half duplex: our own requests come back as an echo and must be framed (and then
-  // ignored) rather than skipped byte by byte, or they could hide a response.
-  config.servo_request = servo_bus;
-  config.telemetry_servo_count = servo_count;
-  return config;
-}
-
-void FramerConfig::accept(FrameFamily family) {
-  switch (family) {
-    case FrameFamily::kBase:
-      base = true;
-      break;
-    case FrameFamily::kTelemetry:
-      telemetry = true;
-      break;
-    case FrameFamily::kServoResponse:
-      servo_response = true;
-      break;
-    case FrameFamily::kServoRequest:
-      servo_request = true;
-      break;
-    case FrameFamily::kSyncWrite:
-      sync_write = true;
-      break;
+  if (family_count == families.size()) {
+    throw std::length_error(std::string("a framer accepts at most ") +
+                            std::to_string(families.size()) + " frame families");
   }
+  families[family_count++] = Accepted{family, expected};
 }
 
-FramerConfig FramerConfig::forSimulator() {
-  FramerConfig config;
-  config.base = true;
-  config.servo_request = true;
-  config.sync_write = true;
-  return config;
+bool FramerConfig::accepts(const FrameFamily& family) const {
+  for (std::size_t i = 0; i < family_count; ++i) {
+    if (families[i].family == family) return true;
+  }
+  return false;
+}
+
+std::size_t FramerConfig::expectedOf(const FrameFamily& family) const {
+  for (std::size_t i = 0; i < family_count; ++i) {
+    if (families[i].family == family) return families[i].expected;
+  }
+  return 0;
+}
+
+uint64_t FramerStats::framesOf(const FrameFamily& family) const {
+  for (std::size_t i = 0; i < family_count; ++i) {
+    if (by_family[i].family == family.name) return by_family[i].frames;
+  }
+  return 0;
+}
+
+void FramerStats::add(const FramerStats& other) {
+  bytes_in += other.bytes_in;
+  bytes_skipped += other.bytes_skipped;
+  checksum_errors += other.checksum_errors;
+  bad_tails += other.bad_tails;
+  bad_lengths += other.bad_lengths;
+  unknown_commands += other.unknown_commands;
+  stale_candidates += other.stale_candidates;
+  for (std::size_t k = 0; k < other.family_count; ++k) {
+    std::size_t i = 0;
+    while (i < family_count && by_family[i].family != other.by_family[k].family) ++i;
+    if (i == family_count) {
+      if (family_count == by_family.size()) continue;  // cannot happen: both come from framers
+      by_family[family_count++].family = other.by_family[k].family;
+    }
+    by_family[i].frames += other.by_family[k].frames;
+  }
 }
 
 StreamFramer::StreamFramer(const FramerConfig& config, FrameHandler handler)
     : config_(config), handler_(std::move(handler)) {
-  // Order matters only for the shared first byte 0x12: telemetry is asked before requests.
-  if (config_.base) {
-    addEntry(base::kHeader0, FrameFamily::kBase,
-             [](const uint8_t* data, std::size_t available, std::size_t) {
-               return base::probeFrame(data, available);
-             });
+  // Entries that share a first byte are asked in rank order (telemetry before servo requests).
+  std::array<FramerConfig::Accepted, kMaxFamiliesPerFramer> by_rank = config_.families;
+  std::stable_sort(by_rank.begin(), by_rank.begin() + config_.family_count,
+                   [](const FramerConfig::Accepted& a, const FramerConfig::Accepted& b) {
+                     return a.family.rank < b.family.rank;
+                   });
+  for (std::size_t i = 0; i < config_.family_count; ++i) {
+    stats_.by_family[i].family = config_.families[i].family.name;
   }
-  if (config_.servo_response) {
-    addEntry(servo::kResponseHeader0, FrameFamily::kServoResponse,
-             [](const uint8_t* data, std::size_t available, std::size_t) {
-               return servo::probeResponse(data, available);
-             });
-  }
-  if (config_.sync_write) {
-    addEntry(body::kSyncWriteHeader[0], FrameFamily::kSyncWrite,
-             [](const uint8_t* data, std::size_t available, std::size_t) {
-               return body::probeSyncWrite(data, available);
-             });
-  }
-  if (config_.telemetry) {
-    addEntry(body::kTelemetryHeader0, FrameFamily::kTelemetry,
-             [](const uint8_t* data, std::size_t available, std::size_t servo_count) {
-               return body::probeTelemetry(data, available, servo_count);
-             });
-  }
-  if (config_.servo_request) {
-    addEntry(servo::kRequestHeader0, FrameFamily::kServoRequest,
-             [](const uint8_t* data, std::size_t available, std::size_t) {
-               return servo::probeRequest(data, available);
-             });
+  stats_.family_count = config_.family_count;
+  for (std::size_t k = 0; k < config_.family_count; ++k) {
+    std::size_t stats_index = 0;
+    while (!(config_.families[stats_index].family == by_rank[k].family)) ++stats_index;
+    addEntry(by_rank[k], stats_index);
   }
   int start_count = 0;
   for (int byte = 0; byte < 256; ++byte) {
@@ -123,21 +91,21 @@ StreamFramer::StreamFramer(const FramerConfig& config, FrameHandler handler)
   if (start_count != 1) single_start_ = -1;
 }
 
-void StreamFramer::addEntry(uint8_t header0, FrameFamily family,
-                            Probe (*probe)(const uint8_t*, std::size_t, std::size_t)) {
+void StreamFramer::addEntry(const FramerConfig::Accepted& accepted, std::size_t stats_index) {
+  const uint8_t header0 = accepted.family.header0;
   // Keep entries with the same first byte adjacent and in the order they were added.
   std::size_t at = entry_count_;
   for (std::size_t i = 0; i < entry_count_; ++i) {
-    if (entries_[i].header0 == header0) at = i + 1;
+    if (entries_[i].accepted.family.header0 == header0) at = i + 1;
   }
   std::move_backward(entries_.begin() + at, entries_.begin() + entry_count_,
                      entries_.begin() + entry_count_ + 1);
-  entries_[at] = Entry{header0, family, probe};
+  entries_[at] = Entry{accepted, stats_index};
   ++entry_count_;
   is_start_[header0] = true;
   first_entry_.fill(kNoEntry);
   for (std::size_t i = entry_count_; i-- > 0;)
-    first_entry_[entries_[i].header0] = static_cast<uint8_t>(i);
+    first_entry_[entries_[i].accepted.family.header0] = static_cast<uint8_t>(i);
 }
 
 void StreamFramer::feed(const uint8_t* data, std::size_t size) {
@@ -211,12 +179,12 @@ std::size_t StreamFramer::scan(const uint8_t* data, std::size_t available,
     pos = start;
     if (pos >= start_limit) break;
 
-    FrameFamily family = FrameFamily::kBase;
-    const Probe probe = examine(data + pos, available - pos, &family);
+    const Entry* entry = nullptr;
+    const Probe probe = examine(data + pos, available - pos, &entry);
     switch (probe.status) {
       case Probe::Status::kFrame:
-        ++stats_.frames[familyIndex(family)];
-        if (handler_) handler_(family, data + pos, probe.size);
+        ++stats_.by_family[entry->stats_index].frames;
+        if (handler_) handler_(entry->accepted.family, data + pos, probe.size);
         pos += probe.size;
         break;
       case Probe::Status::kNeedMore:
@@ -231,17 +199,17 @@ std::size_t StreamFramer::scan(const uint8_t* data, std::size_t available,
   return pos;
 }
 
-Probe StreamFramer::examine(const uint8_t* data, std::size_t available, FrameFamily* family) {
+Probe StreamFramer::examine(const uint8_t* data, std::size_t available, const Entry** found) {
   Probe result = Probe::invalid(DecodeError::kBadHeader);
   // Entries sharing a first byte are adjacent (addEntry keeps them so): start at the first one.
   for (std::size_t i = first_entry_[data[0]]; i < entry_count_; ++i) {
     const Entry& entry = entries_[i];
-    if (entry.header0 != data[0]) break;
-    result = entry.probe(data, available, config_.telemetry_servo_count);
+    if (entry.accepted.family.header0 != data[0]) break;
+    result = entry.accepted.family.probe(data, available, entry.accepted.expected);
     if (result.status == Probe::Status::kInvalid && result.reason == DecodeError::kBadHeader) {
       continue;
     }
-    *family = entry.family;
+    *found = &entry;
     break;
   }
   if (result.status == Probe::Status::kInvalid) {

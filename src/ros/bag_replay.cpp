@@ -1,3 +1,4 @@
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 
 #include <rosbag/bag.h>
@@ -87,8 +88,8 @@ Recording readRecording(const std::string& path) {
 
 std::set<std::string> configuredPorts(const DriverParams& params) {
   std::set<std::string> ports;
-  for (const device::DeviceDescription& device : device::deviceSet()) {
-    if (params.enabled(device.kind)) ports.insert(params.portOf(device.kind));
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    if (params.enabled(*device)) ports.insert(params.portOf(*device));
   }
   return ports;
 }

@@ -5,10 +5,11 @@
 #include <functional>
 #include <sstream>
 
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
-#include "serial_robot_driver/ros/servo_bus_interface.h"
+#include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/ros/wire_capture.h"
 
@@ -58,28 +59,6 @@ class PortMonitor : public device::LinkListener {
 
 namespace {
 
-/// How the ROS interface of each device of the set is built.
-using InterfaceFactory = std::function<std::unique_ptr<DeviceInterface>(
-    ros::NodeHandle&, const DriverParams&, device::SerialLink&)>;
-
-template <typename Interface>
-std::unique_ptr<DeviceInterface> make(ros::NodeHandle& nh, const DriverParams& params,
-                                      device::SerialLink& link) {
-  return std::make_unique<Interface>(nh, params, link);
-}
-
-InterfaceFactory interfaceFor(device::DeviceKind kind) {
-  switch (kind) {
-    case device::DeviceKind::kBase:
-      return make<BaseInterface>;
-    case device::DeviceKind::kBody:
-      return make<BodyInterface>;
-    case device::DeviceKind::kServoBus:
-      break;
-  }
-  return make<ServoBusInterface>;
-}
-
 }  // namespace
 
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
@@ -91,9 +70,9 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   diagnostics_.setHardwareID(params_.port);
 
   // Devices naming the same path share one port, one reader thread and one framer.
-  std::map<std::string, std::vector<device::DeviceKind>> users;
-  for (const device::DeviceDescription& device : device::deviceSet()) {
-    if (params_.enabled(device.kind)) users[params_.portOf(device.kind)].push_back(device.kind);
+  std::map<std::string, std::vector<const device::DeviceModule*>> users;
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    if (params_.enabled(*device)) users[params_.portOf(*device)].push_back(device);
   }
   if (params_.capture) {
     capture_ = std::make_unique<WireCapture>(nh_, params_);
@@ -105,13 +84,16 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     device::SerialLinkOptions options;
     options.path = path;
     // validate() made every device on a shared port agree on the baud rate.
-    options.baud = static_cast<unsigned>(params_.baudOf(use.front()));
+    options.baud = static_cast<unsigned>(params_.baudOf(*use.front()));
     options.reconnect_interval = params_.reconnect_interval;
-    options.framer = device::framerFor(use, params_.body.servo_ids.size());
-    if (std::count(use.begin(), use.end(), device::DeviceKind::kServoBus) > 0) {
-      // A servo answer must not wait behind a stray header longer than an answer may take.
-      options.stale_frame_timeout = std::chrono::milliseconds(
-          std::max<long>(1, std::lround(params_.servo_bus.timeout * 1000.0)));
+    options.framer = device::framerFor(use, params_);
+    for (const device::DeviceModule* device : use) {
+      if (!device->stale_frame_timeout) continue;
+      // The shortest any device on the port asks for.
+      const auto timeout = device->stale_frame_timeout(params_);
+      if (options.stale_frame_timeout.count() == 0 || timeout < options.stale_frame_timeout) {
+        options.stale_frame_timeout = timeout;
+      }
     }
     Port port;
     port.link = std::make_unique<device::SerialLink>(options, stream_factory);
@@ -124,13 +106,17 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     });
   }
 
-  for (const device::DeviceDescription& description : device::deviceSet()) {
-    if (!params_.enabled(description.kind)) continue;
-    devices_.push_back(
-        interfaceFor(description.kind)(nh_, params_, portFor(params_.portOf(description.kind))));
-    // The device's status carries its name from the set.
+  for (const device::DeviceModule* module : device::registeredDevices()) {
+    if (!params_.enabled(*module)) continue;
+    const RosDeviceModule* ros_side = findInterface(module->name);
+    if (ros_side == nullptr) {
+      throw ParameterError(std::string(module->name) + "/enabled",
+                           "the device has no ROS interface in this build");
+    }
+    devices_.push_back(ros_side->make(nh_, params_, portFor(params_.portOf(*module))));
+    // The device's status carries its registered name.
     DeviceInterface* device = devices_.back().get();
-    diagnostics_.add(description.name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
+    diagnostics_.add(module->name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
       device->diagnose(s);
     });
     device->addDiagnostics(diagnostics_);
@@ -241,9 +227,9 @@ std::string DriverNode::startupSummary() const {
   for (const auto& [path, port] : ports_) {
     text << separator << path << " (" << port.link->options().baud << " baud:";
     const char* comma = " ";
-    for (const device::DeviceDescription& device : device::deviceSet()) {
-      if (!params_.enabled(device.kind) || params_.portOf(device.kind) != path) continue;
-      text << comma << device.name;
+    for (const device::DeviceModule* device : device::registeredDevices()) {
+      if (!params_.enabled(*device) || params_.portOf(*device) != path) continue;
+      text << comma << device->name;
       comma = ", ";
     }
     text << ")";
@@ -271,7 +257,6 @@ void DriverNode::shutdown() {
 
 void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status) {
   const device::LinkStats s = port.link->stats();
-  using protocol::FrameFamily;
   status.hardware_id = port.link->options().path;
   if (s.connected) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "connected");
@@ -289,10 +274,10 @@ void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticSt
   status.add("bytes out", s.bytes_out);
   status.add("frames out", s.frames_out);
   status.add("write failures", s.write_failures);
-  for (std::size_t i = 0; i < protocol::kFrameFamilyCount; ++i) {
-    if (s.framer.frames[i] == 0) continue;
-    status.add(std::string("frames in: ") + protocol::toString(static_cast<FrameFamily>(i)),
-               s.framer.frames[i]);
+  for (std::size_t i = 0; i < s.framer.family_count; ++i) {
+    if (s.framer.by_family[i].frames == 0) continue;
+    status.add(std::string("frames in: ") + s.framer.by_family[i].family,
+               s.framer.by_family[i].frames);
   }
   status.add("checksum errors", s.framer.checksum_errors);
   status.add("bad tails", s.framer.bad_tails);

@@ -19,82 +19,13 @@ namespace serial_robot_driver::ros_layer {
 
 namespace {
 
-const ParamSpec& specFor(const std::string& key) {
-  for (const ParamSpec& spec : parameterTable()) {
-    if (spec.key == key) return spec;
-  }
-  throw std::invalid_argument("no parameter ~" + key + " in the table");
-}
+using params::specFor;
 
 template <typename T>
 constexpr bool kScalar = std::is_same_v<T, bool> || std::is_same_v<T, int> ||
                          std::is_same_v<T, double> || std::is_same_v<T, std::string>;
 
 }  // namespace
-
-std::string toText(const ParamValue& value) {
-  std::ostringstream text;
-  std::visit(
-      [&text](const auto& typed) {
-        using T = std::decay_t<decltype(typed)>;
-        if constexpr (std::is_same_v<T, bool>) {
-          text << (typed ? "true" : "false");
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          text << '"' << typed << '"';
-        } else if constexpr (kScalar<T>) {
-          text << typed;
-        } else {
-          text << '[';
-          for (std::size_t i = 0; i < typed.size(); ++i) text << (i ? ", " : "") << typed[i];
-          text << ']';
-        }
-      },
-      value);
-  return text.str();
-}
-
-TuningResult tuneParams(const DriverParams& in_force,
-                        const std::vector<ParamAssignment>& requested) {
-  TuningResult result{in_force, {}};
-  for (const auto& [key, value] : requested) {
-    const ParamSpec& spec = specFor(key);
-    if (spec.get(in_force).index() != value.index()) {
-      throw std::invalid_argument("~" + key + ": the value has another type than the parameter");
-    }
-    spec.set(result.applied, value);
-  }
-  const auto refuse = [&](const std::string& key, const std::string& why) {
-    const ParamSpec& spec = specFor(key);
-    result.refusals.push_back("~" + key + " = " + toText(spec.get(result.applied)) + " refused (" +
-                              why + "); keeping " + toText(spec.get(in_force)));
-    spec.set(result.applied, spec.get(in_force));
-  };
-  // Each round refuses at least one changed value, and `in_force` itself passes validate().
-  for (std::size_t round = 0; round <= requested.size(); ++round) {
-    try {
-      result.applied.validate();
-      return result;
-    } catch (const ParameterError& error) {
-      bool named_value_changed = false;
-      for (const auto& [key, value] : requested) {
-        if (key == error.name() && specFor(key).get(result.applied) != specFor(key).get(in_force)) {
-          named_value_changed = true;
-        }
-      }
-      if (named_value_changed) {
-        refuse(error.name(), error.what());
-        continue;
-      }
-      // A rule between several values, broken by the change: refuse all of it.
-      for (const auto& [key, value] : requested) {
-        if (specFor(key).get(result.applied) != specFor(key).get(in_force))
-          refuse(key, error.what());
-      }
-    }
-  }
-  result.applied.validate();  // unreachable unless `in_force` was invalid: throws then
-  return result;
-}
 
 /// One group's server: its type erased, so RuntimeTuning holds them in one list.
 class RuntimeTuning::Server {

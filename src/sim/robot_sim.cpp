@@ -17,7 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "serial_robot_driver/device/device_set.h"
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 
@@ -140,17 +140,17 @@ void RobotSim::start() {
     // The framer calls back into the devices on this port; a frame for a device that lives on
     // another port (or is disabled) is only counted.
     port->framer = std::make_unique<protocol::StreamFramer>(
-        protocol::FramerConfig::forSimulator(),
-        [this, raw](FrameFamily family, const uint8_t* data, std::size_t size) {
+        device::simulatorFramerFor(device::registeredDevices()),
+        [this, raw](const FrameFamily& family, const uint8_t* data, std::size_t size) {
           // Paced: the request arrived when its last bit was through the line, not when this
           // thread woke up to feed it.
           const TimePoint at = rx_frame_end_ == TimePoint{} ? Clock::now() : rx_frame_end_;
           Outbox outbox;
-          if (family == FrameFamily::kBase && base_port_ == raw) {
+          if (family == protocol::base::kFrames && base_port_ == raw) {
             base_->handleFrame(data, size, at, &outbox);
-          } else if (family == FrameFamily::kSyncWrite && body_port_ == raw) {
+          } else if (family == protocol::body::kSyncWriteFrames && body_port_ == raw) {
             body_->handleSyncWrite(data, size);
-          } else if (family == FrameFamily::kServoRequest && servo_port_ == raw) {
+          } else if (family == protocol::servo::kRequestFrames && servo_port_ == raw) {
             servo_bus_->handleRequest(data, size, at);
           } else {
             ++counters_.frames_for_absent_device;
@@ -164,12 +164,9 @@ void RobotSim::start() {
     return raw;
   };
   // The ports named as the driver names its devices (the device set).
-  using device::DeviceKind;
-  if (base_) base_port_ = portFor(options_.base_link, device::describe(DeviceKind::kBase).name);
-  if (body_) body_port_ = portFor(options_.body_link, device::describe(DeviceKind::kBody).name);
-  if (servo_bus_) {
-    servo_port_ = portFor(options_.servo_link, device::describe(DeviceKind::kServoBus).name);
-  }
+  if (base_) base_port_ = portFor(options_.base_link, "base");
+  if (body_) body_port_ = portFor(options_.body_link, "body");
+  if (servo_bus_) servo_port_ = portFor(options_.servo_link, "servo_bus");
 
   for (auto& port : ports_) {
     port->pty = std::make_unique<PseudoTerminal>(port->link);
@@ -498,15 +495,7 @@ SimStats RobotSim::snapshotLocked() const {
   if (servo_bus_) stats.servo_bus = servo_bus_->stats();
   for (const auto& port : ports_) {
     const protocol::FramerStats& framer = port->framer->stats();
-    stats.framer.bytes_in += framer.bytes_in;
-    stats.framer.bytes_skipped += framer.bytes_skipped;
-    stats.framer.checksum_errors += framer.checksum_errors;
-    stats.framer.bad_tails += framer.bad_tails;
-    stats.framer.bad_lengths += framer.bad_lengths;
-    stats.framer.unknown_commands += framer.unknown_commands;
-    for (std::size_t f = 0; f < protocol::kFrameFamilyCount; ++f) {
-      stats.framer.frames[f] += framer.frames[f];
-    }
+    stats.framer.add(framer);
     // Bad sync-writes: the CRC failures the body's framer saw (on a shared port this also counts
     // bad frames of the other devices: the framer cannot tell whose a broken frame was).
     if (port.get() == body_port_) stats.body_port_checksum_errors = framer.checksum_errors;

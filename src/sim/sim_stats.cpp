@@ -78,11 +78,11 @@ std::string formatStats(const SimStats& stats) {
   line("rx_checksum_errors", stats.framer.checksum_errors);
   line("rx_bad_lengths", stats.framer.bad_lengths);
   line("rx_unknown_commands", stats.framer.unknown_commands);
-  line("rx_frames_base", stats.framer.frames[static_cast<std::size_t>(FrameFamily::kBase)]);
+  line("rx_frames_base", stats.framer.framesOf(protocol::base::kFrames));
   line("rx_frames_servo_request",
-       stats.framer.frames[static_cast<std::size_t>(FrameFamily::kServoRequest)]);
+       stats.framer.framesOf(protocol::servo::kRequestFrames));
   line("rx_frames_sync_write",
-       stats.framer.frames[static_cast<std::size_t>(FrameFamily::kSyncWrite)]);
+       stats.framer.framesOf(protocol::body::kSyncWriteFrames));
   line("frames_for_absent_device", stats.frames_for_absent_device);
   line("tx_bytes", stats.bytes_sent);
   line("garbage_bursts", stats.garbage_bursts);

@@ -109,7 +109,7 @@ class FakeBase {
     std::vector<SeenFrame> seen;
     for (const auto& frame : device_.frames()) {
       const auto decoded = protocol::base::decodeFrame(frame.bytes.data(), frame.bytes.size());
-      if (frame.family != protocol::FrameFamily::kBase || !decoded) continue;
+      if (frame.family != protocol::base::kFrames || !decoded) continue;
       seen.push_back(SeenFrame{frame.bytes, decoded->seq, decoded->msg_id, frame.arrival});
     }
     return seen;

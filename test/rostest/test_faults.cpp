@@ -78,7 +78,7 @@ std::unique_ptr<test_support::FakeDevice> handPlayedRobot(const std::string& pat
 std::vector<uint8_t> msgIds(const test_support::FakeDevice& robot) {
   std::vector<uint8_t> ids;
   for (const auto& frame : robot.frames()) {
-    if (frame.family != protocol::FrameFamily::kBase || frame.bytes.size() < 5) continue;
+    if (frame.family != protocol::base::kFrames || frame.bytes.size() < 5) continue;
     ids.push_back(frame.bytes[4]);  // 55 AA LEN SEQ MSGID ...
   }
   return ids;
@@ -400,7 +400,7 @@ TEST_F(ExtremeInputs, ServoRequestsOutOfRangeFailCleanlyWithoutBytes) {
 
   const auto requests_on_wire = [&] {
     const sim::SimStats s = robot.stats();
-    return s.framer.frames[static_cast<std::size_t>(protocol::FrameFamily::kServoRequest)];
+    return s.framer.frames[static_cast<std::size_t>(protocol::servo::kRequestFrames)];
   };
   const uint64_t wire_before = requests_on_wire();
   const uint64_t sim_requests_before = robot.stats().servo_bus.requests;

@@ -92,9 +92,9 @@ uint64_t telemetryIntact(const sim::SimStats& s) {
 }
 uint64_t hostFramesReceived(const sim::SimStats& s) {
   using protocol::FrameFamily;
-  return s.framer.frames[static_cast<std::size_t>(FrameFamily::kBase)] +
-         s.framer.frames[static_cast<std::size_t>(FrameFamily::kServoRequest)] +
-         s.framer.frames[static_cast<std::size_t>(FrameFamily::kSyncWrite)];
+  return s.framer.frames[static_cast<std::size_t>(protocol::base::kFrames)] +
+         s.framer.frames[static_cast<std::size_t>(protocol::servo::kRequestFrames)] +
+         s.framer.frames[static_cast<std::size_t>(protocol::body::kSyncWriteFrames)];
 }
 
 /// Both sides at rest while the pty is unplugged.

@@ -87,7 +87,7 @@ class ServoBusTest : public ::testing::Test {
         reply = it->second;
       }
     }
-    bus_->onFrame(protocol::FrameFamily::kServoResponse, reply.data(), reply.size(), Clock::now());
+    bus_->onFrame(protocol::servo::kResponseFrames, reply.data(), reply.size(), Clock::now());
     return true;
   }
 

@@ -156,7 +156,7 @@ TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
   const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->step([&] {
-    controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
+    controller_.onFrame(protocol::base::kFrames, error.data(), error.size(), clock_->now());
   });
   clock_->tick(1);
   // The error wakes the loop: Reset, then the speed frame (rushed), then the tick's speed frame.
@@ -453,7 +453,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   EXPECT_EQ(silent_events, 1) << "reported once, not every tick";
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
   const Bytes& reply = golden::base::kBattery87ReplySeq0;
-  controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), clock->now());
+  controller.onFrame(protocol::base::kFrames, reply.data(), reply.size(), clock->now());
   EXPECT_FALSE(controller.stats().base_silent);
   controller.stop();
 }
@@ -463,12 +463,12 @@ TEST_F(BaseControllerTest, TimeoutErrorWhileRunningIsCountedButNotTheOneAtStart)
   const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->tick(1);  // Reset + first frame
   clock_->step([&] {
-    controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
+    controller_.onFrame(protocol::base::kFrames, error.data(), error.size(), clock_->now());
   });
   EXPECT_EQ(controller_.stats().timeout_errors_while_running, 0u) << "in flight before our Reset";
   clock_->tick(100);  // 2 s of running
   clock_->step([&] {
-    controller_.onFrame(protocol::FrameFamily::kBase, error.data(), error.size(), clock_->now());
+    controller_.onFrame(protocol::base::kFrames, error.data(), error.size(), clock_->now());
   });
   EXPECT_EQ(controller_.stats().timeout_errors_while_running, 1u);
   ASSERT_TRUE(controller_.stats().seconds_since_running_timeout_error.has_value());
@@ -492,7 +492,7 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   EXPECT_EQ(controller.stats().battery_requests, 2u);
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
   const Bytes& reply = golden::base::kBattery87ReplySeq0;
-  controller.onFrame(protocol::FrameFamily::kBase, reply.data(), reply.size(), Clock::now());
+  controller.onFrame(protocol::base::kFrames, reply.data(), reply.size(), Clock::now());
   ASSERT_EQ(percents.size(), 1u);
   EXPECT_EQ(percents[0], 87);
   controller.stop();

@@ -137,7 +137,7 @@ TEST(BodyControllerTelemetry, GoldenFrameReachesTheCallbackWithItsArrivalTime) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
   const Clock::time_point arrival = Clock::time_point(std::chrono::milliseconds(1234));
-  controller.onFrame(FrameFamily::kTelemetry, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
                      arrival);
 
   ASSERT_EQ(received.frames.size(), 1u);
@@ -159,7 +159,7 @@ TEST(BodyControllerTelemetry, FootBlockIsLittleEndian) {
   Received received;
   BodyController controller({BodyJoint{"ankle", 7, calibration(2048, 1)}}, nullptr,
                             recorder(&received));
-  controller.onFrame(FrameFamily::kTelemetry, kFootTelemetry.data(), kFootTelemetry.size(),
+  controller.onFrame(protocol::body::kTelemetryFrames, kFootTelemetry.data(), kFootTelemetry.size(),
                      Clock::now());
   ASSERT_EQ(received.frames.size(), 1u);
   const Telemetry& t = received.frames[0];
@@ -175,7 +175,7 @@ TEST(BodyControllerTelemetry, FrameOfAnotherServoCountIsADecodeError) {
   std::vector<BodyJoint> joints = twoJoints();
   joints.push_back(BodyJoint{"ankle", 4, calibration(2048, 1)});
   BodyController controller(joints, nullptr, recorder(&received));
-  controller.onFrame(FrameFamily::kTelemetry, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
                      Clock::now());
   EXPECT_TRUE(received.frames.empty());
   const BodyStats stats = controller.stats();
@@ -189,9 +189,9 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
   const Bytes& base_reset = golden::base::kResetSeq2;
-  controller.onFrame(FrameFamily::kBase, base_reset.data(), base_reset.size(), Clock::now());
+  controller.onFrame(protocol::base::kFrames, base_reset.data(), base_reset.size(), Clock::now());
   // Even telemetry bytes under another family tag are not ours to decode.
-  controller.onFrame(FrameFamily::kServoResponse, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+  controller.onFrame(protocol::servo::kResponseFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
                      Clock::now());
   EXPECT_TRUE(received.frames.empty());
   EXPECT_EQ(controller.stats().frames_decoded, 0u);
@@ -200,7 +200,7 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
 
 TEST(BodyControllerTelemetry, WorksWithoutACallback) {
   BodyController controller(twoJoints(), nullptr);
-  controller.onFrame(FrameFamily::kTelemetry, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
                      Clock::now());
   EXPECT_EQ(controller.stats().frames_decoded, 1u);
 }

@@ -192,9 +192,9 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   stream.insert(stream.end(), kPingReply.begin(), kPingReply.end());
   pty.write(stream.data(), stream.size());
   ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 2; }, kWaitSeconds));
-  EXPECT_EQ(listener.frames[0].first, protocol::FrameFamily::kBase);
+  EXPECT_EQ(listener.frames[0].first, protocol::base::kFrames);
   EXPECT_EQ(listener.frames[0].second, kBatteryReply);
-  EXPECT_EQ(listener.frames[1].first, protocol::FrameFamily::kServoResponse);
+  EXPECT_EQ(listener.frames[1].first, protocol::servo::kResponseFrames);
   EXPECT_EQ(listener.frames[1].second, kPingReply);
 
   const Bytes& reset = golden::base::kResetSeq2;

@@ -56,7 +56,7 @@ class FakeBus {
     if (!connected) return false;
     std::lock_guard<std::mutex> lock(mutex_);  // two callers may write (the client serializes them)
     written.push_back(frame);
-    if (echo) deliver(FrameFamily::kServoRequest, frame);
+    if (echo) deliver(protocol::servo::kRequestFrames, frame);
     if (drop_link_on_write) client->onLinkDown();
     auto it = script_.find(frame);
     if (it == script_.end()) return true;
@@ -64,11 +64,11 @@ class FakeBus {
     if (++script.writes < script.first_answered_write) return true;
     if (from_other_thread) {
       answer_threads_.emplace_back([this, frames = script.frames] {
-        for (const Bytes& reply : frames) deliver(FrameFamily::kServoResponse, reply);
+        for (const Bytes& reply : frames) deliver(protocol::servo::kResponseFrames, reply);
       });
       return true;
     }
-    for (const Bytes& reply : script.frames) deliver(FrameFamily::kServoResponse, reply);
+    for (const Bytes& reply : script.frames) deliver(protocol::servo::kResponseFrames, reply);
     return true;
   }
 
@@ -176,7 +176,7 @@ TEST_F(ServoBusClientTest, AnswerOfTheWrongShapeIsReportedAsMalformed) {
 }
 
 TEST_F(ServoBusClientTest, AnswersArrivingWithoutARequestAreMismatched) {
-  client_.onFrame(FrameFamily::kServoResponse, kPing3Reply.data(), kPing3Reply.size(),
+  client_.onFrame(protocol::servo::kResponseFrames, kPing3Reply.data(), kPing3Reply.size(),
                   Clock::now());
   EXPECT_EQ(client_.stats().mismatched, 1u);
 }

@@ -391,8 +391,8 @@ TEST(RobotSimBody, TelemetryDecodesWithGravityOnZ) {
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
-  ASSERT_TRUE(host.waitUntil([&] { return host.framesOf(FrameFamily::kTelemetry).size() >= 5; }));
-  for (const Bytes& frame : host.framesOf(FrameFamily::kTelemetry)) {
+  ASSERT_TRUE(host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 5; }));
+  for (const Bytes& frame : host.framesOf(protocol::body::kTelemetryFrames)) {
     ASSERT_EQ(frame.size(), 32u);
     EXPECT_EQ(frame[2], 0x20);
     // Servo 0 at 2048 (08 00), standing still.
@@ -420,7 +420,7 @@ TEST(RobotSimBody, SyncWriteMovesTheServoTowardItsTarget) {
   host.send(kSyncWrite2And3);
   bool saw_full_speed = false;
   const auto reached = [&] {
-    for (const Bytes& frame : host.framesOf(FrameFamily::kTelemetry)) {
+    for (const Bytes& frame : host.framesOf(protocol::body::kTelemetryFrames)) {
       const auto telemetry = protocol::body::decodeTelemetry(frame.data(), frame.size(), 2);
       if (!telemetry) continue;
       EXPECT_EQ(telemetry->servos[0].position, 2048);
@@ -459,8 +459,8 @@ TEST(RobotSimBody, FootAlternateInterleavesFrameLengths) {
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
-  ASSERT_TRUE(host.waitUntil([&] { return host.framesOf(FrameFamily::kTelemetry).size() >= 6; }));
-  const auto frames = host.framesOf(FrameFamily::kTelemetry);
+  ASSERT_TRUE(host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 6; }));
+  const auto frames = host.framesOf(protocol::body::kTelemetryFrames);
   for (std::size_t i = 1; i < frames.size(); ++i) EXPECT_NE(frames[i].size(), frames[i - 1].size());
   for (const Bytes& frame : frames) {
     ASSERT_TRUE(frame.size() == 32u || frame.size() == 48u);
@@ -495,7 +495,7 @@ class RobotSimServoBus : public ::testing::Test {
     host_->frames().clear();
     host_->send(request);
     host_->waitUntil([] { return false; }, milliseconds(150));
-    EXPECT_TRUE(host_->framesOf(FrameFamily::kServoResponse).empty());
+    EXPECT_TRUE(host_->framesOf(protocol::servo::kResponseFrames).empty());
   }
   std::unique_ptr<RobotSim> sim_;
   std::unique_ptr<Host> host_;
@@ -514,8 +514,8 @@ TEST_F(RobotSimServoBus, PingAnswersOnlineServosOnly) {
 TEST_F(RobotSimServoBus, VoltageReadIsPlausible) {
   host_->send(kReadVoltage0);
   ASSERT_TRUE(
-      host_->waitUntil([&] { return !host_->framesOf(FrameFamily::kServoResponse).empty(); }));
-  const Bytes reply = host_->framesOf(FrameFamily::kServoResponse).at(0);
+      host_->waitUntil([&] { return !host_->framesOf(protocol::servo::kResponseFrames).empty(); }));
+  const Bytes reply = host_->framesOf(protocol::servo::kResponseFrames).at(0);
   ASSERT_EQ(reply.size(), 9u);  // 05 1C 03 04 id data_id V_L V_H SUM
   EXPECT_EQ(Bytes(reply.begin(), reply.begin() + 6), (Bytes{0x05, 0x1C, 0x03, 0x04, 0x00, 0x01}));
   const int millivolts = reply[6] | (reply[7] << 8);
@@ -544,7 +544,7 @@ TEST_F(RobotSimServoBus, RotateMovesTheAngleWithoutAnAnswerByDefault) {
   }
   EXPECT_TRUE(reached);
   // Only READ_ANGLE answers arrived: response_switch is 0, ROTATE is silent.
-  for (const Bytes& frame : host_->framesOf(FrameFamily::kServoResponse)) EXPECT_EQ(frame[2], 0x0A);
+  for (const Bytes& frame : host_->framesOf(protocol::servo::kResponseFrames)) EXPECT_EQ(frame[2], 0x0A);
 }
 
 TEST_F(RobotSimServoBus, ResponseSwitchOneAnswersAfterTheMotion) {
@@ -658,8 +658,8 @@ TEST_F(ServoBusSimMotion, MoveWithAWrongLengthIsMalformed) {
 TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {
   host_->send(kReadBatch0);
   ASSERT_TRUE(
-      host_->waitUntil([&] { return !host_->framesOf(FrameFamily::kServoResponse).empty(); }));
-  Bytes reply = host_->framesOf(FrameFamily::kServoResponse).at(0);
+      host_->waitUntil([&] { return !host_->framesOf(protocol::servo::kResponseFrames).empty(); }));
+  Bytes reply = host_->framesOf(protocol::servo::kResponseFrames).at(0);
   ASSERT_EQ(reply.size(), 5u + 33u);
   EXPECT_EQ(reply[2], 0x05);
   EXPECT_EQ(reply[3], 33);
@@ -712,10 +712,10 @@ TEST(RobotSim, SharedPortCarriesAllThreeDevicesBehindTheLink) {
   host.send({0x12, 0x4C, 0x01, 0x01, 0x01, 0x61});  // PING id 1
   EXPECT_TRUE(host.waitForFrame(kPing1Reply));
   EXPECT_TRUE(host.waitUntil([&] {
-    return !host.framesOf(FrameFamily::kBase).empty() &&
-           host.framesOf(FrameFamily::kTelemetry).size() >= 3;
+    return !host.framesOf(protocol::base::kFrames).empty() &&
+           host.framesOf(protocol::body::kTelemetryFrames).size() >= 3;
   }));
-  EXPECT_EQ(host.framesOf(FrameFamily::kBase).at(0)[4], 0x02);  // the battery reply
+  EXPECT_EQ(host.framesOf(protocol::base::kFrames).at(0)[4], 0x02);  // the battery reply
 }
 
 TEST(RobotSim, DevicesWithTheirOwnLinksGetTheirOwnPtys) {
@@ -752,7 +752,7 @@ TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
-  host.waitUntil([&] { return host.framesOf(FrameFamily::kTelemetry).size() >= 100; });
+  host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 100; });
   sim.stop();  // the pty stays open: drain everything that was sent
   for (int i = 0; i < 10; ++i) host.pump(20);
   host.feedPadding();
@@ -760,7 +760,7 @@ TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
   const SendCounters& telemetry = stats.sent[static_cast<std::size_t>(OutputKind::kTelemetry)];
   EXPECT_GT(telemetry.damaged, 0u);
   EXPECT_GT(stats.garbage_bursts, 0u);
-  EXPECT_EQ(host.framesOf(FrameFamily::kTelemetry).size(), telemetry.intact);
+  EXPECT_EQ(host.framesOf(protocol::body::kTelemetryFrames).size(), telemetry.intact);
   EXPECT_EQ(telemetry.intact + telemetry.damaged + telemetry.discarded,
             stats.body.telemetry_generated);
 }
@@ -787,7 +787,7 @@ TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
   // What the line carried in that time, plus one write's worth in flight at the start.
   EXPECT_LE(static_cast<double>(received - std::min(received, held_at_start)),
             960.0 * elapsed_s + 16.0);
-  EXPECT_FALSE(host.framesOf(FrameFamily::kTelemetry).empty());  // cut into slices, not damaged
+  EXPECT_FALSE(host.framesOf(protocol::body::kTelemetryFrames).empty());  // cut into slices, not damaged
   EXPECT_EQ(host.framerStats().checksum_errors, 0u);
 }
 

@@ -139,15 +139,15 @@ MixedStream mixedStream() {
   // Junk without any header byte, so the skip count is exact.
   const Bytes junk = {0x00, 0x01, 0xAA, 0x34, 0x4C, 0x1C, 0xFD, 0x7E};
   const std::vector<Frame> frames = {
-      {FrameFamily::kTelemetry, kTelemetry},
-      {FrameFamily::kBase, kBaseBatteryReply},
-      {FrameFamily::kServoResponse, kServoPingReply},
-      {FrameFamily::kServoRequest, kServoRotate},
-      {FrameFamily::kSyncWrite, kSyncWrite},
-      {FrameFamily::kTelemetry, kTelemetryFoot},
-      {FrameFamily::kBase, kBaseErrorStatus},
-      {FrameFamily::kServoRequest, kServoReadAngle},
-      {FrameFamily::kServoResponse, kServoReadAngleReply},
+      {protocol::body::kTelemetryFrames, kTelemetry},
+      {protocol::base::kFrames, kBaseBatteryReply},
+      {protocol::servo::kResponseFrames, kServoPingReply},
+      {protocol::servo::kRequestFrames, kServoRotate},
+      {protocol::body::kSyncWriteFrames, kSyncWrite},
+      {protocol::body::kTelemetryFrames, kTelemetryFoot},
+      {protocol::base::kFrames, kBaseErrorStatus},
+      {protocol::servo::kRequestFrames, kServoReadAngle},
+      {protocol::servo::kResponseFrames, kServoReadAngleReply},
   };
   MixedStream stream;
   for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -164,11 +164,11 @@ MixedStream mixedStream() {
 // --- small pieces ------------------------------------------------------------------------------
 
 TEST(StreamFramerConfig, ToStringNamesEveryFamily) {
-  EXPECT_STREQ(toString(FrameFamily::kBase), "base");
-  EXPECT_STREQ(toString(FrameFamily::kTelemetry), "telemetry");
-  EXPECT_STREQ(toString(FrameFamily::kServoResponse), "servo_response");
-  EXPECT_STREQ(toString(FrameFamily::kServoRequest), "servo_request");
-  EXPECT_STREQ(toString(FrameFamily::kSyncWrite), "sync_write");
+  EXPECT_STREQ(toString(protocol::base::kFrames), "base");
+  EXPECT_STREQ(toString(protocol::body::kTelemetryFrames), "telemetry");
+  EXPECT_STREQ(toString(protocol::servo::kResponseFrames), "servo_response");
+  EXPECT_STREQ(toString(protocol::servo::kRequestFrames), "servo_request");
+  EXPECT_STREQ(toString(protocol::body::kSyncWriteFrames), "sync_write");
 }
 
 TEST(StreamFramerConfig, ForDriverEnablesWhatTheDevicesSend) {
@@ -243,19 +243,19 @@ TEST_P(StreamFramerGolden, ByteByByteEmitsOnlyAfterTheLastByte) {
 TEST_P(StreamFramerGolden, IgnoredWhenItsFamilyIsDisabled) {
   FramerConfig config = allFamilies();
   switch (GetParam().family) {
-    case FrameFamily::kBase:
+    case protocol::base::kFrames:
       config.base = false;
       break;
-    case FrameFamily::kTelemetry:
+    case protocol::body::kTelemetryFrames:
       config.telemetry = false;
       break;
-    case FrameFamily::kServoResponse:
+    case protocol::servo::kResponseFrames:
       config.servo_response = false;
       break;
-    case FrameFamily::kServoRequest:
+    case protocol::servo::kRequestFrames:
       config.servo_request = false;
       break;
-    case FrameFamily::kSyncWrite:
+    case protocol::body::kSyncWriteFrames:
       config.sync_write = false;
       break;
   }
@@ -269,32 +269,32 @@ TEST_P(StreamFramerGolden, IgnoredWhenItsFamilyIsDisabled) {
 
 INSTANTIATE_TEST_SUITE_P(
     StreamFramerVectors, StreamFramerGolden,
-    ::testing::Values(GoldenCase{"BaseReset", kBaseReset, FrameFamily::kBase},
-                      GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, FrameFamily::kBase},
-                      GoldenCase{"BaseClearEncoders", kBaseClearEncoders, FrameFamily::kBase},
-                      GoldenCase{"BaseLeft4", kBaseLeft4, FrameFamily::kBase},
-                      GoldenCase{"BaseRight4", kBaseRight4, FrameFamily::kBase},
-                      GoldenCase{"BaseBoth4", kBaseBoth4, FrameFamily::kBase},
-                      GoldenCase{"BaseBothMinus6", kBaseBothMinus6, FrameFamily::kBase},
-                      GoldenCase{"BaseBatteryReply", kBaseBatteryReply, FrameFamily::kBase},
-                      GoldenCase{"BaseErrorStatus", kBaseErrorStatus, FrameFamily::kBase},
-                      GoldenCase{"BaseLen1", kBaseLen1, FrameFamily::kBase},
-                      GoldenCase{"Telemetry", kTelemetry, FrameFamily::kTelemetry},
-                      GoldenCase{"TelemetryFoot", kTelemetryFoot, FrameFamily::kTelemetry},
-                      GoldenCase{"SyncWrite", kSyncWrite, FrameFamily::kSyncWrite},
-                      GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, FrameFamily::kSyncWrite},
-                      GoldenCase{"ServoPing", kServoPing, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoRotate", kServoRotate, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoReadAngle", kServoReadAngle, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoSpinCcw", kServoSpinCcw, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoSpinStop", kServoSpinStop, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoSpinTurns", kServoSpinTurns, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoSpinMs", kServoSpinMs, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoDamping", kServoDamping, FrameFamily::kServoRequest},
-                      GoldenCase{"ServoPingReply", kServoPingReply, FrameFamily::kServoResponse},
+    ::testing::Values(GoldenCase{"BaseReset", kBaseReset, protocol::base::kFrames},
+                      GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, protocol::base::kFrames},
+                      GoldenCase{"BaseClearEncoders", kBaseClearEncoders, protocol::base::kFrames},
+                      GoldenCase{"BaseLeft4", kBaseLeft4, protocol::base::kFrames},
+                      GoldenCase{"BaseRight4", kBaseRight4, protocol::base::kFrames},
+                      GoldenCase{"BaseBoth4", kBaseBoth4, protocol::base::kFrames},
+                      GoldenCase{"BaseBothMinus6", kBaseBothMinus6, protocol::base::kFrames},
+                      GoldenCase{"BaseBatteryReply", kBaseBatteryReply, protocol::base::kFrames},
+                      GoldenCase{"BaseErrorStatus", kBaseErrorStatus, protocol::base::kFrames},
+                      GoldenCase{"BaseLen1", kBaseLen1, protocol::base::kFrames},
+                      GoldenCase{"Telemetry", kTelemetry, protocol::body::kTelemetryFrames},
+                      GoldenCase{"TelemetryFoot", kTelemetryFoot, protocol::body::kTelemetryFrames},
+                      GoldenCase{"SyncWrite", kSyncWrite, protocol::body::kSyncWriteFrames},
+                      GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, protocol::body::kSyncWriteFrames},
+                      GoldenCase{"ServoPing", kServoPing, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoRotate", kServoRotate, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoReadAngle", kServoReadAngle, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoSpinCcw", kServoSpinCcw, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoSpinStop", kServoSpinStop, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoSpinTurns", kServoSpinTurns, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoSpinMs", kServoSpinMs, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoDamping", kServoDamping, protocol::servo::kRequestFrames},
+                      GoldenCase{"ServoPingReply", kServoPingReply, protocol::servo::kResponseFrames},
                       GoldenCase{"ServoReadAngleReply", kServoReadAngleReply,
-                                 FrameFamily::kServoResponse},
-                      GoldenCase{"ServoEmptyReply", kServoEmptyReply, FrameFamily::kServoResponse}),
+                                 protocol::servo::kResponseFrames},
+                      GoldenCase{"ServoEmptyReply", kServoEmptyReply, protocol::servo::kResponseFrames}),
     [](const ::testing::TestParamInfo<GoldenCase>& info) { return info.param.name; });
 
 // --- streams -----------------------------------------------------------------------------------
@@ -305,17 +305,17 @@ TEST(StreamFramerStream, BackToBackFramesAllComeOutInOrder) {
   RecordingFramer framer(allFamilies());
   framer.feed(stream);
   const std::vector<Frame> expected = {
-      {FrameFamily::kBase, kBaseReset},         {FrameFamily::kBase, kBaseBoth4},
-      {FrameFamily::kServoRequest, kServoPing}, {FrameFamily::kServoResponse, kServoPingReply},
-      {FrameFamily::kTelemetry, kTelemetry},    {FrameFamily::kTelemetry, kTelemetry},
-      {FrameFamily::kSyncWrite, kSyncWrite},    {FrameFamily::kServoRequest, kServoDamping},
-      {FrameFamily::kBase, kBaseLen1}};
+      {protocol::base::kFrames, kBaseReset},         {protocol::base::kFrames, kBaseBoth4},
+      {protocol::servo::kRequestFrames, kServoPing}, {protocol::servo::kResponseFrames, kServoPingReply},
+      {protocol::body::kTelemetryFrames, kTelemetry},    {protocol::body::kTelemetryFrames, kTelemetry},
+      {protocol::body::kSyncWriteFrames, kSyncWrite},    {protocol::servo::kRequestFrames, kServoDamping},
+      {protocol::base::kFrames, kBaseLen1}};
   EXPECT_EQ(framer.frames(), expected);
-  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kBase), 3u);
-  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kTelemetry), 2u);
-  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kServoRequest), 2u);
-  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kServoResponse), 1u);
-  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kSyncWrite), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), protocol::base::kFrames), 3u);
+  EXPECT_EQ(frameCount(framer.stats(), protocol::body::kTelemetryFrames), 2u);
+  EXPECT_EQ(frameCount(framer.stats(), protocol::servo::kRequestFrames), 2u);
+  EXPECT_EQ(frameCount(framer.stats(), protocol::servo::kResponseFrames), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), protocol::body::kSyncWriteFrames), 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, 0u);
   EXPECT_EQ(errorCount(framer.stats()), 0u);
 }
@@ -348,8 +348,8 @@ TEST(StreamFramerStream, RandomChunkSizesGiveTheSameFrames) {
     EXPECT_EQ(framer.frames(), expected);
     EXPECT_EQ(framer.stats().bytes_skipped, kRepeats * stream.junk);
     EXPECT_EQ(errorCount(framer.stats()), 0u);
-    EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kTelemetry), 2u * kRepeats);
-    EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kSyncWrite), 1u * kRepeats);
+    EXPECT_EQ(frameCount(framer.stats(), protocol::body::kTelemetryFrames), 2u * kRepeats);
+    EXPECT_EQ(frameCount(framer.stats(), protocol::body::kSyncWriteFrames), 1u * kRepeats);
     EXPECT_EQ(framer.framer().buffered(), 0u);
   }
 }
@@ -369,7 +369,7 @@ TEST(StreamFramerStream, ChunkLargerThanTheBuffer) {
   EXPECT_EQ(framer.framer().buffered(), 10u);
   framer.feed(Bytes(kTelemetry.begin() + 10, kTelemetry.end()));
   ASSERT_EQ(framer.frames().size(), frames + 1);
-  EXPECT_EQ(framer.frames().back(), (Frame{FrameFamily::kTelemetry, kTelemetry}));
+  EXPECT_EQ(framer.frames().back(), (Frame{protocol::body::kTelemetryFrames, kTelemetry}));
   EXPECT_EQ(framer.stats().bytes_skipped, 0u);
   EXPECT_EQ(framer.framer().buffered(), 0u);
 }
@@ -379,8 +379,8 @@ TEST(StreamFramerStream, JunkWithLoneHeaderBytesIsSkipped) {
   const Bytes junk = {0x55, 0x55, 0x12, 0x12, 0x05, 0xFF, 0xFE, 0x12, 0x00, 0xFF, 0xFF, 0x00};
   RecordingFramer framer(allFamilies());
   framer.feed(concat({junk, kServoPingReply, junk, kBaseReset, junk}));
-  const std::vector<Frame> expected = {{FrameFamily::kServoResponse, kServoPingReply},
-                                       {FrameFamily::kBase, kBaseReset}};
+  const std::vector<Frame> expected = {{protocol::servo::kResponseFrames, kServoPingReply},
+                                       {protocol::base::kFrames, kBaseReset}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, 3 * junk.size());
   EXPECT_EQ(errorCount(framer.stats()), 0u);
@@ -391,7 +391,7 @@ TEST(StreamFramerStream, DynamixelFrameThatIsNotASyncWriteIsSkipped) {
   FramerConfig config = FramerConfig::forSimulator();
   RecordingFramer framer(config);
   framer.feed(concat({kDynamixelPing, kSyncWrite}));
-  const std::vector<Frame> expected = {{FrameFamily::kSyncWrite, kSyncWrite}};
+  const std::vector<Frame> expected = {{protocol::body::kSyncWriteFrames, kSyncWrite}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, kDynamixelPing.size());
   EXPECT_EQ(errorCount(framer.stats()), 0u);
@@ -402,15 +402,15 @@ TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
   requests_only.servo_request = true;
   RecordingFramer framer(requests_only);
   framer.feed(concat({kTelemetry, kServoPing, kTelemetryFoot, kServoRotate}));
-  const std::vector<Frame> expected = {{FrameFamily::kServoRequest, kServoPing},
-                                       {FrameFamily::kServoRequest, kServoRotate}};
+  const std::vector<Frame> expected = {{protocol::servo::kRequestFrames, kServoPing},
+                                       {protocol::servo::kRequestFrames, kServoRotate}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size() + kTelemetryFoot.size());
 
   RecordingFramer telemetry_only(FramerConfig::forDriver(false, true, false, kServoCount));
   telemetry_only.feed(concat({kServoPing, kTelemetry, kServoRotate, kTelemetryFoot}));
-  const std::vector<Frame> expected_telemetry = {{FrameFamily::kTelemetry, kTelemetry},
-                                                 {FrameFamily::kTelemetry, kTelemetryFoot}};
+  const std::vector<Frame> expected_telemetry = {{protocol::body::kTelemetryFrames, kTelemetry},
+                                                 {protocol::body::kTelemetryFrames, kTelemetryFoot}};
   EXPECT_EQ(telemetry_only.frames(), expected_telemetry);
   EXPECT_EQ(telemetry_only.stats().bytes_skipped, kServoPing.size() + kServoRotate.size());
 }
@@ -436,8 +436,8 @@ TEST(StreamFramerStream, RealFrameHiddenInsideABrokenOneIsFound) {
   const Bytes broken_header = {0x55, 0xAA, 0x09};
   RecordingFramer framer(allFamilies());
   framer.feed(concat({broken_header, kServoPingReply, kBaseReset}));
-  const std::vector<Frame> expected = {{FrameFamily::kServoResponse, kServoPingReply},
-                                       {FrameFamily::kBase, kBaseReset}};
+  const std::vector<Frame> expected = {{protocol::servo::kResponseFrames, kServoPingReply},
+                                       {protocol::base::kFrames, kBaseReset}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().checksum_errors, 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, broken_header.size());
@@ -460,8 +460,8 @@ class StreamFramerBroken : public ::testing::TestWithParam<BrokenCase> {};
 TEST_P(StreamFramerBroken, CountedSkippedAndTheNextFrameStillComesThrough) {
   const BrokenCase& c = GetParam();
   for (const Frame& good :
-       {Frame{FrameFamily::kServoResponse, kServoPingReply},
-        Frame{FrameFamily::kBase, kBaseBatteryReply}, Frame{FrameFamily::kSyncWrite, kSyncWrite}}) {
+       {Frame{protocol::servo::kResponseFrames, kServoPingReply},
+        Frame{protocol::base::kFrames, kBaseBatteryReply}, Frame{protocol::body::kSyncWriteFrames, kSyncWrite}}) {
     SCOPED_TRACE(toString(good.family));
     RecordingFramer framer(allFamilies());
     framer.feed(concat({c.broken, good.bytes}));
@@ -583,9 +583,9 @@ TEST_P(StreamFramerTruncated, FollowingFramesStillComeThrough) {
   RecordingFramer framer(allFamilies());
   framer.feedInRandomChunks(concat({truncated, followers, kTelemetry}), &rng, 16);
   ASSERT_EQ(framer.frames().size(), 7u);
-  EXPECT_EQ(framer.frames()[0], (Frame{FrameFamily::kServoResponse, kServoPingReply}));
-  EXPECT_EQ(framer.frames()[5], (Frame{FrameFamily::kBase, kBaseBatteryReply}));
-  EXPECT_EQ(framer.frames()[6], (Frame{FrameFamily::kTelemetry, kTelemetry}));
+  EXPECT_EQ(framer.frames()[0], (Frame{protocol::servo::kResponseFrames, kServoPingReply}));
+  EXPECT_EQ(framer.frames()[5], (Frame{protocol::base::kFrames, kBaseBatteryReply}));
+  EXPECT_EQ(framer.frames()[6], (Frame{protocol::body::kTelemetryFrames, kTelemetry}));
   EXPECT_EQ(framer.stats().bytes_skipped, truncated.size());
   // The truncated candidate failed exactly once (which check fails depends on the bytes after it).
   EXPECT_EQ(errorCount(framer.stats()), 1u);
@@ -627,10 +627,10 @@ TEST(StreamFramerState, ResetDropsThePartialFrame) {
   EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size());
   framer.feed(kServoPing);
   ASSERT_EQ(framer.frames().size(), 1u);
-  EXPECT_EQ(framer.frames()[0], (Frame{FrameFamily::kServoRequest, kServoPing}));
+  EXPECT_EQ(framer.frames()[0], (Frame{protocol::servo::kRequestFrames, kServoPing}));
   // Statistics survive a reset: they describe the port, not the buffer.
   EXPECT_EQ(framer.stats().bytes_in, kTelemetry.size() + kServoPing.size());
-  EXPECT_EQ(frameCount(framer.stats(), FrameFamily::kServoRequest), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), protocol::servo::kRequestFrames), 1u);
   expectBytesAccountedFor(framer, 0);
 }
 
@@ -652,27 +652,27 @@ void expectDecoderAccepts(const Frame& frame) {
   const uint8_t* data = frame.bytes.data();
   const std::size_t size = frame.bytes.size();
   switch (frame.family) {
-    case FrameFamily::kBase: {
+    case protocol::base::kFrames: {
       const auto decoded = base::decodeFrame(data, size);
       EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
       break;
     }
-    case FrameFamily::kTelemetry: {
+    case protocol::body::kTelemetryFrames: {
       const auto decoded = body::decodeTelemetry(data, size, kServoCount);
       EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
       break;
     }
-    case FrameFamily::kServoResponse: {
+    case protocol::servo::kResponseFrames: {
       const auto decoded = servo::decodeResponse(data, size);
       EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
       break;
     }
-    case FrameFamily::kServoRequest: {
+    case protocol::servo::kRequestFrames: {
       const auto decoded = servo::decodeRequest(data, size);
       EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
       break;
     }
-    case FrameFamily::kSyncWrite: {
+    case protocol::body::kSyncWriteFrames: {
       const auto decoded = body::decodeSyncWrite(data, size);
       EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
       break;
@@ -756,7 +756,7 @@ TEST(StreamFramerStale, AStrayHeaderWithALongLenStopsHoldingBackTheAnswerBehindI
   while (framer.framer().dropStaleCandidate()) {
   }
   ASSERT_EQ(framer.frames().size(), 1u);
-  EXPECT_EQ(framer.frames()[0], (Frame{FrameFamily::kServoResponse, golden::servo::kPing3Reply}));
+  EXPECT_EQ(framer.frames()[0], (Frame{protocol::servo::kResponseFrames, golden::servo::kPing3Reply}));
   EXPECT_EQ(framer.framer().buffered(), 0u);
   EXPECT_EQ(framer.stats().stale_candidates, 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, 4u);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/decode_result.h"
+#include "serial_robot_driver/protocol/frame_family.h"
 
 namespace serial_robot_driver::protocol::base {
 
@@ -68,6 +69,8 @@ struct Frame {
 /// Probes the `available` bytes at a stream position for a complete, verified frame: header,
 /// LEN range and XOR (kBadHeader / kBadLength / kBadChecksum).
 Probe probeFrame(const uint8_t* data, std::size_t available);
+/// The base's frames (both directions share the layout): "base", 55 AA, XOR.
+extern const FrameFamily kFrames;
 
 /// Decodes one complete frame (exactly frameSize(LEN) bytes).
 Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/decode_result.h"
+#include "serial_robot_driver/protocol/frame_family.h"
 
 namespace serial_robot_driver::protocol::body {
 
@@ -40,6 +41,8 @@ std::vector<uint8_t> encodeSyncWrite(const std::vector<ServoTarget>& targets);
 /// Probes for a complete sync write: header and broadcast id, LEN (7 + 3N, N <= 64),
 /// instruction, CRC (kBadHeader / kBadLength / kBadChecksum).
 Probe probeSyncWrite(const uint8_t* data, std::size_t available);
+/// Sync writes (host -> board; what the simulated board reads): "sync_write".
+extern const FrameFamily kSyncWriteFrames;
 /// For the simulator: a complete sync-write frame back into targets (CRC and layout checked).
 Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size_t size);
 
@@ -81,6 +84,8 @@ uint8_t telemetrySum(const uint8_t* frame, std::size_t len);
 /// Probes for a complete telemetry frame of `servo_count` servos: header, LEN (24 + 4N or 40 + 4N),
 /// then tail before SUM (kBadHeader / kBadLength / kBadTail / kBadChecksum).
 Probe probeTelemetry(const uint8_t* data, std::size_t available, std::size_t servo_count);
+/// Telemetry (board -> host): "telemetry"; the framer's argument is the servo count.
+extern const FrameFamily kTelemetryFrames;
 
 /// Decodes one complete telemetry frame for `servo_count` configured servos. LEN must be
 /// telemetryLen(servo_count, false|true) and match `size`.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "serial_robot_driver/protocol/decode_result.h"
+#include "serial_robot_driver/protocol/frame_family.h"
 #include "serial_robot_driver/protocol/servo_params.h"
 
 namespace serial_robot_driver::protocol::servo {
@@ -115,6 +116,10 @@ struct Packet {
 /// N (kBadLength), sum (kBadChecksum).
 Probe probeResponse(const uint8_t* data, std::size_t available);
 Probe probeRequest(const uint8_t* data, std::size_t available);
+/// Responses (servo -> host): "servo_response".
+extern const FrameFamily kResponseFrames;
+/// Requests (host -> servo: the half-duplex echo, or what the simulated bus reads): "servo_request".
+extern const FrameFamily kRequestFrames;
 
 /// Decodes one complete response (05 1C ...) or request (12 4C ..., for the simulator and for
 /// recognising the half-duplex echo of our own request).

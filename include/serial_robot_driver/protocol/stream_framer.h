@@ -1,8 +1,8 @@
 // One stream framer per serial port: it takes byte chunks of any size, finds complete frames of the
 // families it is configured for and hands each one to a callback together with its family.
-// The framer knows no layout: it is a table of {first header byte, family, probe}, and each codec's
-// probe says "need more", "invalid (why)" or "frame of N bytes" (verified: LEN, checksum, tail).
-// Adding a family is one table entry in the constructor plus its codec's probe. Several devices can
+// The framer knows no layout and no family by name: it is configured with the families to accept
+// (protocol/frame_family.h: first header byte and the codec's probe), and each probe says "need
+// more", "invalid (why)" or "frame of N bytes" (verified: LEN, checksum, tail). Several devices can
 // therefore share one port: their inbound headers differ (docs/protocols.md, table at the top).
 //
 // Design (after kobuki's packet finder and novatel's multi-family extractor):
@@ -18,35 +18,28 @@
 #include <functional>
 
 #include "serial_robot_driver/protocol/decode_result.h"
+#include "serial_robot_driver/protocol/frame_family.h"
 
 namespace serial_robot_driver::protocol {
 
-enum class FrameFamily : uint8_t {
-  kBase = 0,       ///< 55 AA, XOR (both directions share the layout)
-  kTelemetry,      ///< 12 34 ... SUM 1F 2F (board -> host)
-  kServoResponse,  ///< 05 1C, sum (servo -> host)
-  kServoRequest,   ///< 12 4C, sum (host -> servo: the half-duplex echo or the simulator input)
-  kSyncWrite,      ///< FF FF FD 00, CRC-16 (host -> board; the simulator's input)
-};
-constexpr std::size_t kFrameFamilyCount = 5;
-const char* toString(FrameFamily family);
+/// The most families one framer accepts (the driver's ports carry one to three).
+constexpr std::size_t kMaxFamiliesPerFramer = 8;
 
+/// What a framer accepts: families and, per family, the argument its probe gets.
 struct FramerConfig {
-  bool base = false;
-  bool telemetry = false;
-  bool servo_response = false;
-  bool servo_request = false;
-  bool sync_write = false;
-  /// Telemetry LEN must equal 24 + 4N or 40 + 4N for this N.
-  std::size_t telemetry_servo_count = 0;
+  struct Accepted {
+    FrameFamily family;
+    std::size_t expected = 0;  ///< passed to the family's probe (the telemetry's servo count)
+  };
+  std::array<Accepted, kMaxFamiliesPerFramer> families{};
+  std::size_t family_count = 0;
 
-  /// Accept frames of `family` as well.
-  void accept(FrameFamily family);
-  /// What the driver listens for on a port shared by the given devices (tests and benchmarks;
-  /// the driver builds it from its device set, device/device_set.h).
-  static FramerConfig forDriver(bool base, bool body, bool servo_bus, std::size_t servo_count);
-  /// What the simulator listens for.
-  static FramerConfig forSimulator();
+  /// Accept frames of `family` as well (again: only `expected` is updated). Throws
+  /// std::length_error beyond kMaxFamiliesPerFramer families.
+  void accept(const FrameFamily& family, std::size_t expected = 0);
+  bool accepts(const FrameFamily& family) const;
+  /// The probe argument `family` was accepted with (0 when it is not accepted).
+  std::size_t expectedOf(const FrameFamily& family) const;
 };
 
 struct FramerStats {
@@ -57,7 +50,18 @@ struct FramerStats {
   uint64_t bad_lengths = 0;      ///< impossible LEN bytes
   uint64_t unknown_commands = 0;  ///< servo-bus headers with a CMD outside 1..16
   uint64_t stale_candidates = 0;  ///< incomplete candidates given up on (dropStaleCandidate)
-  std::array<uint64_t, kFrameFamilyCount> frames{};  ///< verified frames per family
+  /// Verified frames per accepted family, in the order the config names them.
+  struct FamilyFrames {
+    const char* family = nullptr;  ///< FrameFamily::name
+    uint64_t frames = 0;
+  };
+  std::array<FamilyFrames, kMaxFamiliesPerFramer> by_family{};
+  std::size_t family_count = 0;
+
+  /// Verified frames of `family` (0 when it is not accepted).
+  uint64_t framesOf(const FrameFamily& family) const;
+  /// Adds every counter of `other` (a family it has and this has not is appended).
+  void add(const FramerStats& other);
 };
 
 class StreamFramer {
@@ -66,7 +70,7 @@ class StreamFramer {
   /// passed to feed(), and is valid only during the call. The handler must not throw, nor call
   /// feed() or reset() on the same framer.
   using FrameHandler =
-      std::function<void(FrameFamily family, const uint8_t* data, std::size_t size)>;
+      std::function<void(const FrameFamily& family, const uint8_t* data, std::size_t size)>;
 
   /// Large enough for several of the longest frames (telemetry: 255 bytes).
   static constexpr std::size_t kBufferSize = 4096;
@@ -93,18 +97,16 @@ class StreamFramer {
   std::size_t buffered() const { return size_; }
 
  private:
-  /// One enabled family: frames start with `header0`; `probe` is its codec's probe.
+  /// One accepted family; `stats_index` is its slot in stats_.by_family.
   struct Entry {
-    uint8_t header0 = 0;
-    FrameFamily family = FrameFamily::kBase;
-    Probe (*probe)(const uint8_t* data, std::size_t available, std::size_t servo_count) = nullptr;
+    FramerConfig::Accepted accepted{};
+    std::size_t stats_index = 0;
   };
-  void addEntry(uint8_t header0, FrameFamily family,
-                Probe (*probe)(const uint8_t*, std::size_t, std::size_t));
+  void addEntry(const FramerConfig::Accepted& accepted, std::size_t stats_index);
   /// Asks the entries whose first header byte matches, in table order; a kBadHeader from one
   /// (two families share 0x12) passes the candidate to the next. Counts length/checksum/tail
   /// errors.
-  Probe examine(const uint8_t* data, std::size_t available, FrameFamily* family);
+  Probe examine(const uint8_t* data, std::size_t available, const Entry** found);
   /// Emits the frames found among the bytes at `data`, examining candidates that start before
   /// `start_limit`. Returns how many bytes were consumed: it stops early only at an incomplete
   /// candidate.
@@ -115,7 +117,7 @@ class StreamFramer {
   FramerConfig config_;
   FrameHandler handler_;
   FramerStats stats_;
-  std::array<Entry, kFrameFamilyCount> entries_{};
+  std::array<Entry, kMaxFamiliesPerFramer> entries_{};
   std::size_t entry_count_ = 0;
   /// is_start_[b]: b is the first header byte of an enabled family.
   std::array<bool, 256> is_start_{};

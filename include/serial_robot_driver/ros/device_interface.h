@@ -1,7 +1,7 @@
 // The shape every ROS-side device (or input) has, so DriverNode handles them all one way: each is
 // constructed on its port before the ports start (it registers its listener, topics and services
 // there), started once the ports run, and shut down before the ports close. DriverNode adds its
-// diagnostic status under the device's name from the device set (device/device_set.h).
+// diagnostic status under the device's name it was registered under (device/device_module.h).
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>

@@ -1,6 +1,6 @@
 // driver_node: one node that owns the robot's serial port(s).
 //
-// The devices it drives are the device set (device/device_set.h); each has a ROS interface of its
+// The devices it drives are the registered ones (device/device_module.h); each has a ROS interface of its
 // own (ros/*_interface.h) with its topics and services, listed in full in docs/node_api.md:
 //   base      in cmd_vel; out odom (+ tf), wheel_command, battery;
 //             base/reset, base/reset_odometry, base/clear_encoders

@@ -29,26 +29,6 @@ namespace serial_robot_driver::ros_layer {
 class DeviceInterface;
 class TrajectoryServer;
 
-/// One requested value: the parameter's key as in the table ("base/max_wheel_speed") and the value.
-using ParamAssignment = std::pair<std::string, ParamValue>;
-
-struct TuningResult {
-  DriverParams applied;  ///< the parameters in force after the change (they pass validate())
-  /// One line per refused value: which, why (validate()'s message) and the value kept instead.
-  std::vector<std::string> refusals;
-};
-
-/// The parameters `in_force` with `requested` applied, as far as validate() accepts them: a
-/// refused value is dropped (the value in force is kept). When validate() names a parameter that
-/// was not changed (a rule between several values), every changed value of the request is
-/// refused. Throws std::invalid_argument for a key that is not in the table or a value of the wrong
-/// type (a programming error: the .cfg files and the table agree, see test_runtime_tuning.cpp).
-TuningResult tuneParams(const DriverParams& in_force,
-                        const std::vector<ParamAssignment>& requested);
-
-/// A parameter value as text for a log line: 0.5, true, 20, "odom".
-std::string toText(const ParamValue& value);
-
 class RuntimeTuning {
  public:
   /// Starts the servers of the enabled groups under `private_nh`: ~base (base enabled), ~imu

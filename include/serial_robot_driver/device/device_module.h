@@ -1,0 +1,63 @@
+// What makes a device known to the driver: one DeviceModule per device, defined in the device's
+// own folder (src/devices/<name>/) and registered by one line in cmake/devices.cmake. The framer
+// configuration, the parameter table and its checks, the node's interfaces (ros/ros_device_module.h)
+// and the simulator (sim/sim_device_module.h) all walk the registered modules; none of them names
+// a device.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/protocol/stream_framer.h"
+
+namespace serial_robot_driver::params {
+struct DriverParams;
+struct DevicePortParams;
+struct ParamSpec;
+}  // namespace serial_robot_driver::params
+
+namespace serial_robot_driver::device {
+
+struct DeviceModule {
+  /// The parameter namespace (~<name>/enabled, ~<name>/port, ~<name>/baud and the device's own),
+  /// the diagnostic status ("<node>: <name>") and the simulator's name for its link.
+  const char* name;
+  /// For people: the diagnostics analyzer's path ("Servo bus").
+  const char* title;
+  /// What the driver's framer accepts on the device's port: the device's frames, and on a
+  /// half-duplex line the echo of the driver's own requests (framed, then ignored, so that they
+  /// cannot hide an answer).
+  std::vector<protocol::FrameFamily> driver_frames;
+  /// What the simulated device reads: the driver's frames to it.
+  std::vector<protocol::FrameFamily> simulator_frames;
+  /// The device's port parameters inside DriverParams.
+  params::DevicePortParams& (*port_params)(params::DriverParams& params);
+  /// Appends the device's rows (keys "<name>/...", and any section of its own) to the table.
+  void (*add_parameters)(std::vector<params::ParamSpec>& table);
+  /// Checks that relate several values (one value's range is its row's check); throws
+  /// params::ParameterError. Called only while the device is enabled. May be null.
+  void (*validate)(const params::DriverParams& params);
+  /// The argument the driver's framer passes to the probes of driver_frames (the telemetry's
+  /// servo count); null: 0.
+  std::size_t (*probe_argument)(const params::DriverParams& params);
+  /// How long an incomplete frame may hold back the bytes behind it on the device's port before
+  /// the framer gives up on it (a request/response bus: no longer than an answer may take);
+  /// null: the link's default.
+  std::chrono::milliseconds (*stale_frame_timeout)(const params::DriverParams& params);
+};
+
+/// The registered devices, in start and shutdown order (cmake/devices.cmake: the base first, so
+/// its zero-speed frame goes out before anything else stops).
+const std::vector<const DeviceModule*>& registeredDevices();
+/// The registered device called `name`, or null.
+const DeviceModule* findDevice(const std::string& name);
+
+/// What the driver's framer accepts on a port shared by `devices`.
+protocol::FramerConfig framerFor(const std::vector<const DeviceModule*>& devices,
+                                 const params::DriverParams& params);
+/// What the simulator's framer accepts on a port shared by `devices`.
+protocol::FramerConfig simulatorFramerFor(const std::vector<const DeviceModule*>& devices);
+
+}  // namespace serial_robot_driver::device

@@ -1,0 +1,138 @@
+// Every parameter of the driver, loaded once at start-up into one struct (names and defaults:
+// docs/node_api.md and config/robot.yaml). The table (params/param_table.h) is where each key is
+// spelled and bound to its field; validate() throws ParameterError naming the first bad
+// parameter, and the node prints it and exits non-zero. ROS-free: the ROS layer only reads the
+// parameter server into it (ros/driver_params.h).
+#pragma once
+
+#include <any>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
+#include "serial_robot_driver/params/param_table.h"
+#include "serial_robot_driver/params/port_params.h"
+#include "serial_robot_driver/transport/recorded_stream.h"
+
+namespace serial_robot_driver::device {
+struct DeviceModule;
+}
+
+namespace serial_robot_driver::params {
+
+/// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override them).
+struct TrajectoryParams {
+  double goal_tolerance = 0.05;      ///< rad, per joint
+  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
+  double path_tolerance = 0.0;       ///< rad; 0: not checked
+  double max_velocity = 0.0;         ///< rad/s per joint; a faster trajectory is refused; 0: no limit
+};
+
+/// The parameter sections of devices that DriverParams has no member for: each device keeps its
+/// own struct here under its name (a device added by its folder alone uses this).
+class DeviceSections {
+ public:
+  /// The section of `device`, created with its defaults on first use.
+  template <typename Section>
+  Section& get(const std::string& device) {
+    std::any& section = sections_[device];
+    if (!section.has_value()) section = Section{};
+    return std::any_cast<Section&>(section);
+  }
+  template <typename Section>
+  const Section& get(const std::string& device) const {
+    const auto found = sections_.find(device);
+    if (found == sections_.end()) {
+      static const Section defaults{};
+      return defaults;
+    }
+    return std::any_cast<const Section&>(found->second);
+  }
+
+ private:
+  std::map<std::string, std::any> sections_;
+};
+
+/// The tf frame name of a frame parameter under `tf_prefix`, as robot_state_publisher resolves its
+/// links: "<prefix>/<frame>" with the prefix's own leading and trailing slashes dropped
+/// ("/robot1/" and "robot1" alike); a frame written with a leading '/' is taken as it is, without
+/// the slash; an empty prefix leaves the frame as configured. The one place a frame name is made.
+std::string resolveFrame(const std::string& tf_prefix, const std::string& frame);
+
+struct DriverParams {
+  std::string port = "/dev/ttyUSB0";
+  int baud = 115200;
+  double loop_rate = kBaseDefaults.loop_rate;
+  double reconnect_interval = 1.0;
+  bool capture = false;      ///< publish every chunk in and out on serial_raw
+  std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
+  double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
+  /// Not a parameter: the running replay's timeline (set by the node once the bag is read), which
+  /// maps the frames' arrival times back to their recorded stamps.
+  std::shared_ptr<const transport::ReplayPacing> replay_timeline;
+  // The robot's own devices' sections (their rows: src/devices/<name>/<name>_module.cpp).
+  BaseParams base;
+  BodyParams body;
+  ImuParams imu;
+  ServoBusParams servo_bus;
+  /// Sections of other registered devices.
+  DeviceSections sections;
+  TrajectoryParams trajectory;
+  /// Not a ~ parameter: `tf_prefix` searched upward from the node's namespace (as
+  /// robot_state_publisher does), so one value in a robot's namespace serves all its nodes.
+  std::string tf_prefix;
+
+  /// Puts every frame parameter (base/odom_frame, base/base_frame, imu/frame_id) under tf_prefix
+  /// (resolveFrame). Loading from the parameter server calls it once, after reading tf_prefix.
+  void resolveFrames();
+
+  /// Throws ParameterError naming the first parameter that is out of range or inconsistent.
+  void validate() const;
+
+  /// The port parameters (~<name>/enabled, port, baud) of a registered device.
+  const DevicePortParams& portParams(const device::DeviceModule& device) const;
+  DevicePortParams& portParams(const device::DeviceModule& device);
+  bool enabled(const device::DeviceModule& device) const { return portParams(device).enabled; }
+  /// Whether the registered device called `name` is enabled (false for an unknown name).
+  bool enabled(const std::string& device) const;
+  /// The device's own port or baud, or the node-wide one it inherits.
+  std::string portOf(const device::DeviceModule& device) const;
+  int baudOf(const device::DeviceModule& device) const;
+  std::string basePort() const { return base.port.empty() ? port : base.port; }
+  std::string bodyPort() const { return body.port.empty() ? port : body.port; }
+  std::string servoBusPort() const { return servo_bus.port.empty() ? port : servo_bus.port; }
+  int baseBaud() const { return base.baud > 0 ? base.baud : baud; }
+  int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
+  int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
+  /// A topic's publisher queue: `live` frames (a slow subscriber drops old ones), but unbounded
+  /// while replaying, where a full-speed replay must not lose what subscribers have not read yet.
+  int publisherQueue(int live) const { return replay_bag.empty() ? live : 0; }
+};
+
+/// Reads every table key present in `source` (missing keys keep their defaults; a key of the
+/// wrong type is a ParameterError). `unknown_keys` receives the keys the driver does not know.
+/// `extra_known` are keys read elsewhere that are not typos (diagnostic_period, tf_prefix).
+DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unknown_keys);
+
+/// One requested value: the parameter's key as in the table ("base/max_wheel_speed") and the value.
+using ParamAssignment = std::pair<std::string, ParamValue>;
+
+struct TuningResult {
+  DriverParams applied;  ///< the parameters in force after the change (they pass validate())
+  /// One line per refused value: which, why (validate()'s message) and the value kept instead.
+  std::vector<std::string> refusals;
+};
+
+/// The parameters `in_force` with `requested` applied, as far as validate() accepts them: a
+/// refused value is dropped (the value in force is kept). When validate() names a parameter that
+/// was not changed (a rule between several values), every changed value of the request is
+/// refused. Throws std::invalid_argument for a key that is not in the table or a value of the wrong
+/// type (a programming error: the .cfg files and the table agree, see test_runtime_tuning.cpp).
+TuningResult tuneParams(const DriverParams& in_force,
+                        const std::vector<ParamAssignment>& requested);
+
+}  // namespace serial_robot_driver::params

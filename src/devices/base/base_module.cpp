@@ -1,0 +1,84 @@
+// The AP1 wheeled base as a device of the driver: its frames, its parameter section and checks.
+#include <sstream>
+
+#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/params/driver_params.h"
+#include "serial_robot_driver/protocol/base_codec.h"
+
+namespace serial_robot_driver::devices::base {
+
+namespace {
+
+using params::BaseParams;
+using params::DriverParams;
+using params::require;
+
+void addParameters(std::vector<params::ParamSpec>& table) {
+  using B = BaseParams;
+  params::SectionRows<B>(table, "base", "base", [](DriverParams& p) -> B& { return p.base; })
+      .add("wheel_diameter", &B::wheel_diameter, params::positiveNumber)
+      .add("encoder_resolution", &B::encoder_resolution, params::positiveInteger)
+      .add("pid_rate", &B::pid_rate, params::positiveNumber)
+      .add("wheel_separation", &B::wheel_separation, params::positiveNumber)
+      // > 0: there is no "no limit" value. No maximum: the base's top speed is not documented,
+      // and the speed field's own range (int16 ticks per PID period) depends on tunable geometry.
+      .add("max_wheel_speed", &B::max_wheel_speed, params::positiveNumber)
+      .add("max_wheel_accel", &B::max_wheel_accel, params::nonNegativeNumber)
+      .add("cmd_vel_timeout", &B::cmd_vel_timeout, params::positiveNumber)
+      .add("speed_dithering", &B::speed_dithering)
+      .add("battery_poll_rate", &B::battery_poll_rate, params::nonNegativeNumber)
+      .add("battery_warn_percent", &B::battery_warn_percent, params::percent)
+      .add("battery_error_percent", &B::battery_error_percent, params::percent)
+      .add("odom_frame", &B::odom_frame, params::frameId)
+      .add("base_frame", &B::base_frame, params::frameId)
+      .add("publish_tf", &B::publish_tf)
+      .add("left_wheel_direction", &B::left_wheel_direction, params::direction)
+      .add("right_wheel_direction", &B::right_wheel_direction, params::direction)
+      .add("left_wheel_joint", &B::left_wheel_joint, params::frameId)
+      .add("right_wheel_joint", &B::right_wheel_joint, params::frameId)
+      .add("use_imu_heading", &B::use_imu_heading);
+}
+
+void validate(const DriverParams& p) {
+  const BaseParams& base = p.base;
+  // Every tick's wheel frame is the base's heartbeat; it stops with a timeout error after 1 s
+  // without one. 5 Hz leaves five frames in that second, so one lost frame is harmless.
+  std::ostringstream rate;
+  rate << "must be at least " << params::kMinBaseLoopRate
+       << " Hz while the base is enabled: each loop tick sends the wheel frame that keeps the "
+          "base's 1 s heartbeat alive (got "
+       << p.loop_rate << ")";
+  require(p.loop_rate >= params::kMinBaseLoopRate, "loop_rate", rate.str());
+  require(base.battery_poll_rate <= p.loop_rate, "base/battery_poll_rate",
+          "must not exceed loop_rate (requests go out from the loop)");
+  require(base.battery_error_percent <= base.battery_warn_percent, "base/battery_error_percent",
+          "must not exceed base/battery_warn_percent (" +
+              std::to_string(base.battery_warn_percent) + ")");
+  require(base.odom_frame != base.base_frame, "base/base_frame",
+          "must differ from base/odom_frame ('" + base.odom_frame + "')");
+  require(base.left_wheel_joint != base.right_wheel_joint, "base/right_wheel_joint",
+          "must differ from base/left_wheel_joint ('" + base.left_wheel_joint + "')");
+  if (base.use_imu_heading) {
+    require(p.body.enabled, "base/use_imu_heading",
+            "needs the servo controller board's IMU, but body/enabled is false");
+    require(
+        p.imu.orientation_variance >= 0, "base/use_imu_heading",
+        "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
+  }
+}
+
+}  // namespace
+
+extern const device::DeviceModule kModule{
+    "base",
+    "Base",
+    {protocol::base::kFrames},
+    {protocol::base::kFrames},
+    [](DriverParams& p) -> params::DevicePortParams& { return p.base; },
+    addParameters,
+    validate,
+    nullptr,
+    nullptr,
+};
+
+}  // namespace serial_robot_driver::devices::base

@@ -1,0 +1,136 @@
+// The servo controller board as a device of the driver: its frames, its parameter sections
+// (~body/... and its IMU's ~imu/...) and checks.
+#include <array>
+#include <set>
+
+#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/params/driver_params.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+
+namespace serial_robot_driver::devices::body {
+
+namespace {
+
+using params::BodyParams;
+using params::DriverParams;
+using params::ImuParams;
+using params::require;
+
+void servoIds(const std::vector<int>& ids, const std::string& key) {
+  require(!ids.empty(), key, "must list at least one servo id");
+  require(ids.size() <= protocol::body::kMaxTelemetryServos, key,
+          "at most " + std::to_string(protocol::body::kMaxTelemetryServos) +
+              " servos fit in a telemetry frame");
+  std::set<int> seen;
+  for (int id : ids) {
+    // 253 = FD would put FF FF FD, the sync-write header, inside a sync-write frame.
+    require(id >= 0 && id <= 252, key,
+            "ids must be 0..252 (253 would look like a frame header, 254 is broadcast), got " +
+                std::to_string(id));
+    require(seen.insert(id).second, key, "id " + std::to_string(id) + " is listed twice");
+  }
+}
+
+void addParameters(std::vector<params::ParamSpec>& table) {
+  using B = BodyParams;
+  params::SectionRows<B>(table, "body", "body", [](DriverParams& p) -> B& { return p.body; })
+      .add("servo_ids", &B::servo_ids, servoIds)
+      .add("joint_names", &B::joint_names, params::uniqueNames)
+      .add("ticks_per_revolution", &B::ticks_per_revolution,
+           [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); })
+      .add("zero_ticks", &B::zero_ticks,
+           [](const std::vector<int>& zeros, const std::string& key) {
+             for (int zero : zeros)
+               require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
+           })
+      .add("directions", &B::directions, params::directionList)
+      .add("velocity_scale", &B::velocity_scale, params::nonNegativeNumber);
+  // The IMU is the board's: its keys are checked while the body is enabled.
+  using I = ImuParams;
+  params::SectionRows<I>(table, "body", "imu", [](DriverParams& p) -> I& { return p.imu; })
+      .add("frame_id", &I::frame_id,
+           [](const std::string& v, const std::string& key) {
+             require(!v.empty(), key, "must not be empty");
+           })
+      .add("axis_map", &I::axis_map,
+           [](const std::vector<std::string>& entries, const std::string& key) {
+             std::string problem;
+             require(params::parseAxisMap(entries, &problem).has_value(), key, problem);
+           })
+      .add("accel_scale", &I::accel_scale, params::positiveNumber)
+      .add("gyro_scale", &I::gyro_scale, params::positiveNumber)
+      .add("angle_scale", &I::angle_scale, params::positiveNumber)
+      .add("orientation_variance", &I::orientation_variance, params::finiteNumber)
+      .add("angular_velocity_variance", &I::angular_velocity_variance, params::nonNegativeNumber)
+      .add("linear_acceleration_variance", &I::linear_acceleration_variance,
+           params::nonNegativeNumber);
+}
+
+void validate(const DriverParams& p) {
+  const std::size_t n = p.body.servo_ids.size();
+  const auto requireOnePerServo = [n](std::size_t size, const std::string& name) {
+    require(size == n, name,
+            "has " + std::to_string(size) + " entries but body/servo_ids has " + std::to_string(n));
+  };
+  requireOnePerServo(p.body.joint_names.size(), "body/joint_names");
+  requireOnePerServo(p.body.zero_ticks.size(), "body/zero_ticks");
+  requireOnePerServo(p.body.directions.size(), "body/directions");
+}
+
+}  // namespace
+
+extern const device::DeviceModule kModule{
+    "body",
+    "Body",
+    {protocol::body::kTelemetryFrames},
+    {protocol::body::kSyncWriteFrames},
+    [](DriverParams& p) -> params::DevicePortParams& { return p.body; },
+    addParameters,
+    validate,
+    // A telemetry frame's LEN depends on how many servos it carries.
+    [](const DriverParams& p) { return p.body.servo_ids.size(); },
+    nullptr,
+};
+
+}  // namespace serial_robot_driver::devices::body
+
+namespace serial_robot_driver::params {
+
+std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std::string* problem) {
+  const auto fail = [problem](const std::string& text) {
+    if (problem) *problem = text;
+    return std::nullopt;
+  };
+  if (entries.size() != 3) {
+    return fail("must list 3 axes (imu x, y, z), e.g. [x, y, z] or [-y, x, z]; got " +
+                std::to_string(entries.size()));
+  }
+  AxisMap map;
+  std::array<bool, 3> used{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string entry = entries[i];
+    int sign = 1;
+    if (!entry.empty() && (entry[0] == '-' || entry[0] == '+')) {
+      sign = entry[0] == '-' ? -1 : 1;
+      entry.erase(0, 1);
+    }
+    if (entry != "x" && entry != "y" && entry != "z") {
+      return fail("entry '" + entries[i] + "' is not x, y or z with an optional sign");
+    }
+    const int source = entry[0] - 'x';
+    if (used[source]) return fail("sensor axis " + entry + " is used twice");
+    used[source] = true;
+    map.source[i] = source;
+    map.sign[i] = sign;
+  }
+  // The determinant of a signed permutation: the permutation's parity times the signs.
+  const int inversions = (map.source[0] > map.source[1]) + (map.source[0] > map.source[2]) +
+                         (map.source[1] > map.source[2]);
+  const int determinant = (inversions % 2 ? -1 : 1) * map.sign[0] * map.sign[1] * map.sign[2];
+  if (determinant != 1) {
+    return fail("is a mirror image (left-handed); flip the sign of one axis to make it a rotation");
+  }
+  return map;
+}
+
+}  // namespace serial_robot_driver::params

@@ -1,0 +1,217 @@
+#include "serial_robot_driver/params/driver_params.h"
+
+#include <set>
+#include <stdexcept>
+
+#include "serial_robot_driver/device/device_module.h"
+
+namespace serial_robot_driver::params {
+
+namespace {
+
+/// The node-wide rows (the devices add theirs: DeviceModule::add_parameters).
+void addNodeParameters(std::vector<ParamSpec>& table) {
+  using P = DriverParams;
+  const auto node = [&table](const char* key, auto P::*field, auto rule) {
+    using T = std::remove_reference_t<decltype(std::declval<P&>().*field)>;
+    table.push_back(makeRow<T>(key, "", [field](P& p) -> T& { return p.*field; }, Rule<T>(rule)));
+  };
+  node("port", &P::port, [](const std::string& v, const std::string& key) {
+    require(!v.empty(), key, "must name a serial device, e.g. /dev/ttyUSB0");
+  });
+  node("baud", &P::baud, baudRate);
+  node("loop_rate", &P::loop_rate, [](const double& v, const std::string& key) {
+    positiveNumber(v, key);
+    require(v <= 1000, key, "must be at most 1000 Hz");
+  });
+  node("reconnect_interval", &P::reconnect_interval, positiveNumber);
+  node("capture", &P::capture, Rule<bool>{});
+  node("replay_bag", &P::replay_bag, Rule<std::string>{});
+  node("replay_rate", &P::replay_rate, nonNegativeNumber);
+}
+
+/// Trajectory defaults (follow_joint_trajectory, joint_trajectory): node-wide, used by every
+/// device with joints.
+void addTrajectoryParameters(std::vector<ParamSpec>& table) {
+  SectionRows<TrajectoryParams>(table, "", "trajectory",
+                                [](DriverParams& p) -> TrajectoryParams& { return p.trajectory; })
+      .add("goal_tolerance", &TrajectoryParams::goal_tolerance, nonNegativeNumber)
+      .add("goal_time_tolerance", &TrajectoryParams::goal_time_tolerance, nonNegativeNumber)
+      .add("path_tolerance", &TrajectoryParams::path_tolerance, nonNegativeNumber)
+      .add("max_velocity", &TrajectoryParams::max_velocity, nonNegativeNumber);
+}
+
+std::vector<ParamSpec> buildTable() {
+  std::vector<ParamSpec> table;
+  addNodeParameters(table);
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    // Every device's port parameters, then its own.
+    const auto port = [device](DriverParams& p) -> DevicePortParams& {
+      return device->port_params(p);
+    };
+    SectionRows<DevicePortParams>(table, device->name, device->name, port)
+        .add("enabled", &DevicePortParams::enabled)
+        .add("port", &DevicePortParams::port)
+        .add("baud", &DevicePortParams::baud, baudOrInherit);
+    if (device->add_parameters) device->add_parameters(table);
+  }
+  addTrajectoryParameters(table);
+  std::set<std::string> keys;
+  for (const ParamSpec& spec : table) {
+    if (!keys.insert(spec.key).second) {
+      throw std::logic_error("parameter ~" + spec.key + " is in the table twice");
+    }
+  }
+  return table;
+}
+
+}  // namespace
+
+const std::vector<ParamSpec>& parameterTable() {
+  static const std::vector<ParamSpec> table = buildTable();
+  return table;
+}
+
+std::string resolveFrame(const std::string& tf_prefix, const std::string& frame) {
+  if (!frame.empty() && frame[0] == '/') return frame.substr(1);
+  const std::size_t first = tf_prefix.find_first_not_of('/');
+  if (first == std::string::npos) return frame;  // empty, or nothing but slashes
+  const std::size_t last = tf_prefix.find_last_not_of('/');
+  return tf_prefix.substr(first, last - first + 1) + "/" + frame;
+}
+
+void DriverParams::resolveFrames() {
+  base.odom_frame = resolveFrame(tf_prefix, base.odom_frame);
+  base.base_frame = resolveFrame(tf_prefix, base.base_frame);
+  imu.frame_id = resolveFrame(tf_prefix, imu.frame_id);
+}
+
+const DevicePortParams& DriverParams::portParams(const device::DeviceModule& device) const {
+  return device.port_params(const_cast<DriverParams&>(*this));
+}
+
+DevicePortParams& DriverParams::portParams(const device::DeviceModule& device) {
+  return device.port_params(*this);
+}
+
+bool DriverParams::enabled(const std::string& name) const {
+  const device::DeviceModule* device = device::findDevice(name);
+  return device != nullptr && enabled(*device);
+}
+
+std::string DriverParams::portOf(const device::DeviceModule& device) const {
+  const DevicePortParams& own = portParams(device);
+  return own.port.empty() ? port : own.port;
+}
+
+int DriverParams::baudOf(const device::DeviceModule& device) const {
+  const DevicePortParams& own = portParams(device);
+  return own.baud > 0 ? own.baud : baud;
+}
+
+void DriverParams::validate() const {
+  // Single values first (the table; a device's only while it is enabled), then what relates
+  // several parameters.
+  for (const auto& spec : parameterTable()) {
+    if (spec.device.empty() || enabled(spec.device)) spec.check(*this);
+  }
+
+  require(tf_prefix.find(' ') == std::string::npos, "tf_prefix", "must not contain spaces");
+  require(!capture || replay_bag.empty(), "capture",
+          "cannot be combined with ~replay_bag: a replay reads a capture and writes nothing");
+  const auto& devices = device::registeredDevices();
+  std::string all_devices;
+  bool any_enabled = false;
+  for (const device::DeviceModule* device : devices) {
+    all_devices += (all_devices.empty() ? "" : ", ") + std::string(device->name);
+    any_enabled |= enabled(*device);
+  }
+  require(any_enabled, std::string(devices.front()->name) + "/enabled",
+          "every device is disabled (" + all_devices + "): nothing to drive");
+  for (const device::DeviceModule* device : devices) {
+    if (enabled(*device) && device->validate) device->validate(*this);
+  }
+
+  // Devices sharing a path share one port, so they must agree on its baud rate.
+  struct Use {
+    std::string name, path;
+    int baud;
+  };
+  std::vector<Use> uses;
+  for (const device::DeviceModule* device : devices) {
+    if (!enabled(*device)) continue;
+    uses.push_back({device->name, portOf(*device), baudOf(*device)});
+  }
+  for (std::size_t i = 0; i < uses.size(); ++i) {
+    for (std::size_t j = i + 1; j < uses.size(); ++j) {
+      require(uses[i].path != uses[j].path || uses[i].baud == uses[j].baud, uses[j].name + "/baud",
+              "differs from " + uses[i].name + "'s baud on the shared port " + uses[i].path);
+    }
+  }
+}
+
+DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unknown_keys) {
+  DriverParams params;
+  // diagnostic_period: read by diagnostic_updater itself; tf_prefix: searched for, may be private.
+  std::set<std::string> known = {"diagnostic_period", "tf_prefix"};
+  for (const auto& spec : parameterTable()) {
+    known.insert(spec.key);
+    if (!source.has(spec.key)) continue;
+    ParamValue value = spec.get(params);
+    // A present key of the wrong type is an error, not a silent default.
+    if (!source.get(spec.key, &value)) throw ParameterError(spec.key, "must be " + typeName(value));
+    spec.set(params, value);
+  }
+  if (unknown_keys) {
+    unknown_keys->clear();
+    for (const auto& key : source.keys()) {
+      if (!known.count(key)) unknown_keys->push_back(key);
+    }
+  }
+  return params;
+}
+
+TuningResult tuneParams(const DriverParams& in_force,
+                        const std::vector<ParamAssignment>& requested) {
+  TuningResult result{in_force, {}};
+  for (const auto& [key, value] : requested) {
+    const ParamSpec& spec = specFor(key);
+    if (spec.get(in_force).index() != value.index()) {
+      throw std::invalid_argument("~" + key + ": the value has another type than the parameter");
+    }
+    spec.set(result.applied, value);
+  }
+  const auto refuse = [&](const std::string& key, const std::string& why) {
+    const ParamSpec& spec = specFor(key);
+    result.refusals.push_back("~" + key + " = " + toText(spec.get(result.applied)) + " refused (" +
+                              why + "); keeping " + toText(spec.get(in_force)));
+    spec.set(result.applied, spec.get(in_force));
+  };
+  // Each round refuses at least one changed value, and `in_force` itself passes validate().
+  for (std::size_t round = 0; round <= requested.size(); ++round) {
+    try {
+      result.applied.validate();
+      return result;
+    } catch (const ParameterError& error) {
+      bool named_value_changed = false;
+      for (const auto& [key, value] : requested) {
+        if (key == error.name() && specFor(key).get(result.applied) != specFor(key).get(in_force)) {
+          named_value_changed = true;
+        }
+      }
+      if (named_value_changed) {
+        refuse(error.name(), error.what());
+        continue;
+      }
+      // A rule between several values, broken by the change: refuse all of it.
+      for (const auto& [key, value] : requested) {
+        if (specFor(key).get(result.applied) != specFor(key).get(in_force))
+          refuse(key, error.what());
+      }
+    }
+  }
+  result.applied.validate();  // unreachable unless `in_force` was invalid: throws then
+  return result;
+}
+
+}  // namespace serial_robot_driver::params
