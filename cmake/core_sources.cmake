@@ -23,6 +23,8 @@ set(SRD_CORE_SOURCES
   src/trajectory/command.cpp
   src/trajectory/tolerances.cpp
   src/trajectory/bus_joint.cpp
+  src/trajectory/joint_groups.cpp
+  src/trajectory/executor.cpp
   src/device/servo_bus_queries.cpp
   src/device/servo_bus_settings.cpp
   src/device/servo_bus_motion.cpp

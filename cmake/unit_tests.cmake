@@ -51,13 +51,15 @@ target_include_directories(trajectory_action_definition_tests PRIVATE ${catkin_I
 target_link_libraries(trajectory_action_definition_tests ${catkin_LIBRARIES} gtest_main)
 add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_messages_cpp)
 
-# The ROS-free trajectory core: interpolation, replacement, goal validation, tolerances.
-catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp)
+# The ROS-free trajectory core: interpolation, replacement, goal validation, tolerances, the joint
+# groups and the executor (goals, ticks, stops) on a clock the tests step.
+catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp
+  test/unit/test_trajectory_joints.cpp
+  test/unit/test_trajectory_executor.cpp)
 target_link_libraries(trajectory_tests srd_core gtest_main)
 
-# Trajectories' ROS-side pure functions (messages, bus joints, what a stop holds); no roscore.
-catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp
-  test/unit/test_trajectory_stop.cpp)
+# Trajectories' ROS-side pure functions (messages, bus joints from parameters, stamps); no roscore.
+catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp)
 target_include_directories(trajectory_ros_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(trajectory_ros_tests srd_ros gtest_main)
 

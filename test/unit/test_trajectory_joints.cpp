@@ -1,6 +1,6 @@
-// What a stop holds and the clock trajectories run on, without a roscore: the streamed joints'
-// hold position, the body's last commanded position, the bus joints' stop hook (a SPIN stop, never
-// a move), the steady start of a goal's ROS stamp and the bus joints' freshness limit.
+// The ROS-free joint groups and the clock trajectories run on: where a stop holds a streamed
+// joint, the body's last commanded position, the bus joints' stop hook (a SPIN stop, never a
+// move), one ROTATE per bus segment and the bus joints' freshness limit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,11 +11,9 @@
 #include <vector>
 
 #include "serial_robot_driver/device/body_controller.h"
-#include "serial_robot_driver/ros/trajectory_bus_joints.h"
-#include "serial_robot_driver/ros/trajectory_joints.h"
-#include "serial_robot_driver/ros/trajectory_server.h"
+#include "serial_robot_driver/trajectory/joint_groups.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::trajectory {
 namespace {
 
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
@@ -77,7 +75,7 @@ TEST(TrajectoryStop, BodyJointsOfferTheLastCommandToTheServer) {
 }
 
 TEST(TrajectoryStop, BusJointStopIsAStopOfItsServoNeverAMove) {
-  const std::vector<trajectory::BusJoint> joints = {{9, "tilt", -20.0, -1}, {4, "pan", 0.0, 1}};
+  const std::vector<BusJoint> joints = {{9, "tilt", -20.0, -1}, {4, "pan", 0.0, 1}};
   std::vector<uint8_t> stopped;
   int moves = 0;
   const TrajectoryJoints group = busTrajectoryJoints(
@@ -110,20 +108,33 @@ TEST(TrajectoryStop, BusStateTimeoutFollowsThePollRate) {
   EXPECT_EQ(busTrajectoryJoints({{9, "tilt", 0.0, 1}}, {}, 1.0).state_timeout, 3.0);
 }
 
-TEST(TrajectoryStop, GoalStampBecomesASteadyStartOnce) {
-  // Zero: now on the steady clock, whatever the ROS clock says.
-  EXPECT_EQ(steadyStart(ros::Time(), 500.0, ros::Time(1e9)), 500.0);
-  // 2 s ahead of the ROS clock: 2 s ahead on the steady clock.
-  EXPECT_NEAR(steadyStart(ros::Time(1000.0), 500.0, ros::Time(998.0)), 502.0, 1e-9);
-  // 1.5 s behind.
-  EXPECT_NEAR(steadyStart(ros::Time(1000.0), 500.0, ros::Time(1001.5)), 498.5, 1e-9);
-}
-
 TEST(TrajectoryStop, SteadyNowNeverGoesBack) {
   const double first = steadyNow();
   const double second = steadyNow();
   EXPECT_GE(second, first);
 }
 
+TEST(TrajectoryJointGroups, BusSegmentIsOneRotateInTheServosDegrees) {
+  const std::vector<BusJoint> joints = {{9, "tilt", -20.0, -1}};
+  std::vector<std::tuple<uint8_t, double, uint32_t>> queued;
+  const TrajectoryJoints group = busTrajectoryJoints(
+      joints,
+      [&](uint8_t id, double angle_deg, uint32_t interval_ms) {
+        queued.emplace_back(id, angle_deg, interval_ms);
+        return std::string();
+      },
+      20.0);
+  ASSERT_EQ(group.joints.size(), 1u);
+  EXPECT_EQ(group.joints[0].name, "tilt");
+  EXPECT_FALSE(group.write);
+  EXPECT_EQ(group.state_timeout, 0.5);  // three polls at 20 Hz are less
+  EXPECT_TRUE(group.move(0, M_PI / 2, 0.7504).empty());
+  ASSERT_EQ(queued.size(), 1u);
+  EXPECT_EQ(std::get<0>(queued[0]), 9);
+  EXPECT_NEAR(std::get<1>(queued[0]), -110.0, 1e-9);  // -20 - 90
+  EXPECT_EQ(std::get<2>(queued[0]), 750u);
+  EXPECT_EQ(busTrajectoryJoints(joints, {}, 2.0).state_timeout, 1.5);
+}
+
 }  // namespace
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::trajectory
