@@ -23,6 +23,7 @@ constexpr double kMaxVelocityDps = 750.0;
 constexpr double kMinVelocityDps = 0.1;  // the wire unit; anything less is sent as 0
 constexpr uint16_t kMinRampMs = 20;      // the firmware's shortest ramp
 constexpr uint32_t kMaxMultiTurnIntervalMs = 4096000;
+
 }  // namespace
 
 ServoStatus toMoveCommand(const MoveRequest& request, servo::MoveCommand* out) {
