@@ -14,6 +14,8 @@ catkin_add_gtest(core_tests
   test/unit/test_base_controller.cpp
   test/unit/test_body_controller.cpp
   test/unit/test_servo_bus_client.cpp
+  test/unit/test_servo_bus_client_operations.cpp
+  test/unit/test_servo_bus_client_rejections.cpp
   test/unit/test_servo_bus.cpp
   test/unit/test_servo_bus_stops.cpp
   test/unit/test_servo_bus_on_link.cpp
