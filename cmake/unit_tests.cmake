@@ -5,13 +5,22 @@ catkin_add_gtest(core_tests
   test/unit/test_servo_bus_codec.cpp
   test/unit/test_servo_commands.cpp
   test/unit/test_servo_params.cpp
-  test/unit/test_stream_framer.cpp
+  test/unit/test_stream_framer_golden_frames.cpp
+  test/unit/test_stream_framer_streams.cpp
+  test/unit/test_stream_framer_broken_frames.cpp
+  test/unit/test_stream_framer_buffering.cpp
+  test/unit/test_stream_framer_random_junk.cpp
   test/unit/test_diff_drive.cpp
   test/unit/test_odometry.cpp
-  test/unit/test_transport.cpp
+  test/unit/test_transport_pty_io.cpp
+  test/unit/test_transport_errors_and_links.cpp
+  test/unit/test_transport_baud_and_lock.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_serial_link.cpp
-  test/unit/test_base_controller.cpp
+  test/unit/test_base_controller_commands.cpp
+  test/unit/test_base_controller_odometry.cpp
+  test/unit/test_base_controller_polling.cpp
+  test/unit/test_base_controller_retune.cpp
   test/unit/test_body_controller.cpp
   test/unit/test_servo_bus_client.cpp
   test/unit/test_servo_bus_client_operations.cpp
@@ -19,7 +28,10 @@ catkin_add_gtest(core_tests
   test/unit/test_servo_bus.cpp
   test/unit/test_servo_bus_stops.cpp
   test/unit/test_servo_bus_on_link.cpp
-  test/unit/test_sim.cpp
+  test/unit/test_sim_device_models.cpp
+  test/unit/test_sim_pty_devices.cpp
+  test/unit/test_sim_whole_robot.cpp
+  test/unit/test_sim_command_line.cpp
   test/unit/test_device_set.cpp
   test/unit/test_servo_health.cpp
   test/unit/test_e_stop.cpp)
