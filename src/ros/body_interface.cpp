@@ -8,7 +8,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/ros/conversions.h"
-#include "serial_robot_driver/ros/trajectory_joints.h"
+#include "serial_robot_driver/trajectory/joint_groups.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -53,7 +53,7 @@ void BodyInterface::attachEStop(device::EStop& e_stop) {
 }
 
 std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
-  return {bodyTrajectoryJoints(controller_)};
+  return {trajectory::bodyTrajectoryJoints(controller_)};
 }
 
 void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
