@@ -17,6 +17,7 @@
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/framer_configs.h"
 
 namespace {
 std::atomic<uint64_t> g_allocations{0};
@@ -105,7 +106,7 @@ const MixedStream& mixedStream() {
   return stream;
 }
 
-FramerConfig driverConfig() { return FramerConfig::forDriver(true, true, true, kServoCount); }
+FramerConfig driverConfig() { return test_support::driverFramer({"base", "body", "servo_bus"}, kServoCount); }
 
 // Framer over the mixed stream, fed in chunks of state.range(0) bytes (a serial read returns small
 // chunks; a backlog after a stall returns big ones).
@@ -146,23 +147,16 @@ void BM_FramerAndDecodeMixedStream(benchmark::State& state) {
   uint64_t frames = 0;
   uint64_t decoded_ok = 0;
   StreamFramer framer(driverConfig(),
-                      [&](FrameFamily family, const uint8_t* data, std::size_t size) {
+                      [&](const FrameFamily& family, const uint8_t* data, std::size_t size) {
                         ++frames;
-                        switch (family) {
-                          case protocol::body::kTelemetryFrames:
-                            decoded_ok += body::decodeTelemetry(data, size, kServoCount).ok();
-                            break;
-                          case protocol::base::kFrames:
-                            decoded_ok += base::decodeFrame(data, size).ok();
-                            break;
-                          case protocol::servo::kResponseFrames:
-                            decoded_ok += servo::decodeResponse(data, size).ok();
-                            break;
-                          case protocol::servo::kRequestFrames:
-                            decoded_ok += servo::decodeRequest(data, size).ok();
-                            break;
-                          case protocol::body::kSyncWriteFrames:
-                            break;
+                        if (family == body::kTelemetryFrames) {
+                          decoded_ok += body::decodeTelemetry(data, size, kServoCount).ok();
+                        } else if (family == base::kFrames) {
+                          decoded_ok += base::decodeFrame(data, size).ok();
+                        } else if (family == servo::kResponseFrames) {
+                          decoded_ok += servo::decodeResponse(data, size).ok();
+                        } else if (family == servo::kRequestFrames) {
+                          decoded_ok += servo::decodeRequest(data, size).ok();
                         }
                       });
   constexpr std::size_t kChunk = 512;

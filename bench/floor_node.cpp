@@ -27,6 +27,7 @@
 #include "serial_robot_driver/protocol/base_codec.h"
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/framer_configs.h"
 
 namespace srd = serial_robot_driver;
 
@@ -97,7 +98,7 @@ int main(int argc, char** argv) {
   std::thread reader;
   if (body) {
     reader = std::thread([&] {
-      const auto config = srd::protocol::FramerConfig::forDriver(false, true, false, ids.size());
+      const auto config = test_support::driverFramer({"body"}, ids.size());
       srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
                                                      std::size_t size) {
         if (family != srd::protocol::body::kTelemetryFrames) return;

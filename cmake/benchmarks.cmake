@@ -4,12 +4,13 @@
 find_package(benchmark QUIET)
 if(benchmark_FOUND)
   add_executable(bench_framer bench/bench_framer.cpp)
+  target_include_directories(bench_framer PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/framer_configs.h
   target_link_libraries(bench_framer srd_core srd_sim benchmark::benchmark)
 endif()
 
 # The floor: the least a roscpp driver of this robot must do, driver_bench's yardstick.
 add_executable(floor_node bench/floor_node.cpp)
-target_include_directories(floor_node PRIVATE ${catkin_INCLUDE_DIRS})
+target_include_directories(floor_node PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})
 target_link_libraries(floor_node srd_core ${catkin_LIBRARIES})
 add_dependencies(floor_node ${catkin_EXPORTED_TARGETS})
 

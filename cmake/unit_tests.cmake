@@ -32,7 +32,7 @@ catkin_add_gtest(core_tests
   test/unit/test_sim_pty_devices.cpp
   test/unit/test_sim_whole_robot.cpp
   test/unit/test_sim_command_line.cpp
-  test/unit/test_device_set.cpp
+  test/unit/test_device_registry.cpp
   test/unit/test_servo_health.cpp
   test/unit/test_e_stop.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h

@@ -37,21 +37,10 @@ void check(bool condition) {
   if (!condition) std::abort();
 }
 
-bool enabled(const FramerConfig& config, FrameFamily family) {
-  switch (family) {
-    case protocol::base::kFrames:
-      return config.base;
-    case protocol::body::kTelemetryFrames:
-      return config.telemetry;
-    case protocol::servo::kResponseFrames:
-      return config.servo_response;
-    case protocol::servo::kRequestFrames:
-      return config.servo_request;
-    case protocol::body::kSyncWriteFrames:
-      return config.sync_write;
-  }
-  return false;
-}
+// The families input byte 0 selects, bit by bit.
+const FrameFamily* const kFamilies[] = {&base::kFrames, &body::kTelemetryFrames,
+                                        &servo::kResponseFrames, &servo::kRequestFrames,
+                                        &body::kSyncWriteFrames};
 
 // A verified frame may still carry content its decoder refuses (a Dynamixel sync write to another
 // address), but never a framing error.
@@ -60,44 +49,36 @@ void checkFramingAgrees(const serial_robot_driver::protocol::Decoded<T>& decoded
   check(decoded.ok() || decoded.error() == DecodeError::kUnexpectedContent);
 }
 
-void decodeFrame(const FramerConfig& config, FrameFamily family, const uint8_t* frame,
+void decodeFrame(const FramerConfig& config, const FrameFamily& family, const uint8_t* frame,
                  std::size_t size) {
-  check(enabled(config, family));
+  check(config.accepts(family));
   check(size > 0 && size <= StreamFramer::kLongestFrame);
   // An exact-size heap copy, so that a decoder reading past the frame trips ASan.
   std::unique_ptr<uint8_t[]> copy(new uint8_t[size]);
   std::memcpy(copy.get(), frame, size);
   const uint8_t* data = copy.get();
-  switch (family) {
-    case protocol::base::kFrames: {
-      const auto decoded = base::decodeFrame(data, size);
-      check(decoded.ok());
-      (void)base::interpretReply(*decoded);
-      (void)base::interpretWheelSpeed(*decoded);
-      break;
-    }
-    case protocol::body::kTelemetryFrames: {
-      const auto decoded = body::decodeTelemetry(data, size, config.telemetry_servo_count);
-      check(decoded.ok());
-      check(decoded->servo_count == config.telemetry_servo_count);
-      break;
-    }
-    case protocol::servo::kResponseFrames: {
-      const auto decoded = servo::decodeResponse(data, size);
-      check(decoded.ok());
-      check(decoded->content_size + servo::kOverhead == size);
-      break;
-    }
-    case protocol::servo::kRequestFrames: {
-      const auto decoded = servo::decodeRequest(data, size);
-      check(decoded.ok());
-      check(decoded->content_size + servo::kOverhead == size);
-      break;
-    }
-    case protocol::body::kSyncWriteFrames: {
-      checkFramingAgrees(body::decodeSyncWrite(data, size));
-      break;
-    }
+  if (family == base::kFrames) {
+    const auto decoded = base::decodeFrame(data, size);
+    check(decoded.ok());
+    (void)base::interpretReply(*decoded);
+    (void)base::interpretWheelSpeed(*decoded);
+  } else if (family == body::kTelemetryFrames) {
+    const std::size_t servo_count = config.expectedOf(body::kTelemetryFrames);
+    const auto decoded = body::decodeTelemetry(data, size, servo_count);
+    check(decoded.ok());
+    check(decoded->servo_count == servo_count);
+  } else if (family == servo::kResponseFrames) {
+    const auto decoded = servo::decodeResponse(data, size);
+    check(decoded.ok());
+    check(decoded->content_size + servo::kOverhead == size);
+  } else if (family == servo::kRequestFrames) {
+    const auto decoded = servo::decodeRequest(data, size);
+    check(decoded.ok());
+    check(decoded->content_size + servo::kOverhead == size);
+  } else if (family == body::kSyncWriteFrames) {
+    checkFramingAgrees(body::decodeSyncWrite(data, size));
+  } else {
+    check(false);  // a family nobody configured
   }
 }
 
@@ -107,20 +88,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* input, std::size_t input_si
   constexpr std::size_t kPrefix = 3;
   if (input_size < kPrefix) return 0;
   FramerConfig config;
-  config.base = (input[0] & 0x01) != 0;
-  config.telemetry = (input[0] & 0x02) != 0;
-  config.servo_response = (input[0] & 0x04) != 0;
-  config.servo_request = (input[0] & 0x08) != 0;
-  config.sync_write = (input[0] & 0x10) != 0;
+  for (std::size_t bit = 0; bit < sizeof(kFamilies) / sizeof(kFamilies[0]); ++bit) {
+    // The telemetry's argument: its servo count.
+    const std::size_t expected = kFamilies[bit] == &body::kTelemetryFrames ? input[1] % 64 : 0;
+    if (input[0] & (1u << bit)) config.accept(*kFamilies[bit], expected);
+  }
   const bool reset_half_way = (input[0] & 0x80) != 0;
-  config.telemetry_servo_count = input[1] % 64;
   const std::size_t max_chunk = input[2];
 
   const uint8_t* stream = input + kPrefix;
   const std::size_t stream_size = input_size - kPrefix;
 
   uint64_t frame_bytes = 0;
-  StreamFramer framer(config, [&](FrameFamily family, const uint8_t* data, std::size_t size) {
+  StreamFramer framer(config, [&](const FrameFamily& family, const uint8_t* data, std::size_t size) {
     frame_bytes += size;
     decodeFrame(config, family, data, size);
   });

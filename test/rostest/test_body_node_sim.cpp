@@ -2,6 +2,7 @@
 // launch/record.launch recording that namespace; and the main() of the test_body_node target.
 #include <gtest/gtest.h>
 
+#include "serial_robot_driver/protocol/body_codec.h"
 #include "support/body_node_fixture.h"
 
 namespace {
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
   Board board;
   // The pty first: the node keeps retrying its port until the symlink exists.
   serial_robot_driver::protocol::FramerConfig framer;
-  framer.sync_write = true;
+  framer.accept(serial_robot_driver::protocol::body::kSyncWriteFrames);
   board.device = std::make_unique<test_support::FakeDevice>(port, framer);
   board.device->plug();
   board.subscribers.push_back(subscribe(nh, "joint_states", &board.joints));

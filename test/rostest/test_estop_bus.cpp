@@ -19,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
@@ -52,7 +54,7 @@ std::string g_bus_sim_port;
 
 std::unique_ptr<PtyTap> plugBus() {
   srd::protocol::FramerConfig framer;
-  framer.servo_request = true;
+  framer.accept(serial_robot_driver::protocol::servo::kRequestFrames);
   return std::make_unique<PtyTap>(g_bus_port, g_bus_sim_port, framer);
 }
 
@@ -241,7 +243,7 @@ int main(int argc, char** argv) {
   robot.start();
   g_robot = &robot;
   srd::protocol::FramerConfig base_framer;
-  base_framer.base = true;
+  base_framer.accept(serial_robot_driver::protocol::base::kFrames);
   PtyTap base(base_port, *options.base_link, base_framer);
   g_base = &base;
   std::unique_ptr<PtyTap> bus = plugBus();

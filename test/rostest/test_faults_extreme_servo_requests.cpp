@@ -37,7 +37,7 @@ TEST_F(ExtremeInputs, ServoRequestsOutOfRangeFailCleanlyWithoutBytes) {
 
   const auto requests_on_wire = [&] {
     const sim::SimStats s = robot.stats();
-    return s.framer.frames[static_cast<std::size_t>(protocol::servo::kRequestFrames)];
+    return s.framer.framesOf(protocol::servo::kRequestFrames);
   };
   const uint64_t wire_before = requests_on_wire();
   const uint64_t sim_requests_before = robot.stats().servo_bus.requests;

@@ -20,7 +20,7 @@ using namespace faults_test;  // NOLINT: the shared fixture
 /// the node writes in the current session.
 std::unique_ptr<test_support::FakeDevice> handPlayedRobot(const std::string& path) {
   protocol::FramerConfig config;
-  config.base = true;
+  config.accept(protocol::base::kFrames);
   return std::make_unique<test_support::FakeDevice>(path, config);
 }
 

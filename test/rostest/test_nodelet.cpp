@@ -24,6 +24,7 @@
 #include "support/fake_device.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
+#include "support/framer_configs.h"
 
 namespace {
 
@@ -52,7 +53,7 @@ std::vector<FakeDevice::Frame> speedFrames(const FakeDevice& device) {
 
 std::unique_ptr<FakeDevice> makeBase(const std::string& port) {
   auto base =
-      std::make_unique<FakeDevice>(port, protocol::FramerConfig::forDriver(true, false, false, 0));
+      std::make_unique<FakeDevice>(port, test_support::driverFramer({"base"}));
   base->plug();
   return base;
 }

@@ -12,6 +12,7 @@
 #include "support/fake_device.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
+#include "support/framer_configs.h"
 
 namespace {
 
@@ -22,7 +23,7 @@ namespace protocol = serial_robot_driver::protocol;
 TEST(PortBusy, SecondInstanceIsRefusedAndTheFirstKeepsDriving) {
   std::string port;
   ASSERT_TRUE(ros::param::get("/driver_node/port", port));
-  FakeDevice base(port, protocol::FramerConfig::forDriver(true, false, false, 0));
+  FakeDevice base(port, test_support::driverFramer({"base"}));
   base.plug();
   ASSERT_TRUE(waitFor([&] { return base.frameCount() >= 5; }, 20.0))
       << "the first node sends nothing";

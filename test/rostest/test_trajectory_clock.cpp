@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
@@ -156,7 +157,7 @@ int main(int argc, char** argv) {
   robot.start();
   g_robot = &robot;
   serial_robot_driver::protocol::FramerConfig framer;
-  framer.sync_write = true;
+  framer.accept(serial_robot_driver::protocol::body::kSyncWriteFrames);
   test_support::PtyTap tap(port, *options.body_link, framer);
   g_tap = &tap;
 

@@ -16,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
@@ -285,7 +287,7 @@ int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   test_support::RosTestNode node(argc, argv, "test_trajectory_stop");
   serial_robot_driver::protocol::FramerConfig body_framer;
-  body_framer.sync_write = true;
+  body_framer.accept(serial_robot_driver::protocol::body::kSyncWriteFrames);
   test_support::FakeDevice body(test_support::nodeParam(kNode, "port"), body_framer);
   body.plug();
   g_body = &body;
@@ -300,7 +302,7 @@ int main(int argc, char** argv) {
   robot.start();
   g_robot = &robot;
   serial_robot_driver::protocol::FramerConfig bus_framer;
-  bus_framer.servo_request = true;
+  bus_framer.accept(serial_robot_driver::protocol::servo::kRequestFrames);
   test_support::PtyTap tap(bus_port, *options.servo_link, bus_framer);
   g_bus = &tap;
 

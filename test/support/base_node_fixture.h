@@ -136,7 +136,7 @@ class FakeBase {
  private:
   static protocol::FramerConfig baseFramer() {
     protocol::FramerConfig config;
-    config.base = true;
+    config.accept(protocol::base::kFrames);
     return config;
   }
 

@@ -65,7 +65,7 @@ using ServoBusPlayer = test_support::FakeDevice;
 /// request is written back first, as an adapter with a looped-back transmit line does.
 inline std::unique_ptr<ServoBusPlayer> servoBus(const std::string& path, bool echo) {
   protocol::FramerConfig config;
-  config.servo_request = true;
+  config.accept(protocol::servo::kRequestFrames);
   auto bus = std::make_unique<ServoBusPlayer>(path, config, echo);
   bus->plug();
   return bus;

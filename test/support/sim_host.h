@@ -30,6 +30,7 @@
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "serial_robot_driver/sim/servo_bus_sim.h"
 #include "support/golden_frames.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::sim::sim_test {
 
@@ -210,11 +211,11 @@ inline SimOptions onlyServoBus() {
   return options;
 }
 
-inline FramerConfig baseHostConfig() { return FramerConfig::forDriver(true, false, false, 0); }
+inline FramerConfig baseHostConfig() { return test_support::driverFramer({"base"}); }
 inline FramerConfig bodyHostConfig(std::size_t servos) {
-  return FramerConfig::forDriver(false, true, false, servos);
+  return test_support::driverFramer({"body"}, servos);
 }
-inline FramerConfig servoHostConfig() { return FramerConfig::forDriver(false, false, true, 0); }
+inline FramerConfig servoHostConfig() { return test_support::driverFramer({"servo_bus"}); }
 
 inline std::string slaveOf(const RobotSim& sim) { return sim.ports().at(0).slave_path; }
 

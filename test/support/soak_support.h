@@ -31,6 +31,7 @@
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
+#include "support/framer_configs.h"
 
 namespace soak_test {
 
@@ -63,9 +64,9 @@ inline uint64_t telemetryIntact(const sim::SimStats& s) {
 }
 inline uint64_t hostFramesReceived(const sim::SimStats& s) {
   using protocol::FrameFamily;
-  return s.framer.frames[static_cast<std::size_t>(protocol::base::kFrames)] +
-         s.framer.frames[static_cast<std::size_t>(protocol::servo::kRequestFrames)] +
-         s.framer.frames[static_cast<std::size_t>(protocol::body::kSyncWriteFrames)];
+  return s.framer.framesOf(protocol::base::kFrames) +
+         s.framer.framesOf(protocol::servo::kRequestFrames) +
+         s.framer.framesOf(protocol::body::kSyncWriteFrames);
 }
 
 /// Both sides at rest while the pty is unplugged.

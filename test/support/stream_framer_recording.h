@@ -16,6 +16,7 @@
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/golden_frames.h"
 #include "support/test_helpers.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::protocol::stream_framer_test {
 
@@ -52,16 +53,7 @@ inline const Bytes& kServoEmptyReply = golden::servo::kEmptyPingReply;
 
 constexpr std::size_t kServoCount = 2;
 
-inline FramerConfig allFamilies() {
-  FramerConfig config;
-  config.base = true;
-  config.telemetry = true;
-  config.servo_response = true;
-  config.servo_request = true;
-  config.sync_write = true;
-  config.telemetry_servo_count = kServoCount;
-  return config;
-}
+inline FramerConfig allFamilies() { return test_support::everyFamily(kServoCount); }
 
 struct Frame {
   FrameFamily family;
@@ -72,7 +64,7 @@ struct Frame {
 };
 
 inline std::ostream& operator<<(std::ostream& os, const Frame& frame) {
-  os << toString(frame.family) << " [" << frame.bytes.size() << " bytes]";
+  os << frame.family.name << " [" << frame.bytes.size() << " bytes]";
   return os;
 }
 
@@ -111,11 +103,13 @@ class RecordingFramer {
 };
 
 inline uint64_t frameCount(const FramerStats& stats, FrameFamily family) {
-  return stats.frames[static_cast<std::size_t>(family)];
+  return stats.framesOf(family);
 }
 
 inline uint64_t totalFrames(const FramerStats& stats) {
-  return std::accumulate(stats.frames.begin(), stats.frames.end(), uint64_t{0});
+  uint64_t total = 0;
+  for (std::size_t i = 0; i < stats.family_count; ++i) total += stats.by_family[i].frames;
+  return total;
 }
 
 inline uint64_t errorCount(const FramerStats& stats) {

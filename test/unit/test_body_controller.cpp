@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/device/body_controller.h"
 #include "support/golden_frames.h"
 

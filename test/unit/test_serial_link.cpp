@@ -13,6 +13,7 @@
 #include "serial_robot_driver/transport/recorded_stream.h"
 #include "support/test_helpers.h"
 #include "support/golden_frames.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::device {
 namespace {
@@ -51,7 +52,7 @@ SerialLinkOptions optionsFor(const std::string& path) {
   SerialLinkOptions options;
   options.path = path;
   options.reconnect_interval = 0.05;
-  options.framer = protocol::FramerConfig::forDriver(true, true, true, 2);
+  options.framer = test_support::driverFramer({"base", "body", "servo_bus"}, 2);
   return options;
 }
 
@@ -119,7 +120,11 @@ void expectSameCounters(const protocol::FramerStats& replayed, const protocol::F
   EXPECT_EQ(replayed.checksum_errors, live.checksum_errors);
   EXPECT_EQ(replayed.unknown_commands, live.unknown_commands);
   EXPECT_EQ(replayed.stale_candidates, live.stale_candidates);
-  EXPECT_EQ(replayed.frames, live.frames);
+  ASSERT_EQ(replayed.family_count, live.family_count);
+  for (std::size_t i = 0; i < live.family_count; ++i) {
+    EXPECT_STREQ(replayed.by_family[i].family, live.by_family[i].family);
+    EXPECT_EQ(replayed.by_family[i].frames, live.by_family[i].frames);
+  }
 }
 
 // A partial frame followed by silence, live on a pty and captured; then that capture replayed at

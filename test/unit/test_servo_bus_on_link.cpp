@@ -17,6 +17,7 @@
 #include "serial_robot_driver/device/servo_bus.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/test_helpers.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::device {
 namespace {
@@ -42,7 +43,7 @@ struct BusOnLink {
     SerialLinkOptions link_options;
     link_options.path = options.link;
     link_options.reconnect_interval = 0.05;
-    link_options.framer = protocol::FramerConfig::forDriver(false, false, true, 0);
+    link_options.framer = test_support::driverFramer({"servo_bus"});
     link_options.stale_frame_timeout = config.client.timeout;
     link = std::make_unique<SerialLink>(link_options);
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/sim_host.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::sim {
 namespace {
@@ -24,7 +25,7 @@ TEST(RobotSim, SharedPortCarriesAllThreeDevicesBehindTheLink) {
   ASSERT_GT(::readlink(options.link.c_str(), target, sizeof(target) - 1), 0);
   EXPECT_EQ(std::string(target), ports[0].slave_path);
 
-  Host host(options.link, FramerConfig::forDriver(true, true, true, 2));
+  Host host(options.link, test_support::driverFramer({"base", "body", "servo_bus"}, 2));
   ASSERT_TRUE(host.ok());
   host.send(kBatteryRequestSeq1);
   host.send({0x12, 0x4C, 0x01, 0x01, 0x01, 0x61});  // PING id 1

@@ -28,7 +28,7 @@ TEST_P(StreamFramerBroken, CountedSkippedAndTheNextFrameStillComesThrough) {
   for (const Frame& good :
        {Frame{protocol::servo::kResponseFrames, kServoPingReply},
         Frame{protocol::base::kFrames, kBaseBatteryReply}, Frame{protocol::body::kSyncWriteFrames, kSyncWrite}}) {
-    SCOPED_TRACE(toString(good.family));
+    SCOPED_TRACE(good.family.name);
     RecordingFramer framer(allFamilies());
     framer.feed(concat({c.broken, good.bytes}));
     ASSERT_EQ(framer.frames().size(), 1u);

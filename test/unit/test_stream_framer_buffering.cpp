@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "support/stream_framer_recording.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
@@ -55,7 +56,7 @@ TEST(StreamFramerStale, AStrayHeaderWithALongLenStopsHoldingBackTheAnswerBehindI
   // 05 1C 01 21: a PING answer header claiming N = 33, so 38 bytes; only the real answer follows.
   Bytes stream = {0x05, 0x1C, 0x01, 0x21};
   stream.insert(stream.end(), golden::servo::kPing3Reply.begin(), golden::servo::kPing3Reply.end());
-  RecordingFramer framer(FramerConfig::forDriver(false, false, true, 0));
+  RecordingFramer framer(test_support::driverFramer({"servo_bus"}));
   framer.feed(stream);
   EXPECT_TRUE(framer.frames().empty());
   EXPECT_EQ(framer.framer().buffered(), stream.size());

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/stream_framer_recording.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
@@ -11,43 +12,43 @@ using namespace stream_framer_test;  // NOLINT: the shared fixture
 
 // --- small pieces ------------------------------------------------------------------------------
 
-TEST(StreamFramerConfig, ToStringNamesEveryFamily) {
-  EXPECT_STREQ(toString(protocol::base::kFrames), "base");
-  EXPECT_STREQ(toString(protocol::body::kTelemetryFrames), "telemetry");
-  EXPECT_STREQ(toString(protocol::servo::kResponseFrames), "servo_response");
-  EXPECT_STREQ(toString(protocol::servo::kRequestFrames), "servo_request");
-  EXPECT_STREQ(toString(protocol::body::kSyncWriteFrames), "sync_write");
+TEST(StreamFramerConfig, EveryFamilyHasItsName) {
+  EXPECT_STREQ(protocol::base::kFrames.name, "base");
+  EXPECT_STREQ(protocol::body::kTelemetryFrames.name, "telemetry");
+  EXPECT_STREQ(protocol::servo::kResponseFrames.name, "servo_response");
+  EXPECT_STREQ(protocol::servo::kRequestFrames.name, "servo_request");
+  EXPECT_STREQ(protocol::body::kSyncWriteFrames.name, "sync_write");
 }
 
 TEST(StreamFramerConfig, ForDriverEnablesWhatTheDevicesSend) {
-  const FramerConfig all = FramerConfig::forDriver(true, true, true, 7);
-  EXPECT_TRUE(all.base);
-  EXPECT_TRUE(all.telemetry);
-  EXPECT_TRUE(all.servo_response);
-  EXPECT_TRUE(all.servo_request);  // the half-duplex echo of our own requests
-  EXPECT_FALSE(all.sync_write);
-  EXPECT_EQ(all.telemetry_servo_count, 7u);
+  const FramerConfig all = test_support::driverFramer({"base", "body", "servo_bus"}, 7);
+  EXPECT_TRUE(all.accepts(base::kFrames));
+  EXPECT_TRUE(all.accepts(body::kTelemetryFrames));
+  EXPECT_TRUE(all.accepts(servo::kResponseFrames));
+  EXPECT_TRUE(all.accepts(servo::kRequestFrames));  // the half-duplex echo of our own requests
+  EXPECT_FALSE(all.accepts(body::kSyncWriteFrames));
+  EXPECT_EQ(all.expectedOf(body::kTelemetryFrames), 7u);
 
-  const FramerConfig body_only = FramerConfig::forDriver(false, true, false, 2);
-  EXPECT_FALSE(body_only.base);
-  EXPECT_TRUE(body_only.telemetry);
-  EXPECT_FALSE(body_only.servo_response);
-  EXPECT_FALSE(body_only.servo_request);
+  const FramerConfig body_only = test_support::driverFramer({"body"}, 2);
+  EXPECT_FALSE(body_only.accepts(base::kFrames));
+  EXPECT_TRUE(body_only.accepts(body::kTelemetryFrames));
+  EXPECT_FALSE(body_only.accepts(servo::kResponseFrames));
+  EXPECT_FALSE(body_only.accepts(servo::kRequestFrames));
 
-  const FramerConfig bus_only = FramerConfig::forDriver(false, false, true, 0);
-  EXPECT_FALSE(bus_only.base);
-  EXPECT_FALSE(bus_only.telemetry);
-  EXPECT_TRUE(bus_only.servo_response);
-  EXPECT_TRUE(bus_only.servo_request);
+  const FramerConfig bus_only = test_support::driverFramer({"servo_bus"});
+  EXPECT_FALSE(bus_only.accepts(base::kFrames));
+  EXPECT_FALSE(bus_only.accepts(body::kTelemetryFrames));
+  EXPECT_TRUE(bus_only.accepts(servo::kResponseFrames));
+  EXPECT_TRUE(bus_only.accepts(servo::kRequestFrames));
 }
 
 TEST(StreamFramerConfig, ForSimulatorEnablesWhatTheHostSends) {
-  const FramerConfig config = FramerConfig::forSimulator();
-  EXPECT_TRUE(config.base);
-  EXPECT_FALSE(config.telemetry);
-  EXPECT_FALSE(config.servo_response);
-  EXPECT_TRUE(config.servo_request);
-  EXPECT_TRUE(config.sync_write);
+  const FramerConfig config = test_support::simulatorFramer();
+  EXPECT_TRUE(config.accepts(base::kFrames));
+  EXPECT_FALSE(config.accepts(body::kTelemetryFrames));
+  EXPECT_FALSE(config.accepts(servo::kResponseFrames));
+  EXPECT_TRUE(config.accepts(servo::kRequestFrames));
+  EXPECT_TRUE(config.accepts(body::kSyncWriteFrames));
 }
 
 // --- every golden frame, alone
@@ -89,24 +90,15 @@ TEST_P(StreamFramerGolden, ByteByByteEmitsOnlyAfterTheLastByte) {
 }
 
 TEST_P(StreamFramerGolden, IgnoredWhenItsFamilyIsDisabled) {
-  FramerConfig config = allFamilies();
-  switch (GetParam().family) {
-    case protocol::base::kFrames:
-      config.base = false;
-      break;
-    case protocol::body::kTelemetryFrames:
-      config.telemetry = false;
-      break;
-    case protocol::servo::kResponseFrames:
-      config.servo_response = false;
-      break;
-    case protocol::servo::kRequestFrames:
-      config.servo_request = false;
-      break;
-    case protocol::body::kSyncWriteFrames:
-      config.sync_write = false;
-      break;
+  // Every family but the frame's own.
+  const FramerConfig all = allFamilies();
+  FramerConfig config;
+  for (std::size_t i = 0; i < all.family_count; ++i) {
+    if (!(all.families[i].family == GetParam().family)) {
+      config.accept(all.families[i].family, all.families[i].expected);
+    }
   }
+  ASSERT_EQ(config.family_count + 1, all.family_count);
   RecordingFramer framer(config);
   framer.feed(GetParam().bytes);
   EXPECT_TRUE(framer.frames().empty());

@@ -15,32 +15,21 @@ using namespace stream_framer_test;  // NOLINT: the shared fixture
 void expectDecoderAccepts(const Frame& frame) {
   const uint8_t* data = frame.bytes.data();
   const std::size_t size = frame.bytes.size();
-  switch (frame.family) {
-    case protocol::base::kFrames: {
-      const auto decoded = base::decodeFrame(data, size);
-      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
-      break;
-    }
-    case protocol::body::kTelemetryFrames: {
-      const auto decoded = body::decodeTelemetry(data, size, kServoCount);
-      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
-      break;
-    }
-    case protocol::servo::kResponseFrames: {
-      const auto decoded = servo::decodeResponse(data, size);
-      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
-      break;
-    }
-    case protocol::servo::kRequestFrames: {
-      const auto decoded = servo::decodeRequest(data, size);
-      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
-      break;
-    }
-    case protocol::body::kSyncWriteFrames: {
-      const auto decoded = body::decodeSyncWrite(data, size);
-      EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
-      break;
-    }
+  const auto expectOk = [](const auto& decoded) {
+    EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
+  };
+  if (frame.family == base::kFrames) {
+    expectOk(base::decodeFrame(data, size));
+  } else if (frame.family == body::kTelemetryFrames) {
+    expectOk(body::decodeTelemetry(data, size, kServoCount));
+  } else if (frame.family == servo::kResponseFrames) {
+    expectOk(servo::decodeResponse(data, size));
+  } else if (frame.family == servo::kRequestFrames) {
+    expectOk(servo::decodeRequest(data, size));
+  } else if (frame.family == body::kSyncWriteFrames) {
+    expectOk(body::decodeSyncWrite(data, size));
+  } else {
+    ADD_FAILURE() << "a frame of family " << frame.family.name;
   }
 }
 

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "support/stream_framer_recording.h"
+#include "support/framer_configs.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
@@ -99,7 +100,7 @@ TEST(StreamFramerStream, JunkWithLoneHeaderBytesIsSkipped) {
 }
 
 TEST(StreamFramerStream, DynamixelFrameThatIsNotASyncWriteIsSkipped) {
-  FramerConfig config = FramerConfig::forSimulator();
+  FramerConfig config = test_support::simulatorFramer();
   RecordingFramer framer(config);
   framer.feed(concat({kDynamixelPing, kSyncWrite}));
   const std::vector<Frame> expected = {{protocol::body::kSyncWriteFrames, kSyncWrite}};
@@ -110,7 +111,7 @@ TEST(StreamFramerStream, DynamixelFrameThatIsNotASyncWriteIsSkipped) {
 
 TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
   FramerConfig requests_only;
-  requests_only.servo_request = true;
+  requests_only.accept(servo::kRequestFrames);
   RecordingFramer framer(requests_only);
   framer.feed(concat({kTelemetry, kServoPing, kTelemetryFoot, kServoRotate}));
   const std::vector<Frame> expected = {{protocol::servo::kRequestFrames, kServoPing},
@@ -118,7 +119,7 @@ TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size() + kTelemetryFoot.size());
 
-  RecordingFramer telemetry_only(FramerConfig::forDriver(false, true, false, kServoCount));
+  RecordingFramer telemetry_only(test_support::driverFramer({"body"}, kServoCount));
   telemetry_only.feed(concat({kServoPing, kTelemetry, kServoRotate, kTelemetryFoot}));
   const std::vector<Frame> expected_telemetry = {{protocol::body::kTelemetryFrames, kTelemetry},
                                                  {protocol::body::kTelemetryFrames, kTelemetryFoot}};
@@ -128,14 +129,14 @@ TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
 
 TEST(StreamFramerStream, TelemetryLengthFollowsTheConfiguredServoCount) {
   // LEN 32 is 24 + 4*2; with 3 servos only 36 and 52 are legal.
-  RecordingFramer three(FramerConfig::forDriver(false, true, false, 3));
+  RecordingFramer three(test_support::driverFramer({"body"}, 3));
   three.feed(kTelemetry);
   EXPECT_TRUE(three.frames().empty());
   EXPECT_EQ(three.stats().bad_lengths, 1u);
   EXPECT_EQ(three.stats().bytes_skipped, kTelemetry.size());
 
   // LEN 48 is 40 + 4*2 (foot block) but also 24 + 4*6: the configuration decides, not the framer.
-  RecordingFramer six(FramerConfig::forDriver(false, true, false, 6));
+  RecordingFramer six(test_support::driverFramer({"body"}, 6));
   six.feed(kTelemetryFoot);
   ASSERT_EQ(six.frames().size(), 1u);
   EXPECT_EQ(six.stats().bad_lengths, 0u);
