@@ -34,6 +34,13 @@ set(SRD_CORE_SOURCES
   src/device/servo_bus_stops.cpp
   src/device/servo_health.cpp
   src/device/servo_bus_health.cpp
+  src/device/status_report.cpp
+  src/device/base_status.cpp
+  src/device/body_status.cpp
+  src/device/servo_bus_status.cpp
+  src/device/servo_joint_commands.cpp
+  src/device/link_status.cpp
+  src/device/e_stop_status.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,
