@@ -41,6 +41,7 @@ set(SRD_CORE_SOURCES
   src/device/servo_joint_commands.cpp
   src/device/link_status.cpp
   src/device/e_stop_status.cpp
+  src/device/wire_capture_status.cpp
 )
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

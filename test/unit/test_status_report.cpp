@@ -1,5 +1,6 @@
 // The core's diagnostic status type (the same merge and value rules as diagnostic_updater's
-// DiagnosticStatusWrapper) and the statuses of the node's own parts: a port, the e-stop.
+// DiagnosticStatusWrapper) and the statuses of the node's own parts: a port, the e-stop, the wire
+// capture.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -9,6 +10,7 @@
 #include "serial_robot_driver/device/e_stop_status.h"
 #include "serial_robot_driver/device/link_status.h"
 #include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/device/wire_capture_status.h"
 
 namespace {
 
@@ -143,6 +145,28 @@ TEST(LinkStatus, ALatencyTimerAbove1MsWarnsOnlyWhileConnected) {
   EXPECT_EQ(down.message, "not connected: No such file or directory");
   stats.last_error.clear();
   EXPECT_EQ(linkStatus(stats, options).message, "not connected");
+}
+
+TEST(WireCaptureStatus, ADroppedChunkWarns) {
+  WireCaptureStats stats;
+  stats.chunks = 40;
+  stats.bytes = 1200;
+  stats.queued = 3;
+  stats.in_roscpp = 2;
+  const StatusReport capturing = wireCaptureStatus(stats);
+  EXPECT_EQ(capturing.level, StatusLevel::kOk);
+  EXPECT_EQ(capturing.message, "capturing on serial_raw");
+  EXPECT_TRUE(capturing.hardware_id.empty()) << "the node's own";
+  EXPECT_EQ(capturing.values, (Values{{"chunks published", "40"},
+                                      {"bytes published", "1200"},
+                                      {"chunks dropped", "0"},
+                                      {"chunks queued", "3"},
+                                      {"chunks held by roscpp", "2"}}));
+  stats.dropped = 1;
+  const StatusReport dropping = wireCaptureStatus(stats);
+  EXPECT_EQ(dropping.level, StatusLevel::kWarn);
+  EXPECT_EQ(dropping.message, "chunks dropped: the subscribers fell behind");
+  EXPECT_EQ(*dropping.find("chunks dropped"), "1");
 }
 
 }  // namespace
