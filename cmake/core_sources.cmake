@@ -18,22 +18,24 @@ set(SRD_CORE_SOURCES
   src/device/device_set.cpp
   src/device/base_controller.cpp
   src/device/body_controller.cpp
+  src/device/bus_mutex.cpp
+  src/device/servo_transactions.cpp
+  src/device/servo_move.cpp
   src/device/servo_bus_client.cpp
   src/trajectory/spline.cpp
   src/trajectory/command.cpp
   src/trajectory/tolerances.cpp
   src/trajectory/bus_joint.cpp
-  src/device/servo_bus_queries.cpp
-  src/device/servo_bus_settings.cpp
-  src/device/servo_bus_motion.cpp
+  src/trajectory/joint_groups.cpp
+  src/trajectory/executor.cpp
   src/device/servo_bus_text.cpp
   src/device/servo_bus.cpp
+  src/device/servo_poller.cpp
+  src/device/stop_keeper.cpp
+  src/device/motion_safety.cpp
   src/device/e_stop.cpp
   src/device/motion_gate.cpp
-  src/device/servo_bus_safety.cpp
-  src/device/servo_bus_stops.cpp
   src/device/servo_health.cpp
-  src/device/servo_bus_health.cpp
   src/device/status_report.cpp
   src/device/base_status.cpp
   src/device/body_status.cpp

@@ -6,7 +6,8 @@ target_include_directories(test_multi_port PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_multi_port srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_multi_port driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
 
-add_rostest_gtest(test_faults test/rostest/faults.test test/rostest/test_faults.cpp)
+add_rostest_gtest(test_faults test/rostest/faults.test test/rostest/test_faults_unplug_replug.cpp
+  test/rostest/test_faults_extreme_commands.cpp test/rostest/test_faults_extreme_servo_requests.cpp)
 target_include_directories(test_faults PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_faults srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_faults driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)

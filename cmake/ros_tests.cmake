@@ -14,18 +14,28 @@ target_include_directories(srd_test_support PUBLIC ${PROJECT_SOURCE_DIR}/test
 target_link_libraries(srd_test_support PUBLIC srd_core srd_sim ${catkin_LIBRARIES})
 add_dependencies(srd_test_support ${PROJECT_NAME}_generate_messages_cpp)
 
-add_rostest_gtest(test_base_node test/rostest/base_node.test test/rostest/test_base_node.cpp)
+# Behaviours in several sources of one target: one .test, one ROS master and one driver_node.
+add_rostest_gtest(test_base_node test/rostest/base_node.test
+  test/rostest/test_base_node_driving.cpp
+  test/rostest/test_base_node_resets_and_status.cpp
+  test/rostest/test_base_node_process.cpp)
 target_include_directories(test_base_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_base_node srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_base_node driver_node ${PROJECT_NAME}_generate_messages_cpp)
 
-add_rostest_gtest(test_body_node test/rostest/body_node.test test/rostest/test_body_node.cpp)
+add_rostest_gtest(test_body_node test/rostest/body_node.test
+  test/rostest/test_body_node_telemetry.cpp
+  test/rostest/test_body_node_commands.cpp
+  test/rostest/test_body_node_sim.cpp)
 target_include_directories(test_body_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_body_node srd_test_support ${catkin_LIBRARIES})
 add_dependencies(test_body_node driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
 
 add_rostest_gtest(test_servo_bus_node test/rostest/servo_bus_node.test
-  test/rostest/test_servo_bus_node.cpp)
+  test/rostest/test_servo_bus_node_reads_and_writes.cpp
+  test/rostest/test_servo_bus_node_motion.cpp
+  test/rostest/test_servo_bus_node_rejections.cpp
+  test/rostest/test_servo_bus_node_armed.cpp)
 target_include_directories(test_servo_bus_node PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_servo_bus_node srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_servo_bus_node driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)

@@ -5,19 +5,33 @@ catkin_add_gtest(core_tests
   test/unit/test_servo_bus_codec.cpp
   test/unit/test_servo_commands.cpp
   test/unit/test_servo_params.cpp
-  test/unit/test_stream_framer.cpp
+  test/unit/test_stream_framer_golden_frames.cpp
+  test/unit/test_stream_framer_streams.cpp
+  test/unit/test_stream_framer_broken_frames.cpp
+  test/unit/test_stream_framer_buffering.cpp
+  test/unit/test_stream_framer_random_junk.cpp
   test/unit/test_diff_drive.cpp
   test/unit/test_odometry.cpp
-  test/unit/test_transport.cpp
+  test/unit/test_transport_pty_io.cpp
+  test/unit/test_transport_errors_and_links.cpp
+  test/unit/test_transport_baud_and_lock.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_serial_link.cpp
-  test/unit/test_base_controller.cpp
+  test/unit/test_base_controller_commands.cpp
+  test/unit/test_base_controller_odometry.cpp
+  test/unit/test_base_controller_polling.cpp
+  test/unit/test_base_controller_retune.cpp
   test/unit/test_body_controller.cpp
   test/unit/test_servo_bus_client.cpp
+  test/unit/test_servo_bus_client_operations.cpp
+  test/unit/test_servo_bus_client_rejections.cpp
   test/unit/test_servo_bus.cpp
   test/unit/test_servo_bus_stops.cpp
   test/unit/test_servo_bus_on_link.cpp
-  test/unit/test_sim.cpp
+  test/unit/test_sim_device_models.cpp
+  test/unit/test_sim_pty_devices.cpp
+  test/unit/test_sim_whole_robot.cpp
+  test/unit/test_sim_command_line.cpp
   test/unit/test_device_set.cpp
   test/unit/test_servo_health.cpp
   test/unit/test_e_stop.cpp
@@ -56,13 +70,15 @@ target_include_directories(trajectory_action_definition_tests PRIVATE ${catkin_I
 target_link_libraries(trajectory_action_definition_tests ${catkin_LIBRARIES} gtest_main)
 add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_messages_cpp)
 
-# The ROS-free trajectory core: interpolation, replacement, goal validation, tolerances.
-catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp)
+# The ROS-free trajectory core: interpolation, replacement, goal validation, tolerances, the joint
+# groups and the executor (goals, ticks, stops) on a clock the tests step.
+catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp
+  test/unit/test_trajectory_joints.cpp
+  test/unit/test_trajectory_executor.cpp)
 target_link_libraries(trajectory_tests srd_core gtest_main)
 
-# Trajectories' ROS-side pure functions (messages, bus joints, what a stop holds); no roscore.
-catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp
-  test/unit/test_trajectory_stop.cpp)
+# Trajectories' ROS-side pure functions (messages, bus joints from parameters, stamps); no roscore.
+catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp)
 target_include_directories(trajectory_ros_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(trajectory_ros_tests srd_ros gtest_main)
 

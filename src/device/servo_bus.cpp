@@ -5,41 +5,21 @@
 
 namespace serial_robot_driver::device {
 
-namespace {
-/// How often a polled servo is asked again while its port is down (reopened every
-/// reconnect_interval, 1 s by default).
-constexpr std::chrono::milliseconds kPortDownRetry{100};
-
-Clock::duration periodOf(double rate_hz) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));
-}
-}  // namespace
-
 ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events,
                    std::shared_ptr<LoopClock> clock)
     : config_(std::move(config)),
       settings_(config_),
       events_(std::move(events)),
       clock_(clock ? std::move(clock) : steadyLoopClock()),
-      poll_period_(std::chrono::duration_cast<Clock::duration>(
-          std::chrono::duration<double>(1.0 / config_.poll_rate))),
-      client_(config_.client, std::move(writer)) {
-  client_.setMotionGate(&gate_, [this](uint8_t id) { noteCommanded(id); });
-  const Clock::time_point now = clock_->now();
-  for (uint8_t id : config_.polled_ids) {
-    PolledServo servo;
-    servo.id = id;
-    servo.next_poll = now;
-    polled_.push_back(servo);
-  }
-  // Every polled servo has a health entry, so a health_rate turned on at runtime finds them.
-  if (config_.health_rate > 0.0) health_period_ = periodOf(config_.health_rate);
-  for (uint8_t id : config_.polled_ids) {
-    HealthServo servo;
-    servo.report.id = id;
-    servo.next_poll = now;
-    health_.push_back(servo);
-  }
+      client_(config_.client, std::move(writer)),
+      poller_(config_.polled_ids, settings_, client_, events_, *clock_, mutex_,
+              {[this](uint8_t id) { dropQueuedMovesLocked(id); },
+               [this](uint8_t id) { safety_.noteMotion(id, false); }}),
+      stops_(client_, events_, *clock_, mutex_,
+             [this](uint8_t id) { safety_.noteStopWrittenLocked(id); }),
+      safety_(config_.polled_ids, settings_, client_, events_, *clock_, mutex_, stops_, poller_,
+              {[this] { queued_moves_.clear(); }, [this] { deliverStops(); }}) {
+  client_.setMotionGate(&safety_.gate(), [this](uint8_t id) { safety_.noteCommanded(id); });
 }
 
 ServoBus::~ServoBus() { shutdown(); }
@@ -54,7 +34,8 @@ void ServoBus::onFrame(protocol::FrameFamily family, const uint8_t* data, std::s
 void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (motion_locked_) return;  // the e-stop holds: the caller refused (and counted) it already
+    // The e-stop holds: the caller refused (and counted) it already.
+    if (safety_.motionLockedLocked()) return;
     for (const MoveRequest& move : moves) {
       auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
                                  [&move](const MoveRequest& m) { return m.id == move.id; });
@@ -91,18 +72,7 @@ void ServoBus::retune(const ServoBusConfig& next) {
     settings_.relax_power_mw = next.relax_power_mw;
     settings_.protect = next.protect;
     settings_.on_shutdown = next.on_shutdown;
-    poll_period_ = periodOf(next.poll_rate);
-    const Clock::time_point now = clock_->now();
-    const Clock::time_point soonest = now + poll_period_;
-    for (PolledServo& servo : polled_) {
-      // A servo in back-off keeps its back-off; the others are due within the new period.
-      if (servo.backoff.count() == 0) servo.next_poll = std::min(servo.next_poll, soonest);
-    }
-    const bool health_was_off = health_period_.count() == 0;
-    health_period_ = next.health_rate > 0.0 ? periodOf(next.health_rate) : Clock::duration(0);
-    for (HealthServo& servo : health_) {
-      servo.next_poll = health_was_off ? now : std::min(servo.next_poll, now + health_period_);
-    }
+    poller_.retuneLocked(next.poll_rate, next.health_rate);
   }
   wakeWorker();  // the worker may be waiting for a poll that is now due earlier
 }
@@ -119,7 +89,7 @@ void ServoBus::start() {
 
 void ServoBus::shutdown() {
   // The last words are decided from here on: no motion frame passes any more, whoever waited.
-  gate_.close();
+  safety_.closeGate();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
@@ -132,7 +102,7 @@ void ServoBus::shutdown() {
     std::unique_lock<std::mutex> lock(mutex_);
     wake_.wait(lock, [this] { return !working_; });
   }
-  finalWords();
+  safety_.finalWords();
   client_.shutdown();  // every later call fails at once
 }
 
@@ -144,12 +114,7 @@ ServoBusConfig ServoBus::settings() const {
 ServoBusWorkerStats ServoBus::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   ServoBusWorkerStats stats = stats_;
-  for (const PolledServo& servo : polled_) {
-    if (servo.backoff.count() > 0) stats.offline_ids.push_back(servo.id);
-  }
-  const double poll_rate = 1.0 / std::chrono::duration<double>(poll_period_).count();
-  stats.asked_poll_rate =
-      poll_rate * static_cast<double>(polled_.size() - stats.offline_ids.size());
+  poller_.addStatsLocked(&stats);
   return stats;
 }
 
@@ -170,9 +135,7 @@ void ServoBus::wakeWorker() {
 Clock::time_point ServoBus::nextWorkLocked() const {
   if (!started_ || stop_) return Clock::time_point::max();
   if (!queued_moves_.empty()) return Clock::time_point::min();
-  Clock::time_point next = std::min(nextStopWork(), nextHealthPoll());
-  for (const PolledServo& servo : polled_) next = std::min(next, servo.next_poll);
-  return next;
+  return std::min(stops_.nextWorkLocked(), poller_.nextPollLocked());
 }
 
 Clock::time_point ServoBus::nextWork() {
@@ -206,7 +169,7 @@ void ServoBus::workerLoop() {
 
 void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
   // Stops first: nothing else this bus does may go before them.
-  if (stopWorkOnce(lock, StopPace::kScheduled)) return;
+  if (stops_.workOnce(lock, StopPace::kScheduled)) return;
   if (!queued_moves_.empty()) {
     const MoveRequest move = queued_moves_.front();
     queued_moves_.pop_front();
@@ -215,31 +178,11 @@ void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
     lock.lock();
     return;
   }
-  const Clock::time_point now = clock_->now();
-  // Health polls are background work of a second kind, due at their own (lower) rate.
-  if (nextHealthPoll() <= now) {
-    const auto first = std::min_element(
-        health_.begin(), health_.end(),
-        [](const HealthServo& a, const HealthServo& b) { return a.next_poll < b.next_poll; });
-    const auto index = static_cast<std::size_t>(first - health_.begin());
-    lock.unlock();
-    pollHealthOnce(index);
-    lock.lock();
-    return;
-  }
-  // The servo whose poll is due first.
-  auto due = std::min_element(
-      polled_.begin(), polled_.end(),
-      [](const PolledServo& a, const PolledServo& b) { return a.next_poll < b.next_poll; });
-  if (due == polled_.end() || now < due->next_poll) return;
-  PolledServo& servo = *due;
-  lock.unlock();
-  pollOnce(servo);  // the schedule is only changed by this thread; mutex_ for stats() readers
-  lock.lock();
+  poller_.pollDue(lock);
 }
 
 void ServoBus::sendMove(const MoveRequest& move) {
-  ServoStatus status = refuseWhileLocked(move.id);  // an overheated servo (protect)
+  ServoStatus status = safety_.refusal(move.id);  // an overheated servo (protect)
   if (status.ok()) {
     // Through the motion gate: refused if the e-stop came meanwhile.
     status = client_.move(move, BusPriority::kWorker);
@@ -249,10 +192,12 @@ void ServoBus::sendMove(const MoveRequest& move) {
     std::lock_guard<std::mutex> lock(mutex_);
     const bool replaced = std::any_of(queued_moves_.begin(), queued_moves_.end(),
                                       [&move](const MoveRequest& m) { return m.id == move.id; });
-    if (!replaced && !motion_locked_ && stops_.count(move.id) == 0) queued_moves_.push_front(move);
+    if (!replaced && !safety_.motionLockedLocked() && !stops_.keptLocked(move.id)) {
+      queued_moves_.push_front(move);
+    }
     return;
   }
-  if (status.ok()) noteMotion(move.id, true);
+  if (status.ok()) safety_.noteMotion(move.id, true);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (status.ok()) {
@@ -264,40 +209,59 @@ void ServoBus::sendMove(const MoveRequest& move) {
   if (!status.ok() && events_.on_move_failed) events_.on_move_failed(move, status);
 }
 
-void ServoBus::pollOnce(PolledServo& servo) {
-  ServoAngleSample sample;
-  sample.id = servo.id;
-  const ServoStatus status =
-      client_.readAngle(servo.id, &sample.angle_deg, &sample.arrival, BusPriority::kBackground);
-  if (status.error == ServoError::kPreempted) return;  // a stop went first: due again at once
-  const Clock::time_point now = clock_->now();
-  bool went_silent = false;
+// The e-stop and the stops: the policy is the MotionSafety's, the delivery the worker's.
+
+void ServoBus::setMotionLocked(bool locked) { safety_.setMotionLocked(locked); }
+
+void ServoBus::stopServo(uint8_t id) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (status.error == ServoError::kNotConnected || status.error == ServoError::kShutdown) {
-      // The port is down, not the servo: ask again at the poll rate, but no more often than
-      // kPortDownRetry, so a down port at a high state_rate does not keep the worker busy.
-      servo.next_poll = now + std::max<Clock::duration>(poll_period_, kPortDownRetry);
-      return;
-    }
-    if (!status.ok()) {
-      went_silent = servo.backoff.count() == 0;
-      servo.backoff = went_silent ? kFirstBackoff : std::min(servo.backoff * 2, kMaxBackoff);
-      servo.next_poll = now + servo.backoff;
-    } else {
-      servo.backoff = std::chrono::milliseconds(0);
-      // Keep the rate without drifting; after a stall, start again from now.
-      servo.next_poll = std::max(servo.next_poll + poll_period_, now);
-      ++stats_.angles_polled;
-    }
+    dropQueuedMovesLocked(id);
+    stops_.armLocked(id, clock_->now());
   }
-  if (!status.ok()) {
-    if (went_silent && events_.on_servo_silent) {
-      events_.on_servo_silent(servo.id, status, servo.backoff);
-    }
+  deliverStops();
+}
+
+void ServoBus::deliverStops() {
+  bool worker_running = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    worker_running = started_ && !stop_;
+  }
+  if (worker_running) {
+    stops_.askUrgent();  // nobody takes the bus before the worker has written them
+    wakeWorker();
     return;
   }
-  if (events_.on_angle) events_.on_angle(sample);
+  // No worker (before start()): write them here; their confirmation waits for the worker.
+  std::unique_lock<std::mutex> lock(mutex_);
+  stops_.writeDue(lock, StopPace::kNow);
 }
+
+void ServoBus::onLinkUp() {
+  // On the reader thread, before any write on the reopened port can succeed: the stops go first.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!safety_.rearmStopsLocked(clock_->now()) || !started_ || stop_) return;
+  }
+  stops_.askUrgent();
+  wakeWorker();  // a worker of its own; on the link, this thread is the worker
+}
+
+// Motion through the device: the MotionSafety's.
+
+ServoStatus ServoBus::move(const MoveRequest& request) { return safety_.move(request); }
+ServoStatus ServoBus::rotate(const RotateRequest& request) { return safety_.rotate(request); }
+ServoStatus ServoBus::spin(const SpinRequest& request) { return safety_.spin(request); }
+ServoStatus ServoBus::damping(uint8_t id, uint16_t power_mw, bool wait) {
+  return safety_.damping(id, power_mw, wait);
+}
+ServoStatus ServoBus::relax(const std::vector<uint8_t>& ids) { return safety_.relax(ids); }
+ServoStatus ServoBus::hold(const std::vector<uint8_t>& ids) { return safety_.hold(ids); }
+bool ServoBus::motionLocked() const { return safety_.motionLocked(); }
+std::vector<uint8_t> ServoBus::movingIds() const { return safety_.movingIds(); }
+std::vector<uint8_t> ServoBus::commandedIds() const { return safety_.commandedIds(); }
+std::vector<PendingStopReport> ServoBus::pendingStops() const { return stops_.reports(); }
+std::vector<ServoHealthReport> ServoBus::health() const { return poller_.health(); }
 
 }  // namespace serial_robot_driver::device

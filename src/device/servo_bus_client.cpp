@@ -1,11 +1,12 @@
-// ServoBusClient's transactions on the wire: matching answers to the pending request, timeouts
-// and retries, the half-duplex echo. The operations built on them are in servo_bus_queries.cpp
-// (ping, scan, angles), servo_bus_settings.cpp (parameters) and servo_bus_motion.cpp (motions).
 #include "serial_robot_driver/device/servo_bus_client.h"
 
-#include <algorithm>
-#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "servo_bus_text.h"
 
@@ -13,420 +14,414 @@ namespace serial_robot_driver::device {
 
 namespace servo = protocol::servo;
 using servo::Command;
+using servo::ParamInfo;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
 
 namespace {
 
-/// The longest a reader thread waiting for the bus pumps before it looks again; unlock() wakes it
-/// sooner.
-constexpr std::chrono::milliseconds kReaderWaitSlice{10};
+constexpr uint8_t kMaxSpinMode = 3;
+constexpr double kDegreesPerTurn = 360.0;
 
-double toMs(Clock::duration duration) {
-  return std::chrono::duration<double, std::milli>(duration).count();
+constexpr uint8_t kServoIdParam = servo::dataId(servo::ServoDataId::kServoId);
+constexpr uint8_t kBaudrateParam = servo::dataId(servo::ServoDataId::kBaudrate);
+constexpr std::size_t kReadDataHeader = 2;  // id, data_id, then the value
+constexpr uint8_t kDefaultServoId = 0;      // what RESET_USER_DATA sets the id to
+
+ServoStatus fromWriteCheck(servo::WriteCheck check, const ParamInfo& param, int64_t value) {
+  ServoError error = ServoError::kInvalidArgument;
+  switch (check) {
+    case servo::WriteCheck::kOk:
+      return ok("");
+    case servo::WriteCheck::kReadOnly:
+      error = ServoError::kReadOnly;
+      break;
+    case servo::WriteCheck::kOutOfRange:
+      error = ServoError::kOutOfRange;
+      break;
+    case servo::WriteCheck::kDangerous:
+      error = ServoError::kDangerous;
+      break;
+  }
+  // The switch that arms dangerous writes is named by the caller's layer (a ROS parameter there).
+  return fail(error, servo::describe(check, param, value));
+}
+
+ServoParamValue toParamValue(const ParamInfo& param, int64_t raw) {
+  // The table's units are already engineering units (mV, mA, mW, degC, ms, 0.1deg): no scaling.
+  return ServoParamValue{std::string(param.name), param.data_id, raw, std::string(param.unit)};
+}
+
+std::string valueText(const ServoParamValue& value) {
+  std::string text = std::to_string(value.value);
+  if (!value.unit.empty()) text += " " + value.unit;
+  return text;
 }
 
 }  // namespace
 
-const char* toString(ServoError error) {
-  switch (error) {
-    case ServoError::kOk:
-      return "ok";
-    case ServoError::kInvalidArgument:
-      return "invalid argument";
-    case ServoError::kUnknownParam:
-      return "unknown parameter";
-    case ServoError::kReadOnly:
-      return "read-only parameter";
-    case ServoError::kOutOfRange:
-      return "value out of range";
-    case ServoError::kDangerous:
-      return "dangerous write refused";
-    case ServoError::kNotConnected:
-      return "port not connected";
-    case ServoError::kIdInUse:
-      return "servo id in use";
-    case ServoError::kMotionRefused:
-      return "motion refused";
-    case ServoError::kTimeout:
-      return "timeout";
-    case ServoError::kBadAnswer:
-      return "malformed answer";
-    case ServoError::kRefused:
-      return "refused by the servo";
-    case ServoError::kReadBackMismatch:
-      return "read-back mismatch";
-    case ServoError::kShutdown:
-      return "shutting down";
-    case ServoError::kPreempted:
-      return "gave way to a stop";
-  }
-  return "unknown";
-}
-
-template <typename Predicate>
-void BusMutex::waitTurn(std::unique_lock<std::mutex>& lock, Predicate free) {
-  while (!free()) {
-    if (pump_ == nullptr || !pump_->on_reader_thread()) {
-      released_.wait(lock);
-      continue;
-    }
-    // The reader thread: whoever holds the bus may be waiting for an answer only it can read.
-    reader_waiting_ = true;
-    lock.unlock();
-    const bool port_up = pump_->pump(Clock::now() + kReaderWaitSlice);
-    lock.lock();
-    // A port that is down has nothing to read: the holder's write fails at once, so this wait
-    // is short, but it must not spin.
-    if (!port_up) released_.wait_for(lock, kReaderWaitSlice, free);
-  }
-}
-
-void BusMutex::lock() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  ++waiting_;
-  waitTurn(lock, [this] { return !held_ && !urgent_ && yielded_ == 0; });
-  --waiting_;
-  held_ = true;
-}
-
-bool BusMutex::lockBackground() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  waitTurn(lock, [this] { return urgent_ || (!held_ && waiting_ == 0 && yielded_ == 0); });
-  if (urgent_) return false;  // a stop is coming: the poll gives way and is due again at once
-  held_ = true;
-  return true;
-}
-
-bool BusMutex::lockUnlessUrgent() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  ++waiting_;
-  waitTurn(lock, [this] { return urgent_ || (!held_ && yielded_ == 0); });
-  --waiting_;
-  if (urgent_) return false;
-  held_ = true;
-  return true;
-}
-
-void BusMutex::lockUrgent() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  waitTurn(lock, [this] { return !held_; });
-  held_ = true;
-}
-
-void BusMutex::requestUrgent() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  urgent_ = true;
-  wakeWaiters(lock);  // a background wait gives up
-}
-
-void BusMutex::endUrgent() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  urgent_ = false;
-  wakeWaiters(lock);
-}
-
-bool BusMutex::urgentRequested() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return urgent_;
-}
-
-void BusMutex::yieldToUrgent() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  if (!urgent_) return;
-  held_ = false;
-  ++yielded_;
-  wakeWaiters(lock);
-  waitTurn(lock, [this] { return !held_ && !urgent_; });
-  --yielded_;
-  held_ = true;
-}
-
-int BusMutex::foregroundWaiting() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return waiting_;
-}
-
-void BusMutex::unlock() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  held_ = false;
-  wakeWaiters(lock);
-}
-
-void BusMutex::wakeWaiters(std::unique_lock<std::mutex>& lock) {
-  // Returns with `lock` held, as it came: yieldToUrgent() goes on waiting with it.
-  released_.notify_all();
-  if (!std::exchange(reader_waiting_, false)) return;
-  lock.unlock();
-  pump_->wake();  // the reader pumping its port: its read returns at once
-  lock.lock();
-}
-
-ServoBusClient::Expectation::Expectation(Command answer_cmd, uint8_t answer_id)
-    : Expectation(answer_cmd, answer_id, servo::commandInfo(answer_cmd).answer.min) {}
-
 ServoBusClient::ServoBusClient(ServoBusOptions options, FrameWriter writer)
-    : options_(std::move(options)), writer_(std::move(writer)) {}
+    : transactions_(std::move(options), std::move(writer)) {}
 
-ServoBusStats ServoBusClient::stats() const {
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  return stats_;
+// Queries: PING, scan, READ_ANGLE and the multi-turn angle.
+
+ServoStatus ServoBusClient::pingLocked(uint8_t id) {
+  servo::Packet answer;
+  const ServoStatus status =
+      transactions_.exchangeLocked(servo::encodePing(id), Expectation(Command::kPing, id), &answer);
+  if (!status.ok()) return status;
+  return ok(servoName(id) + " is online (" + status.message + ")");
 }
 
-void ServoBusClient::shutdown() {
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  stopping_ = true;
-  answer_cv_.notify_all();
+ServoStatus ServoBusClient::ping(uint8_t id) {
+  if (auto rejection = rejectBroadcast(id, Command::kPing)) return *rejection;
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  return pingLocked(id);
 }
 
-void ServoBusClient::onLinkDown() {
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  if (pending_.active) {
-    link_lost_ = true;
-    answer_cv_.notify_all();
+ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival,
+                                      BusPriority priority) {
+  if (auto rejection = rejectBroadcast(id, Command::kReadAngle)) return *rejection;
+  servo::Packet answer;
+  Clock::time_point answered_at;
+  ServoStatus status;
+  const std::vector<uint8_t> request = servo::encodeReadAngle(id);
+  const Expectation expect(Command::kReadAngle, id);
+  if (!transactions_.takeBus(priority)) {
+    return fail(ServoError::kPreempted, servoName(id) + "'s READ_ANGLE gave way to a stop");
   }
-}
-
-bool ServoBusClient::matches(const servo::Packet& packet) const {
-  const Expectation& expect = pending_.expect;
-  if (packet.cmd != static_cast<uint8_t>(expect.cmd) || packet.content_size == 0) return false;
-  const uint8_t id = packet.id();
-  if (id != expect.id && !(expect.alt_id && id == *expect.alt_id)) return false;
-  // An answer about another data_id is a late answer to an earlier request, not garbage.
-  if (expect.data_id && (packet.content_size < 2 || packet.content[1] != *expect.data_id)) {
-    return false;
-  }
-  return true;
-}
-
-void ServoBusClient::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                             Clock::time_point arrival) {
-  if (family == protocol::FrameFamily::kServoRequest) {
-    // On a half-duplex adapter our own request comes back: recognise it, skip it.
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    if (!last_request_.empty() && size == last_request_.size() &&
-        std::equal(data, data + size, last_request_.begin())) {
-      ++stats_.echoes;
-    } else {
-      ++stats_.mismatched;  // another host's request: not ours to answer or wait for
-    }
-    return;
-  }
-  if (family != protocol::FrameFamily::kServoResponse) return;  // another device on this port
-
-  const protocol::Decoded<servo::Packet> packet = servo::decodeResponse(data, size);
   {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    if (!packet.ok()) {
-      ++stats_.garbled;
-      return;
-    }
-    if (!pending_.active || pending_.answered || pending_.garbled || !matches(*packet)) {
-      ++stats_.mismatched;
-      return;
-    }
-    if (packet->content_size != pending_.expect.content_size) {
-      ++stats_.garbled;
-      pending_.garbled = true;
-    } else {
-      pending_.answered = true;
-    }
-    pending_.answer = *packet;
-    pending_.arrival = arrival;
+    std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
+    // Background work makes one attempt: the next poll is the retry.
+    const ServoBusOptions options = transactions_.options();
+    const int attempts = priority == BusPriority::kBackground ? 1 : options.retries + 1;
+    status = transactions_.transact(request, expect, options.timeout, attempts, &answer,
+                                    FrameGate::kSafetyAction, priority == BusPriority::kWorker,
+                                    &answered_at);
   }
-  // Notified after the unlock: a caller woken while this thread still held state_mutex_ would
-  // only block on it again (one more sleep and wake-up per transaction on a busy bus). Only the
-  // transaction's own caller waits, and it cannot leave before its predicate holds.
-  answer_cv_.notify_one();
+  if (!status.ok()) return status;
+  const protocol::Decoded<servo::AngleAnswer> decoded = servo::decodeAngleAnswer(answer);
+  if (!decoded) return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable angle");
+  if (arrival != nullptr) *arrival = answered_at;
+  *angle_deg = decoded->angle_decidegrees / kDecidegreesPerDegree;
+  // The poll reads no message: it would cost a formatted string on every transaction.
+  if (priority == BusPriority::kBackground) return ok({});
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f deg", *angle_deg);
+  return ok(servoName(id) + " is at " + text);
 }
 
-void ServoBusClient::setReaderPump(ReaderPump pump) {
-  pump_ = std::move(pump);
-  bus_mutex_.setReaderPump(pump_.pump ? &pump_ : nullptr);
+ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* reading) {
+  if (auto rejection = rejectBroadcast(id, Command::kReadMultiTurnAngle)) return *rejection;
+  servo::Packet answer;
+  const ServoStatus status = transactions_.exchange(
+      servo::encodeReadMultiTurnAngle(id), Expectation(Command::kReadMultiTurnAngle, id), &answer);
+  if (!status.ok()) return status;
+  const protocol::Decoded<servo::MultiTurnAngle> decoded = servo::decodeMultiTurnAngle(answer);
+  if (!decoded) {
+    return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable multi-turn angle");
+  }
+  reading->angle_deg = decoded->angle_decidegrees / kDecidegreesPerDegree;
+  reading->turns = decoded->turns;
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.1f deg (%d turns)", reading->angle_deg, reading->turns);
+  return ok(servoName(id) + " is at " + text);
 }
 
-void ServoBusClient::waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::time_point deadline) {
-  const auto settled = [this] {
-    return pending_.answered || pending_.garbled || link_lost_ || stopping_ ||
-           (motion_wait_ && urgent_);
-  };
-  if (!pump_.pump || !pump_.on_reader_thread()) {
-    answer_cv_.wait_until(lock, deadline, settled);
-    return;
-  }
-  // The reader thread reads the answer itself: onFrame() runs inside pump(), on this thread.
-  while (!settled() && Clock::now() < deadline) {
-    lock.unlock();
-    const bool port_up = pump_.pump(deadline);
-    lock.lock();
-    if (!port_up && !settled()) link_lost_ = true;  // down, lost or stopping: no answer can come
-  }
+ServoStatus ServoBusClient::pingOnceLocked(uint8_t id) {
+  servo::Packet answer;
+  return transactions_.transact(servo::encodePing(id), Expectation(Command::kPing, id),
+                                transactions_.options().timeout, 1, &answer);
 }
 
-std::optional<ServoStatus> ServoBusClient::writeRequest(const std::vector<uint8_t>& request,
-                                                        Command cmd, uint8_t id, FrameGate gate) {
-  bool written = false;
-  if (gate == FrameGate::kMotion && gate_ != nullptr) {
-    const GateState state = gate_->writeIfOpen(
-        [&] {
-          const bool out = writer_(request);
-          if (out && on_motion_written_) on_motion_written_(id);
-          return out;
-        },
-        &written);
-    if (state != GateState::kOpen) {
-      return fail(ServoError::kMotionRefused,
-                  std::string(toString(state)) + ": " + commandName(cmd) + " to " + servoName(id) +
-                      " was not written (refused when its turn on the bus came)");
-    }
-  } else {
-    written = writer_(request);
+ServoStatus ServoBusClient::scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids) {
+  if (first_id > last_id) {
+    return fail(ServoError::kInvalidArgument, "first_id " + std::to_string(first_id) +
+                                                  " is above last_id " + std::to_string(last_id));
   }
-  if (!written) return notConnected();
-  return std::nullopt;
+  if (last_id == servo::kBroadcastId) {
+    return fail(ServoError::kInvalidArgument,
+                "id 255 is the broadcast address and cannot be scanned (ids 0..254)");
+  }
+  ids->clear();
+  for (int id = first_id; id <= last_id; ++id) {
+    // The bus is taken per id: a service call or a poll waits for one PING at most.
+    std::lock_guard<BusMutex> bus(transactions_.busMutex());
+    const ServoStatus status = pingOnceLocked(static_cast<uint8_t>(id));
+    if (status.ok()) {
+      ids->push_back(static_cast<uint8_t>(id));
+    } else if (status.error != ServoError::kTimeout && status.error != ServoError::kBadAnswer) {
+      return fail(status.error, "scan stopped at id " + std::to_string(id) + ": " + status.message);
+    }
+  }
+  std::string list;
+  for (uint8_t id : *ids) list += (list.empty() ? "" : ", ") + std::to_string(id);
+  return ok(std::to_string(ids->size()) + " of " + std::to_string(last_id - first_id + 1) +
+            " ids answered PING" + (list.empty() ? "" : ": " + list));
 }
 
-ServoStatus ServoBusClient::transact(const std::vector<uint8_t>& request, const Expectation& expect,
-                                     std::chrono::milliseconds timeout, int attempts,
-                                     servo::Packet* answer, FrameGate gate, bool give_way) {
-  bool any_garbled = false;
-  std::size_t garbled_size = 0;
-  for (int attempt = 1; attempt <= attempts; ++attempt) {
-    // A stop asked during the last attempt goes out before this one: the worker that writes it
-    // ends here, a caller hands the bus over and goes on after it.
-    if (attempt > 1 && give_way && bus_mutex_.urgentRequested()) {
-      return fail(ServoError::kPreempted,
-                  servoName(expect.id) + "'s " + commandName(expect.cmd) + " gave way to a stop");
-    }
-    if (attempt > 1) bus_mutex_.yieldToUrgent();
-    {
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
-      pending_ = Pending{};
-      pending_.active = true;
-      pending_.expect = expect;
-      last_request_ = request;
-      link_lost_ = false;
-      motion_wait_ = gate == FrameGate::kMotion;
-    }
-    const Clock::time_point sent_at = Clock::now();
-    if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate)) {
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      pending_.active = false;
-      motion_wait_ = false;
-      return *refusal;
-    }
+// Parameters: READ_DATA / WRITE_DATA with their checks and read-back, READ_BATCH_DATA and
+// RESET_USER_DATA.
 
-    std::unique_lock<std::mutex> lock(state_mutex_);
-    if (attempt == 1) {
-      ++stats_.transactions;
-    } else {
-      ++stats_.retries;
-    }
-    waitForAnswer(lock, sent_at + timeout);
-    pending_.active = false;
-    const bool cut_short = motion_wait_ && urgent_ && !pending_.answered;
-    motion_wait_ = false;
-
-    if (pending_.answered) {
-      const double latency_ms = toMs(pending_.arrival - sent_at);
-      stats_.last_latency_ms = latency_ms;
-      stats_.max_latency_ms = std::max(stats_.max_latency_ms, latency_ms);
-      *answer = pending_.answer;
-      return ok("answered in " + formatMs(latency_ms));
-    }
-    if (link_lost_) {
-      return fail(ServoError::kNotConnected, "servo bus port was lost while waiting for " +
-                                                 servoName(expect.id) + "'s " +
-                                                 commandName(expect.cmd) + " answer");
-    }
-    if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
-    if (cut_short) {
-      return fail(ServoError::kPreempted,
-                  std::string(commandName(expect.cmd)) + " was written to " + servoName(expect.id) +
-                      ", but the wait for its completion was cut short by a stop");
-    }
-    if (pending_.garbled) {
-      any_garbled = true;
-      garbled_size = pending_.answer.content_size;
-    }
-  }
-
-  if (any_garbled) {
+ServoStatus ServoBusClient::readParamLocked(uint8_t id, const ParamInfo& param,
+                                            ServoParamValue* value) {
+  // The answer's size follows from the parameter's type, not from the command alone.
+  Expectation expect(Command::kReadData, id, kReadDataHeader + servo::typeSize(param.type));
+  expect.data_id = param.data_id;
+  servo::Packet answer;
+  const ServoStatus status =
+      transactions_.exchangeLocked(servo::encodeReadData(id, param.data_id), expect, &answer);
+  if (!status.ok()) return status;
+  const protocol::Decoded<int64_t> raw = servo::decodeReadDataAnswer(answer, param);
+  if (!raw) {
     return fail(ServoError::kBadAnswer,
-                servoName(expect.id) + " sent a malformed " + commandName(expect.cmd) +
-                    " answer (" + std::to_string(garbled_size) + " content bytes, expected " +
-                    std::to_string(expect.content_size) + ")");
+                servoName(id) + " sent an unreadable value for " + quoted(param.name));
   }
-  {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    ++stats_.timeouts;
+  *value = toParamValue(param, *raw);
+  return ok(servoName(id) + " " + quoted(param.name) + " = " + valueText(*value));
+}
+
+ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
+                                      ServoParamValue* value, BusPriority priority) {
+  const ParamInfo* param = servo::findParam(param_name);
+  if (param == nullptr) {
+    return fail(ServoError::kUnknownParam,
+                "unknown servo parameter " + quoted(param_name) +
+                    " (use a name such as 'voltage' or a data_id such as '51')");
   }
-  return fail(ServoError::kTimeout,
-              servoName(expect.id) + " did not answer " + commandName(expect.cmd) + " within " +
-                  std::to_string(timeout.count()) + " ms (" + attemptsText(attempts) + ")");
-}
-
-ServoBusOptions ServoBusClient::options() const {
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  return options_;
-}
-
-void ServoBusClient::retune(std::chrono::milliseconds timeout, int retries) {
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  options_.timeout = timeout;
-  options_.retries = retries;
-}
-
-ServoStatus ServoBusClient::exchangeLocked(const std::vector<uint8_t>& request,
-                                           const Expectation& expect, servo::Packet* answer) {
-  const ServoBusOptions options = this->options();  // one transaction, one set of options
-  return transact(request, expect, options.timeout, options.retries + 1, answer);
-}
-
-bool ServoBusClient::takeBus(BusPriority priority) {
-  switch (priority) {
-    case BusPriority::kCaller:
-      bus_mutex_.lock();
-      return true;
-    case BusPriority::kWorker:
-      return bus_mutex_.lockUnlessUrgent();
-    case BusPriority::kBackground:
-      return bus_mutex_.lockBackground();
+  if (auto rejection = rejectBroadcast(id, Command::kReadData)) return *rejection;
+  if (priority == BusPriority::kBackground) {
+    if (!transactions_.takeBus(BusPriority::kBackground)) {
+      return fail(ServoError::kPreempted, servoName(id) + "'s health poll gave way to a stop");
+    }
+    std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
+    return readParamLocked(id, *param, value);
   }
-  return false;
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  return readParamLocked(id, *param, value);
 }
 
-ServoStatus ServoBusClient::exchange(const std::vector<uint8_t>& request, const Expectation& expect,
-                                     servo::Packet* answer) {
-  std::lock_guard<BusMutex> bus(bus_mutex_);
-  return exchangeLocked(request, expect, answer);
+ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, int64_t value) {
+  const ParamInfo* param = servo::findParam(param_name);
+  if (param == nullptr) {
+    return fail(ServoError::kUnknownParam,
+                "unknown servo parameter " + quoted(param_name) +
+                    " (use a name such as 'soft_start_time' or a data_id such as '50')");
+  }
+  if (auto rejection = rejectBroadcast(id, Command::kWriteData)) return *rejection;
+  const servo::WriteCheck check =
+      servo::checkWrite(*param, value, transactions_.options().allow_dangerous_writes);
+  if (check != servo::WriteCheck::kOk) return fromWriteCheck(check, *param, value);
+
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  const bool id_change = param->data_id == kServoIdParam && value != id;
+  const uint8_t new_id = static_cast<uint8_t>(value);
+  if (id_change) {
+    // Two servos with one id can no longer be told apart: make sure the new id is free.
+    const ServoStatus probe = pingLocked(new_id);
+    if (probe.ok()) {
+      return fail(ServoError::kIdInUse, "servo_id change of " + servoName(id) +
+                                            " refused: a servo already answers at id " +
+                                            std::to_string(new_id));
+    }
+    if (probe.error != ServoError::kTimeout) return probe;
+  }
+
+  Expectation expect(Command::kWriteData, id);
+  if (id_change) expect.alt_id = new_id;  // the answer may already come from the new address
+  expect.data_id = param->data_id;
+  servo::Packet answer;
+  const ServoStatus status =
+      transactions_.exchangeLocked(servo::encodeWriteData(id, *param, value), expect, &answer);
+  if (!status.ok()) return status;
+  const std::string assignment = quoted(param->name) + " = " + std::to_string(value);
+  if (refused(answer)) {
+    return fail(ServoError::kRefused,
+                servoName(id) + " refused to write " + assignment + " (result 0)");
+  }
+  if (param->data_id == kBaudrateParam) {
+    return ok(servoName(id) + " accepted " + assignment +
+              "; not read back because the new baud rate takes effect at once");
+  }
+
+  const uint8_t read_id = id_change ? new_id : id;
+  ServoParamValue read_back;
+  const ServoStatus read_status = readParamLocked(read_id, *param, &read_back);
+  if (!read_status.ok()) {
+    return fail(read_status.error, servoName(id) + " accepted " + assignment +
+                                       " but the read-back failed: " + read_status.message);
+  }
+  if (read_back.value != value) {
+    return fail(ServoError::kReadBackMismatch, "wrote " + assignment + " to " + servoName(id) +
+                                                   " but it reads back " +
+                                                   std::to_string(read_back.value));
+  }
+  if (id_change) {
+    return ok(servoName(id) + " is now " + servoName(new_id) + " (read back at the new id)");
+  }
+  return ok(servoName(id) + " " + quoted(param->name) + " = " + valueText(read_back) +
+            " (written and read back)");
 }
 
-ServoStatus ServoBusClient::sendCommand(const std::vector<uint8_t>& request, Command cmd,
-                                        uint8_t id, FrameGate gate) {
-  {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
-    last_request_ = request;
+ServoStatus ServoBusClient::readAll(uint8_t id, std::vector<ServoParamValue>* values) {
+  if (auto rejection = rejectBroadcast(id, Command::kReadBatchData)) return *rejection;
+  servo::Packet answer;
+  const ServoStatus status = transactions_.exchange(
+      servo::encodeReadBatchData(id), Expectation(Command::kReadBatchData, id), &answer);
+  if (!status.ok()) return status;
+
+  const uint8_t* block = answer.content.data() + 1;
+  std::vector<ServoParamValue> result;
+  for (const ParamInfo& param : servo::paramTable()) {
+    const std::optional<std::size_t> offset = servo::userBlockOffset(param);
+    if (!offset) continue;  // read-only parameters are not in the user block
+    const std::size_t size = servo::typeSize(param.type);
+    const std::optional<int64_t> raw = *offset + size <= servo::kUserBlockSize
+                                           ? servo::readValue(param, block + *offset, size)
+                                           : std::nullopt;
+    if (!raw) {
+      return fail(ServoError::kBadAnswer,
+                  servoName(id) + " sent a user block without " + quoted(param.name));
+    }
+    result.push_back(toParamValue(param, *raw));
   }
-  if (auto refusal = writeRequest(request, cmd, id, gate)) return *refusal;
-  {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    ++stats_.commands;
+  const std::size_t count = result.size();
+  *values = std::move(result);
+  return ok("read " + std::to_string(count) + " parameters of " + servoName(id));
+}
+
+ServoStatus ServoBusClient::resetUserData(uint8_t id) {
+  if (auto rejection = rejectBroadcast(id, Command::kResetUserData)) return *rejection;
+  if (!transactions_.options().allow_dangerous_writes) {
+    return fail(ServoError::kDangerous,
+                "reset_user_data restores the factory id and baud rate and can make the servo "
+                "unreachable; refused because dangerous writes are not allowed");
   }
-  return ok(std::string(commandName(cmd)) + " sent to " + servoName(id) +
-            " (not waiting for completion)");
+  Expectation expect(Command::kResetUserData, id);
+  expect.alt_id = kDefaultServoId;  // the reset moves the servo to id 0 and it may answer there
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  ServoStatus last;
+  const ServoBusOptions options = transactions_.options();  // the same for every attempt
+  for (int attempt = 1; attempt <= options.retries + 1; ++attempt) {
+    servo::Packet answer;
+    // One attempt at a time: a re-sent reset would go to an id the servo may have left already.
+    last =
+        transactions_.transact(servo::encodeResetUserData(id), expect, options.timeout, 1, &answer);
+    if (last.ok()) {
+      if (refused(answer)) {
+        return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");
+      }
+      return ok(servoName(id) +
+                " reset its user data to the factory defaults; it now answers at "
+                "id 0 (answer from id " +
+                std::to_string(answer.id()) + ")");
+    }
+    if (last.error != ServoError::kTimeout) return last;
+    // No answer: the servo may have reset and moved to id 0 without answering. (For a servo at
+    // id 0 already a PING proves nothing: the reset is re-sent instead.)
+    if (id != kDefaultServoId && pingOnceLocked(kDefaultServoId).ok()) {
+      return ok(servoName(id) +
+                " reset its user data to the factory defaults; it gave no answer "
+                "but now answers PING at id 0");
+    }
+  }
+  return fail(ServoError::kTimeout, servoName(id) +
+                                        " did not answer RESET_USER_DATA and no servo "
+                                        "answers PING at id 0 (" +
+                                        last.message + ")");
+}
+
+// Motions: servo/move (CMD 8, 11..15), ROTATE, SPIN and DAMPING.
+
+ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priority) {
+  servo::MoveCommand command;
+  const ServoStatus checked = toMoveCommand(request, &command);
+  if (!checked.ok()) return checked;
+  const std::vector<uint8_t> frame = servo::encodeMove(command);
+  if (!transactions_.takeBus(priority)) {
+    return fail(ServoError::kPreempted, std::string(commandName(command.cmd)) + " to " +
+                                            servoName(request.id) + " gave way to a stop");
+  }
+  std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
+  return transactions_.sendCommand(frame, command.cmd, request.id, FrameGate::kMotion);
+}
+
+ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
+  if (!std::isfinite(request.angle_deg)) {
+    return fail(ServoError::kInvalidArgument, "angle is not a finite number");
+  }
+  const double decidegrees = std::round(request.angle_deg * kDecidegreesPerDegree);
+  if (decidegrees < std::numeric_limits<int16_t>::min() ||
+      decidegrees > std::numeric_limits<int16_t>::max()) {
+    char text[96];
+    std::snprintf(text, sizeof(text), "angle %.1f deg is out of range -3276.8 .. 3276.7 deg",
+                  request.angle_deg);
+    return fail(ServoError::kInvalidArgument, text);
+  }
+  if (request.wait) {
+    if (auto rejection = rejectBroadcast(request.id, Command::kRotate)) return *rejection;
+  }
+  const std::vector<uint8_t> frame = servo::encodeRotate(
+      request.id, static_cast<int16_t>(decidegrees), request.interval_ms, request.power_mw);
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  return sendMotion(frame, Command::kRotate, request.id, request.wait,
+                    std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion);
+}
+
+ServoStatus ServoBusClient::spin(const SpinRequest& request) {
+  if (request.mode > kMaxSpinMode) {
+    return fail(ServoError::kInvalidArgument,
+                "spin mode " + std::to_string(request.mode) +
+                    " is out of range 0..3 (0 stop, 1 continuous, 2 turns, 3 milliseconds)");
+  }
+  const auto mode = static_cast<servo::SpinMode>(request.mode);
+  std::chrono::milliseconds motion_time{0};
+  if (request.wait) {
+    if (auto rejection = rejectBroadcast(request.id, Command::kSpin)) return *rejection;
+    double expected_ms = 0.0;
+    if (mode == servo::SpinMode::kDurationMs) {
+      expected_ms = request.value;
+    } else if (mode == servo::SpinMode::kTurns && request.speed_dps > 0) {
+      expected_ms = request.value * kDegreesPerTurn * 1000.0 / request.speed_dps;
+    }
+    // A service must not hang: long spins are started without waiting and polled instead.
+    if (expected_ms > kMaxMotionWait.count()) {
+      char text[160];
+      std::snprintf(text, sizeof(text),
+                    "waiting for this SPIN would block the servo bus for about %.0f s (limit "
+                    "%.1f s); call it with wait = false",
+                    expected_ms / 1000.0, kMaxMotionWait.count() / 1000.0);
+      return fail(ServoError::kInvalidArgument, text);
+    }
+    motion_time = std::chrono::milliseconds(std::llround(expected_ms));
+  }
+  const std::vector<uint8_t> frame =
+      servo::encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  // A SPIN stop is what the e-stop itself sends: never held back.
+  const FrameGate gate =
+      mode == servo::SpinMode::kStop ? FrameGate::kSafetyAction : FrameGate::kMotion;
+  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time, gate);
+}
+
+ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, FrameGate gate) {
+  if (wait) {
+    if (auto rejection = rejectBroadcast(id, Command::kDamping)) return *rejection;
+  }
+  const std::vector<uint8_t> frame = servo::encodeDamping(id, power_mw);
+  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0), gate);
 }
 
 ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
                                        bool wait, std::chrono::milliseconds motion_time,
                                        FrameGate gate) {
-  if (!wait) return sendCommand(request, cmd, id, gate);
+  if (!wait) return transactions_.sendCommand(request, cmd, id, gate);
   servo::Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
   ServoStatus status =
-      transact(request, Expectation(cmd, id), motion_time + options().timeout, 1, &answer, gate);
+      transactions_.transact(request, Expectation(cmd, id),
+                             motion_time + transactions_.options().timeout, 1, &answer, gate);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";
@@ -439,34 +434,6 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
   }
   return ok(std::string(commandName(cmd)) + " completed by " + servoName(id) + ", " +
             status.message);
-}
-
-void ServoBusClient::writeStops(const std::vector<uint8_t>& ids, std::vector<bool>* written) {
-  written->assign(ids.size(), false);
-  bus_mutex_.lockUrgent();
-  std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    const std::vector<uint8_t> frame =
-        servo::encodeSpin(ids[i], false, servo::SpinMode::kStop, 0, 0);
-    (*written)[i] = sendCommand(frame, Command::kSpin, ids[i], FrameGate::kSafetyAction).ok();
-  }
-}
-
-void ServoBusClient::requestUrgent() {
-  {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    urgent_ = true;
-  }
-  answer_cv_.notify_all();  // a motion wait gives way
-  bus_mutex_.requestUrgent();
-}
-
-void ServoBusClient::endUrgent() {
-  {
-    std::lock_guard<std::mutex> lock(state_mutex_);
-    urgent_ = false;
-  }
-  bus_mutex_.endUrgent();
 }
 
 }  // namespace serial_robot_driver::device

@@ -1,4 +1,4 @@
-// Sentences and checks shared by the ServoBusClient operations (servo_bus_*.cpp). Internal to
+// Sentences and checks shared by the servo transactions and operations. Internal to
 // srd_core: not installed.
 #pragma once
 
@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "serial_robot_driver/device/servo_bus_client.h"
+#include "serial_robot_driver/device/servo_transactions.h"
 #include "serial_robot_driver/protocol/servo_commands.h"
 
 namespace serial_robot_driver::device::servo_text {

@@ -7,7 +7,7 @@
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/ros/conversions.h"
-#include "serial_robot_driver/ros/trajectory_joints.h"
+#include "serial_robot_driver/trajectory/joint_groups.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -52,7 +52,7 @@ void BodyInterface::attachEStop(device::EStop& e_stop) {
 }
 
 std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
-  return {bodyTrajectoryJoints(controller_)};
+  return {trajectory::bodyTrajectoryJoints(controller_)};
 }
 
 void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,

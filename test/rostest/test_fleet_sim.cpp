@@ -40,6 +40,11 @@ class TfFramesOf {
     // A MessageEvent callback (not a message one) carries the publisher's name.
     sub_ = nh.subscribe("/tf", 100, &TfFramesOf::onTf, this);
   }
+  // onTf runs on the spinner thread until the subscription ends, and the mutex and set it uses die
+  // before sub_ would: shutdown() waits for a running callback.
+  ~TfFramesOf() { sub_.shutdown(); }
+  TfFramesOf(const TfFramesOf&) = delete;
+  TfFramesOf& operator=(const TfFramesOf&) = delete;
   std::set<std::string> frames() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return frames_;

@@ -42,6 +42,11 @@ class PortsInDiagnostics {
       : candidates_(std::move(candidate_paths)) {
     sub_ = nh.subscribe("/diagnostics", 100, &PortsInDiagnostics::onDiagnostics, this);
   }
+  // onDiagnostics runs on the spinner thread until the subscription ends, and the members it uses
+  // die before sub_ would: shutdown() waits for a running callback.
+  ~PortsInDiagnostics() { sub_.shutdown(); }
+  PortsInDiagnostics(const PortsInDiagnostics&) = delete;
+  PortsInDiagnostics& operator=(const PortsInDiagnostics&) = delete;
 
   std::set<std::string> mentionedBy(const std::string& ns) const {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -1,10 +1,9 @@
 // The ROS-side pieces of trajectories that need no roscore: messages to commands, bus joints from
-// parameters, polled angles to joint measurements, and one ROTATE per bus segment.
+// parameters, polled angles to joint measurements, and a goal's ROS stamp as a steady start.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "serial_robot_driver/ros/trajectory_bus_joints.h"
@@ -58,26 +57,13 @@ TEST(TrajectoryRos, PolledAngleBecomesTheJointsPosition) {
   EXPECT_NEAR(state.position[0], M_PI / 2, 1e-12);
 }
 
-TEST(TrajectoryRos, BusSegmentIsOneRotateInTheServosDegrees) {
-  const std::vector<trajectory::BusJoint> joints = {{9, "tilt", -20.0, -1}};
-  std::vector<std::tuple<uint8_t, double, uint32_t>> queued;
-  const TrajectoryJoints group = busTrajectoryJoints(
-      joints,
-      [&](uint8_t id, double angle_deg, uint32_t interval_ms) {
-        queued.emplace_back(id, angle_deg, interval_ms);
-        return std::string();
-      },
-      20.0);
-  ASSERT_EQ(group.joints.size(), 1u);
-  EXPECT_EQ(group.joints[0].name, "tilt");
-  EXPECT_FALSE(group.write);
-  EXPECT_EQ(group.state_timeout, 0.5);  // three polls at 20 Hz are less
-  EXPECT_TRUE(group.move(0, M_PI / 2, 0.7504).empty());
-  ASSERT_EQ(queued.size(), 1u);
-  EXPECT_EQ(std::get<0>(queued[0]), 9);
-  EXPECT_NEAR(std::get<1>(queued[0]), -110.0, 1e-9);  // -20 - 90
-  EXPECT_EQ(std::get<2>(queued[0]), 750u);
-  EXPECT_EQ(busTrajectoryJoints(joints, {}, 2.0).state_timeout, 1.5);
+TEST(TrajectoryRos, GoalStampBecomesASteadyStartOnce) {
+  // Zero: now on the steady clock, whatever the ROS clock says.
+  EXPECT_EQ(steadyStart(ros::Time(), 500.0, ros::Time(1e9)), 500.0);
+  // 2 s ahead of the ROS clock: 2 s ahead on the steady clock.
+  EXPECT_NEAR(steadyStart(ros::Time(1000.0), 500.0, ros::Time(998.0)), 502.0, 1e-9);
+  // 1.5 s behind.
+  EXPECT_NEAR(steadyStart(ros::Time(1000.0), 500.0, ros::Time(1001.5)), 498.5, 1e-9);
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
-// The UART servo bus as a device: the client (the wire and its operations), the queue of moves
-// from a stream of targets (servo_commands) and the scheduled angle poll (servo_states), with the
-// back-off of a servo that stops answering. ROS-free: the ROS layer (ros/servo_bus_interface.h)
-// converts messages to calls and events to messages.
+// The UART servo bus as a device: the owner that wires its parts and runs their worker. The parts:
+// the client (servo_bus_client.h: the typed operations over the transaction client), the polls
+// (servo_poller.h: servo_states, health, protect), the motion policy (motion_safety.h: what may be
+// written, the servos set moving, the last words) with the stops it keeps until confirmed
+// (stop_keeper.h). The bus itself keeps the queue of moves from a stream of targets
+// (servo_commands). ROS-free: the ROS layer (ros/servo_bus_interface.h) converts messages to
+// calls and events to messages.
 //
 // Threading model:
 //  - The worker writes the queued moves first, then polls the servo whose poll falls due first.
@@ -18,6 +21,9 @@
 //  - The operations of client() (the services) run on their caller's thread, serialized with the
 //    worker by the client's bus lock.
 //  - The ServoBusEvents hooks run on the worker thread without mutex_ held.
+//  - One mutex_ guards the bus's state and its parts' (they are given it), so a decision across
+//    them is one step: the e-stop drops the queue and arms the stops of the servos it finds
+//    commanded under one lock, as a queued move put back checks the e-stop and the stops.
 //  - With health_rate > 0 the worker also polls each servo's health (five READ_DATA, each as
 //    background work, so a caller still waits for one transaction at most) when it falls due.
 //  - The motion operations (move, rotate, spin, damping, relax, hold) run on their caller's thread
@@ -35,116 +41,37 @@
 //  - shutdown() closes the gate, stops the worker (joins its thread, or waits for the piece of
 //    work the reader thread is doing), then says the last words (on_shutdown) on its caller's,
 //    each stop confirmed like the e-stop's for at most kShutdownStopBudget.
-//  - Stats are one struct under mutex_; stats() returns a snapshot.
+//  - Stats are one struct under mutex_ (with the poller's counts); stats() returns a snapshot.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
-#include <functional>
-#include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
-#include <set>
-#include <string>
 #include <thread>
 #include <vector>
 
 #include "serial_robot_driver/device/loop_clock.h"
-#include "serial_robot_driver/device/motion_gate.h"
+#include "serial_robot_driver/device/motion_safety.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/device/servo_bus_client.h"
-#include "serial_robot_driver/device/servo_health.h"
+#include "serial_robot_driver/device/servo_bus_config.h"
+#include "serial_robot_driver/device/servo_bus_events.h"
+#include "serial_robot_driver/device/servo_poller.h"
+#include "serial_robot_driver/device/stop_keeper.h"
 
 namespace serial_robot_driver::device {
 
-/// What servos set moving get when the bus shuts down (before its port closes).
-enum class ShutdownAction { kStop, kRelax, kNone };
-/// "stop", "relax", "none"; nullopt for anything else.
-std::optional<ShutdownAction> shutdownActionFromString(const std::string& text);
-const char* toString(ShutdownAction action);
-
-struct ServoBusConfig {
-  ServoBusOptions client;
-  std::vector<uint8_t> polled_ids;  ///< servos whose angle is polled (servo_states)
-  double poll_rate = 10.0;          ///< polls per second of each polled servo, > 0
-  uint16_t relax_power_mw = 50;     ///< DAMPING power of relax()
-  /// For each servo set spinning or moving: kStop a SPIN stop, kRelax relax(), kNone nothing.
-  ShutdownAction on_shutdown = ShutdownAction::kStop;
-  /// Health polls (voltage, current, power, temperature, status) per second of each polled
-  /// servo, as background work between the angle polls; 0: none.
-  double health_rate = 1.0;
-  /// A servo at its own temperature limit is relaxed and its moves refused until it has cooled
-  /// OverheatGuard::kCoolDownC below it.
-  bool protect = false;
-};
-
-/// The health of one polled servo (health_rate > 0).
-struct ServoHealthReport {
-  uint8_t id = 0;
-  bool polled = false;        ///< at least one health poll finished (answered or not)
-  bool online = false;        ///< the last health poll was answered
-  std::string last_error;     ///< why the last poll failed
-  bool limits_known = false;  ///< the servo's limits, read once when it first answered
-  ServoLimits limits;
-  ServoReadings readings;     ///< valid once a poll was answered
-  HealthAssessment assessment;
-  bool overheated = false;    ///< protect: relaxed, its moves refused
-};
-
-/// One polled angle.
-struct ServoAngleSample {
-  uint8_t id = 0;
-  double angle_deg = 0.0;
-  Clock::time_point arrival;  ///< when the answer's last byte was read
-};
-
-/// What the bus reports; every hook may be empty.
-struct ServoBusEvents {
-  std::function<void(const ServoAngleSample&)> on_angle;
-  /// A polled servo stopped answering (once, until it answers again); asked again after `backoff`.
-  std::function<void(uint8_t id, const ServoStatus& status, std::chrono::milliseconds backoff)>
-      on_servo_silent;
-  std::function<void(const MoveRequest& move, const ServoStatus& status)> on_move_failed;
-  /// protect: servo `report.id` was relaxed for its temperature (`overheated`), or has cooled.
-  std::function<void(const ServoHealthReport& report)> on_overheat;
-  /// A stop of servo `id`: ok once the servo is seen at rest after it; an error when an attempt
-  /// failed (it is retried) or, at shutdown, when it could not be confirmed in time.
-  std::function<void(uint8_t id, const ServoStatus& status)> on_stop;
-};
-
-/// A stop not yet known to have reached its servo.
-struct PendingStopReport {
-  uint8_t id = 0;
-  int written = 0;  ///< times the stop went out so far
-  std::string why;  ///< what is still missing: written, answered, seen at rest
-};
-
-struct ServoBusWorkerStats {
-  uint64_t angles_polled = 0;        ///< on_angle reports
-  uint64_t moves_sent = 0;           ///< queued moves written
-  uint64_t moves_failed = 0;         ///< queued moves the client refused or could not write
-  uint64_t moves_replaced = 0;       ///< queued moves replaced by a newer target of the same servo
-  std::vector<uint8_t> offline_ids;  ///< polled servos in back-off
-  /// Angle reads per second the schedule asks for: the poll rate in force times the polled
-  /// servos not in back-off. What the line delivers is angles_polled over time.
-  double asked_poll_rate = 0.0;
-};
-
 class ServoBus : public LinkListener, public LinkWorker {
  public:
-  /// A servo that stops answering the poll is asked again after a back-off that doubles from the
-  /// first to the longest, so a dead servo costs one timeout per back-off period, not per poll.
-  static constexpr std::chrono::milliseconds kFirstBackoff{500};
-  static constexpr std::chrono::milliseconds kMaxBackoff{8000};
-  /// A stopped servo's angle is read twice this far apart; it is at rest when it moved no more
-  /// than kRestToleranceDeg meanwhile.
-  static constexpr std::chrono::milliseconds kStopSettle{100};
-  static constexpr double kRestToleranceDeg = 0.5;
-  /// How long shutdown() keeps writing and confirming its stops, at most.
-  static constexpr std::chrono::milliseconds kShutdownStopBudget{1000};
+  // The parts' constants, by the bus's name (see servo_poller.h, stop_keeper.h, motion_safety.h).
+  static constexpr std::chrono::milliseconds kFirstBackoff{ServoPoller::kFirstBackoff};
+  static constexpr std::chrono::milliseconds kMaxBackoff{ServoPoller::kMaxBackoff};
+  static constexpr std::chrono::milliseconds kStopSettle{StopKeeper::kStopSettle};
+  static constexpr double kRestToleranceDeg = StopKeeper::kRestToleranceDeg;
+  static constexpr std::chrono::milliseconds kShutdownStopBudget{MotionSafety::kShutdownStopBudget};
 
   /// `clock` empty: the steady clock.
   ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events = {},
@@ -195,7 +122,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Stops not yet known to have reached their servo (for diagnostics).
   std::vector<PendingStopReport> pendingStops() const;
   /// Motion frames refused when their turn on the bus came (e-stop engaged or shutting down).
-  uint64_t motionRefusedAtWrite() const { return gate_.refusedAtWrite(); }
+  uint64_t motionRefusedAtWrite() const { return safety_.refusedAtWrite(); }
   /// One report per polled servo (empty when health_rate is 0).
   std::vector<ServoHealthReport> health() const;
 
@@ -232,13 +159,6 @@ class ServoBus : public LinkListener, public LinkWorker {
   void work() override;
 
  private:
-  /// One polled servo and its schedule.
-  struct PolledServo {
-    uint8_t id = 0;
-    Clock::time_point next_poll;
-    std::chrono::milliseconds backoff{0};  ///< 0: online
-  };
-
   void workerLoop();
   /// When the worker has something to do next (mutex_ held): min() for a queued move, max()
   /// before start(), after shutdown() or with nothing scheduled.
@@ -247,82 +167,28 @@ class ServoBus : public LinkListener, public LinkWorker {
   void workOnce(std::unique_lock<std::mutex>& lock);
   /// A change the worker must see: its own thread, or the link's reader thread.
   void wakeWorker();
-  /// A stop until the servo is seen at rest (see the threading model).
-  struct PendingStop {
-    enum class Phase { kWrite, kFirstLook, kSecondLook } phase = Phase::kWrite;
-    Clock::time_point due;
-    double first_angle = 0.0;
-    int written = 0;
-    bool port_down = false;  ///< the last write failed
-    std::string why = "not written yet";
-  };
-  /// How stop work is paced: by the bus's clock (the worker), or back to back with real sleeps
-  /// for the settle (shutdown(), on its caller's thread, whatever clock the bus has).
-  enum class StopPace { kScheduled, kNow };
-
-  /// A motion frame of servo `id` went out (told by the client under the motion gate's lock, so
-  /// an e-stop engaged right after it finds the servo among those to stop). A pending stop of
-  /// the servo (a hold) is superseded.
-  void noteCommanded(uint8_t id);
-  /// Notes the outcome of a motion command of servo `id`: moving or at rest.
-  void noteMotion(uint8_t id, bool moving);
-  ServoStatus refuseWhileLocked(uint8_t id) const;
-  void dropQueuedMovesLocked(uint8_t id);  // mutex_ held
-  /// Adds a stop of `id` to be written now (mutex_ held).
-  void armStopLocked(uint8_t id, Clock::time_point now);
   /// Asks the client for urgent work and wakes the worker, or, without a running worker, writes
   /// the stops itself.
   void deliverStops();
-  /// Reserves the bus for the stops (ServoBusClient::requestUrgent) until endUrgentLocked().
-  void askUrgent();
-  void endUrgentLocked();  // mutex_ held
-  /// When the stop work falls due next (mutex_ held); max() when none.
-  Clock::time_point nextStopWork() const;
-  /// One piece of stop work that is due (mutex_ held by `lock`, released around the bus): every
-  /// stop to be written, or one look at a stopped servo. False when nothing was due.
-  bool stopWorkOnce(std::unique_lock<std::mutex>& lock, StopPace pace);
-  void writeDueStops(std::unique_lock<std::mutex>& lock, StopPace pace);
-  void lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t id, StopPace pace);
-  void finalWords();
-  /// The health poll's schedule: the servo due first, and when (max when none).
-  Clock::time_point nextHealthPoll() const;  // mutex_ held
-  void pollHealthOnce(std::size_t index);
-  /// Reads `names` in order into `values`; the first failure.
-  ServoStatus readHealthParams(uint8_t id, const std::vector<const char*>& names,
-                               std::vector<int64_t>* values);
+  void dropQueuedMovesLocked(uint8_t id);  // mutex_ held
   void sendMove(const MoveRequest& move);
-  void pollOnce(PolledServo& servo);
 
   const ServoBusConfig config_;
   ServoBusConfig settings_;  // guarded by mutex_: config_ as retune() left it
   const ServoBusEvents events_;
   const std::shared_ptr<LoopClock> clock_;
-  Clock::duration poll_period_;  // guarded by mutex_ (retune)
   ServoBusClient client_;
 
-  mutable std::mutex mutex_;  // guards everything below
+  mutable std::mutex mutex_;  // guards everything below, the parts' state included
   std::condition_variable wake_;
   bool stop_ = false;
   bool started_ = false;
-  bool working_ = false;          // work() in progress on the link's reader thread
-  SerialLink* link_ = nullptr;    // runOn(): the worker is the link's reader thread
+  bool working_ = false;        // work() in progress on the link's reader thread
+  SerialLink* link_ = nullptr;  // runOn(): the worker is the link's reader thread
   std::deque<MoveRequest> queued_moves_;
-  std::map<uint8_t, PendingStop> stops_;  // not yet known to have reached their servo
-  std::set<uint8_t> commanded_;           // set moving or positioned since start-up
-  bool urgent_asked_ = false;             // askUrgent() .. endUrgentLocked()
-  MotionGate gate_;                       // every motion frame passes it when written
-  std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
-  std::set<uint8_t> moving_;          // servos set moving and not stopped since
-  bool motion_locked_ = false;
-  bool final_words_said_ = false;
-  // Health polls: one entry per polled servo, changed by the worker only (read under mutex_).
-  struct HealthServo {
-    ServoHealthReport report;
-    Clock::time_point next_poll;
-    OverheatGuard guard;
-  };
-  std::vector<HealthServo> health_;  // one per polled servo; polled while health_period_ > 0
-  Clock::duration health_period_{0};
+  ServoPoller poller_;   // the angle and health polls
+  StopKeeper stops_;     // stops not yet known to have reached their servo
+  MotionSafety safety_;  // what may move; the servos set moving; the last words
   ServoBusWorkerStats stats_;
   std::thread worker_;
 };

@@ -11,10 +11,14 @@
 
 #include "serial_robot_driver/device/e_stop.h"
 
+namespace serial_robot_driver::trajectory {
+struct TrajectoryJoints;
+}  // namespace serial_robot_driver::trajectory
+
 namespace serial_robot_driver::ros_layer {
 
 class TrajectoryServer;
-struct TrajectoryJoints;
+using trajectory::TrajectoryJoints;
 
 class DeviceInterface {
  public:

@@ -1,0 +1,224 @@
+// Trajectory execution, ROS-free, with the semantics of ros_control's joint_trajectory_controller:
+// goals checked whole before anything moves, one spline per joint sampled each tick, path and goal
+// tolerances, cancel holds the joints where they are, a new goal or message for the same joints
+// preempts from the current desired state. The ROS layer (ros/trajectory_server.h) only converts
+// messages and calls in here.
+//
+// Stops (an empty trajectory, a cancel, an abort, stopAll) hold each joint where the node last
+// commanded it: a streamed joint at the position last written for it (by the executor, else by the
+// device's own last command, else where it is measured when that is fresh); a per-segment joint
+// by its `stop` hook, with nothing positional sent. A joint neither commanded nor measured is left
+// alone, and the answer names it.
+//
+// Time: sampling, tolerances, goal timing and staleness run on the injected clock (the steady
+// clock in the driver, see steadyNow(); tests step it by hand). A goal's start is given on that
+// clock, so a step of the ROS or wall clock changes nothing on the wire.
+//
+// Threading: every call may come from any thread; they share the state below under mutex_ and call
+// the goal callbacks with it held. tick() writes one frame per streamed group (a short write) and
+// hands segment moves to the bus's own queue. updateActual() only takes actual_mutex_, so a port's
+// reader never waits for a tick. takeOver() runs another command's write under mutex_ so no
+// trajectory frame can follow it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/trajectory/command.h"
+#include "serial_robot_driver/trajectory/joint_groups.h"
+#include "serial_robot_driver/trajectory/spline.h"
+#include "serial_robot_driver/trajectory/tolerances.h"
+
+namespace serial_robot_driver::trajectory {
+
+/// control_msgs/FollowJointTrajectoryResult's error codes (the ROS layer checks they agree).
+namespace result_code {
+constexpr int kSuccessful = 0;
+constexpr int kInvalidGoal = -1;
+constexpr int kInvalidJoints = -2;
+constexpr int kOldHeaderTimestamp = -3;
+constexpr int kPathToleranceViolated = -4;
+constexpr int kGoalToleranceViolated = -5;
+}  // namespace result_code
+
+/// The defaults of goals and messages (~trajectory/...).
+struct GoalDefaults {
+  double goal_tolerance = 0.05;      ///< rad, per joint
+  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
+  double path_tolerance = 0.0;       ///< rad; 0: not checked
+  double max_velocity = 0.0;         ///< rad/s per joint; faster is refused; 0: no limit
+};
+
+/// A follow_joint_trajectory goal.
+struct Goal {
+  std::string id;  ///< what cancelGoal() names it by
+  TrajectoryCommand command;
+  std::optional<double> start_time;  ///< on the executor's clock; nothing: at once
+  std::vector<NamedTolerance> path_tolerance;
+  std::vector<NamedTolerance> goal_tolerance;
+  double goal_time_tolerance = 0.0;  ///< s; 0: the default; negative: none
+};
+
+enum class GoalStatus { kRejected, kSucceeded, kCanceled, kAborted };
+
+/// How a goal ended: its result (error_code, error_string) and the status text.
+struct GoalOutcome {
+  GoalStatus status = GoalStatus::kSucceeded;
+  int error_code = result_code::kSuccessful;
+  std::string error_string;
+  std::string text;
+};
+
+/// A running goal's state, once per tick; velocities of `actual` and `error` are empty unless
+/// every joint's velocity is measured.
+struct GoalFeedback {
+  std::vector<std::string> joint_names;
+  double time_from_start = 0.0;  ///< s since the goal's start (0 before it)
+  std::vector<JointSample> desired;
+  std::vector<double> actual_positions;
+  std::vector<double> actual_velocities;
+  std::vector<double> error_positions;
+  std::vector<double> error_velocities;
+};
+
+/// What a goal tells its client; all may be empty. Called with the executor's lock held.
+struct GoalCallbacks {
+  std::function<void()> accepted;  ///< before anything else that is told of an accepted goal
+  std::function<void(const GoalFeedback&)> feedback;
+  std::function<void(const GoalOutcome&)> finished;  ///< rejected or ended; once
+};
+
+class TrajectoryExecutor {
+ public:
+  using Clock = std::function<double()>;
+  /// A warning for the log (the driver's ROS_WARN); some are throttled to one a second per kind.
+  using Warn = std::function<void(const std::string&)>;
+
+  TrajectoryExecutor(std::vector<TrajectoryJoints> groups, const GoalDefaults& defaults,
+                     Clock clock = steadyNow, Warn warn = {});
+
+  /// The executor's clock now.
+  double now() const { return clock_(); }
+  /// New defaults for the goals and messages accepted from now on; a running goal goes on with
+  /// the tolerances it was accepted with.
+  void retune(const GoalDefaults& defaults);
+  /// A new measurement timeout (s) for the joints `names` (others ignored), for the goals running
+  /// and to come (e.g. after ~servo_bus/state_rate changed).
+  void setStateTimeout(const std::vector<std::string>& names, double seconds);
+
+  /// Until start() goals are rejected and messages ignored. False when it had started already.
+  bool start();
+  /// Aborts every goal; then as before start(). Idempotent.
+  void shutdown();
+
+  /// The measured state of some joints (other names are ignored; velocities empty or shorter:
+  /// unknown). Any thread; freshness is the time of this call.
+  void updateActual(const std::vector<std::string>& names, const std::vector<double>& positions,
+                    const std::vector<double>& velocities);
+
+  /// A follow_joint_trajectory goal: rejected, or accepted (preempting the goals on its joints)
+  /// and run by tick(); an empty trajectory holds its joints and succeeds at once.
+  void submitGoal(const Goal& goal, GoalCallbacks callbacks);
+  /// Cancels the running goal `id` (holding its joints); nothing when it is over.
+  void cancelGoal(const std::string& id);
+  /// A joint_trajectory message: as a goal nobody follows; one that fails its check is ignored.
+  void submitTrajectory(const TrajectoryCommand& command, std::optional<double> start_time);
+
+  /// Another command (`source`, e.g. "joint_commands") for `names`: runs `write` under the lock
+  /// and, when it wrote (returns true), stops the trajectories of those joints and aborts the
+  /// goals that ran them, saying so.
+  void takeOver(const std::vector<std::string>& names, const std::string& source,
+                const std::function<bool()>& write);
+  /// Aborts every goal and holds every joint it drives where it was last commanded, with `reason`
+  /// (the e-stop's hook).
+  void stopAll(const std::string& reason);
+  /// The node's e-stop (before start()): engaging it calls stopAll(); while it holds, goals are
+  /// rejected and joint_trajectory messages ignored, both counted.
+  void attachEStop(device::EStop& e_stop);
+
+  /// One loop tick: supervises the goals (ending them, else giving feedback), then writes or
+  /// queues what the splines ask for.
+  void tick();
+
+ private:
+  struct Track {
+    std::size_t group = 0;  ///< index into groups_
+    std::size_t local = 0;  ///< index into that group's joints
+    double state_timeout = 0.5;
+    JointSpline spline;
+    bool writing = false;       ///< tick() writes this joint (until its spline's end is written)
+    double sent_segment = 0.0;  ///< per-segment joints: start of the segment whose move went out
+    /// Streamed joints: the position last written (a write that succeeded); cleared when another
+    /// command takes the joint over.
+    std::optional<double> last_written;
+    bool moved = false;  ///< per-segment joints: a move of this joint was queued
+  };
+  struct Measured {
+    JointSample sample;
+    bool velocity_known = false;
+    std::optional<double> received;  ///< clock time of receipt; nothing: never measured
+  };
+  struct ActiveGoal {
+    std::string id;
+    GoalCallbacks callbacks;
+    std::vector<std::size_t> joints;
+    std::vector<std::string> names;
+    std::vector<JointTolerance> path_tolerances;
+    std::vector<JointTolerance> goal_tolerances;
+    double start_time = 0.0;
+    double end_time = 0.0;
+    double goal_time_tolerance = 0.0;
+  };
+  /// The warnings throttled to one a second, each kind on its own.
+  enum ThrottledWarning { kTrajectoryError, kMessageRefused, kMessageInvalid, kThrottledKinds };
+
+  /// Checks `command` (starting at `start`, now `now`) against the joints and where they are;
+  /// the indices of its joints in `check`. mutex_ held (so are all below).
+  CommandCheck check(const TrajectoryCommand& command, double start, double now);
+  /// Ends the goals that drive any of `joints` with `status`, `code` and `message`.
+  void endGoalsOn(const std::vector<std::size_t>& joints, GoalStatus status, int code,
+                  const std::string& message);
+  /// Splices the command into the joints' splines.
+  void apply(const TrajectoryCommand& command, const std::vector<std::size_t>& joints, double start,
+             double now);
+  /// Holds `joints` where they were last commanded (see the top of this file); returns the text
+  /// naming the joints left alone ("" when none).
+  std::string hold(const std::vector<std::size_t>& joints, double now);
+  /// The latest measurement of every joint (takes actual_mutex_).
+  std::vector<Measured> measured() const;
+  /// The first of `joints` whose measurement is older than its timeout at `now`, or -1.
+  long staleJoint(const std::vector<Measured>& measured, const std::vector<std::size_t>& joints,
+                  double now) const;
+  /// Writes (streamed groups) or queues (per-segment groups) what the tracks ask for.
+  void writeTracks(double now);
+  /// Ends a goal when its tolerances say so (true); gives its feedback otherwise.
+  bool superviseGoal(ActiveGoal& goal, double now, const std::vector<Measured>& measured);
+  void warn(const std::string& text) const;
+  void warnThrottled(ThrottledWarning kind, const std::string& text, double now);
+
+  const std::vector<TrajectoryJoints> groups_;
+  std::vector<JointRange> ranges_;                      ///< every joint, in track order
+  std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track
+  const Clock clock_;
+  const Warn warn_;
+
+  mutable std::mutex actual_mutex_;  // guards the measurements below
+  std::vector<Measured> actual_;
+
+  std::mutex mutex_;  // guards everything below
+  GoalDefaults defaults_;
+  std::vector<Track> tracks_;
+  std::vector<ActiveGoal> goals_;
+  bool running_ = false;
+  device::EStop* e_stop_ = nullptr;
+  std::array<std::optional<double>, kThrottledKinds> last_warned_;
+};
+
+}  // namespace serial_robot_driver::trajectory

@@ -1,0 +1,493 @@
+#include "serial_robot_driver/trajectory/executor.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+
+namespace serial_robot_driver::trajectory {
+
+namespace {
+
+int resultCode(CommandError error) {
+  switch (error) {
+    case CommandError::kNone:
+      return result_code::kSuccessful;
+    case CommandError::kInvalidJoints:
+      return result_code::kInvalidJoints;
+    case CommandError::kInvalidGoal:
+      return result_code::kInvalidGoal;
+    case CommandError::kOldTimestamp:
+      return result_code::kOldHeaderTimestamp;
+  }
+  return result_code::kInvalidGoal;
+}
+
+GoalOutcome outcome(GoalStatus status, int code, const std::string& error_string,
+                    const std::string& text) {
+  return {status, code, error_string, text};
+}
+
+/// The outcome whose result and status text are both `message`.
+GoalOutcome outcome(GoalStatus status, int code, const std::string& message) {
+  return outcome(status, code, message, message);
+}
+
+void finish(const GoalCallbacks& callbacks, const GoalOutcome& result) {
+  if (callbacks.finished) callbacks.finished(result);
+}
+
+bool overlaps(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) {
+  return std::any_of(a.begin(), a.end(),
+                     [&](std::size_t j) { return std::find(b.begin(), b.end(), j) != b.end(); });
+}
+
+/// "; joint 'a', 'b' left alone: ..." for the joints a stop could not hold, "" when none.
+std::string leftAloneText(const std::vector<std::string>& names) {
+  if (names.empty()) return "";
+  std::string text = names.size() == 1 ? "joint " : "joints ";
+  for (std::size_t i = 0; i < names.size(); ++i) text += (i ? ", '" : "'") + names[i] + "'";
+  return text +
+         " left alone: never commanded by the driver nor recently measured, so there is no "
+         "position to hold";
+}
+
+/// `base`, then `; left_alone` when there is one.
+std::string withLeftAlone(const std::string& base, const std::string& left_alone) {
+  if (left_alone.empty()) return base;
+  return base.empty() ? left_alone : base + "; " + left_alone;
+}
+
+}  // namespace
+
+TrajectoryExecutor::TrajectoryExecutor(std::vector<TrajectoryJoints> groups,
+                                       const GoalDefaults& defaults, Clock clock, Warn warn)
+    : groups_(std::move(groups)),
+      clock_(std::move(clock)),
+      warn_(std::move(warn)),
+      defaults_(defaults) {
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    for (std::size_t local = 0; local < groups_[g].joints.size(); ++local) {
+      index_[groups_[g].joints[local].name] = ranges_.size();
+      ranges_.push_back(groups_[g].joints[local]);
+      Track track;
+      track.group = g;
+      track.local = local;
+      track.state_timeout = groups_[g].state_timeout;
+      tracks_.push_back(track);
+    }
+  }
+  actual_.resize(ranges_.size());
+}
+
+void TrajectoryExecutor::warn(const std::string& text) const {
+  if (warn_) warn_(text);
+}
+
+void TrajectoryExecutor::warnThrottled(ThrottledWarning kind, const std::string& text, double now) {
+  std::optional<double>& last = last_warned_[kind];
+  if (last && now - *last < 1.0) return;
+  last = now;
+  warn(text);
+}
+
+bool TrajectoryExecutor::start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (running_) return false;
+  running_ = true;
+  return true;
+}
+
+void TrajectoryExecutor::shutdown() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_) return;
+  running_ = false;
+  for (const ActiveGoal& goal : goals_) {
+    finish(goal.callbacks,
+           outcome(GoalStatus::kAborted, result_code::kInvalidGoal, "the driver is shutting down"));
+  }
+  goals_.clear();
+}
+
+void TrajectoryExecutor::updateActual(const std::vector<std::string>& names,
+                                      const std::vector<double>& positions,
+                                      const std::vector<double>& velocities) {
+  const std::size_t count = std::min(names.size(), positions.size());
+  const bool velocity_known = velocities.size() >= count;
+  // Freshness is the time of receipt: a message's stamp is on a clock that may step.
+  const double received = now();
+  std::lock_guard<std::mutex> lock(actual_mutex_);
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto joint = index_.find(names[i]);
+    if (joint == index_.end()) continue;
+    Measured& m = actual_[joint->second];
+    m.sample.position = positions[i];
+    m.sample.velocity = velocity_known ? velocities[i] : 0.0;
+    m.velocity_known = velocity_known;
+    m.received = received;
+  }
+}
+
+std::vector<TrajectoryExecutor::Measured> TrajectoryExecutor::measured() const {
+  std::lock_guard<std::mutex> lock(actual_mutex_);
+  return actual_;
+}
+
+long TrajectoryExecutor::staleJoint(const std::vector<Measured>& measured,
+                                    const std::vector<std::size_t>& joints, double now) const {
+  for (std::size_t j : joints) {
+    if (!measured[j].received || now - *measured[j].received > tracks_[j].state_timeout) {
+      return static_cast<long>(j);
+    }
+  }
+  return -1;
+}
+
+void TrajectoryExecutor::retune(const GoalDefaults& defaults) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  defaults_ = defaults;
+}
+
+void TrajectoryExecutor::setStateTimeout(const std::vector<std::string>& names, double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const std::string& name : names) {
+    const auto joint = index_.find(name);
+    if (joint != index_.end()) tracks_[joint->second].state_timeout = seconds;
+  }
+}
+
+CommandCheck TrajectoryExecutor::check(const TrajectoryCommand& command, double start, double now) {
+  CommandCheck result = validate(command, ranges_, defaults_.max_velocity, start - now);
+  if (!result.ok()) return result;
+  const std::vector<Measured> actual = measured();
+  const long stale = staleJoint(actual, result.joint_indices, now);
+  if (stale >= 0 && !command.points.empty()) {
+    result.error = CommandError::kInvalidGoal;
+    result.message = "joint '" + ranges_[stale].name +
+                     "': no recent measurement (is its telemetry or poll arriving?), so the "
+                     "trajectory cannot start from where it is";
+    return result;
+  }
+  if (defaults_.max_velocity > 0.0) {
+    // The bridge starts from the desired state where a trajectory runs, else from the measurement.
+    std::vector<double> current;
+    for (std::size_t j : result.joint_indices) {
+      current.push_back(tracks_[j].writing ? tracks_[j].spline.sample(now).position
+                                           : actual[j].sample.position);
+    }
+    result = validate(command, ranges_, defaults_.max_velocity, start - now, current);
+  }
+  return result;
+}
+
+void TrajectoryExecutor::endGoalsOn(const std::vector<std::size_t>& joints, GoalStatus status,
+                                    int code, const std::string& message) {
+  for (auto it = goals_.begin(); it != goals_.end();) {
+    if (!overlaps(it->joints, joints)) {
+      ++it;
+      continue;
+    }
+    finish(it->callbacks, outcome(status, code, message));
+    it = goals_.erase(it);
+  }
+}
+
+void TrajectoryExecutor::apply(const TrajectoryCommand& command,
+                               const std::vector<std::size_t>& joints, double start, double now) {
+  const std::vector<Measured> actual = measured();
+  for (std::size_t column = 0; column < joints.size(); ++column) {
+    Track& track = tracks_[joints[column]];
+    // A joint nobody drives starts from where it is; a driven one from where it is meant to be.
+    if (!track.writing) track.spline = JointSpline(actual[joints[column]].sample.position);
+    track.spline.splice(std::max(start, now), waypointsFor(command, column, start, now));
+    track.writing = true;
+    track.sent_segment = -std::numeric_limits<double>::infinity();  // no move went out yet
+  }
+}
+
+std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, double now) {
+  const std::vector<Measured> actual = measured();
+  std::vector<std::string> left_alone;
+  for (std::size_t j : joints) {
+    Track& track = tracks_[j];
+    const TrajectoryJoints& group = groups_[track.group];
+    if (group.move) {
+      // Per-segment: a stop where the servo is, never a move to an angle that may be stale. The
+      // desired state is the spline now (feedback, and where a later goal bridges from).
+      if (!track.writing && !track.moved) {
+        left_alone.push_back(ranges_[j].name);
+        continue;
+      }
+      track.spline = JointSpline(track.spline.sample(now).position);
+      track.writing = true;  // until the next tick: it has nothing more to send
+      const std::string error = group.stop ? group.stop(track.local) : std::string();
+      if (!error.empty()) warnThrottled(kTrajectoryError, "trajectory: " + error, now);
+      continue;
+    }
+    // Streamed: where it was last commanded, by this executor, else by anyone; never commanded,
+    // where it is measured if that is fresh; else nothing is written for it.
+    const std::optional<double> position = streamedHoldPosition(
+        track.last_written, group.last_commanded ? group.last_commanded(track.local) : std::nullopt,
+        staleJoint(actual, {j}, now) < 0 ? std::optional<double>(actual[j].sample.position)
+                                         : std::nullopt);
+    if (!position) {
+      track.writing = false;
+      left_alone.push_back(ranges_[j].name);
+      continue;
+    }
+    track.spline = JointSpline(*position);
+    track.writing = true;  // written once, then the servo keeps it
+  }
+  return leftAloneText(left_alone);
+}
+
+void TrajectoryExecutor::submitGoal(const Goal& goal, GoalCallbacks callbacks) {
+  const TrajectoryCommand& command = goal.command;
+  const double now = this->now();
+  const double start = goal.start_time.value_or(now);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_) {
+    finish(callbacks,
+           outcome(GoalStatus::kRejected, result_code::kInvalidGoal, "the driver is not running"));
+    return;
+  }
+  if (e_stop_ && e_stop_->refuse("follow_joint_trajectory")) {
+    warn("follow_joint_trajectory: goal rejected: e_stop is engaged");
+    finish(callbacks,
+           outcome(GoalStatus::kRejected, result_code::kInvalidGoal, "e_stop is engaged"));
+    return;
+  }
+  const CommandCheck checked = check(command, start, now);
+  if (!checked.ok()) {
+    warn("follow_joint_trajectory: goal rejected: " + checked.message);
+    finish(callbacks, outcome(GoalStatus::kRejected, resultCode(checked.error), checked.message));
+    return;
+  }
+  if (callbacks.accepted) callbacks.accepted();
+  endGoalsOn(checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
+             "preempted by a new goal");
+  if (command.points.empty()) {
+    // joint_trajectory_controller's "stop": hold where they are, and that is done at once.
+    const std::string left_alone = hold(checked.joint_indices, now);
+    if (!left_alone.empty()) warn("follow_joint_trajectory: stop: " + left_alone);
+    finish(callbacks, outcome(GoalStatus::kSucceeded, result_code::kSuccessful, left_alone,
+                              withLeftAlone("stopped where they were last commanded", left_alone)));
+    return;
+  }
+  apply(command, checked.joint_indices, start, now);
+
+  ActiveGoal active;
+  active.id = goal.id;
+  active.callbacks = std::move(callbacks);
+  active.joints = checked.joint_indices;
+  active.names = command.joint_names;
+  const JointTolerance path_defaults{defaults_.path_tolerance, 0.0};
+  const JointTolerance goal_defaults{defaults_.goal_tolerance, 0.0};
+  active.path_tolerances = resolveTolerances(active.names, path_defaults, goal.path_tolerance);
+  active.goal_tolerances = resolveTolerances(active.names, goal_defaults, goal.goal_tolerance);
+  active.start_time = start;
+  active.end_time = start + command.points.back().time_from_start;
+  active.goal_time_tolerance = goal.goal_time_tolerance == 0.0
+                                   ? defaults_.goal_time_tolerance
+                                   : std::max(0.0, goal.goal_time_tolerance);
+  goals_.push_back(std::move(active));
+}
+
+void TrajectoryExecutor::cancelGoal(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = std::find_if(goals_.begin(), goals_.end(),
+                         [&](const ActiveGoal& goal) { return goal.id == id; });
+  if (it == goals_.end()) return;  // already over
+  const std::string message =
+      withLeftAlone("cancelled: holding where they were last commanded", hold(it->joints, now()));
+  finish(it->callbacks, outcome(GoalStatus::kCanceled, result_code::kSuccessful, message));
+  goals_.erase(it);
+}
+
+void TrajectoryExecutor::submitTrajectory(const TrajectoryCommand& command,
+                                          std::optional<double> start_time) {
+  const double now = this->now();
+  const double start = start_time.value_or(now);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_) return;
+  if (e_stop_ && e_stop_->refuse("joint_trajectory")) {
+    warnThrottled(kMessageRefused,
+                  "joint_trajectory: message ignored, nothing moves: e_stop is engaged", now);
+    return;
+  }
+  const CommandCheck checked = check(command, start, now);
+  if (!checked.ok()) {
+    warnThrottled(kMessageInvalid,
+                  "joint_trajectory: message ignored, nothing moves: " + checked.message, now);
+    return;
+  }
+  endGoalsOn(checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
+             "preempted by a joint_trajectory message");
+  if (command.points.empty()) {
+    const std::string left_alone = hold(checked.joint_indices, now);
+    if (!left_alone.empty()) warn("joint_trajectory: stop: " + left_alone);
+  } else {
+    apply(command, checked.joint_indices, start, now);
+  }
+}
+
+void TrajectoryExecutor::takeOver(const std::vector<std::string>& names, const std::string& source,
+                                  const std::function<bool()>& write) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!write()) return;
+  std::vector<std::size_t> taken;
+  for (const std::string& name : names) {
+    const auto joint = index_.find(name);
+    if (joint == index_.end()) continue;
+    // What this executor wrote is no longer the joint's last command.
+    tracks_[joint->second].last_written.reset();
+    if (!tracks_[joint->second].writing) continue;
+    tracks_[joint->second].writing = false;
+    taken.push_back(joint->second);
+  }
+  if (taken.empty()) return;
+  const std::string message = "joint '" + ranges_[taken.front()].name + "' taken over by " +
+                              source + ": trajectory stopped";
+  warn(message);
+  endGoalsOn(taken, GoalStatus::kAborted, result_code::kInvalidGoal, message);
+}
+
+void TrajectoryExecutor::stopAll(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::size_t> all;
+  for (std::size_t j = 0; j < tracks_.size(); ++j) {
+    if (tracks_[j].writing) all.push_back(j);
+  }
+  for (const ActiveGoal& goal : goals_)
+    all.insert(all.end(), goal.joints.begin(), goal.joints.end());
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  const std::string left_alone = hold(all, now());
+  endGoalsOn(all, GoalStatus::kAborted, result_code::kInvalidGoal,
+             withLeftAlone(reason, left_alone));
+}
+
+void TrajectoryExecutor::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  e_stop.addListener([this](bool engaged) {
+    if (engaged) stopAll("e_stop engaged");
+  });
+}
+
+void TrajectoryExecutor::tick() {
+  const double now = this->now();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_) return;
+  // Idle (the usual case) costs one scan of the tracks.
+  const bool busy = !goals_.empty() || std::any_of(tracks_.begin(), tracks_.end(),
+                                                   [](const Track& t) { return t.writing; });
+  if (!busy) return;
+  const std::vector<Measured> actual = measured();
+  for (auto it = goals_.begin(); it != goals_.end();) {
+    it = superviseGoal(*it, now, actual) ? goals_.erase(it) : std::next(it);
+  }
+  writeTracks(now);
+}
+
+void TrajectoryExecutor::writeTracks(double now) {
+  // Streamed groups: one frame for every joint a trajectory drives. Per-segment groups: a move at
+  // each segment's start. A joint whose spline has ended is written once more at its final
+  // position (streamed), then left to its servo.
+  std::vector<std::vector<std::string>> names(groups_.size());
+  std::vector<std::vector<double>> positions(groups_.size());
+  for (std::size_t j = 0; j < tracks_.size(); ++j) {
+    Track& track = tracks_[j];
+    if (!track.writing) continue;
+    const TrajectoryJoints& group = groups_[track.group];
+    if (group.move) {
+      if (const auto move = segmentMoveAt(track.spline, now, track.sent_segment)) {
+        const std::string error = group.move(track.local, move->position, move->duration);
+        track.sent_segment = move->segment_start;
+        if (error.empty()) track.moved = true;
+        if (!error.empty()) warnThrottled(kTrajectoryError, "trajectory: " + error, now);
+      }
+    } else {
+      names[track.group].push_back(ranges_[j].name);
+      positions[track.group].push_back(track.spline.sample(now).position);
+    }
+    const bool owned = std::any_of(goals_.begin(), goals_.end(), [&](const ActiveGoal& goal) {
+      return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
+    });
+    if (!owned && now > track.spline.endTime()) track.writing = false;
+    track.spline.prune(now);
+  }
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    if (names[g].empty() || !groups_[g].write) continue;
+    const std::string error = groups_[g].write(names[g], positions[g]);
+    if (!error.empty()) {
+      warnThrottled(kTrajectoryError, "trajectory: " + error, now);
+      continue;
+    }
+    for (std::size_t k = 0; k < names[g].size(); ++k) {
+      tracks_[index_.at(names[g][k])].last_written = positions[g][k];
+    }
+  }
+}
+
+bool TrajectoryExecutor::superviseGoal(ActiveGoal& goal, double now,
+                                       const std::vector<Measured>& actual) {
+  const long stale = staleJoint(actual, goal.joints, now);
+  if (stale >= 0) {
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "telemetry lost: no state of joint '%s' for more than %.1f s, so nobody can tell "
+                  "whether it follows",
+                  ranges_[stale].name.c_str(), tracks_[stale].state_timeout);
+    // Held where last commanded: there is no measurement to stop at.
+    const std::string message = withLeftAlone(text, hold(goal.joints, now));
+    warn("follow_joint_trajectory: " + message);
+    finish(goal.callbacks,
+           outcome(GoalStatus::kAborted, result_code::kPathToleranceViolated, message));
+    return true;
+  }
+  std::vector<JointSample> desired, measured;
+  GoalFeedback feedback;
+  feedback.joint_names = goal.names;
+  feedback.time_from_start = std::max(0.0, now - goal.start_time);
+  const bool velocity_known = std::all_of(goal.joints.begin(), goal.joints.end(),
+                                          [&](std::size_t j) { return actual[j].velocity_known; });
+  for (std::size_t j : goal.joints) {
+    const JointSample d = tracks_[j].spline.sample(now);
+    JointSample a = actual[j].sample;
+    if (!actual[j].velocity_known) a.velocity = d.velocity;  // unmeasured: never a violation
+    desired.push_back(d);
+    measured.push_back(a);
+    feedback.actual_positions.push_back(a.position);
+    feedback.error_positions.push_back(d.position - a.position);
+    if (velocity_known) {
+      feedback.actual_velocities.push_back(a.velocity);
+      feedback.error_velocities.push_back(d.velocity - a.velocity);
+    }
+  }
+  feedback.desired = desired;
+  if (goal.callbacks.feedback) goal.callbacks.feedback(feedback);
+
+  if (now < goal.end_time) {
+    const auto violation =
+        findViolation(goal.names, goal.path_tolerances, desired, measured, "path");
+    if (!violation) return false;
+    const std::string message = withLeftAlone(violation->message, hold(goal.joints, now));
+    warn("follow_joint_trajectory: aborted: " + message);
+    finish(goal.callbacks,
+           outcome(GoalStatus::kAborted, result_code::kPathToleranceViolated, message));
+    return true;
+  }
+  const auto violation = findViolation(goal.names, goal.goal_tolerances, desired, measured, "goal");
+  if (!violation) {
+    finish(goal.callbacks,
+           outcome(GoalStatus::kSucceeded, result_code::kSuccessful, "", "reached"));
+    return true;
+  }
+  if (now <= goal.end_time + goal.goal_time_tolerance) return false;
+  const std::string message = violation->message + " after the goal time tolerance";
+  warn("follow_joint_trajectory: aborted: " + message);
+  finish(goal.callbacks,
+         outcome(GoalStatus::kAborted, result_code::kGoalToleranceViolated, message));
+  return true;
+}
+
+}  // namespace serial_robot_driver::trajectory

@@ -1,0 +1,119 @@
+// driver_node processes this test starts itself (base_node.test): a port that appears later, a bad
+// parameter, SIGINT while driving; and the main() of the test_base_node target.
+#include <gtest/gtest.h>
+
+#include "support/base_node_fixture.h"
+
+namespace {
+
+using namespace base_node_test;  // NOLINT: the shared fixture
+
+// 12. A node started while its port does not exist yet keeps retrying and connects when the
+// device appears, starting with a Reset.
+TEST(BaseNodeProcess, ConnectsWhenThePortAppearsLater) {
+  ASSERT_FALSE(g_driver_path.empty());
+  const std::string port = g_port + "_late";
+  test_support::removeStaleLink(port);
+  ChildProcess node(g_driver_path, driverArgs("/late", "driver_late", port));
+  ASSERT_TRUE(node.started());
+  // Up and failing to open its port (its services exist once the base interface is built).
+  ASSERT_TRUE(ros::service::waitForService("/late/base/reset", 20000)) << node.output();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_TRUE(node.running()) << node.output();
+
+  FakeBase base(port);
+  ASSERT_TRUE(base.waitForCount(2, 10.0)) << "no frames after the port appeared\n" << node.output();
+  const std::vector<SeenFrame> frames = base.frames();
+  EXPECT_EQ(frames[0].bytes, resetFrame(frames[0].seq));
+  EXPECT_TRUE(frames[1].isSpeed());
+
+  node.signal(SIGTERM);
+  const auto status = node.waitExit(10.0);
+  ASSERT_TRUE(status.has_value()) << "driver_node did not exit on SIGTERM";
+  EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 0) << node.output();
+}
+
+// 13. A bad parameter stops the node at start-up with a non-zero status and names the parameter.
+// A speed limit of 0 is one: it would not mean "no limit".
+TEST(BaseNodeProcess, BadParameterExitsNamingIt) {
+  ASSERT_FALSE(g_driver_path.empty());
+  const std::vector<std::pair<std::string, std::string>> cases = {{"base/wheel_diameter", "-1"},
+                                                                  {"base/max_wheel_speed", "0.0"},
+                                                                  {"base/max_wheel_speed", "-0.5"}};
+  int run = 0;
+  for (const auto& [name, value] : cases) {
+    SCOPED_TRACE(name + " " + value);
+    // A node name of its own each time: `_name:=value` stays on the parameter server.
+    std::vector<std::string> args =
+        driverArgs("/bad", "driver_bad" + std::to_string(run++), g_port + "_bad");
+    args.push_back("_" + name + ":=" + value);
+    ChildProcess node(g_driver_path, args);
+    ASSERT_TRUE(node.started());
+    const auto status = node.waitExit(20.0);
+    ASSERT_TRUE(status.has_value()) << "driver_node kept running with " << name << " " << value;
+    ASSERT_TRUE(WIFEXITED(*status)) << node.output();
+    EXPECT_EQ(WEXITSTATUS(*status), 2);
+    EXPECT_NE(node.output().find(name), std::string::npos) << node.output();
+  }
+}
+
+// 14. SIGINT while driving: the node's last frame before it closes the port is a zero-speed frame,
+// and it exits cleanly.
+TEST(BaseNodeProcess, SigintStopsTheWheelsBeforeExit) {
+  ASSERT_FALSE(g_driver_path.empty());
+  const std::string port = g_port + "_sigint";
+  FakeBase base(port);
+  ChildProcess node(g_driver_path, driverArgs("/sig", "driver_sigint", port));
+  ASSERT_TRUE(node.started());
+  ros::Publisher cmd_vel = g_ros->nh().advertise<geometry_msgs::Twist>("/sig/cmd_vel", 10);
+  ASSERT_TRUE(waitFor([&] { return cmd_vel.getNumSubscribers() > 0; }, 20.0)) << node.output();
+
+  CmdVelStreamer streamer(cmd_vel);
+  streamer.set(0.5, 0.0);  // 20.37 ticks per period
+  ASSERT_TRUE(base.waitUntil(
+      [](const std::vector<SeenFrame>& frames) {
+        const auto first = firstMoving(frames, 0);
+        return first && speedCount(frames, *first) >= 10;
+      },
+      10.0))
+      << node.output();
+
+  node.signal(SIGINT);  // the streamer keeps going: the stop must come from the shutdown
+  const auto status = node.waitExit(10.0);
+  streamer.stop(false);
+  ASSERT_TRUE(status.has_value()) << "driver_node did not exit on SIGINT";
+  EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 0) << node.output();
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last bytes
+  const std::vector<SeenFrame> speed = speedFramesFrom(base.frames(), 0);
+  ASSERT_GE(speed.size(), 2u);
+  const SeenFrame& last = speed.back();
+  const SeenFrame& before_last = speed[speed.size() - 2];
+  EXPECT_EQ(last.bytes, zeroSpeedFrame(last.seq));
+  EXPECT_EQ(last.seq, static_cast<uint8_t>(before_last.seq + 1));
+  EXPECT_FALSE(before_last.isZeroSpeed()) << "the wheels had already stopped before the SIGINT";
+  EXPECT_EQ(base.frames().back().bytes, last.bytes);
+  EXPECT_EQ(base.garbage(), 0u);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  test_support::RosTestNode node(argc, argv, "test_base_node");
+  ros::NodeHandle private_nh("~");
+
+  std::string node_name = "driver_node";
+  private_nh.getParam("node_name", node_name);
+  if (!ros::param::get("/" + node_name + "/port", g_port) || g_port.empty()) {
+    std::fprintf(stderr, "cannot read /%s/port from the parameter server\n", node_name.c_str());
+    return 1;
+  }
+  g_driver_path = test_support::findDriverNode();
+
+  RosSide ros_side(node_name);
+  g_ros = &ros_side;
+  const int result = RUN_ALL_TESTS();
+  g_ros = nullptr;
+  return result;
+}

@@ -1,0 +1,438 @@
+// The trajectory executor without ROS: goals accepted or rejected (with the action's codes and
+// texts), the splines sampled each tick, path and goal tolerances, the goal time tolerance,
+// preemption, what a cancel, an e-stop or lost telemetry holds, and take-overs. Time is a number
+// the tests step by hand.
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/trajectory/executor.h"
+
+namespace serial_robot_driver::trajectory {
+namespace {
+
+constexpr double kEps = 1e-9;
+
+/// What a goal was told.
+struct GoalLog {
+  int accepted = 0;
+  std::vector<GoalFeedback> feedback;
+  std::vector<GoalOutcome> outcomes;
+
+  GoalCallbacks callbacks() {
+    return {[this] { ++accepted; }, [this](const GoalFeedback& f) { feedback.push_back(f); },
+            [this](const GoalOutcome& o) { outcomes.push_back(o); }};
+  }
+  bool over() const { return !outcomes.empty(); }
+  const GoalOutcome& outcome() const { return outcomes.at(0); }
+};
+
+/// Two streamed joints (arm_1, arm_2: the body) and one per-segment joint (pan: a bus servo),
+/// every call they get recorded, on a clock at 100 s.
+class ExecutorRig : public ::testing::Test {
+ protected:
+  using Frame = std::pair<std::vector<std::string>, std::vector<double>>;
+
+  ExecutorRig()
+      : executor(
+            groups(), defaults(), [this] { return now; }, warner()) {
+    executor.start();
+  }
+
+  static GoalDefaults defaults() {
+    GoalDefaults d;
+    d.goal_tolerance = 0.05;
+    d.goal_time_tolerance = 0.5;
+    return d;
+  }
+
+  std::vector<TrajectoryJoints> groups() {
+    TrajectoryJoints body;
+    body.joints = {{"arm_1", -3.0, 3.0}, {"arm_2", -3.0, 3.0}};
+    body.write = [this](const std::vector<std::string>& names, const std::vector<double>& p) {
+      frames.emplace_back(names, p);
+      return write_error;
+    };
+    body.last_commanded = [this](std::size_t) { return body_last_commanded; };
+    TrajectoryJoints bus;
+    bus.joints = {{"pan", -3.0, 3.0}};
+    bus.move = [this](std::size_t index, double position, double duration) {
+      moves.emplace_back(index, position, duration);
+      return std::string();
+    };
+    bus.stop = [this](std::size_t index) {
+      stops.push_back(index);
+      return std::string();
+    };
+    return {body, bus};
+  }
+
+  TrajectoryExecutor::Warn warner() {
+    return [this](const std::string& text) { warnings.push_back(text); };
+  }
+
+  void measure(const std::vector<std::string>& names, const std::vector<double>& positions,
+               const std::vector<double>& velocities = {}) {
+    executor.updateActual(names, positions, velocities);
+  }
+
+  /// A goal moving `names` to `positions` in `seconds`, starting at once.
+  static Goal goalTo(const std::vector<std::string>& names, const std::vector<double>& positions,
+                     double seconds = 1.0, const std::string& id = "g") {
+    Goal goal;
+    goal.id = id;
+    goal.command.joint_names = names;
+    goal.command.points.push_back({seconds, positions, {}, {}});
+    return goal;
+  }
+
+  /// Steps the clock to `time`, then ticks.
+  void tickAt(double time) {
+    now = time;
+    executor.tick();
+  }
+
+  double now = 100.0;
+  std::vector<Frame> frames;
+  std::string write_error;
+  std::optional<double> body_last_commanded;
+  std::vector<std::tuple<std::size_t, double, double>> moves;
+  std::vector<std::size_t> stops;
+  std::vector<std::string> warnings;
+  TrajectoryExecutor executor;
+};
+
+TEST_F(ExecutorRig, RejectsEveryGoalBeforeStartAndAfterShutdown) {
+  TrajectoryExecutor idle(groups(), defaults(), [this] { return now; });
+  GoalLog log;
+  idle.submitGoal(goalTo({"arm_1"}, {0.5}), log.callbacks());
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.accepted, 0);
+  EXPECT_EQ(log.outcome().status, GoalStatus::kRejected);
+  EXPECT_EQ(log.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(log.outcome().error_string, "the driver is not running");
+  EXPECT_EQ(log.outcome().text, "the driver is not running");
+
+  measure({"arm_1"}, {0.0});
+  GoalLog running;
+  executor.submitGoal(goalTo({"arm_1"}, {0.5}), running.callbacks());
+  executor.shutdown();
+  ASSERT_TRUE(running.over());
+  EXPECT_EQ(running.outcome().status, GoalStatus::kAborted);
+  EXPECT_EQ(running.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(running.outcome().text, "the driver is shutting down");
+  executor.shutdown();  // idempotent: told once
+  EXPECT_EQ(running.outcomes.size(), 1u);
+}
+
+TEST_F(ExecutorRig, AcceptanceErrorsCarryTheActionsCodes) {
+  GoalLog unknown;
+  executor.submitGoal(goalTo({"elbow"}, {0.5}), unknown.callbacks());
+  EXPECT_EQ(unknown.outcome().status, GoalStatus::kRejected);
+  EXPECT_EQ(unknown.outcome().error_code, result_code::kInvalidJoints);
+
+  // Never measured: nobody knows where the bridge would start.
+  GoalLog unmeasured;
+  executor.submitGoal(goalTo({"arm_1"}, {0.5}), unmeasured.callbacks());
+  EXPECT_EQ(unmeasured.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(unmeasured.outcome().error_string,
+            "joint 'arm_1': no recent measurement (is its telemetry or poll arriving?), so the "
+            "trajectory cannot start from where it is");
+
+  measure({"arm_1"}, {0.0});
+  Goal old = goalTo({"arm_1"}, {0.5});
+  old.start_time = now - 10.0;
+  GoalLog late;
+  executor.submitGoal(old, late.callbacks());
+  EXPECT_EQ(late.outcome().error_code, result_code::kOldHeaderTimestamp);
+
+  GoalLog unreachable;
+  executor.submitGoal(goalTo({"arm_1"}, {5.0}), unreachable.callbacks());
+  EXPECT_EQ(unreachable.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(unreachable.accepted + unknown.accepted + unmeasured.accepted + late.accepted, 0);
+  EXPECT_EQ(warnings.size(), 4u);
+  EXPECT_EQ(warnings[0].rfind("follow_joint_trajectory: goal rejected: ", 0), 0u);
+
+  // The speed limit comes from the defaults in force when the goal arrives.
+  GoalDefaults slow = defaults();
+  slow.max_velocity = 0.1;
+  executor.retune(slow);
+  GoalLog fast;
+  executor.submitGoal(goalTo({"arm_1"}, {0.5}), fast.callbacks());
+  EXPECT_EQ(fast.outcome().error_code, result_code::kInvalidGoal);
+  GoalLog gentle;
+  executor.submitGoal(goalTo({"arm_1"}, {0.05}), gentle.callbacks());
+  EXPECT_EQ(gentle.accepted, 1);
+  EXPECT_FALSE(gentle.over());
+}
+
+TEST_F(ExecutorRig, SamplesTheSplineEachTickAndSucceedsWithinTheGoalTolerance) {
+  measure({"arm_1"}, {0.0}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  EXPECT_EQ(log.accepted, 1);
+  EXPECT_FALSE(log.over());
+
+  measure({"arm_1"}, {0.4}, {1.0});
+  tickAt(100.5);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames[0].first, std::vector<std::string>{"arm_1"});
+  EXPECT_NEAR(frames[0].second.at(0), 0.5, kEps);  // linear: halfway at half time
+  ASSERT_EQ(log.feedback.size(), 1u);
+  const GoalFeedback& feedback = log.feedback[0];
+  EXPECT_EQ(feedback.joint_names, std::vector<std::string>{"arm_1"});
+  EXPECT_NEAR(feedback.time_from_start, 0.5, kEps);
+  EXPECT_NEAR(feedback.desired.at(0).position, 0.5, kEps);
+  EXPECT_NEAR(feedback.desired.at(0).velocity, 1.0, kEps);
+  EXPECT_NEAR(feedback.actual_positions.at(0), 0.4, kEps);
+  EXPECT_NEAR(feedback.error_positions.at(0), 0.1, kEps);
+  EXPECT_NEAR(feedback.actual_velocities.at(0), 1.0, kEps);
+  EXPECT_NEAR(feedback.error_velocities.at(0), 0.0, kEps);
+
+  measure({"arm_1"}, {0.98});  // no velocity: unknown, never a violation, not in the feedback
+  tickAt(101.0);
+  ASSERT_TRUE(log.over());
+  EXPECT_TRUE(log.feedback.back().actual_velocities.empty());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kSucceeded);
+  EXPECT_EQ(log.outcome().error_code, result_code::kSuccessful);
+  EXPECT_EQ(log.outcome().error_string, "");
+  EXPECT_EQ(log.outcome().text, "reached");
+  EXPECT_NEAR(frames.back().second.at(0), 1.0, kEps);
+
+  // The end is written once more, then the servo keeps it.
+  const std::size_t written = frames.size();
+  tickAt(101.1);
+  tickAt(101.2);
+  EXPECT_EQ(frames.size(), written + 1);
+}
+
+TEST_F(ExecutorRig, PathToleranceAbortHoldsWhereLastWritten) {
+  GoalDefaults strict = defaults();
+  strict.path_tolerance = 0.1;
+  executor.retune(strict);
+  measure({"arm_1"}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  measure({"arm_1"}, {0.2});
+  tickAt(100.25);
+  ASSERT_FALSE(log.over());
+  EXPECT_NEAR(frames.back().second.at(0), 0.25, kEps);
+
+  measure({"arm_1"}, {0.2});  // 0.3 rad behind
+  tickAt(100.5);
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kAborted);
+  EXPECT_EQ(log.outcome().error_code, result_code::kPathToleranceViolated);
+  EXPECT_NE(log.outcome().text.find("path tolerance"), std::string::npos);
+  EXPECT_EQ(log.outcome().error_string, log.outcome().text);
+  EXPECT_EQ(warnings.back(), "follow_joint_trajectory: aborted: " + log.outcome().text);
+  // Held at the last written position, not the measurement nor the spline.
+  EXPECT_NEAR(frames.back().second.at(0), 0.25, kEps);
+}
+
+TEST_F(ExecutorRig, GoalTimeToleranceGivesTheJointsTimeToArrive) {
+  measure({"arm_1"}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  for (double t : {100.5, 101.0, 101.3, 101.5}) {
+    measure({"arm_1"}, {0.8});
+    tickAt(t);
+    ASSERT_FALSE(log.over()) << "at " << t;
+  }
+  measure({"arm_1"}, {0.8});
+  tickAt(101.6);
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().error_code, result_code::kGoalToleranceViolated);
+  EXPECT_NE(log.outcome().text.find("after the goal time tolerance"), std::string::npos);
+
+  // A goal's own tolerance replaces the default; a negative one means none.
+  Goal strict = goalTo({"arm_1"}, {1.0}, 1.0, "strict");
+  strict.goal_time_tolerance = -1.0;
+  GoalLog strict_log;
+  executor.submitGoal(strict, strict_log.callbacks());
+  now = 102.7;  // past its end (102.6), measured now
+  measure({"arm_1"}, {0.8});
+  executor.tick();
+  ASSERT_TRUE(strict_log.over());
+  EXPECT_EQ(strict_log.outcome().error_code, result_code::kGoalToleranceViolated);
+}
+
+TEST_F(ExecutorRig, NewGoalOrMessagePreemptsFromTheDesiredState) {
+  measure({"arm_1", "arm_2"}, {0.0, 0.0});
+  GoalLog first;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}, 1.0, "first"), first.callbacks());
+  measure({"arm_1", "arm_2"}, {0.0, 0.0});
+  tickAt(100.5);
+  // A goal on other joints leaves it running.
+  GoalLog other;
+  executor.submitGoal(goalTo({"arm_2"}, {0.5}, 1.0, "other"), other.callbacks());
+  EXPECT_FALSE(first.over());
+
+  GoalLog second;
+  executor.submitGoal(goalTo({"arm_1"}, {0.5}, 1.0, "second"), second.callbacks());
+  ASSERT_TRUE(first.over());
+  EXPECT_EQ(first.outcome().status, GoalStatus::kCanceled);
+  EXPECT_EQ(first.outcome().error_code, result_code::kSuccessful);
+  EXPECT_EQ(first.outcome().text, "preempted by a new goal");
+  EXPECT_FALSE(second.over());
+  // The bridge starts where arm_1 was meant to be (0.5), not where it is measured (0).
+  tickAt(100.5);
+  EXPECT_NEAR(frames.back().second.at(0), 0.5, kEps);
+
+  TrajectoryCommand message;
+  message.joint_names = {"arm_1"};
+  message.points.push_back({1.0, {0.0}, {}, {}});
+  executor.submitTrajectory(message, std::nullopt);
+  ASSERT_TRUE(second.over());
+  EXPECT_EQ(second.outcome().status, GoalStatus::kCanceled);
+  EXPECT_EQ(second.outcome().text, "preempted by a joint_trajectory message");
+  EXPECT_FALSE(other.over());
+}
+
+TEST_F(ExecutorRig, CancelHoldsEveryJointWhereItWasLastCommanded) {
+  measure({"arm_1", "pan"}, {0.0, 0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1", "pan"}, {1.0, 1.0}, 1.0, "g"), log.callbacks());
+  measure({"arm_1", "pan"}, {0.1, 0.1});
+  tickAt(100.2);
+  ASSERT_EQ(moves.size(), 1u);  // one move per segment, to its end in the time left
+  EXPECT_NEAR(std::get<1>(moves[0]), 1.0, kEps);
+  EXPECT_NEAR(std::get<2>(moves[0]), 0.8, kEps);
+  const double written = frames.back().second.at(0);
+
+  executor.cancelGoal("unknown");
+  EXPECT_FALSE(log.over());
+  executor.cancelGoal("g");
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kCanceled);
+  EXPECT_EQ(log.outcome().error_code, result_code::kSuccessful);
+  EXPECT_EQ(log.outcome().text, "cancelled: holding where they were last commanded");
+  EXPECT_EQ(stops, std::vector<std::size_t>{0});  // the servo stops where it is, no move
+  tickAt(100.3);
+  EXPECT_NEAR(frames.back().second.at(0), written, kEps);
+  EXPECT_EQ(moves.size(), 1u);
+  executor.cancelGoal("g");  // over: nothing more
+  EXPECT_EQ(log.outcomes.size(), 1u);
+}
+
+TEST_F(ExecutorRig, EmptyTrajectoryHoldsOrNamesTheJointsLeftAlone) {
+  Goal stop;
+  stop.id = "stop";
+  stop.command.joint_names = {"arm_2", "pan"};
+  GoalLog log;
+  executor.submitGoal(stop, log.callbacks());
+  ASSERT_TRUE(log.over());
+  const std::string left_alone =
+      "joints 'arm_2', 'pan' left alone: never commanded by the driver nor recently measured, so "
+      "there is no position to hold";
+  EXPECT_EQ(log.accepted, 1);
+  EXPECT_EQ(log.outcome().status, GoalStatus::kSucceeded);
+  EXPECT_EQ(log.outcome().error_string, left_alone);
+  EXPECT_EQ(log.outcome().text, "stopped where they were last commanded; " + left_alone);
+  tickAt(100.1);
+  EXPECT_TRUE(frames.empty());
+  EXPECT_TRUE(stops.empty());
+
+  // The device's own last command is held when the executor never wrote the joint.
+  body_last_commanded = 0.7;
+  GoalLog held;
+  stop.command.joint_names = {"arm_2"};
+  executor.submitGoal(stop, held.callbacks());
+  EXPECT_EQ(held.outcome().error_string, "");
+  EXPECT_EQ(held.outcome().text, "stopped where they were last commanded");
+  tickAt(100.2);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_NEAR(frames[0].second.at(0), 0.7, kEps);
+}
+
+TEST_F(ExecutorRig, EStopAbortsHoldsAndRefuses) {
+  device::EStop e_stop;
+  executor.attachEStop(e_stop);
+  measure({"arm_1"}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  measure({"arm_1"}, {0.2});
+  tickAt(100.25);
+  const double written = frames.back().second.at(0);
+
+  e_stop.set(true);
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kAborted);
+  EXPECT_EQ(log.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(log.outcome().text, "e_stop engaged");
+  tickAt(100.5);
+  EXPECT_NEAR(frames.back().second.at(0), written, kEps);  // held, not followed on
+
+  GoalLog refused;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), refused.callbacks());
+  EXPECT_EQ(refused.outcome().status, GoalStatus::kRejected);
+  EXPECT_EQ(refused.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(refused.outcome().text, "e_stop is engaged");
+  TrajectoryCommand message;
+  message.joint_names = {"arm_1"};
+  message.points.push_back({1.0, {1.0}, {}, {}});
+  const std::size_t warned = warnings.size();
+  executor.submitTrajectory(message, std::nullopt);
+  executor.submitTrajectory(message, std::nullopt);  // within a second: counted, not logged
+  EXPECT_EQ(warnings.size(), warned + 1);
+  EXPECT_EQ(warnings.back(), "joint_trajectory: message ignored, nothing moves: e_stop is engaged");
+  EXPECT_EQ(e_stop.stats().refused.at("follow_joint_trajectory"), 1u);
+  EXPECT_EQ(e_stop.stats().refused.at("joint_trajectory"), 2u);
+}
+
+TEST_F(ExecutorRig, StaleBusJointAbortsAndStopsItsServo) {
+  measure({"pan"}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"pan"}, {1.0}, 2.0), log.callbacks());
+  tickAt(100.4);
+  EXPECT_FALSE(log.over());
+  // A slower poll: the joint may go longer without an answer.
+  executor.setStateTimeout({"pan", "not_a_joint"}, 1.0);
+  tickAt(100.9);
+  EXPECT_FALSE(log.over());
+  tickAt(101.1);
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kAborted);
+  EXPECT_EQ(log.outcome().error_code, result_code::kPathToleranceViolated);
+  EXPECT_EQ(log.outcome().text,
+            "telemetry lost: no state of joint 'pan' for more than 1.0 s, so nobody can tell "
+            "whether it follows");
+  EXPECT_EQ(stops, std::vector<std::size_t>{0});
+}
+
+TEST_F(ExecutorRig, TakeOverStopsTheTrajectoryOnlyWhenTheOtherCommandWrote) {
+  measure({"arm_1"}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  executor.takeOver({"arm_1"}, "joint_commands", [] { return false; });
+  EXPECT_FALSE(log.over());
+  bool ran = false;
+  executor.takeOver({"arm_1"}, "joint_commands", [&] { return ran = true; });
+  EXPECT_TRUE(ran);
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kAborted);
+  EXPECT_EQ(log.outcome().error_code, result_code::kInvalidGoal);
+  EXPECT_EQ(log.outcome().text, "joint 'arm_1' taken over by joint_commands: trajectory stopped");
+  tickAt(100.5);
+  EXPECT_TRUE(frames.empty());  // the other command's position stays
+}
+
+TEST_F(ExecutorRig, WriteErrorsAreLoggedAtMostOnceASecond) {
+  write_error = "joint 'arm_1' out of range";
+  measure({"arm_1"}, {0.0});
+  TrajectoryCommand message;
+  message.joint_names = {"arm_1"};
+  message.points.push_back({5.0, {1.0}, {}, {}});
+  executor.submitTrajectory(message, std::nullopt);
+  for (double t = 100.1; t < 101.05; t += 0.1) tickAt(t);
+  tickAt(101.2);
+  EXPECT_EQ(warnings, std::vector<std::string>(2, "trajectory: joint 'arm_1' out of range"));
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::trajectory
