@@ -2,8 +2,6 @@
 
 #include <limits>
 
-#include "serial_robot_driver/protocol/byte_order.h"
-
 namespace serial_robot_driver::protocol::servo {
 
 namespace {
@@ -109,19 +107,6 @@ std::string label(const ParamInfo& param) {
 
 }  // namespace
 
-std::size_t typeSize(ParamType type) {
-  switch (type) {
-    case ParamType::kU8:
-      return 1;
-    case ParamType::kU16:
-    case ParamType::kI16:
-      return 2;
-    case ParamType::kU32:
-      return 4;
-  }
-  return 0;
-}
-
 int64_t typeMin(ParamType type) { return type == ParamType::kI16 ? kI16Min : 0; }
 
 int64_t typeMax(ParamType type) {
@@ -187,33 +172,12 @@ std::string describe(WriteCheck check, const ParamInfo& param, int64_t value) {
 
 std::optional<int64_t> readValue(const ParamInfo& param, const uint8_t* data, std::size_t size) {
   if (size != typeSize(param.type)) return std::nullopt;
-  switch (param.type) {
-    case ParamType::kU8:
-      return data[0];
-    case ParamType::kU16:
-      return readLE16(data);
-    case ParamType::kI16:
-      return readLE16Signed(data);
-    case ParamType::kU32:
-      return readLE32(data);
-  }
-  return std::nullopt;
+  return wire::readInteger(data, wireType(param.type), wire::ByteOrder::kLittle);
 }
 
 std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out) {
-  switch (param.type) {
-    case ParamType::kU8:
-      out[0] = static_cast<uint8_t>(value);
-      break;
-    case ParamType::kU16:
-    case ParamType::kI16:
-      // Two's complement: the low 16 bits of a negative i16 are its wire form.
-      writeLE16(out, static_cast<uint16_t>(value));
-      break;
-    case ParamType::kU32:
-      writeLE32(out, static_cast<uint32_t>(value));
-      break;
-  }
+  // Two's complement: the low bytes of a negative i16 are its wire form.
+  wire::writeInteger(out, value, wireType(param.type), wire::ByteOrder::kLittle);
   return typeSize(param.type);
 }
 
