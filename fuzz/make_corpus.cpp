@@ -187,8 +187,10 @@ std::string seedName(const char* command_name) {
 }
 
 // Selector bytes of fuzz_decoders.cpp: decoder index + 5 * mode (0 raw, 1 fix sum, 2 fix all).
-enum Decoder : uint8_t { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite };
-uint8_t selector(Decoder decoder, uint8_t mode) { return static_cast<uint8_t>(decoder + 5 * mode); }
+enum class Decoder : uint8_t { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite };
+uint8_t selector(Decoder decoder, uint8_t mode) {
+  return static_cast<uint8_t>(static_cast<uint8_t>(decoder) + 5 * mode);
+}
 constexpr uint8_t kRaw = 0, kFixSum = 1, kFixAll = 2;
 
 // Prefix bits of fuzz_framer.cpp.
@@ -233,38 +235,38 @@ void writeFramerSeeds(SeedWriter& seeds) {
 }
 
 void writeDecoderSeeds(SeedWriter& seeds) {
-  seeds.write("base_reset_raw", {selector(kBase, kRaw), 2}, kBaseReset);
-  seeds.write("base_battery_request_raw", {selector(kBase, kRaw), 2}, kBaseBatteryRequest);
-  seeds.write("base_clear_encoders_raw", {selector(kBase, kRaw), 2}, kBaseClearEncoders);
-  seeds.write("base_wheels_raw", {selector(kBase, kRaw), 2}, kBaseBothMinus6);
-  seeds.write("base_error_status_raw", {selector(kBase, kRaw), 2}, kBaseErrorStatus);
-  seeds.write("base_battery_fixsum", {selector(kBase, kFixSum), 2}, kBaseBatteryReply);
-  seeds.write("base_fixall", {selector(kBase, kFixAll), 2}, kBaseLeft4);
-  seeds.write("telemetry_raw", {selector(kTelemetry, kRaw), 2}, kTelemetry);
-  seeds.write("telemetry_foot_raw", {selector(kTelemetry, kRaw), 2}, kTelemetryFoot);
-  seeds.write("telemetry_fixsum", {selector(kTelemetry, kFixSum), 2}, kTelemetry);
-  seeds.write("telemetry_fixall", {selector(kTelemetry, kFixAll), 6}, kTelemetryFoot);
+  seeds.write("base_reset_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseReset);
+  seeds.write("base_battery_request_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseBatteryRequest);
+  seeds.write("base_clear_encoders_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseClearEncoders);
+  seeds.write("base_wheels_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseBothMinus6);
+  seeds.write("base_error_status_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseErrorStatus);
+  seeds.write("base_battery_fixsum", {selector(Decoder::kBase, kFixSum), 2}, kBaseBatteryReply);
+  seeds.write("base_fixall", {selector(Decoder::kBase, kFixAll), 2}, kBaseLeft4);
+  seeds.write("telemetry_raw", {selector(Decoder::kTelemetry, kRaw), 2}, kTelemetry);
+  seeds.write("telemetry_foot_raw", {selector(Decoder::kTelemetry, kRaw), 2}, kTelemetryFoot);
+  seeds.write("telemetry_fixsum", {selector(Decoder::kTelemetry, kFixSum), 2}, kTelemetry);
+  seeds.write("telemetry_fixall", {selector(Decoder::kTelemetry, kFixAll), 6}, kTelemetryFoot);
   for (const servo::CommandInfo& info : servo::commandTable()) {
     const std::string name = seedName(info.name);
-    seeds.write("servo_request_" + name + "_raw", {selector(kServoRequest, kRaw), 0},
+    seeds.write("servo_request_" + name + "_raw", {selector(Decoder::kServoRequest, kRaw), 0},
                 request(info.cmd));
-    seeds.write("servo_answer_" + name + "_raw", {selector(kServoResponse, kRaw), 0},
+    seeds.write("servo_answer_" + name + "_raw", {selector(Decoder::kServoResponse, kRaw), 0},
                 answer(info.cmd));
   }
-  seeds.write("servo_request_fixsum", {selector(kServoRequest, kFixSum), 0},
+  seeds.write("servo_request_fixsum", {selector(Decoder::kServoRequest, kFixSum), 0},
               request(servo::Command::kSpin));
-  seeds.write("servo_response_fixsum", {selector(kServoResponse, kFixSum), 0},
+  seeds.write("servo_response_fixsum", {selector(Decoder::kServoResponse, kFixSum), 0},
               answer(servo::Command::kPing));
-  seeds.write("servo_read_data_fixall", {selector(kServoResponse, kFixAll), 0},
+  seeds.write("servo_read_data_fixall", {selector(Decoder::kServoResponse, kFixAll), 0},
               answer(servo::Command::kReadData));
-  seeds.write("servo_read_batch_fixall", {selector(kServoResponse, kFixAll), 0},
+  seeds.write("servo_read_batch_fixall", {selector(Decoder::kServoResponse, kFixAll), 0},
               answer(servo::Command::kReadBatchData));
-  seeds.write("sync_write_raw", {selector(kSyncWrite, kRaw), 0}, kSyncWrite);
-  seeds.write("sync_write_fixcrc", {selector(kSyncWrite, kFixSum), 0}, kSyncWrite);
+  seeds.write("sync_write_raw", {selector(Decoder::kSyncWrite, kRaw), 0}, kSyncWrite);
+  seeds.write("sync_write_fixcrc", {selector(Decoder::kSyncWrite, kFixSum), 0}, kSyncWrite);
   // Three bytes more: with the fix-ups they become a third servo record.
-  seeds.write("sync_write_fixall", {selector(kSyncWrite, kFixAll), 0},
+  seeds.write("sync_write_fixall", {selector(Decoder::kSyncWrite, kFixAll), 0},
               join({kSyncWrite, {5, 0, 8}}));
-  seeds.write("dynamixel_ping_raw", {selector(kSyncWrite, kRaw), 0}, dynamixelPing());
+  seeds.write("dynamixel_ping_raw", {selector(Decoder::kSyncWrite, kRaw), 0}, dynamixelPing());
 }
 
 }  // namespace
