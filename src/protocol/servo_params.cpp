@@ -192,4 +192,28 @@ std::optional<std::size_t> userBlockOffset(const ParamInfo& param) {
   return std::nullopt;
 }
 
+std::array<uint8_t, kUserBlockSize> packUserBlock(
+    const std::function<int64_t(const ParamInfo&)>& value_of) {
+  std::array<uint8_t, kUserBlockSize> block{};
+  for (const ParamInfo& param : kParams) {
+    if (const std::optional<std::size_t> offset = userBlockOffset(param)) {
+      writeValue(param, value_of(param), &block[*offset]);
+    }
+  }
+  return block;
+}
+
+std::vector<std::pair<const ParamInfo*, int64_t>> unpackUserBlock(
+    const std::array<uint8_t, kUserBlockSize>& block) {
+  std::vector<std::pair<const ParamInfo*, int64_t>> values;
+  for (const ParamInfo& param : kParams) {
+    const std::optional<std::size_t> offset = userBlockOffset(param);
+    if (!offset) continue;
+    // The table's user parameters fill the block exactly (test_servo_params checks it).
+    const std::size_t size = typeSize(param.type);
+    values.emplace_back(&param, *readValue(param, &block[*offset], size));
+  }
+  return values;
+}
+
 }  // namespace serial_robot_driver::protocol::servo

@@ -301,35 +301,21 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
     }
 
     case Command::kReadBatchData: {
-      std::array<uint8_t, servo::kUserBlockSize> block{};
-      for (const servo::ParamInfo& param_info : servo::paramTable()) {
-        const auto offset = servo::userBlockOffset(param_info);
-        if (!offset) continue;
-        servo::writeValue(param_info, param(*s, param_info.data_id), &block[*offset]);
-      }
-      reply(servo::userBlockAnswerContent(id, block));
+      const auto value_of = [&](const servo::ParamInfo& info) { return param(*s, info.data_id); };
+      reply(servo::userBlockAnswerContent(id, servo::packUserBlock(value_of)));
       break;
     }
 
     case Command::kWriteBatchData: {
       const auto block = servo::decodeUserBlock(packet);
       if (!block) return malformed();
+      const auto values = servo::unpackUserBlock(*block);
       // All or nothing: one bad cell rejects the block.
-      std::map<uint8_t, int64_t> values;
-      bool ok = true;
-      for (const servo::ParamInfo& param_info : servo::paramTable()) {
-        const auto offset = servo::userBlockOffset(param_info);
-        if (!offset) continue;
-        const auto value =
-            servo::readValue(param_info, block->data() + *offset, servo::typeSize(param_info.type));
-        if (!value || servo::checkWrite(param_info, *value, true) != servo::WriteCheck::kOk) {
-          ok = false;
-          break;
-        }
-        values[param_info.data_id] = *value;
-      }
+      const bool ok = std::all_of(values.begin(), values.end(), [](const auto& cell) {
+        return servo::checkWrite(*cell.first, cell.second, true) == servo::WriteCheck::kOk;
+      });
       if (ok) {
-        for (const auto& [data_id, value] : values) s->params[data_id] = value;
+        for (const auto& [param_info, value] : values) s->params[param_info->data_id] = value;
       } else {
         ++stats_.writes_rejected;
       }

@@ -1,9 +1,10 @@
 // Servo controller board protocol (docs/protocols.md, section 2).
 //
 // Host -> board: Dynamixel 2.0 Sync Write of goal positions, CRC-16/BUYPASS (Boost.CRC):
-//   FF FF FD 00 | FE | LEN_L LEN_H | 83 | 74 00 | 02 00 | (ID, POS_L, POS_H) x N | CRC_L CRC_H
-// Board -> host: telemetry, big-endian except the foot block:
-//   12 34 | LEN | servo block (4N) | IMU block (18) | [foot block (16, little-endian)] | SUM | 1F 2F
+//   header | id | LEN | command fields | servo record x N | CRC
+// Board -> host: telemetry:
+//   header | LEN | servo record x N | IMU values | [foot values] | SUM | tail
+// The records and values are the field lists below; the envelopes' constants are next to them.
 #pragma once
 
 #include <array>

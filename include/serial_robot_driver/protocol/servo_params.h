@@ -6,9 +6,12 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "serial_robot_driver/protocol/wire_fields.h"
 
@@ -120,5 +123,12 @@ std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out);
 
 /// Byte offset of a user-block parameter inside the 32-byte block, nullopt for read-only ones.
 std::optional<std::size_t> userBlockOffset(const ParamInfo& param);
+
+/// The user block with each read-write parameter's value, as `value_of` gives it, at its offset.
+std::array<uint8_t, kUserBlockSize> packUserBlock(
+    const std::function<int64_t(const ParamInfo&)>& value_of);
+/// Every parameter of a user block with its value, in block order.
+std::vector<std::pair<const ParamInfo*, int64_t>> unpackUserBlock(
+    const std::array<uint8_t, kUserBlockSize>& block);
 
 }  // namespace serial_robot_driver::protocol::servo
