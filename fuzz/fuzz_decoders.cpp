@@ -116,19 +116,23 @@ void runTelemetry(const uint8_t* d, std::size_t n, std::size_t servo_count) {
 
 void runServoParams(const servo::Packet& packet) {
   const auto cmd = static_cast<servo::Command>(packet.cmd);
-  if (cmd == servo::Command::kReadData && packet.content_size >= 2) {
-    if (const servo::ParamInfo* param = servo::findParamById(packet.content[1])) {
-      (void)servo::readValue(*param, &packet.content[2], packet.content_size - 2u);
-    }
+  if (cmd == servo::Command::kReadData) {
+    const auto data = servo::decodeDataContent(packet);
+    const servo::ParamInfo* param = data.ok() ? servo::findParamById(data->data_id) : nullptr;
+    if (param != nullptr) (void)servo::readValue(*param, data->value.data(), data->value_size);
   }
-  if (cmd == servo::Command::kReadBatchData && packet.content_size == 1 + servo::kUserBlockSize) {
-    for (const servo::ParamInfo& param : servo::paramTable()) {
-      const auto offset = servo::userBlockOffset(param);
-      if (!offset) continue;
-      const std::size_t size = servo::typeSize(param.type);
-      check(*offset + size <= servo::kUserBlockSize);
-      (void)servo::readValue(param, &packet.content[1 + *offset], size);
-    }
+  if (cmd == servo::Command::kReadBatchData) {
+    const auto block = servo::decodeUserBlock(packet);
+    if (!block.ok()) return;
+    // The user parameters cover every byte of the block: unpacked and packed again, it is the same.
+    const auto values = servo::unpackUserBlock(*block);
+    const auto value_of = [&](const servo::ParamInfo& param) {
+      for (const auto& [unpacked, value] : values) {
+        if (unpacked == &param) return value;
+      }
+      std::abort();
+    };
+    check(servo::packUserBlock(value_of) == *block);
   }
 }
 
