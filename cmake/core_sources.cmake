@@ -41,6 +41,14 @@ set(SRD_CORE_SOURCES
   src/device/e_stop.cpp
   src/device/motion_gate.cpp
   src/device/servo_health.cpp
+  src/device/status_report.cpp
+  src/device/base_status.cpp
+  src/device/body_status.cpp
+  src/device/servo_bus_status.cpp
+  src/device/servo_joint_commands.cpp
+  src/device/link_status.cpp
+  src/device/e_stop_status.cpp
+  src/device/wire_capture_status.cpp
 )
 
 srd_device_sources(core srd_device_core_sources)

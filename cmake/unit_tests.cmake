@@ -34,7 +34,12 @@ catkin_add_gtest(core_tests
   test/unit/test_sim_command_line.cpp
   test/unit/test_device_registry.cpp
   test/unit/test_servo_health.cpp
-  test/unit/test_e_stop.cpp)
+  test/unit/test_e_stop.cpp
+  test/unit/test_status_report.cpp
+  test/unit/test_base_status.cpp
+  test/unit/test_body_status.cpp
+  test/unit/test_servo_bus_status.cpp
+  test/unit/test_servo_joint_commands.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
 # test_device_set.cpp reads config/analyzers.yaml from the sources.

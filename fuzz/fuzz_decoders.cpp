@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "serial_robot_driver/protocol/base_codec.h"
@@ -24,12 +25,14 @@
 #include "serial_robot_driver/protocol/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/servo_commands.h"
 #include "serial_robot_driver/protocol/servo_params.h"
+#include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace {
 
 namespace base = serial_robot_driver::protocol::base;
 namespace body = serial_robot_driver::protocol::body;
 namespace servo = serial_robot_driver::protocol::servo;
+namespace wire = serial_robot_driver::protocol::wire;
 using serial_robot_driver::protocol::writeLE16;
 
 enum class Target { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite, kCount };
@@ -76,16 +79,19 @@ void fixServo(uint8_t* d, std::size_t n, Mode mode, uint8_t header0, uint8_t hea
 }
 
 void fixSyncWrite(uint8_t* d, std::size_t n, Mode mode) {
-  constexpr std::size_t kFixedPart = 12;  // header, id, LEN, instruction, address, data size
-  if (mode == Mode::kFixEverything && n >= kFixedPart + 2) {
-    std::memcpy(d, body::kSyncWriteHeader.data(), body::kSyncWriteHeader.size());
-    d[4] = body::kBroadcastId;
-    writeLE16(d + 5, static_cast<uint16_t>(n - body::kSyncWritePrefix));
-    d[7] = body::kSyncWriteInstruction;
-    writeLE16(d + 8, body::kGoalPositionAddress);
-    writeLE16(d + 10, body::kGoalPositionSize);
+  // header, id, LEN, then the command fields LEN counts first
+  constexpr auto kCommand = wire::listOf(body::kSyncWriteCommandFields);
+  constexpr std::size_t kHeaderSize = body::kSyncWriteHeader.size();
+  if (mode == Mode::kFixEverything &&
+      n >= body::kSyncWritePrefix + kCommand.size() + body::kCrcSize) {
+    std::memcpy(d, body::kSyncWriteHeader.data(), kHeaderSize);
+    d[kHeaderSize] = body::kBroadcastId;
+    writeLE16(d + kHeaderSize + 1, static_cast<uint16_t>(n - body::kSyncWritePrefix));
+    wire::encodeFields(kCommand, body::SyncWriteCommand{}, d + body::kSyncWritePrefix);
   }
-  if (n >= 2) writeLE16(d + n - 2, body::dynamixelCrc(d, n - 2));
+  if (n >= body::kCrcSize) {
+    writeLE16(d + n - body::kCrcSize, body::dynamixelCrc(d, n - body::kCrcSize));
+  }
 }
 
 // --- decoders --------------------------------------------------------------------------------
@@ -110,19 +116,23 @@ void runTelemetry(const uint8_t* d, std::size_t n, std::size_t servo_count) {
 
 void runServoParams(const servo::Packet& packet) {
   const auto cmd = static_cast<servo::Command>(packet.cmd);
-  if (cmd == servo::Command::kReadData && packet.content_size >= 2) {
-    if (const servo::ParamInfo* param = servo::findParamById(packet.content[1])) {
-      (void)servo::readValue(*param, &packet.content[2], packet.content_size - 2u);
-    }
+  if (cmd == servo::Command::kReadData) {
+    const auto data = servo::decodeDataContent(packet);
+    const servo::ParamInfo* param = data.ok() ? servo::findParamById(data->data_id) : nullptr;
+    if (param != nullptr) (void)servo::readValue(*param, data->value.data(), data->value_size);
   }
-  if (cmd == servo::Command::kReadBatchData && packet.content_size == 1 + servo::kUserBlockSize) {
-    for (const servo::ParamInfo& param : servo::paramTable()) {
-      const auto offset = servo::userBlockOffset(param);
-      if (!offset) continue;
-      const std::size_t size = servo::typeSize(param.type);
-      check(*offset + size <= servo::kUserBlockSize);
-      (void)servo::readValue(param, &packet.content[1 + *offset], size);
-    }
+  if (cmd == servo::Command::kReadBatchData) {
+    const auto block = servo::decodeUserBlock(packet);
+    if (!block.ok()) return;
+    // The user parameters cover every byte of the block: unpacked and packed again, it is the same.
+    const auto values = servo::unpackUserBlock(*block);
+    const auto value_of = [&](const servo::ParamInfo& param) {
+      for (const auto& [unpacked, value] : values) {
+        if (unpacked == &param) return value;
+      }
+      std::abort();
+    };
+    check(servo::packUserBlock(value_of) == *block);
   }
 }
 
@@ -147,6 +157,18 @@ void runServoResponse(const uint8_t* d, std::size_t n) {
     const auto angle = servo::decodeMultiTurnAngle(*packet);
     check(angle.ok() && servo::multiTurnAngleContent(*angle) == content);
   }
+  if (cmd == servo::Command::kPing) check(servo::pingAnswerContent(packet->id()) == content);
+  // The answers that are an id and a result byte re-encode when that byte is 0 or 1.
+  if (info.result_index != servo::kNoResult && cmd != servo::Command::kWriteData &&
+      content[info.result_index] <= 1) {
+    const bool ok = content[info.result_index] == 1;
+    check(servo::resultAnswerContent(packet->id(), ok) == content);
+  }
+  if (cmd == servo::Command::kReadData) check(servo::decodeDataContent(*packet).ok());
+  if (cmd == servo::Command::kReadBatchData) {
+    const auto block = servo::decodeUserBlock(*packet);
+    check(block.ok() && servo::userBlockAnswerContent(packet->id(), *block) == content);
+  }
 }
 
 void runServoRequest(const uint8_t* d, std::size_t n) {
@@ -161,6 +183,25 @@ void runServoRequest(const uint8_t* d, std::size_t n) {
   if (servo::isMove(cmd)) {
     const auto move = servo::decodeMove(*packet);
     check(move.ok() && sameBytes(servo::encodeMove(*move), d, n));
+  }
+  if (cmd == servo::Command::kReadData || cmd == servo::Command::kWriteData) {
+    const auto data = servo::decodeDataContent(*packet);
+    check(data.ok());
+    const servo::ParamInfo* param = servo::findParamById(data->data_id);
+    const auto value = param != nullptr
+                           ? servo::readValue(*param, data->value.data(), data->value_size)
+                           : std::nullopt;
+    if (cmd == servo::Command::kWriteData && value) {
+      check(sameBytes(servo::encodeWriteData(data->id, *param, *value), d, n));
+    }
+  }
+  if (cmd == servo::Command::kDamping) {
+    const auto power = servo::decodeDamping(*packet);
+    check(power.ok() && sameBytes(servo::encodeDamping(packet->id(), *power), d, n));
+  }
+  if (cmd == servo::Command::kWriteBatchData) {
+    const auto block = servo::decodeUserBlock(*packet);
+    check(block.ok() && sameBytes(servo::encodeWriteBatchData(packet->id(), *block), d, n));
   }
   if (cmd == servo::Command::kSpin) {
     const auto spin = servo::decodeSpin(*packet);

@@ -16,17 +16,17 @@ per_target=$(( total / ${#targets[@]} ))
 
 CC="${CC:-clang}" CXX="${CXX:-clang++}" cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$build" -j2 -- --no-print-directory >/dev/null
-bash "$here/make_corpus.sh" >/dev/null
+bash "$here/make_corpus.sh" "$build/seeds" >/dev/null
 
 status=0
 for target in "${targets[@]}"; do
-  # New inputs go to a scratch corpus in the build tree; the committed seeds stay read-only.
+  # New inputs go to a scratch corpus in the build tree; the generated seeds stay read-only.
   work="$build/corpus/$target"
   mkdir -p "$work" "$build/artifacts"
   log="$build/$target.log"
   echo "== $target: ${per_target} s"
-  seeds="$here/corpus/$target"
-  [ -d "$seeds" ] || seeds="$here/corpus/fuzz_decoders"  # per-decoder targets share those seeds
+  seeds="$build/seeds/$target"
+  [ -d "$seeds" ] || seeds="$build/seeds/fuzz_decoders"  # per-decoder targets share those seeds
   if "$build/$target" "$work" "$seeds" \
       -max_total_time="$per_target" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$build/artifacts/$target-" >"$log" 2>&1; then

@@ -269,20 +269,14 @@ ServoStatus ServoBusClient::readAll(uint8_t id, std::vector<ServoParamValue>* va
       servo::encodeReadBatchData(id), Expectation(Command::kReadBatchData, id), &answer);
   if (!status.ok()) return status;
 
-  const uint8_t* block = answer.content.data() + 1;
+  // The exchange checked the answer's size against the command table, so the block is whole.
+  const auto block = servo::decodeUserBlock(answer);
+  if (!block) {
+    return fail(ServoError::kBadAnswer, servoName(id) + " sent a user block of the wrong size");
+  }
   std::vector<ServoParamValue> result;
-  for (const ParamInfo& param : servo::paramTable()) {
-    const std::optional<std::size_t> offset = servo::userBlockOffset(param);
-    if (!offset) continue;  // read-only parameters are not in the user block
-    const std::size_t size = servo::typeSize(param.type);
-    const std::optional<int64_t> raw = *offset + size <= servo::kUserBlockSize
-                                           ? servo::readValue(param, block + *offset, size)
-                                           : std::nullopt;
-    if (!raw) {
-      return fail(ServoError::kBadAnswer,
-                  servoName(id) + " sent a user block without " + quoted(param.name));
-    }
-    result.push_back(toParamValue(param, *raw));
+  for (const auto& [param, raw] : servo::unpackUserBlock(*block)) {
+    result.push_back(toParamValue(*param, raw));
   }
   const std::size_t count = result.size();
   *values = std::move(result);

@@ -3,34 +3,54 @@
 #include <algorithm>
 #include "serial_robot_driver/protocol/stream_framer.h"
 
-#include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace serial_robot_driver::protocol::base {
 
 namespace {
 
-constexpr uint8_t kWheelSpeedLen = 9;  // MSGID + 2 x int16 + 4 zero bytes
+constexpr auto kBE = wire::ByteOrder::kBig;
 constexpr uint8_t kMaxBatteryPercent = 100;
 
-// Builds 55 AA | LEN | SEQ | MSGID | PARAM... | XOR.
-std::vector<uint8_t> buildFrame(uint8_t seq, MsgId msg_id, const uint8_t* params,
-                                std::size_t param_count) {
-  std::vector<uint8_t> frame;
-  frame.reserve(param_count + 1 + kOverhead);
-  frame.push_back(kHeader0);
-  frame.push_back(kHeader1);
-  frame.push_back(static_cast<uint8_t>(param_count + 1));
-  frame.push_back(seq);
-  frame.push_back(static_cast<uint8_t>(msg_id));
-  frame.insert(frame.end(), params, params + param_count);
-  frame.push_back(xorChecksum(frame.data(), frame.size()));
+// Frame envelope: header (2), LEN, SEQ, MSGID, PARAM..., XOR.
+constexpr std::size_t kLenOffset = 2;
+constexpr std::size_t kSeqOffset = 3;
+constexpr std::size_t kMsgIdOffset = 4;
+constexpr std::size_t kParamsOffset = 5;
+
+// The PARAM of each frame kind, as one field list each.
+constexpr std::array<wire::Field<WheelSpeed>, 3> kWheelSpeedParams = {{
+    wire::field<&WheelSpeed::left_ticks>("left", wire::kI16, kBE, "ticks/period"),
+    wire::field<&WheelSpeed::right_ticks>("right", wire::kI16, kBE, "ticks/period"),
+    wire::reservedField<WheelSpeed>("reserved", 4),
+}};
+struct BatteryLevel {
+  uint8_t percent = 0;
+};
+constexpr std::array<wire::Field<BatteryLevel>, 1> kBatteryReplyParams = {
+    {wire::field<&BatteryLevel::percent>("percent", wire::kU8, kBE, "%")}};
+// The vendor's one-byte commands (battery request, Reset, clear encoders, the error status).
+struct NoParams {};
+constexpr std::array<wire::Field<NoParams>, 1> kSimpleCommandParams = {
+    {wire::reservedField<NoParams>("reserved", 1)}};
+
+template <typename Record>
+std::vector<uint8_t> buildFrame(uint8_t seq, MsgId msg_id, wire::FieldList<Record> params,
+                                const Record& record) {
+  const std::size_t len = 1 + params.size();  // MSGID + PARAM
+  std::vector<uint8_t> frame(frameSize(static_cast<uint8_t>(len)));
+  frame[0] = kHeader0;
+  frame[1] = kHeader1;
+  frame[kLenOffset] = static_cast<uint8_t>(len);
+  frame[kSeqOffset] = seq;
+  frame[kMsgIdOffset] = static_cast<uint8_t>(msg_id);
+  wire::encodeFields(params, record, &frame[kParamsOffset]);
+  frame.back() = xorChecksum(frame.data(), frame.size() - 1);
   return frame;
 }
 
-// The vendor's one-byte commands all carry a single 00 parameter (LEN 2).
 std::vector<uint8_t> buildSimpleCommand(uint8_t seq, MsgId msg_id) {
-  const uint8_t param = 0x00;
-  return buildFrame(seq, msg_id, &param, 1);
+  return buildFrame(seq, msg_id, wire::listOf(kSimpleCommandParams), NoParams{});
 }
 
 }  // namespace
@@ -42,10 +62,8 @@ uint8_t xorChecksum(const uint8_t* data, std::size_t size) {
 }
 
 std::vector<uint8_t> encodeWheelSpeed(uint8_t seq, int16_t left_ticks, int16_t right_ticks) {
-  std::array<uint8_t, kWheelSpeedLen - 1> params{};  // trailing 4 bytes stay zero
-  writeBE16(&params[0], static_cast<uint16_t>(left_ticks));
-  writeBE16(&params[2], static_cast<uint16_t>(right_ticks));
-  return buildFrame(seq, MsgId::kWheelSpeed, params.data(), params.size());
+  return buildFrame(seq, MsgId::kWheelSpeed, wire::listOf(kWheelSpeedParams),
+                    WheelSpeed{left_ticks, right_ticks});
 }
 
 std::vector<uint8_t> encodeBatteryRequest(uint8_t seq) {
@@ -63,11 +81,10 @@ std::vector<uint8_t> encodeErrorStatus(uint8_t seq) {
 }
 
 std::vector<uint8_t> encodeBatteryReply(uint8_t seq, uint8_t percent) {
-  return buildFrame(seq, MsgId::kBattery, &percent, 1);
+  return buildFrame(seq, MsgId::kBattery, wire::listOf(kBatteryReplyParams), BatteryLevel{percent});
 }
 
 Probe probeFrame(const uint8_t* data, std::size_t available) {
-  constexpr std::size_t kLenOffset = 2;
   if (available < 1) return Probe::needMore();
   if (data[0] != kHeader0) return Probe::invalid(DecodeError::kBadHeader);
   if (available < 2) return Probe::needMore();
@@ -84,7 +101,6 @@ Probe probeFrame(const uint8_t* data, std::size_t available) {
 }
 
 Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size) {
-  constexpr std::size_t kLenOffset = 2;
   if (size <= kLenOffset) return DecodeError::kTooShort;
   if (data[0] != kHeader0 || data[1] != kHeader1) return DecodeError::kBadHeader;
   const uint8_t len = data[kLenOffset];
@@ -94,10 +110,10 @@ Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size) {
   if (xorChecksum(data, size - 1) != data[size - 1]) return DecodeError::kBadChecksum;
 
   Frame frame;
-  frame.seq = data[3];
-  frame.msg_id = data[4];
+  frame.seq = data[kSeqOffset];
+  frame.msg_id = data[kMsgIdOffset];
   frame.param_count = static_cast<uint8_t>(len - 1);
-  std::copy(data + 5, data + 5 + frame.param_count, frame.params.begin());
+  std::copy(data + kParamsOffset, data + kParamsOffset + frame.param_count, frame.params.begin());
   return frame;
 }
 
@@ -108,11 +124,15 @@ Decoded<Reply> interpretReply(const Frame& frame) {
     case static_cast<uint8_t>(MsgId::kErrorStatus):
       reply.kind = Reply::Kind::kTimeoutError;
       break;
-    case static_cast<uint8_t>(MsgId::kBattery):
-      if (frame.param_count < 1) return DecodeError::kUnexpectedContent;
+    case static_cast<uint8_t>(MsgId::kBattery): {
+      const auto params = wire::listOf(kBatteryReplyParams);
+      if (frame.param_count < params.size()) return DecodeError::kUnexpectedContent;
+      BatteryLevel level;
+      wire::decodeFields(params, frame.params.data(), &level);
       reply.kind = Reply::Kind::kBattery;
-      reply.battery_percent = std::min(frame.params[0], kMaxBatteryPercent);
+      reply.battery_percent = std::min(level.percent, kMaxBatteryPercent);
       break;
+    }
     default:
       // Unknown ids are counted and published raw by the device layer, never fatal.
       reply.kind = Reply::Kind::kUnknown;
@@ -122,13 +142,13 @@ Decoded<Reply> interpretReply(const Frame& frame) {
 }
 
 Decoded<WheelSpeed> interpretWheelSpeed(const Frame& frame) {
+  const auto params = wire::listOf(kWheelSpeedParams);
   if (frame.msg_id != static_cast<uint8_t>(MsgId::kWheelSpeed) ||
-      frame.param_count != kWheelSpeedLen - 1) {
+      frame.param_count != params.size()) {
     return DecodeError::kUnexpectedContent;
   }
   WheelSpeed speed;
-  speed.left_ticks = readBE16Signed(&frame.params[0]);
-  speed.right_ticks = readBE16Signed(&frame.params[2]);
+  wire::decodeFields(params, frame.params.data(), &speed);
   return speed;
 }
 

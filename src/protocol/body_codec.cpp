@@ -10,30 +10,24 @@ namespace serial_robot_driver::protocol::body {
 
 namespace {
 
-// Sync write layout: header(4) id(1) LEN(2) instruction(1) address(2) size(2) data(3N) crc(2).
+// Sync write envelope: header (4), id, LEN (2), the command fields, the servo records, CRC (2).
 constexpr std::size_t kIdOffset = 4;
 constexpr std::size_t kLenOffset = 5;
-constexpr std::size_t kInstructionOffset = 7;
-constexpr std::size_t kAddressOffset = 8;
-constexpr std::size_t kDataSizeOffset = 10;
-constexpr std::size_t kFirstTargetOffset = 12;
-constexpr std::size_t kBytesPerTarget = 3;
-constexpr std::size_t kCrcSize = 2;
+constexpr std::size_t kCommandOffset = kSyncWritePrefix;
+constexpr auto kCommandFields = wire::listOf(kSyncWriteCommandFields);
+constexpr auto kTargetFields = wire::listOf(kServoTargetFields);
+constexpr std::size_t kFirstTargetOffset = kCommandOffset + kCommandFields.size();
 constexpr std::size_t kMinSyncWriteLen = syncWriteLen(0);
 
-// Telemetry layout: header(2) LEN(1) servos(4N) imu(18) [foot(16)] SUM(1) tail(2).
+// Telemetry envelope: header (2), LEN, the blocks, SUM, tail (2).
 constexpr std::size_t kTelemetryLenOffset = 2;
-constexpr std::size_t kTelemetryServoOffset = 3;
-constexpr std::size_t kBytesPerServo = 4;
-constexpr std::size_t kTelemetryTrailer = 3;   // SUM + tail
+constexpr auto kSampleFields = wire::listOf(kServoSampleFields);
 constexpr std::size_t kMaxTelemetryLen = 255;  // LEN is one byte
 
 std::size_t imuOffset(std::size_t servo_count) {
-  return kTelemetryServoOffset + kBytesPerServo * servo_count;
+  return kTelemetryPrefix + kSampleFields.size() * servo_count;
 }
-std::size_t footOffset(std::size_t servo_count) {
-  return imuOffset(servo_count) + 2 * kImuValueCount;
-}
+std::size_t footOffset(std::size_t servo_count) { return imuOffset(servo_count) + kImuBlockSize; }
 
 }  // namespace
 
@@ -50,14 +44,11 @@ std::vector<uint8_t> encodeSyncWrite(const std::vector<ServoTarget>& targets) {
   std::copy(kSyncWriteHeader.begin(), kSyncWriteHeader.end(), frame.begin());
   frame[kIdOffset] = kBroadcastId;
   writeLE16(&frame[kLenOffset], static_cast<uint16_t>(syncWriteLen(targets.size())));
-  frame[kInstructionOffset] = kSyncWriteInstruction;
-  writeLE16(&frame[kAddressOffset], kGoalPositionAddress);
-  writeLE16(&frame[kDataSizeOffset], kGoalPositionSize);
+  wire::encodeFields(kCommandFields, SyncWriteCommand{}, &frame[kCommandOffset]);
   std::size_t pos = kFirstTargetOffset;
   for (const ServoTarget& target : targets) {
-    frame[pos] = target.id;
-    writeLE16(&frame[pos + 1], target.position);
-    pos += kBytesPerTarget;
+    wire::encodeFields(kTargetFields, target, &frame[pos]);
+    pos += kTargetFields.size();
   }
   writeLE16(&frame[pos], dynamixelCrc(frame.data(), pos));
   return frame;
@@ -73,13 +64,13 @@ Probe probeSyncWrite(const uint8_t* data, std::size_t available) {
   }
   if (available < kSyncWritePrefix) return Probe::needMore();
   const std::size_t len = readLE16(data + kLenOffset);
-  if (len < kMinSyncWriteLen || (len - kMinSyncWriteLen) % kBytesPerTarget != 0 ||
-      (len - kMinSyncWriteLen) / kBytesPerTarget > kMaxSyncWriteServos) {
+  if (len < kMinSyncWriteLen || (len - kMinSyncWriteLen) % kTargetFields.size() != 0 ||
+      (len - kMinSyncWriteLen) / kTargetFields.size() > kMaxSyncWriteServos) {
     return Probe::invalid(DecodeError::kBadLength);
   }
-  if (available <= kInstructionOffset) return Probe::needMore();
+  if (available <= kCommandOffset) return Probe::needMore();
   // Another Dynamixel instruction is not a frame of ours; not counted as an error.
-  if (data[kInstructionOffset] != kSyncWriteInstruction) {
+  if (data[kCommandOffset] != kSyncWriteInstruction) {
     return Probe::invalid(DecodeError::kBadHeader);
   }
   const std::size_t size = kSyncWritePrefix + len;
@@ -96,10 +87,10 @@ Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size
     return DecodeError::kBadHeader;
   }
   const std::size_t len = readLE16(&data[kLenOffset]);
-  if (len < kMinSyncWriteLen || (len - kMinSyncWriteLen) % kBytesPerTarget != 0) {
+  if (len < kMinSyncWriteLen || (len - kMinSyncWriteLen) % kTargetFields.size() != 0) {
     return DecodeError::kBadLength;
   }
-  const std::size_t servo_count = (len - kMinSyncWriteLen) / kBytesPerTarget;
+  const std::size_t servo_count = (len - kMinSyncWriteLen) / kTargetFields.size();
   if (servo_count > kMaxSyncWriteServos) return DecodeError::kBadLength;
   if (size < kSyncWritePrefix + len) return DecodeError::kTooShort;
   if (size > kSyncWritePrefix + len) return DecodeError::kBadLength;
@@ -107,17 +98,18 @@ Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size
     return DecodeError::kBadChecksum;
   }
   // A valid Dynamixel frame, but not the goal-position sync write we speak.
-  if (data[kIdOffset] != kBroadcastId || data[kInstructionOffset] != kSyncWriteInstruction ||
-      readLE16(&data[kAddressOffset]) != kGoalPositionAddress ||
-      readLE16(&data[kDataSizeOffset]) != kGoalPositionSize) {
+  SyncWriteCommand command;
+  wire::decodeFields(kCommandFields, &data[kCommandOffset], &command);
+  const SyncWriteCommand ours;
+  if (data[kIdOffset] != kBroadcastId || command.instruction != ours.instruction ||
+      command.address != ours.address || command.data_size != ours.data_size) {
     return DecodeError::kUnexpectedContent;
   }
 
   std::vector<ServoTarget> targets(servo_count);
   for (std::size_t i = 0; i < servo_count; ++i) {
-    const uint8_t* entry = &data[kFirstTargetOffset + kBytesPerTarget * i];
-    targets[i].id = entry[0];
-    targets[i].position = readLE16(&entry[1]);
+    wire::decodeFields(kTargetFields, &data[kFirstTargetOffset + kTargetFields.size() * i],
+                       &targets[i]);
   }
   return targets;
 }
@@ -170,17 +162,22 @@ Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::s
   Telemetry telemetry;
   telemetry.servo_count = servo_count;
   for (std::size_t i = 0; i < servo_count; ++i) {
-    const uint8_t* servo = &data[kTelemetryServoOffset + kBytesPerServo * i];
-    telemetry.servos[i].position = readBE16(&servo[0]);
-    telemetry.servos[i].speed = readBE16Signed(&servo[2]);
+    wire::decodeFields(kSampleFields, &data[kTelemetryPrefix + kSampleFields.size() * i],
+                       &telemetry.servos[i]);
   }
-  const uint8_t* imu = &data[imuOffset(servo_count)];
-  for (std::size_t k = 0; k < kImuValueCount; ++k) telemetry.imu[k] = readBE16Signed(&imu[2 * k]);
+  const auto read = [&](const wire::Field<TelemetryValue>& field, std::size_t offset) {
+    return wire::readInteger(&data[offset], field.type, field.order);
+  };
+  for (std::size_t k = 0; k < kImuValueCount; ++k) {
+    const std::size_t offset = imuOffset(servo_count) + kImuValueField.type.width * k;
+    telemetry.imu[k] = static_cast<int16_t>(read(kImuValueField, offset));
+  }
   telemetry.has_foot = has_foot;
   if (has_foot) {
-    // The only little-endian block of the frame (vendor layout).
-    const uint8_t* foot = &data[footOffset(servo_count)];
-    for (std::size_t j = 0; j < kFootSensorCount; ++j) telemetry.foot[j] = readLE16(&foot[2 * j]);
+    for (std::size_t j = 0; j < kFootSensorCount; ++j) {
+      const std::size_t offset = footOffset(servo_count) + kFootValueField.type.width * j;
+      telemetry.foot[j] = static_cast<uint16_t>(read(kFootValueField, offset));
+    }
   }
   return telemetry;
 }
@@ -196,17 +193,22 @@ std::vector<uint8_t> encodeTelemetry(const Telemetry& telemetry) {
   frame[1] = kTelemetryHeader1;
   frame[kTelemetryLenOffset] = static_cast<uint8_t>(len);
   for (std::size_t i = 0; i < servo_count; ++i) {
-    uint8_t* servo = &frame[kTelemetryServoOffset + kBytesPerServo * i];
-    writeBE16(&servo[0], telemetry.servos[i].position);
-    writeBE16(&servo[2], static_cast<uint16_t>(telemetry.servos[i].speed));
+    wire::encodeFields(kSampleFields, telemetry.servos[i],
+                       &frame[kTelemetryPrefix + kSampleFields.size() * i]);
   }
-  uint8_t* imu = &frame[imuOffset(servo_count)];
+  const auto write = [&](const wire::Field<TelemetryValue>& field, std::size_t offset,
+                         int64_t value) {
+    wire::writeInteger(&frame[offset], value, field.type, field.order);
+  };
   for (std::size_t k = 0; k < kImuValueCount; ++k) {
-    writeBE16(&imu[2 * k], static_cast<uint16_t>(telemetry.imu[k]));
+    const std::size_t offset = imuOffset(servo_count) + kImuValueField.type.width * k;
+    write(kImuValueField, offset, telemetry.imu[k]);
   }
   if (telemetry.has_foot) {
-    uint8_t* foot = &frame[footOffset(servo_count)];
-    for (std::size_t j = 0; j < kFootSensorCount; ++j) writeLE16(&foot[2 * j], telemetry.foot[j]);
+    for (std::size_t j = 0; j < kFootSensorCount; ++j) {
+      const std::size_t offset = footOffset(servo_count) + kFootValueField.type.width * j;
+      write(kFootValueField, offset, telemetry.foot[j]);
+    }
   }
   frame[len - kTelemetryTrailer] = telemetrySum(frame.data(), len);
   frame[len - 2] = kTelemetryTail0;

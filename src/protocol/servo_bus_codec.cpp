@@ -3,7 +3,7 @@
 #include <algorithm>
 #include "serial_robot_driver/protocol/stream_framer.h"
 
-#include "serial_robot_driver/protocol/byte_order.h"
+#include "servo_layouts.h"
 
 namespace serial_robot_driver::protocol::servo {
 
@@ -12,8 +12,6 @@ namespace {
 constexpr std::size_t kCmdOffset = 2;
 constexpr std::size_t kSizeOffset = 3;
 constexpr std::size_t kContentOffset = 4;
-constexpr uint8_t kSpinDirectionBit = 0x80;
-constexpr uint8_t kSpinModeMask = 0x03;
 
 // Builds HEADER | CMD | N | CONTENT | SUM. Callers keep N <= kMaxContent.
 std::vector<uint8_t> buildPacket(uint8_t header0, uint8_t header1, Command cmd,
@@ -33,8 +31,40 @@ std::vector<uint8_t> buildRequest(Command cmd, const uint8_t* content, std::size
   return buildPacket(kRequestHeader0, kRequestHeader1, cmd, content, content_size);
 }
 
+// The request `fields` lay out for `record`, followed by `tail_size` bytes of `tail`.
+template <typename Record>
+std::vector<uint8_t> buildRequest(Command cmd, layout::FieldList<Record> fields,
+                                  const Record& record, const uint8_t* tail = nullptr,
+                                  std::size_t tail_size = 0) {
+  std::array<uint8_t, kMaxContent> content{};
+  const std::size_t size = fields.size();
+  wire::encodeFields(fields, record, content.data());
+  std::copy(tail, tail + tail_size, content.begin() + size);
+  return buildRequest(cmd, content.data(), size + tail_size);
+}
+
 std::vector<uint8_t> buildIdOnlyRequest(Command cmd, uint8_t id) {
-  return buildRequest(cmd, &id, 1);
+  return buildRequest(cmd, layout::listOf(layout::kId), layout::IdContent{id});
+}
+
+// A CONTENT (answer, simulator side) as `fields` lay it out, followed by `tail_size` bytes.
+template <typename Record>
+std::vector<uint8_t> contentOf(layout::FieldList<Record> fields, const Record& record,
+                               const uint8_t* tail = nullptr, std::size_t tail_size = 0) {
+  std::vector<uint8_t> content(fields.size() + tail_size);
+  wire::encodeFields(fields, record, content.data());
+  std::copy(tail, tail + tail_size, content.begin() + fields.size());
+  return content;
+}
+
+// `record` with the members `fields` describe read from `content`, which must be exactly their
+// size.
+template <typename Record>
+Decoded<Record> decodeExactly(layout::FieldList<Record> fields, const uint8_t* content,
+                              std::size_t content_size, Record record = {}) {
+  if (content_size != fields.size()) return DecodeError::kBadLength;
+  wire::decodeFields(fields, content, &record);
+  return record;
 }
 
 Decoded<Packet> decodePacket(uint8_t header0, uint8_t header1, const uint8_t* data,
@@ -67,8 +97,8 @@ uint8_t byteSum(const uint8_t* data, std::size_t size) {
 }
 
 uint8_t spinMethod(bool clockwise, SpinMode mode) {
-  return static_cast<uint8_t>((clockwise ? kSpinDirectionBit : 0) |
-                              (static_cast<uint8_t>(mode) & kSpinModeMask));
+  return static_cast<uint8_t>((clockwise ? layout::kSpinDirectionBit : 0) |
+                              (static_cast<uint8_t>(mode) & layout::kSpinModeMask));
 }
 
 std::vector<uint8_t> encodePing(uint8_t id) { return buildIdOnlyRequest(Command::kPing, id); }
@@ -78,14 +108,15 @@ std::vector<uint8_t> encodeResetUserData(uint8_t id) {
 }
 
 std::vector<uint8_t> encodeReadData(uint8_t id, uint8_t data_id) {
-  const std::array<uint8_t, 2> content = {id, data_id};
-  return buildRequest(Command::kReadData, content.data(), content.size());
+  return buildRequest(Command::kReadData, layout::listOf(layout::kDataId),
+                      layout::DataIdContent{id, data_id});
 }
 
 std::vector<uint8_t> encodeWriteData(uint8_t id, const ParamInfo& param, int64_t value) {
-  std::array<uint8_t, 2 + 4> content = {id, param.data_id};  // room for the widest type (u32)
-  const std::size_t value_size = writeValue(param, value, &content[2]);
-  return buildRequest(Command::kWriteData, content.data(), 2 + value_size);
+  std::array<uint8_t, largestTypeSize()> value_bytes{};
+  const std::size_t value_size = writeValue(param, value, value_bytes.data());
+  return buildRequest(Command::kWriteData, layout::listOf(layout::kDataId),
+                      layout::DataIdContent{id, param.data_id}, value_bytes.data(), value_size);
 }
 
 std::vector<uint8_t> encodeReadBatchData(uint8_t id) {
@@ -94,24 +125,26 @@ std::vector<uint8_t> encodeReadBatchData(uint8_t id) {
 
 std::vector<uint8_t> encodeWriteBatchData(uint8_t id,
                                           const std::array<uint8_t, kUserBlockSize>& block) {
-  std::array<uint8_t, 1 + kUserBlockSize> content{};
-  content[0] = id;
-  std::copy(block.begin(), block.end(), content.begin() + 1);
-  return buildRequest(Command::kWriteBatchData, content.data(), content.size());
+  return buildRequest(Command::kWriteBatchData, layout::listOf(layout::kId), layout::IdContent{id},
+                      block.data(), block.size());
 }
 
 std::vector<uint8_t> encodeSpin(uint8_t id, bool clockwise, SpinMode mode, uint16_t speed_dps,
                                 uint16_t value) {
-  std::array<uint8_t, 6> content = {id, spinMethod(clockwise, mode)};
-  writeLE16(&content[2], speed_dps);
-  writeLE16(&content[4], value);
-  return buildRequest(Command::kSpin, content.data(), content.size());
+  return encodeSpin(SpinCommand{id, clockwise, mode, speed_dps, value});
 }
 
 std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw) {
-  std::array<uint8_t, 3> content = {id};
-  writeLE16(&content[1], power_mw);
-  return buildRequest(Command::kDamping, content.data(), content.size());
+  return buildRequest(Command::kDamping, layout::listOf(layout::kDamping),
+                      layout::PowerContent{id, power_mw});
+}
+
+Decoded<uint16_t> decodeDamping(const Packet& request) {
+  if (request.cmd != static_cast<uint8_t>(Command::kDamping)) return DecodeError::kUnknownCommand;
+  const auto damping =
+      decodeExactly(layout::listOf(layout::kDamping), request.content.data(), request.content_size);
+  if (!damping) return damping.error();
+  return damping->power_mw;
 }
 
 std::vector<uint8_t> encodeReadAngle(uint8_t id) {
@@ -120,60 +153,8 @@ std::vector<uint8_t> encodeReadAngle(uint8_t id) {
 
 namespace {
 
-// The layout of each move after the id: angle (i16 / i32), interval or velocity (u16 / u32),
-// the ramps (accel, decel u16) or not, then power (u16). One description for encode and decode.
-struct MoveLayout {
-  std::size_t angle_size;
-  std::size_t second_size;
-  bool by_velocity;
-  bool ramps;
-};
-
-MoveLayout moveLayout(Command cmd) {
-  switch (cmd) {
-    case Command::kMoveByInterval:
-      return {2, 2, false, true};
-    case Command::kMoveByVelocity:
-      return {2, 2, true, true};
-    case Command::kMultiTurnMove:
-      return {4, 4, false, false};
-    case Command::kMultiTurnMoveByInterval:
-      return {4, 4, false, true};
-    case Command::kMultiTurnMoveByVelocity:
-      return {4, 2, true, true};
-    default:  // ROTATE
-      return {2, 2, false, false};
-  }
-}
-
-void writeField(uint8_t* at, std::size_t size, uint32_t value) {
-  if (size == 2) {
-    writeLE16(at, static_cast<uint16_t>(value));
-  } else {
-    writeLE32(at, value);
-  }
-}
-
 std::vector<uint8_t> buildMove(const MoveCommand& move) {
-  const MoveLayout layout = moveLayout(move.cmd);
-  std::array<uint8_t, 1 + 4 + 4 + 3 * 2> content{};
-  std::size_t size = 0;
-  content[size++] = move.id;
-  const auto angle = static_cast<uint32_t>(move.angle_decidegrees);
-  writeField(&content[size], layout.angle_size,
-             layout.angle_size == 2 ? static_cast<uint16_t>(static_cast<int16_t>(angle)) : angle);
-  size += layout.angle_size;
-  writeField(&content[size], layout.second_size,
-             layout.by_velocity ? move.velocity_decidegrees_per_s : move.interval_ms);
-  size += layout.second_size;
-  if (layout.ramps) {
-    writeLE16(&content[size], move.ramps.accel_ms);
-    writeLE16(&content[size + 2], move.ramps.decel_ms);
-    size += 4;
-  }
-  writeLE16(&content[size], move.ramps.power_mw);
-  size += 2;
-  return buildRequest(move.cmd, content.data(), size);
+  return buildRequest(move.cmd, layout::moveFields(move.cmd), move);
 }
 
 MoveCommand moveOf(Command cmd, uint8_t id, int32_t angle, uint32_t interval_ms, uint16_t velocity,
@@ -193,69 +174,51 @@ MoveCommand moveOf(Command cmd, uint8_t id, int32_t angle, uint32_t interval_ms,
 std::vector<uint8_t> encodeMove(const MoveCommand& move) { return buildMove(move); }
 
 std::vector<uint8_t> encodeSpin(const SpinCommand& spin) {
-  return encodeSpin(spin.id, spin.clockwise, spin.mode, spin.speed_dps, spin.value);
+  return buildRequest(Command::kSpin, layout::listOf(layout::kSpin), spin);
 }
 
-bool isMove(Command cmd) {
-  return cmd == Command::kRotate ||
-         (cmd >= Command::kMoveByInterval && cmd <= Command::kMultiTurnMoveByVelocity);
+bool isMove(Command cmd) { return layout::moveFields(cmd).count > 0; }
+bool isMultiTurn(Command cmd) {
+  const auto* angle = layout::moveFields(cmd).find("angle");
+  return angle != nullptr && angle->type.width == wire::kI32.width;
 }
-bool isMultiTurn(Command cmd) { return moveLayout(cmd).angle_size == 4; }
-bool isByVelocity(Command cmd) { return moveLayout(cmd).by_velocity; }
-bool hasRamps(Command cmd) { return moveLayout(cmd).ramps; }
+bool isByVelocity(Command cmd) { return layout::moveFields(cmd).has("velocity"); }
+bool hasRamps(Command cmd) { return layout::moveFields(cmd).has("accel"); }
 
 Decoded<MoveCommand> decodeMove(const Packet& request) {
   const auto cmd = static_cast<Command>(request.cmd);
   if (!isMove(cmd)) return DecodeError::kUnknownCommand;
-  const MoveLayout layout = moveLayout(cmd);
-  const std::size_t size = 1 + layout.angle_size + layout.second_size + (layout.ramps ? 4 : 0) + 2;
-  if (request.content_size != size) return DecodeError::kBadLength;
-  const uint8_t* at = request.content.data() + 1;
   MoveCommand move;
   move.cmd = cmd;
-  move.id = request.id();
-  move.angle_decidegrees =
-      layout.angle_size == 2 ? readLE16Signed(at) : static_cast<int32_t>(readLE32(at));
-  at += layout.angle_size;
-  const uint32_t second = layout.second_size == 2 ? readLE16(at) : readLE32(at);
-  if (layout.by_velocity) {
-    move.velocity_decidegrees_per_s = static_cast<uint16_t>(second);
-  } else {
-    move.interval_ms = second;
-  }
-  at += layout.second_size;
-  if (layout.ramps) {
-    move.ramps.accel_ms = readLE16(at);
-    move.ramps.decel_ms = readLE16(at + 2);
-    at += 4;
-  }
-  move.ramps.power_mw = readLE16(at);
-  return move;
+  return decodeExactly(layout::moveFields(cmd), request.content.data(), request.content_size, move);
 }
 
 Decoded<SpinCommand> decodeSpin(const Packet& request) {
   if (request.cmd != static_cast<uint8_t>(Command::kSpin)) return DecodeError::kUnknownCommand;
-  if (request.content_size != 6) return DecodeError::kBadLength;
-  SpinCommand spin;
-  spin.id = request.id();
-  const uint8_t method = request.content[1];
-  spin.clockwise = (method & kSpinDirectionBit) != 0;
-  spin.mode = static_cast<SpinMode>(method & kSpinModeMask);
-  spin.speed_dps = readLE16(&request.content[2]);
-  spin.value = readLE16(&request.content[4]);
-  return spin;
+  return decodeExactly(layout::listOf(layout::kSpin), request.content.data(), request.content_size);
+}
+
+std::vector<uint8_t> pingAnswerContent(uint8_t id) {
+  return contentOf(layout::listOf(layout::kId), layout::IdContent{id});
+}
+
+std::vector<uint8_t> resultAnswerContent(uint8_t id, bool ok) {
+  return contentOf(layout::listOf(layout::kIdResult),
+                   layout::ResultContent{id, static_cast<uint8_t>(ok ? 1 : 0)});
+}
+
+std::vector<uint8_t> writeDataAnswerContent(uint8_t id, uint8_t data_id, bool ok) {
+  return contentOf(layout::listOf(layout::kDataIdResult),
+                   layout::DataIdResult{id, data_id, static_cast<uint8_t>(ok ? 1 : 0)});
 }
 
 std::vector<uint8_t> angleAnswerContent(const AngleAnswer& answer) {
-  std::vector<uint8_t> content(3);
-  content[0] = answer.id;
-  writeLE16(&content[1], static_cast<uint16_t>(answer.angle_decidegrees));
-  return content;
+  return contentOf(layout::listOf(layout::kAngleAnswer), answer);
 }
 
 Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer) {
-  if (answer.content_size != 3) return DecodeError::kBadLength;
-  return AngleAnswer{answer.content[0], readLE16Signed(&answer.content[1])};
+  return decodeExactly(layout::listOf(layout::kAngleAnswer), answer.content.data(),
+                       answer.content_size);
 }
 
 Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer) {
@@ -263,20 +226,46 @@ Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer) {
 }
 
 std::vector<uint8_t> readDataAnswerContent(uint8_t id, const ParamInfo& param, int64_t value) {
-  std::vector<uint8_t> content = {id, param.data_id};
-  uint8_t bytes[8] = {};
-  const std::size_t size = writeValue(param, value, bytes);
-  content.insert(content.end(), bytes, bytes + size);
-  return content;
+  std::array<uint8_t, largestTypeSize()> value_bytes{};
+  const std::size_t value_size = writeValue(param, value, value_bytes.data());
+  return contentOf(layout::listOf(layout::kDataId), layout::DataIdContent{id, param.data_id},
+                   value_bytes.data(), value_size);
 }
 
 Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param) {
-  constexpr std::size_t kHeader = 2;  // id, data_id
-  if (answer.content_size < kHeader) return DecodeError::kBadLength;
+  const std::size_t value_offset = layout::listOf(layout::kDataId).size();
+  if (answer.content_size < value_offset) return DecodeError::kBadLength;
   const std::optional<int64_t> value =
-      readValue(param, answer.content.data() + kHeader, answer.content_size - kHeader);
+      readValue(param, answer.content.data() + value_offset, answer.content_size - value_offset);
   if (!value) return DecodeError::kBadLength;
   return *value;
+}
+
+Decoded<DataContent> decodeDataContent(const Packet& packet) {
+  const auto fields = layout::listOf(layout::kDataId);
+  if (packet.content_size < fields.size()) return DecodeError::kBadLength;
+  layout::DataIdContent head;
+  wire::decodeFields(fields, packet.content.data(), &head);
+  DataContent data;
+  data.id = head.id;
+  data.data_id = head.data_id;
+  data.value_size = packet.content_size - fields.size();
+  if (data.value_size > data.value.size()) return DecodeError::kBadLength;
+  std::copy_n(packet.content.begin() + fields.size(), data.value_size, data.value.begin());
+  return data;
+}
+
+std::vector<uint8_t> userBlockAnswerContent(uint8_t id,
+                                            const std::array<uint8_t, kUserBlockSize>& block) {
+  return contentOf(layout::listOf(layout::kId), layout::IdContent{id}, block.data(), block.size());
+}
+
+Decoded<std::array<uint8_t, kUserBlockSize>> decodeUserBlock(const Packet& packet) {
+  const std::size_t block_offset = layout::listOf(layout::kId).size();
+  if (packet.content_size != block_offset + kUserBlockSize) return DecodeError::kBadLength;
+  std::array<uint8_t, kUserBlockSize> block{};
+  std::copy_n(packet.content.begin() + block_offset, kUserBlockSize, block.begin());
+  return block;
 }
 
 std::vector<uint8_t> encodeRotate(uint8_t id, int16_t angle_decidegrees, uint16_t interval_ms,
@@ -323,20 +312,11 @@ std::vector<uint8_t> encodeReadMultiTurnAngle(uint8_t id) {
 }
 
 Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size) {
-  if (size != kMultiTurnAngleAnswerSize) return DecodeError::kBadLength;
-  MultiTurnAngle angle;
-  angle.id = content[0];
-  angle.angle_decidegrees = static_cast<int32_t>(readLE32(content + 1));
-  angle.turns = readLE16Signed(content + 5);
-  return angle;
+  return decodeExactly(layout::listOf(layout::kMultiTurnAngle), content, size);
 }
 
 std::vector<uint8_t> multiTurnAngleContent(const MultiTurnAngle& angle) {
-  std::vector<uint8_t> content(kMultiTurnAngleAnswerSize);
-  content[0] = angle.id;
-  writeLE32(&content[1], static_cast<uint32_t>(angle.angle_decidegrees));
-  writeLE16(&content[5], static_cast<uint16_t>(angle.turns));
-  return content;
+  return contentOf(layout::listOf(layout::kMultiTurnAngle), angle);
 }
 
 namespace {

@@ -1,51 +1,51 @@
 #include "serial_robot_driver/protocol/servo_commands.h"
 
+#include "servo_layouts.h"
+
 namespace serial_robot_driver::protocol::servo {
 
 namespace {
 
-constexpr ContentSize exactly(std::size_t size) {
-  return {static_cast<uint8_t>(size), static_cast<uint8_t>(size)};
-}
-// id, data_id, then a parameter value of 1..4 bytes (its type, servo_params.h).
-constexpr ContentSize kWithParamValue = {2 + 1, 2 + 4};
-constexpr ContentSize kIdOnly = exactly(1);
-constexpr ContentSize kIdResult = exactly(2);
-constexpr ContentSize kUserBlock = exactly(1 + kUserBlockSize);
+using layout::content;
+using layout::Tail;
 
-// Request layouts of the motions (little-endian after the id):
-//   SPIN      id, method u8, speed u16, value u16
-//   ROTATE    id, angle i16, interval u16, power u16
-//   DAMPING   id, power u16
-//   CMD 11    id, angle i16, interval u16, accel u16, decel u16, power u16
-//   CMD 12    id, angle i16, velocity u16, accel u16, decel u16, power u16
-//   CMD 13    id, angle i32, interval u32, power u16
-//   CMD 14    id, angle i32, interval u32, accel u16, decel u16, power u16
-//   CMD 15    id, angle i32, velocity u16, accel u16, decel u16, power u16
-// Answers: READ_ANGLE id, angle i16; CMD 16 id, angle i32, turns i16; a motion id, result.
+constexpr CommandInfo row(Command cmd, const char* name, const layout::ContentLayout& request,
+                          const layout::ContentLayout& answer, Answers answers) {
+  return {cmd, name, request.size, answer.size, answers, answer.result_index};
+}
+
+// Sizes and result bytes come from the field lists the codec encodes and decodes with.
+constexpr auto kMotion = Answers::kWhenResponseSwitch;
+constexpr auto kMotionDone = content(layout::kIdResult);
 constexpr std::array<CommandInfo, kMaxCommand> kTable = {{
-    {Command::kPing, "PING", kIdOnly, kIdOnly, Answers::kAlways, kNoResult},
-    {Command::kResetUserData, "RESET_USER_DATA", kIdOnly, kIdResult, Answers::kAlways, 1},
-    {Command::kReadData, "READ_DATA", exactly(2), kWithParamValue, Answers::kAlways, kNoResult},
-    {Command::kWriteData, "WRITE_DATA", kWithParamValue, exactly(3), Answers::kAlways, 2},
-    {Command::kReadBatchData, "READ_BATCH_DATA", kIdOnly, kUserBlock, Answers::kAlways, kNoResult},
-    {Command::kWriteBatchData, "WRITE_BATCH_DATA", kUserBlock, kIdResult, Answers::kAlways, 1},
-    {Command::kSpin, "SPIN", exactly(6), kIdResult, Answers::kWhenResponseSwitch, 1},
-    {Command::kRotate, "ROTATE", exactly(7), kIdResult, Answers::kWhenResponseSwitch, 1},
-    {Command::kDamping, "DAMPING", exactly(3), kIdResult, Answers::kWhenResponseSwitch, 1},
-    {Command::kReadAngle, "READ_ANGLE", kIdOnly, exactly(3), Answers::kAlways, kNoResult},
-    {Command::kMoveByInterval, "MOVE_BY_INTERVAL (CMD 11)", exactly(11), kIdResult,
-     Answers::kWhenResponseSwitch, 1},
-    {Command::kMoveByVelocity, "MOVE_BY_VELOCITY (CMD 12)", exactly(11), kIdResult,
-     Answers::kWhenResponseSwitch, 1},
-    {Command::kMultiTurnMove, "MULTI_TURN_MOVE (CMD 13)", exactly(11), kIdResult,
-     Answers::kWhenResponseSwitch, 1},
-    {Command::kMultiTurnMoveByInterval, "MULTI_TURN_MOVE_BY_INTERVAL (CMD 14)", exactly(15),
-     kIdResult, Answers::kWhenResponseSwitch, 1},
-    {Command::kMultiTurnMoveByVelocity, "MULTI_TURN_MOVE_BY_VELOCITY (CMD 15)", exactly(13),
-     kIdResult, Answers::kWhenResponseSwitch, 1},
-    {Command::kReadMultiTurnAngle, "READ_MULTI_TURN_ANGLE (CMD 16)", kIdOnly,
-     exactly(kMultiTurnAngleAnswerSize), Answers::kAlways, kNoResult},
+    row(Command::kPing, "PING", content(layout::kId), content(layout::kId), Answers::kAlways),
+    row(Command::kResetUserData, "RESET_USER_DATA", content(layout::kId),
+        content(layout::kIdResult), Answers::kAlways),
+    row(Command::kReadData, "READ_DATA", content(layout::kDataId),
+        content(layout::kDataId, Tail::kParamValue), Answers::kAlways),
+    row(Command::kWriteData, "WRITE_DATA", content(layout::kDataId, Tail::kParamValue),
+        content(layout::kDataIdResult), Answers::kAlways),
+    row(Command::kReadBatchData, "READ_BATCH_DATA", content(layout::kId),
+        content(layout::kId, Tail::kUserBlock), Answers::kAlways),
+    row(Command::kWriteBatchData, "WRITE_BATCH_DATA", content(layout::kId, Tail::kUserBlock),
+        content(layout::kIdResult), Answers::kAlways),
+    row(Command::kSpin, "SPIN", content(layout::kSpin), kMotionDone, kMotion),
+    row(Command::kRotate, "ROTATE", content(layout::kRotate), kMotionDone, kMotion),
+    row(Command::kDamping, "DAMPING", content(layout::kDamping), kMotionDone, kMotion),
+    row(Command::kReadAngle, "READ_ANGLE", content(layout::kId), content(layout::kAngleAnswer),
+        Answers::kAlways),
+    row(Command::kMoveByInterval, "MOVE_BY_INTERVAL (CMD 11)", content(layout::kMoveByInterval),
+        kMotionDone, kMotion),
+    row(Command::kMoveByVelocity, "MOVE_BY_VELOCITY (CMD 12)", content(layout::kMoveByVelocity),
+        kMotionDone, kMotion),
+    row(Command::kMultiTurnMove, "MULTI_TURN_MOVE (CMD 13)", content(layout::kMultiTurnMove),
+        kMotionDone, kMotion),
+    row(Command::kMultiTurnMoveByInterval, "MULTI_TURN_MOVE_BY_INTERVAL (CMD 14)",
+        content(layout::kMultiTurnMoveByInterval), kMotionDone, kMotion),
+    row(Command::kMultiTurnMoveByVelocity, "MULTI_TURN_MOVE_BY_VELOCITY (CMD 15)",
+        content(layout::kMultiTurnMoveByVelocity), kMotionDone, kMotion),
+    row(Command::kReadMultiTurnAngle, "READ_MULTI_TURN_ANGLE (CMD 16)", content(layout::kId),
+        content(layout::kMultiTurnAngle), Answers::kAlways),
 }};
 
 constexpr bool inCommandOrder() {
@@ -55,6 +55,15 @@ constexpr bool inCommandOrder() {
   return true;
 }
 static_assert(inCommandOrder(), "commandTable() is indexed by CMD");
+
+constexpr std::size_t longestContent() {
+  std::size_t longest = 0;
+  for (const CommandInfo& info : kTable) {
+    longest = std::max<std::size_t>(longest, std::max(info.request.max, info.answer.max));
+  }
+  return longest;
+}
+static_assert(longestContent() == kMaxContent, "kMaxContent is the longest CONTENT of the table");
 
 }  // namespace
 

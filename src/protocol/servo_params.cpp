@@ -2,8 +2,6 @@
 
 #include <limits>
 
-#include "serial_robot_driver/protocol/byte_order.h"
-
 namespace serial_robot_driver::protocol::servo {
 
 namespace {
@@ -109,19 +107,6 @@ std::string label(const ParamInfo& param) {
 
 }  // namespace
 
-std::size_t typeSize(ParamType type) {
-  switch (type) {
-    case ParamType::kU8:
-      return 1;
-    case ParamType::kU16:
-    case ParamType::kI16:
-      return 2;
-    case ParamType::kU32:
-      return 4;
-  }
-  return 0;
-}
-
 int64_t typeMin(ParamType type) { return type == ParamType::kI16 ? kI16Min : 0; }
 
 int64_t typeMax(ParamType type) {
@@ -187,33 +172,12 @@ std::string describe(WriteCheck check, const ParamInfo& param, int64_t value) {
 
 std::optional<int64_t> readValue(const ParamInfo& param, const uint8_t* data, std::size_t size) {
   if (size != typeSize(param.type)) return std::nullopt;
-  switch (param.type) {
-    case ParamType::kU8:
-      return data[0];
-    case ParamType::kU16:
-      return readLE16(data);
-    case ParamType::kI16:
-      return readLE16Signed(data);
-    case ParamType::kU32:
-      return readLE32(data);
-  }
-  return std::nullopt;
+  return wire::readInteger(data, wireType(param.type), wire::ByteOrder::kLittle);
 }
 
 std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out) {
-  switch (param.type) {
-    case ParamType::kU8:
-      out[0] = static_cast<uint8_t>(value);
-      break;
-    case ParamType::kU16:
-    case ParamType::kI16:
-      // Two's complement: the low 16 bits of a negative i16 are its wire form.
-      writeLE16(out, static_cast<uint16_t>(value));
-      break;
-    case ParamType::kU32:
-      writeLE32(out, static_cast<uint32_t>(value));
-      break;
-  }
+  // Two's complement: the low bytes of a negative i16 are its wire form.
+  wire::writeInteger(out, value, wireType(param.type), wire::ByteOrder::kLittle);
   return typeSize(param.type);
 }
 
@@ -226,6 +190,30 @@ std::optional<std::size_t> userBlockOffset(const ParamInfo& param) {
     offset += typeSize(other.type);
   }
   return std::nullopt;
+}
+
+std::array<uint8_t, kUserBlockSize> packUserBlock(
+    const std::function<int64_t(const ParamInfo&)>& value_of) {
+  std::array<uint8_t, kUserBlockSize> block{};
+  for (const ParamInfo& param : kParams) {
+    if (const std::optional<std::size_t> offset = userBlockOffset(param)) {
+      writeValue(param, value_of(param), &block[*offset]);
+    }
+  }
+  return block;
+}
+
+std::vector<std::pair<const ParamInfo*, int64_t>> unpackUserBlock(
+    const std::array<uint8_t, kUserBlockSize>& block) {
+  std::vector<std::pair<const ParamInfo*, int64_t>> values;
+  for (const ParamInfo& param : kParams) {
+    const std::optional<std::size_t> offset = userBlockOffset(param);
+    if (!offset) continue;
+    // The table's user parameters fill the block exactly (test_servo_params checks it).
+    const std::size_t size = typeSize(param.type);
+    values.emplace_back(&param, *readValue(param, &block[*offset], size));
+  }
+  return values;
 }
 
 }  // namespace serial_robot_driver::protocol::servo

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/device/base_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -18,8 +19,6 @@ namespace {
 constexpr double kTwistLinearVariance = 0.0025;  // std 0.05 m/s
 constexpr double kTwistLateralVariance = 1e-6;   // a differential drive cannot slide sideways
 constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
-// An FF from a running base stays a WARN this long (s).
-constexpr double kRecentTimeoutErrorS = 10.0;
 }  // namespace
 
 device::BaseConfig makeBaseConfig(const DriverParams& params) {
@@ -232,71 +231,11 @@ bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigg
 }
 
 void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  using diagnostic_msgs::DiagnosticStatus;
-  const device::BaseStats s = controller_.stats();
-  const bool connected = link_.connected();
-  status.summary(DiagnosticStatus::OK, "driving");
-  if (!connected) {
-    status.mergeSummary(DiagnosticStatus::ERROR, "port " + link_.options().path + " not connected");
-  } else {
-    if (s.base_silent && s.seconds_without_reply) {
-      status.mergeSummaryf(DiagnosticStatus::ERROR, "no reply from the base for %.0f s",
-                           *s.seconds_without_reply);
-    }
-    if (s.seconds_since_running_timeout_error &&
-        *s.seconds_since_running_timeout_error < kRecentTimeoutErrorS) {
-      status.mergeSummaryf(DiagnosticStatus::WARN,
-                           "base reported a timeout error (FF) %.0f s ago: frames were lost",
-                           *s.seconds_since_running_timeout_error);
-    }
-  }
-  if (s.battery_percent) {
-    const int percent = *s.battery_percent;
-    const Tuned limits = tuned();
-    if (percent < limits.battery_error_percent) {
-      status.mergeSummaryf(DiagnosticStatus::ERROR, "battery %d %% (below %d %%)", percent,
-                           limits.battery_error_percent);
-    } else if (percent < limits.battery_warn_percent) {
-      status.mergeSummaryf(DiagnosticStatus::WARN, "battery %d %% (below %d %%)", percent,
-                           limits.battery_warn_percent);
-    }
-  }
-  if (s.e_stop) status.mergeSummary(DiagnosticStatus::WARN, "e-stop engaged: holding zero speed");
-  if (s.heading_source) {
-    // ~base/use_imu_heading: odom without the IMU is worth a warning, the driving goes on.
-    if (*s.heading_source != kinematics::HeadingSource::kImu) {
-      status.mergeSummaryf(DiagnosticStatus::WARN, "odom heading: %s",
-                           kinematics::toString(*s.heading_source));
-    }
-    status.add("odom heading source", kinematics::toString(*s.heading_source));
-    status.add("odom heading IMU fallbacks", s.imu_heading_fallbacks);
-    status.add("odom heading IMU yaw age (s)",
-               s.imu_yaw_age ? std::to_string(*s.imu_yaw_age) : std::string("none yet"));
-  }
-  status.hardware_id = link_.options().path;
-  status.add("port", link_.options().path);
-  status.add("connected", connected);
-  status.add("speed frames out", s.speed_frames);
-  status.add("immediate frames (new cmd_vel)", s.immediate_frames);
-  status.add("e-stop engaged", s.e_stop);
-  status.add("cmd_vel ignored (e-stop)", s.ignored_commands_e_stop);
-  status.add("resets sent", s.resets_sent);
-  status.add("FF timeout errors received", s.timeout_errors_received);
-  status.add("FF timeout errors while running", s.timeout_errors_while_running);
-  if (s.seconds_without_reply)
-    status.addf("seconds without reply", "%.1f", *s.seconds_without_reply);
-  status.addf("min immediate frame spacing (ms)", "%.3f", s.min_immediate_interval_ms);
-  status.add("battery requests", s.battery_requests);
-  status.add("battery replies", s.battery_replies);
-  status.add("unknown replies", s.unknown_replies);
-  status.add("bad replies", s.bad_replies);
-  status.add("write failures", s.write_failures);
-  status.add("cmd_vel timeouts", s.cmd_vel_timeouts);
-  status.add("rejected cmd_vel (NaN/Inf)", s.rejected_commands);
-  status.add("loop overruns", s.loop_overruns);
-  status.addf("last loop period (ms)", "%.3f", s.last_period_ms);
-  status.addf("worst loop period (ms)", "%.3f", s.worst_period_ms);
-  if (s.battery_percent) status.add("battery (%)", static_cast<int>(*s.battery_percent));
+  const Tuned limits = tuned();
+  writeStatusReport(
+      device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
+                         {limits.battery_warn_percent, limits.battery_error_percent}),
+      status);
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -6,7 +6,6 @@
 
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
-#include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/trajectory/joint_groups.h"
 
@@ -107,53 +106,19 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   }
 }
 
-void BodyInterface::logTelemetryFlow(bool connected, uint64_t frames_decoded) {
-  // Once per outage, not once per period: a frame count that stood still for a whole
-  // diagnostics period while the port is up means the board stopped talking.
-  const bool stalled = connected && frames_decoded > 0 && frames_decoded == frames_at_last_diagnose_;
-  if (stalled && !telemetry_stop_logged_) {
+void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
+  const device::BodyStatus::Update update = status_.update(
+      controller_.stats(), link_.stats().framer, {link_.options().path, link_.connected()});
+  writeStatusReport(update.report, status, SummaryWrite::kMerge);
+  // Once per outage, not once per period.
+  if (update.flow == device::BodyStatus::FlowChange::kStopped) {
     ROS_WARN("body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
              "board powered and streaming?",
              link_.options().path.c_str());
-    telemetry_stop_logged_ = true;
-  } else if (!stalled && telemetry_stop_logged_ && frames_decoded != frames_at_last_diagnose_) {
+  } else if (update.flow == device::BodyStatus::FlowChange::kResumed) {
     ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
-    telemetry_stop_logged_ = false;
   }
-  frames_at_last_diagnose_ = frames_decoded;
-}
-
-void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
-  const device::BodyStats stats = controller_.stats();
-  const bool connected = link_.connected();
-  if (!connected) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
-                        "port " + link_.options().path + " not connected");
-  } else if (stats.frames_decoded == 0) {
-    // ERROR, as the frequency check's "No events recorded." already is: a board streaming
-    // nothing is a fault a robot monitor must show red, not a warning.
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR, "no telemetry received yet");
-  } else if (stats.frames_decoded == frames_at_last_diagnose_) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR, "telemetry stopped");
-  }
-  logTelemetryFlow(connected, stats.frames_decoded);
-  status.hardware_id = link_.options().path;
-  status.add("port", link_.options().path);
-  status.add("connected", connected);
-  status.add("frames decoded", stats.frames_decoded);
-  status.add("decode errors", stats.decode_errors);
-  status.add("last decode error",
-             stats.last_decode_error ? protocol::toString(*stats.last_decode_error) : "none");
-  status.add("commands sent", stats.commands_sent);
-  status.add("commands rejected", stats.commands_rejected);
-  status.add("joint targets out of range", stats.joints_out_of_range);
-  status.add("command write failures", stats.write_failures);
-  status.add("commands refused when written (e_stop)", stats.motion_refused);
-  const device::LinkStats link_stats = link_.stats();
-  status.add("port checksum errors", link_stats.framer.checksum_errors);
-  status.add("port bad tails", link_stats.framer.bad_tails);
-  status.add("port bytes skipped (resync)", link_stats.framer.bytes_skipped);
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -195,4 +195,23 @@ JointCommand fromJointState(const sensor_msgs::JointState& msg) {
   return JointCommand{msg.name, msg.position};
 }
 
+void writeStatusReport(const device::StatusReport& report,
+                       diagnostic_updater::DiagnosticStatusWrapper& status, SummaryWrite summary) {
+  static_assert(static_cast<unsigned char>(device::StatusLevel::kWarn) ==
+                        diagnostic_msgs::DiagnosticStatus::WARN &&
+                    static_cast<unsigned char>(device::StatusLevel::kError) ==
+                        diagnostic_msgs::DiagnosticStatus::ERROR &&
+                    static_cast<unsigned char>(device::StatusLevel::kStale) ==
+                        diagnostic_msgs::DiagnosticStatus::STALE,
+                "StatusLevel's values are DiagnosticStatus's levels");
+  const auto level = static_cast<unsigned char>(report.level);
+  if (summary == SummaryWrite::kReplace) {
+    status.summary(level, report.message);
+  } else {
+    status.mergeSummary(level, report.message);
+  }
+  if (!report.hardware_id.empty()) status.hardware_id = report.hardware_id;
+  for (const auto& [key, value] : report.values) status.add(key, value);
+}
+
 }  // namespace serial_robot_driver::ros_layer

@@ -1,13 +1,16 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <functional>
 #include <sstream>
 
 #include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/device/e_stop_status.h"
+#include "serial_robot_driver/device/link_status.h"
 #include "serial_robot_driver/ros/base_interface.h"
 #include "serial_robot_driver/ros/body_interface.h"
+#include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
@@ -192,21 +195,7 @@ void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
 }
 
 void DriverNode::diagnoseEStop(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const device::EStopStats stats = e_stop_.stats();
-  if (stats.engaged) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "engaged: every actuator stopped, motion commands refused");
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "released");
-  }
-  status.add("engaged", stats.engaged);
-  status.add("engagements", stats.engagements);
-  uint64_t refused = 0;
-  for (const auto& [source, count] : stats.refused) {
-    status.add("refused: " + source, count);
-    refused += count;
-  }
-  status.add("commands refused", refused);
+  writeStatusReport(device::eStopStatus(e_stop_.stats()), status);
 }
 
 device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }
@@ -256,40 +245,7 @@ void DriverNode::shutdown() {
 }
 
 void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const device::LinkStats s = port.link->stats();
-  status.hardware_id = port.link->options().path;
-  if (s.connected) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "connected");
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
-                   "not connected" + (s.last_error.empty() ? std::string() : ": " + s.last_error));
-  }
-  status.add("path", port.link->options().path);
-  status.add("baud", port.link->options().baud);
-  status.add("connected", s.connected);
-  status.add("connects", s.connects);
-  status.add("disconnects", s.disconnects);
-  status.add("last error", s.last_error);
-  status.add("bytes in", s.framer.bytes_in);
-  status.add("bytes out", s.bytes_out);
-  status.add("frames out", s.frames_out);
-  status.add("write failures", s.write_failures);
-  for (std::size_t i = 0; i < s.framer.family_count; ++i) {
-    if (s.framer.by_family[i].frames == 0) continue;
-    status.add(std::string("frames in: ") + s.framer.by_family[i].family,
-               s.framer.by_family[i].frames);
-  }
-  status.add("checksum errors", s.framer.checksum_errors);
-  status.add("bad tails", s.framer.bad_tails);
-  status.add("bad lengths", s.framer.bad_lengths);
-  status.add("unknown servo commands", s.framer.unknown_commands);
-  status.add("stale partial frames dropped", s.framer.stale_candidates);
-  status.add("bytes skipped (resync)", s.framer.bytes_skipped);
-  status.add("low latency", s.low_latency);
-  status.add("latency_timer (ms)", s.latency_timer_ms ? std::to_string(*s.latency_timer_ms) : "n/a");
-  if (s.connected && s.latency_timer_ms && *s.latency_timer_ms > 1) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "latency_timer above 1 ms");
-  }
+  writeStatusReport(device::linkStatus(port.link->stats(), port.link->options()), status);
 }
 
 }  // namespace serial_robot_driver::ros_layer

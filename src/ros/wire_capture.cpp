@@ -117,18 +117,7 @@ WireCaptureStats WireCapture::stats() const {
 }
 
 void WireCapture::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) const {
-  const WireCaptureStats s = stats();
-  if (s.dropped > 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "chunks dropped: the subscribers fell behind");
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "capturing on serial_raw");
-  }
-  status.add("chunks published", s.chunks);
-  status.add("bytes published", s.bytes);
-  status.add("chunks dropped", s.dropped);
-  status.add("chunks queued", s.queued);
-  status.add("chunks held by roscpp", s.in_roscpp);
+  writeStatusReport(device::wireCaptureStatus(stats()), status);
 }
 
 }  // namespace serial_robot_driver::ros_layer

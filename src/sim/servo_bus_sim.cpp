@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/protocol/servo_commands.h"
 #include "serial_robot_driver/protocol/servo_params.h"
 
@@ -221,12 +220,10 @@ void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint
 void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast, TimePoint now) {
   runMotions(s, now);  // the angle and the queue as of this request
   const uint8_t id = packet.id();
-  const uint8_t* content = packet.content.data();
-  const std::size_t size = packet.content_size;
   const TimePoint due = now + fromSeconds(config_.answer_latency_s);
   const auto cmd = static_cast<Command>(packet.cmd);
   const servo::CommandInfo& info = servo::commandInfo(cmd);
-  if (!info.request.fits(size)) {
+  if (!info.request.fits(packet.content_size)) {
     ++stats_.malformed;
     return;
   }
@@ -261,17 +258,19 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
 
   switch (cmd) {
     case Command::kPing:
-      reply({id});
+      reply(servo::pingAnswerContent(id));
       break;
 
     case Command::kResetUserData:
       resetUserData(s);
       // The servo now has its factory id and answers from there.
-      reply({kFactoryId, 1});
+      reply(servo::resultAnswerContent(kFactoryId, true));
       break;
 
     case Command::kReadData: {
-      const servo::ParamInfo* param_info = servo::findParamById(content[1]);
+      const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
+      if (!request) return malformed();
+      const servo::ParamInfo* param_info = servo::findParamById(request->data_id);
       if (param_info == nullptr) {
         ++stats_.unknown_data_ids;
         return;
@@ -281,12 +280,14 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
     }
 
     case Command::kWriteData: {
-      const servo::ParamInfo* param_info = servo::findParamById(content[1]);
+      const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
+      if (!request) return malformed();
+      const servo::ParamInfo* param_info = servo::findParamById(request->data_id);
       if (param_info == nullptr) {
         ++stats_.unknown_data_ids;
         return;
       }
-      const auto value = servo::readValue(*param_info, content + 2, size - 2);
+      const auto value = servo::readValue(*param_info, request->value.data(), request->value_size);
       if (!value) return malformed();
       // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
       const bool ok = servo::checkWrite(*param_info, *value, true) == servo::WriteCheck::kOk;
@@ -295,44 +296,30 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
       } else {
         ++stats_.writes_rejected;
       }
-      reply({id, param_info->data_id, static_cast<uint8_t>(ok ? 1 : 0)});
+      reply(servo::writeDataAnswerContent(id, param_info->data_id, ok));
       break;
     }
 
     case Command::kReadBatchData: {
-      std::vector<uint8_t> answer_content(1 + servo::kUserBlockSize, 0);
-      answer_content[0] = id;
-      for (const servo::ParamInfo& param_info : servo::paramTable()) {
-        const auto offset = servo::userBlockOffset(param_info);
-        if (!offset) continue;
-        servo::writeValue(param_info, param(*s, param_info.data_id),
-                          &answer_content[1 + *offset]);
-      }
-      reply(answer_content);
+      const auto value_of = [&](const servo::ParamInfo& info) { return param(*s, info.data_id); };
+      reply(servo::userBlockAnswerContent(id, servo::packUserBlock(value_of)));
       break;
     }
 
     case Command::kWriteBatchData: {
+      const auto block = servo::decodeUserBlock(packet);
+      if (!block) return malformed();
+      const auto values = servo::unpackUserBlock(*block);
       // All or nothing: one bad cell rejects the block.
-      std::map<uint8_t, int64_t> values;
-      bool ok = true;
-      for (const servo::ParamInfo& param_info : servo::paramTable()) {
-        const auto offset = servo::userBlockOffset(param_info);
-        if (!offset) continue;
-        const auto value = servo::readValue(param_info, content + 1 + *offset,
-                                            servo::typeSize(param_info.type));
-        if (!value || servo::checkWrite(param_info, *value, true) != servo::WriteCheck::kOk) {
-          ok = false;
-          break;
-        }
-        values[param_info.data_id] = *value;
-      }
+      const bool ok = std::all_of(values.begin(), values.end(), [](const auto& cell) {
+        return servo::checkWrite(*cell.first, cell.second, true) == servo::WriteCheck::kOk;
+      });
       if (ok) {
-        for (const auto& [data_id, value] : values) s->params[data_id] = value;
+        for (const auto& [param_info, value] : values) s->params[param_info->data_id] = value;
       } else {
         ++stats_.writes_rejected;
       }
-      reply({id, static_cast<uint8_t>(ok ? 1 : 0)});
+      reply(servo::resultAnswerContent(id, ok));
       break;
     }
 
@@ -350,13 +337,13 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
       switch (spin->mode) {
         case servo::SpinMode::kStop:
           stopAll(s);
-          reply({id, 1});
+          reply(servo::resultAnswerContent(id, true));
           return;
         case servo::SpinMode::kContinuous:
           stopAll(s);
           s->relaxed = false;
           s->spin_rate_dps = rate;
-          reply({id, 1});
+          reply(servo::resultAnswerContent(id, true));
           return;
         case servo::SpinMode::kTurns:
           motion.duration_s = speed > 0 ? spin->value * 360.0 / speed : 0.0;
@@ -384,7 +371,7 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
     case Command::kDamping:
       stopAll(s);  // damping releases the holding torque: nothing keeps moving
       s->relaxed = true;
-      reply({id, 1});
+      reply(servo::resultAnswerContent(id, true));
       break;
 
     case Command::kReadAngle:
@@ -439,7 +426,7 @@ void ServoBusSim::runMotions(Servo* s, TimePoint now) {
     const TimePoint finished = motion.start + fromSeconds(motion.duration_s);
     if (motion.answer) {
       answer(std::max(finished, now) + fromSeconds(config_.answer_latency_s), motion.cmd,
-             {motion.answer_id, 1});
+             servo::resultAnswerContent(motion.answer_id, true));
     }
     cursor = finished;  // the next queued motion starts where this one ended
     s->motions.pop_front();

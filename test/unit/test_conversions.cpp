@@ -292,5 +292,49 @@ TEST(ConversionsJointCommand, NamesAndPositionsOnly) {
   EXPECT_EQ(command.positions, msg.position);
 }
 
+TEST(WriteStatusReport, ReplacesTheUpdatersPlaceholderSummaryAndAppendsTheValues) {
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  // What diagnostic_updater::Updater hands a task.
+  status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "No message was set");
+  status.hardware_id = "node";
+  device::StatusReport report;
+  report.summary(device::StatusLevel::kWarn, "battery 19 % (below 20 %)");
+  report.hardware_id = "/dev/ttyUSB0";
+  report.add("connected", true);
+  report.add("battery (%)", 19);
+  writeStatusReport(report, status);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(status.message, "battery 19 % (below 20 %)");
+  EXPECT_EQ(status.hardware_id, "/dev/ttyUSB0");
+  ASSERT_EQ(status.values.size(), 2u);
+  EXPECT_EQ(status.values[0].key, "connected");
+  EXPECT_EQ(status.values[0].value, "True");
+  EXPECT_EQ(status.values[1].key, "battery (%)");
+  EXPECT_EQ(status.values[1].value, "19");
+
+  device::StatusReport no_id;
+  writeStatusReport(no_id, status);
+  EXPECT_EQ(status.hardware_id, "/dev/ttyUSB0") << "a report without one keeps the status's";
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK);
+}
+
+TEST(WriteStatusReport, MergesIntoAnotherChecksVerdict) {
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "Frequency too low.");
+  status.add("Events in window", 3);
+  device::StatusReport fine;
+  writeStatusReport(fine, status, SummaryWrite::kMerge);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(status.message, "Frequency too low.");
+  device::StatusReport stopped;
+  stopped.mergeSummary(device::StatusLevel::kError, "telemetry stopped");
+  stopped.add("frames decoded", 10);
+  writeStatusReport(stopped, status, SummaryWrite::kMerge);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_EQ(status.message, "Frequency too low.; telemetry stopped");
+  ASSERT_EQ(status.values.size(), 2u);
+  EXPECT_EQ(status.values[1].key, "frames decoded");
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::ros_layer

@@ -1,7 +1,9 @@
 // The UART bus servo parameter table, written out by hand from docs/protocols.md, section 3.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
+#include <iterator>
 #include <set>
 #include <string>
 #include <vector>
@@ -313,6 +315,22 @@ TEST(ServoParams, ReadOnlyParamsHaveNoUserBlockOffset) {
   for (const ParamInfo& param : paramTable()) {
     EXPECT_EQ(userBlockOffset(param).has_value(), !param.read_only) << param.name;
   }
+}
+
+TEST(ServoParams, UserBlockPacksEveryReadWriteParamAndUnpacksToTheSameValues) {
+  // A value per parameter that fits its type and tells the parameters apart.
+  const auto value_of = [](const ParamInfo& param) {
+    return param.type == ParamType::kI16 ? -int64_t{param.data_id} : int64_t{param.data_id};
+  };
+  const std::array<uint8_t, kUserBlockSize> block = packUserBlock(value_of);
+  EXPECT_EQ(block[0], 32);  // reserved_32 first, u8
+  EXPECT_EQ(block[6], 38);  // stall_power_limit, u16 little-endian
+  EXPECT_EQ(block[7], 0);
+  EXPECT_EQ(block[30], 0xCB);  // angle_mid_offset -53 = 0xFFCB
+  EXPECT_EQ(block[31], 0xFF);
+  const auto values = unpackUserBlock(block);
+  ASSERT_EQ(values.size(), std::size(kOffsets));
+  for (const auto& [param, value] : values) EXPECT_EQ(value, value_of(*param)) << param->name;
 }
 
 }  // namespace

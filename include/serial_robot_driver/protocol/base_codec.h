@@ -52,7 +52,7 @@ class SequenceCounter {
   uint8_t value_ = 0;
 };
 
-/// Wheel speeds in encoder ticks per PID period, sent big-endian with 4 trailing zero bytes (LEN 9).
+/// Wheel speeds in encoder ticks per PID period (PARAM layout: base_codec.cpp, kWheelSpeedParams).
 std::vector<uint8_t> encodeWheelSpeed(uint8_t seq, int16_t left_ticks, int16_t right_ticks);
 std::vector<uint8_t> encodeBatteryRequest(uint8_t seq);
 std::vector<uint8_t> encodeReset(uint8_t seq);

@@ -1,9 +1,10 @@
 // Servo controller board protocol (docs/protocols.md, section 2).
 //
 // Host -> board: Dynamixel 2.0 Sync Write of goal positions, CRC-16/BUYPASS (Boost.CRC):
-//   FF FF FD 00 | FE | LEN_L LEN_H | 83 | 74 00 | 02 00 | (ID, POS_L, POS_H) x N | CRC_L CRC_H
-// Board -> host: telemetry, big-endian except the foot block:
-//   12 34 | LEN | servo block (4N) | IMU block (18) | [foot block (16, little-endian)] | SUM | 1F 2F
+//   header | id | LEN | command fields | servo record x N | CRC
+// Board -> host: telemetry:
+//   header | LEN | servo record x N | IMU values | [foot values] | SUM | tail
+// The records and values are the field lists below; the envelopes' constants are next to them.
 #pragma once
 
 #include <array>
@@ -13,6 +14,7 @@
 
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/protocol/frame_family.h"
+#include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace serial_robot_driver::protocol::body {
 
@@ -24,21 +26,42 @@ constexpr uint16_t kGoalPositionAddress = 0x0074;
 constexpr uint16_t kGoalPositionSize = 2;
 /// Bytes before the LEN field counts start: header (4) + id (1) + LEN (2).
 constexpr std::size_t kSyncWritePrefix = 7;
-/// LEN = instruction + address + size + 3N + CRC = 7 + 3N.
-constexpr std::size_t syncWriteLen(std::size_t servo_count) { return 7 + 3 * servo_count; }
 /// The largest sync write we build or accept (ids are 0..253 without broadcast).
 constexpr std::size_t kMaxSyncWriteServos = 64;
 
 /// CRC-16/BUYPASS as used by Dynamixel 2.0 (poly 0x8005, init 0, no reflection, no final XOR).
 uint16_t dynamixelCrc(const uint8_t* data, std::size_t size);
+constexpr std::size_t kCrcSize = 2;
+
+/// The fields LEN counts before the servo records.
+struct SyncWriteCommand {
+  uint8_t instruction = kSyncWriteInstruction;
+  uint16_t address = kGoalPositionAddress;
+  uint16_t data_size = kGoalPositionSize;
+};
+constexpr std::array<wire::Field<SyncWriteCommand>, 3> kSyncWriteCommandFields = {{
+    wire::field<&SyncWriteCommand::instruction>("instruction", wire::kU8, wire::ByteOrder::kLittle),
+    wire::field<&SyncWriteCommand::address>("address", wire::kU16, wire::ByteOrder::kLittle),
+    wire::field<&SyncWriteCommand::data_size>("data_size", wire::kU16, wire::ByteOrder::kLittle),
+}};
 
 struct ServoTarget {
   uint8_t id = 0;
   uint16_t position = 0;  ///< raw ticks
 };
+constexpr std::array<wire::Field<ServoTarget>, 2> kServoTargetFields = {{
+    wire::field<&ServoTarget::id>("id", wire::kU8, wire::ByteOrder::kLittle),
+    wire::field<&ServoTarget::position>("position", wire::kU16, wire::ByteOrder::kLittle, "ticks"),
+}};
+
+/// LEN: the command fields, one record per servo, the CRC.
+constexpr std::size_t syncWriteLen(std::size_t servo_count) {
+  return wire::listOf(kSyncWriteCommandFields).size() +
+         wire::listOf(kServoTargetFields).size() * servo_count + kCrcSize;
+}
 
 std::vector<uint8_t> encodeSyncWrite(const std::vector<ServoTarget>& targets);
-/// Probes for a complete sync write: header and broadcast id, LEN (7 + 3N, N <= 64),
+/// Probes for a complete sync write: header and broadcast id, LEN (syncWriteLen, N <= 64),
 /// instruction, CRC (kBadHeader / kBadLength / kBadChecksum).
 Probe probeSyncWrite(const uint8_t* data, std::size_t available);
 /// Sync writes (host -> board; what the simulated board reads): "sync_write".
@@ -53,11 +76,6 @@ constexpr uint8_t kTelemetryTail0 = 0x1F;
 constexpr uint8_t kTelemetryTail1 = 0x2F;
 constexpr std::size_t kImuValueCount = 9;
 constexpr std::size_t kFootSensorCount = 8;
-/// LEN = 24 + 4N without the foot block and 40 + 4N with it; LEN is one byte, so N <= 57.
-constexpr std::size_t kMaxTelemetryServos = 57;
-constexpr std::size_t telemetryLen(std::size_t servo_count, bool with_foot) {
-  return 24 + 4 * servo_count + (with_foot ? 16 : 0);
-}
 
 /// Indices into Telemetry::imu (assumption of docs/protocols.md: accel, gyro, attitude).
 enum ImuIndex : std::size_t {
@@ -68,6 +86,35 @@ struct ServoSample {
   uint16_t position = 0;  ///< raw ticks
   int16_t speed = 0;      ///< raw, signed two's complement (assumption)
 };
+
+// The blocks of a telemetry frame, one field list each: a servo record (N of them), an IMU value
+// (kImuValueCount) and a foot sensor (kFootSensorCount, the only little-endian block).
+constexpr std::array<wire::Field<ServoSample>, 2> kServoSampleFields = {{
+    wire::field<&ServoSample::position>("position", wire::kU16, wire::ByteOrder::kBig, "ticks"),
+    wire::field<&ServoSample::speed>("speed", wire::kI16, wire::ByteOrder::kBig),
+}};
+struct TelemetryValue {
+  int64_t value = 0;
+};
+constexpr wire::Field<TelemetryValue> kImuValueField =
+    wire::field<&TelemetryValue::value>("imu", wire::kI16, wire::ByteOrder::kBig);
+constexpr wire::Field<TelemetryValue> kFootValueField =
+    wire::field<&TelemetryValue::value>("foot", wire::kU16, wire::ByteOrder::kLittle);
+/// Bytes around the blocks: header (2) + LEN before them, SUM + tail (2) after them.
+constexpr std::size_t kTelemetryPrefix = 3;
+constexpr std::size_t kTelemetryTrailer = 3;
+constexpr std::size_t kImuBlockSize = kImuValueField.type.width * kImuValueCount;
+constexpr std::size_t kFootBlockSize = kFootValueField.type.width * kFootSensorCount;
+
+/// LEN is the whole frame; one byte, so at most kMaxTelemetryServos servos.
+constexpr std::size_t telemetryLen(std::size_t servo_count, bool with_foot) {
+  return kTelemetryPrefix + wire::listOf(kServoSampleFields).size() * servo_count + kImuBlockSize +
+         (with_foot ? kFootBlockSize : 0) + kTelemetryTrailer;
+}
+constexpr std::size_t kMaxTelemetryServos = 57;
+static_assert(telemetryLen(kMaxTelemetryServos, false) <= 255 &&
+                  telemetryLen(kMaxTelemetryServos + 1, false) > 255,
+              "LEN is one byte");
 
 /// One decoded telemetry frame in raw units. Fixed-size storage: decoding never allocates.
 struct Telemetry {
@@ -81,7 +128,7 @@ struct Telemetry {
 /// SUM byte: (sum of bytes 2 .. LEN-4) mod 256 of a frame whose LEN byte is already in place.
 uint8_t telemetrySum(const uint8_t* frame, std::size_t len);
 
-/// Probes for a complete telemetry frame of `servo_count` servos: header, LEN (24 + 4N or 40 + 4N),
+/// Probes for a complete telemetry frame of `servo_count` servos: header, LEN (telemetryLen),
 /// then tail before SUM (kBadHeader / kBadLength / kBadTail / kBadChecksum).
 Probe probeTelemetry(const uint8_t* data, std::size_t available, std::size_t servo_count);
 /// Telemetry (board -> host): "telemetry"; the framer's argument is the servo count.

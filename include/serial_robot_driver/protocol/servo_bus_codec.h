@@ -2,7 +2,8 @@
 //
 //   request  12 4C | CMD | N | CONTENT (N) | SUM
 //   response 05 1C | CMD | N | CONTENT (N) | SUM
-// SUM = sum of all preceding bytes mod 256; multi-byte values little-endian.
+// SUM = sum of all preceding bytes mod 256. Each command's CONTENT is one field list in
+// src/protocol/servo_layouts.h; the functions below encode and decode with those lists.
 #pragma once
 
 #include <array>
@@ -21,7 +22,7 @@ constexpr uint8_t kRequestHeader1 = 0x4C;
 constexpr uint8_t kResponseHeader0 = 0x05;
 constexpr uint8_t kResponseHeader1 = 0x1C;
 constexpr std::size_t kOverhead = 5;  ///< header (2), CMD, N, SUM
-/// Longest CONTENT of any command: WRITE_BATCH_DATA / READ_BATCH_DATA reply = id + 32 bytes.
+/// Longest CONTENT of any command, the user block with its id (servo_commands.cpp checks it).
 constexpr uint8_t kMaxContent = 1 + kUserBlockSize;
 constexpr std::size_t kMaxFrameSize = kMaxContent + kOverhead;
 constexpr uint8_t kBroadcastId = 255;
@@ -38,13 +39,13 @@ enum class Command : uint8_t {
   kRotate = 8,
   kDamping = 9,
   kReadAngle = 10,
-  // The newer firmware's motion set, as the vendor SDK packs it (little-endian after the id).
-  kMoveByInterval = 11,           ///< i16 angle, u16 interval, u16 accel, u16 decel, u16 power
-  kMoveByVelocity = 12,           ///< i16 angle, u16 velocity (0.1 deg/s), u16 accel, decel, power
-  kMultiTurnMove = 13,            ///< i32 angle, u32 interval, u16 power
-  kMultiTurnMoveByInterval = 14,  ///< i32 angle, u32 interval, u16 accel, u16 decel, u16 power
-  kMultiTurnMoveByVelocity = 15,  ///< i32 angle, u16 velocity, u16 accel, u16 decel, u16 power
-  kReadMultiTurnAngle = 16,       ///< request: id; answer: id, i32 angle, i16 turns
+  // The newer firmware's motion set, as the vendor SDK packs it.
+  kMoveByInterval = 11,
+  kMoveByVelocity = 12,
+  kMultiTurnMove = 13,
+  kMultiTurnMoveByInterval = 14,
+  kMultiTurnMoveByVelocity = 15,
+  kReadMultiTurnAngle = 16,
 };
 constexpr uint8_t kMinCommand = 1;
 constexpr uint8_t kMaxCommand = 16;
@@ -53,7 +54,7 @@ constexpr bool isKnownCommand(uint8_t cmd) { return cmd >= kMinCommand && cmd <=
 
 uint8_t byteSum(const uint8_t* data, std::size_t size);
 
-/// SPIN method byte: bit 7 direction, bits 1..0 mode.
+/// SPIN's mode (the method byte's low bits, servo_layouts.h).
 enum class SpinMode : uint8_t { kStop = 0, kContinuous = 1, kTurns = 2, kDurationMs = 3 };
 uint8_t spinMethod(bool clockwise, SpinMode mode);
 
@@ -98,8 +99,7 @@ struct MultiTurnAngle {
   int32_t angle_decidegrees = 0;
   int16_t turns = 0;
 };
-constexpr std::size_t kMultiTurnAngleAnswerSize = 7;  ///< id, i32 angle, i16 turns
-/// Decodes the CONTENT of a CMD 16 answer (kBadLength unless exactly 7 bytes).
+/// Decodes the CONTENT of a CMD 16 answer (kBadLength unless exactly its layout's size).
 Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size);
 /// The CONTENT of a CMD 16 answer (simulator side).
 std::vector<uint8_t> multiTurnAngleContent(const MultiTurnAngle& angle);
@@ -132,7 +132,13 @@ std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& con
 // --- Typed requests and answers: the simulator encodes answers and decodes requests with the
 // same functions the client uses the other way round. Sizes and result bytes: servo_commands.h.
 
-/// A READ_ANGLE answer: id, i16 angle (0.1 deg).
+/// The answer of PING, and of the commands whose answer reports a result (simulator side; the
+/// client finds the result byte through commandInfo(cmd).result_index).
+std::vector<uint8_t> pingAnswerContent(uint8_t id);
+std::vector<uint8_t> resultAnswerContent(uint8_t id, bool ok);
+std::vector<uint8_t> writeDataAnswerContent(uint8_t id, uint8_t data_id, bool ok);
+
+/// A READ_ANGLE answer.
 struct AngleAnswer {
   uint8_t id = 0;
   int16_t angle_decidegrees = 0;
@@ -141,9 +147,26 @@ std::vector<uint8_t> angleAnswerContent(const AngleAnswer& answer);
 Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer);
 /// A CMD 16 answer packet.
 Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer);
-/// A READ_DATA answer: id, data_id, then the value as `param`'s type lays it out.
+/// A READ_DATA answer: its fields, then the value as `param`'s type lays it out.
 std::vector<uint8_t> readDataAnswerContent(uint8_t id, const ParamInfo& param, int64_t value);
 Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param);
+
+/// A READ_DATA / WRITE_DATA request or READ_DATA answer: the parameter's data_id and the value
+/// bytes that follow it (none in a READ_DATA request), still in the parameter's type.
+struct DataContent {
+  uint8_t id = 0;
+  uint8_t data_id = 0;
+  std::array<uint8_t, largestTypeSize()> value{};
+  std::size_t value_size = 0;
+};
+/// kBadLength when the content is shorter than its fields or the value longer than any type.
+Decoded<DataContent> decodeDataContent(const Packet& packet);
+
+/// A READ_BATCH_DATA answer (simulator side) and the user block of it or of a WRITE_BATCH_DATA
+/// request (kBadLength unless the packet is that long).
+std::vector<uint8_t> userBlockAnswerContent(uint8_t id,
+                                            const std::array<uint8_t, kUserBlockSize>& block);
+Decoded<std::array<uint8_t, kUserBlockSize>> decodeUserBlock(const Packet& packet);
 
 /// Any of the motions CMD 8 (ROTATE) and 11..15, as its request carries it.
 struct MoveCommand {
@@ -163,7 +186,7 @@ bool hasRamps(Command cmd);
 std::vector<uint8_t> encodeMove(const MoveCommand& move);
 Decoded<MoveCommand> decodeMove(const Packet& request);
 
-/// A SPIN request: id, method (bit 7 clockwise, bits 1..0 mode), speed u16 deg/s, value u16.
+/// A SPIN request.
 struct SpinCommand {
   uint8_t id = 0;
   bool clockwise = false;
@@ -173,5 +196,8 @@ struct SpinCommand {
 };
 std::vector<uint8_t> encodeSpin(const SpinCommand& spin);
 Decoded<SpinCommand> decodeSpin(const Packet& request);
+
+/// The power of a DAMPING request.
+Decoded<uint16_t> decodeDamping(const Packet& request);
 
 }  // namespace serial_robot_driver::protocol::servo

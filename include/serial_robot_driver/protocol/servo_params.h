@@ -2,12 +2,18 @@
 // and safety flags in one place, so validation, encoding and the services read the same facts.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
+
+#include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace serial_robot_driver::protocol::servo {
 
@@ -47,8 +53,35 @@ enum class ServoDataId : uint8_t {
 constexpr uint8_t dataId(ServoDataId id) { return static_cast<uint8_t>(id); }
 
 enum class ParamType { kU8, kU16, kU32, kI16 };
+constexpr std::array<ParamType, 4> kParamTypes = {ParamType::kU8, ParamType::kU16, ParamType::kU32,
+                                                  ParamType::kI16};
 
-std::size_t typeSize(ParamType type);
+/// How a value of `type` goes on the wire (little-endian, as all of the servo bus).
+constexpr wire::WireType wireType(ParamType type) {
+  switch (type) {
+    case ParamType::kU8:
+      return wire::kU8;
+    case ParamType::kU16:
+      return wire::kU16;
+    case ParamType::kU32:
+      return wire::kU32;
+    case ParamType::kI16:
+      return wire::kI16;
+  }
+  return wire::reserved(0);
+}
+constexpr std::size_t typeSize(ParamType type) { return wireType(type).width; }
+/// The narrowest and widest parameter value on the wire.
+constexpr std::size_t smallestTypeSize() {
+  std::size_t smallest = typeSize(kParamTypes[0]);
+  for (ParamType type : kParamTypes) smallest = std::min(smallest, typeSize(type));
+  return smallest;
+}
+constexpr std::size_t largestTypeSize() {
+  std::size_t largest = 0;
+  for (ParamType type : kParamTypes) largest = std::max(largest, typeSize(type));
+  return largest;
+}
 int64_t typeMin(ParamType type);
 int64_t typeMax(ParamType type);
 
@@ -90,5 +123,12 @@ std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out);
 
 /// Byte offset of a user-block parameter inside the 32-byte block, nullopt for read-only ones.
 std::optional<std::size_t> userBlockOffset(const ParamInfo& param);
+
+/// The user block with each read-write parameter's value, as `value_of` gives it, at its offset.
+std::array<uint8_t, kUserBlockSize> packUserBlock(
+    const std::function<int64_t(const ParamInfo&)>& value_of);
+/// Every parameter of a user block with its value, in block order.
+std::vector<std::pair<const ParamInfo*, int64_t>> unpackUserBlock(
+    const std::array<uint8_t, kUserBlockSize>& block);
 
 }  // namespace serial_robot_driver::protocol::servo

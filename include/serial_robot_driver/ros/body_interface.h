@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/device/body_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
@@ -50,8 +51,6 @@ class BodyInterface : public DeviceInterface {
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
                         device::Clock::time_point arrival);
   void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
-  /// Logs "telemetry stopped" once when no frame came for a diagnostics period, and "resumed".
-  void logTelemetryFlow(bool connected, uint64_t frames_decoded);
 
   device::SerialLink& link_;
   const ArrivalStamps arrival_stamps_;
@@ -72,9 +71,7 @@ class BodyInterface : public DeviceInterface {
   // The node's trajectory server (its own threading comment); set before the link starts.
   TrajectoryServer* trajectory_ = nullptr;
   device::EStop* e_stop_ = nullptr;  // the node's, set before start()
-  // Diagnostics timer thread only.
-  uint64_t frames_at_last_diagnose_ = 0;
-  bool telemetry_stop_logged_ = false;
+  device::BodyStatus status_;        // diagnostics timer thread only
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -2,7 +2,7 @@
 // are unit-tested without a roscore.
 #pragma once
 
-#include <Eigen/Core>
+#include <diagnostic_updater/DiagnosticStatusWrapper.h>
 #include <geometry_msgs/Quaternion.h>
 #include <ros/time.h>
 #include <sensor_msgs/Imu.h>
@@ -10,12 +10,14 @@
 #include <serial_robot_driver/FootPressure.h>
 #include <serial_robot_driver/Telemetry.h>
 
+#include <Eigen/Core>
 #include <chrono>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/device/status_report.h"
 #include "serial_robot_driver/protocol/body_codec.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -86,5 +88,16 @@ struct JointCommand {
   std::vector<double> positions;
 };
 JointCommand fromJointState(const sensor_msgs::JointState& msg);
+
+/// How writeStatusReport treats the status's summary so far.
+enum class SummaryWrite {
+  kReplace,  ///< the report's level and message are the status's (the updater's fresh status)
+  kMerge,    ///< merged into another check's verdict (DiagnosticStatusWrapper::mergeSummary)
+};
+/// A core status report as the updater publishes it: its summary, its hardware_id when it has
+/// one, and its values appended in order.
+void writeStatusReport(const device::StatusReport& report,
+                       diagnostic_updater::DiagnosticStatusWrapper& status,
+                       SummaryWrite summary = SummaryWrite::kReplace);
 
 }  // namespace serial_robot_driver::ros_layer

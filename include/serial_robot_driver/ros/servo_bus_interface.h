@@ -39,6 +39,8 @@
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/device/servo_bus.h"
 #include "serial_robot_driver/device/servo_bus_client.h"
+#include "serial_robot_driver/device/servo_bus_status.h"
+#include "serial_robot_driver/device/servo_joint_commands.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
@@ -52,24 +54,14 @@ device::ServoBusOptions makeServoBusOptions(const DriverParams& params);
 /// servos, at state_rate).
 device::ServoBusConfig makeServoBusConfig(const DriverParams& params);
 
-/// The bus servo id of a servo_states / servo_commands joint name ("servo_<id>", id 0..254), or
-/// -1 when the name is not of that form.
-int servoIdFromJointName(const std::string& name);
-std::string servoJointName(uint8_t id);
-
-/// The moves of one servo_commands message, or the reason it is rejected (nothing is sent then).
-/// Positions in rad, velocities in rad/s (an entry without a velocity, or 0: ROTATE with
-/// `interval_ms`; else CMD 12 by velocity).
-struct ServoCommandBatch {
-  std::vector<device::MoveRequest> moves;
-  std::string error;  ///< non-empty: rejected
-};
+// Joint names and servo_commands' checks are the core's (device/servo_joint_commands.h).
+using device::ServoCommandBatch;
+using device::servoIdFromJointName;
+using device::servoJointName;
+/// A servo call's message, naming the parameter that arms a refused dangerous write.
+std::string servoStatusMessage(const device::ServoStatus& status);
+/// device::toServoMoves of the message's names, positions (rad) and velocities (rad/s).
 ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms);
-
-/// The status of servo `id` from its health report (null: not polled yet): its readings and
-/// limits, WARN within 10 % of a limit, ERROR beyond it or when the servo does not answer.
-void diagnoseServoHealth(uint8_t id, const device::ServoHealthReport* report,
-                         diagnostic_updater::DiagnosticStatusWrapper& status);
 
 class ServoBusInterface : public DeviceInterface {
  public:
@@ -100,6 +92,8 @@ class ServoBusInterface : public DeviceInterface {
 
  private:
   device::ServoBusEvents makeEvents();
+  /// servo/* on nh_ (servo_bus_services.cpp).
+  void advertiseServices();
   void onServoCommands(const sensor_msgs::JointState::ConstPtr& msg);
   /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
   /// trajectory stops (its goal aborts) and its queued move is dropped.
@@ -133,9 +127,7 @@ class ServoBusInterface : public DeviceInterface {
   device::EStop* e_stop_ = nullptr;  // the node's, set before start()
 
   // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
-  uint64_t polls_at_last_check_ = 0;
-  std::chrono::steady_clock::time_point last_rate_check_{};
-  double achieved_rate_ = -1.0;  ///< reads/s over the last window; < 0: none yet
+  device::ServoBusStatus status_;
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -33,17 +33,13 @@
 
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/device/wire_capture_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
 
-struct WireCaptureStats {
-  uint64_t chunks = 0;        ///< published: handed to roscpp, which queues it for every subscriber
-  uint64_t bytes = 0;         ///< in published chunks
-  uint64_t dropped = 0;       ///< chunks lost to a full queue (the capture's, see above)
-  std::size_t queued = 0;     ///< waiting in the capture's queue now
-  std::size_t in_roscpp = 0;  ///< published chunks roscpp still holds unsent (some subscriber)
-};
+// Its counters and status are the core's (device/wire_capture_status.h).
+using device::WireCaptureStats;
 
 struct WireCaptureLimits {
   /// About 10 s of a busy 1 Mbaud port; a backlog beyond this means the subscribers cannot keep up.

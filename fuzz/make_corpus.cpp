@@ -1,0 +1,287 @@
+// Writes the fuzz targets' seed corpora through the codecs' own encoders, so that no seed spells a
+// frame's bytes by hand: one seed per servo command (request and answer) and per base / body frame
+// kind, plus a few streams that mix them. The golden vectors of docs/protocols.md stay in the unit
+// tests, which check these same encoders against them.
+//
+//   make_corpus OUT_DIR
+//     OUT_DIR/fuzz_framer/    3-byte prefix (families, servo count, max chunk) + byte stream
+//     OUT_DIR/fuzz_decoders/  1-byte selector (decoder + 5 * mode), servo count, frame
+// (the input layouts of fuzz_framer.cpp and fuzz_decoders.cpp).
+#include <array>
+#include <cctype>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/protocol/servo_commands.h"
+#include "serial_robot_driver/protocol/servo_params.h"
+
+namespace {
+
+namespace base = serial_robot_driver::protocol::base;
+namespace body = serial_robot_driver::protocol::body;
+namespace servo = serial_robot_driver::protocol::servo;
+using Bytes = std::vector<uint8_t>;
+
+Bytes join(std::initializer_list<Bytes> parts) {
+  Bytes all;
+  for (const Bytes& part : parts) all.insert(all.end(), part.begin(), part.end());
+  return all;
+}
+
+class SeedWriter {
+ public:
+  explicit SeedWriter(std::filesystem::path dir) : dir_(std::move(dir)) {
+    std::filesystem::create_directories(dir_);
+  }
+  void write(const std::string& name, const Bytes& prefix, const Bytes& frames) {
+    const Bytes seed = join({prefix, frames});
+    std::ofstream out(dir_ / name, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(seed.data()),
+              static_cast<std::streamsize>(seed.size()));
+    ++count_;
+  }
+  int count() const { return count_; }
+
+ private:
+  std::filesystem::path dir_;
+  int count_ = 0;
+};
+
+// --- base --------------------------------------------------------------------------------------
+const Bytes kBaseReset = base::encodeReset(2);
+const Bytes kBaseBatteryRequest = base::encodeBatteryRequest(1);
+const Bytes kBaseClearEncoders = base::encodeClearEncoders(3);
+const Bytes kBaseLeft4 = base::encodeWheelSpeed(0, 4, 0);
+const Bytes kBaseBothMinus6 = base::encodeWheelSpeed(0, -6, -6);
+const Bytes kBaseBatteryReply = base::encodeBatteryReply(7, 100);
+const Bytes kBaseErrorStatus = base::encodeErrorStatus(8);
+
+// --- body --------------------------------------------------------------------------------------
+body::Telemetry telemetry(bool with_foot) {
+  body::Telemetry frame;
+  frame.servo_count = 2;
+  frame.servos[0] = {2048, 10};
+  frame.servos[1] = {1024, -5};
+  frame.imu = {1, -1, 16384, 0, 0, 100, 0, 0, -16384};
+  frame.has_foot = with_foot;
+  for (std::size_t j = 0; j < body::kFootSensorCount; ++j) {
+    frame.foot[j] = static_cast<uint16_t>(j + 1);
+  }
+  return frame;
+}
+const Bytes kTelemetry = body::encodeTelemetry(telemetry(false));
+const Bytes kTelemetryFoot = body::encodeTelemetry(telemetry(true));
+const Bytes kSyncWrite = body::encodeSyncWrite({{2, 2048}, {3, 1024}});
+
+// A Dynamixel 2.0 PING to id 1: a frame with a valid CRC that is not our sync write.
+Bytes dynamixelPing() {
+  constexpr uint8_t kPingInstruction = 0x01;
+  constexpr uint16_t kPingLen = 1 + body::kCrcSize;
+  Bytes frame(body::kSyncWriteHeader.begin(), body::kSyncWriteHeader.end());
+  frame.push_back(1);
+  frame.push_back(static_cast<uint8_t>(kPingLen));
+  frame.push_back(static_cast<uint8_t>(kPingLen >> 8));
+  frame.push_back(kPingInstruction);
+  const uint16_t crc = body::dynamixelCrc(frame.data(), frame.size());
+  frame.push_back(static_cast<uint8_t>(crc));
+  frame.push_back(static_cast<uint8_t>(crc >> 8));
+  return frame;
+}
+
+// --- servo bus: one request and one answer per command ------------------------------------------
+const servo::ParamInfo& param(const char* name) { return *servo::findParam(name); }
+
+servo::MoveRamps ramps(uint16_t accel_ms, uint16_t decel_ms) {
+  servo::MoveRamps result;
+  result.accel_ms = accel_ms;
+  result.decel_ms = decel_ms;
+  return result;
+}
+
+std::array<uint8_t, servo::kUserBlockSize> userBlock() {
+  std::array<uint8_t, servo::kUserBlockSize> block{};
+  for (const servo::ParamInfo& info : servo::paramTable()) {
+    if (const auto offset = servo::userBlockOffset(info)) {
+      servo::writeValue(info, info.min + (info.max - info.min) / 2, &block[*offset]);
+    }
+  }
+  return block;
+}
+
+Bytes request(servo::Command cmd) {
+  using servo::Command;
+  switch (cmd) {
+    case Command::kPing:
+      return servo::encodePing(3);
+    case Command::kResetUserData:
+      return servo::encodeResetUserData(3);
+    case Command::kReadData:
+      return servo::encodeReadData(3, param("voltage").data_id);
+    case Command::kWriteData:
+      return servo::encodeWriteData(3, param("angle_limit_low"), -900);
+    case Command::kReadBatchData:
+      return servo::encodeReadBatchData(3);
+    case Command::kWriteBatchData:
+      return servo::encodeWriteBatchData(3, userBlock());
+    case Command::kSpin:
+      return servo::encodeSpin(0, true, servo::SpinMode::kDurationMs, 100, 1000);
+    case Command::kRotate:
+      return servo::encodeRotate(2, 900, 500, 0);
+    case Command::kDamping:
+      return servo::encodeDamping(0, 500);
+    case Command::kReadAngle:
+      return servo::encodeReadAngle(0);
+    case Command::kMoveByInterval:
+      return servo::encodeMoveByInterval(1, 900, 1000, ramps(100, 100));
+    case Command::kMoveByVelocity:
+      return servo::encodeMoveByVelocity(1, -900, 3600, ramps(100, 100));
+    case Command::kMultiTurnMove:
+      return servo::encodeMultiTurnMove(1, 7200, 2000, 0);
+    case Command::kMultiTurnMoveByInterval:
+      return servo::encodeMultiTurnMoveByInterval(1, -3600, 1000, ramps(200, 200));
+    case Command::kMultiTurnMoveByVelocity:
+      return servo::encodeMultiTurnMoveByVelocity(1, 36000, 3600, ramps(100, 100));
+    case Command::kReadMultiTurnAngle:
+      return servo::encodeReadMultiTurnAngle(1);
+  }
+  return {};
+}
+
+Bytes answerContent(servo::Command cmd) {
+  using servo::Command;
+  switch (cmd) {
+    case Command::kPing:
+      return servo::pingAnswerContent(3);
+    case Command::kReadData:
+      return servo::readDataAnswerContent(3, param("voltage"), 7400);
+    case Command::kWriteData:
+      return servo::writeDataAnswerContent(3, param("angle_limit_low").data_id, true);
+    case Command::kReadBatchData:
+      return servo::userBlockAnswerContent(3, userBlock());
+    case Command::kReadAngle:
+      return servo::angleAnswerContent({0, 902});
+    case Command::kReadMultiTurnAngle:
+      return servo::multiTurnAngleContent({1, 7200, 2});
+    default:  // every other command answers with a result byte (see the command table)
+      return servo::resultAnswerContent(1, true);
+  }
+}
+
+Bytes answer(servo::Command cmd) { return servo::encodeResponse(cmd, answerContent(cmd)); }
+
+// "MULTI_TURN_MOVE_BY_INTERVAL (CMD 14)" -> "multi_turn_move_by_interval"
+std::string seedName(const char* command_name) {
+  std::string name;
+  for (const char* c = command_name; *c != '\0' && *c != ' '; ++c) {
+    name.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(*c))));
+  }
+  return name;
+}
+
+// Selector bytes of fuzz_decoders.cpp: decoder index + 5 * mode (0 raw, 1 fix sum, 2 fix all).
+enum class Decoder : uint8_t { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite };
+uint8_t selector(Decoder decoder, uint8_t mode) {
+  return static_cast<uint8_t>(static_cast<uint8_t>(decoder) + 5 * mode);
+}
+constexpr uint8_t kRaw = 0, kFixSum = 1, kFixAll = 2;
+
+// Prefix bits of fuzz_framer.cpp.
+constexpr uint8_t kBaseBit = 0x01, kTelemetryBit = 0x02, kResponseBit = 0x04, kRequestBit = 0x08,
+                  kSyncWriteBit = 0x10, kResetBit = 0x80;
+constexpr uint8_t kAllFamilies =
+    kBaseBit | kTelemetryBit | kResponseBit | kRequestBit | kSyncWriteBit;
+
+void writeFramerSeeds(SeedWriter& seeds) {
+  const Bytes all = {kAllFamilies, 2, 0};  // one feed
+  seeds.write("base_reset", all, kBaseReset);
+  seeds.write("base_wheels", all, join({kBaseLeft4, kBaseBothMinus6}));
+  seeds.write("base_replies", {kBaseBit, 0, 0}, join({kBaseBatteryReply, kBaseErrorStatus}));
+  seeds.write("telemetry", all, kTelemetry);
+  seeds.write("telemetry_foot_chunked", {kTelemetryBit, 2, 5}, join({kTelemetryFoot, kTelemetry}));
+  seeds.write("sync_write", all, kSyncWrite);
+  seeds.write("simulator_input", {kBaseBit | kRequestBit | kSyncWriteBit, 0, 4},
+              join({dynamixelPing(), kSyncWrite, request(servo::Command::kRotate), kBaseReset}));
+  Bytes requests, answers;
+  for (const servo::CommandInfo& info : servo::commandTable()) {
+    requests = join({requests, request(info.cmd)});
+    answers = join({answers, answer(info.cmd)});
+  }
+  seeds.write("servo_requests", all, requests);
+  seeds.write("servo_responses", {kResponseBit | kRequestBit, 2, 1}, answers);
+  const Bytes junk = {0x00, base::kHeader0, servo::kRequestHeader0};
+  seeds.write("driver_mixed_with_junk",
+              {kBaseBit | kTelemetryBit | kResponseBit | kRequestBit, 2, 7},
+              join({junk,
+                    kTelemetry,
+                    {servo::kResponseHeader0},
+                    kBaseBatteryReply,
+                    {body::kSyncWriteHeader[0], body::kSyncWriteHeader[1]},
+                    request(servo::Command::kReadAngle),
+                    answer(servo::Command::kReadAngle),
+                    {body::kTelemetryHeader0, body::kTelemetryHeader1},
+                    kTelemetryFoot,
+                    kBaseErrorStatus}));
+  seeds.write("everything_reset", {kAllFamilies | kResetBit, 2, 3},
+              join({kTelemetry, kSyncWrite, kBaseClearEncoders, answer(servo::Command::kPing),
+                    kBaseBatteryRequest, kTelemetryFoot}));
+}
+
+void writeDecoderSeeds(SeedWriter& seeds) {
+  seeds.write("base_reset_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseReset);
+  seeds.write("base_battery_request_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseBatteryRequest);
+  seeds.write("base_clear_encoders_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseClearEncoders);
+  seeds.write("base_wheels_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseBothMinus6);
+  seeds.write("base_error_status_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseErrorStatus);
+  seeds.write("base_battery_fixsum", {selector(Decoder::kBase, kFixSum), 2}, kBaseBatteryReply);
+  seeds.write("base_fixall", {selector(Decoder::kBase, kFixAll), 2}, kBaseLeft4);
+  seeds.write("telemetry_raw", {selector(Decoder::kTelemetry, kRaw), 2}, kTelemetry);
+  seeds.write("telemetry_foot_raw", {selector(Decoder::kTelemetry, kRaw), 2}, kTelemetryFoot);
+  seeds.write("telemetry_fixsum", {selector(Decoder::kTelemetry, kFixSum), 2}, kTelemetry);
+  seeds.write("telemetry_fixall", {selector(Decoder::kTelemetry, kFixAll), 6}, kTelemetryFoot);
+  for (const servo::CommandInfo& info : servo::commandTable()) {
+    const std::string name = seedName(info.name);
+    seeds.write("servo_request_" + name + "_raw", {selector(Decoder::kServoRequest, kRaw), 0},
+                request(info.cmd));
+    seeds.write("servo_answer_" + name + "_raw", {selector(Decoder::kServoResponse, kRaw), 0},
+                answer(info.cmd));
+  }
+  seeds.write("servo_request_fixsum", {selector(Decoder::kServoRequest, kFixSum), 0},
+              request(servo::Command::kSpin));
+  seeds.write("servo_response_fixsum", {selector(Decoder::kServoResponse, kFixSum), 0},
+              answer(servo::Command::kPing));
+  seeds.write("servo_read_data_fixall", {selector(Decoder::kServoResponse, kFixAll), 0},
+              answer(servo::Command::kReadData));
+  seeds.write("servo_read_batch_fixall", {selector(Decoder::kServoResponse, kFixAll), 0},
+              answer(servo::Command::kReadBatchData));
+  seeds.write("sync_write_raw", {selector(Decoder::kSyncWrite, kRaw), 0}, kSyncWrite);
+  seeds.write("sync_write_fixcrc", {selector(Decoder::kSyncWrite, kFixSum), 0}, kSyncWrite);
+  // Three bytes more: with the fix-ups they become a third servo record.
+  seeds.write("sync_write_fixall", {selector(Decoder::kSyncWrite, kFixAll), 0},
+              join({kSyncWrite, {5, 0, 8}}));
+  seeds.write("dynamixel_ping_raw", {selector(Decoder::kSyncWrite, kRaw), 0}, dynamixelPing());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
+    return 2;
+  }
+  const std::filesystem::path out = argv[1];
+  SeedWriter framer(out / "fuzz_framer");
+  SeedWriter decoders(out / "fuzz_decoders");
+  writeFramerSeeds(framer);
+  writeDecoderSeeds(decoders);
+  std::printf("corpus written to %s (%d framer seeds, %d decoder seeds)\n", out.c_str(),
+              framer.count(), decoders.count());
+  return 0;
+}
