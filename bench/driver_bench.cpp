@@ -50,8 +50,8 @@
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/WheelCommand.h"
-#include "serial_robot_driver/protocol/base_codec.h"
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "support/pty_frame_reader.h"
 
 namespace serial_robot_driver::bench {

@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 
 namespace servo = serial_robot_driver::protocol::servo;
 using Clock = std::chrono::steady_clock;

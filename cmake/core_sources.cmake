@@ -4,11 +4,6 @@
 include(${SRD_ROOT}/cmake/devices.cmake)
 set(SRD_CORE_SOURCES
   src/protocol/decode_result.cpp
-  src/protocol/base_codec.cpp
-  src/protocol/body_codec.cpp
-  src/protocol/servo_params.cpp
-  src/protocol/servo_bus_codec.cpp
-  src/protocol/servo_commands.cpp
   src/protocol/stream_framer.cpp
   src/kinematics/diff_drive.cpp
   src/kinematics/odometry.cpp
@@ -21,31 +16,15 @@ set(SRD_CORE_SOURCES
   src/device/device_module.cpp
   src/params/param_table.cpp
   src/params/driver_params.cpp
-  src/device/base_controller.cpp
-  src/device/body_controller.cpp
-  src/device/bus_mutex.cpp
-  src/device/servo_transactions.cpp
-  src/device/servo_move.cpp
-  src/device/servo_bus_client.cpp
   src/trajectory/spline.cpp
   src/trajectory/command.cpp
   src/trajectory/tolerances.cpp
   src/trajectory/bus_joint.cpp
   src/trajectory/joint_groups.cpp
   src/trajectory/executor.cpp
-  src/device/servo_bus_text.cpp
-  src/device/servo_bus.cpp
-  src/device/servo_poller.cpp
-  src/device/stop_keeper.cpp
-  src/device/motion_safety.cpp
   src/device/e_stop.cpp
   src/device/motion_gate.cpp
-  src/device/servo_health.cpp
   src/device/status_report.cpp
-  src/device/base_status.cpp
-  src/device/body_status.cpp
-  src/device/servo_bus_status.cpp
-  src/device/servo_joint_commands.cpp
   src/device/link_status.cpp
   src/device/e_stop_status.cpp
   src/device/wire_capture_status.cpp
@@ -62,10 +41,9 @@ set(SRD_CORE_GENERATED_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_dev
 # the tests and the benchmarks use them; the driver never does.
 set(SRD_SIM_SOURCES
   src/sim/pseudo_terminal.cpp
-  src/sim/base_sim.cpp
-  src/sim/body_sim.cpp
-  src/sim/servo_bus_sim.cpp
   src/sim/robot_sim.cpp
   src/sim/command_line.cpp
   src/sim/sim_stats.cpp
 )
+srd_device_sources(sim srd_device_sim_sources)
+list(APPEND SRD_SIM_SOURCES ${srd_device_sim_sources})

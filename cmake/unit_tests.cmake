@@ -1,10 +1,8 @@
-# GoogleTest unit tests of the ROS-free core and simulator (no roscore needed).
+# GoogleTest unit tests of the ROS-free core and simulator (no roscore needed): these, and every
+# device's own (src/devices/<name>/test/*.cpp).
+srd_device_sources(test srd_device_unit_tests)
 catkin_add_gtest(core_tests
-  test/unit/test_base_codec.cpp
-  test/unit/test_body_codec.cpp
-  test/unit/test_servo_bus_codec.cpp
-  test/unit/test_servo_commands.cpp
-  test/unit/test_servo_params.cpp
+  ${srd_device_unit_tests}
   test/unit/test_stream_framer_golden_frames.cpp
   test/unit/test_stream_framer_streams.cpp
   test/unit/test_stream_framer_broken_frames.cpp
@@ -17,32 +15,16 @@ catkin_add_gtest(core_tests
   test/unit/test_transport_baud_and_lock.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_serial_link.cpp
-  test/unit/test_base_controller_commands.cpp
-  test/unit/test_base_controller_odometry.cpp
-  test/unit/test_base_controller_polling.cpp
-  test/unit/test_base_controller_retune.cpp
-  test/unit/test_body_controller.cpp
-  test/unit/test_servo_bus_client.cpp
-  test/unit/test_servo_bus_client_operations.cpp
-  test/unit/test_servo_bus_client_rejections.cpp
-  test/unit/test_servo_bus.cpp
-  test/unit/test_servo_bus_stops.cpp
-  test/unit/test_servo_bus_on_link.cpp
   test/unit/test_sim_device_models.cpp
   test/unit/test_sim_pty_devices.cpp
   test/unit/test_sim_whole_robot.cpp
   test/unit/test_sim_command_line.cpp
   test/unit/test_device_registry.cpp
-  test/unit/test_servo_health.cpp
   test/unit/test_e_stop.cpp
-  test/unit/test_status_report.cpp
-  test/unit/test_base_status.cpp
-  test/unit/test_body_status.cpp
-  test/unit/test_servo_bus_status.cpp
-  test/unit/test_servo_joint_commands.cpp)
+  test/unit/test_status_report.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
-# test_device_set.cpp reads config/analyzers.yaml from the sources.
+# test_device_registry.cpp reads config/analyzers.yaml from the sources.
 target_compile_definitions(core_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 
 # Conversions and parameter validation of the ROS layer (pure functions, no roscore needed).

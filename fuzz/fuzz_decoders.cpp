@@ -19,12 +19,12 @@
 #include <optional>
 #include <vector>
 
-#include "serial_robot_driver/protocol/base_codec.h"
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/protocol/byte_order.h"
-#include "serial_robot_driver/protocol/servo_bus_codec.h"
-#include "serial_robot_driver/protocol/servo_commands.h"
-#include "serial_robot_driver/protocol/servo_params.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_commands.h"
+#include "serial_robot_driver/devices/servo_bus/servo_params.h"
 #include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace {

@@ -18,9 +18,9 @@
 #include <cstring>
 #include <memory>
 
-#include "serial_robot_driver/protocol/base_codec.h"
-#include "serial_robot_driver/protocol/body_codec.h"
-#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 
 namespace {

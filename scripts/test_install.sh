@@ -46,7 +46,7 @@ for f in lib/serial_robot_driver/driver_node lib/serial_robot_driver/robot_sim l
          share/serial_robot_driver/config/robot.yaml share/serial_robot_driver/config/analyzers.yaml \
          share/serial_robot_driver/config/99-serial-robot.rules \
          share/serial_robot_driver/msg/Telemetry.msg share/serial_robot_driver/srv/ServoPing.srv \
-         include/serial_robot_driver/protocol/base_codec.h include/serial_robot_driver/Telemetry.h; do
+         include/serial_robot_driver/devices/base/base_codec.h include/serial_robot_driver/Telemetry.h; do
   [ -e "$prefix/$f" ] || fail "missing $f"
 done
 for f in include/serial_robot_driver/ros include/serial_robot_driver/sim \

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 
 namespace serial_robot_driver::sim {
 

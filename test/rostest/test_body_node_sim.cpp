@@ -2,7 +2,7 @@
 // launch/record.launch recording that namespace; and the main() of the test_body_node target.
 #include <gtest/gtest.h>
 
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "support/body_node_fixture.h"
 
 namespace {

@@ -19,8 +19,8 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/protocol/base_codec.h"
-#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"

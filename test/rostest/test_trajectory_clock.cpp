@@ -18,7 +18,7 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"

@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/device/base_controller.h"
+#include "serial_robot_driver/devices/base/base_controller.h"
 #include "support/golden_frames.h"
 #include "support/manual_clock.h"
 

@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "serial_robot_driver/WheelCommand.h"
-#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/fake_device.h"

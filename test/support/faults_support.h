@@ -29,7 +29,7 @@
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/WheelCommand.h"
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/sim/robot_sim.h"

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/servo_bus_client.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "support/golden_frames.h"
 
 namespace serial_robot_driver::device {

@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/servo_bus.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "support/golden_frames.h"
 #include "support/manual_clock.h"
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/protocol/base_codec.h"
-#include "serial_robot_driver/protocol/body_codec.h"
-#include "serial_robot_driver/protocol/servo_bus_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/golden_frames.h"
 #include "support/test_helpers.h"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/params/driver_params.h"
 

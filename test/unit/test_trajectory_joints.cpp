@@ -10,7 +10,7 @@
 #include <tuple>
 #include <vector>
 
-#include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/trajectory/joint_groups.h"
 
 namespace serial_robot_driver::trajectory {

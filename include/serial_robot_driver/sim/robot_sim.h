@@ -16,9 +16,9 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/sim/base_sim.h"
-#include "serial_robot_driver/sim/body_sim.h"
-#include "serial_robot_driver/sim/servo_bus_sim.h"
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/sim_options.h"
 #include "serial_robot_driver/sim/sim_stats.h"
 

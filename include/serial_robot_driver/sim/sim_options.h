@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "serial_robot_driver/sim/base_sim.h"
-#include "serial_robot_driver/sim/body_sim.h"
-#include "serial_robot_driver/sim/servo_bus_sim.h"
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 
 namespace serial_robot_driver::sim {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/body_controller.h"
+#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/command.h"
 

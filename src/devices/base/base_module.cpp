@@ -3,7 +3,7 @@
 
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/params/driver_params.h"
-#include "serial_robot_driver/protocol/base_codec.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
 
 namespace serial_robot_driver::devices::base {
 

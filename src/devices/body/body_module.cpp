@@ -5,7 +5,7 @@
 
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/params/driver_params.h"
-#include "serial_robot_driver/protocol/body_codec.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 
 namespace serial_robot_driver::devices::body {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "serial_robot_driver/device/base_controller.h"
+#include "serial_robot_driver/devices/base/base_controller.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/servo_bus.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {

@@ -1,4 +1,4 @@
-#include "serial_robot_driver/ros/base_interface.h"
+#include "serial_robot_driver/devices/base/base_interface.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 
 namespace serial_robot_driver::devices::base {

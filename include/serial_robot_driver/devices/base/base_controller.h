@@ -1,0 +1,258 @@
+// The AP1 wheeled base as the driver sees it: cmd_vel in, wheel-speed frames out at the loop rate,
+// the 1 s heartbeat, the Reset/timeout-error cycle, battery polling and encoder clearing.
+// ROS-free: the ROS layer feeds commands in and publishes the events it reports.
+//
+// Threading model:
+//  - start() runs the control loop on its own thread: absolute deadlines on the LoopClock (the
+//    steady clock unless a test passes its own) (deadline += period, never "sleep one period"), so
+//    the period does not drift. Each tick writes
+//    the current wheel frame, which is also the heartbeat.
+//  - setCommand() (cmd_vel callback) and setEStop() only store and wake the loop, which puts the
+//    frame on the wire at once. Such immediate frames are spaced from each other by what the line
+//    can carry (minImmediateInterval()), never by the loop rate or the last tick, and never move
+//    the tick deadlines.
+//    Callbacks never touch the port.
+//  - onFrame() runs on the port's reader thread: an FF error frame wakes the loop to send a Reset.
+//  - Every base write happens with mutex_ held, so the sequence counter and "Reset before the next
+//    speed frame" are consistent whichever thread writes (loop, or a base/* service).
+//  - The BaseEvents hooks are called without mutex_ held, on the thread that caused them (loop,
+//    reader, or the caller of stop()). Stats are one struct under mutex_; stats() is a snapshot.
+//  - Odometry (mutex_) integrates the wheel speeds of each speed frame the base accepted, from its
+//    write until the next accepted frame, the base's own 1 s timeout, or an FF error, whichever
+//    comes first. The loop reports a sample after every scheduled tick (on_odometry).
+//  - With use_imu_heading, onImuYaw() runs on the body port's reader thread and only hands the
+//    sample to kinematics::HeadingFusion (its own short lock, never mutex_, so telemetry never
+//    waits for a base write); the loop reads the newest sample when it advances the odometry.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "serial_robot_driver/device/loop_clock.h"
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/kinematics/diff_drive.h"
+#include "serial_robot_driver/kinematics/heading_fusion.h"
+#include "serial_robot_driver/kinematics/odometry.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+
+namespace serial_robot_driver::device {
+
+struct BaseConfig {
+  kinematics::DiffDriveGeometry geometry;
+  double max_wheel_speed = 1.0;    ///< m/s; must be > 0 (no "no limit" value)
+  double max_wheel_accel = 0.0;    ///< m/s^2; 0: no limit
+  double cmd_vel_timeout = 0.5;    ///< s without a command: zero speed
+  bool speed_dithering = true;     ///< carry the tick remainder (false: vendor truncation)
+  double battery_poll_rate = 1.0;  ///< Hz; 0: never ask
+  double loop_rate = 50.0;         ///< Hz
+  double heartbeat_gap = 1.0;      ///< s; a gap this long in our sending means the base timed out
+  int baud = 115200;               ///< of the base's port: sets how closely immediate frames follow
+  /// Largest share of the line's capacity immediate speed frames may take (a cmd_vel flood).
+  double immediate_line_share = 0.5;
+  int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
+  int right_wheel_direction = 1;
+  /// With battery polling on, this many poll periods without any reply mean the base is silent.
+  double silent_after_polls = 3.0;
+  kinematics::PoseCovarianceModel odometry_covariance;
+  /// Odometry's heading from the IMU yaw given to onImuYaw() while it is fresh (see
+  /// kinematics::HeadingFusion); the commanded turn otherwise.
+  bool use_imu_heading = false;
+  double imu_yaw_variance = 0.0003;  ///< rad^2, odom's yaw variance while the IMU heading is used
+  Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
+};
+
+/// Where the odometry stood after a scheduled tick.
+struct OdometrySample {
+  Clock::time_point time;
+  kinematics::Pose2D pose;
+  double linear = 0;             ///< m/s the base runs at now (0 once its timeout stopped it)
+  double angular = 0;            ///< rad/s
+  double position_variance = 0;  ///< m^2, x and y
+  double yaw_variance = 0;       ///< rad^2
+  double travelled = 0;          ///< m since the last reset
+  /// Each wheel's signed path (left, right; m) since the controller started, from the same
+  /// accepted speeds as the pose; reset_odometry leaves it alone (wheel angles do not jump).
+  kinematics::WheelSpeeds wheel_travel = kinematics::WheelSpeeds::Zero();
+  /// Each wheel's speed (left, right; m/s) the base runs at now (0 once its timeout stopped it).
+  kinematics::WheelSpeeds wheel_speeds = kinematics::WheelSpeeds::Zero();
+  /// Each wheel's angle (left, right; rad): wheel_travel through the wheel radius, continuous
+  /// when the diameter is retuned (the travel before a change keeps the radius it had).
+  kinematics::WheelSpeeds wheel_angles = kinematics::WheelSpeeds::Zero();
+  /// wheel_speeds as the wheels' angular speeds (rad/s) with the diameter in force.
+  kinematics::WheelSpeeds wheel_rates = kinematics::WheelSpeeds::Zero();
+  /// Where the heading came from (kImu only with use_imu_heading).
+  bool imu_heading = false;
+};
+
+/// One wheel frame as written.
+struct WheelFrameSent {
+  kinematics::WheelTicks ticks;  ///< as on the wire (wheel directions applied)
+  uint8_t seq = 0;
+  bool reset_before = false;
+  kinematics::WheelSpeeds speeds = kinematics::WheelSpeeds::Zero();  ///< m/s the ticks stand for
+  Clock::time_point time;
+};
+
+struct BaseStats {
+  uint64_t speed_frames = 0;
+  uint64_t immediate_frames = 0;     ///< speed frames sent at once for a new cmd_vel
+  uint64_t resets_sent = 0;
+  uint64_t battery_requests = 0;
+  uint64_t clear_encoders_sent = 0;
+  uint64_t write_failures = 0;
+  uint64_t timeout_errors_received = 0;  ///< FF frames from the base
+  uint64_t battery_replies = 0;
+  uint64_t unknown_replies = 0;
+  uint64_t bad_replies = 0;
+  uint64_t cmd_vel_timeouts = 0;
+  uint64_t rejected_commands = 0;    ///< NaN/Inf cmd_vel
+  uint64_t ignored_commands_e_stop = 0;       ///< cmd_vel received while the e-stop was engaged
+  uint64_t timeout_errors_while_running = 0;  ///< FF after the base had accepted our Reset
+  std::optional<double> seconds_since_running_timeout_error;
+  /// Battery polling on and requests unanswered: seconds since the first unanswered request.
+  std::optional<double> seconds_without_reply;
+  bool base_silent = false;  ///< seconds_without_reply beyond BaseConfig::silent_after_polls
+  bool e_stop = false;
+  double min_immediate_interval_ms = 0;
+  uint64_t loop_overruns = 0;        ///< ticks that started more than one period late
+  double last_period_ms = 0;
+  double worst_period_ms = 0;
+  std::optional<uint8_t> battery_percent;
+  /// use_imu_heading only: where the heading comes from, how often the IMU went stale, and the
+  /// age of the newest IMU yaw (s).
+  std::optional<kinematics::HeadingSource> heading_source;
+  uint64_t imu_heading_fallbacks = 0;
+  std::optional<double> imu_yaw_age;
+};
+
+/// What the base reports; every hook may be empty. Called without the controller's lock held.
+struct BaseEvents {
+  std::function<void(const WheelFrameSent&)> on_wheel_frame;
+  /// `arrival`: when the reply's last byte was read (its stamp).
+  std::function<void(uint8_t percent, Clock::time_point arrival)> on_battery;
+  std::function<void(const protocol::base::Frame&)> on_unknown_reply;
+  std::function<void()> on_timeout_error;
+  std::function<void(const OdometrySample&)> on_odometry;  ///< after every scheduled tick
+  std::function<void()> on_cmd_vel_timeout;                ///< once per timeout, when it starts
+  std::function<void(double seconds)> on_silent;           ///< once, when the base goes silent
+  /// use_imu_heading: the heading's source changed (IMU fused, or the IMU went stale); loop thread.
+  std::function<void(kinematics::HeadingSource)> on_heading_source;
+};
+
+class BaseController : public LinkListener {
+ public:
+  /// `clock` empty: the steady clock.
+  BaseController(BaseConfig config, FrameWriter writer, BaseEvents events = {},
+                 std::shared_ptr<LoopClock> clock = {});
+  ~BaseController() override;
+
+  /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded and false returned.
+  /// Ignored (and counted) while the e-stop is engaged.
+  bool setCommand(double linear_x, double angular_z);
+  /// Engaged: a zero-speed frame goes out at once (no ramp) and zero is held; frames keep flowing.
+  /// Released: the wheels stay still until the next cmd_vel.
+  void setEStop(bool engaged);
+  /// Puts the odometry pose (and its covariance) back to zero; a fused heading restarts at zero
+  /// too.
+  void resetOdometry();
+  /// Any thread (the body port's reader): the yaw (rad) of the IMU on the base, measured at
+  /// `stamp`. Used only with use_imu_heading.
+  void onImuYaw(double yaw, Clock::time_point stamp);
+  /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
+  /// the port's baud (10 bits per byte) divided by immediate_line_share.
+  Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
+  /// Writes a Reset now (base/reset). False when the port is down.
+  bool sendReset();
+  /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.
+  bool sendClearEncoders();
+
+  /// Applies the tunable part of `next` from the next frame on, all at once (under the loop's
+  /// lock): geometry.wheel_diameter and .wheel_separation, max_wheel_speed, max_wheel_accel,
+  /// cmd_vel_timeout, speed_dithering, battery_poll_rate, use_imu_heading. Everything else in `next` is ignored
+  /// (it needs a new controller). No Reset, the sequence goes on, the odometry keeps its pose:
+  /// the motion up to now is integrated with the geometry it ran under, from now on with the new
+  /// one. Expects validated values.
+  void retune(const BaseConfig& next);
+  /// The configuration in force.
+  BaseConfig config() const;
+
+  void start();
+  /// Stops the loop and writes one zero-speed frame, so the robot stops before the port closes.
+  void stop();
+
+  BaseStats stats() const;
+
+  // LinkListener (reader thread)
+  void onLinkUp() override;
+  void onLinkDown() override;
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) override;
+
+ private:
+  void run();
+  /// A scheduled tick: battery poll when due, then the wheel frame.
+  void tick(Clock::time_point now);
+  /// Sends the wheel frame for the current command (Reset first when needed).
+  void sendSpeed(Clock::time_point now, bool immediate);
+  /// Requires mutex_. Writes one frame with the next SEQ; false on failure.
+  bool writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now);
+  /// `timed_out_now`: set when the cmd_vel timeout started with this call.
+  kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now, bool* timed_out_now);
+  /// Integrates the speeds the base runs on up to `now` (capped at its heartbeat timeout).
+  void advanceOdometryLocked(Clock::time_point now);
+  /// A speed frame with these (robot-side, before wheel directions) ticks was accepted at `now`.
+  void acceptedSpeedLocked(const kinematics::WheelTicks& ticks, Clock::time_point now);
+  OdometrySample odometrySampleLocked(Clock::time_point now) const;
+  kinematics::WheelTicks onWire(const kinematics::WheelTicks& ticks) const;
+
+  BaseConfig config_;  ///< its tunable part changes under mutex_ (retune)
+  const FrameWriter writer_;
+  const BaseEvents events_;
+  const std::shared_ptr<LoopClock> clock_;
+  const Clock::duration period_;
+  const Clock::duration min_immediate_interval_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  bool stopped_ = false;
+  bool command_pending_ = false;  ///< a new cmd_vel or an FF error wants an early frame
+  protocol::base::SequenceCounter seq_;
+  kinematics::AccelerationLimiter limiter_;
+  kinematics::TickQuantizer quantizer_;
+  double linear_x_ = 0;
+  double angular_z_ = 0;
+  std::optional<Clock::time_point> last_command_;
+  bool command_timed_out_ = true;
+  bool needs_reset_ = true;
+  std::optional<Clock::time_point> last_write_;        ///< any base frame
+  std::optional<Clock::time_point> last_speed_frame_;
+  std::optional<Clock::time_point> last_immediate_frame_;  ///< the last one a command rushed out
+  std::optional<Clock::time_point> last_tick_;
+  Clock::time_point next_battery_poll_{};
+  bool e_stop_ = false;
+  kinematics::Odometry odometry_;
+  kinematics::HeadingFusion heading_;  ///< used with use_imu_heading only
+  kinematics::HeadingSource reported_heading_source_ = kinematics::HeadingSource::kWaitingForImu;
+  kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
+  kinematics::WheelSpeeds wheel_travel_ = kinematics::WheelSpeeds::Zero();  ///< see OdometrySample
+  /// Wheel angles and travel when the diameter last changed (see OdometrySample::wheel_angles).
+  kinematics::WheelSpeeds wheel_angles_at_retune_ = kinematics::WheelSpeeds::Zero();
+  kinematics::WheelSpeeds travel_at_retune_ = kinematics::WheelSpeeds::Zero();
+  std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
+  Clock::time_point integrated_until_{};
+  std::optional<Clock::time_point> last_reset_sent_;
+  std::optional<Clock::time_point> unanswered_since_;  ///< first battery request with no reply yet
+  bool silent_reported_ = false;
+  std::optional<Clock::time_point> last_running_timeout_error_;
+  BaseStats stats_;
+  std::thread loop_;
+};
+
+}  // namespace serial_robot_driver::device

@@ -1,0 +1,78 @@
+// ROS face of the AP1 base: cmd_vel in (and the node's e-stop); wheel_command, odom (+ tf), wheel_states, battery and
+// diagnostics out; base/reset, base/clear_encoders and base/reset_odometry services. The control
+// loop itself is device::BaseController's thread; odom and tf are published from it, once per tick.
+// odom is the motion the base was commanded and accepted, not a measurement: the AP1 reports no
+// encoder counts.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/Twist.h>
+#include <ros/ros.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <memory>
+
+#include "serial_robot_driver/devices/base/base_controller.h"
+#include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/ros/driver_params.h"
+
+namespace serial_robot_driver::ros_layer {
+
+device::BaseConfig makeBaseConfig(const DriverParams& params);
+
+class BaseInterface : public DeviceInterface {
+ public:
+  /// Registers the controller on `link` (before the link starts) and advertises the topics and
+  /// services. `link` must outlive this object.
+  BaseInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
+  /// Starts the control loop (after the links are started).
+  void start() override { controller_.start(); }
+  /// Stops the loop and writes a zero-speed frame (before the port closes).
+  void shutdown() override { controller_.stop(); }
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~base tunables: the controller's from its next tick on, and the interface's own.
+  void retune(const DriverParams& params) override;
+  /// Engaged: zero speed held at once (frames keep flowing as the heartbeat), cmd_vel ignored.
+  void attachEStop(device::EStop& e_stop) override;
+  /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
+  void onImuYaw(double yaw, device::Clock::time_point stamp) { controller_.onImuYaw(yaw, stamp); }
+
+ private:
+  device::BaseEvents events();
+  void onCmdVel(const geometry_msgs::Twist::ConstPtr& msg);
+  void publishOdometry(const device::OdometrySample& sample);
+  void publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp);
+  bool onResetOdometry(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+
+  device::SerialLink& link_;
+  ArrivalStamps arrival_stamps_;  // before controller_: its events use it
+  const BaseParams params_;  // as started: frames and joint names (the tunables: tuned())
+  /// The ~base tunables the interface itself uses, changed together by retune().
+  struct Tuned {
+    bool publish_tf = true;
+    double cmd_vel_timeout = 0;
+    int battery_warn_percent = 0;
+    int battery_error_percent = 0;
+  };
+  Tuned tuned() const;
+  mutable std::mutex tuned_mutex_;
+  Tuned tuned_;  // guarded by tuned_mutex_
+  // Before the controller: its loop publishes through them until it stops.
+  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
+  ros::Publisher odom_pub_;
+  ros::Publisher wheel_states_pub_;  // advertised in the constructor's body
+  device::BaseController controller_;
+  ros::Publisher wheel_command_pub_;
+  ros::Publisher battery_pub_;
+  ros::Subscriber cmd_vel_sub_;
+  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
+  ros::ServiceServer reset_odometry_srv_;
+  ros::ServiceServer reset_srv_;
+  ros::ServiceServer clear_encoders_srv_;
+};
+
+}  // namespace serial_robot_driver::ros_layer

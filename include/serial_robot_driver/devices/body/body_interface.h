@@ -1,0 +1,77 @@
+// ROS face of the servo controller board: joint_states, imu/data, foot_pressure and telemetry out
+// (published on the link's reader thread as each frame is decoded, stamped with the frame's
+// arrival time); joint_commands in (one sync-write frame per message); one diagnostic status.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
+#include <functional>
+#include <memory>
+
+#include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/devices/body/body_status.h"
+#include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
+
+namespace serial_robot_driver::ros_layer {
+
+class BodyInterface : public DeviceInterface {
+ public:
+  /// Registers the controller on `link` (before the link starts) and advertises the topics.
+  /// `link` must outlive this object.
+  BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
+
+  /// Nothing to start: the body speaks when the link's reader hands it a frame.
+  void start() override {}
+  /// Stops taking joint commands. Frames that still arrive before the link stops are published.
+  void shutdown() override;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~imu tunables (accel_scale, gyro_scale, angle_scale) from the next telemetry frame on.
+  void retune(const DriverParams& params) override;
+
+  const device::BodyController& controller() const { return controller_; }
+  /// Called on the reader thread with every frame's IMU yaw (imuYaw()) and arrival time. Set it
+  /// before the link starts (~base/use_imu_heading: the base's odometry).
+  using ImuYawListener = std::function<void(double yaw, device::Clock::time_point arrival)>;
+  void setImuYawListener(ImuYawListener listener) { imu_yaw_listener_ = std::move(listener); }
+  /// The body's joints, streamed: one sync-write frame per loop tick.
+  std::vector<TrajectoryJoints> trajectoryJoints() override;
+  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
+  /// joint_commands are refused while it holds.
+  /// Engaged: the controller's motion gate is locked, so no sync-write goes out from then on,
+  /// even one already waiting; joint_commands are refused and counted.
+  void attachEStop(device::EStop& e_stop) override;
+
+ private:
+  void publishTelemetry(const protocol::body::Telemetry& telemetry,
+                        device::Clock::time_point arrival);
+  void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
+
+  device::SerialLink& link_;
+  const ArrivalStamps arrival_stamps_;
+  /// Swapped whole by retune() (~imu scales) and loaded once per frame by the reader thread, so
+  /// a frame is converted with one set of scales (std::atomic_load / atomic_store).
+  std::shared_ptr<const ImuParams> imu_params_;
+  device::BodyController controller_;
+  // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
+  double min_rate_ = 1.0;
+  double max_rate_ = 1000.0;
+  diagnostic_updater::FrequencyStatus telemetry_rate_;  // ticked on the reader thread (locks)
+  ros::Publisher joint_states_pub_;
+  ros::Publisher imu_pub_;
+  ros::Publisher foot_pressure_pub_;
+  ros::Publisher telemetry_pub_;
+  ros::Subscriber joint_commands_sub_;
+  ImuYawListener imu_yaw_listener_;
+  // The node's trajectory server (its own threading comment); set before the link starts.
+  TrajectoryServer* trajectory_ = nullptr;
+  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
+  device::BodyStatus status_;        // diagnostics timer thread only
+};
+
+}  // namespace serial_robot_driver::ros_layer

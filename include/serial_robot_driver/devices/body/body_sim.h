@@ -1,0 +1,86 @@
+// Simulated servo controller board (docs/protocols.md, section 2).
+//
+// Streams telemetry frames at a fixed rate: every configured servo moves toward its last
+// sync-write target at a bounded speed and reports that speed; the IMU sees gravity on z and the
+// wheeled base's true heading and yaw rate (the board sits on the base); the optional foot block
+// carries plausible pressure readings.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/sim/sim_types.h"
+
+namespace serial_robot_driver::sim {
+
+/// When telemetry frames carry the 16-byte foot block.
+enum class FootMode { kNever, kAlways, kAlternate };
+
+struct BodySimConfig {
+  std::vector<uint8_t> servo_ids = {1, 2};
+  double telemetry_rate_hz = 50.0;  ///< 0: no telemetry at all
+  FootMode foot_mode = FootMode::kNever;
+  double servo_speed = 2048.0;  ///< ticks/s, the bound on every servo's motion
+  uint16_t initial_position = 2048;
+  uint16_t max_position = 4095;  ///< targets are clamped to 0..max_position
+  bool imu_noise = false;        ///< add +-2 LSB of noise to the IMU values
+  // IMU raw scales of docs/protocols.md (16 g, 2000 deg/s, 180 deg full scale over 32768).
+  double accel_lsb_per_g = 32768.0 / 16.0;
+  double gyro_lsb_per_dps = 32768.0 / 2000.0;
+  double angle_lsb_per_deg = 32768.0 / 180.0;
+  uint32_t seed = 1;
+};
+
+/// How the chassis the board is mounted on moves (the base's true motion; zero without a base).
+struct ChassisMotion {
+  double yaw_rad = 0.0;   ///< heading, counter-clockwise
+  double yaw_rate = 0.0;  ///< rad/s
+};
+
+struct BodySimServoState {
+  uint8_t id = 0;
+  double position = 0.0;  ///< ticks
+  uint16_t target = 0;
+  int16_t speed = 0;  ///< ticks/s of the last step, as reported
+};
+
+struct BodySimStats {
+  uint64_t telemetry_generated = 0;
+  uint64_t telemetry_with_foot = 0;
+  uint64_t sync_writes_ok = 0;
+  uint64_t sync_writes_malformed = 0;   ///< verified CRC but a layout decodeSyncWrite rejected
+  uint64_t sync_write_unknown_ids = 0;  ///< targets for ids the board does not have
+  double yaw_rad = 0.0;                 ///< the heading the IMU reports (the chassis')
+  std::vector<BodySimServoState> servos;
+};
+
+class BodySim {
+ public:
+  BodySim(const BodySimConfig& config, TimePoint now);
+
+  /// A CRC-verified FF FF FD 00 frame from the host.
+  void handleSyncWrite(const uint8_t* data, std::size_t size);
+  /// Moves the servos up to `now`; emits the telemetry frames that are due, their IMU reporting
+  /// `chassis` (the base's true heading and yaw rate now).
+  void tick(TimePoint now, const ChassisMotion& chassis, Outbox* out);
+  TimePoint nextEvent() const;
+
+  const BodySimStats& stats() const { return stats_; }
+
+ private:
+  void advance(TimePoint now);
+  std::vector<uint8_t> buildTelemetry(const ChassisMotion& chassis);
+  int16_t noise();
+
+  BodySimConfig config_;
+  BodySimStats stats_;
+  TimePoint last_step_;
+  TimePoint next_telemetry_;
+  Clock::duration telemetry_period_{};
+  std::mt19937 rng_;
+};
+
+}  // namespace serial_robot_driver::sim

@@ -1,0 +1,35 @@
+// How a device::ServoBus is configured: its client's options, the polls, the shutdown action and
+// the protection; retune() changes the tunable part at runtime. ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
+
+namespace serial_robot_driver::device {
+
+/// What servos set moving get when the bus shuts down (before its port closes).
+enum class ShutdownAction { kStop, kRelax, kNone };
+/// "stop", "relax", "none"; nullopt for anything else.
+std::optional<ShutdownAction> shutdownActionFromString(const std::string& text);
+const char* toString(ShutdownAction action);
+
+struct ServoBusConfig {
+  ServoBusOptions client;
+  std::vector<uint8_t> polled_ids;  ///< servos whose angle is polled (servo_states)
+  double poll_rate = 10.0;          ///< polls per second of each polled servo, > 0
+  uint16_t relax_power_mw = 50;     ///< DAMPING power of relax()
+  /// For each servo set spinning or moving: kStop a SPIN stop, kRelax relax(), kNone nothing.
+  ShutdownAction on_shutdown = ShutdownAction::kStop;
+  /// Health polls (voltage, current, power, temperature, status) per second of each polled
+  /// servo, as background work between the angle polls; 0: none.
+  double health_rate = 1.0;
+  /// A servo at its own temperature limit is relaxed and its moves refused until it has cooled
+  /// OverheatGuard::kCoolDownC below it.
+  bool protect = false;
+};
+
+}  // namespace serial_robot_driver::device

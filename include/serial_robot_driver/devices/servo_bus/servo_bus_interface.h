@@ -1,0 +1,133 @@
+// ROS face of the UART bus servos: the servo/* services, servo_states / servo_commands and the
+// "servo_bus" diagnostic status. The bus itself (transactions, validation, messages, the move
+// queue and the poll schedule) is device::ServoBus; this class only translates.
+//
+// Threading: the services are served from this class's OWN callback queue by its own QueueSpinner
+// (2 threads). A servo call blocks for up to timeout * (retries + 1), or for a whole motion when
+// `wait` is set; on the global queue that would hold up cmd_vel and joint_commands.
+// servo_commands arrive on the caller's (global) queue: the callback only checks the message and
+// queues the moves in device::ServoBus, whose worker thread writes them and runs the servo_states
+// poll (servo_states is published from that thread); both take the bus after any waiting service
+// call, so a service call waits for one transaction at most.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/ServoDamping.h"
+#include "serial_robot_driver/ServoHold.h"
+#include "serial_robot_driver/ServoMove.h"
+#include "serial_robot_driver/ServoPing.h"
+#include "serial_robot_driver/ServoRead.h"
+#include "serial_robot_driver/ServoReadAll.h"
+#include "serial_robot_driver/ServoReadAngle.h"
+#include "serial_robot_driver/ServoRelax.h"
+#include "serial_robot_driver/ServoResetUserData.h"
+#include "serial_robot_driver/ServoRotate.h"
+#include "serial_robot_driver/ServoScan.h"
+#include "serial_robot_driver/ServoSpin.h"
+#include "serial_robot_driver/ServoWrite.h"
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_status.h"
+#include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
+#include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/queue_spinner.h"
+#include "serial_robot_driver/ros/trajectory_bus_joints.h"
+
+namespace serial_robot_driver::ros_layer {
+
+/// Client options from ~servo_bus/{timeout, retries, allow_dangerous_writes}.
+device::ServoBusOptions makeServoBusOptions(const DriverParams& params);
+/// The bus device's configuration: the client options and the poll (state_ids and the joint_ids
+/// servos, at state_rate).
+device::ServoBusConfig makeServoBusConfig(const DriverParams& params);
+
+// Joint names and servo_commands' checks are the core's (device/servo_joint_commands.h).
+using device::ServoCommandBatch;
+using device::servoIdFromJointName;
+using device::servoJointName;
+/// A servo call's message, naming the parameter that arms a refused dangerous write.
+std::string servoStatusMessage(const device::ServoStatus& status);
+/// device::toServoMoves of the message's names, positions (rad) and velocities (rad/s).
+ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms);
+
+class ServoBusInterface : public DeviceInterface {
+ public:
+  /// Registers the client with `link` and advertises servo/* in `nh`'s namespace. Must be
+  /// constructed before the link is started.
+  ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
+  ~ServoBusInterface();
+  ServoBusInterface(const ServoBusInterface&) = delete;
+  ServoBusInterface& operator=(const ServoBusInterface&) = delete;
+
+  /// Starts the service spinner: calls are served from here on.
+  void start() override;
+  /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
+  void shutdown() override;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The ~servo_bus tunables: timeout and retries from the next transaction, state_rate from the
+  /// next poll, command_interval_ms from the next servo_commands message.
+  void retune(const DriverParams& params) override;
+  /// ~servo_bus/joint_ids as trajectory joints: one queued move per segment.
+  std::vector<TrajectoryJoints> trajectoryJoints() override;
+  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
+  /// Engaged: queued moves dropped, a SPIN stop to every servo the driver set moving; motion
+  /// services and servo_commands refused until it is released (reads, pings, scans still work).
+  void attachEStop(device::EStop& e_stop) override;
+  /// With ~servo_bus/health_rate > 0: "servo_bus servo <id>", one status per polled servo (its
+  /// readings against its own limits; an offline servo is an ERROR).
+  void addDiagnostics(diagnostic_updater::Updater& updater) override;
+
+ private:
+  device::ServoBusEvents makeEvents();
+  /// servo/* on nh_ (servo_bus_services.cpp).
+  void advertiseServices();
+  void onServoCommands(const sensor_msgs::JointState::ConstPtr& msg);
+  /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
+  /// trajectory stops (its goal aborts) and its queued move is dropped.
+  void yieldJoint(uint8_t id, const char* source);
+  /// yieldJoint() for each of `ids`; empty: every configured servo (servo/relax, servo/hold).
+  void yieldJoints(const std::vector<uint8_t>& ids, const char* source);
+  /// A motion service or topic while the e-stop holds: counted, and its refusal (else ok).
+  device::ServoStatus refuseWhileEStopped(const std::string& source);
+  void diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  // Bus servos as joints (trajectories): fixed before the bus starts, read on the worker thread.
+  const std::vector<trajectory::BusJoint> bus_joints_;
+  const double state_rate_;
+  TrajectoryServer* trajectory_ = nullptr;  // set before start()
+
+  device::SerialLink& link_;
+  device::ServoBus bus_;
+  device::ServoBusClient& client_;  // bus_'s
+  ros::CallbackQueue queue_;
+  ros::NodeHandle nh_;  // the caller's namespace, bound to queue_
+  std::vector<ros::ServiceServer> services_;
+  std::unique_ptr<QueueSpinner> spinner_;
+  bool shut_down_ = false;
+
+  // servo_states / servo_commands
+  ros::NodeHandle topics_nh_;  // the caller's namespace on the caller's queue
+  ros::Publisher states_pub_;
+  ros::Subscriber commands_sub_;
+  std::atomic<uint16_t> command_interval_ms_;  // retune() from the dynamic_reconfigure callback
+  std::atomic<uint64_t> commands_rejected_{0};
+  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
+
+  // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
+  device::ServoBusStatus status_;
+};
+
+}  // namespace serial_robot_driver::ros_layer

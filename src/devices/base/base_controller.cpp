@@ -1,0 +1,522 @@
+#include "serial_robot_driver/devices/base/base_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace serial_robot_driver::device {
+
+namespace base = protocol::base;
+using kinematics::WheelSpeeds;
+
+namespace {
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+Clock::duration fromSeconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+/// A speed frame's airtime at `baud` (start + 8 data + stop bits per byte), stretched so that
+/// frames sent this closely take at most `line_share` of the line.
+Clock::duration immediateInterval(int baud, double line_share) {
+  const double frame_bits =
+      10.0 * static_cast<double>(protocol::base::encodeWheelSpeed(0, 0, 0).size());
+  const double airtime = frame_bits / std::max(baud, 1);
+  return fromSeconds(airtime / std::clamp(line_share, 0.01, 1.0));
+}
+
+int16_t withDirection(int16_t ticks, int direction) {
+  if (direction >= 0) return ticks;
+  // -(-32768) does not fit in int16: saturate.
+  return ticks == std::numeric_limits<int16_t>::min() ? std::numeric_limits<int16_t>::max()
+                                                      : static_cast<int16_t>(-ticks);
+}
+
+}  // namespace
+
+BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents events,
+                               std::shared_ptr<LoopClock> clock)
+    : config_(config),
+      writer_(std::move(writer)),
+      events_(std::move(events)),
+      clock_(clock ? std::move(clock) : steadyLoopClock()),
+      period_(fromSeconds(1.0 / config.loop_rate)),
+      min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
+      limiter_(config.max_wheel_accel),
+      quantizer_(config.geometry, config.speed_dithering),
+      odometry_(config.geometry.wheel_separation, config.odometry_covariance),
+      heading_(config.imu_stale_after) {}
+
+BaseController::~BaseController() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (loop_.joinable()) loop_.join();
+}
+
+bool BaseController::setCommand(double linear_x, double angular_z) {
+  const bool valid = std::isfinite(linear_x) && std::isfinite(angular_z);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (e_stop_) {
+      ++stats_.ignored_commands_e_stop;
+      return valid;
+    }
+    linear_x_ = valid ? linear_x : 0.0;
+    angular_z_ = valid ? angular_z : 0.0;
+    last_command_ = clock_->now();
+    command_pending_ = true;
+    if (!valid) ++stats_.rejected_commands;
+  }
+  wake_.notify_all();
+  return valid;
+}
+
+void BaseController::setEStop(bool engaged) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (engaged == e_stop_) return;
+    e_stop_ = engaged;
+    stats_.e_stop = engaged;
+    if (engaged) {
+      command_pending_ = true;  // the zero frame goes out now, not at the next tick
+    } else {
+      // Obey cmd_vel from the next message only: the command from before the stop is forgotten.
+      last_command_.reset();
+      linear_x_ = angular_z_ = 0.0;
+    }
+  }
+  wake_.notify_all();
+}
+
+void BaseController::resetOdometry() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = clock_->now();
+  advanceOdometryLocked(now);
+  odometry_.reset();
+  if (config_.use_imu_heading) {
+    heading_.restart();
+    advanceOdometryLocked(now);  // anchors the IMU's yaw now at heading zero, if it is fresh
+  }
+}
+
+void BaseController::onImuYaw(double yaw, Clock::time_point stamp) {
+  // Stored even while use_imu_heading is off (addSample only copies two values under its own
+  // lock): config_ belongs to the loop's lock, and retune may switch the fusion on at any time.
+  heading_.addSample(yaw, stamp);
+}
+
+bool BaseController::sendReset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = clock_->now();
+  const bool ok = writeLocked(base::encodeReset(seq_.peek()), now);
+  if (ok) {
+    ++stats_.resets_sent;
+    needs_reset_ = false;
+    last_reset_sent_ = now;
+  }
+  return ok;
+}
+
+bool BaseController::sendClearEncoders() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool ok = writeLocked(base::encodeClearEncoders(seq_.peek()), clock_->now());
+  if (ok) ++stats_.clear_encoders_sent;
+  return ok;
+}
+
+void BaseController::start() {
+  if (loop_.joinable()) return;
+  loop_ = std::thread([this] { run(); });
+}
+
+void BaseController::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopped_) return;
+    stopping_ = true;
+    stopped_ = true;
+  }
+  wake_.notify_all();
+  if (loop_.joinable()) loop_.join();
+  // Last words: a zero-speed frame, so the wheels stop now rather than at the base's 1 s timeout.
+  WheelFrameSent sent;
+  bool written = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sent.seq = seq_.peek();
+    sent.time = clock_->now();
+    written = writeLocked(base::encodeWheelSpeed(sent.seq, 0, 0), sent.time);
+    if (written) {
+      ++stats_.speed_frames;
+      if (!needs_reset_) acceptedSpeedLocked(kinematics::WheelTicks{}, sent.time);
+    }
+  }
+  if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
+}
+
+void BaseController::retune(const BaseConfig& next) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = clock_->now();
+  // The motion so far, and the wheel angles so far, with the geometry they ran under.
+  advanceOdometryLocked(now);
+  wheel_angles_at_retune_ +=
+      (wheel_travel_ - travel_at_retune_) / (config_.geometry.wheel_diameter / 2.0);
+  travel_at_retune_ = wheel_travel_;
+  kinematics::DiffDriveGeometry geometry = config_.geometry;
+  geometry.wheel_diameter = next.geometry.wheel_diameter;
+  geometry.wheel_separation = next.geometry.wheel_separation;
+  // The base goes on running the ticks it accepted last; with the new geometry they stand for
+  // other speeds (a corrected diameter is the truth about what the wheels did all along).
+  held_speeds_ *= config_.geometry.ticksPerPeriodPerMps() / geometry.ticksPerPeriodPerMps();
+  config_.geometry = geometry;
+  config_.max_wheel_speed = next.max_wheel_speed;
+  config_.max_wheel_accel = next.max_wheel_accel;
+  config_.cmd_vel_timeout = next.cmd_vel_timeout;
+  config_.speed_dithering = next.speed_dithering;
+  limiter_.setMaxAccel(next.max_wheel_accel);
+  quantizer_.retune(geometry, next.speed_dithering);
+  odometry_.setWheelSeparation(geometry.wheel_separation);
+  if (next.use_imu_heading != config_.use_imu_heading) {
+    // On: anchored where odometry stands now; off: the commanded turn goes on from the last fused
+    // heading. Either way the heading does not jump.
+    if (next.use_imu_heading) heading_.restart();
+    config_.use_imu_heading = next.use_imu_heading;
+  }
+  if (next.battery_poll_rate != config_.battery_poll_rate) {
+    if (next.battery_poll_rate > 0) {
+      // A faster rate starts now, not after the slower period still pending.
+      next_battery_poll_ = std::min(next_battery_poll_, now + fromSeconds(1.0 / next.battery_poll_rate));
+    } else {
+      unanswered_since_.reset();  // no requests, nothing unanswered
+      silent_reported_ = false;
+    }
+    config_.battery_poll_rate = next.battery_poll_rate;
+  }
+}
+
+BaseConfig BaseController::config() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return config_;
+}
+
+BaseStats BaseController::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = clock_->now();
+  BaseStats snapshot = stats_;
+  if (config_.use_imu_heading) {
+    snapshot.heading_source = heading_.source();
+    snapshot.imu_heading_fallbacks = heading_.fallbacks();
+    snapshot.imu_yaw_age = heading_.sampleAge(now);
+  }
+  snapshot.min_immediate_interval_ms = seconds(min_immediate_interval_) * 1e3;
+  if (last_running_timeout_error_) {
+    snapshot.seconds_since_running_timeout_error = seconds(now - *last_running_timeout_error_);
+  }
+  if (config_.battery_poll_rate > 0 && unanswered_since_) {
+    snapshot.seconds_without_reply = seconds(now - *unanswered_since_);
+    snapshot.base_silent =
+        *snapshot.seconds_without_reply > config_.silent_after_polls / config_.battery_poll_rate;
+  }
+  return snapshot;
+}
+
+void BaseController::onLinkUp() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    needs_reset_ = true;  // the base may have timed out while we were away
+    quantizer_.reset();
+    command_pending_ = true;
+    unanswered_since_.reset();  // a new connection gets its own poll periods to answer
+    silent_reported_ = false;
+  }
+  wake_.notify_all();
+}
+
+void BaseController::onLinkDown() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  needs_reset_ = true;
+}
+
+void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+                             Clock::time_point arrival) {
+  if (family != protocol::base::kFrames) return;
+  const auto frame = base::decodeFrame(data, size);
+  if (!frame) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.bad_replies;
+    return;
+  }
+  const auto reply = base::interpretReply(*frame);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!reply) {
+      ++stats_.bad_replies;
+      return;
+    }
+    unanswered_since_.reset();  // any well-formed frame shows the base is there
+    silent_reported_ = false;
+  }
+  switch (reply->kind) {
+    case base::Reply::Kind::kTimeoutError: {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const Clock::time_point now = clock_->now();
+        ++stats_.timeout_errors_received;
+        // One FF may still be in flight from before our Reset (e.g. at power-on): not "running".
+        const bool running = !needs_reset_ && last_reset_sent_ &&
+                             seconds(now - *last_reset_sent_) >= config_.heartbeat_gap;
+        if (running) {
+          ++stats_.timeout_errors_while_running;
+          last_running_timeout_error_ = now;
+        }
+        // The base has stopped its wheels and ignores speed frames until our next Reset.
+        advanceOdometryLocked(now);
+        held_speeds_.setZero();
+        needs_reset_ = true;
+        command_pending_ = true;  // Reset on the wire now, not at the next tick
+      }
+      wake_.notify_all();
+      if (events_.on_timeout_error) events_.on_timeout_error();
+      break;
+    }
+    case base::Reply::Kind::kBattery: {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++stats_.battery_replies;
+        stats_.battery_percent = reply->battery_percent;
+      }
+      if (events_.on_battery) events_.on_battery(reply->battery_percent, arrival);
+      break;
+    }
+    case base::Reply::Kind::kUnknown: {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++stats_.unknown_replies;
+      }
+      if (events_.on_unknown_reply) events_.on_unknown_reply(reply->frame);
+      break;
+    }
+  }
+}
+
+bool BaseController::writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now) {
+  if (!writer_(frame)) {
+    ++stats_.write_failures;
+    needs_reset_ = true;  // whatever the base saw, start the next exchange with a Reset
+    return false;
+  }
+  seq_.next();
+  last_write_ = now;
+  return true;
+}
+
+WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now, bool* timed_out_now) {
+  if (e_stop_) return WheelSpeeds::Zero();
+  const bool timed_out =
+      !last_command_ || seconds(now - *last_command_) > config_.cmd_vel_timeout;
+  if (timed_out && !command_timed_out_ && last_command_) {
+    ++stats_.cmd_vel_timeouts;
+    *timed_out_now = true;
+  }
+  command_timed_out_ = timed_out;
+  if (timed_out) return WheelSpeeds::Zero();
+  // Work on the twist scaled to at most 1 so absurd (finite) commands cannot overflow to inf and
+  // lose their direction; the clamp then restores the right magnitude.
+  const double scale = std::max({1.0, std::abs(linear_x_), std::abs(angular_z_)});
+  const WheelSpeeds unit =
+      kinematics::wheelSpeedsFromTwist(config_.geometry, linear_x_ / scale, angular_z_ / scale);
+  return kinematics::clampWheelSpeeds(unit, config_.max_wheel_speed / scale) * scale;
+}
+
+kinematics::WheelTicks BaseController::onWire(const kinematics::WheelTicks& ticks) const {
+  return kinematics::WheelTicks{withDirection(ticks.left, config_.left_wheel_direction),
+                                withDirection(ticks.right, config_.right_wheel_direction)};
+}
+
+void BaseController::advanceOdometryLocked(Clock::time_point now) {
+  double dt = 0;
+  if (accepted_at_) {
+    // The base runs the last accepted speeds until its heartbeat timeout stops it.
+    const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(config_.heartbeat_gap));
+    if (end > integrated_until_) {
+      dt = seconds(end - integrated_until_);
+      wheel_travel_ += held_speeds_ * dt;
+      integrated_until_ = end;
+    }
+  }
+  // The fused heading follows the IMU even while the wheels stand still (the robot was pushed).
+  const std::optional<double> heading =
+      config_.use_imu_heading ? heading_.heading(now, odometry_.pose().yaw) : std::nullopt;
+  if (heading) {
+    odometry_.integrate(held_speeds_, dt, *heading, config_.imu_yaw_variance);
+  } else if (dt > 0) {
+    odometry_.integrate(held_speeds_, dt);
+  }
+}
+
+void BaseController::acceptedSpeedLocked(const kinematics::WheelTicks& ticks,
+                                         Clock::time_point now) {
+  advanceOdometryLocked(now);
+  const double per_tick = 1.0 / config_.geometry.ticksPerPeriodPerMps();
+  held_speeds_ = WheelSpeeds(ticks.left * per_tick, ticks.right * per_tick);
+  accepted_at_ = now;
+  integrated_until_ = now;
+}
+
+OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const {
+  OdometrySample sample;
+  sample.time = now;
+  sample.pose = odometry_.pose();
+  const bool running = accepted_at_ && seconds(now - *accepted_at_) < config_.heartbeat_gap;
+  if (running) {
+    sample.linear = (held_speeds_.x() + held_speeds_.y()) / 2.0;
+    sample.angular = (held_speeds_.y() - held_speeds_.x()) / config_.geometry.wheel_separation;
+    sample.wheel_speeds = held_speeds_;
+  }
+  sample.wheel_travel = wheel_travel_;
+  const double radius = config_.geometry.wheel_diameter / 2.0;
+  sample.wheel_angles = wheel_angles_at_retune_ + (wheel_travel_ - travel_at_retune_) / radius;
+  sample.wheel_rates = sample.wheel_speeds / radius;
+  sample.position_variance = odometry_.positionVariance();
+  sample.yaw_variance = odometry_.yawVariance();
+  sample.travelled = odometry_.travelled();
+  sample.imu_heading =
+      config_.use_imu_heading && heading_.source() == kinematics::HeadingSource::kImu;
+  return sample;
+}
+
+void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
+  WheelFrameSent sent;
+  bool written = false;
+  bool timed_out_now = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double dt = last_speed_frame_ ? seconds(now - *last_speed_frame_) : seconds(period_);
+    const WheelSpeeds target = targetSpeedsLocked(now, &timed_out_now);
+    if (e_stop_) {
+      limiter_.reset();  // an e-stop does not ramp down
+      quantizer_.reset();
+    }
+    const WheelSpeeds speeds = e_stop_ ? target : limiter_.step(target, dt);
+
+    // The base drops into its timeout error after 1 s without a frame; if our own gap reached that,
+    // assume it did, even if its FF frame was lost.
+    if (last_write_ && seconds(now - *last_write_) >= config_.heartbeat_gap) needs_reset_ = true;
+    if (needs_reset_) {
+      if (!writeLocked(base::encodeReset(seq_.peek()), now)) return;
+      ++stats_.resets_sent;
+      needs_reset_ = false;
+      last_reset_sent_ = now;
+      sent.reset_before = true;
+    }
+    const kinematics::WheelTicks ticks = quantizer_.quantize(speeds);
+    sent.ticks = onWire(ticks);
+    sent.seq = seq_.peek();
+    sent.speeds = speeds;
+    sent.time = now;
+    written = writeLocked(base::encodeWheelSpeed(sent.seq, sent.ticks.left, sent.ticks.right), now);
+    if (written) {
+      ++stats_.speed_frames;
+      if (immediate) {
+        ++stats_.immediate_frames;
+        last_immediate_frame_ = now;
+      }
+      last_speed_frame_ = now;
+      acceptedSpeedLocked(ticks, now);  // a Reset went out before it whenever one was due
+    }
+  }
+  if (timed_out_now && events_.on_cmd_vel_timeout) events_.on_cmd_vel_timeout();
+  if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
+}
+
+void BaseController::tick(Clock::time_point now) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (last_tick_) {
+      const double period_ms = seconds(now - *last_tick_) * 1e3;
+      stats_.last_period_ms = period_ms;
+      if (period_ms > stats_.worst_period_ms) stats_.worst_period_ms = period_ms;
+    }
+    last_tick_ = now;
+    if (config_.battery_poll_rate > 0 && now >= next_battery_poll_) {
+      next_battery_poll_ = now + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(1.0 / config_.battery_poll_rate));
+      // A Reset pending goes out with the speed frame below; the battery request can wait for it.
+      if (!needs_reset_ && writeLocked(base::encodeBatteryRequest(seq_.peek()), now)) {
+        ++stats_.battery_requests;
+        if (!unanswered_since_) unanswered_since_ = now;
+      }
+    }
+  }
+  sendSpeed(now, false);
+
+  std::optional<double> went_silent;
+  std::optional<kinematics::HeadingSource> heading_changed;
+  OdometrySample sample;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (config_.battery_poll_rate > 0 && unanswered_since_ && !silent_reported_) {
+      const double silent_for = seconds(now - *unanswered_since_);
+      if (silent_for > config_.silent_after_polls / config_.battery_poll_rate) {
+        silent_reported_ = true;
+        went_silent = silent_for;
+      }
+    }
+    advanceOdometryLocked(now);
+    sample = odometrySampleLocked(now);
+    if (config_.use_imu_heading && heading_.source() != reported_heading_source_) {
+      reported_heading_source_ = heading_.source();
+      heading_changed = reported_heading_source_;
+    }
+  }
+  if (went_silent && events_.on_silent) events_.on_silent(*went_silent);
+  if (heading_changed && events_.on_heading_source) events_.on_heading_source(*heading_changed);
+  if (events_.on_odometry) events_.on_odometry(sample);
+}
+
+void BaseController::run() {
+  Clock::time_point deadline = clock_->now() + period_;
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping_) {
+    // Wake at the next tick, or earlier for a new command that may be rushed out.
+    while (!stopping_ && !command_pending_ && clock_->now() < deadline) {
+      clock_->waitUntil(lock, wake_, deadline);
+    }
+    if (stopping_) break;
+    const Clock::time_point now = clock_->now();
+    if (now < deadline) {
+      // Woken early by a command: send it at once unless the last rushed frame is so recent that
+      // a flood would take more than its share of the line; then it goes when the line allows (or
+      // with the tick). The 50 Hz ticks are not counted against the share: they are a small,
+      // fixed load, and counting them would hold back every command that follows a tick.
+      const bool may_rush =
+          !last_immediate_frame_ || now - *last_immediate_frame_ >= min_immediate_interval_;
+      if (!may_rush) {
+        const Clock::time_point until =
+            std::min(deadline, *last_immediate_frame_ + min_immediate_interval_);
+        while (!stopping_ && clock_->now() < until) clock_->waitUntil(lock, wake_, until);
+        continue;  // re-evaluate with command_pending_ still set
+      }
+      command_pending_ = false;
+      lock.unlock();
+      sendSpeed(now, true);
+      lock.lock();
+      continue;
+    }
+    command_pending_ = false;
+    lock.unlock();
+    tick(now);
+    lock.lock();
+    deadline += period_;
+    if (clock_->now() >= deadline) {
+      // Late by a whole period (machine stalled): count it and re-anchor rather than burst.
+      ++stats_.loop_overruns;
+      deadline = clock_->now() + period_;
+    }
+  }
+}
+
+}  // namespace serial_robot_driver::device

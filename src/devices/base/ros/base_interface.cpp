@@ -1,0 +1,241 @@
+#include "serial_robot_driver/devices/base/base_interface.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/BatteryState.h>
+#include <sensor_msgs/JointState.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/devices/base/base_status.h"
+#include "serial_robot_driver/ros/conversions.h"
+
+namespace serial_robot_driver::ros_layer {
+
+namespace {
+// Twist variances of odom (see publishOdometry): (m/s)^2 and (rad/s)^2.
+constexpr double kTwistLinearVariance = 0.0025;  // std 0.05 m/s
+constexpr double kTwistLateralVariance = 1e-6;   // a differential drive cannot slide sideways
+constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
+}  // namespace
+
+device::BaseConfig makeBaseConfig(const DriverParams& params) {
+  device::BaseConfig config;
+  config.geometry.wheel_diameter = params.base.wheel_diameter;
+  config.geometry.wheel_separation = params.base.wheel_separation;
+  config.geometry.encoder_resolution = params.base.encoder_resolution;
+  config.geometry.pid_rate = params.base.pid_rate;
+  config.max_wheel_speed = params.base.max_wheel_speed;
+  config.max_wheel_accel = params.base.max_wheel_accel;
+  config.cmd_vel_timeout = params.base.cmd_vel_timeout;
+  config.speed_dithering = params.base.speed_dithering;
+  config.battery_poll_rate = params.base.battery_poll_rate;
+  config.loop_rate = params.loop_rate;
+  config.baud = params.baseBaud();
+  config.left_wheel_direction = params.base.left_wheel_direction;
+  config.right_wheel_direction = params.base.right_wheel_direction;
+  config.use_imu_heading = params.base.use_imu_heading;
+  config.imu_yaw_variance = params.imu.orientation_variance;
+  return config;
+}
+
+device::BaseEvents BaseInterface::events() {
+  // The publishers are advertised in the constructor's body, before the controller can report.
+  device::BaseEvents events;
+  events.on_wheel_frame = [this](const device::WheelFrameSent& sent) {
+    if (wheel_command_pub_.getNumSubscribers() == 0) return;  // 50 Hz: skip work nobody reads
+    serial_robot_driver::WheelCommand msg;
+    msg.header.stamp = ros::Time::now();
+    msg.left_ticks = sent.ticks.left;
+    msg.right_ticks = sent.ticks.right;
+    msg.seq = sent.seq;
+    msg.reset_before = sent.reset_before;
+    msg.left_speed = sent.speeds.x();
+    msg.right_speed = sent.speeds.y();
+    wheel_command_pub_.publish(msg);
+  };
+  events.on_battery = [this](uint8_t percent, device::Clock::time_point arrival) {
+    sensor_msgs::BatteryState msg;
+    msg.header.stamp = arrival_stamps_(arrival);
+    // The base reports only a percentage; everything else is unknown (NaN per the message docs).
+    const float unknown = std::numeric_limits<float>::quiet_NaN();
+    msg.voltage = msg.temperature = msg.current = unknown;
+    msg.charge = msg.capacity = msg.design_capacity = unknown;
+    msg.percentage = percent / 100.0f;
+    msg.power_supply_status = sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
+    msg.power_supply_health = sensor_msgs::BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;
+    msg.power_supply_technology = sensor_msgs::BatteryState::POWER_SUPPLY_TECHNOLOGY_UNKNOWN;
+    msg.present = true;
+    battery_pub_.publish(msg);
+  };
+  events.on_odometry = [this](const device::OdometrySample& sample) { publishOdometry(sample); };
+  events.on_cmd_vel_timeout = [this] {
+    ROS_INFO_THROTTLE(10.0, "no cmd_vel for %.2f s (base/cmd_vel_timeout): commanding zero speed",
+                      tuned().cmd_vel_timeout);
+  };
+  events.on_silent = [this](double seconds) {
+    ROS_ERROR_THROTTLE(10.0,
+                       "no reply from the base on %s for %.1f s (battery requests unanswered)",
+                       link_.options().path.c_str(), seconds);
+  };
+  events.on_timeout_error = [] {
+    ROS_WARN_THROTTLE(5.0, "base reported a connection-timeout error (FF): sending Reset");
+  };
+  events.on_heading_source = [this](kinematics::HeadingSource source) {
+    if (source == kinematics::HeadingSource::kImu) {
+      ROS_INFO("odom heading: following the IMU's yaw (base/use_imu_heading)");
+    } else if (source == kinematics::HeadingSource::kImuStale) {
+      ROS_WARN(
+          "odom heading: no IMU yaw for %.2f s (is the body's telemetry flowing?); integrating "
+          "the commanded turn from the last fused heading until it returns",
+          std::chrono::duration<double>(kinematics::kImuHeadingStaleAfter).count());
+    }
+  };
+  events.on_unknown_reply = [](const protocol::base::Frame& frame) {
+    ROS_DEBUG_THROTTLE(5.0, "base sent a frame with unknown MSGID 0x%02X", frame.msg_id);
+  };
+  return events;
+}
+
+BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
+                             device::SerialLink& link)
+    : link_(link),
+      arrival_stamps_(params),
+      params_(params.base),
+      tuned_{params.base.publish_tf, params.base.cmd_vel_timeout, params.base.battery_warn_percent,
+             params.base.battery_error_percent},
+      tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
+                                             : nullptr),
+      odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
+      controller_(makeBaseConfig(params), link.writer(), events()) {
+  wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
+  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
+  wheel_states_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
+
+  link.addListener(&controller_);
+
+  // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.
+  cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &BaseInterface::onCmdVel, this,
+                              ros::TransportHints().tcpNoDelay());
+  reset_srv_ = nh.advertiseService("base/reset", &BaseInterface::onReset, this);
+  reset_odometry_srv_ =
+      nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
+  clear_encoders_srv_ = nh.advertiseService("base/clear_encoders", &BaseInterface::onClearEncoders, this);
+}
+
+void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {
+  // Counted with the other refused commands; the controller ignores it (and counts it) itself.
+  if (e_stop_) e_stop_->refuse("cmd_vel");
+  if (!controller_.setCommand(msg->linear.x, msg->angular.z)) {
+    ROS_WARN_THROTTLE(1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
+                      msg->linear.x, msg->angular.z);
+  }
+}
+
+void BaseInterface::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  e_stop.addListener([this](bool engaged) { controller_.setEStop(engaged); });
+}
+
+void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
+  // Called on the control loop's thread once per tick; never touches the port.
+  const ros::Time stamp = ros::Time::now();
+  const double half_yaw = sample.pose.yaw / 2.0;
+  geometry_msgs::Quaternion orientation;
+  orientation.z = std::sin(half_yaw);
+  orientation.w = std::cos(half_yaw);
+
+  nav_msgs::Odometry odom;
+  odom.header.stamp = stamp;
+  odom.header.frame_id = params_.odom_frame;
+  odom.child_frame_id = params_.base_frame;
+  odom.pose.pose.position.x = sample.pose.x;
+  odom.pose.pose.position.y = sample.pose.y;
+  odom.pose.pose.orientation = orientation;
+  odom.twist.twist.linear.x = sample.linear;
+  odom.twist.twist.angular.z = sample.angular;
+  // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
+  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
+  // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
+  constexpr double kNotEstimated = 1e6;
+  odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
+  odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
+  odom.pose.covariance[35] = sample.yaw_variance;
+  // The twist is what the base was told, good to about one tick per period (0.0245 m/s with the
+  // default geometry), plus what the wheels fail to follow.
+  odom.twist.covariance[0] = kTwistLinearVariance;
+  odom.twist.covariance[7] = kTwistLateralVariance;
+  odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
+  odom.twist.covariance[35] = kTwistAngularVariance;
+  odom_pub_.publish(odom);
+  publishWheelStates(sample, stamp);
+
+  if (!tuned().publish_tf) return;
+  // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
+  if (!tf_broadcaster_) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  geometry_msgs::TransformStamped transform;
+  transform.header = odom.header;
+  transform.child_frame_id = odom.child_frame_id;
+  transform.transform.translation.x = sample.pose.x;
+  transform.transform.translation.y = sample.pose.y;
+  transform.transform.rotation = orientation;
+  tf_broadcaster_->sendTransform(transform);
+}
+
+void BaseInterface::publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp) {
+  // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
+  sensor_msgs::JointState wheels;
+  wheels.header.stamp = stamp;
+  wheels.header.frame_id = params_.base_frame;
+  wheels.name = {params_.left_wheel_joint, params_.right_wheel_joint};
+  // In rad, from the controller: with the diameter each stretch of travel ran under.
+  wheels.position = {sample.wheel_angles.x(), sample.wheel_angles.y()};
+  wheels.velocity = {sample.wheel_rates.x(), sample.wheel_rates.y()};
+  wheel_states_pub_.publish(wheels);
+}
+
+BaseInterface::Tuned BaseInterface::tuned() const {
+  std::lock_guard<std::mutex> lock(tuned_mutex_);
+  return tuned_;
+}
+
+void BaseInterface::retune(const DriverParams& params) {
+  controller_.retune(makeBaseConfig(params));
+  std::lock_guard<std::mutex> lock(tuned_mutex_);
+  tuned_ = Tuned{params.base.publish_tf, params.base.cmd_vel_timeout,
+                 params.base.battery_warn_percent, params.base.battery_error_percent};
+}
+
+bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  controller_.resetOdometry();
+  res.success = true;
+  res.message = "odometry pose reset to zero";
+  return true;
+}
+
+bool BaseInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  res.success = controller_.sendReset();
+  res.message = res.success ? "Reset sent" : "base port " + link_.options().path + " is not connected";
+  return true;
+}
+
+bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  res.success = controller_.sendClearEncoders();
+  // The AP1 reports no encoder counts, so clearing them changes nothing the node publishes.
+  res.message = res.success ? "clear-encoders sent (the node never reads encoder counts; odom is "
+                              "not affected: use base/reset_odometry)"
+                            : "base port " + link_.options().path + " is not connected";
+  return true;
+}
+
+void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const Tuned limits = tuned();
+  writeStatusReport(
+      device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
+                         {limits.battery_warn_percent, limits.battery_error_percent}),
+      status);
+}
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,124 @@
+#include "serial_robot_driver/devices/body/body_interface.h"
+
+#include <sensor_msgs/Imu.h>
+
+#include <boost/make_shared.hpp>
+
+#include "serial_robot_driver/FootPressure.h"
+#include "serial_robot_driver/Telemetry.h"
+#include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/trajectory/joint_groups.h"
+
+namespace serial_robot_driver::ros_layer {
+
+BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
+                             device::SerialLink& link)
+    : link_(link),
+      arrival_stamps_(params),
+      imu_params_(std::make_shared<const ImuParams>(params.imu)),
+      controller_(
+          makeBodyJoints(params.body), link.writer(),
+          {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
+            publishTelemetry(telemetry, arrival);
+          }}),
+      telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
+                      "telemetry rate") {
+  // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
+  joint_states_pub_ =
+      nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
+  imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", params.publisherQueue(20));
+  foot_pressure_pub_ =
+      nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
+  telemetry_pub_ =
+      nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
+  // tcpNoDelay: a joint command must not wait in Nagle's buffer.
+  joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
+                                     ros::TransportHints().tcpNoDelay());
+  link.addListener(&controller_);
+}
+
+void BodyInterface::retune(const DriverParams& params) {
+  std::atomic_store(&imu_params_, std::make_shared<const ImuParams>(params.imu));
+}
+
+void BodyInterface::shutdown() {
+  joint_commands_sub_.shutdown();
+  controller_.gate().close();  // no position goes out once the node is shutting down
+}
+
+void BodyInterface::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  e_stop.addListener([this](bool engaged) { controller_.gate().setLocked(engaged); });
+}
+
+std::vector<TrajectoryJoints> BodyInterface::trajectoryJoints() {
+  return {trajectory::bodyTrajectoryJoints(controller_)};
+}
+
+void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
+                                     device::Clock::time_point arrival) {
+  // Runs on the link's reader thread; ros::Publisher::publish is thread-safe. A message nobody
+  // subscribes to is not even built: at hundreds of frames per second that is most of the CPU.
+  telemetry_rate_.tick();
+  const ros::Time stamp = arrival_stamps_(arrival);
+  const auto& joints = controller_.joints();
+  // The trajectory server needs every frame: its goals are checked against it.
+  const auto joint_state =
+      boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
+  if (trajectory_) trajectory_->updateActual(*joint_state);
+  // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
+  // gets this very message, not a serialized copy.
+  if (joint_states_pub_.getNumSubscribers() > 0) {
+    joint_states_pub_.publish(joint_state);
+  }
+  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
+  if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, *imu), arrival);
+  if (imu_pub_.getNumSubscribers() > 0) {
+    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp)));
+  }
+  if (foot_pressure_pub_.getNumSubscribers() > 0) {
+    if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
+  }
+  if (telemetry_pub_.getNumSubscribers() > 0) {
+    telemetry_pub_.publish(toTelemetryMsg(telemetry, joints, stamp));
+  }
+}
+
+void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
+  if (e_stop_ && e_stop_->refuse("joint_commands")) {
+    ROS_WARN_THROTTLE(1.0, "joint_commands refused: e_stop is engaged");
+    return;
+  }
+  const JointCommand command = fromJointState(*msg);
+  device::JointCommandResult result;
+  const auto send = [&] {
+    result = controller_.sendJointCommand(command.names, command.positions);
+    return result.ok();
+  };
+  // A joint under a trajectory is taken over by this command, and its goal aborted.
+  if (trajectory_) {
+    trajectory_->takeOver(command.names, "joint_commands", send);
+  } else {
+    send();
+  }
+  if (!result.ok() || !result.out_of_range.empty()) {
+    ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
+  }
+}
+
+void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
+  const device::BodyStatus::Update update = status_.update(
+      controller_.stats(), link_.stats().framer, {link_.options().path, link_.connected()});
+  writeStatusReport(update.report, status, SummaryWrite::kMerge);
+  // Once per outage, not once per period.
+  if (update.flow == device::BodyStatus::FlowChange::kStopped) {
+    ROS_WARN("body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
+             "board powered and streaming?",
+             link_.options().path.c_str());
+  } else if (update.flow == device::BodyStatus::FlowChange::kResumed) {
+    ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
+  }
+}
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,253 @@
+#include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "serial_robot_driver/ros/conversions.h"
+
+namespace serial_robot_driver::ros_layer {
+
+namespace {
+
+constexpr int kSpinnerThreads = 2;
+constexpr double kMsPerSecond = 1000.0;
+constexpr double kWarnThrottleS = 5.0;
+
+}  // namespace
+
+/// The core says "dangerous"; only this layer knows which parameter arms such writes.
+std::string servoStatusMessage(const device::ServoStatus& status) {
+  if (status.error != device::ServoError::kDangerous) return status.message;
+  return status.message + " (set ~servo_bus/allow_dangerous_writes to true to arm it)";
+}
+
+ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms) {
+  return device::toServoMoves(msg.name, msg.position, msg.velocity, interval_ms);
+}
+
+device::ServoBusOptions makeServoBusOptions(const DriverParams& params) {
+  device::ServoBusOptions options;
+  options.timeout =
+      std::chrono::milliseconds(std::llround(params.servo_bus.timeout * kMsPerSecond));
+  options.retries = params.servo_bus.retries;
+  options.allow_dangerous_writes = params.servo_bus.allow_dangerous_writes;
+  return options;
+}
+
+device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
+  device::ServoBusConfig config;
+  config.client = makeServoBusOptions(params);
+  for (int id : params.servo_bus.state_ids) config.polled_ids.push_back(static_cast<uint8_t>(id));
+  // Joint servos are polled too: their angles are the trajectories' measurements.
+  for (int id : params.servo_bus.joint_ids) {
+    const auto joint_id = static_cast<uint8_t>(id);
+    if (std::find(config.polled_ids.begin(), config.polled_ids.end(), joint_id) ==
+        config.polled_ids.end()) {
+      config.polled_ids.push_back(joint_id);
+    }
+  }
+  config.poll_rate = params.servo_bus.state_rate;
+  config.relax_power_mw = static_cast<uint16_t>(params.servo_bus.relax_power_mw);
+  // validate() accepted only the names shutdownActionFromString() knows.
+  config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
+                           .value_or(device::ShutdownAction::kStop);
+  config.health_rate = params.servo_bus.health_rate;
+  config.protect = params.servo_bus.protect;
+  return config;
+}
+
+device::ServoBusEvents ServoBusInterface::makeEvents() {
+  device::ServoBusEvents events;
+  // On the bus worker thread.
+  events.on_angle = [this](const device::ServoAngleSample& sample) {
+    const sensor_msgs::JointState msg =
+        busJointState(bus_joints_, sample.id, sample.angle_deg, toRosTime(sample.arrival));
+    states_pub_.publish(msg);
+    if (trajectory_) trajectory_->updateActual(msg);
+  };
+  events.on_servo_silent = [](uint8_t id, const device::ServoStatus& status,
+                              std::chrono::milliseconds backoff) {
+    ROS_WARN_THROTTLE(
+        kWarnThrottleS, "servo_states: %s does not answer (%s); asked again in %.1f s",
+        servoJointName(id).c_str(), status.message.c_str(), backoff.count() / kMsPerSecond);
+  };
+  events.on_overheat = [](const device::ServoHealthReport& report) {
+    if (report.overheated) {
+      ROS_ERROR("servo_bus: %s at %ld degC reached its over_temperature limit (%ld degC): relaxed, "
+                "its moves refused until it has cooled %ld degC (~servo_bus/protect)",
+                servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c),
+                static_cast<long>(report.limits.over_temperature_c),
+                static_cast<long>(device::OverheatGuard::kCoolDownC));
+    } else {
+      ROS_INFO("servo_bus: %s has cooled to %ld degC: its moves are obeyed again",
+               servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c));
+    }
+  };
+  events.on_move_failed = [](const device::MoveRequest& move, const device::ServoStatus& status) {
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",
+                      servoJointName(move.id).c_str(), servoStatusMessage(status).c_str());
+  };
+  events.on_stop = [](uint8_t id, const device::ServoStatus& status) {
+    if (status.ok()) {
+      ROS_INFO("servo_bus: %s stopped: %s", servoJointName(id).c_str(), status.message.c_str());
+    } else if (status.error == device::ServoError::kShutdown) {
+      ROS_ERROR("servo_bus: %s", status.message.c_str());
+    } else {
+      ROS_WARN_THROTTLE(kWarnThrottleS,
+                        "servo_bus: %s's stop not yet confirmed, writing it again: %s",
+                        servoJointName(id).c_str(), status.message.c_str());
+    }
+  };
+  return events;
+}
+
+ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params,
+                                     device::SerialLink& link)
+    : bus_joints_(makeBusJoints(params.servo_bus)),
+      state_rate_(params.servo_bus.state_rate),
+      link_(link),
+      bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
+      client_(bus_.client()),
+      nh_(nh),
+      topics_nh_(nh),
+      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
+  // The bus's worker (the poll, the queued moves) runs on the port's reader thread: a poll writes
+  // its request and reads the answer itself, with no second thread to wake per transaction.
+  bus_.runOn(link_);
+
+  // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
+  // wait = true) and must never hold up cmd_vel or joint_commands on the global queue.
+  nh_.setCallbackQueue(&queue_);
+  advertiseServices();
+
+  if (params.servo_bus.allow_dangerous_writes) {
+    ROS_WARN(
+        "servo_bus: dangerous writes (servo_id, baudrate, response_switch, reserved cells, "
+        "reset_user_data) are ARMED");
+  }
+
+  states_pub_ = topics_nh_.advertise<sensor_msgs::JointState>("servo_states", 10);
+  commands_sub_ = topics_nh_.subscribe("servo_commands", 10, &ServoBusInterface::onServoCommands,
+                                       this, ros::TransportHints().tcpNoDelay());
+}
+
+void ServoBusInterface::retune(const DriverParams& params) {
+  bus_.retune(makeServoBusConfig(params));
+  command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
+  // The joints' measurements come as often as the poll: their freshness limit follows it.
+  if (trajectory_ && !bus_joints_.empty()) {
+    std::vector<std::string> names;
+    for (const trajectory::BusJoint& joint : bus_joints_) names.push_back(joint.name);
+    trajectory_->setStateTimeout(names, busStateTimeout(params.servo_bus.state_rate));
+  }
+}
+
+void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
+  if (!refuseWhileEStopped("servo_commands").ok()) {
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands refused, nothing sent: e_stop is engaged");
+    return;
+  }
+  const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_.load());
+  if (!batch.error.empty()) {
+    commands_rejected_.fetch_add(1);
+    ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
+                      batch.error.c_str());
+    return;
+  }
+  // A joint servo under a trajectory is taken over by this command, and its goal aborted.
+  std::vector<std::string> joints;
+  for (const device::MoveRequest& move : batch.moves) {
+    if (const trajectory::BusJoint* joint = findBusJoint(bus_joints_, move.id)) {
+      joints.push_back(joint->name);
+    }
+  }
+  const auto queue = [&] {
+    bus_.queueMoves(batch.moves);
+    return true;
+  };
+  if (trajectory_ && !joints.empty()) {
+    trajectory_->takeOver(joints, "servo_commands", queue);
+  } else {
+    queue();
+  }
+}
+
+device::ServoStatus ServoBusInterface::refuseWhileEStopped(const std::string& source) {
+  if (!e_stop_ || !e_stop_->refuse(source)) return {};
+  return {device::ServoError::kMotionRefused,
+          "e_stop is engaged: no servo moves until it is released (publish false on e_stop)"};
+}
+
+void ServoBusInterface::attachEStop(device::EStop& e_stop) {
+  e_stop_ = &e_stop;
+  // On the e_stop subscriber's thread: the SPIN stops take the bus as a caller, ahead of the poll.
+  // On the e_stop subscriber's thread, and it never waits for the bus: the gate is locked (no
+  // motion frame from now on) and the stops are handed to the bus's worker, which writes them
+  // ahead of everything else and keeps writing them until each servo is seen at rest.
+  e_stop.addListener([this](bool engaged) {
+    bus_.setMotionLocked(engaged);
+    const std::vector<uint8_t> commanded = bus_.commandedIds();
+    if (engaged && !commanded.empty()) {
+      ROS_WARN(
+          "e_stop: stopping bus servo(s) %s (each stop is written until the servo is seen at "
+          "rest)",
+          device::servoIdList(commanded).c_str());
+    }
+  });
+}
+
+void ServoBusInterface::yieldJoints(const std::vector<uint8_t>& ids, const char* source) {
+  for (uint8_t id : ids.empty() ? bus_.config().polled_ids : ids) yieldJoint(id, source);
+}
+
+void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
+  const trajectory::BusJoint* joint = findBusJoint(bus_joints_, id);
+  if (!trajectory_ || !joint) return;
+  trajectory_->takeOver({joint->name}, source, [&] {
+    // A trajectory move still queued must not follow the service's command.
+    bus_.dropQueuedMoves(id);
+    return true;
+  });
+}
+
+std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
+  const auto queue_move = [this](uint8_t id, double angle_deg, uint32_t interval_ms) {
+    device::MoveRequest move;
+    move.id = id;
+    move.angle_deg = angle_deg;
+    move.interval_ms = interval_ms;
+    bus_.queueMoves({move});
+    return std::string();
+  };
+  // A stop holds a joint with a SPIN stop: written ahead of queued moves, allowed while the
+  // e-stop holds, and never a move to an angle that may be a poll period old.
+  const auto stop_servo = [this](uint8_t id) {
+    bus_.stopServo(id);
+    return std::string();
+  };
+  return {busTrajectoryJoints(bus_joints_, queue_move, state_rate_, stop_servo)};
+}
+
+void ServoBusInterface::start() {
+  if (spinner_ || shut_down_) return;
+  // Two threads: one call waits on the bus while another is accepted and queued behind the bus
+  // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
+  spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
+  spinner_->start();
+  bus_.start();
+}
+
+ServoBusInterface::~ServoBusInterface() { shutdown(); }
+
+void ServoBusInterface::shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  commands_sub_.shutdown();
+  bus_.shutdown();  // fails a call waiting on the bus, so the spinner can stop quickly
+  for (ros::ServiceServer& service : services_) service.shutdown();
+  if (spinner_) spinner_->stop();
+}
+
+}  // namespace serial_robot_driver::ros_layer

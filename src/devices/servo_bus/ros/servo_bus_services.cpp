@@ -1,0 +1,212 @@
+// The servo/* services: each one a client or bus call behind the same outcome handling (logged,
+// never thrown through, the message always returned). Served from ServoBusInterface's own queue.
+#include <exception>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
+
+namespace serial_robot_driver::ros_layer {
+
+namespace {
+
+void logOutcome(const std::string& service, const device::ServoStatus& status) {
+  if (status.ok()) {
+    ROS_DEBUG("%s: %s", service.c_str(), status.message.c_str());
+  } else {
+    ROS_DEBUG("%s failed (%s): %s", service.c_str(), device::toString(status.error),
+              status.message.c_str());
+  }
+}
+
+// The outcome fields every servo/* response has; servo/ping calls its flag `online`.
+template <typename Response>
+void setOutcome(Response& res, bool ok, const std::string& message) {
+  res.success = ok;
+  res.message = message;
+}
+void setOutcome(ServoPing::Response& res, bool ok, const std::string& message) {
+  res.online = ok;
+  res.message = message;
+}
+// servo/scan has no flag: the ids it found are the outcome.
+void setOutcome(ServoScan::Response& res, bool /*ok*/, const std::string& message) {
+  res.message = message;
+}
+
+/// Whether a successful call is logged at INFO (it changed a servo's settings) or DEBUG only.
+enum class Announce { kDebug, kInfo };
+
+/// The client operation behind one service: it fills the response's own fields (values, angle)
+/// and returns the status; the outcome fields are filled by advertiseServo().
+template <typename Service>
+using ServoCall =
+    std::function<device::ServoStatus(typename Service::Request&, typename Service::Response&)>;
+
+/// Advertises one servo/* service from its call. The service logs the outcome, never throws
+/// through to its caller and always returns true, so the caller gets the message instead of a bare
+/// "service call failed".
+template <typename Service>
+ros::ServiceServer advertiseServo(ros::NodeHandle& nh, const std::string& name,
+                                  ServoCall<Service> call, Announce announce = Announce::kDebug) {
+  using Request = typename Service::Request;
+  using Response = typename Service::Response;
+  const boost::function<bool(Request&, Response&)> serve = [name, call, announce](Request& req,
+                                                                                  Response& res) {
+    try {
+      const device::ServoStatus status = call(req, res);
+      logOutcome(name, status);
+      if (status.ok() && announce == Announce::kInfo) {
+        ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
+      }
+      setOutcome(res, status.ok(), servoStatusMessage(status));
+    } catch (const std::exception& error) {
+      ROS_ERROR("%s: internal error: %s", name.c_str(), error.what());
+      res = Response();
+      setOutcome(res, false, std::string("internal error: ") + error.what());
+    }
+    return true;
+  };
+  return nh.advertiseService<Request, Response>(name, serve);
+}
+
+}  // namespace
+
+void ServoBusInterface::advertiseServices() {
+  services_ = {
+      advertiseServo<ServoPing>(
+          nh_, "servo/ping",
+          [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }),
+      advertiseServo<ServoRead>(nh_, "servo/read",
+                                [this](ServoRead::Request& req, ServoRead::Response& res) {
+                                  device::ServoParamValue value;
+                                  const device::ServoStatus status =
+                                      client_.readParam(req.id, req.param, &value);
+                                  if (status.ok()) {
+                                    res.value = value.value;
+                                    res.unit = value.unit;
+                                  }
+                                  return status;
+                                }),
+      advertiseServo<ServoWrite>(
+          nh_, "servo/write",
+          [this](ServoWrite::Request& req, ServoWrite::Response&) {
+            return client_.writeParam(req.id, req.param, req.value);
+          },
+          Announce::kInfo),
+      advertiseServo<ServoReadAngle>(
+          nh_, "servo/read_angle",
+          [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
+            res.angle_deg = 0.0;
+            res.turns = 0;
+            if (req.multi_turn) {
+              device::MultiTurnReading reading;
+              const device::ServoStatus status = client_.readMultiTurnAngle(req.id, &reading);
+              if (status.ok()) {
+                res.angle_deg = reading.angle_deg;
+                res.turns = reading.turns;
+              }
+              return status;
+            }
+            double angle_deg = 0.0;
+            const device::ServoStatus status = client_.readAngle(req.id, &angle_deg);
+            if (status.ok()) res.angle_deg = angle_deg;
+            return status;
+          }),
+      advertiseServo<ServoMove>(nh_, "servo/move",
+                                [this](ServoMove::Request& req, ServoMove::Response&) {
+                                  device::MoveRequest request;
+                                  request.id = req.id;
+                                  request.angle_deg = req.angle_deg;
+                                  request.multi_turn = req.multi_turn;
+                                  request.interval_ms = req.interval_ms;
+                                  request.velocity_dps = req.velocity_dps;
+                                  request.accel_ms = req.accel_ms;
+                                  request.decel_ms = req.decel_ms;
+                                  request.power_mw = req.power_mw;
+                                  device::ServoStatus refused = refuseWhileEStopped("servo/move");
+                                  if (!refused.ok()) return refused;
+                                  yieldJoint(req.id, "servo/move");
+                                  return bus_.move(request);
+                                }),
+      advertiseServo<ServoScan>(nh_, "servo/scan",
+                                [this](ServoScan::Request& req, ServoScan::Response& res) {
+                                  return client_.scan(req.first_id, req.last_id, &res.ids);
+                                }),
+      advertiseServo<ServoRotate>(nh_, "servo/rotate",
+                                  [this](ServoRotate::Request& req, ServoRotate::Response&) {
+                                    device::RotateRequest request;
+                                    request.id = req.id;
+                                    request.angle_deg = req.angle_deg;
+                                    request.interval_ms = req.interval_ms;
+                                    request.power_mw = req.power_mw;
+                                    request.wait = req.wait;
+                                    device::ServoStatus refused =
+                                        refuseWhileEStopped("servo/rotate");
+                                    if (!refused.ok()) return refused;
+                                    yieldJoint(req.id, "servo/rotate");
+                                    return bus_.rotate(request);
+                                  }),
+      advertiseServo<ServoSpin>(nh_, "servo/spin",
+                                [this](ServoSpin::Request& req, ServoSpin::Response&) {
+                                  device::SpinRequest request;
+                                  request.id = req.id;
+                                  request.clockwise = req.clockwise;
+                                  request.mode = req.mode;
+                                  request.speed_dps = req.speed_dps;
+                                  request.value = req.value;
+                                  request.wait = req.wait;
+                                  // A SPIN stop is no motion: it works while the e-stop holds.
+                                  if (req.mode != 0) {
+                                    device::ServoStatus refused = refuseWhileEStopped("servo/spin");
+                                    if (!refused.ok()) return refused;
+                                  }
+                                  yieldJoint(req.id, "servo/spin");
+                                  return bus_.spin(request);
+                                }),
+      advertiseServo<ServoDamping>(nh_, "servo/damping",
+                                   [this](ServoDamping::Request& req, ServoDamping::Response&) {
+                                     device::ServoStatus refused =
+                                         refuseWhileEStopped("servo/damping");
+                                     if (!refused.ok()) return refused;
+                                     yieldJoint(req.id, "servo/damping");
+                                     return bus_.damping(req.id, req.power_mw, req.wait);
+                                   }),
+      advertiseServo<ServoRelax>(nh_, "servo/relax",
+                                 [this](ServoRelax::Request& req, ServoRelax::Response&) {
+                                   device::ServoStatus refused = refuseWhileEStopped("servo/relax");
+                                   if (!refused.ok()) return refused;
+                                   yieldJoints(req.ids, "servo/relax");
+                                   return bus_.relax(req.ids);
+                                 }),
+      advertiseServo<ServoHold>(nh_, "servo/hold",
+                                [this](ServoHold::Request& req, ServoHold::Response&) {
+                                  device::ServoStatus refused = refuseWhileEStopped("servo/hold");
+                                  if (!refused.ok()) return refused;
+                                  yieldJoints(req.ids, "servo/hold");
+                                  return bus_.hold(req.ids);
+                                }),
+      advertiseServo<ServoReadAll>(nh_, "servo/read_all",
+                                   [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
+                                     std::vector<device::ServoParamValue> values;
+                                     const device::ServoStatus status =
+                                         client_.readAll(req.id, &values);
+                                     res.names.clear();
+                                     res.values.clear();
+                                     for (const device::ServoParamValue& value : values) {
+                                       res.names.push_back(value.name);
+                                       res.values.push_back(value.value);
+                                     }
+                                     return status;
+                                   }),
+      advertiseServo<ServoResetUserData>(
+          nh_, "servo/reset_user_data",
+          [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
+            return client_.resetUserData(req.id);
+          },
+          Announce::kInfo),
+  };
+}
+
+}  // namespace serial_robot_driver::ros_layer

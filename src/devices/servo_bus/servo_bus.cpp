@@ -1,0 +1,267 @@
+#include "serial_robot_driver/devices/servo_bus/servo_bus.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace serial_robot_driver::device {
+
+ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events,
+                   std::shared_ptr<LoopClock> clock)
+    : config_(std::move(config)),
+      settings_(config_),
+      events_(std::move(events)),
+      clock_(clock ? std::move(clock) : steadyLoopClock()),
+      client_(config_.client, std::move(writer)),
+      poller_(config_.polled_ids, settings_, client_, events_, *clock_, mutex_,
+              {[this](uint8_t id) { dropQueuedMovesLocked(id); },
+               [this](uint8_t id) { safety_.noteMotion(id, false); }}),
+      stops_(client_, events_, *clock_, mutex_,
+             [this](uint8_t id) { safety_.noteStopWrittenLocked(id); }),
+      safety_(config_.polled_ids, settings_, client_, events_, *clock_, mutex_, stops_, poller_,
+              {[this] { queued_moves_.clear(); }, [this] { deliverStops(); }}) {
+  client_.setMotionGate(&safety_.gate(), [this](uint8_t id) { safety_.noteCommanded(id); });
+}
+
+ServoBus::~ServoBus() { shutdown(); }
+
+void ServoBus::onLinkDown() { client_.onLinkDown(); }
+
+void ServoBus::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+                       Clock::time_point arrival) {
+  client_.onFrame(family, data, size, arrival);
+}
+
+void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // The e-stop holds: the caller refused (and counted) it already.
+    if (safety_.motionLockedLocked()) return;
+    for (const MoveRequest& move : moves) {
+      auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
+                                 [&move](const MoveRequest& m) { return m.id == move.id; });
+      if (queued != queued_moves_.end()) {
+        *queued = move;
+        ++stats_.moves_replaced;
+      } else {
+        queued_moves_.push_back(move);
+      }
+    }
+  }
+  wakeWorker();
+}
+
+void ServoBus::dropQueuedMoves(uint8_t id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  dropQueuedMovesLocked(id);
+}
+
+void ServoBus::dropQueuedMovesLocked(uint8_t id) {
+  queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
+                                     [id](const MoveRequest& m) { return m.id == id; }),
+                      queued_moves_.end());
+}
+
+void ServoBus::retune(const ServoBusConfig& next) {
+  client_.retune(next.client.timeout, next.client.retries);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    settings_.client.timeout = next.client.timeout;
+    settings_.client.retries = next.client.retries;
+    settings_.poll_rate = next.poll_rate;
+    settings_.health_rate = next.health_rate;
+    settings_.relax_power_mw = next.relax_power_mw;
+    settings_.protect = next.protect;
+    settings_.on_shutdown = next.on_shutdown;
+    poller_.retuneLocked(next.poll_rate, next.health_rate);
+  }
+  wakeWorker();  // the worker may be waiting for a poll that is now due earlier
+}
+
+void ServoBus::start() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (started_ || stop_) return;
+    started_ = true;
+    if (link_ == nullptr) worker_ = std::thread([this] { workerLoop(); });
+  }
+  if (link_ != nullptr) link_->wake();  // the reader thread takes the work from now on
+}
+
+void ServoBus::shutdown() {
+  // The last words are decided from here on: no motion frame passes any more, whoever waited.
+  safety_.closeGate();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wakeWorker();
+  // The worker's poll is one background transaction at most.
+  if (worker_.joinable()) worker_.join();
+  {
+    // Running on the link's reader thread: the piece of work in progress ends first.
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait(lock, [this] { return !working_; });
+  }
+  safety_.finalWords();
+  client_.shutdown();  // every later call fails at once
+}
+
+ServoBusConfig ServoBus::settings() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return settings_;
+}
+
+ServoBusWorkerStats ServoBus::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ServoBusWorkerStats stats = stats_;
+  poller_.addStatsLocked(&stats);
+  return stats;
+}
+
+void ServoBus::runOn(SerialLink& link) {
+  link_ = &link;
+  link.addListener(this);
+  link.setWorker(this);
+  client_.setReaderPump({[&link] { return link.onReaderThread(); },
+                         [&link](Clock::time_point until) { return link.pump(until); },
+                         [&link] { link.wake(); }});
+}
+
+void ServoBus::wakeWorker() {
+  wake_.notify_all();
+  if (link_ != nullptr) link_->wake();
+}
+
+Clock::time_point ServoBus::nextWorkLocked() const {
+  if (!started_ || stop_) return Clock::time_point::max();
+  if (!queued_moves_.empty()) return Clock::time_point::min();
+  return std::min(stops_.nextWorkLocked(), poller_.nextPollLocked());
+}
+
+Clock::time_point ServoBus::nextWork() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return nextWorkLocked();
+}
+
+void ServoBus::work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (!started_ || stop_) return;
+  working_ = true;
+  workOnce(lock);
+  working_ = false;
+  lock.unlock();
+  wake_.notify_all();  // shutdown() waits for the piece of work in progress
+}
+
+void ServoBus::workerLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_) {
+    Clock::time_point due = nextWorkLocked();
+    // Nothing scheduled: wait to be woken (bounded, so the clock's arithmetic cannot overflow).
+    if (due == Clock::time_point::max()) due = clock_->now() + std::chrono::hours(1);
+    if (clock_->now() < due) {
+      clock_->waitUntil(lock, wake_, due);
+    } else {
+      workOnce(lock);
+    }
+  }
+}
+
+void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
+  // Stops first: nothing else this bus does may go before them.
+  if (stops_.workOnce(lock, StopPace::kScheduled)) return;
+  if (!queued_moves_.empty()) {
+    const MoveRequest move = queued_moves_.front();
+    queued_moves_.pop_front();
+    lock.unlock();
+    sendMove(move);
+    lock.lock();
+    return;
+  }
+  poller_.pollDue(lock);
+}
+
+void ServoBus::sendMove(const MoveRequest& move) {
+  ServoStatus status = safety_.refusal(move.id);  // an overheated servo (protect)
+  if (status.ok()) {
+    // Through the motion gate: refused if the e-stop came meanwhile.
+    status = client_.move(move, BusPriority::kWorker);
+  }
+  if (status.error == ServoError::kPreempted) {
+    // A stop goes first; the move goes after it unless a newer target or the e-stop replaced it.
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool replaced = std::any_of(queued_moves_.begin(), queued_moves_.end(),
+                                      [&move](const MoveRequest& m) { return m.id == move.id; });
+    if (!replaced && !safety_.motionLockedLocked() && !stops_.keptLocked(move.id)) {
+      queued_moves_.push_front(move);
+    }
+    return;
+  }
+  if (status.ok()) safety_.noteMotion(move.id, true);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (status.ok()) {
+      ++stats_.moves_sent;
+    } else {
+      ++stats_.moves_failed;
+    }
+  }
+  if (!status.ok() && events_.on_move_failed) events_.on_move_failed(move, status);
+}
+
+// The e-stop and the stops: the policy is the MotionSafety's, the delivery the worker's.
+
+void ServoBus::setMotionLocked(bool locked) { safety_.setMotionLocked(locked); }
+
+void ServoBus::stopServo(uint8_t id) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dropQueuedMovesLocked(id);
+    stops_.armLocked(id, clock_->now());
+  }
+  deliverStops();
+}
+
+void ServoBus::deliverStops() {
+  bool worker_running = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    worker_running = started_ && !stop_;
+  }
+  if (worker_running) {
+    stops_.askUrgent();  // nobody takes the bus before the worker has written them
+    wakeWorker();
+    return;
+  }
+  // No worker (before start()): write them here; their confirmation waits for the worker.
+  std::unique_lock<std::mutex> lock(mutex_);
+  stops_.writeDue(lock, StopPace::kNow);
+}
+
+void ServoBus::onLinkUp() {
+  // On the reader thread, before any write on the reopened port can succeed: the stops go first.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!safety_.rearmStopsLocked(clock_->now()) || !started_ || stop_) return;
+  }
+  stops_.askUrgent();
+  wakeWorker();  // a worker of its own; on the link, this thread is the worker
+}
+
+// Motion through the device: the MotionSafety's.
+
+ServoStatus ServoBus::move(const MoveRequest& request) { return safety_.move(request); }
+ServoStatus ServoBus::rotate(const RotateRequest& request) { return safety_.rotate(request); }
+ServoStatus ServoBus::spin(const SpinRequest& request) { return safety_.spin(request); }
+ServoStatus ServoBus::damping(uint8_t id, uint16_t power_mw, bool wait) {
+  return safety_.damping(id, power_mw, wait);
+}
+ServoStatus ServoBus::relax(const std::vector<uint8_t>& ids) { return safety_.relax(ids); }
+ServoStatus ServoBus::hold(const std::vector<uint8_t>& ids) { return safety_.hold(ids); }
+bool ServoBus::motionLocked() const { return safety_.motionLocked(); }
+std::vector<uint8_t> ServoBus::movingIds() const { return safety_.movingIds(); }
+std::vector<uint8_t> ServoBus::commandedIds() const { return safety_.commandedIds(); }
+std::vector<PendingStopReport> ServoBus::pendingStops() const { return stops_.reports(); }
+std::vector<ServoHealthReport> ServoBus::health() const { return poller_.health(); }
+
+}  // namespace serial_robot_driver::device

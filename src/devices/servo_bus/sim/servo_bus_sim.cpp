@@ -1,0 +1,499 @@
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "serial_robot_driver/devices/servo_bus/servo_commands.h"
+#include "serial_robot_driver/devices/servo_bus/servo_params.h"
+
+namespace serial_robot_driver::sim {
+
+namespace servo = protocol::servo;
+using servo::Command;
+
+namespace {
+
+// data_ids of docs/protocols.md, section 3 the simulator gives a behaviour to.
+constexpr uint8_t kVoltage = servo::dataId(servo::ServoDataId::kVoltage);
+constexpr uint8_t kCurrent = servo::dataId(servo::ServoDataId::kCurrent);
+constexpr uint8_t kPower = servo::dataId(servo::ServoDataId::kPower);
+constexpr uint8_t kTemperature = servo::dataId(servo::ServoDataId::kTemperature);
+constexpr uint8_t kServoStatus = servo::dataId(servo::ServoDataId::kServoStatus);
+constexpr uint8_t kServoType = servo::dataId(servo::ServoDataId::kServoType);
+constexpr uint8_t kFirmwareVersion = servo::dataId(servo::ServoDataId::kFirmwareVersion);
+constexpr uint8_t kSerialNumber = servo::dataId(servo::ServoDataId::kSerialNumber);
+constexpr uint8_t kResponseSwitch = servo::dataId(servo::ServoDataId::kResponseSwitch);
+constexpr uint8_t kServoId = servo::dataId(servo::ServoDataId::kServoId);
+constexpr uint8_t kAngleLimitSwitch = servo::dataId(servo::ServoDataId::kAngleLimitSwitch);
+constexpr uint8_t kAngleLimitHigh = servo::dataId(servo::ServoDataId::kAngleLimitHigh);
+constexpr uint8_t kAngleLimitLow = servo::dataId(servo::ServoDataId::kAngleLimitLow);
+
+constexpr int64_t kNominalVoltage = 7400;  // mV, a 2S LiPo
+constexpr int64_t kNominalTemperature = 35;
+constexpr int64_t kIdleCurrent = 20;  // mA
+constexpr int64_t kMovingCurrent = 350;
+
+constexpr auto kDriftPeriod = std::chrono::milliseconds(100);
+
+// Factory values of the user block (assumption: datasheet-like numbers). The id goes back to the
+// factory default 0 like on the real servo, so a reset on a chain may collide with servo 0.
+const std::map<uint8_t, int64_t>& userDefaults() {
+  using servo::ServoDataId;
+  static const std::map<uint8_t, int64_t> defaults = {
+      {dataId(ServoDataId::kReserved32), 0},
+      {dataId(ServoDataId::kResponseSwitch), 0},
+      {dataId(ServoDataId::kReserved35), 0},
+      {dataId(ServoDataId::kBaudrate), 5},
+      {dataId(ServoDataId::kStallProtectMode), 1},
+      {dataId(ServoDataId::kStallPowerLimit), 4000},
+      {dataId(ServoDataId::kOverVoltLow), 4500},
+      {dataId(ServoDataId::kOverVoltHigh), 14000},
+      {dataId(ServoDataId::kOverTemperature), 65},
+      {dataId(ServoDataId::kOverPower), 12000},
+      {dataId(ServoDataId::kOverCurrent), 3000},
+      {dataId(ServoDataId::kAccelSwitch), 1},
+      {dataId(ServoDataId::kReserved45), 0},
+      {dataId(ServoDataId::kPoLockSwitch), 0},
+      {dataId(ServoDataId::kWbLockSwitch), 0},
+      {dataId(ServoDataId::kAngleLimitSwitch), 0},
+      {dataId(ServoDataId::kSoftStartSwitch), 0},
+      {dataId(ServoDataId::kSoftStartTime), 3000},
+      {dataId(ServoDataId::kAngleLimitHigh), 1800},
+      {dataId(ServoDataId::kAngleLimitLow), -1800},
+      {dataId(ServoDataId::kAngleMidOffset), 0},
+  };
+  return defaults;
+}
+
+int16_t toDecidegrees(double degrees) {
+  constexpr double kMin = std::numeric_limits<int16_t>::min();
+  constexpr double kMax = std::numeric_limits<int16_t>::max();
+  return static_cast<int16_t>(std::lround(std::clamp(degrees * 10.0, kMin, kMax)));
+}
+
+// An angle folded into one turn, -180 .. 180.
+double wrapDegrees(double degrees) {
+  double wrapped = std::fmod(degrees + 180.0, 360.0);
+  if (wrapped < 0) wrapped += 360.0;
+  return wrapped - 180.0;
+}
+
+// The single-turn view of the multi-turn angle: unchanged within +-180, else folded into one turn.
+double foldDegrees(double degrees) {
+  return std::fabs(degrees) <= 180.0 ? degrees : wrapDegrees(degrees);
+}
+
+constexpr uint8_t kFactoryId = 0;
+constexpr double kDegreesPerTurn = 360.0;
+constexpr double kMsPerSecond = 1000.0;
+
+}  // namespace
+
+ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
+    : config_(config), rng_(config.seed), last_drift_(now) {
+  for (uint8_t id : config_.servo_ids) {
+    const bool offline = std::find(config_.offline_ids.begin(), config_.offline_ids.end(), id) !=
+                         config_.offline_ids.end();
+    if (offline || id == servo::kBroadcastId) continue;
+    Servo s;
+    s.last_step = now;
+    s.params[kVoltage] = kNominalVoltage;
+    s.params[kCurrent] = kIdleCurrent;
+    s.params[kPower] = kNominalVoltage * kIdleCurrent / 1000;
+    s.params[kTemperature] = kNominalTemperature;
+    s.params[kServoStatus] = 0;
+    s.params[kServoType] = 0x0101;
+    s.params[kFirmwareVersion] = 0x0102;
+    s.params[kSerialNumber] = 0x53520000 + id;
+    resetUserData(&s);
+    s.params[kServoId] = id;  // configured on this chain
+    if (auto held = config_.temperature_c.find(id); held != config_.temperature_c.end()) {
+      s.params[kTemperature] = held->second;
+    }
+    if (auto held = config_.voltage_mv.find(id); held != config_.voltage_mv.end()) {
+      s.params[kVoltage] = held->second;
+    }
+    servos_.push_back(std::move(s));
+  }
+}
+
+void ServoBusSim::resetUserData(Servo* s) const {
+  for (const auto& [data_id, value] : userDefaults()) s->params[data_id] = value;
+  s->params[kServoId] = kFactoryId;
+}
+
+void ServoBusSim::beginMove(Motion* m, double start_angle) {
+  const double distance = std::fabs(m->target_angle - start_angle);
+  if (m->velocity_dps > 0) {
+    // Accelerate to the velocity, cruise, decelerate; a short move never reaches the cruise speed
+    // (triangular profile over the same ramp times).
+    double peak = m->velocity_dps;
+    const double ramps = (m->accel_s + m->decel_s) / 2.0;
+    if (distance < peak * ramps) peak = ramps > 0 ? distance / ramps : peak;
+    m->peak_dps = peak;
+    m->duration_s = peak > 0 ? distance / peak + ramps : 0.0;
+    if (distance == 0.0) m->duration_s = 0.0;
+  } else {
+    // By interval: the ramps share the interval; ramps longer than it are shortened in proportion.
+    const double ramp_sum = m->accel_s + m->decel_s;
+    if (ramp_sum > m->duration_s && ramp_sum > 0) {
+      const double scale = m->duration_s / ramp_sum;
+      m->accel_s *= scale;
+      m->decel_s *= scale;
+    }
+    const double cruise_time = m->duration_s - (m->accel_s + m->decel_s) / 2.0;
+    m->peak_dps = cruise_time > 0 ? distance / cruise_time : 0.0;
+  }
+}
+
+double ServoBusSim::moveAngle(const Motion& m, double elapsed) {
+  if (elapsed >= m.duration_s || m.duration_s <= 0) return m.target_angle;
+  const double direction = m.target_angle >= m.start_angle ? 1.0 : -1.0;
+  const double v = m.peak_dps;
+  double travelled = 0.0;
+  if (elapsed < m.accel_s) {
+    travelled = 0.5 * v / m.accel_s * elapsed * elapsed;
+  } else if (elapsed < m.duration_s - m.decel_s) {
+    travelled = 0.5 * v * m.accel_s + v * (elapsed - m.accel_s);
+  } else {
+    const double left = m.duration_s - elapsed;
+    travelled = std::fabs(m.target_angle - m.start_angle) - 0.5 * v / m.decel_s * left * left;
+  }
+  return m.start_angle + direction * travelled;
+}
+
+void ServoBusSim::requestMove(Servo* s, Motion motion, uint8_t id, bool broadcast, TimePoint now) {
+  if (!motion.multi_turn && param(*s, kAngleLimitSwitch) == 1) {
+    motion.target_angle = std::clamp(motion.target_angle, param(*s, kAngleLimitLow) / 10.0,
+                                     param(*s, kAngleLimitHigh) / 10.0);
+  }
+  motion.kind = Motion::Kind::kRotate;
+  motion.answer = !broadcast && param(*s, kResponseSwitch) == 1;
+  motion.answer_id = id;
+  startMotion(s, motion, now);
+}
+
+int64_t ServoBusSim::param(const Servo& s, uint8_t data_id) {
+  const auto it = s.params.find(data_id);
+  return it == s.params.end() ? 0 : it->second;
+}
+
+void ServoBusSim::answer(TimePoint due, Command cmd, const std::vector<uint8_t>& content) {
+  PendingAnswer pending{due, servo::encodeResponse(cmd, content)};
+  const auto position =
+      std::upper_bound(pending_.begin(), pending_.end(), due,
+                       [](TimePoint t, const PendingAnswer& other) { return t < other.due; });
+  pending_.insert(position, std::move(pending));
+}
+
+void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint now) {
+  const auto decoded = servo::decodeRequest(data, size);
+  if (!decoded || decoded->content_size == 0) {
+    ++stats_.malformed;
+    return;
+  }
+  const servo::Packet& packet = *decoded;
+  ++stats_.requests;
+  const uint8_t id = packet.id();
+  const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(packet);
+  if (spin && spin->mode == servo::SpinMode::kStop && config_.lost_stops > 0) {
+    --config_.lost_stops;
+    ++stats_.stops_lost;
+    return;
+  }
+  if (id == servo::kBroadcastId) {
+    ++stats_.broadcasts;
+    for (Servo& s : servos_) execute(&s, packet, true, now);
+    return;
+  }
+  // The address is the servo_id parameter, which a write may have changed.
+  for (Servo& s : servos_) {
+    if (param(s, kServoId) == id) {
+      execute(&s, packet, false, now);
+      return;
+    }
+  }
+  ++stats_.unaddressed;
+}
+
+void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast, TimePoint now) {
+  runMotions(s, now);  // the angle and the queue as of this request
+  const uint8_t id = packet.id();
+  const TimePoint due = now + fromSeconds(config_.answer_latency_s);
+  const auto cmd = static_cast<Command>(packet.cmd);
+  const servo::CommandInfo& info = servo::commandInfo(cmd);
+  if (!info.request.fits(packet.content_size)) {
+    ++stats_.malformed;
+    return;
+  }
+  // Nobody answers the broadcast id; a motion answers (on completion) only with response_switch 1.
+  const bool answers = !broadcast && (info.answers == servo::Answers::kAlways ||
+                                      param(*s, kResponseSwitch) == 1);
+  const auto reply = [&](const std::vector<uint8_t>& answer_content) {
+    if (answers) answer(due, cmd, answer_content);
+  };
+  const auto malformed = [&]() { ++stats_.malformed; };
+
+  if (servo::isMove(cmd)) {
+    const protocol::Decoded<servo::MoveCommand> move = servo::decodeMove(packet);
+    if (!move) return malformed();
+    Motion motion;
+    motion.cmd = cmd;
+    motion.multi_turn = servo::isMultiTurn(cmd);
+    motion.target_angle = move->angle_decidegrees / 10.0;
+    if (servo::isByVelocity(cmd)) {
+      motion.velocity_dps = move->velocity_decidegrees_per_s / 10.0;
+      if (motion.velocity_dps <= 0) return malformed();
+    } else {
+      motion.duration_s = move->interval_ms / kMsPerSecond;
+    }
+    if (servo::hasRamps(cmd)) {
+      motion.accel_s = move->ramps.accel_ms / kMsPerSecond;
+      motion.decel_s = move->ramps.decel_ms / kMsPerSecond;
+    }
+    requestMove(s, motion, id, broadcast, now);
+    return;
+  }
+
+  switch (cmd) {
+    case Command::kPing:
+      reply(servo::pingAnswerContent(id));
+      break;
+
+    case Command::kResetUserData:
+      resetUserData(s);
+      // The servo now has its factory id and answers from there.
+      reply(servo::resultAnswerContent(kFactoryId, true));
+      break;
+
+    case Command::kReadData: {
+      const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
+      if (!request) return malformed();
+      const servo::ParamInfo* param_info = servo::findParamById(request->data_id);
+      if (param_info == nullptr) {
+        ++stats_.unknown_data_ids;
+        return;
+      }
+      reply(servo::readDataAnswerContent(id, *param_info, param(*s, param_info->data_id)));
+      break;
+    }
+
+    case Command::kWriteData: {
+      const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
+      if (!request) return malformed();
+      const servo::ParamInfo* param_info = servo::findParamById(request->data_id);
+      if (param_info == nullptr) {
+        ++stats_.unknown_data_ids;
+        return;
+      }
+      const auto value = servo::readValue(*param_info, request->value.data(), request->value_size);
+      if (!value) return malformed();
+      // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
+      const bool ok = servo::checkWrite(*param_info, *value, true) == servo::WriteCheck::kOk;
+      if (ok) {
+        s->params[param_info->data_id] = *value;
+      } else {
+        ++stats_.writes_rejected;
+      }
+      reply(servo::writeDataAnswerContent(id, param_info->data_id, ok));
+      break;
+    }
+
+    case Command::kReadBatchData: {
+      const auto value_of = [&](const servo::ParamInfo& info) { return param(*s, info.data_id); };
+      reply(servo::userBlockAnswerContent(id, servo::packUserBlock(value_of)));
+      break;
+    }
+
+    case Command::kWriteBatchData: {
+      const auto block = servo::decodeUserBlock(packet);
+      if (!block) return malformed();
+      const auto values = servo::unpackUserBlock(*block);
+      // All or nothing: one bad cell rejects the block.
+      const bool ok = std::all_of(values.begin(), values.end(), [](const auto& cell) {
+        return servo::checkWrite(*cell.first, cell.second, true) == servo::WriteCheck::kOk;
+      });
+      if (ok) {
+        for (const auto& [param_info, value] : values) s->params[param_info->data_id] = value;
+      } else {
+        ++stats_.writes_rejected;
+      }
+      reply(servo::resultAnswerContent(id, ok));
+      break;
+    }
+
+    case Command::kSpin: {
+      const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(packet);
+      if (!spin) return malformed();
+      const double speed = spin->speed_dps;
+      const double rate = spin->clockwise ? -speed : speed;  // clockwise is negative
+      Motion motion;
+      motion.kind = Motion::Kind::kSpin;
+      motion.cmd = Command::kSpin;
+      motion.answer = answers;
+      motion.answer_id = id;
+      motion.rate_dps = rate;
+      switch (spin->mode) {
+        case servo::SpinMode::kStop:
+          stopAll(s);
+          reply(servo::resultAnswerContent(id, true));
+          return;
+        case servo::SpinMode::kContinuous:
+          stopAll(s);
+          s->relaxed = false;
+          s->spin_rate_dps = rate;
+          reply(servo::resultAnswerContent(id, true));
+          return;
+        case servo::SpinMode::kTurns:
+          motion.duration_s = speed > 0 ? spin->value * 360.0 / speed : 0.0;
+          break;
+        case servo::SpinMode::kDurationMs:
+          motion.duration_s = spin->value / 1000.0;
+          break;
+      }
+      startMotion(s, motion, now);
+      break;
+    }
+
+    case Command::kReadMultiTurnAngle: {
+      servo::MultiTurnAngle reading;
+      reading.id = id;
+      const double decidegrees =
+          std::clamp(std::round(s->angle_deg * 10.0), double(std::numeric_limits<int32_t>::min()),
+                     double(std::numeric_limits<int32_t>::max()));
+      reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
+      reading.turns = static_cast<int16_t>(std::trunc(s->angle_deg / kDegreesPerTurn));
+      reply(servo::multiTurnAngleContent(reading));
+      break;
+    }
+
+    case Command::kDamping:
+      stopAll(s);  // damping releases the holding torque: nothing keeps moving
+      s->relaxed = true;
+      reply(servo::resultAnswerContent(id, true));
+      break;
+
+    case Command::kReadAngle:
+      reply(servo::angleAnswerContent(
+          servo::AngleAnswer{id, toDecidegrees(foldDegrees(s->angle_deg))}));
+      break;
+
+    default:  // the moves, above
+      break;
+  }
+}
+
+void ServoBusSim::stopAll(Servo* s) {
+  s->motions.clear();
+  s->spin_rate_dps = 0.0;
+}
+
+void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
+  if (!motion.answer) stopAll(s);  // response_switch 0: the new command interrupts
+  s->spin_rate_dps = 0.0;
+  s->relaxed = false;
+  s->motions.push_back(motion);
+  runMotions(s, now);
+}
+
+void ServoBusSim::runMotions(Servo* s, TimePoint now) {
+  if (s->spin_rate_dps != 0.0) {
+    s->angle_deg += s->spin_rate_dps * toSeconds(now - s->last_step);  // turns accumulate
+  }
+  s->last_step = now;
+  TimePoint cursor = now;
+  while (!s->motions.empty()) {
+    Motion& motion = s->motions.front();
+    if (!motion.started) {
+      motion.started = true;
+      motion.start = cursor;
+      if (motion.kind == Motion::Kind::kRotate && !motion.multi_turn) {
+        s->angle_deg = foldDegrees(s->angle_deg);  // a single-turn move works within one turn
+      }
+      motion.start_angle = s->angle_deg;
+      if (motion.kind == Motion::Kind::kRotate) beginMove(&motion, motion.start_angle);
+    }
+    const double elapsed = toSeconds(now - motion.start);
+    const bool done = elapsed >= motion.duration_s;
+    const double progress = done ? motion.duration_s : elapsed;
+    if (motion.kind == Motion::Kind::kRotate) {
+      s->angle_deg = moveAngle(motion, progress);
+    } else {
+      s->angle_deg = motion.start_angle + motion.rate_dps * progress;
+    }
+    if (!done) break;
+    const TimePoint finished = motion.start + fromSeconds(motion.duration_s);
+    if (motion.answer) {
+      answer(std::max(finished, now) + fromSeconds(config_.answer_latency_s), motion.cmd,
+             servo::resultAnswerContent(motion.answer_id, true));
+    }
+    cursor = finished;  // the next queued motion starts where this one ended
+    s->motions.pop_front();
+  }
+}
+
+void ServoBusSim::driftReadOnly(Servo* s) {
+  std::uniform_int_distribution<int> step(-1, 1);
+  const bool moving = !s->motions.empty() || s->spin_rate_dps != 0.0;
+  const auto id = static_cast<uint8_t>(param(*s, kServoId));
+  const bool voltage_held = config_.voltage_mv.count(id) > 0;
+  const bool temperature_held = config_.temperature_c.count(id) > 0;
+  int64_t& voltage = s->params[kVoltage];
+  if (!voltage_held) {
+    voltage =
+        std::clamp<int64_t>(voltage + 5 * step(rng_), kNominalVoltage - 60, kNominalVoltage + 60);
+  }
+  int64_t& temperature = s->params[kTemperature];
+  if (!temperature_held && std::uniform_int_distribution<int>(0, 49)(rng_) == 0) {
+    temperature = std::clamp<int64_t>(temperature + step(rng_), kNominalTemperature - 1,
+                                      kNominalTemperature + 2);
+  }
+  const int64_t current =
+      (moving ? kMovingCurrent : kIdleCurrent) + std::uniform_int_distribution<int>(0, 5)(rng_);
+  s->params[kCurrent] = current;
+  s->params[kPower] = voltage * current / 1000;
+}
+
+void ServoBusSim::tick(TimePoint now, Outbox* out) {
+  const bool drift = now - last_drift_ >= kDriftPeriod;
+  if (drift) last_drift_ = now;
+  for (Servo& s : servos_) {
+    runMotions(&s, now);
+    if (drift) driftReadOnly(&s);
+  }
+  while (!pending_.empty() && pending_.front().due <= now) {
+    out->push_back(Outgoing{OutputKind::kServoResponse, std::move(pending_.front().bytes),
+                            pending_.front().due});
+    pending_.pop_front();
+    ++stats_.answers;
+  }
+}
+
+TimePoint ServoBusSim::nextEvent() const {
+  TimePoint next = last_drift_ + kDriftPeriod;
+  if (!pending_.empty()) next = std::min(next, pending_.front().due);
+  for (const Servo& s : servos_) {
+    if (s.motions.empty()) continue;
+    const Motion& motion = s.motions.front();
+    if (motion.started) next = std::min(next, motion.start + fromSeconds(motion.duration_s));
+  }
+  return next;
+}
+
+ServoBusSimStats ServoBusSim::stats() const {
+  ServoBusSimStats copy = stats_;
+  copy.servos.clear();
+  for (const Servo& s : servos_) {
+    BusServoSnapshot snapshot;
+    snapshot.id = static_cast<uint8_t>(param(s, kServoId));
+    snapshot.angle_deg = s.angle_deg;
+    snapshot.moving = !s.motions.empty() || s.spin_rate_dps != 0.0;
+    snapshot.relaxed = s.relaxed;
+    snapshot.params = s.params;
+    copy.servos.push_back(std::move(snapshot));
+  }
+  return copy;
+}
+
+}  // namespace serial_robot_driver::sim
