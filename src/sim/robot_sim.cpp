@@ -17,16 +17,16 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/transport/byte_stream.h"
-#include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "robot_sim_port.h"
+#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
+#include "serial_robot_driver/transport/byte_stream.h"
 
 namespace serial_robot_driver::sim {
 
-using protocol::FrameFamily;
 using detail::kMaxBacklogBytes;
 using detail::setNonBlocking;
+using protocol::FrameFamily;
 
 namespace {
 

@@ -17,8 +17,7 @@ void RobotSim::startHosted(TimePoint now) {
     const SimDeviceModule* module = findSimDevice(options.name);
     const device::DeviceModule* core = device::findDevice(options.name);
     if (module == nullptr || module->make == nullptr || core == nullptr) {
-      throw std::invalid_argument("robot_sim: no registered device '" + options.name +
-                                  "' to host");
+      throw std::invalid_argument("robot_sim: no registered device '" + options.name + "' to host");
     }
     const bool twice = std::any_of(hosted_.begin(), hosted_.end(),
                                    [&](const Hosted& other) { return other.name == options.name; });
@@ -32,8 +31,8 @@ void RobotSim::startHosted(TimePoint now) {
   }
 }
 
-bool RobotSim::deliverToHosted(Port* port, const protocol::FrameFamily& family,
-                               const uint8_t* data, std::size_t size, TimePoint at) {
+bool RobotSim::deliverToHosted(Port* port, const protocol::FrameFamily& family, const uint8_t* data,
+                               std::size_t size, TimePoint at) {
   for (Hosted& hosted : hosted_) {
     if (hosted.port != port) continue;
     if (std::find(hosted.families.begin(), hosted.families.end(), family) ==

@@ -1,7 +1,7 @@
 // The simulated robot: the three devices of docs/protocols.md on one or more pseudo-terminals,
 // speaking the real bytes, with optional fault injection, and any other registered device asked
-// for (SimOptions::hosted, through its sim/sim_device_module.h). ROS-free; `robot_sim` is a thin main
-// around it (its flags: command_line.h) and tests run it in-process.
+// for (SimOptions::hosted, through its sim/sim_device_module.h). ROS-free; `robot_sim` is a thin
+// main around it (its flags: command_line.h) and tests run it in-process.
 //
 // Threading: start() spawns one thread that owns the ptys and the devices. It polls the pty master
 // fds, feeds each port's StreamFramer, runs the device timers on the steady clock and writes the

@@ -8,10 +8,10 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/devices/base/base_sim.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/sim_types.h"
 
 namespace serial_robot_driver::sim {
