@@ -33,12 +33,14 @@ PingResult EchoController::ping() {
     std::lock_guard<std::mutex> lock(mutex_);
     expected_.reset();
     ++stats_.write_failures;
+    stats_.last_ping_failed = true;
     return PingResult{false, {}, "the port is down"};
   }
   std::unique_lock<std::mutex> lock(mutex_);
   const bool answered =
       answered_.wait_for(lock, timeout_, [this] { return answer_arrival_.has_value(); });
   expected_.reset();
+  stats_.last_ping_failed = !answered;
   if (!answered) {
     ++stats_.timeouts;
     return PingResult{false, {}, "no answer within " + std::to_string(timeout_.count()) + " ms"};
@@ -46,16 +48,6 @@ PingResult EchoController::ping() {
   const auto round_trip = std::max(Clock::duration::zero(), *answer_arrival_ - sent);
   stats_.last_round_trip = round_trip;
   return PingResult{true, round_trip, ""};
-}
-
-void EchoController::onLinkUp() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  stats_.link_up = true;
-}
-
-void EchoController::onLinkDown() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  stats_.link_up = false;
 }
 
 void EchoController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,

@@ -22,7 +22,7 @@ struct EchoStats {
   uint64_t timeouts = 0;     ///< no matching answer in time
   uint64_t write_failures = 0;
   std::optional<std::chrono::nanoseconds> last_round_trip;  ///< of the last successful ping
-  bool link_up = false;
+  bool last_ping_failed = false;                            ///< no answer, or not sent
 };
 
 struct PingResult {
@@ -39,8 +39,6 @@ class EchoController : public LinkListener {
   /// link's reader (which delivers the answer); one ping at a time, others wait their turn.
   PingResult ping();
 
-  void onLinkUp() override;
-  void onLinkDown() override;
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) override;
 

@@ -5,8 +5,6 @@
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 
-#include <atomic>
-
 #include "serial_robot_driver/devices/echo/echo_controller.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
@@ -29,7 +27,6 @@ class EchoInterface : public DeviceInterface {
   device::SerialLink& link_;
   device::EchoController controller_;
   ros::ServiceServer ping_srv_;
-  std::atomic<bool> last_ping_failed_{false};
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -1,9 +1,10 @@
 #include "serial_robot_driver/devices/echo/echo_interface.h"
 
-#include <atomic>
 #include <cstdio>
 
 #include "serial_robot_driver/devices/echo/echo_params.h"
+#include "serial_robot_driver/devices/echo/echo_status.h"
+#include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -22,7 +23,6 @@ void EchoInterface::shutdown() { ping_srv_.shutdown(); }
 
 bool EchoInterface::onPing(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   const device::PingResult result = controller_.ping();
-  last_ping_failed_ = !result.ok;
   response.success = result.ok;
   if (result.ok) {
     char text[64];
@@ -36,27 +36,8 @@ bool EchoInterface::onPing(std_srvs::Trigger::Request&, std_srvs::Trigger::Respo
 }
 
 void EchoInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  using diagnostic_msgs::DiagnosticStatus;
-  const device::EchoStats stats = controller_.stats();
-  if (!link_.connected()) {
-    status.summary(DiagnosticStatus::ERROR, "port " + link_.options().path + " is not open");
-  } else if (last_ping_failed_) {
-    status.summary(DiagnosticStatus::WARN, "the last ping had no answer");
-  } else if (stats.round_trips == 0) {
-    status.summary(DiagnosticStatus::OK, "no ping yet");
-  } else {
-    status.summary(DiagnosticStatus::OK, "answering");
-  }
-  status.add("port", link_.options().path);
-  status.add("pings", stats.pings);
-  status.add("round trips", stats.round_trips);
-  status.add("mismatched answers", stats.mismatches);
-  status.add("timeouts", stats.timeouts);
-  status.add("write failures", stats.write_failures);
-  if (stats.last_round_trip) {
-    status.addf("last round trip ms", "%.3f",
-                std::chrono::duration<double, std::milli>(*stats.last_round_trip).count());
-  }
+  writeStatusReport(
+      device::echoStatus(controller_.stats(), {link_.options().path, link_.connected()}), status);
 }
 
 }  // namespace serial_robot_driver::ros_layer

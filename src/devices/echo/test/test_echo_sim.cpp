@@ -113,7 +113,9 @@ TEST(EchoSim, CommandLineHostsItAloneOnItsOwnLink) {
   EXPECT_EQ(stats.pings, 3u);
   EXPECT_EQ(stats.round_trips, 3u);
   EXPECT_EQ(stats.mismatches + stats.timeouts, 0u);
+  EXPECT_FALSE(stats.last_ping_failed);
   EXPECT_FALSE(controller.ping().ok) << "the port is closed";
+  EXPECT_TRUE(controller.stats().last_ping_failed);
 }
 
 TEST(EchoController, CountsTimeoutsAndMismatchedAnswers) {
@@ -136,6 +138,7 @@ TEST(EchoController, CountsTimeoutsAndMismatchedAnswers) {
   EXPECT_EQ(stats.timeouts, 1u);
   EXPECT_EQ(stats.mismatches, 1u);
   EXPECT_EQ(stats.round_trips, 0u);
+  EXPECT_TRUE(stats.last_ping_failed);
 }
 
 }  // namespace
