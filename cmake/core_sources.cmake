@@ -42,8 +42,16 @@ set(SRD_CORE_GENERATED_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_dev
 set(SRD_SIM_SOURCES
   src/sim/pseudo_terminal.cpp
   src/sim/robot_sim.cpp
+  src/sim/robot_sim_plug.cpp
+  src/sim/robot_sim_hosted.cpp
   src/sim/command_line.cpp
   src/sim/sim_stats.cpp
+  src/sim/sim_device_module.cpp
 )
 srd_device_sources(sim srd_device_sim_sources)
 list(APPEND SRD_SIM_SOURCES ${srd_device_sim_sources})
+# The simulator parts robot_sim can host (sim/sim_device_module.h): every device with a sim/ folder.
+srd_write_registry("${CMAKE_BINARY_DIR}/srd_generated/registered_sim_devices.cpp"
+  "serial_robot_driver/sim/sim_device_module.h" "serial_robot_driver::sim::SimDeviceModule"
+  kSimModule "serial_robot_driver::sim::registeredSimDevices" sim)
+list(APPEND SRD_SIM_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_sim_devices.cpp")

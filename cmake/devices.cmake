@@ -6,6 +6,7 @@ set(SRD_DEVICES
   base
   body
   servo_bus
+  echo  # the tests' loop-back device (src/devices/echo/), disabled unless ~echo/enabled
 )
 
 # Writes a registry source: `function`() returns every device's `symbol` (of type `type`,

@@ -158,3 +158,22 @@ add_rostest_gtest(test_estop_bus test/rostest/estop_bus.test test/rostest/test_e
 target_include_directories(test_estop_bus PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_estop_bus srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_estop_bus driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
+# Each device's own rostests, found by convention: src/devices/<name>/test/ros/<x>.test and the
+# gtest sources beside it named test_<x>*.cpp make the target test_<x> (run with
+# `rostest --text serial_robot_driver <x>.test`), against driver_node and robot_sim.
+foreach(device ${SRD_DEVICES})
+  file(GLOB device_rostests RELATIVE "${PROJECT_SOURCE_DIR}" CONFIGURE_DEPENDS
+    "${PROJECT_SOURCE_DIR}/src/devices/${device}/test/ros/*.test")
+  foreach(launch ${device_rostests})
+    get_filename_component(stem "${launch}" NAME_WE)
+    get_filename_component(folder "${launch}" DIRECTORY)
+    file(GLOB sources RELATIVE "${PROJECT_SOURCE_DIR}" CONFIGURE_DEPENDS
+      "${PROJECT_SOURCE_DIR}/${folder}/test_${stem}*.cpp")
+    list(SORT sources)
+    add_rostest_gtest(test_${stem} ${launch} ${sources})
+    target_include_directories(test_${stem} PRIVATE ${catkin_INCLUDE_DIRS})
+    target_link_libraries(test_${stem} srd_test_support srd_sim ${catkin_LIBRARIES})
+    add_dependencies(test_${stem} driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
+  endforeach()
+endforeach()

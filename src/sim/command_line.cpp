@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/sim/sim_device_module.h"
 
 namespace serial_robot_driver::sim {
 
@@ -184,9 +185,49 @@ Flag heldValue(const std::string& name, const std::string& value_name, const std
               {}};
 }
 
+/// The hosted device `name` in `options`, added on first mention.
+HostedDeviceOptions& hostedDevice(SimOptions& options, const std::string& name) {
+  for (HostedDeviceOptions& hosted : options.hosted) {
+    if (hosted.name == name) return hosted;
+  }
+  options.hosted.push_back(HostedDeviceOptions{name, std::nullopt, {}});
+  return options.hosted.back();
+}
+
+/// The flags of every registered device robot_sim hosts through its SimDeviceModule (none of the
+/// built-in ones): --<name> hosts it, --<name>-link and --<name>-<option> too, with that setting.
+std::vector<Flag> withHostedDevices(std::vector<Flag> table) {
+  bool titled = false;
+  for (const SimDeviceModule* module : registeredSimDevices()) {
+    if (module->make == nullptr) continue;
+    if (!titled) table.push_back(section("Other devices (none unless asked for):"));
+    titled = true;
+    const std::string name = module->name;
+    const std::string flag = "--" + flagName(name);
+    table.push_back(toggle(flag, "simulate the " + name + " device (on the shared pty)",
+                           [name](SimOptions& o) { hostedDevice(o, name); }));
+    table.push_back(Flag{flag + "-link", "PATH", "own pty for the " + name + " device (hosts it)",
+                         [name](const std::string& value, SimOptions& o) {
+                           hostedDevice(o, name).link = value;
+                           return std::string();
+                         },
+                         nullptr});
+    for (const SimDeviceOption& option : module->options) {
+      const std::string key = option.option;
+      table.push_back(Flag{flag + "-" + key, option.value_name, option.help,
+                           [name, key](const std::string& value, SimOptions& o) {
+                             hostedDevice(o, name).settings[key] = value;
+                             return std::string();
+                           },
+                           nullptr});
+    }
+  }
+  return table;
+}
+
 /// Every flag of robot_sim, in --help order.
 const std::vector<Flag>& flags() {
-  static const std::vector<Flag> table = {
+  static const std::vector<Flag> table = withHostedDevices({
       section("Ports:"),
       text("--link", "PATH", "symlink to the shared pty (default: none, just print the path)",
            &SimOptions::link),
@@ -281,7 +322,7 @@ const std::vector<Flag>& flags() {
       section("Output:"),
       text("--stats-file", "PATH", "\"key value\" counters, rewritten every second and at exit",
            &SimOptions::stats_file),
-  };
+  });
   return table;
 }
 
@@ -362,7 +403,8 @@ CommandLine parseCommandLine(int argc, const char* const* argv) {
     if (!problem.empty()) return fail(problem);
   }
   const SimOptions& options = result.options;
-  if (!result.help && !options.enable_base && !options.enable_body && !options.enable_servo_bus) {
+  if (!result.help && !options.enable_base && !options.enable_body && !options.enable_servo_bus &&
+      options.hosted.empty()) {
     return fail("--no-base, --no-body and --no-servo-bus together leave nothing to simulate");
   }
   return result;

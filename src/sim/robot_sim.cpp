@@ -17,37 +17,26 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robot_sim_port.h"
 #include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/transport/byte_stream.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
+#include "serial_robot_driver/transport/byte_stream.h"
 
 namespace serial_robot_driver::sim {
 
+using detail::kMaxBacklogBytes;
+using detail::setNonBlocking;
 using protocol::FrameFamily;
 
 namespace {
 
-/// Bytes queued for a port nobody reads before whole frames are discarded (frames are never cut).
-constexpr std::size_t kMaxBacklogBytes = 16 * 1024;
 /// How long an unplug waits for the host to read what was already sent.
 constexpr auto kDrainTimeout = std::chrono::milliseconds(250);
-constexpr auto kReplugRetry = std::chrono::seconds(1);
 constexpr std::size_t kMaxGarbageBurst = 24;
 /// With --pace-baud, a long frame goes into the pty in pieces of what the line carries in this
 /// much time: a finer slice would only wake the simulator more often. A shorter frame goes in
 /// whole once its last bit is through the line, as a UART reader would see it complete.
 constexpr auto kPaceSlice = std::chrono::milliseconds(2);
-
-void setNonBlocking(int fd) {
-  const int flags = ::fcntl(fd, F_GETFL, 0);
-  if (flags >= 0) ::fcntl(fd, F_SETFL, flags | O_NONBLOCK);
-}
-
-std::string joinNames(const std::vector<std::string>& names) {
-  std::string joined;
-  for (const std::string& name : names) joined += (joined.empty() ? "" : ",") + name;
-  return joined;
-}
 
 /// Index of the checksum byte a corruption flips.
 std::size_t checksumIndex(OutputKind kind, std::size_t size) {
@@ -56,38 +45,6 @@ std::size_t checksumIndex(OutputKind kind, std::size_t size) {
 }
 
 }  // namespace
-
-struct RobotSim::Port {
-  struct PendingWrite {
-    std::vector<uint8_t> bytes;
-    std::size_t offset = 0;
-    bool is_frame = true;  ///< false for garbage bursts
-    OutputKind kind = OutputKind::kBaseReply;
-    bool damaged = false;
-    TimePoint ready_at{};  ///< --pace-baud: the line carries it from then on, not before
-  };
-
-  std::string link;
-  std::vector<std::string> device_names;
-  std::unique_ptr<PseudoTerminal> pty;
-  std::string slave_path;
-  std::unique_ptr<protocol::StreamFramer> framer;
-  std::deque<PendingWrite> backlog;
-  std::size_t backlog_bytes = 0;
-  /// --pace-baud: when the line is free again for what we send, and for what the host sent.
-  TimePoint tx_line_free{};
-  TimePoint rx_line_free{};
-  /// --pace-baud: bytes the host wrote, each chunk with the time its last bit is through the line.
-  std::deque<std::pair<TimePoint, std::vector<uint8_t>>> rx_in_flight;
-  bool plugged = true;
-  bool draining = false;
-  int drain_probe_fd = -1;  ///< our own handle on the slave, to see whether the host read it all
-  TimePoint drain_deadline;
-  TimePoint next_unplug = TimePoint::max();
-  TimePoint replug_at = TimePoint::max();
-  TimePoint next_garbage = TimePoint::max();
-  std::mt19937 rng;
-};
 
 RobotSim::RobotSim(SimOptions options) : options_(std::move(options)) {}
 
@@ -107,7 +64,8 @@ void RobotSim::event(const std::string& text) const {
 
 void RobotSim::start() {
   if (running_ || thread_.joinable()) return;
-  if (!options_.enable_base && !options_.enable_body && !options_.enable_servo_bus) {
+  if (!options_.enable_base && !options_.enable_body && !options_.enable_servo_bus &&
+      options_.hosted.empty()) {
     throw std::invalid_argument("robot_sim: every device is disabled");
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -152,7 +110,7 @@ void RobotSim::start() {
             body_->handleSyncWrite(data, size);
           } else if (family == protocol::servo::kRequestFrames && servo_port_ == raw) {
             servo_bus_->handleRequest(data, size, at);
-          } else {
+          } else if (!deliverToHosted(raw, family, data, size, at)) {
             ++counters_.frames_for_absent_device;
           }
           for (Outgoing& frame : outbox) route(std::move(frame));
@@ -167,6 +125,8 @@ void RobotSim::start() {
   if (base_) base_port_ = portFor(options_.base_link, "base");
   if (body_) body_port_ = portFor(options_.body_link, "body");
   if (servo_bus_) servo_port_ = portFor(options_.servo_link, "servo_bus");
+  startHosted(now);
+  for (Hosted& hosted : hosted_) hosted.port = portFor(hosted.port_link, hosted.name);
 
   for (auto& port : ports_) {
     port->pty = std::make_unique<PseudoTerminal>(port->link);
@@ -304,46 +264,6 @@ void RobotSim::flush(Port* port) {
   }
 }
 
-void RobotSim::unplug(Port* port, TimePoint now) {
-  for (const Port::PendingWrite& pending : port->backlog) {
-    if (pending.is_frame) ++counters_.sent[static_cast<std::size_t>(pending.kind)].discarded;
-  }
-  port->backlog.clear();
-  port->backlog_bytes = 0;
-  port->rx_in_flight.clear();
-  if (port->drain_probe_fd >= 0) {
-    ::close(port->drain_probe_fd);
-    port->drain_probe_fd = -1;
-  }
-  port->pty->close();  // closes both sides and removes the symlink
-  port->pty.reset();
-  port->draining = false;
-  port->plugged = false;
-  port->replug_at = now + fromSeconds(options_.faults.unplug_duration_s);
-  ++counters_.unplugs;
-  event("robot_sim: " + joinNames(port->device_names) + " unplugged" +
-        (port->link.empty() ? "" : " (link " + port->link + ")"));
-}
-
-void RobotSim::replug(Port* port, TimePoint now) {
-  try {
-    port->pty = std::make_unique<PseudoTerminal>(port->link);
-  } catch (const transport::TransportError& error) {
-    port->replug_at = now + kReplugRetry;
-    event(std::string("robot_sim: replug failed, retrying: ") + error.what());
-    return;
-  }
-  port->slave_path = port->pty->slavePath();
-  setNonBlocking(port->pty->masterFd());
-  port->framer->reset();  // a partial frame from before the unplug is meaningless now
-  port->plugged = true;
-  port->replug_at = TimePoint::max();
-  port->next_unplug = now + fromSeconds(options_.faults.unplug_every_s);
-  ++counters_.replugs;
-  event("robot_sim: " + joinNames(port->device_names) + " on " + port->slave_path +
-        (port->link.empty() ? "" : " (link " + port->link + ")"));
-}
-
 void RobotSim::step(TimePoint now) {
   // --pace-baud: what the host wrote reaches the devices once its last bit is through the line.
   for (auto& owned : ports_) {
@@ -366,6 +286,11 @@ void RobotSim::step(TimePoint now) {
   }
   if (servo_bus_) servo_bus_->tick(now, &outbox);
   for (Outgoing& frame : outbox) route(std::move(frame));
+  for (Hosted& hosted : hosted_) {
+    HostedOutbox hosted_out;
+    hosted.device->tick(now, &hosted_out);
+    sendHosted(hosted.port, &hosted_out);
+  }
 
   const FaultOptions& faults = options_.faults;
   for (auto& owned : ports_) {
@@ -477,6 +402,7 @@ void RobotSim::run() {
     if (base_) next = std::min(next, base_->nextEvent());
     if (body_) next = std::min(next, body_->nextEvent());
     if (servo_bus_) next = std::min(next, servo_bus_->nextEvent());
+    for (const Hosted& hosted : hosted_) next = std::min(next, hosted.device->nextEvent());
     next = std::min(next, next_stats_write_);
     for (auto& port : ports_) {
       next = std::min({next, port->next_unplug, port->replug_at, port->next_garbage});
@@ -493,6 +419,9 @@ SimStats RobotSim::snapshotLocked() const {
   if (base_) stats.base = base_->stats();
   if (body_) stats.body = body_->stats();
   if (servo_bus_) stats.servo_bus = servo_bus_->stats();
+  for (const Hosted& hosted : hosted_) {
+    for (auto& line : hosted.device->statsLines()) stats.hosted.push_back(std::move(line));
+  }
   for (const auto& port : ports_) {
     const protocol::FramerStats& framer = port->framer->stats();
     stats.framer.add(framer);

@@ -89,6 +89,9 @@ std::string formatStats(const SimStats& stats) {
   line("garbage_bytes", stats.garbage_bytes);
   line("unplugs", stats.unplugs);
   line("replugs", stats.replugs);
+  // Only with hosted devices, so the built-in robot's stats read as they always did.
+  for (const auto& [key, value] : stats.hosted) line(key, value);
+  if (!stats.hosted.empty()) line("hosted_frames_discarded", stats.hosted_frames_discarded);
   return out.str();
 }
 

@@ -1,6 +1,7 @@
 // The simulated robot: the three devices of docs/protocols.md on one or more pseudo-terminals,
-// speaking the real bytes, with optional fault injection. ROS-free; `robot_sim` is a thin main
-// around it (its flags: command_line.h) and tests run it in-process.
+// speaking the real bytes, with optional fault injection, and any other registered device asked
+// for (SimOptions::hosted, through its sim/sim_device_module.h). ROS-free; `robot_sim` is a thin
+// main around it (its flags: command_line.h) and tests run it in-process.
 //
 // Threading: start() spawns one thread that owns the ptys and the devices. It polls the pty master
 // fds, feeds each port's StreamFramer, runs the device timers on the steady clock and writes the
@@ -19,6 +20,7 @@
 #include "serial_robot_driver/devices/base/base_sim.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/sim/sim_device_module.h"
 #include "serial_robot_driver/sim/sim_options.h"
 #include "serial_robot_driver/sim/sim_stats.h"
 
@@ -26,7 +28,7 @@ namespace serial_robot_driver::sim {
 
 /// One pty and the devices on it.
 struct SimPort {
-  std::vector<std::string> devices;  ///< "base", "body", "servo_bus"
+  std::vector<std::string> devices;  ///< "base", "body", "servo_bus", hosted devices' names
   std::string link;                  ///< "" when none
   std::string slave_path;            ///< changes after a replug
   bool plugged = true;
@@ -52,6 +54,20 @@ class RobotSim {
 
  private:
   struct Port;
+  /// A registered device hosted through its SimDeviceModule, on its port.
+  struct Hosted {
+    std::string name;
+    std::vector<protocol::FrameFamily> families;  ///< what it reads (simulator_frames)
+    std::unique_ptr<SimDevice> device;
+    std::string port_link;  ///< its effective link
+    Port* port = nullptr;
+  };
+  void startHosted(TimePoint now);
+  /// Hands a frame to the hosted device on `port` that reads `family`; false when none does.
+  bool deliverToHosted(Port* port, const protocol::FrameFamily& family, const uint8_t* data,
+                       std::size_t size, TimePoint at);
+  /// Writes what a hosted device emitted on its port (faults apply as to every frame there).
+  void sendHosted(Port* port, HostedOutbox* outbox);
   void run();
   void step(TimePoint now);
   void route(Outgoing frame);  ///< to the port of the device that emitted it
@@ -76,6 +92,7 @@ class RobotSim {
   std::unique_ptr<BaseSim> base_;
   std::unique_ptr<BodySim> body_;
   std::unique_ptr<ServoBusSim> servo_bus_;
+  std::vector<Hosted> hosted_;
   SimStats counters_;  ///< the RobotSim-level fields only; devices keep their own
   TimePoint started_at_;
   TimePoint next_stats_write_;

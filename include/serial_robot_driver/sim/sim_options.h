@@ -6,10 +6,12 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "serial_robot_driver/devices/base/base_sim.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/sim/sim_device_module.h"
 
 namespace serial_robot_driver::sim {
 
@@ -37,6 +39,8 @@ struct SimOptions {
   BaseSimConfig base;
   BodySimConfig body;
   ServoBusSimConfig servo_bus;
+  /// Other registered devices to host (--<name>; sim/sim_device_module.h), none by default.
+  std::vector<HostedDeviceOptions> hosted;
   FaultOptions faults;
   /// 0: bytes move as fast as the pty takes them. Otherwise the line's baud rate: each port sends
   /// and receives at most pace_baud / 10 bytes per second (start + 8 data + stop bits), so the

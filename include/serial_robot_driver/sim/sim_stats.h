@@ -5,11 +5,13 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/devices/base/base_sim.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/sim_types.h"
 
 namespace serial_robot_driver::sim {
@@ -39,6 +41,10 @@ struct SimStats {
   uint64_t unplugs = 0;
   uint64_t replugs = 0;
   double uptime_s = 0.0;
+  /// The hosted devices' own "key value" lines (SimDevice::statsLines), in hosting order.
+  std::vector<std::pair<std::string, std::string>> hosted;
+  /// Frames the hosted devices wanted sent but their port could not take (unplugged, full).
+  uint64_t hosted_frames_discarded = 0;
 };
 
 /// `key value` lines (one per line, stable key names) for the stats file and the exit summary.

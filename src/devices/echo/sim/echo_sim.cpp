@@ -1,0 +1,69 @@
+#include "serial_robot_driver/devices/echo/echo_sim.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "serial_robot_driver/devices/echo/echo_codec.h"
+
+namespace serial_robot_driver::sim {
+
+namespace echo = protocol::echo;
+
+void EchoSim::handleFrame(const protocol::FrameFamily& family, const uint8_t* data,
+                          std::size_t size, TimePoint at, HostedOutbox* out) {
+  if (family != echo::kRequestFrames) return;
+  const auto payload = echo::decode(echo::kRequestType, data, size);
+  if (!payload) return;  // the framer verified it; nothing else can fail
+  ++stats_.requests;
+  if (latency_ == Clock::duration::zero()) {
+    ++stats_.answers;
+    out->push_back(echo::encodeAnswer(*payload));
+    return;
+  }
+  pending_.emplace_back(at + latency_, echo::encodeAnswer(*payload));
+}
+
+void EchoSim::tick(TimePoint now, HostedOutbox* out) {
+  while (!pending_.empty() && pending_.front().first <= now) {
+    ++stats_.answers;
+    out->push_back(std::move(pending_.front().second));
+    pending_.pop_front();
+  }
+}
+
+TimePoint EchoSim::nextEvent() const {
+  return pending_.empty() ? TimePoint::max() : pending_.front().first;
+}
+
+std::vector<std::pair<std::string, std::string>> EchoSim::statsLines() const {
+  return {{"echo_requests", std::to_string(stats_.requests)},
+          {"echo_answers", std::to_string(stats_.answers)}};
+}
+
+}  // namespace serial_robot_driver::sim
+
+namespace serial_robot_driver::devices::echo {
+
+namespace {
+
+std::unique_ptr<sim::SimDevice> makeEchoSim(const sim::HostedDeviceOptions& options, uint32_t,
+                                            sim::TimePoint) {
+  double latency_ms = 0.0;
+  const auto setting = options.settings.find("latency-ms");
+  if (setting != options.settings.end()) {
+    char* end = nullptr;
+    latency_ms = std::strtod(setting->second.c_str(), &end);
+    if (setting->second.empty() || *end != '\0' || !std::isfinite(latency_ms) || latency_ms < 0) {
+      throw std::invalid_argument("bad value for --echo-latency-ms: '" + setting->second + "'");
+    }
+  }
+  return std::make_unique<sim::EchoSim>(sim::fromSeconds(latency_ms / 1000.0));
+}
+
+}  // namespace
+
+extern const sim::SimDeviceModule kSimModule{
+    "echo", makeEchoSim, {{"latency-ms", "MS", "echo answer latency (default 0)"}}};
+
+}  // namespace serial_robot_driver::devices::echo
