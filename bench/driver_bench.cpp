@@ -443,7 +443,7 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
   sim::PseudoTerminal pty(context.paths.link(ns));
   SpeedFrameLog log;
   protocol::FramerConfig framer;
-  framer.base = true;
+  framer.accept(protocol::base::kFrames);
   PtyFrameReader reader(pty, framer, [&log](auto family, auto data, auto size, auto arrival) {
     log.onFrame(family, data, size, arrival);
   });
