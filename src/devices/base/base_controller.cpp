@@ -44,8 +44,7 @@ BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents
       min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
       limiter_(config.max_wheel_accel),
       quantizer_(config.geometry, config.speed_dithering),
-      odometry_(config.geometry.wheel_separation, config.odometry_covariance),
-      heading_(config.imu_stale_after) {}
+      odometry_(config) {}
 
 BaseController::~BaseController() {
   {
@@ -93,19 +92,12 @@ void BaseController::setEStop(bool engaged) {
 
 void BaseController::resetOdometry() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Clock::time_point now = clock_->now();
-  advanceOdometryLocked(now);
-  odometry_.reset();
-  if (config_.use_imu_heading) {
-    heading_.restart();
-    advanceOdometryLocked(now);  // anchors the IMU's yaw now at heading zero, if it is fresh
-  }
+  odometry_.reset(clock_->now());
 }
 
 void BaseController::onImuYaw(double yaw, Clock::time_point stamp) {
-  // Stored even while use_imu_heading is off (addSample only copies two values under its own
-  // lock): config_ belongs to the loop's lock, and retune may switch the fusion on at any time.
-  heading_.addSample(yaw, stamp);
+  // Not under mutex_: the odometry takes the sample under the heading fusion's own short lock.
+  odometry_.addImuYaw(yaw, stamp);
 }
 
 bool BaseController::sendReset() {
@@ -151,7 +143,7 @@ void BaseController::stop() {
     written = writeLocked(base::encodeWheelSpeed(sent.seq, 0, 0), sent.time);
     if (written) {
       ++stats_.speed_frames;
-      if (!needs_reset_) acceptedSpeedLocked(kinematics::WheelTicks{}, sent.time);
+      if (!needs_reset_) odometry_.speedAccepted(kinematics::WheelTicks{}, sent.time);
     }
   }
   if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
@@ -160,17 +152,11 @@ void BaseController::stop() {
 void BaseController::retune(const BaseConfig& next) {
   std::lock_guard<std::mutex> lock(mutex_);
   const Clock::time_point now = clock_->now();
-  // The motion so far, and the wheel angles so far, with the geometry they ran under.
-  advanceOdometryLocked(now);
-  wheel_angles_at_retune_ +=
-      (wheel_travel_ - travel_at_retune_) / (config_.geometry.wheel_diameter / 2.0);
-  travel_at_retune_ = wheel_travel_;
   kinematics::DiffDriveGeometry geometry = config_.geometry;
   geometry.wheel_diameter = next.geometry.wheel_diameter;
   geometry.wheel_separation = next.geometry.wheel_separation;
-  // The base goes on running the ticks it accepted last; with the new geometry they stand for
-  // other speeds (a corrected diameter is the truth about what the wheels did all along).
-  held_speeds_ *= config_.geometry.ticksPerPeriodPerMps() / geometry.ticksPerPeriodPerMps();
+  // The motion so far with the geometry it ran under, from now on with the new one.
+  odometry_.retune(geometry, next.use_imu_heading, now);
   config_.geometry = geometry;
   config_.max_wheel_speed = next.max_wheel_speed;
   config_.max_wheel_accel = next.max_wheel_accel;
@@ -178,13 +164,7 @@ void BaseController::retune(const BaseConfig& next) {
   config_.speed_dithering = next.speed_dithering;
   limiter_.setMaxAccel(next.max_wheel_accel);
   quantizer_.retune(geometry, next.speed_dithering);
-  odometry_.setWheelSeparation(geometry.wheel_separation);
-  if (next.use_imu_heading != config_.use_imu_heading) {
-    // On: anchored where odometry stands now; off: the commanded turn goes on from the last fused
-    // heading. Either way the heading does not jump.
-    if (next.use_imu_heading) heading_.restart();
-    config_.use_imu_heading = next.use_imu_heading;
-  }
+  config_.use_imu_heading = next.use_imu_heading;
   if (next.battery_poll_rate != config_.battery_poll_rate) {
     if (next.battery_poll_rate > 0) {
       // A faster rate starts now, not after the slower period still pending.
@@ -206,11 +186,7 @@ BaseStats BaseController::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   const Clock::time_point now = clock_->now();
   BaseStats snapshot = stats_;
-  if (config_.use_imu_heading) {
-    snapshot.heading_source = heading_.source();
-    snapshot.imu_heading_fallbacks = heading_.fallbacks();
-    snapshot.imu_yaw_age = heading_.sampleAge(now);
-  }
+  odometry_.addHeadingStats(snapshot, now);
   snapshot.min_immediate_interval_ms = seconds(min_immediate_interval_) * 1e3;
   if (last_running_timeout_error_) {
     snapshot.seconds_since_running_timeout_error = seconds(now - *last_running_timeout_error_);
@@ -273,8 +249,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
           last_running_timeout_error_ = now;
         }
         // The base has stopped its wheels and ignores speed frames until our next Reset.
-        advanceOdometryLocked(now);
-        held_speeds_.setZero();
+        odometry_.baseStopped(now);
         needs_reset_ = true;
         command_pending_ = true;  // Reset on the wire now, not at the next tick
       }
@@ -336,58 +311,6 @@ kinematics::WheelTicks BaseController::onWire(const kinematics::WheelTicks& tick
                                 withDirection(ticks.right, config_.right_wheel_direction)};
 }
 
-void BaseController::advanceOdometryLocked(Clock::time_point now) {
-  double dt = 0;
-  if (accepted_at_) {
-    // The base runs the last accepted speeds until its heartbeat timeout stops it.
-    const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(config_.heartbeat_gap));
-    if (end > integrated_until_) {
-      dt = seconds(end - integrated_until_);
-      wheel_travel_ += held_speeds_ * dt;
-      integrated_until_ = end;
-    }
-  }
-  // The fused heading follows the IMU even while the wheels stand still (the robot was pushed).
-  const std::optional<double> heading =
-      config_.use_imu_heading ? heading_.heading(now, odometry_.pose().yaw) : std::nullopt;
-  if (heading) {
-    odometry_.integrate(held_speeds_, dt, *heading, config_.imu_yaw_variance);
-  } else if (dt > 0) {
-    odometry_.integrate(held_speeds_, dt);
-  }
-}
-
-void BaseController::acceptedSpeedLocked(const kinematics::WheelTicks& ticks,
-                                         Clock::time_point now) {
-  advanceOdometryLocked(now);
-  const double per_tick = 1.0 / config_.geometry.ticksPerPeriodPerMps();
-  held_speeds_ = WheelSpeeds(ticks.left * per_tick, ticks.right * per_tick);
-  accepted_at_ = now;
-  integrated_until_ = now;
-}
-
-OdometrySample BaseController::odometrySampleLocked(Clock::time_point now) const {
-  OdometrySample sample;
-  sample.time = now;
-  sample.pose = odometry_.pose();
-  const bool running = accepted_at_ && seconds(now - *accepted_at_) < config_.heartbeat_gap;
-  if (running) {
-    sample.linear = (held_speeds_.x() + held_speeds_.y()) / 2.0;
-    sample.angular = (held_speeds_.y() - held_speeds_.x()) / config_.geometry.wheel_separation;
-    sample.wheel_speeds = held_speeds_;
-  }
-  sample.wheel_travel = wheel_travel_;
-  const double radius = config_.geometry.wheel_diameter / 2.0;
-  sample.wheel_angles = wheel_angles_at_retune_ + (wheel_travel_ - travel_at_retune_) / radius;
-  sample.wheel_rates = sample.wheel_speeds / radius;
-  sample.position_variance = odometry_.positionVariance();
-  sample.yaw_variance = odometry_.yawVariance();
-  sample.travelled = odometry_.travelled();
-  sample.imu_heading =
-      config_.use_imu_heading && heading_.source() == kinematics::HeadingSource::kImu;
-  return sample;
-}
-
 void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
   WheelFrameSent sent;
   bool written = false;
@@ -425,7 +348,7 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
         last_immediate_frame_ = now;
       }
       last_speed_frame_ = now;
-      acceptedSpeedLocked(ticks, now);  // a Reset went out before it whenever one was due
+      odometry_.speedAccepted(ticks, now);  // a Reset went out before it whenever one was due
     }
   }
   if (timed_out_now && events_.on_cmd_vel_timeout) events_.on_cmd_vel_timeout();
@@ -465,12 +388,9 @@ void BaseController::tick(Clock::time_point now) {
         went_silent = silent_for;
       }
     }
-    advanceOdometryLocked(now);
-    sample = odometrySampleLocked(now);
-    if (config_.use_imu_heading && heading_.source() != reported_heading_source_) {
-      reported_heading_source_ = heading_.source();
-      heading_changed = reported_heading_source_;
-    }
+    odometry_.advance(now);
+    sample = odometry_.sample(now);
+    heading_changed = odometry_.headingSourceChange();
   }
   if (went_silent && events_.on_silent) events_.on_silent(*went_silent);
   if (heading_changed && events_.on_heading_source) events_.on_heading_source(*heading_changed);

@@ -36,10 +36,11 @@
 
 #include "serial_robot_driver/device/loop_clock.h"
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/base/base_odometry.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/kinematics/heading_fusion.h"
 #include "serial_robot_driver/kinematics/odometry.h"
-#include "serial_robot_driver/devices/base/base_codec.h"
 
 namespace serial_robot_driver::device {
 
@@ -204,11 +205,6 @@ class BaseController : public LinkListener {
   bool writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now);
   /// `timed_out_now`: set when the cmd_vel timeout started with this call.
   kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now, bool* timed_out_now);
-  /// Integrates the speeds the base runs on up to `now` (capped at its heartbeat timeout).
-  void advanceOdometryLocked(Clock::time_point now);
-  /// A speed frame with these (robot-side, before wheel directions) ticks was accepted at `now`.
-  void acceptedSpeedLocked(const kinematics::WheelTicks& ticks, Clock::time_point now);
-  OdometrySample odometrySampleLocked(Clock::time_point now) const;
   kinematics::WheelTicks onWire(const kinematics::WheelTicks& ticks) const;
 
   BaseConfig config_;  ///< its tunable part changes under mutex_ (retune)
@@ -237,16 +233,7 @@ class BaseController : public LinkListener {
   std::optional<Clock::time_point> last_tick_;
   Clock::time_point next_battery_poll_{};
   bool e_stop_ = false;
-  kinematics::Odometry odometry_;
-  kinematics::HeadingFusion heading_;  ///< used with use_imu_heading only
-  kinematics::HeadingSource reported_heading_source_ = kinematics::HeadingSource::kWaitingForImu;
-  kinematics::WheelSpeeds held_speeds_ = kinematics::WheelSpeeds::Zero();  ///< the base runs these
-  kinematics::WheelSpeeds wheel_travel_ = kinematics::WheelSpeeds::Zero();  ///< see OdometrySample
-  /// Wheel angles and travel when the diameter last changed (see OdometrySample::wheel_angles).
-  kinematics::WheelSpeeds wheel_angles_at_retune_ = kinematics::WheelSpeeds::Zero();
-  kinematics::WheelSpeeds travel_at_retune_ = kinematics::WheelSpeeds::Zero();
-  std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
-  Clock::time_point integrated_until_{};
+  BaseOdometry odometry_;  ///< not thread-safe: used under mutex_ (onImuYaw excepted)
   std::optional<Clock::time_point> last_reset_sent_;
   std::optional<Clock::time_point> unanswered_since_;  ///< first battery request with no reply yet
   bool silent_reported_ = false;
