@@ -70,3 +70,5 @@ catkin_add_gtest(runtime_tuning_tests test/unit/test_runtime_tuning.cpp)
 target_include_directories(runtime_tuning_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(runtime_tuning_tests srd_ros gtest_main)
 add_dependencies(runtime_tuning_tests ${PROJECT_NAME}_gencfg)
+# It finds the .cfg files in the sources (each device's src/devices/<name>/ros/, cfg/).
+target_compile_definitions(runtime_tuning_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
