@@ -27,6 +27,12 @@ target_link_libraries(core_tests srd_core srd_sim gtest_main)
 # test_device_registry.cpp reads config/analyzers.yaml from the sources.
 target_compile_definitions(core_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 
+# The parameter docs (docs/node_api.md's tables, config/robot.yaml) against the parameter table.
+catkin_add_gtest(param_docs_tests test/unit/test_param_docs.cpp)
+target_include_directories(param_docs_tests PRIVATE ${YAML_CPP_INCLUDE_DIR})
+target_link_libraries(param_docs_tests srd_core ${YAML_CPP_LIBRARIES} gtest_main)
+target_compile_definitions(param_docs_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+
 # Conversions and parameter validation of the ROS layer (pure functions, no roscore needed).
 catkin_add_gtest(ros_layer_tests
   test/unit/test_conversions.cpp
@@ -70,3 +76,5 @@ catkin_add_gtest(runtime_tuning_tests test/unit/test_runtime_tuning.cpp)
 target_include_directories(runtime_tuning_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(runtime_tuning_tests srd_ros gtest_main)
 add_dependencies(runtime_tuning_tests ${PROJECT_NAME}_gencfg)
+# It finds the .cfg files in the sources (each device's src/devices/<name>/ros/, cfg/).
+target_compile_definitions(runtime_tuning_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

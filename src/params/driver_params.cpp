@@ -173,7 +173,7 @@ DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unk
 
 TuningResult tuneParams(const DriverParams& in_force,
                         const std::vector<ParamAssignment>& requested) {
-  TuningResult result{in_force, {}};
+  TuningResult result{in_force, {}, {}};
   for (const auto& [key, value] : requested) {
     const ParamSpec& spec = specFor(key);
     if (spec.get(in_force).index() != value.index()) {
@@ -187,10 +187,20 @@ TuningResult tuneParams(const DriverParams& in_force,
                               why + "); keeping " + toText(spec.get(in_force)));
     spec.set(result.applied, spec.get(in_force));
   };
+  const auto describeChanges = [&] {
+    for (const auto& [key, value] : requested) {
+      const ParamSpec& spec = specFor(key);
+      const ParamValue now = spec.get(result.applied);
+      if (now == spec.get(in_force)) continue;
+      result.changes.push_back("~" + key + " = " + toText(now) + " (was " +
+                               toText(spec.get(in_force)) + ")");
+    }
+  };
   // Each round refuses at least one changed value, and `in_force` itself passes validate().
   for (std::size_t round = 0; round <= requested.size(); ++round) {
     try {
       result.applied.validate();
+      describeChanges();
       return result;
     } catch (const ParameterError& error) {
       bool named_value_changed = false;
@@ -211,6 +221,7 @@ TuningResult tuneParams(const DriverParams& in_force,
     }
   }
   result.applied.validate();  // unreachable unless `in_force` was invalid: throws then
+  describeChanges();
   return result;
 }
 

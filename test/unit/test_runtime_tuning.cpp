@@ -1,17 +1,22 @@
 // Runtime tuning without a ROS master: the .cfg files (their generated Config classes) against the
-// parameter table (every tunable's default, minimum and maximum are the table's and validate()'s),
-// and tuneParams(), which decides what of a requested change applies.
+// parameter table (every tunable's default, minimum and maximum are the table's and validate()'s;
+// every choice of an enum is a value the table accepts), where the .cfg files are and who starts
+// their servers, and tuneParams(), which decides what of a requested change applies.
 #include <gtest/gtest.h>
 
 #include <boost/any.hpp>
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <map>
+#include <regex>
 #include <set>
 
 #include "serial_robot_driver/BaseTuningConfig.h"
 #include "serial_robot_driver/ImuTuningConfig.h"
 #include "serial_robot_driver/ServoBusTuningConfig.h"
 #include "serial_robot_driver/TrajectoryTuningConfig.h"
+#include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -48,9 +53,26 @@ ParamValue valueOf(const Config& config, const Description& description) {
   return boost::any_cast<std::string>(any);
 }
 
+/// The values of an enum's choices, from the edit_method text dynamic_reconfigure generates
+/// ("{'enum': [{'name': 'stop', 'type': 'str', 'value': 'stop', ...}, ...]"); empty: no enum.
+std::vector<ParamValue> enumValues(const std::string& edit_method, const std::string& type) {
+  std::vector<ParamValue> values;
+  const std::regex value_entry("'value': ('([^']*)'|[-0-9.eE+]+)");
+  for (auto it = std::sregex_iterator(edit_method.begin(), edit_method.end(), value_entry);
+       it != std::sregex_iterator(); ++it) {
+    const std::string text = (*it)[1].str();
+    if (type == "str") values.emplace_back((*it)[2].str());
+    if (type == "int") values.emplace_back(std::stoi(text));
+    if (type == "double") values.emplace_back(std::stod(text));
+  }
+  return values;
+}
+
 /// Every parameter of Config is the table's `<group>/<name>` with the table's type and default,
 /// and its range is the table's: the table accepts the minimum (or, for a bound that must be
 /// exceeded such as "> 0", the next value up) and the maximum, and refuses the values beyond.
+/// A .cfg minimum below what the table accepts would let dynamic_reconfigure offer values the
+/// node then refuses. An enum's choices are all values the table accepts.
 template <typename Config>
 void expectAgreesWithTheTable(const std::string& group, const std::set<std::string>& tunables) {
   std::set<std::string> names;
@@ -66,6 +88,9 @@ void expectAgreesWithTheTable(const std::string& group, const std::set<std::stri
     EXPECT_EQ(cfg_default.index(), table_default.index()) << "type differs";
     EXPECT_EQ(toText(cfg_default), toText(table_default)) << "default differs";
     EXPECT_TRUE(tableAccepts(key, cfg_default));
+    for (const ParamValue& choice : enumValues(description->edit_method, description->type)) {
+      EXPECT_TRUE(tableAccepts(key, choice)) << "enum choice " << toText(choice);
+    }
     if (description->type == "int") {
       const int min = std::get<int>(valueOf(Config::__getMin__(), description));
       const int max = std::get<int>(valueOf(Config::__getMax__(), description));
@@ -116,6 +141,49 @@ TEST(RuntimeTuningTable, TrajectoryServerHasTheGoalDefaultsAsTheTableHasThem) {
       "trajectory", {"goal_tolerance", "goal_time_tolerance", "path_tolerance", "max_velocity"});
 }
 
+// The .cfg files are where CMake looks for them (each device's src/devices/<name>/ros/, the node's
+// cfg/), each is tested above, and a device has a .cfg exactly when its ROS module starts tuning
+// servers (RosDeviceModule::add_tuning), so no group is left without its server or its test.
+TEST(RuntimeTuningTable, EveryCfgFileIsInItsDevicesFolderAndTestedAbove) {
+  namespace fs = std::filesystem;
+  const fs::path sources = SRD_SOURCE_DIR;
+  std::map<std::string, std::string> found;  // file name -> folder, relative to the sources
+  const auto collect = [&](const fs::path& folder) {
+    if (!fs::is_directory(folder)) return;
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      if (entry.path().extension() != ".cfg") continue;
+      found[entry.path().filename().string()] = fs::relative(folder, sources).string();
+    }
+  };
+  collect(sources / "cfg");
+  for (const ros_layer::RosDeviceModule* module : ros_layer::registeredInterfaces()) {
+    SCOPED_TRACE(module->name);
+    const fs::path folder = sources / "src/devices" / module->name / "ros";
+    const std::size_t before = found.size();
+    collect(folder);
+    EXPECT_EQ(module->add_tuning != nullptr, found.size() > before)
+        << "a device with a tuning .cfg starts its server, and only such a device";
+  }
+  const std::map<std::string, std::string> tested{
+      {"BaseTuning.cfg", "src/devices/base/ros"},
+      {"ImuTuning.cfg", "src/devices/body/ros"},
+      {"ServoBusTuning.cfg", "src/devices/servo_bus/ros"},
+      {"TrajectoryTuning.cfg", "cfg"}};
+  EXPECT_EQ(found, tested);
+}
+
+TEST(RuntimeTuningTable, TheEnumChoicesAreRead) {
+  const auto& descriptions = serial_robot_driver::ServoBusTuningConfig::__getParamDescriptions__();
+  for (const auto& description : descriptions) {
+    if (description->name != "on_shutdown") continue;
+    EXPECT_EQ(
+        enumValues(description->edit_method, description->type),
+        (std::vector<ParamValue>{std::string("stop"), std::string("relax"), std::string("none")}));
+    return;
+  }
+  ADD_FAILURE() << "no on_shutdown";
+}
+
 TEST(TuneParams, AValidChangeApplies) {
   const DriverParams in_force;
   const TuningResult result =
@@ -124,6 +192,20 @@ TEST(TuneParams, AValidChangeApplies) {
   EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.5);
   EXPECT_DOUBLE_EQ(result.applied.base.wheel_separation, 0.5);
   EXPECT_DOUBLE_EQ(result.applied.base.wheel_diameter, in_force.base.wheel_diameter);
+}
+
+// What changes is what RuntimeTuning logs and hands to the devices: nothing when the request
+// only repeats the values in force or is refused.
+TEST(TuneParams, ChangesListEachValueThatDiffersFromTheValueInForce) {
+  DriverParams in_force;
+  in_force.base.max_wheel_speed = 0.8;
+  const TuningResult result =
+      tuneParams(in_force, {{"base/max_wheel_speed", 0.5},
+                            {"base/wheel_separation", in_force.base.wheel_separation},
+                            {"base/cmd_vel_timeout", 0.0}});
+  EXPECT_EQ(result.changes, std::vector<std::string>{"~base/max_wheel_speed = 0.5 (was 0.8)"});
+  EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.8}}).changes.empty());
+  EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.0}}).changes.empty());
 }
 
 TEST(TuneParams, AValueTheStartUpCheckRefusesKeepsTheValueInForce) {

@@ -125,6 +125,9 @@ struct TuningResult {
   DriverParams applied;  ///< the parameters in force after the change (they pass validate())
   /// One line per refused value: which, why (validate()'s message) and the value kept instead.
   std::vector<std::string> refusals;
+  /// One line per requested value that applies and differs from the value in force, in request
+  /// order: "~base/max_wheel_speed = 0.5 (was 1)". Empty: nothing changes (nothing to retune).
+  std::vector<std::string> changes;
 };
 
 /// The parameters `in_force` with `requested` applied, as far as validate() accepts them: a

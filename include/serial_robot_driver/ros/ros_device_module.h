@@ -3,13 +3,14 @@
 // device's folder (src/devices/<name>/ros/).
 #pragma once
 
+#include <ros/node_handle.h>
+
 #include <memory>
 #include <vector>
 
-#include <ros/node_handle.h>
-
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/ros/runtime_tuning.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -19,6 +20,11 @@ struct RosDeviceModule {
   /// Builds the device's interface on its port (before the ports start).
   std::unique_ptr<DeviceInterface> (*make)(ros::NodeHandle& nh, const DriverParams& params,
                                            device::SerialLink& link);
+  /// Starts the device's runtime tuning servers (addGroupServer, ros/tuning_group_server.h) under
+  /// `private_nh` into `servers`; RuntimeTuning calls it while the device is enabled. Null: the
+  /// device has nothing to tune.
+  void (*add_tuning)(RuntimeTuning& tuning, const ros::NodeHandle& private_nh,
+                     RuntimeTuning::Servers& servers);
 };
 
 /// The registered devices' ROS sides, in the order of the devices (cmake/devices.cmake).

@@ -31,10 +31,10 @@ class TrajectoryServer;
 
 class RuntimeTuning {
  public:
-  /// Starts the servers of the enabled groups under `private_nh`: ~base (base enabled), ~imu
-  /// (body enabled), ~servo_bus (servo_bus enabled), ~trajectory (`trajectory` not null: some
-  /// device has joints). `params` are the parameters in force; `devices` and `trajectory` get
-  /// every accepted change and must outlive this object.
+  /// Starts the servers under `private_nh`: each enabled device's (RosDeviceModule::add_tuning:
+  /// ~base, ~imu, ~servo_bus) and ~trajectory (`trajectory` not null: some device has joints).
+  /// `params` are the parameters in force; `devices` and `trajectory` get every accepted change
+  /// and must outlive this object.
   RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
                 std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory = nullptr);
   ~RuntimeTuning();
@@ -52,7 +52,13 @@ class RuntimeTuning {
   /// accepted change to the devices. Returns the parameters in force afterwards.
   DriverParams apply(const std::string& group, const std::vector<ParamAssignment>& requested);
 
-  class Server;  // one group's dynamic_reconfigure server (runtime_tuning.cpp)
+  /// One group's dynamic_reconfigure server (ros/tuning_group_server.h), its type erased so the
+  /// servers of every group are held in one list.
+  class Server {
+   public:
+    virtual ~Server() = default;
+  };
+  using Servers = std::vector<std::unique_ptr<Server>>;
 
  private:
   mutable std::mutex mutex_;
@@ -60,7 +66,7 @@ class RuntimeTuning {
   bool stopped_ = false;
   const std::vector<DeviceInterface*> devices_;
   TrajectoryServer* const trajectory_;
-  std::vector<std::unique_ptr<Server>> servers_;  // last: destroyed first
+  Servers servers_;  // last: destroyed first
 };
 
 }  // namespace serial_robot_driver::ros_layer

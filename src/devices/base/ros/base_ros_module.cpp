@@ -1,8 +1,21 @@
+#include "serial_robot_driver/BaseTuningConfig.h"
 #include "serial_robot_driver/devices/base/base_interface.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
+#include "serial_robot_driver/ros/tuning_group_server.h"
 
 namespace serial_robot_driver::devices::base {
 
-extern const ros_layer::RosDeviceModule kRosModule{"base", ros_layer::makeInterface<ros_layer::BaseInterface>};
+namespace {
+
+// The ~base group: the wheel, speed, battery and odometry tunables (BaseTuning.cfg).
+void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_nh,
+               ros_layer::RuntimeTuning::Servers& servers) {
+  ros_layer::addGroupServer<BaseTuningConfig>(tuning, private_nh, "base", servers);
+}
+
+}  // namespace
+
+extern const ros_layer::RosDeviceModule kRosModule{
+    "base", ros_layer::makeInterface<ros_layer::BaseInterface>, addTuning};
 
 }  // namespace serial_robot_driver::devices::base

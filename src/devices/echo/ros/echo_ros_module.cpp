@@ -4,6 +4,6 @@
 namespace serial_robot_driver::devices::echo {
 
 extern const ros_layer::RosDeviceModule kRosModule{
-    "echo", ros_layer::makeInterface<ros_layer::EchoInterface>};
+    "echo", ros_layer::makeInterface<ros_layer::EchoInterface>, nullptr /* nothing to tune */};
 
 }  // namespace serial_robot_driver::devices::echo
