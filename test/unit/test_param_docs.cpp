@@ -6,6 +6,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -52,16 +54,18 @@ std::string withoutBackticks(const std::string& text) {
 struct DocumentedParam {
   std::string key;
   std::string default_text;
+  std::string file;
   int line;
 };
 
-/// The rows of the parameter tables under "## Parameters" in docs/node_api.md. A section
+/// The rows of the parameter tables under "## Parameters" in `path` (docs/node_api.md, or a device
+/// folder's README.md: a device that is not one of the robot's own documents itself). A section
 /// "### ... (`~<prefix>/`)" names its rows' prefix; "### General" has none (its names carry the
 /// `~`). A row's first cell may list several parameters ("`port` / `baud`"); its default cell
 /// then lists their defaults in the same order, separated the same way.
-std::vector<DocumentedParam> documentedParams() {
-  std::ifstream file(kSourceDir + "/docs/node_api.md");
-  EXPECT_TRUE(file.good());
+std::vector<DocumentedParam> documentedParamsIn(const std::string& path) {
+  std::ifstream file(kSourceDir + "/" + path);
+  EXPECT_TRUE(file.good()) << path;
   std::vector<DocumentedParam> documented;
   bool in_parameters = false;
   std::string prefix;
@@ -90,7 +94,7 @@ std::vector<DocumentedParam> documentedParams() {
       }
       continue;
     }
-    EXPECT_GE(default_column, 0) << "node_api.md:" << number << ": a table without a default";
+    EXPECT_GE(default_column, 0) << path << ":" << number << ": a table without a default";
     if (default_column < 0) continue;
     const std::vector<std::string> names = split(cells.front(), " / ");
     std::vector<std::string> defaults = split(cells[default_column], " / ");
@@ -98,8 +102,25 @@ std::vector<DocumentedParam> documentedParams() {
     for (std::size_t i = 0; i < names.size(); ++i) {
       std::string name = withoutBackticks(names[i]);
       if (name.rfind("~", 0) == 0) name = name.substr(1);
-      documented.push_back({prefix + name, withoutBackticks(defaults[i]), number});
+      documented.push_back({prefix + name, withoutBackticks(defaults[i]), path, number});
     }
+  }
+  return documented;
+}
+
+/// docs/node_api.md's parameters and those of every device folder's README.md.
+std::vector<DocumentedParam> documentedParams() {
+  std::vector<DocumentedParam> documented = documentedParamsIn("docs/node_api.md");
+  std::vector<std::string> readmes;
+  for (const auto& entry : std::filesystem::directory_iterator(kSourceDir + "/src/devices")) {
+    if (std::filesystem::exists(entry.path() / "README.md")) {
+      readmes.push_back("src/devices/" + entry.path().filename().string() + "/README.md");
+    }
+  }
+  std::sort(readmes.begin(), readmes.end());
+  for (const std::string& readme : readmes) {
+    const std::vector<DocumentedParam> more = documentedParamsIn(readme);
+    documented.insert(documented.end(), more.begin(), more.end());
   }
   return documented;
 }
@@ -154,16 +175,16 @@ TEST(ParameterDocs, NodeApiDocumentsEveryKeyOfTheTableAndNoOther) {
   std::set<std::string> documented;
   for (const DocumentedParam& param : documentedParams()) {
     EXPECT_TRUE(documented.insert(param.key).second)
-        << "~" << param.key << " documented twice (node_api.md:" << param.line << ")";
+        << "~" << param.key << " documented twice (" << param.file << ":" << param.line << ")";
   }
   std::set<std::string> in_table;
   for (const ParamSpec& spec : parameterTable()) {
     in_table.insert(spec.key);
-    EXPECT_EQ(documented.count(spec.key), 1u) << "~" << spec.key << " is not in node_api.md";
+    EXPECT_EQ(documented.count(spec.key), 1u) << "~" << spec.key << " is not in docs/node_api.md nor in its device's README.md";
   }
   for (const std::string& key : documented) {
     EXPECT_TRUE(in_table.count(key) || kDocumentedOutsideTheTable.count(key))
-        << "node_api.md documents ~" << key << ", which the parameter table does not have";
+        << "the docs document ~" << key << ", which the parameter table does not have";
   }
 }
 
@@ -172,7 +193,7 @@ TEST(ParameterDocs, NodeApiDefaultsAreTheTableDefaults) {
   int compared = 0;
   for (const DocumentedParam& param : documentedParams()) {
     if (kDocumentedOutsideTheTable.count(param.key) || param.default_text.empty()) continue;
-    SCOPED_TRACE("node_api.md:" + std::to_string(param.line) + " ~" + param.key);
+    SCOPED_TRACE(param.file + ":" + std::to_string(param.line) + " ~" + param.key);
     ASSERT_NO_THROW(specFor(param.key));
     const ParamValue table_default = specFor(param.key).get(defaults);
     EXPECT_TRUE(statesDefault(param.default_text, table_default))
