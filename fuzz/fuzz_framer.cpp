@@ -1,10 +1,11 @@
-// libFuzzer target: the stream framer over arbitrary bytes, with every family it can be configured
-// for, fed in arbitrary chunks; every frame it emits goes to that family's decoder.
+// libFuzzer target: the stream framer over arbitrary bytes, with every frame family of the
+// registered devices it can be configured for, fed in arbitrary chunks; every frame it emits goes
+// to that family's decoder (FrameFamily::decodes).
 //
 // Input layout (so that seeds are plain frames behind a 3-byte prefix):
-//   byte 0  families: bit 0 base, 1 telemetry, 2 servo response, 3 servo request, 4 sync write,
-//           bit 7: reset() half way through the stream
-//   byte 1  configured telemetry servo count (used modulo 64, so also beyond the legal 57)
+//   byte 0  families: bit i the i-th registered family (registered_families.h: base, telemetry,
+//           sync write, servo response, servo request, ...), bit 7: reset() half way through
+//   byte 1  every probe's argument, modulo 64 (the telemetry's servo count, so also beyond 57)
 //   byte 2  largest chunk size (0: the whole stream in one feed), chunk sizes drawn from it
 //   rest    the byte stream
 //
@@ -18,35 +19,17 @@
 #include <cstring>
 #include <memory>
 
-#include "serial_robot_driver/devices/base/base_codec.h"
-#include "serial_robot_driver/devices/body/body_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "registered_families.h"
 
 namespace {
 
-using serial_robot_driver::protocol::DecodeError;
 using serial_robot_driver::protocol::FrameFamily;
 using serial_robot_driver::protocol::FramerConfig;
 using serial_robot_driver::protocol::StreamFramer;
-namespace base = serial_robot_driver::protocol::base;
-namespace body = serial_robot_driver::protocol::body;
-namespace servo = serial_robot_driver::protocol::servo;
 
 void check(bool condition) {
   if (!condition) std::abort();
-}
-
-// The families input byte 0 selects, bit by bit.
-const FrameFamily* const kFamilies[] = {&base::kFrames, &body::kTelemetryFrames,
-                                        &servo::kResponseFrames, &servo::kRequestFrames,
-                                        &body::kSyncWriteFrames};
-
-// A verified frame may still carry content its decoder refuses (a Dynamixel sync write to another
-// address), but never a framing error.
-template <typename T>
-void checkFramingAgrees(const serial_robot_driver::protocol::Decoded<T>& decoded) {
-  check(decoded.ok() || decoded.error() == DecodeError::kUnexpectedContent);
 }
 
 void decodeFrame(const FramerConfig& config, const FrameFamily& family, const uint8_t* frame,
@@ -56,30 +39,8 @@ void decodeFrame(const FramerConfig& config, const FrameFamily& family, const ui
   // An exact-size heap copy, so that a decoder reading past the frame trips ASan.
   std::unique_ptr<uint8_t[]> copy(new uint8_t[size]);
   std::memcpy(copy.get(), frame, size);
-  const uint8_t* data = copy.get();
-  if (family == base::kFrames) {
-    const auto decoded = base::decodeFrame(data, size);
-    check(decoded.ok());
-    (void)base::interpretReply(*decoded);
-    (void)base::interpretWheelSpeed(*decoded);
-  } else if (family == body::kTelemetryFrames) {
-    const std::size_t servo_count = config.expectedOf(body::kTelemetryFrames);
-    const auto decoded = body::decodeTelemetry(data, size, servo_count);
-    check(decoded.ok());
-    check(decoded->servo_count == servo_count);
-  } else if (family == servo::kResponseFrames) {
-    const auto decoded = servo::decodeResponse(data, size);
-    check(decoded.ok());
-    check(decoded->content_size + servo::kOverhead == size);
-  } else if (family == servo::kRequestFrames) {
-    const auto decoded = servo::decodeRequest(data, size);
-    check(decoded.ok());
-    check(decoded->content_size + servo::kOverhead == size);
-  } else if (family == body::kSyncWriteFrames) {
-    checkFramingAgrees(body::decodeSyncWrite(data, size));
-  } else {
-    check(false);  // a family nobody configured
-  }
+  // The family's own decoder must take what its probe accepted.
+  check(family.decodes(copy.get(), size, config.expectedOf(family)));
 }
 
 }  // namespace
@@ -88,10 +49,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* input, std::size_t input_si
   constexpr std::size_t kPrefix = 3;
   if (input_size < kPrefix) return 0;
   FramerConfig config;
-  for (std::size_t bit = 0; bit < sizeof(kFamilies) / sizeof(kFamilies[0]); ++bit) {
-    // The telemetry's argument: its servo count.
-    const std::size_t expected = kFamilies[bit] == &body::kTelemetryFrames ? input[1] % 64 : 0;
-    if (input[0] & (1u << bit)) config.accept(*kFamilies[bit], expected);
+  const auto& families = fuzz_support::registeredFamilies();
+  for (std::size_t bit = 0; bit < families.size() && bit < 7; ++bit) {
+    // Every probe gets byte 1 as its argument (the telemetry: its servo count; others ignore it).
+    if (input[0] & (1u << bit)) config.accept(families[bit], input[1] % 64);
   }
   const bool reset_half_way = (input[0] & 0x80) != 0;
   const std::size_t max_chunk = input[2];

@@ -22,6 +22,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
+#include "registered_families.h"
 
 namespace {
 
@@ -193,11 +194,15 @@ uint8_t selector(Decoder decoder, uint8_t mode) {
 }
 constexpr uint8_t kRaw = 0, kFixSum = 1, kFixAll = 2;
 
-// Prefix bits of fuzz_framer.cpp.
-constexpr uint8_t kBaseBit = 0x01, kTelemetryBit = 0x02, kResponseBit = 0x04, kRequestBit = 0x08,
-                  kSyncWriteBit = 0x10, kResetBit = 0x80;
-constexpr uint8_t kAllFamilies =
-    kBaseBit | kTelemetryBit | kResponseBit | kRequestBit | kSyncWriteBit;
+// Prefix bits of fuzz_framer.cpp: one per registered family (registered_families.h).
+const uint8_t kBaseBit = fuzz_support::familyBit("base");
+const uint8_t kTelemetryBit = fuzz_support::familyBit("telemetry");
+const uint8_t kResponseBit = fuzz_support::familyBit("servo_response");
+const uint8_t kRequestBit = fuzz_support::familyBit("servo_request");
+const uint8_t kSyncWriteBit = fuzz_support::familyBit("sync_write");
+constexpr uint8_t kResetBit = 0x80;
+const uint8_t kAllFamilies =
+    static_cast<uint8_t>(kBaseBit | kTelemetryBit | kResponseBit | kRequestBit | kSyncWriteBit);
 
 void writeFramerSeeds(SeedWriter& seeds) {
   const Bytes all = {kAllFamilies, 2, 0};  // one feed
@@ -207,7 +212,7 @@ void writeFramerSeeds(SeedWriter& seeds) {
   seeds.write("telemetry", all, kTelemetry);
   seeds.write("telemetry_foot_chunked", {kTelemetryBit, 2, 5}, join({kTelemetryFoot, kTelemetry}));
   seeds.write("sync_write", all, kSyncWrite);
-  seeds.write("simulator_input", {kBaseBit | kRequestBit | kSyncWriteBit, 0, 4},
+  seeds.write("simulator_input", {static_cast<uint8_t>(kBaseBit | kRequestBit | kSyncWriteBit), 0, 4},
               join({dynamixelPing(), kSyncWrite, request(servo::Command::kRotate), kBaseReset}));
   Bytes requests, answers;
   for (const servo::CommandInfo& info : servo::commandTable()) {
@@ -215,10 +220,10 @@ void writeFramerSeeds(SeedWriter& seeds) {
     answers = join({answers, answer(info.cmd)});
   }
   seeds.write("servo_requests", all, requests);
-  seeds.write("servo_responses", {kResponseBit | kRequestBit, 2, 1}, answers);
+  seeds.write("servo_responses", {static_cast<uint8_t>(kResponseBit | kRequestBit), 2, 1}, answers);
   const Bytes junk = {0x00, base::kHeader0, servo::kRequestHeader0};
   seeds.write("driver_mixed_with_junk",
-              {kBaseBit | kTelemetryBit | kResponseBit | kRequestBit, 2, 7},
+              {static_cast<uint8_t>(kBaseBit | kTelemetryBit | kResponseBit | kRequestBit), 2, 7},
               join({junk,
                     kTelemetry,
                     {servo::kResponseHeader0},
@@ -229,7 +234,7 @@ void writeFramerSeeds(SeedWriter& seeds) {
                     {body::kTelemetryHeader0, body::kTelemetryHeader1},
                     kTelemetryFoot,
                     kBaseErrorStatus}));
-  seeds.write("everything_reset", {kAllFamilies | kResetBit, 2, 3},
+  seeds.write("everything_reset", {static_cast<uint8_t>(kAllFamilies | kResetBit), 2, 3},
               join({kTelemetry, kSyncWrite, kBaseClearEncoders, answer(servo::Command::kPing),
                     kBaseBatteryRequest, kTelemetryFoot}));
 }

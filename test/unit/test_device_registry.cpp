@@ -43,6 +43,8 @@ TEST(DeviceRegistry, FrameFamiliesHaveUniqueNames) {
   for (const DeviceModule* device : registeredDevices()) {
     for (const auto* list : {&device->driver_frames, &device->simulator_frames}) {
       for (const FrameFamily& family : *list) {
+        EXPECT_NE(family.probe, nullptr) << family.name;
+        EXPECT_NE(family.decodes, nullptr) << family.name << ": the fuzzers decode what it frames";
         if (!seen.insert(family.name).second) continue;  // the same family twice (an echo)
         EXPECT_TRUE(names.insert(family.name).second) << family.name << " named twice";
       }

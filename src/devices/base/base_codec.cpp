@@ -159,6 +159,13 @@ constexpr FrameFamily kFrames{
     [](const uint8_t* data, std::size_t available, std::size_t) {
       return probeFrame(data, available);
     },
-    0};
+    0,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      const auto decoded = decodeFrame(frame, size);
+      if (!decoded.ok()) return false;
+      (void)interpretReply(*decoded);  // any PARAM: no throw, no read beyond it
+      (void)interpretWheelSpeed(*decoded);
+      return true;
+    }};
 
 }  // namespace serial_robot_driver::protocol::base

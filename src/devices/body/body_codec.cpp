@@ -224,9 +224,20 @@ constexpr FrameFamily kSyncWriteFrames{
     [](const uint8_t* data, std::size_t available, std::size_t) {
       return probeSyncWrite(data, available);
     },
-    0};
+    0,
+    // A well-framed sync write may still carry content the decoder refuses (a Dynamixel sync
+    // write to another address), never a framing error.
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      const auto decoded = decodeSyncWrite(frame, size);
+      return decoded.ok() || decoded.error() == DecodeError::kUnexpectedContent;
+    }};
 
 // Rank 0: asked before servo requests, which share the first byte 0x12.
-constexpr FrameFamily kTelemetryFrames{"telemetry", kTelemetryHeader0, probeTelemetry, 0};
+constexpr FrameFamily kTelemetryFrames{
+    "telemetry", kTelemetryHeader0, probeTelemetry, 0,
+    [](const uint8_t* frame, std::size_t size, std::size_t servo_count) {
+      const auto decoded = decodeTelemetry(frame, size, servo_count);
+      return decoded.ok() && decoded->servo_count == servo_count;
+    }};
 
 }  // namespace serial_robot_driver::protocol::body

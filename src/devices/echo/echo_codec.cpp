@@ -52,11 +52,17 @@ constexpr FrameFamily kRequestFrames{"echo_request", kHeader,
                                      [](const uint8_t* data, std::size_t available, std::size_t) {
                                        return probe(kRequestType, data, available);
                                      },
-                                     0};
+                                     0,
+                                     [](const uint8_t* frame, std::size_t size, std::size_t) {
+                                       return decode(kRequestType, frame, size).ok();
+                                     }};
 constexpr FrameFamily kAnswerFrames{"echo_answer", kHeader,
                                     [](const uint8_t* data, std::size_t available, std::size_t) {
                                       return probe(kAnswerType, data, available);
                                     },
-                                    1};
+                                    1,
+                                    [](const uint8_t* frame, std::size_t size, std::size_t) {
+                                      return decode(kAnswerType, frame, size).ok();
+                                    }};
 
 }  // namespace serial_robot_driver::protocol::echo

@@ -368,7 +368,11 @@ constexpr FrameFamily kResponseFrames{
     [](const uint8_t* data, std::size_t available, std::size_t) {
       return probeResponse(data, available);
     },
-    0};
+    0,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      const auto decoded = decodeResponse(frame, size);
+      return decoded.ok() && decoded->content_size + kOverhead == size;
+    }};
 
 // Rank 1: after the body's telemetry, which shares the first byte 0x12.
 constexpr FrameFamily kRequestFrames{
@@ -376,6 +380,10 @@ constexpr FrameFamily kRequestFrames{
     [](const uint8_t* data, std::size_t available, std::size_t) {
       return probeRequest(data, available);
     },
-    1};
+    1,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      const auto decoded = decodeRequest(frame, size);
+      return decoded.ok() && decoded->content_size + kOverhead == size;
+    }};
 
 }  // namespace serial_robot_driver::protocol::servo

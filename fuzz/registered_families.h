@@ -1,0 +1,43 @@
+// Every frame family of the registered devices (cmake/devices.cmake), once, in registration order:
+// fuzz_framer selects among them with its input's first byte, bit i for family i, and make_corpus
+// writes its seeds' prefixes with the same bits.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/device/device_module.h"
+
+namespace fuzz_support {
+
+inline const std::vector<serial_robot_driver::protocol::FrameFamily>& registeredFamilies() {
+  static const std::vector<serial_robot_driver::protocol::FrameFamily> families = [] {
+    std::vector<serial_robot_driver::protocol::FrameFamily> all;
+    const auto add = [&all](const serial_robot_driver::protocol::FrameFamily& family) {
+      for (const auto& known : all) {
+        if (known == family) return;
+      }
+      all.push_back(family);
+    };
+    for (const auto* device : serial_robot_driver::device::registeredDevices()) {
+      for (const auto& family : device->driver_frames) add(family);
+      for (const auto& family : device->simulator_frames) add(family);
+    }
+    return all;
+  }();
+  return families;
+}
+
+/// The prefix bit of the family called `name` (bit 7 is fuzz_framer's reset flag).
+inline uint8_t familyBit(const char* name) {
+  const auto& families = registeredFamilies();
+  for (std::size_t i = 0; i < families.size() && i < 7; ++i) {
+    if (std::strcmp(families[i].name, name) == 0) return static_cast<uint8_t>(1u << i);
+  }
+  throw std::invalid_argument(std::string("no registered frame family ") + name + " in bits 0..6");
+}
+
+}  // namespace fuzz_support
