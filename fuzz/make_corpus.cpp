@@ -194,17 +194,17 @@ uint8_t selector(Decoder decoder, uint8_t mode) {
 }
 constexpr uint8_t kRaw = 0, kFixSum = 1, kFixAll = 2;
 
-// Prefix bits of fuzz_framer.cpp: one per registered family (registered_families.h).
-const uint8_t kBaseBit = fuzz_support::familyBit("base");
-const uint8_t kTelemetryBit = fuzz_support::familyBit("telemetry");
-const uint8_t kResponseBit = fuzz_support::familyBit("servo_response");
-const uint8_t kRequestBit = fuzz_support::familyBit("servo_request");
-const uint8_t kSyncWriteBit = fuzz_support::familyBit("sync_write");
-constexpr uint8_t kResetBit = 0x80;
-const uint8_t kAllFamilies =
-    static_cast<uint8_t>(kBaseBit | kTelemetryBit | kResponseBit | kRequestBit | kSyncWriteBit);
-
 void writeFramerSeeds(SeedWriter& seeds) {
+  // Prefix bits of fuzz_framer.cpp: one per registered family (registered_families.h); asked
+  // here, not at static initialisation, where the device modules may not be built yet.
+  const uint8_t kBaseBit = fuzz_support::familyBit("base");
+  const uint8_t kTelemetryBit = fuzz_support::familyBit("telemetry");
+  const uint8_t kResponseBit = fuzz_support::familyBit("servo_response");
+  const uint8_t kRequestBit = fuzz_support::familyBit("servo_request");
+  const uint8_t kSyncWriteBit = fuzz_support::familyBit("sync_write");
+  constexpr uint8_t kResetBit = 0x80;
+  const uint8_t kAllFamilies =
+      static_cast<uint8_t>(kBaseBit | kTelemetryBit | kResponseBit | kRequestBit | kSyncWriteBit);
   const Bytes all = {kAllFamilies, 2, 0};  // one feed
   seeds.write("base_reset", all, kBaseReset);
   seeds.write("base_wheels", all, join({kBaseLeft4, kBaseBothMinus6}));
