@@ -199,11 +199,11 @@ TEST(TuneParams, AValidChangeApplies) {
 // only repeats the values in force or is refused.
 TEST(TuneParams, ChangesListEachValueThatDiffersFromTheValueInForce) {
   DriverParams in_force;
-  in_force.base.max_wheel_speed = 0.8;
-  const TuningResult result =
-      tuneParams(in_force, {{"base/max_wheel_speed", 0.5},
-                            {"base/wheel_separation", in_force.base.wheel_separation},
-                            {"base/cmd_vel_timeout", 0.0}});
+  in_force.base.controller.max_wheel_speed = 0.8;
+  const TuningResult result = tuneParams(
+      in_force, {{"base/max_wheel_speed", 0.5},
+                 {"base/wheel_separation", in_force.base.controller.geometry.wheel_separation},
+                 {"base/cmd_vel_timeout", 0.0}});
   EXPECT_EQ(result.changes, std::vector<std::string>{"~base/max_wheel_speed = 0.5 (was 0.8)"});
   EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.8}}).changes.empty());
   EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.0}}).changes.empty());
