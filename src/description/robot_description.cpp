@@ -226,10 +226,12 @@ std::string makeRobotDescription(const DriverParams& params, const std::vector<S
   // Simple shapes sized from the wheel geometry: base_link on the ground between the wheels
   // (REP-105), the axle at the wheel radius, a box chassis and a rear caster ball.
   const ros_layer::BaseParams& base = params.base;
-  const double radius = base.wheel_diameter / 2.0;
-  const double wheel_width = std::min(0.25 * base.wheel_diameter, 0.3 * base.wheel_separation);
-  const double chassis_length = std::max(1.2 * base.wheel_diameter, 0.8 * base.wheel_separation);
-  const double chassis_width = base.wheel_separation - 1.2 * wheel_width;
+  const kinematics::DiffDriveGeometry& wheels = base.controller.geometry;
+  const double radius = wheels.wheel_diameter / 2.0;
+  const double wheel_width = std::min(0.25 * wheels.wheel_diameter, 0.3 * wheels.wheel_separation);
+  const double chassis_length =
+      std::max(1.2 * wheels.wheel_diameter, 0.8 * wheels.wheel_separation);
+  const double chassis_width = wheels.wheel_separation - 1.2 * wheel_width;
   const double chassis_height = radius;
   const double chassis_top = radius + chassis_height / 2.0;
   const std::string base_link = linkName(base.base_frame);
@@ -247,7 +249,7 @@ std::string makeRobotDescription(const DriverParams& params, const std::vector<S
     urdf.link(link, key,
               visual(cylinder(radius, wheel_width), "wheel", "0 0 0", numbers({M_PI / 2.0, 0, 0})));
     urdf.joint(joint, key, "continuous", base_link, link,
-               numbers({0, side * base.wheel_separation / 2.0, radius}), "0 0 0",
+               numbers({0, side * wheels.wheel_separation / 2.0, radius}), "0 0 0",
                "    <axis xyz=\"0 1 0\"/>\n");
   };
   wheel(base.left_wheel_joint, "base/left_wheel_joint", 1.0);

@@ -225,8 +225,8 @@ std::string DriverNode::startupSummary() const {
     separator = ", port ";
   }
   if (params_.base.enabled) {
-    text << "; loop " << params_.loop_rate << " Hz, battery poll " << params_.base.battery_poll_rate
-         << " Hz";
+    text << "; loop " << params_.loop_rate << " Hz, battery poll "
+         << params_.base.controller.battery_poll_rate << " Hz";
   }
   text << "; diagnostics every " << diagnostics_period_ << " s";
   return text.str();

@@ -47,20 +47,28 @@ INSTANTIATE_TEST_SUITE_P(
                   p.capture = true;
                   p.replay_bag = "/tmp/field.bag";
                 }},
-        BadCase{"base/wheel_diameter", [](DriverParams& p) { p.base.wheel_diameter = -0.25; }},
         BadCase{"base/wheel_diameter",
-                [](DriverParams& p) { p.base.wheel_diameter = std::nan(""); }},
-        BadCase{"base/encoder_resolution", [](DriverParams& p) { p.base.encoder_resolution = 0; }},
-        BadCase{"base/pid_rate", [](DriverParams& p) { p.base.pid_rate = 0; }},
-        BadCase{"base/wheel_separation", [](DriverParams& p) { p.base.wheel_separation = 0; }},
-        BadCase{"base/max_wheel_speed", [](DriverParams& p) { p.base.max_wheel_speed = -1; }},
-        // 0 is no "no limit": the speed limit cannot be switched off.
-        BadCase{"base/max_wheel_speed", [](DriverParams& p) { p.base.max_wheel_speed = 0; }},
+                [](DriverParams& p) { p.base.controller.geometry.wheel_diameter = -0.25; }},
+        BadCase{"base/wheel_diameter",
+                [](DriverParams& p) { p.base.controller.geometry.wheel_diameter = std::nan(""); }},
+        BadCase{"base/encoder_resolution",
+                [](DriverParams& p) { p.base.controller.geometry.encoder_resolution = 0; }},
+        BadCase{"base/pid_rate", [](DriverParams& p) { p.base.controller.geometry.pid_rate = 0; }},
+        BadCase{"base/wheel_separation",
+                [](DriverParams& p) { p.base.controller.geometry.wheel_separation = 0; }},
         BadCase{"base/max_wheel_speed",
-                [](DriverParams& p) { p.base.max_wheel_speed = std::nan(""); }},
-        BadCase{"base/max_wheel_accel", [](DriverParams& p) { p.base.max_wheel_accel = -1; }},
-        BadCase{"base/cmd_vel_timeout", [](DriverParams& p) { p.base.cmd_vel_timeout = 0; }},
-        BadCase{"base/battery_poll_rate", [](DriverParams& p) { p.base.battery_poll_rate = -1; }},
+                [](DriverParams& p) { p.base.controller.max_wheel_speed = -1; }},
+        // 0 is no "no limit": the speed limit cannot be switched off.
+        BadCase{"base/max_wheel_speed",
+                [](DriverParams& p) { p.base.controller.max_wheel_speed = 0; }},
+        BadCase{"base/max_wheel_speed",
+                [](DriverParams& p) { p.base.controller.max_wheel_speed = std::nan(""); }},
+        BadCase{"base/max_wheel_accel",
+                [](DriverParams& p) { p.base.controller.max_wheel_accel = -1; }},
+        BadCase{"base/cmd_vel_timeout",
+                [](DriverParams& p) { p.base.controller.cmd_vel_timeout = 0; }},
+        BadCase{"base/battery_poll_rate",
+                [](DriverParams& p) { p.base.controller.battery_poll_rate = -1; }},
         BadCase{"base/baud", [](DriverParams& p) { p.base.baud = 7; }},
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 1.0; }},  // heartbeat at risk
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 4.9; }},
@@ -77,9 +85,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"base/base_frame", [](DriverParams& p) { p.base.base_frame = "base link"; }},
         BadCase{"base/base_frame", [](DriverParams& p) { p.base.base_frame = "odom"; }},
         BadCase{"base/left_wheel_direction",
-                [](DriverParams& p) { p.base.left_wheel_direction = 0; }},
+                [](DriverParams& p) { p.base.controller.left_wheel_direction = 0; }},
         BadCase{"base/right_wheel_direction",
-                [](DriverParams& p) { p.base.right_wheel_direction = 2; }},
+                [](DriverParams& p) { p.base.controller.right_wheel_direction = 2; }},
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {}; }},
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 1}; }},
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 300}; }},
@@ -99,27 +107,28 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"x", "y", "-z"}; }},
         BadCase{"imu/axis_map", [](DriverParams& p) { p.imu.axis_map = {"y", "x", "z"}; }},
         BadCase{"servo_bus/timeout", [](DriverParams& p) { p.servo_bus.timeout = 0; }},
-        BadCase{"servo_bus/retries", [](DriverParams& p) { p.servo_bus.retries = -1; }},
+        BadCase{"servo_bus/retries", [](DriverParams& p) { p.servo_bus.bus.client.retries = -1; }},
         BadCase{"servo_bus/baud", [](DriverParams& p) { p.servo_bus.baud = 9600; }},
         // 253 puts FF FF FD (the sync-write header) inside a sync-write frame.
         BadCase{"body/servo_ids", [](DriverParams& p) { p.body.servo_ids = {1, 253}; }},
         BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.servo_bus.state_ids = {1, 255}; }},
         BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.servo_bus.state_ids = {4, 4}; }},
-        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 0; }},
-        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.state_rate = 1001; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.bus.poll_rate = 0; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.servo_bus.bus.poll_rate = 1001; }},
         BadCase{"servo_bus/command_interval_ms",
                 [](DriverParams& p) { p.servo_bus.command_interval_ms = 70000; }},
         BadCase{"servo_bus/on_shutdown", [](DriverParams& p) { p.servo_bus.on_shutdown = "halt"; }},
         BadCase{"servo_bus/relax_power_mw",
                 [](DriverParams& p) { p.servo_bus.relax_power_mw = -1; }},
-        BadCase{"servo_bus/health_rate", [](DriverParams& p) { p.servo_bus.health_rate = -1.0; }},
+        BadCase{"servo_bus/health_rate",
+                [](DriverParams& p) { p.servo_bus.bus.health_rate = -1.0; }},
         BadCase{"base/enabled", [](DriverParams& p) {
                   p.base.enabled = p.body.enabled = p.servo_bus.enabled = false;
                 }}));
 
 TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
   DriverParams params;
-  params.base.use_imu_heading = true;
+  params.base.controller.use_imu_heading = true;
   EXPECT_NO_THROW(params.validate());
   const auto expectRefused = [](const DriverParams& p, const std::string& reason) {
     try {
@@ -261,8 +270,8 @@ TEST(ParameterTable, NothingGivenLoadsTheStructDefaults) {
   for (const auto& spec : parameterTable()) {
     EXPECT_TRUE(spec.get(loaded) == spec.get(defaults)) << spec.key;
   }
-  EXPECT_EQ(loaded.base.wheel_diameter, 0.25);
-  EXPECT_EQ(loaded.servo_bus.retries, 1);
+  EXPECT_EQ(loaded.base.controller.geometry.wheel_diameter, 0.25);
+  EXPECT_EQ(loaded.servo_bus.bus.client.retries, 1);
 }
 
 TEST(ParameterTable, EachKeyLoadsIntoItsOwnField) {
@@ -292,9 +301,9 @@ TEST(ParameterTable, KnownKeysByNameAndType) {
   source.values["base/wheel_diamter"] = 0.3;
   std::vector<std::string> unknown;
   const DriverParams loaded = loadParams(source, &unknown);
-  EXPECT_EQ(loaded.base.wheel_diameter, 0.3);
+  EXPECT_EQ(loaded.base.controller.geometry.wheel_diameter, 0.3);
   EXPECT_EQ(loaded.body.servo_ids, (std::vector<int>{4, 5, 6}));
-  EXPECT_TRUE(loaded.servo_bus.allow_dangerous_writes);
+  EXPECT_TRUE(loaded.servo_bus.bus.client.allow_dangerous_writes);
   EXPECT_EQ(loaded.port, "/dev/ttyACM0");
   EXPECT_EQ(unknown, std::vector<std::string>{"base/wheel_diamter"});
 }

@@ -156,7 +156,7 @@ TEST(YamlParamSource, ReadsTheDriversParametersWithTheirDefaults) {
   const YamlParamSource source(kOtherConfig);
   std::vector<std::string> unknown;
   const DriverParams params = loadParams(source, &unknown);
-  EXPECT_DOUBLE_EQ(params.base.wheel_diameter, 0.1);
+  EXPECT_DOUBLE_EQ(params.base.controller.geometry.wheel_diameter, 0.1);
   EXPECT_EQ(params.base.left_wheel_joint, "wheel_l");
   EXPECT_EQ(params.body.servo_ids, (std::vector<int>{3, 4}));
   EXPECT_EQ(params.body.directions, (std::vector<int>{1, -1}));

@@ -189,20 +189,21 @@ TEST(TuneParams, AValidChangeApplies) {
   const TuningResult result =
       tuneParams(in_force, {{"base/max_wheel_speed", 0.5}, {"base/wheel_separation", 0.5}});
   EXPECT_TRUE(result.refusals.empty());
-  EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.5);
-  EXPECT_DOUBLE_EQ(result.applied.base.wheel_separation, 0.5);
-  EXPECT_DOUBLE_EQ(result.applied.base.wheel_diameter, in_force.base.wheel_diameter);
+  EXPECT_DOUBLE_EQ(result.applied.base.controller.max_wheel_speed, 0.5);
+  EXPECT_DOUBLE_EQ(result.applied.base.controller.geometry.wheel_separation, 0.5);
+  EXPECT_DOUBLE_EQ(result.applied.base.controller.geometry.wheel_diameter,
+                   in_force.base.controller.geometry.wheel_diameter);
 }
 
 // What changes is what RuntimeTuning logs and hands to the devices: nothing when the request
 // only repeats the values in force or is refused.
 TEST(TuneParams, ChangesListEachValueThatDiffersFromTheValueInForce) {
   DriverParams in_force;
-  in_force.base.max_wheel_speed = 0.8;
-  const TuningResult result =
-      tuneParams(in_force, {{"base/max_wheel_speed", 0.5},
-                            {"base/wheel_separation", in_force.base.wheel_separation},
-                            {"base/cmd_vel_timeout", 0.0}});
+  in_force.base.controller.max_wheel_speed = 0.8;
+  const TuningResult result = tuneParams(
+      in_force, {{"base/max_wheel_speed", 0.5},
+                 {"base/wheel_separation", in_force.base.controller.geometry.wheel_separation},
+                 {"base/cmd_vel_timeout", 0.0}});
   EXPECT_EQ(result.changes, std::vector<std::string>{"~base/max_wheel_speed = 0.5 (was 0.8)"});
   EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.8}}).changes.empty());
   EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.0}}).changes.empty());
@@ -210,11 +211,11 @@ TEST(TuneParams, ChangesListEachValueThatDiffersFromTheValueInForce) {
 
 TEST(TuneParams, AValueTheStartUpCheckRefusesKeepsTheValueInForce) {
   DriverParams in_force;
-  in_force.base.cmd_vel_timeout = 0.8;
+  in_force.base.controller.cmd_vel_timeout = 0.8;
   const TuningResult result =
       tuneParams(in_force, {{"base/cmd_vel_timeout", 0.0}, {"base/max_wheel_speed", 0.3}});
-  EXPECT_DOUBLE_EQ(result.applied.base.cmd_vel_timeout, 0.8);
-  EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.3) << "the valid part applies";
+  EXPECT_DOUBLE_EQ(result.applied.base.controller.cmd_vel_timeout, 0.8);
+  EXPECT_DOUBLE_EQ(result.applied.base.controller.max_wheel_speed, 0.3) << "the valid part applies";
   ASSERT_EQ(result.refusals.size(), 1u);
   EXPECT_NE(result.refusals[0].find("~base/cmd_vel_timeout = 0 refused"), std::string::npos)
       << result.refusals[0];
@@ -237,11 +238,11 @@ TEST(TuneParams, ASpeedLimitOfZeroOrLessIsRefusedAndTheLimitInForceStays) {
   EXPECT_FALSE(tableAccepts("base/max_wheel_speed", cfg_min));
 
   DriverParams in_force;
-  in_force.base.max_wheel_speed = 0.8;
+  in_force.base.controller.max_wheel_speed = 0.8;
   for (const double requested : {0.0, -1.0}) {
     SCOPED_TRACE(requested);
     const TuningResult result = tuneParams(in_force, {{"base/max_wheel_speed", requested}});
-    EXPECT_DOUBLE_EQ(result.applied.base.max_wheel_speed, 0.8);
+    EXPECT_DOUBLE_EQ(result.applied.base.controller.max_wheel_speed, 0.8);
     ASSERT_EQ(result.refusals.size(), 1u);
     EXPECT_NE(result.refusals[0].find("~base/max_wheel_speed = "), std::string::npos)
         << result.refusals[0];
@@ -269,11 +270,12 @@ TEST(TuneParams, ARuleBetweenValuesRefusesTheWholeChange) {
 TEST(TuneParams, PollRateAboveTheLoopRateAndImuHeadingWithoutTheBodyAreRefused) {
   DriverParams in_force;
   in_force.loop_rate = 20;
-  EXPECT_EQ(tuneParams(in_force, {{"base/battery_poll_rate", 25.0}}).applied.base.battery_poll_rate,
-            in_force.base.battery_poll_rate);
+  EXPECT_EQ(tuneParams(in_force, {{"base/battery_poll_rate", 25.0}})
+                .applied.base.controller.battery_poll_rate,
+            in_force.base.controller.battery_poll_rate);
   in_force.body.enabled = false;
   const TuningResult result = tuneParams(in_force, {{"base/use_imu_heading", true}});
-  EXPECT_FALSE(result.applied.base.use_imu_heading);
+  EXPECT_FALSE(result.applied.base.controller.use_imu_heading);
   EXPECT_EQ(result.refusals.size(), 1u);
 }
 

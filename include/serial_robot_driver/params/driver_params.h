@@ -66,7 +66,7 @@ std::string resolveFrame(const std::string& tf_prefix, const std::string& frame)
 struct DriverParams {
   std::string port = "/dev/ttyUSB0";
   int baud = 115200;
-  double loop_rate = kBaseDefaults.loop_rate;
+  double loop_rate = device::BaseConfig{}.loop_rate;  ///< Hz; the base controller's default
   double reconnect_interval = 1.0;
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire

@@ -98,6 +98,30 @@ ParamSpec makeRow(std::string key, std::string device, Access access, Rule<T> ru
   return spec;
 }
 
+/// A row whose field (`access`: DriverParams& -> Core&) has another type than the parameter
+/// (`Param`): `to_core` converts a set value, `to_param` reads the field back. The check sees the
+/// value as the parameter reads it, so its message names the parameter in the parameter's unit.
+/// Only for conversions that keep every bad input bad: where one could not (seconds rounded to
+/// milliseconds, an int narrowed, a name parsed), the section keeps the value as written and the
+/// ROS layer converts it where it builds the core's configuration.
+template <typename Param, typename Access, typename ToCore, typename ToParam>
+ParamSpec makeConvertedRow(std::string key, std::string device, Access access, ToCore to_core,
+                           ToParam to_param, Rule<Param> rule) {
+  ParamSpec spec;
+  spec.key = std::move(key);
+  spec.device = std::move(device);
+  spec.get = [access, to_param](const DriverParams& p) {
+    return ParamValue(Param(to_param(access(const_cast<DriverParams&>(p)))));
+  };
+  spec.set = [access, to_core](DriverParams& p, const ParamValue& value) {
+    access(p) = to_core(std::get<Param>(value));
+  };
+  spec.check = [access, to_param, rule, name = spec.key](const DriverParams& p) {
+    if (rule) rule(Param(to_param(access(const_cast<DriverParams&>(p)))), name);
+  };
+  return spec;
+}
+
 /// A row of one section of DriverParams: `key` is "<prefix>/<name>" and `field` reaches the value
 /// inside the section (`&BaseParams::publish_tf`, or a lambda Section& -> T& for a nested field of
 /// a core configuration).
@@ -134,6 +158,19 @@ class SectionRows {
                                   return access(section(p));
                                 },
                                 rule));
+    return *this;
+  }
+
+  /// A field reached by `access` (Section& -> Core&) whose type differs from the parameter's
+  /// `Param` (see makeConvertedRow), e.g. a whole number of ticks the core keeps as a double.
+  template <typename Param, typename Access, typename ToCore, typename ToParam>
+  SectionRows& addConverted(const char* name, Access access, ToCore to_core, ToParam to_param,
+                            typename NoDeduce<Rule<Param>>::type rule = {}) {
+    auto section = section_;
+    table_.push_back(makeConvertedRow<Param>(
+        prefix_ + "/" + name, device_,
+        [section, access](DriverParams& p) -> decltype(auto) { return access(section(p)); },
+        to_core, to_param, rule));
     return *this;
   }
 

@@ -1,4 +1,5 @@
 // The AP1 wheeled base as a device of the driver: its frames, its parameter section and checks.
+#include <cmath>
 #include <sstream>
 
 #include "serial_robot_driver/device/device_module.h"
@@ -14,29 +15,43 @@ using params::DriverParams;
 using params::require;
 
 void addParameters(std::vector<params::ParamSpec>& table) {
+  // Three kinds of rows, in the documented order: the wheel geometry and the controller's other
+  // settings (bound into BaseParams::controller), and the ROS layer's own values.
   using B = BaseParams;
-  params::SectionRows<B>(table, "base", "base", [](DriverParams& p) -> B& { return p.base; })
-      .add("wheel_diameter", &B::wheel_diameter, params::positiveNumber)
-      .add("encoder_resolution", &B::encoder_resolution, params::positiveInteger)
-      .add("pid_rate", &B::pid_rate, params::positiveNumber)
-      .add("wheel_separation", &B::wheel_separation, params::positiveNumber)
-      // > 0: there is no "no limit" value. No maximum: the base's top speed is not documented,
-      // and the speed field's own range (int16 ticks per PID period) depends on tunable geometry.
-      .add("max_wheel_speed", &B::max_wheel_speed, params::positiveNumber)
-      .add("max_wheel_accel", &B::max_wheel_accel, params::nonNegativeNumber)
-      .add("cmd_vel_timeout", &B::cmd_vel_timeout, params::positiveNumber)
-      .add("speed_dithering", &B::speed_dithering)
-      .add("battery_poll_rate", &B::battery_poll_rate, params::nonNegativeNumber)
-      .add("battery_warn_percent", &B::battery_warn_percent, params::percent)
+  using C = device::BaseConfig;
+  using G = kinematics::DiffDriveGeometry;
+  params::SectionRows<G> geometry(table, "base", "base",
+                                  [](DriverParams& p) -> G& { return p.base.controller.geometry; });
+  params::SectionRows<C> controller(table, "base", "base",
+                                    [](DriverParams& p) -> C& { return p.base.controller; });
+  params::SectionRows<B> own(table, "base", "base", [](DriverParams& p) -> B& { return p.base; });
+  geometry
+      .add("wheel_diameter", &G::wheel_diameter, params::positiveNumber)
+      // A whole number of ticks, which the geometry's arithmetic keeps as a double.
+      .addConverted<int>(
+          "encoder_resolution", [](G& g) -> double& { return g.encoder_resolution; },
+          [](int ticks) { return static_cast<double>(ticks); },
+          [](double ticks) { return static_cast<int>(std::lround(ticks)); },
+          params::positiveInteger)
+      .add("pid_rate", &G::pid_rate, params::positiveNumber)
+      .add("wheel_separation", &G::wheel_separation, params::positiveNumber);
+  // > 0: there is no "no limit" value. No maximum: the base's top speed is not documented,
+  // and the speed field's own range (int16 ticks per PID period) depends on tunable geometry.
+  controller.add("max_wheel_speed", &C::max_wheel_speed, params::positiveNumber)
+      .add("max_wheel_accel", &C::max_wheel_accel, params::nonNegativeNumber)
+      .add("cmd_vel_timeout", &C::cmd_vel_timeout, params::positiveNumber)
+      .add("speed_dithering", &C::speed_dithering)
+      .add("battery_poll_rate", &C::battery_poll_rate, params::nonNegativeNumber);
+  own.add("battery_warn_percent", &B::battery_warn_percent, params::percent)
       .add("battery_error_percent", &B::battery_error_percent, params::percent)
       .add("odom_frame", &B::odom_frame, params::frameId)
       .add("base_frame", &B::base_frame, params::frameId)
-      .add("publish_tf", &B::publish_tf)
-      .add("left_wheel_direction", &B::left_wheel_direction, params::direction)
-      .add("right_wheel_direction", &B::right_wheel_direction, params::direction)
-      .add("left_wheel_joint", &B::left_wheel_joint, params::frameId)
-      .add("right_wheel_joint", &B::right_wheel_joint, params::frameId)
-      .add("use_imu_heading", &B::use_imu_heading);
+      .add("publish_tf", &B::publish_tf);
+  controller.add("left_wheel_direction", &C::left_wheel_direction, params::direction)
+      .add("right_wheel_direction", &C::right_wheel_direction, params::direction);
+  own.add("left_wheel_joint", &B::left_wheel_joint, params::frameId)
+      .add("right_wheel_joint", &B::right_wheel_joint, params::frameId);
+  controller.add("use_imu_heading", &C::use_imu_heading);
 }
 
 void validate(const DriverParams& p) {
@@ -49,7 +64,7 @@ void validate(const DriverParams& p) {
           "base's 1 s heartbeat alive (got "
        << p.loop_rate << ")";
   require(p.loop_rate >= params::kMinBaseLoopRate, "loop_rate", rate.str());
-  require(base.battery_poll_rate <= p.loop_rate, "base/battery_poll_rate",
+  require(base.controller.battery_poll_rate <= p.loop_rate, "base/battery_poll_rate",
           "must not exceed loop_rate (requests go out from the loop)");
   require(base.battery_error_percent <= base.battery_warn_percent, "base/battery_error_percent",
           "must not exceed base/battery_warn_percent (" +
@@ -58,7 +73,7 @@ void validate(const DriverParams& p) {
           "must differ from base/odom_frame ('" + base.odom_frame + "')");
   require(base.left_wheel_joint != base.right_wheel_joint, "base/right_wheel_joint",
           "must differ from base/left_wheel_joint ('" + base.left_wheel_joint + "')");
-  if (base.use_imu_heading) {
+  if (base.controller.use_imu_heading) {
     require(p.body.enabled, "base/use_imu_heading",
             "needs the servo controller board's IMU, but body/enabled is false");
     require(

@@ -1,5 +1,6 @@
 // The UART bus servos as a device of the driver: their frames, their parameter section and checks.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 
@@ -26,25 +27,31 @@ void busServoIds(const std::vector<int>& ids, const std::string& key) {
 }
 
 void addParameters(std::vector<params::ParamSpec>& table) {
+  // Rows bound into the bus's configuration (ServoBusParams::bus and its client's options) and
+  // the ROS layer's own values, in the documented order.
   using S = ServoBusParams;
-  params::SectionRows<S>(table, "servo_bus", "servo_bus",
-                         [](DriverParams& p) -> S& { return p.servo_bus; })
-      .add("timeout", &S::timeout,
-           [](const double& v, const std::string& key) {
-             params::positiveNumber(v, key);
-             require(v <= 5.0, key, "must be at most 5 s");
-           })
-      .add("retries", &S::retries, params::integerWithin(0, 10))
-      .add("allow_dangerous_writes", &S::allow_dangerous_writes)
-      .add("state_ids", &S::state_ids, busServoIds)
-      .add("state_rate", &S::state_rate,
-           [](const double& v, const std::string& key) {
-             params::positiveNumber(v, key);
-             // Per servo: one servo on a fast line answers about 1000 times a second. What the
-             // line cannot deliver of the asked rate is reported in diagnostics.
-             require(v <= 1000, key, "must be at most 1000 Hz");
-           })
-      .add("command_interval_ms", &S::command_interval_ms, params::integerWithin(0, 65535, "ms"))
+  using C = device::ServoBusConfig;
+  using O = device::ServoBusOptions;
+  params::SectionRows<O> client(table, "servo_bus", "servo_bus",
+                                [](DriverParams& p) -> O& { return p.servo_bus.bus.client; });
+  params::SectionRows<C> bus(table, "servo_bus", "servo_bus",
+                             [](DriverParams& p) -> C& { return p.servo_bus.bus; });
+  params::SectionRows<S> own(table, "servo_bus", "servo_bus",
+                             [](DriverParams& p) -> S& { return p.servo_bus; });
+  own.add("timeout", &S::timeout, [](const double& v, const std::string& key) {
+    params::positiveNumber(v, key);
+    require(v <= 5.0, key, "must be at most 5 s");
+  });
+  client.add("retries", &O::retries, params::integerWithin(0, 10))
+      .add("allow_dangerous_writes", &O::allow_dangerous_writes);
+  own.add("state_ids", &S::state_ids, busServoIds);
+  bus.add("state_rate", &C::poll_rate, [](const double& v, const std::string& key) {
+    params::positiveNumber(v, key);
+    // Per servo: one servo on a fast line answers about 1000 times a second. What the
+    // line cannot deliver of the asked rate is reported in diagnostics.
+    require(v <= 1000, key, "must be at most 1000 Hz");
+  });
+  own.add("command_interval_ms", &S::command_interval_ms, params::integerWithin(0, 65535, "ms"))
       // Bus servos as named joints; lengths and names are checked in validate().
       .add("joint_ids", &S::joint_ids, busServoIds)
       .add("joint_names", &S::joint_names,
@@ -65,13 +72,12 @@ void addParameters(std::vector<params::ParamSpec>& table) {
       .add("joint_directions", &S::joint_directions, params::directionList)
       // Safe motion.
       .add("relax_power_mw", &S::relax_power_mw, params::integerWithin(0, 65535, "mW"))
-      .add("on_shutdown", &S::on_shutdown,
-           [](const std::string& v, const std::string& key) {
-             require(device::shutdownActionFromString(v).has_value(), key,
-                     "must be stop, relax or none, got '" + v + "'");
-           })
-      .add("health_rate", &S::health_rate, params::numberWithin(0.0, 10.0, "Hz (0: off)"))
-      .add("protect", &S::protect);
+      .add("on_shutdown", &S::on_shutdown, [](const std::string& v, const std::string& key) {
+        require(device::shutdownActionFromString(v).has_value(), key,
+                "must be stop, relax or none, got '" + v + "'");
+      });
+  bus.add("health_rate", &C::health_rate, params::numberWithin(0.0, 10.0, "Hz (0: off)"))
+      .add("protect", &C::protect);
 }
 
 void validate(const DriverParams& p) {
@@ -109,7 +115,7 @@ extern const device::DeviceModule kModule{
     nullptr,
     // A servo answer must not wait behind a stray header longer than an answer may take.
     [](const DriverParams& p) {
-      return std::chrono::milliseconds(std::max<long>(1, std::lround(p.servo_bus.timeout * 1000.0)));
+      return std::max(std::chrono::milliseconds(1), p.servo_bus.timeoutMs());
     },
 };
 

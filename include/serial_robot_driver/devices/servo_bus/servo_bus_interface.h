@@ -48,10 +48,8 @@
 
 namespace serial_robot_driver::ros_layer {
 
-/// Client options from ~servo_bus/{timeout, retries, allow_dangerous_writes}.
-device::ServoBusOptions makeServoBusOptions(const DriverParams& params);
-/// The bus device's configuration: the client options and the poll (state_ids and the joint_ids
-/// servos, at state_rate).
+/// The bus device's configuration: what the parameters bound into ServoBusParams::bus, plus the
+/// polled servos (state_ids and the joint_ids servos) and the safe-motion values kept as written.
 device::ServoBusConfig makeServoBusConfig(const DriverParams& params);
 
 // Joint names and servo_commands' checks are the core's (device/servo_joint_commands.h).

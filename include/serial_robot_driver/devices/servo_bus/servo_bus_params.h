@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -11,15 +12,19 @@
 
 namespace serial_robot_driver::params {
 
-/// The defaults of the bus's core configuration (see kBaseDefaults).
-inline const device::ServoBusConfig kServoBusDefaults{};
-
+/// The bus's parameters. Those that configure device::ServoBus are bound straight into `bus`
+/// (their defaults are its own); the rest are the ROS layer's and the checks'. Three are kept as
+/// written, because the core's type could not hold every bad value for the check to name (a
+/// sub-millisecond timeout, a negative power, an unknown action); their defaults are the core's.
 struct ServoBusParams : DevicePortParams {
-  double timeout = std::chrono::duration<double>(kServoBusDefaults.client.timeout).count();  ///< s
-  int retries = kServoBusDefaults.client.retries;
-  bool allow_dangerous_writes = kServoBusDefaults.client.allow_dangerous_writes;
+  /// The bus's configuration as the parameters set it: client.retries and
+  /// .allow_dangerous_writes, poll_rate (~servo_bus/state_rate), health_rate, protect. The rest
+  /// (client.timeout, polled_ids, relax_power_mw, on_shutdown) ros_layer::makeServoBusConfig fills
+  /// in from the values below.
+  device::ServoBusConfig bus;
+  /// s to wait for one answer (the core's milliseconds: timeoutMs()).
+  double timeout = std::chrono::duration<double>(device::ServoBusOptions{}.timeout).count();
   std::vector<int> state_ids;     ///< bus servos polled for servo_states (empty: no poll)
-  double state_rate = kServoBusDefaults.poll_rate;  ///< Hz, polls of every state_ids servo
   int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
   // Bus servos used as named joints (trajectories, servo_states); one entry per joint_ids.
   std::vector<int> joint_ids;
@@ -27,10 +32,14 @@ struct ServoBusParams : DevicePortParams {
   std::vector<double> joint_zero_deg;  ///< servo angle at joint position 0; empty: all 0
   std::vector<int> joint_directions;   ///< 1 or -1; empty: all 1
   // Safe motion: servo/relax's DAMPING power; what servos set moving get when the node stops.
-  int relax_power_mw = kServoBusDefaults.relax_power_mw;  ///< mW
-  std::string on_shutdown = "stop";                       ///< stop | relax | none
-  double health_rate = kServoBusDefaults.health_rate;  ///< Hz of the health poll; 0: off
-  bool protect = kServoBusDefaults.protect;  ///< relax a servo at its temperature limit
+  int relax_power_mw = device::ServoBusConfig{}.relax_power_mw;  ///< mW
+  std::string on_shutdown =
+      device::toString(device::ServoBusConfig{}.on_shutdown);  ///< stop | relax | none
+
+  /// `timeout` as the bus keeps it: whole milliseconds, rounded.
+  std::chrono::milliseconds timeoutMs() const {
+    return std::chrono::milliseconds(std::llround(timeout * 1000.0));
+  }
 };
 
 }  // namespace serial_robot_driver::params

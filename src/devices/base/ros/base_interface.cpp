@@ -22,21 +22,11 @@ constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
 }  // namespace
 
 device::BaseConfig makeBaseConfig(const DriverParams& params) {
-  device::BaseConfig config;
-  config.geometry.wheel_diameter = params.base.wheel_diameter;
-  config.geometry.wheel_separation = params.base.wheel_separation;
-  config.geometry.encoder_resolution = params.base.encoder_resolution;
-  config.geometry.pid_rate = params.base.pid_rate;
-  config.max_wheel_speed = params.base.max_wheel_speed;
-  config.max_wheel_accel = params.base.max_wheel_accel;
-  config.cmd_vel_timeout = params.base.cmd_vel_timeout;
-  config.speed_dithering = params.base.speed_dithering;
-  config.battery_poll_rate = params.base.battery_poll_rate;
+  // The base's own parameters are bound into its configuration already (base_module.cpp); these
+  // come from node-wide or other devices' parameters.
+  device::BaseConfig config = params.base.controller;
   config.loop_rate = params.loop_rate;
   config.baud = params.baseBaud();
-  config.left_wheel_direction = params.base.left_wheel_direction;
-  config.right_wheel_direction = params.base.right_wheel_direction;
-  config.use_imu_heading = params.base.use_imu_heading;
   config.imu_yaw_variance = params.imu.orientation_variance;
   return config;
 }
@@ -104,8 +94,8 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
     : link_(link),
       arrival_stamps_(params),
       params_(params.base),
-      tuned_{params.base.publish_tf, params.base.cmd_vel_timeout, params.base.battery_warn_percent,
-             params.base.battery_error_percent},
+      tuned_{params.base.publish_tf, params.base.controller.cmd_vel_timeout,
+             params.base.battery_warn_percent, params.base.battery_error_percent},
       tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
                                              : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
@@ -204,7 +194,7 @@ BaseInterface::Tuned BaseInterface::tuned() const {
 void BaseInterface::retune(const DriverParams& params) {
   controller_.retune(makeBaseConfig(params));
   std::lock_guard<std::mutex> lock(tuned_mutex_);
-  tuned_ = Tuned{params.base.publish_tf, params.base.cmd_vel_timeout,
+  tuned_ = Tuned{params.base.publish_tf, params.base.controller.cmd_vel_timeout,
                  params.base.battery_warn_percent, params.base.battery_error_percent};
 }
 

@@ -27,18 +27,8 @@ ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t inte
   return device::toServoMoves(msg.name, msg.position, msg.velocity, interval_ms);
 }
 
-device::ServoBusOptions makeServoBusOptions(const DriverParams& params) {
-  device::ServoBusOptions options;
-  options.timeout =
-      std::chrono::milliseconds(std::llround(params.servo_bus.timeout * kMsPerSecond));
-  options.retries = params.servo_bus.retries;
-  options.allow_dangerous_writes = params.servo_bus.allow_dangerous_writes;
-  return options;
-}
-
 device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
-  device::ServoBusConfig config;
-  config.client = makeServoBusOptions(params);
+  device::ServoBusConfig config = params.servo_bus.bus;
   for (int id : params.servo_bus.state_ids) config.polled_ids.push_back(static_cast<uint8_t>(id));
   // Joint servos are polled too: their angles are the trajectories' measurements.
   for (int id : params.servo_bus.joint_ids) {
@@ -48,13 +38,11 @@ device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
       config.polled_ids.push_back(joint_id);
     }
   }
-  config.poll_rate = params.servo_bus.state_rate;
+  config.client.timeout = params.servo_bus.timeoutMs();
+  // validate() accepted only 0..65535 and the names shutdownActionFromString() knows.
   config.relax_power_mw = static_cast<uint16_t>(params.servo_bus.relax_power_mw);
-  // validate() accepted only the names shutdownActionFromString() knows.
   config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
                            .value_or(device::ShutdownAction::kStop);
-  config.health_rate = params.servo_bus.health_rate;
-  config.protect = params.servo_bus.protect;
   return config;
 }
 
@@ -106,7 +94,7 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
 ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params,
                                      device::SerialLink& link)
     : bus_joints_(makeBusJoints(params.servo_bus)),
-      state_rate_(params.servo_bus.state_rate),
+      state_rate_(params.servo_bus.bus.poll_rate),
       link_(link),
       bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
       client_(bus_.client()),
@@ -122,7 +110,7 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
   nh_.setCallbackQueue(&queue_);
   advertiseServices();
 
-  if (params.servo_bus.allow_dangerous_writes) {
+  if (params.servo_bus.bus.client.allow_dangerous_writes) {
     ROS_WARN(
         "servo_bus: dangerous writes (servo_id, baudrate, response_switch, reserved cells, "
         "reset_user_data) are ARMED");
@@ -140,7 +128,7 @@ void ServoBusInterface::retune(const DriverParams& params) {
   if (trajectory_ && !bus_joints_.empty()) {
     std::vector<std::string> names;
     for (const trajectory::BusJoint& joint : bus_joints_) names.push_back(joint.name);
-    trajectory_->setStateTimeout(names, busStateTimeout(params.servo_bus.state_rate));
+    trajectory_->setStateTimeout(names, busStateTimeout(params.servo_bus.bus.poll_rate));
   }
 }
 
