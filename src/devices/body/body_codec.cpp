@@ -99,7 +99,7 @@ Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size
   }
   // A valid Dynamixel frame, but not the goal-position sync write we speak.
   SyncWriteCommand command;
-  wire::decodeFields(kCommandFields, &data[kCommandOffset], &command);
+  wire::decodeFieldsStatic<kSyncWriteCommandFields>(&data[kCommandOffset], &command);
   const SyncWriteCommand ours;
   if (data[kIdOffset] != kBroadcastId || command.instruction != ours.instruction ||
       command.address != ours.address || command.data_size != ours.data_size) {
@@ -108,8 +108,8 @@ Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size
 
   std::vector<ServoTarget> targets(servo_count);
   for (std::size_t i = 0; i < servo_count; ++i) {
-    wire::decodeFields(kTargetFields, &data[kFirstTargetOffset + kTargetFields.size() * i],
-                       &targets[i]);
+    wire::decodeFieldsStatic<kServoTargetFields>(
+        &data[kFirstTargetOffset + kTargetFields.size() * i], &targets[i]);
   }
   return targets;
 }
@@ -162,8 +162,8 @@ Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::s
   Telemetry telemetry;
   telemetry.servo_count = servo_count;
   for (std::size_t i = 0; i < servo_count; ++i) {
-    wire::decodeFields(kSampleFields, &data[kTelemetryPrefix + kSampleFields.size() * i],
-                       &telemetry.servos[i]);
+    wire::decodeFieldsStatic<kServoSampleFields>(
+        &data[kTelemetryPrefix + kSampleFields.size() * i], &telemetry.servos[i]);
   }
   const auto read = [&](const wire::Field<TelemetryValue>& field, std::size_t offset) {
     return wire::readInteger(&data[offset], field.type, field.order);
