@@ -165,18 +165,22 @@ Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::s
     wire::decodeFieldsStatic<kServoSampleFields>(
         &data[kTelemetryPrefix + kSampleFields.size() * i], &telemetry.servos[i]);
   }
-  const auto read = [&](const wire::Field<TelemetryValue>& field, std::size_t offset) {
-    return wire::readInteger(&data[offset], field.type, field.order);
-  };
+  // The value fields' types as constants, so each read compiles to a load and a byte swap.
+  constexpr wire::WireType kImuType = kImuValueField.type;
+  constexpr wire::ByteOrder kImuOrder = kImuValueField.order;
+  const uint8_t* imu = &data[imuOffset(servo_count)];
   for (std::size_t k = 0; k < kImuValueCount; ++k) {
-    const std::size_t offset = imuOffset(servo_count) + kImuValueField.type.width * k;
-    telemetry.imu[k] = static_cast<int16_t>(read(kImuValueField, offset));
+    telemetry.imu[k] =
+        static_cast<int16_t>(wire::readInteger(imu + kImuType.width * k, kImuType, kImuOrder));
   }
   telemetry.has_foot = has_foot;
   if (has_foot) {
+    constexpr wire::WireType kFootType = kFootValueField.type;
+    constexpr wire::ByteOrder kFootOrder = kFootValueField.order;
+    const uint8_t* foot = &data[footOffset(servo_count)];
     for (std::size_t j = 0; j < kFootSensorCount; ++j) {
-      const std::size_t offset = footOffset(servo_count) + kFootValueField.type.width * j;
-      telemetry.foot[j] = static_cast<uint16_t>(read(kFootValueField, offset));
+      telemetry.foot[j] =
+          static_cast<uint16_t>(wire::readInteger(foot + kFootType.width * j, kFootType, kFootOrder));
     }
   }
   return telemetry;
