@@ -106,7 +106,9 @@ const MixedStream& mixedStream() {
   return stream;
 }
 
-FramerConfig driverConfig() { return test_support::driverFramer({"base", "body", "servo_bus"}, kServoCount); }
+FramerConfig driverConfig() {
+  return test_support::driverFramer({"base", "body", "servo_bus"}, kServoCount);
+}
 
 // Framer over the mixed stream, fed in chunks of state.range(0) bytes (a serial read returns small
 // chunks; a backlog after a stall returns big ones).

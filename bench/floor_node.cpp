@@ -22,10 +22,10 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/devices/body/body_controller.h"
-#include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/framer_configs.h"
 

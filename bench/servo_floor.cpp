@@ -13,19 +13,18 @@
 // prints one line: transactions=N seconds=S cpu_s=C lost=L mean_ms=M
 #include <fcntl.h>
 #include <poll.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
-#include <ros/ros.h>
-#include <sensor_msgs/JointState.h>
-
 #include <chrono>
 #include <cmath>
-#include <memory>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 

@@ -21,10 +21,10 @@
 
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
-#include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
+#include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace {

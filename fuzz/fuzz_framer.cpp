@@ -19,8 +19,8 @@
 #include <cstring>
 #include <memory>
 
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include "registered_families.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
 
 namespace {
 
@@ -61,10 +61,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* input, std::size_t input_si
   const std::size_t stream_size = input_size - kPrefix;
 
   uint64_t frame_bytes = 0;
-  StreamFramer framer(config, [&](const FrameFamily& family, const uint8_t* data, std::size_t size) {
-    frame_bytes += size;
-    decodeFrame(config, family, data, size);
-  });
+  StreamFramer framer(config,
+                      [&](const FrameFamily& family, const uint8_t* data, std::size_t size) {
+                        frame_bytes += size;
+                        decodeFrame(config, family, data, size);
+                      });
 
   // Chunk sizes from a small xorshift seeded by the input, so they do not eat stream bytes.
   uint32_t rng = 0x9E3779B9u ^ (static_cast<uint32_t>(input[0]) << 16) ^ input[1];

@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
+#include "registered_families.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
-#include "registered_families.h"
 
 namespace {
 
@@ -212,7 +212,8 @@ void writeFramerSeeds(SeedWriter& seeds) {
   seeds.write("telemetry", all, kTelemetry);
   seeds.write("telemetry_foot_chunked", {kTelemetryBit, 2, 5}, join({kTelemetryFoot, kTelemetry}));
   seeds.write("sync_write", all, kSyncWrite);
-  seeds.write("simulator_input", {static_cast<uint8_t>(kBaseBit | kRequestBit | kSyncWriteBit), 0, 4},
+  seeds.write("simulator_input",
+              {static_cast<uint8_t>(kBaseBit | kRequestBit | kSyncWriteBit), 0, 4},
               join({dynamixelPing(), kSyncWrite, request(servo::Command::kRotate), kBaseReset}));
   Bytes requests, answers;
   for (const servo::CommandInfo& info : servo::commandTable()) {

@@ -25,7 +25,8 @@ StatusReport linkStatus(const LinkStats& s, const SerialLinkOptions& options) {
   status.add("write failures", s.write_failures);
   for (std::size_t i = 0; i < s.framer.family_count; ++i) {
     if (s.framer.by_family[i].frames == 0) continue;
-    status.add(std::string("frames in: ") + s.framer.by_family[i].family, s.framer.by_family[i].frames);
+    status.add(std::string("frames in: ") + s.framer.by_family[i].family,
+               s.framer.by_family[i].frames);
   }
   status.add("checksum errors", s.framer.checksum_errors);
   status.add("bad tails", s.framer.bad_tails);

@@ -14,7 +14,8 @@ void addNodeParameters(std::vector<ParamSpec>& table) {
   using P = DriverParams;
   const auto node = [&table](const char* key, auto P::*field, auto rule) {
     using T = std::remove_reference_t<decltype(std::declval<P&>().*field)>;
-    table.push_back(makeRow<T>(key, "", [field](P& p) -> T& { return p.*field; }, Rule<T>(rule)));
+    table.push_back(makeRow<T>(
+        key, "", [field](P& p) -> T& { return p.*field; }, Rule<T>(rule)));
   };
   node("port", &P::port, [](const std::string& v, const std::string& key) {
     require(!v.empty(), key, "must name a serial device, e.g. /dev/ttyUSB0");

@@ -23,9 +23,9 @@ std::string numberText(double value) {
 }  // namespace
 
 std::string typeName(const ParamValue& value) {
-  static const char* const kNames[] = {"true or false", "an integer",          "a number",
-                                       "a string",      "a list of integers", "a list of strings",
-                                       "a list of numbers"};
+  static const char* const kNames[] = {
+      "true or false",      "an integer",        "a number",         "a string",
+      "a list of integers", "a list of strings", "a list of numbers"};
   return kNames[value.index()];
 }
 
@@ -102,8 +102,8 @@ void uniqueNames(const std::vector<std::string>& names, const std::string& key) 
 void baudRate(const int& value, const std::string& key) {
   // The port's own table: a rate passes here exactly when the port can open at it.
   require(value > 0 && transport::isSupportedBaud(static_cast<unsigned>(value)), key,
-          "unsupported baud rate " + std::to_string(value) + " (supported: " +
-              transport::supportedBaudRatesText() + ")");
+          "unsupported baud rate " + std::to_string(value) +
+              " (supported: " + transport::supportedBaudRatesText() + ")");
 }
 
 void baudOrInherit(const int& value, const std::string& key) {
@@ -120,9 +120,9 @@ Rule<int> integerWithin(int low, int high, const std::string& unit) {
 
 Rule<double> numberWithin(double low, double high, const std::string& unit) {
   return [low, high, unit](const double& value, const std::string& key) {
-    require(std::isfinite(value) && value >= low && value <= high, key,
-            "must be " + numberText(low) + ".." + numberText(high) +
-                (unit.empty() ? "" : " " + unit));
+    require(
+        std::isfinite(value) && value >= low && value <= high, key,
+        "must be " + numberText(low) + ".." + numberText(high) + (unit.empty() ? "" : " " + unit));
   };
 }
 

@@ -1,4 +1,3 @@
-#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 
 #include <rosbag/bag.h>
@@ -9,6 +8,7 @@
 #include <sstream>
 
 #include "serial_robot_driver/SerialChunk.h"
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {

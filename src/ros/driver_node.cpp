@@ -11,8 +11,8 @@
 #include "serial_robot_driver/devices/base/base_interface.h"
 #include "serial_robot_driver/devices/body/body_interface.h"
 #include "serial_robot_driver/ros/conversions.h"
-#include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
+#include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/ros/wire_capture.h"
 

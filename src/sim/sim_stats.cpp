@@ -79,10 +79,8 @@ std::string formatStats(const SimStats& stats) {
   line("rx_bad_lengths", stats.framer.bad_lengths);
   line("rx_unknown_commands", stats.framer.unknown_commands);
   line("rx_frames_base", stats.framer.framesOf(protocol::base::kFrames));
-  line("rx_frames_servo_request",
-       stats.framer.framesOf(protocol::servo::kRequestFrames));
-  line("rx_frames_sync_write",
-       stats.framer.framesOf(protocol::body::kSyncWriteFrames));
+  line("rx_frames_servo_request", stats.framer.framesOf(protocol::servo::kRequestFrames));
+  line("rx_frames_sync_write", stats.framer.framesOf(protocol::body::kSyncWriteFrames));
   line("frames_for_absent_device", stats.frames_for_absent_device);
   line("tx_bytes", stats.bytes_sent);
   line("garbage_bursts", stats.garbage_bursts);

@@ -19,11 +19,11 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/devices/base/base_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/ServoRead.h"
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/pty_tap.h"
 #include "support/ros_test_support.h"

@@ -7,6 +7,7 @@
 #include <nodelet/NodeletLoad.h>
 #include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
+#include <rosbag/bag.h>
 #include <sys/wait.h>
 
 #include <csignal>
@@ -15,16 +16,14 @@
 #include <thread>
 #include <vector>
 
-#include <rosbag/bag.h>
-
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
-#include "support/golden_frames.h"
 #include "support/fake_device.h"
+#include "support/framer_configs.h"
+#include "support/golden_frames.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
-#include "support/framer_configs.h"
 
 namespace {
 
@@ -52,8 +51,7 @@ std::vector<FakeDevice::Frame> speedFrames(const FakeDevice& device) {
 }
 
 std::unique_ptr<FakeDevice> makeBase(const std::string& port) {
-  auto base =
-      std::make_unique<FakeDevice>(port, test_support::driverFramer({"base"}));
+  auto base = std::make_unique<FakeDevice>(port, test_support::driverFramer({"base"}));
   base->plug();
   return base;
 }

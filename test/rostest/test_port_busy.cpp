@@ -10,9 +10,9 @@
 
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/fake_device.h"
+#include "support/framer_configs.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
-#include "support/framer_configs.h"
 
 namespace {
 

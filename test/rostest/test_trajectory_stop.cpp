@@ -16,9 +16,9 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/fake_device.h"

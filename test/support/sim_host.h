@@ -21,16 +21,16 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/devices/body/body_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/command_line.h"
 #include "serial_robot_driver/sim/robot_sim.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
-#include "support/golden_frames.h"
 #include "support/framer_configs.h"
+#include "support/golden_frames.h"
 
 namespace serial_robot_driver::sim::sim_test {
 

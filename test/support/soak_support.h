@@ -30,8 +30,8 @@
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
-#include "support/ros_test_support.h"
 #include "support/framer_configs.h"
+#include "support/ros_test_support.h"
 
 namespace soak_test {
 

@@ -14,9 +14,9 @@
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "support/framer_configs.h"
 #include "support/golden_frames.h"
 #include "support/test_helpers.h"
-#include "support/framer_configs.h"
 
 namespace serial_robot_driver::protocol::stream_framer_test {
 

@@ -8,19 +8,20 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::device {
 namespace {
 
-using protocol::FramerConfig;
 using protocol::FrameFamily;
+using protocol::FramerConfig;
 
 std::set<std::string> familyNames(const FramerConfig& config) {
   std::set<std::string> names;
-  for (std::size_t i = 0; i < config.family_count; ++i) names.insert(config.families[i].family.name);
+  for (std::size_t i = 0; i < config.family_count; ++i)
+    names.insert(config.families[i].family.name);
   return names;
 }
 

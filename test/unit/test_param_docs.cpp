@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -180,7 +180,8 @@ TEST(ParameterDocs, NodeApiDocumentsEveryKeyOfTheTableAndNoOther) {
   std::set<std::string> in_table;
   for (const ParamSpec& spec : parameterTable()) {
     in_table.insert(spec.key);
-    EXPECT_EQ(documented.count(spec.key), 1u) << "~" << spec.key << " is not in docs/node_api.md nor in its device's README.md";
+    EXPECT_EQ(documented.count(spec.key), 1u)
+        << "~" << spec.key << " is not in docs/node_api.md nor in its device's README.md";
   }
   for (const std::string& key : documented) {
     EXPECT_TRUE(in_table.count(key) || kDocumentedOutsideTheTable.count(key))

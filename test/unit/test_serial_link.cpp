@@ -11,9 +11,9 @@
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/transport/recorded_stream.h"
-#include "support/test_helpers.h"
-#include "support/golden_frames.h"
 #include "support/framer_configs.h"
+#include "support/golden_frames.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::device {
 namespace {

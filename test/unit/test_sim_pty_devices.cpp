@@ -89,7 +89,8 @@ TEST(RobotSimBody, TelemetryDecodesWithGravityOnZ) {
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
-  ASSERT_TRUE(host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 5; }));
+  ASSERT_TRUE(
+      host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 5; }));
   for (const Bytes& frame : host.framesOf(protocol::body::kTelemetryFrames)) {
     ASSERT_EQ(frame.size(), 32u);
     EXPECT_EQ(frame[2], 0x20);
@@ -157,7 +158,8 @@ TEST(RobotSimBody, FootAlternateInterleavesFrameLengths) {
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
-  ASSERT_TRUE(host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 6; }));
+  ASSERT_TRUE(
+      host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 6; }));
   const auto frames = host.framesOf(protocol::body::kTelemetryFrames);
   for (std::size_t i = 1; i < frames.size(); ++i) EXPECT_NE(frames[i].size(), frames[i - 1].size());
   for (const Bytes& frame : frames) {
@@ -242,7 +244,8 @@ TEST_F(RobotSimServoBus, RotateMovesTheAngleWithoutAnAnswerByDefault) {
   }
   EXPECT_TRUE(reached);
   // Only READ_ANGLE answers arrived: response_switch is 0, ROTATE is silent.
-  for (const Bytes& frame : host_->framesOf(protocol::servo::kResponseFrames)) EXPECT_EQ(frame[2], 0x0A);
+  for (const Bytes& frame : host_->framesOf(protocol::servo::kResponseFrames))
+    EXPECT_EQ(frame[2], 0x0A);
 }
 
 TEST_F(RobotSimServoBus, ResponseSwitchOneAnswersAfterTheMotion) {

@@ -2,8 +2,8 @@
 // and the stats file.
 #include <gtest/gtest.h>
 
-#include "support/sim_host.h"
 #include "support/framer_configs.h"
+#include "support/sim_host.h"
 
 namespace serial_robot_driver::sim {
 namespace {
@@ -106,7 +106,8 @@ TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
   // What the line carried in that time, plus one write's worth in flight at the start.
   EXPECT_LE(static_cast<double>(received - std::min(received, held_at_start)),
             960.0 * elapsed_s + 16.0);
-  EXPECT_FALSE(host.framesOf(protocol::body::kTelemetryFrames).empty());  // cut into slices, not damaged
+  EXPECT_FALSE(
+      host.framesOf(protocol::body::kTelemetryFrames).empty());  // cut into slices, not damaged
   EXPECT_EQ(host.framerStats().checksum_errors, 0u);
 }
 

@@ -25,9 +25,9 @@ class StreamFramerBroken : public ::testing::TestWithParam<BrokenCase> {};
 
 TEST_P(StreamFramerBroken, CountedSkippedAndTheNextFrameStillComesThrough) {
   const BrokenCase& c = GetParam();
-  for (const Frame& good :
-       {Frame{protocol::servo::kResponseFrames, kServoPingReply},
-        Frame{protocol::base::kFrames, kBaseBatteryReply}, Frame{protocol::body::kSyncWriteFrames, kSyncWrite}}) {
+  for (const Frame& good : {Frame{protocol::servo::kResponseFrames, kServoPingReply},
+                            Frame{protocol::base::kFrames, kBaseBatteryReply},
+                            Frame{protocol::body::kSyncWriteFrames, kSyncWrite}}) {
     SCOPED_TRACE(good.family.name);
     RecordingFramer framer(allFamilies());
     framer.feed(concat({c.broken, good.bytes}));

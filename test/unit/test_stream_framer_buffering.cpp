@@ -1,8 +1,8 @@
 // StreamFramer's buffer: incomplete frames kept, reset, empty feeds, stale candidates.
 #include <gtest/gtest.h>
 
-#include "support/stream_framer_recording.h"
 #include "support/framer_configs.h"
+#include "support/stream_framer_recording.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
@@ -64,7 +64,8 @@ TEST(StreamFramerStale, AStrayHeaderWithALongLenStopsHoldingBackTheAnswerBehindI
   while (framer.framer().dropStaleCandidate()) {
   }
   ASSERT_EQ(framer.frames().size(), 1u);
-  EXPECT_EQ(framer.frames()[0], (Frame{protocol::servo::kResponseFrames, golden::servo::kPing3Reply}));
+  EXPECT_EQ(framer.frames()[0],
+            (Frame{protocol::servo::kResponseFrames, golden::servo::kPing3Reply}));
   EXPECT_EQ(framer.framer().buffered(), 0u);
   EXPECT_EQ(framer.stats().stale_candidates, 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, 4u);

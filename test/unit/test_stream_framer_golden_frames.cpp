@@ -2,8 +2,8 @@
 // with its family disabled).
 #include <gtest/gtest.h>
 
-#include "support/stream_framer_recording.h"
 #include "support/framer_configs.h"
+#include "support/stream_framer_recording.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
@@ -109,32 +109,32 @@ TEST_P(StreamFramerGolden, IgnoredWhenItsFamilyIsDisabled) {
 
 INSTANTIATE_TEST_SUITE_P(
     StreamFramerVectors, StreamFramerGolden,
-    ::testing::Values(GoldenCase{"BaseReset", kBaseReset, protocol::base::kFrames},
-                      GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, protocol::base::kFrames},
-                      GoldenCase{"BaseClearEncoders", kBaseClearEncoders, protocol::base::kFrames},
-                      GoldenCase{"BaseLeft4", kBaseLeft4, protocol::base::kFrames},
-                      GoldenCase{"BaseRight4", kBaseRight4, protocol::base::kFrames},
-                      GoldenCase{"BaseBoth4", kBaseBoth4, protocol::base::kFrames},
-                      GoldenCase{"BaseBothMinus6", kBaseBothMinus6, protocol::base::kFrames},
-                      GoldenCase{"BaseBatteryReply", kBaseBatteryReply, protocol::base::kFrames},
-                      GoldenCase{"BaseErrorStatus", kBaseErrorStatus, protocol::base::kFrames},
-                      GoldenCase{"BaseLen1", kBaseLen1, protocol::base::kFrames},
-                      GoldenCase{"Telemetry", kTelemetry, protocol::body::kTelemetryFrames},
-                      GoldenCase{"TelemetryFoot", kTelemetryFoot, protocol::body::kTelemetryFrames},
-                      GoldenCase{"SyncWrite", kSyncWrite, protocol::body::kSyncWriteFrames},
-                      GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, protocol::body::kSyncWriteFrames},
-                      GoldenCase{"ServoPing", kServoPing, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoRotate", kServoRotate, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoReadAngle", kServoReadAngle, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoSpinCcw", kServoSpinCcw, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoSpinStop", kServoSpinStop, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoSpinTurns", kServoSpinTurns, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoSpinMs", kServoSpinMs, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoDamping", kServoDamping, protocol::servo::kRequestFrames},
-                      GoldenCase{"ServoPingReply", kServoPingReply, protocol::servo::kResponseFrames},
-                      GoldenCase{"ServoReadAngleReply", kServoReadAngleReply,
-                                 protocol::servo::kResponseFrames},
-                      GoldenCase{"ServoEmptyReply", kServoEmptyReply, protocol::servo::kResponseFrames}),
+    ::testing::Values(
+        GoldenCase{"BaseReset", kBaseReset, protocol::base::kFrames},
+        GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, protocol::base::kFrames},
+        GoldenCase{"BaseClearEncoders", kBaseClearEncoders, protocol::base::kFrames},
+        GoldenCase{"BaseLeft4", kBaseLeft4, protocol::base::kFrames},
+        GoldenCase{"BaseRight4", kBaseRight4, protocol::base::kFrames},
+        GoldenCase{"BaseBoth4", kBaseBoth4, protocol::base::kFrames},
+        GoldenCase{"BaseBothMinus6", kBaseBothMinus6, protocol::base::kFrames},
+        GoldenCase{"BaseBatteryReply", kBaseBatteryReply, protocol::base::kFrames},
+        GoldenCase{"BaseErrorStatus", kBaseErrorStatus, protocol::base::kFrames},
+        GoldenCase{"BaseLen1", kBaseLen1, protocol::base::kFrames},
+        GoldenCase{"Telemetry", kTelemetry, protocol::body::kTelemetryFrames},
+        GoldenCase{"TelemetryFoot", kTelemetryFoot, protocol::body::kTelemetryFrames},
+        GoldenCase{"SyncWrite", kSyncWrite, protocol::body::kSyncWriteFrames},
+        GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, protocol::body::kSyncWriteFrames},
+        GoldenCase{"ServoPing", kServoPing, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoRotate", kServoRotate, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoReadAngle", kServoReadAngle, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoSpinCcw", kServoSpinCcw, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoSpinStop", kServoSpinStop, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoSpinTurns", kServoSpinTurns, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoSpinMs", kServoSpinMs, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoDamping", kServoDamping, protocol::servo::kRequestFrames},
+        GoldenCase{"ServoPingReply", kServoPingReply, protocol::servo::kResponseFrames},
+        GoldenCase{"ServoReadAngleReply", kServoReadAngleReply, protocol::servo::kResponseFrames},
+        GoldenCase{"ServoEmptyReply", kServoEmptyReply, protocol::servo::kResponseFrames}),
     [](const ::testing::TestParamInfo<GoldenCase>& info) { return info.param.name; });
 
 }  // namespace

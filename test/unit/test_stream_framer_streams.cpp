@@ -1,8 +1,8 @@
 // StreamFramer on streams: back-to-back frames, interleaved families, chunking and look-alikes.
 #include <gtest/gtest.h>
 
-#include "support/stream_framer_recording.h"
 #include "support/framer_configs.h"
+#include "support/stream_framer_recording.h"
 
 namespace serial_robot_driver::protocol {
 namespace {
@@ -16,12 +16,15 @@ TEST(StreamFramerStream, BackToBackFramesAllComeOutInOrder) {
                                kTelemetry, kSyncWrite, kServoDamping, kBaseLen1});
   RecordingFramer framer(allFamilies());
   framer.feed(stream);
-  const std::vector<Frame> expected = {
-      {protocol::base::kFrames, kBaseReset},         {protocol::base::kFrames, kBaseBoth4},
-      {protocol::servo::kRequestFrames, kServoPing}, {protocol::servo::kResponseFrames, kServoPingReply},
-      {protocol::body::kTelemetryFrames, kTelemetry},    {protocol::body::kTelemetryFrames, kTelemetry},
-      {protocol::body::kSyncWriteFrames, kSyncWrite},    {protocol::servo::kRequestFrames, kServoDamping},
-      {protocol::base::kFrames, kBaseLen1}};
+  const std::vector<Frame> expected = {{protocol::base::kFrames, kBaseReset},
+                                       {protocol::base::kFrames, kBaseBoth4},
+                                       {protocol::servo::kRequestFrames, kServoPing},
+                                       {protocol::servo::kResponseFrames, kServoPingReply},
+                                       {protocol::body::kTelemetryFrames, kTelemetry},
+                                       {protocol::body::kTelemetryFrames, kTelemetry},
+                                       {protocol::body::kSyncWriteFrames, kSyncWrite},
+                                       {protocol::servo::kRequestFrames, kServoDamping},
+                                       {protocol::base::kFrames, kBaseLen1}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(frameCount(framer.stats(), protocol::base::kFrames), 3u);
   EXPECT_EQ(frameCount(framer.stats(), protocol::body::kTelemetryFrames), 2u);
@@ -121,8 +124,9 @@ TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
 
   RecordingFramer telemetry_only(test_support::driverFramer({"body"}, kServoCount));
   telemetry_only.feed(concat({kServoPing, kTelemetry, kServoRotate, kTelemetryFoot}));
-  const std::vector<Frame> expected_telemetry = {{protocol::body::kTelemetryFrames, kTelemetry},
-                                                 {protocol::body::kTelemetryFrames, kTelemetryFoot}};
+  const std::vector<Frame> expected_telemetry = {
+      {protocol::body::kTelemetryFrames, kTelemetry},
+      {protocol::body::kTelemetryFrames, kTelemetryFoot}};
   EXPECT_EQ(telemetry_only.frames(), expected_telemetry);
   EXPECT_EQ(telemetry_only.stats().bytes_skipped, kServoPing.size() + kServoRotate.size());
 }

@@ -1,8 +1,8 @@
 // What makes a device known to the driver: one DeviceModule per device, defined in the device's
 // own folder (src/devices/<name>/) and registered by one line in cmake/devices.cmake. The framer
-// configuration, the parameter table and its checks, the node's interfaces (ros/ros_device_module.h)
-// and the simulator (sim/sim_device_module.h) all walk the registered modules; none of them names
-// a device.
+// configuration, the parameter table and its checks, the node's interfaces
+// (ros/ros_device_module.h) and the simulator (sim/sim_device_module.h) all walk the registered
+// modules; none of them names a device.
 #pragma once
 
 #include <chrono>

@@ -24,12 +24,13 @@ struct DeviceModule;
 
 namespace serial_robot_driver::params {
 
-/// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override them).
+/// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override
+/// them).
 struct TrajectoryParams {
   double goal_tolerance = 0.05;      ///< rad, per joint
   double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
   double path_tolerance = 0.0;       ///< rad; 0: not checked
-  double max_velocity = 0.0;         ///< rad/s per joint; a faster trajectory is refused; 0: no limit
+  double max_velocity = 0.0;  ///< rad/s per joint; a faster trajectory is refused; 0: no limit
 };
 
 /// The parameter sections of devices that DriverParams has no member for: each device keeps its

@@ -27,9 +27,8 @@ class ParameterError : public std::runtime_error {
 };
 
 /// One parameter's value; the alternative held says the parameter's type.
-using ParamValue =
-    std::variant<bool, int, double, std::string, std::vector<int>, std::vector<std::string>,
-                 std::vector<double>>;
+using ParamValue = std::variant<bool, int, double, std::string, std::vector<int>,
+                                std::vector<std::string>, std::vector<double>>;
 
 /// How a parameter's expected type reads in an error message ("a number").
 std::string typeName(const ParamValue& value);
@@ -75,7 +74,8 @@ Rule<int> integerWithin(int low, int high, const std::string& unit = "");
 /// A finite number within [low, high].
 Rule<double> numberWithin(double low, double high, const std::string& unit = "");
 
-// --- rows ------------------------------------------------------------------------------------------
+// --- rows
+// ------------------------------------------------------------------------------------------
 
 template <typename T>
 struct NoDeduce {
@@ -136,15 +136,13 @@ class SectionRows {
         section_(std::move(section)) {}
 
   template <typename T, typename Owner>
-  SectionRows& add(const char* name, T Owner::*field,
-                   typename NoDeduce<Rule<T>>::type rule = {}) {
+  SectionRows& add(const char* name, T Owner::*field, typename NoDeduce<Rule<T>>::type rule = {}) {
     static_assert(std::is_base_of_v<Owner, Section>, "the field must belong to the section");
     auto section = section_;
-    table_.push_back(makeRow<T>(prefix_ + "/" + name, device_,
-                                [section, field](DriverParams& p) -> T& {
-                                  return static_cast<Owner&>(section(p)).*field;
-                                },
-                                rule));
+    table_.push_back(makeRow<T>(
+        prefix_ + "/" + name, device_,
+        [section, field](DriverParams& p) -> T& { return static_cast<Owner&>(section(p)).*field; },
+        rule));
     return *this;
   }
 
@@ -153,11 +151,9 @@ class SectionRows {
   SectionRows& addNested(const char* name, Access access,
                          typename NoDeduce<Rule<T>>::type rule = {}) {
     auto section = section_;
-    table_.push_back(makeRow<T>(prefix_ + "/" + name, device_,
-                                [section, access](DriverParams& p) -> T& {
-                                  return access(section(p));
-                                },
-                                rule));
+    table_.push_back(makeRow<T>(
+        prefix_ + "/" + name, device_,
+        [section, access](DriverParams& p) -> T& { return access(section(p)); }, rule));
     return *this;
   }
 

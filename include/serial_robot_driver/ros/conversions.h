@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/device/status_report.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {

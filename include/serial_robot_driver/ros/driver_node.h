@@ -1,7 +1,7 @@
 // driver_node: one node that owns the robot's serial port(s).
 //
-// The devices it drives are the registered ones (device/device_module.h); each has a ROS interface of its
-// own (ros/*_interface.h) with its topics and services, listed in full in docs/node_api.md:
+// The devices it drives are the registered ones (device/device_module.h); each has a ROS interface
+// of its own (ros/*_interface.h) with its topics and services, listed in full in docs/node_api.md:
 //   base      in cmd_vel; out odom (+ tf), wheel_command, battery;
 //             base/reset, base/reset_odometry, base/clear_encoders
 //   body      in joint_commands; out joint_states, imu/data, foot_pressure, telemetry
@@ -13,7 +13,8 @@
 // device (ros/trajectory_server.h). Parameters: see ros/driver_params.h and config/robot.yaml.
 //
 // Threading model:
-//  - one reader thread per port (device::SerialLink) decodes and publishes telemetry and base replies
+//  - one reader thread per port (device::SerialLink) decodes and publishes telemetry and base
+//  replies
 //    as soon as their last byte is read;
 //  - the base control loop runs on its own thread (device::BaseController);
 //  - cmd_vel, joint_commands and base/* services run on the global callback queue (a QueueSpinner

@@ -19,21 +19,21 @@ using params::BodyParams;
 using params::DevicePortParams;
 using params::DriverParams;
 using params::ImuParams;
+using params::kMinBaseLoopRate;
+using params::loadParams;
 using params::ParamAssignment;
 using params::ParameterError;
+using params::parameterTable;
 using params::ParamSource;
 using params::ParamSpec;
 using params::ParamValue;
-using params::ServoBusParams;
-using params::TrajectoryParams;
-using params::TuningResult;
-using params::kMinBaseLoopRate;
-using params::loadParams;
-using params::parameterTable;
 using params::parseAxisMap;
 using params::resolveFrame;
+using params::ServoBusParams;
 using params::toText;
+using params::TrajectoryParams;
 using params::tuneParams;
+using params::TuningResult;
 
 /// Reads every parameter from the private namespace of `private_nh` (missing keys keep their
 /// defaults; a key of the wrong type is a ParameterError), then `tf_prefix` searched upward from

@@ -1,8 +1,8 @@
 #include "serial_robot_driver/devices/base/base_codec.h"
 
 #include <algorithm>
-#include "serial_robot_driver/protocol/stream_framer.h"
 
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/protocol/wire_fields.h"
 
 namespace serial_robot_driver::protocol::base {

@@ -168,7 +168,8 @@ void BaseController::retune(const BaseConfig& next) {
   if (next.battery_poll_rate != config_.battery_poll_rate) {
     if (next.battery_poll_rate > 0) {
       // A faster rate starts now, not after the slower period still pending.
-      next_battery_poll_ = std::min(next_battery_poll_, now + fromSeconds(1.0 / next.battery_poll_rate));
+      next_battery_poll_ =
+          std::min(next_battery_poll_, now + fromSeconds(1.0 / next.battery_poll_rate));
     } else {
       unanswered_since_.reset();  // no requests, nothing unanswered
       silent_reported_ = false;
@@ -290,8 +291,7 @@ bool BaseController::writeLocked(const std::vector<uint8_t>& frame, Clock::time_
 
 WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now, bool* timed_out_now) {
   if (e_stop_) return WheelSpeeds::Zero();
-  const bool timed_out =
-      !last_command_ || seconds(now - *last_command_) > config_.cmd_vel_timeout;
+  const bool timed_out = !last_command_ || seconds(now - *last_command_) > config_.cmd_vel_timeout;
   if (timed_out && !command_timed_out_ && last_command_) {
     ++stats_.cmd_vel_timeouts;
     *timed_out_now = true;
@@ -365,8 +365,9 @@ void BaseController::tick(Clock::time_point now) {
     }
     last_tick_ = now;
     if (config_.battery_poll_rate > 0 && now >= next_battery_poll_) {
-      next_battery_poll_ = now + std::chrono::duration_cast<Clock::duration>(
-                                     std::chrono::duration<double>(1.0 / config_.battery_poll_rate));
+      next_battery_poll_ =
+          now + std::chrono::duration_cast<Clock::duration>(
+                    std::chrono::duration<double>(1.0 / config_.battery_poll_rate));
       // A Reset pending goes out with the speed frame below; the battery request can wait for it.
       if (!needs_reset_ && writeLocked(base::encodeBatteryRequest(seq_.peek()), now)) {
         ++stats_.battery_requests;

@@ -3,8 +3,8 @@
 #include <sstream>
 
 #include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::devices::base {
 

@@ -1,10 +1,10 @@
 #include "serial_robot_driver/devices/body/body_codec.h"
 
 #include <algorithm>
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include <boost/crc.hpp>
 
 #include "serial_robot_driver/protocol/byte_order.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
 
 namespace serial_robot_driver::protocol::body {
 
@@ -162,8 +162,8 @@ Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::s
   Telemetry telemetry;
   telemetry.servo_count = servo_count;
   for (std::size_t i = 0; i < servo_count; ++i) {
-    wire::decodeFieldsStatic<kServoSampleFields>(
-        &data[kTelemetryPrefix + kSampleFields.size() * i], &telemetry.servos[i]);
+    wire::decodeFieldsStatic<kServoSampleFields>(&data[kTelemetryPrefix + kSampleFields.size() * i],
+                                                 &telemetry.servos[i]);
   }
   // The value fields' types as constants, so each read compiles to a load and a byte swap.
   constexpr wire::WireType kImuType = kImuValueField.type;
@@ -179,8 +179,8 @@ Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::s
     constexpr wire::ByteOrder kFootOrder = kFootValueField.order;
     const uint8_t* foot = &data[footOffset(servo_count)];
     for (std::size_t j = 0; j < kFootSensorCount; ++j) {
-      telemetry.foot[j] =
-          static_cast<uint16_t>(wire::readInteger(foot + kFootType.width * j, kFootType, kFootOrder));
+      telemetry.foot[j] = static_cast<uint16_t>(
+          wire::readInteger(foot + kFootType.width * j, kFootType, kFootOrder));
     }
   }
   return telemetry;

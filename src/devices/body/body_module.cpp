@@ -4,8 +4,8 @@
 #include <set>
 
 #include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::devices::body {
 

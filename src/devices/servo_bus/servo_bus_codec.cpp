@@ -1,8 +1,8 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 
 #include <algorithm>
-#include "serial_robot_driver/protocol/stream_framer.h"
 
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include "servo_layouts.h"
 
 namespace serial_robot_driver::protocol::servo {
@@ -363,27 +363,27 @@ std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& con
 
 static_assert(kMaxFrameSize <= StreamFramer::kLongestFrame, "servo frame too long for the framer");
 
-constexpr FrameFamily kResponseFrames{
-    "servo_response", kResponseHeader0,
-    [](const uint8_t* data, std::size_t available, std::size_t) {
-      return probeResponse(data, available);
-    },
-    0,
-    [](const uint8_t* frame, std::size_t size, std::size_t) {
-      const auto decoded = decodeResponse(frame, size);
-      return decoded.ok() && decoded->content_size + kOverhead == size;
-    }};
+constexpr FrameFamily kResponseFrames{"servo_response", kResponseHeader0,
+                                      [](const uint8_t* data, std::size_t available, std::size_t) {
+                                        return probeResponse(data, available);
+                                      },
+                                      0,
+                                      [](const uint8_t* frame, std::size_t size, std::size_t) {
+                                        const auto decoded = decodeResponse(frame, size);
+                                        return decoded.ok() &&
+                                               decoded->content_size + kOverhead == size;
+                                      }};
 
 // Rank 1: after the body's telemetry, which shares the first byte 0x12.
-constexpr FrameFamily kRequestFrames{
-    "servo_request", kRequestHeader0,
-    [](const uint8_t* data, std::size_t available, std::size_t) {
-      return probeRequest(data, available);
-    },
-    1,
-    [](const uint8_t* frame, std::size_t size, std::size_t) {
-      const auto decoded = decodeRequest(frame, size);
-      return decoded.ok() && decoded->content_size + kOverhead == size;
-    }};
+constexpr FrameFamily kRequestFrames{"servo_request", kRequestHeader0,
+                                     [](const uint8_t* data, std::size_t available, std::size_t) {
+                                       return probeRequest(data, available);
+                                     },
+                                     1,
+                                     [](const uint8_t* frame, std::size_t size, std::size_t) {
+                                       const auto decoded = decodeRequest(frame, size);
+                                       return decoded.ok() &&
+                                              decoded->content_size + kOverhead == size;
+                                     }};
 
 }  // namespace serial_robot_driver::protocol::servo

@@ -5,8 +5,8 @@
 #include <set>
 
 #include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::devices::servo_bus {
 
@@ -83,7 +83,8 @@ void addParameters(std::vector<params::ParamSpec>& table) {
 void validate(const DriverParams& p) {
   const ServoBusParams& bus = p.servo_bus;
   const std::size_t n = bus.joint_ids.size();
-  const auto requireOnePerJoint = [n](std::size_t size, const std::string& name, bool may_be_empty) {
+  const auto requireOnePerJoint = [n](std::size_t size, const std::string& name,
+                                      bool may_be_empty) {
     require(size == n || (may_be_empty && size == 0), name,
             "has " + std::to_string(size) + " entries but servo_bus/joint_ids has " +
                 std::to_string(n));
@@ -93,9 +94,8 @@ void validate(const DriverParams& p) {
   requireOnePerJoint(bus.joint_directions.size(), "servo_bus/joint_directions", true);
   for (const std::string& name : bus.joint_names) {
     const bool body_has_it =
-        p.body.enabled &&
-        std::find(p.body.joint_names.begin(), p.body.joint_names.end(), name) !=
-            p.body.joint_names.end();
+        p.body.enabled && std::find(p.body.joint_names.begin(), p.body.joint_names.end(), name) !=
+                              p.body.joint_names.end();
     require(!body_has_it, "servo_bus/joint_names",
             "joint '" + name + "' is also a body joint (body/joint_names)");
   }

@@ -7,8 +7,8 @@
 #include <string>
 #include <string_view>
 
-#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
+#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
 namespace serial_robot_driver::device::servo_text {
 

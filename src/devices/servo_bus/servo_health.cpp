@@ -16,8 +16,8 @@ std::string quantity(const char* name, int64_t value, const char* unit) {
 }
 
 /// `value` against an upper (or, with `lower`, a lower) limit; nothing when the limit is unset.
-std::optional<Finding> check(const char* name, int64_t value, const char* limit_name,
-                             int64_t limit, const char* unit, bool lower) {
+std::optional<Finding> check(const char* name, int64_t value, const char* limit_name, int64_t limit,
+                             const char* unit, bool lower) {
   if (limit <= 0) return std::nullopt;
   const double margin = kWarnMargin * static_cast<double>(limit);
   HealthLevel level = HealthLevel::kOk;
@@ -36,7 +36,7 @@ std::optional<Finding> check(const char* name, int64_t value, const char* limit_
   }
   if (level == HealthLevel::kOk) return std::nullopt;
   const char* relation = level == HealthLevel::kError ? (lower ? " at or below " : " at or beyond ")
-                                                       : " within 10 % of ";
+                                                      : " within 10 % of ";
   return Finding{level, quantity(name, value, unit) + relation + quantity(limit_name, limit, unit)};
 }
 
@@ -72,8 +72,8 @@ HealthAssessment assessHealth(uint8_t id, const ServoReadings& r, const ServoLim
     for (const Finding& finding : findings) {
       if (finding.level != level) continue;
       if (assessment.level == HealthLevel::kOk) assessment.level = level;
-      assessment.message += (assessment.message.empty() ? "servo " + std::to_string(id) + ": " : "; ") +
-                            finding.text;
+      assessment.message +=
+          (assessment.message.empty() ? "servo " + std::to_string(id) + ": " : "; ") + finding.text;
     }
   }
   return assessment;

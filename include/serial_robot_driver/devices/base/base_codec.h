@@ -21,9 +21,9 @@ constexpr uint8_t kHeader1 = 0xAA;
 /// Bytes around MSGID+PARAM: header (2), LEN, SEQ, XOR.
 constexpr std::size_t kOverhead = 5;
 constexpr uint8_t kMinLen = 1;  ///< a frame carries at least its MSGID
-/// Longest LEN accepted from the base. The vendor's longest frame has LEN 9; anything far above is a
-/// corrupted length byte, and rejecting it early keeps the framer from stalling on 255-byte waits.
-/// (assumption, one constant to change)
+/// Longest LEN accepted from the base. The vendor's longest frame has LEN 9; anything far above is
+/// a corrupted length byte, and rejecting it early keeps the framer from stalling on 255-byte
+/// waits. (assumption, one constant to change)
 constexpr uint8_t kMaxLen = 32;
 constexpr std::size_t kMaxFrameSize = kMaxLen + kOverhead;
 

@@ -102,7 +102,7 @@ struct WheelFrameSent {
 
 struct BaseStats {
   uint64_t speed_frames = 0;
-  uint64_t immediate_frames = 0;     ///< speed frames sent at once for a new cmd_vel
+  uint64_t immediate_frames = 0;  ///< speed frames sent at once for a new cmd_vel
   uint64_t resets_sent = 0;
   uint64_t battery_requests = 0;
   uint64_t clear_encoders_sent = 0;
@@ -112,7 +112,7 @@ struct BaseStats {
   uint64_t unknown_replies = 0;
   uint64_t bad_replies = 0;
   uint64_t cmd_vel_timeouts = 0;
-  uint64_t rejected_commands = 0;    ///< NaN/Inf cmd_vel
+  uint64_t rejected_commands = 0;             ///< NaN/Inf cmd_vel
   uint64_t ignored_commands_e_stop = 0;       ///< cmd_vel received while the e-stop was engaged
   uint64_t timeout_errors_while_running = 0;  ///< FF after the base had accepted our Reset
   std::optional<double> seconds_since_running_timeout_error;
@@ -121,7 +121,7 @@ struct BaseStats {
   bool base_silent = false;  ///< seconds_without_reply beyond BaseConfig::silent_after_polls
   bool e_stop = false;
   double min_immediate_interval_ms = 0;
-  uint64_t loop_overruns = 0;        ///< ticks that started more than one period late
+  uint64_t loop_overruns = 0;  ///< ticks that started more than one period late
   double last_period_ms = 0;
   double worst_period_ms = 0;
   std::optional<uint8_t> battery_percent;
@@ -175,10 +175,10 @@ class BaseController : public LinkListener {
 
   /// Applies the tunable part of `next` from the next frame on, all at once (under the loop's
   /// lock): geometry.wheel_diameter and .wheel_separation, max_wheel_speed, max_wheel_accel,
-  /// cmd_vel_timeout, speed_dithering, battery_poll_rate, use_imu_heading. Everything else in `next` is ignored
-  /// (it needs a new controller). No Reset, the sequence goes on, the odometry keeps its pose:
-  /// the motion up to now is integrated with the geometry it ran under, from now on with the new
-  /// one. Expects validated values.
+  /// cmd_vel_timeout, speed_dithering, battery_poll_rate, use_imu_heading. Everything else in
+  /// `next` is ignored (it needs a new controller). No Reset, the sequence goes on, the odometry
+  /// keeps its pose: the motion up to now is integrated with the geometry it ran under, from now on
+  /// with the new one. Expects validated values.
   void retune(const BaseConfig& next);
   /// The configuration in force.
   BaseConfig config() const;
@@ -227,7 +227,7 @@ class BaseController : public LinkListener {
   std::optional<Clock::time_point> last_command_;
   bool command_timed_out_ = true;
   bool needs_reset_ = true;
-  std::optional<Clock::time_point> last_write_;        ///< any base frame
+  std::optional<Clock::time_point> last_write_;  ///< any base frame
   std::optional<Clock::time_point> last_speed_frame_;
   std::optional<Clock::time_point> last_immediate_frame_;  ///< the last one a command rushed out
   std::optional<Clock::time_point> last_tick_;

@@ -1,8 +1,8 @@
-// ROS face of the AP1 base: cmd_vel in (and the node's e-stop); wheel_command, odom (+ tf), wheel_states, battery and
-// diagnostics out; base/reset, base/clear_encoders and base/reset_odometry services. The control
-// loop itself is device::BaseController's thread; odom and tf are published from it, once per tick.
-// odom is the motion the base was commanded and accepted, not a measurement: the AP1 reports no
-// encoder counts.
+// ROS face of the AP1 base: cmd_vel in (and the node's e-stop); wheel_command, odom (+ tf),
+// wheel_states, battery and diagnostics out; base/reset, base/clear_encoders and
+// base/reset_odometry services. The control loop itself is device::BaseController's thread; odom
+// and tf are published from it, once per tick. odom is the motion the base was commanded and
+// accepted, not a measurement: the AP1 reports no encoder counts.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -50,7 +50,7 @@ class BaseInterface : public DeviceInterface {
 
   device::SerialLink& link_;
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
-  const BaseParams params_;  // as started: frames and joint names (the tunables: tuned())
+  const BaseParams params_;       // as started: frames and joint names (the tunables: tuned())
   /// The ~base tunables the interface itself uses, changed together by retune().
   struct Tuned {
     bool publish_tf = true;

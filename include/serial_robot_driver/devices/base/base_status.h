@@ -2,8 +2,8 @@
 // ~base/battery_{warn,error}_percent, the e-stop, the odom heading source and the counters.
 #pragma once
 
-#include "serial_robot_driver/devices/base/base_controller.h"
 #include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/devices/base/base_controller.h"
 
 namespace serial_robot_driver::device {
 

@@ -79,7 +79,15 @@ constexpr std::size_t kFootSensorCount = 8;
 
 /// Indices into Telemetry::imu (assumption of docs/protocols.md: accel, gyro, attitude).
 enum ImuIndex : std::size_t {
-  kAccelX = 0, kAccelY, kAccelZ, kGyroX, kGyroY, kGyroZ, kRoll, kPitch, kYaw
+  kAccelX = 0,
+  kAccelY,
+  kAccelZ,
+  kGyroX,
+  kGyroY,
+  kGyroZ,
+  kRoll,
+  kPitch,
+  kYaw
 };
 
 struct ServoSample {

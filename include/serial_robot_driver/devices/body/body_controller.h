@@ -54,9 +54,9 @@ struct BodyStats {
   uint64_t decode_errors = 0;  ///< verified telemetry frames that still did not decode (e.g. LEN)
   std::optional<protocol::DecodeError> last_decode_error;
   uint64_t commands_sent = 0;
-  uint64_t commands_rejected = 0;  ///< invalid commands: nothing was written
-  uint64_t write_failures = 0;     ///< valid commands the link refused (port down)
-  uint64_t motion_refused = 0;     ///< valid commands the motion gate refused (e-stop, shutdown)
+  uint64_t commands_rejected = 0;    ///< invalid commands: nothing was written
+  uint64_t write_failures = 0;       ///< valid commands the link refused (port down)
+  uint64_t motion_refused = 0;       ///< valid commands the motion gate refused (e-stop, shutdown)
   uint64_t joints_out_of_range = 0;  ///< joint targets left out: beyond what the servo can reach
 };
 

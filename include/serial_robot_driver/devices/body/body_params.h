@@ -29,17 +29,18 @@ struct AxisMap {
 };
 
 /// Parses an axis map: three entries "x", "y" or "z" with an optional sign, each sensor axis once,
-/// and right-handed (a rotation, so the orientation can follow). nullopt with `problem` set when not.
+/// and right-handed (a rotation, so the orientation can follow). nullopt with `problem` set when
+/// not.
 std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std::string* problem);
 
 struct ImuParams {
   std::string frame_id = "imu_link";
   std::vector<std::string> axis_map{"x", "y", "z"};  ///< see AxisMap
-  double accel_scale = 0.0047884;        ///< m/s^2 per LSB (16 g / 32768)
-  double gyro_scale = 0.0010653;         ///< rad/s per LSB (2000 deg/s / 32768)
-  double angle_scale = 0.0000958738;     ///< rad per LSB (180 deg / 32768)
+  double accel_scale = 0.0047884;                    ///< m/s^2 per LSB (16 g / 32768)
+  double gyro_scale = 0.0010653;                     ///< rad/s per LSB (2000 deg/s / 32768)
+  double angle_scale = 0.0000958738;                 ///< rad per LSB (180 deg / 32768)
   /// Diagonal variances (REP-145); a negative orientation variance would mean "no orientation".
-  double orientation_variance = 0.0003;  ///< rad^2 (about 1 deg std)
+  double orientation_variance = 0.0003;        ///< rad^2 (about 1 deg std)
   double angular_velocity_variance = 0.0001;   ///< (rad/s)^2
   double linear_acceleration_variance = 0.01;  ///< (m/s^2)^2
 };

@@ -5,8 +5,8 @@
 
 #include <cstdint>
 
-#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 
 namespace serial_robot_driver::device {

@@ -54,8 +54,8 @@
 #include <vector>
 
 #include "serial_robot_driver/device/loop_clock.h"
-#include "serial_robot_driver/devices/servo_bus/motion_safety.h"
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/devices/servo_bus/motion_safety.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_config.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_events.h"

@@ -17,13 +17,13 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/devices/servo_bus/bus_mutex.h"
 #include "serial_robot_driver/device/motion_gate.h"
 #include "serial_robot_driver/device/serial_link.h"
-#include "serial_robot_driver/devices/servo_bus/servo_move.h"
-#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
+#include "serial_robot_driver/devices/servo_bus/bus_mutex.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_move.h"
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
+#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
 namespace serial_robot_driver::device {
 
@@ -39,7 +39,7 @@ struct RotateRequest {
   uint8_t id = 0;
   double angle_deg = 0.0;  ///< sent as int16 in 0.1 deg: -3276.8 .. 3276.7
   uint16_t interval_ms = 0;
-  uint16_t power_mw = 0;   ///< 0: the servo's default
+  uint16_t power_mw = 0;  ///< 0: the servo's default
   /// Wait for the completion answer (sent only when response_switch = 1) up to
   /// interval_ms + timeout; never re-sent.
   bool wait = false;
@@ -48,7 +48,7 @@ struct RotateRequest {
 struct SpinRequest {
   uint8_t id = 0;
   bool clockwise = false;
-  uint8_t mode = 0;        ///< 0 stop, 1 continuous, 2 `value` turns, 3 `value` ms
+  uint8_t mode = 0;  ///< 0 stop, 1 continuous, 2 `value` turns, 3 `value` ms
   uint16_t speed_dps = 0;
   uint16_t value = 0;
   /// Wait for the completion answer (response_switch = 1) up to the expected duration (mode 2:

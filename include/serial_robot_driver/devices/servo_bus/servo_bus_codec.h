@@ -11,9 +11,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "serial_robot_driver/devices/servo_bus/servo_params.h"
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/protocol/frame_family.h"
-#include "serial_robot_driver/devices/servo_bus/servo_params.h"
 
 namespace serial_robot_driver::protocol::servo {
 
@@ -118,7 +118,8 @@ Probe probeResponse(const uint8_t* data, std::size_t available);
 Probe probeRequest(const uint8_t* data, std::size_t available);
 /// Responses (servo -> host): "servo_response".
 extern const FrameFamily kResponseFrames;
-/// Requests (host -> servo: the half-duplex echo, or what the simulated bus reads): "servo_request".
+/// Requests (host -> servo: the half-duplex echo, or what the simulated bus reads):
+/// "servo_request".
 extern const FrameFamily kRequestFrames;
 
 /// Decodes one complete response (05 1C ...) or request (12 4C ..., for the simulator and for

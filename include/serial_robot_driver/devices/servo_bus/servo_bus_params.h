@@ -24,8 +24,8 @@ struct ServoBusParams : DevicePortParams {
   device::ServoBusConfig bus;
   /// s to wait for one answer (the core's milliseconds: timeoutMs()).
   double timeout = std::chrono::duration<double>(device::ServoBusOptions{}.timeout).count();
-  std::vector<int> state_ids;     ///< bus servos polled for servo_states (empty: no poll)
-  int command_interval_ms = 0;    ///< ROTATE interval for servo_commands without a velocity
+  std::vector<int> state_ids;   ///< bus servos polled for servo_states (empty: no poll)
+  int command_interval_ms = 0;  ///< ROTATE interval for servo_commands without a velocity
   // Bus servos used as named joints (trajectories, servo_states); one entry per joint_ids.
   std::vector<int> joint_ids;
   std::vector<std::string> joint_names;

@@ -80,8 +80,8 @@ class ServoBusSim {
     double velocity_dps = 0.0;  ///< kRotate by velocity (> 0): the duration follows at the start
     double accel_s = 0.0;       ///< kRotate ramps
     double decel_s = 0.0;
-    double peak_dps = 0.0;      ///< kRotate: the cruise speed, set when the motion starts
-    double rate_dps = 0.0;      ///< kSpin, signed (counter-clockwise positive)
+    double peak_dps = 0.0;  ///< kRotate: the cruise speed, set when the motion starts
+    double rate_dps = 0.0;  ///< kSpin, signed (counter-clockwise positive)
     double duration_s = 0.0;
     bool started = false;
     double start_angle = 0.0;

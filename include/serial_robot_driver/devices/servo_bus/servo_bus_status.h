@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/device/status_report.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
-#include "serial_robot_driver/device/status_report.h"
 
 namespace serial_robot_driver::device {
 

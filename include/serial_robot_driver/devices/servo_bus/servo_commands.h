@@ -1,7 +1,7 @@
 // The bus servo commands (docs/protocols.md, section 3): each one's name, the size of its request
 // and answer CONTENT and when a servo answers it. The sizes and result bytes are derived from the
-// field lists the codec encodes with (src/devices/servo_bus/servo_layouts.h). The client, the simulator and
-// the fuzzers read this table; a new command is its field lists, one row here and its
+// field lists the codec encodes with (src/devices/servo_bus/servo_layouts.h). The client, the
+// simulator and the fuzzers read this table; a new command is its field lists, one row here and its
 // encode/decode pair in servo_bus_codec.h.
 #pragma once
 

@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
 namespace serial_robot_driver::device {
 

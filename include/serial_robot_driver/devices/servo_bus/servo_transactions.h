@@ -33,9 +33,9 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/devices/servo_bus/bus_mutex.h"
 #include "serial_robot_driver/device/motion_gate.h"
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/devices/servo_bus/bus_mutex.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 
 namespace serial_robot_driver::device {

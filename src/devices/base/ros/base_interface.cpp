@@ -112,15 +112,17 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
   reset_srv_ = nh.advertiseService("base/reset", &BaseInterface::onReset, this);
   reset_odometry_srv_ =
       nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
-  clear_encoders_srv_ = nh.advertiseService("base/clear_encoders", &BaseInterface::onClearEncoders, this);
+  clear_encoders_srv_ =
+      nh.advertiseService("base/clear_encoders", &BaseInterface::onClearEncoders, this);
 }
 
 void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {
   // Counted with the other refused commands; the controller ignores it (and counts it) itself.
   if (e_stop_) e_stop_->refuse("cmd_vel");
   if (!controller_.setCommand(msg->linear.x, msg->angular.z)) {
-    ROS_WARN_THROTTLE(1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
-                      msg->linear.x, msg->angular.z);
+    ROS_WARN_THROTTLE(
+        1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
+        msg->linear.x, msg->angular.z);
   }
 }
 
@@ -174,7 +176,8 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   tf_broadcaster_->sendTransform(transform);
 }
 
-void BaseInterface::publishWheelStates(const device::OdometrySample& sample, const ros::Time& stamp) {
+void BaseInterface::publishWheelStates(const device::OdometrySample& sample,
+                                       const ros::Time& stamp) {
   // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
   sensor_msgs::JointState wheels;
   wheels.header.stamp = stamp;
@@ -207,7 +210,8 @@ bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigg
 
 bool BaseInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   res.success = controller_.sendReset();
-  res.message = res.success ? "Reset sent" : "base port " + link_.options().path + " is not connected";
+  res.message =
+      res.success ? "Reset sent" : "base port " + link_.options().path + " is not connected";
   return true;
 }
 

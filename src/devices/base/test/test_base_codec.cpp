@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/base/base_codec.h"
-#include "support/probe_expectations.h"
 #include "support/golden_frames.h"
+#include "support/probe_expectations.h"
 
 namespace serial_robot_driver::protocol::base {
 namespace {
@@ -261,7 +261,6 @@ TEST(BaseCodec, SequenceNumberAfterWrapIsEncoded) {
   EXPECT_EQ(encodeReset(counter.next()), (Bytes{0x55, 0xAA, 0x02, 0xFF, 0x05, 0x00, 0x07}));
   EXPECT_EQ(encodeReset(counter.next()), golden::base::kResetSeq0);
 }
-
 
 // --- probe (what the stream framer asks) -------------------------------------------------------
 

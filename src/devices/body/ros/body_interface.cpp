@@ -113,9 +113,10 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   writeStatusReport(update.report, status, SummaryWrite::kMerge);
   // Once per outage, not once per period.
   if (update.flow == device::BodyStatus::FlowChange::kStopped) {
-    ROS_WARN("body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
-             "board powered and streaming?",
-             link_.options().path.c_str());
+    ROS_WARN(
+        "body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
+        "board powered and streaming?",
+        link_.options().path.c_str());
   } else if (update.flow == device::BodyStatus::FlowChange::kResumed) {
     ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
   }

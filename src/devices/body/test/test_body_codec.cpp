@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "support/golden_frames.h"
 #include "support/probe_expectations.h"
 #include "support/test_helpers.h"
-#include "support/golden_frames.h"
 
 namespace serial_robot_driver::protocol::body {
 namespace {
@@ -301,7 +301,6 @@ TEST(BodyCodec, TrailingByteAfterFrameIsBadLength) {
   EXPECT_EQ(decoded.error(), DecodeError::kBadLength);
 }
 
-
 // --- probe (what the stream framer asks) -------------------------------------------------------
 
 using test_support::expectProbeFindsFrame;
@@ -352,7 +351,8 @@ TEST(BodyCodecProbe, SyncWriteFrameFoundAndNeedsMoreAtEveryTruncation) {
 }
 
 TEST(BodyCodecProbe, SyncWriteInvalidReasons) {
-  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 16, 0x8F), DecodeError::kBadChecksum);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 16, 0x8F),
+                     DecodeError::kBadChecksum);
   // LEN 0x0B is not 7 + 3N.
   expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0x0B), DecodeError::kBadLength);
   // 7 + 3 * 65 = 202 = 0xCA: one servo more than the 64 accepted.

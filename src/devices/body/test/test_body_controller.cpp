@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/base/base_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "support/golden_frames.h"
 
 namespace serial_robot_driver::device {
@@ -53,13 +53,15 @@ TEST_P(BodyControllerCalibrationPosition, TicksToRadiansAndBack) {
   EXPECT_EQ(*ticks, c.ticks);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    BodyController, BodyControllerCalibrationPosition,
-    testing::Values(PositionCase{2048, 1, 2048, 0.0}, PositionCase{2048, 1, 3072, M_PI / 2},
-                    PositionCase{2048, 1, 1024, -M_PI / 2}, PositionCase{2048, -1, 3072, -M_PI / 2},
-                    PositionCase{2048, -1, 1024, M_PI / 2}, PositionCase{0, 1, 4095, 4095 * kRadPerTick},
-                    PositionCase{1000, -1, 0, 1000 * kRadPerTick},
-                    PositionCase{2048, 1, 2049, kRadPerTick}));
+INSTANTIATE_TEST_SUITE_P(BodyController, BodyControllerCalibrationPosition,
+                         testing::Values(PositionCase{2048, 1, 2048, 0.0},
+                                         PositionCase{2048, 1, 3072, M_PI / 2},
+                                         PositionCase{2048, 1, 1024, -M_PI / 2},
+                                         PositionCase{2048, -1, 3072, -M_PI / 2},
+                                         PositionCase{2048, -1, 1024, M_PI / 2},
+                                         PositionCase{0, 1, 4095, 4095 * kRadPerTick},
+                                         PositionCase{1000, -1, 0, 1000 * kRadPerTick},
+                                         PositionCase{2048, 1, 2049, kRadPerTick}));
 
 TEST(BodyControllerCalibration, ToTicksRoundsToNearest) {
   const JointCalibration cal = calibration(2048, 1);
@@ -74,10 +76,10 @@ TEST(BodyControllerCalibration, ToTicksRoundsToNearest) {
 TEST(BodyControllerCalibration, ToTicksRefusesWhatTheServoCannotReach) {
   // 4096 ticks per turn: the servo takes 0..4095, never a clamped stand-in.
   const JointCalibration cal = calibration(2048, 1);
-  EXPECT_EQ(cal.toTicks(-M_PI), 0);                     // exactly tick 0
-  EXPECT_EQ(cal.toTicks(2047 * kRadPerTick), 4095);     // the highest tick
-  EXPECT_FALSE(cal.toTicks(M_PI).has_value());          // 4096: one turn, not a position
-  EXPECT_FALSE(cal.toTicks(4.0).has_value());           // 4655, the case of the review
+  EXPECT_EQ(cal.toTicks(-M_PI), 0);                  // exactly tick 0
+  EXPECT_EQ(cal.toTicks(2047 * kRadPerTick), 4095);  // the highest tick
+  EXPECT_FALSE(cal.toTicks(M_PI).has_value());       // 4096: one turn, not a position
+  EXPECT_FALSE(cal.toTicks(4.0).has_value());        // 4655, the case of the review
   EXPECT_FALSE(cal.toTicks(-100.0).has_value());
   EXPECT_FALSE(calibration(2048, -1).toTicks(1000.0).has_value());
   const auto [low, high] = cal.reachableRadians();
@@ -139,8 +141,8 @@ TEST(BodyControllerTelemetry, GoldenFrameReachesTheCallbackWithItsArrivalTime) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
   const Clock::time_point arrival = Clock::time_point(std::chrono::milliseconds(1234));
-  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
-                     arrival);
+  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(),
+                     kGoldenTelemetry.size(), arrival);
 
   ASSERT_EQ(received.frames.size(), 1u);
   EXPECT_EQ(received.arrivals[0], arrival);
@@ -177,8 +179,8 @@ TEST(BodyControllerTelemetry, FrameOfAnotherServoCountIsADecodeError) {
   std::vector<BodyJoint> joints = twoJoints();
   joints.push_back(BodyJoint{"ankle", 4, calibration(2048, 1)});
   BodyController controller(joints, nullptr, recorder(&received));
-  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
-                     Clock::now());
+  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(),
+                     kGoldenTelemetry.size(), Clock::now());
   EXPECT_TRUE(received.frames.empty());
   const BodyStats stats = controller.stats();
   EXPECT_EQ(stats.frames_decoded, 0u);
@@ -193,8 +195,8 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
   const Bytes& base_reset = golden::base::kResetSeq2;
   controller.onFrame(protocol::base::kFrames, base_reset.data(), base_reset.size(), Clock::now());
   // Even telemetry bytes under another family tag are not ours to decode.
-  controller.onFrame(protocol::servo::kResponseFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
-                     Clock::now());
+  controller.onFrame(protocol::servo::kResponseFrames, kGoldenTelemetry.data(),
+                     kGoldenTelemetry.size(), Clock::now());
   EXPECT_TRUE(received.frames.empty());
   EXPECT_EQ(controller.stats().frames_decoded, 0u);
   EXPECT_EQ(controller.stats().decode_errors, 0u);
@@ -202,8 +204,8 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
 
 TEST(BodyControllerTelemetry, WorksWithoutACallback) {
   BodyController controller(twoJoints(), nullptr);
-  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
-                     Clock::now());
+  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(),
+                     kGoldenTelemetry.size(), Clock::now());
   EXPECT_EQ(controller.stats().frames_decoded, 1u);
 }
 

@@ -3,21 +3,23 @@
 #include <chrono>
 #include <string>
 
+#include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_status.h"
 #include "serial_robot_driver/ros/conversions.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
 
 namespace serial_robot_driver::ros_layer {
 
 void ServoBusInterface::addDiagnostics(diagnostic_updater::Updater& updater) {
   // Every polled servo has its status, also while health_rate is 0 (it may be tuned on).
   for (uint8_t id : bus_.config().polled_ids) {
-    updater.add("servo_bus servo " + std::to_string(id),
-                [this, id](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseServo(id, s); });
+    updater.add(
+        "servo_bus servo " + std::to_string(id),
+        [this, id](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseServo(id, s); });
   }
 }
 
-void ServoBusInterface::diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status) {
+void ServoBusInterface::diagnoseServo(uint8_t id,
+                                      diagnostic_updater::DiagnosticStatusWrapper& status) {
   const double health_rate = bus_.settings().health_rate;
   const std::vector<device::ServoHealthReport> health =
       health_rate > 0.0 ? bus_.health() : std::vector<device::ServoHealthReport>{};

@@ -63,11 +63,12 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
   };
   events.on_overheat = [](const device::ServoHealthReport& report) {
     if (report.overheated) {
-      ROS_ERROR("servo_bus: %s at %ld degC reached its over_temperature limit (%ld degC): relaxed, "
-                "its moves refused until it has cooled %ld degC (~servo_bus/protect)",
-                servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c),
-                static_cast<long>(report.limits.over_temperature_c),
-                static_cast<long>(device::OverheatGuard::kCoolDownC));
+      ROS_ERROR(
+          "servo_bus: %s at %ld degC reached its over_temperature limit (%ld degC): relaxed, "
+          "its moves refused until it has cooled %ld degC (~servo_bus/protect)",
+          servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c),
+          static_cast<long>(report.limits.over_temperature_c),
+          static_cast<long>(device::OverheatGuard::kCoolDownC));
     } else {
       ROS_INFO("servo_bus: %s has cooled to %ld degC: its moves are obeyed again",
                servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c));

@@ -41,26 +41,16 @@ constexpr auto kDriftPeriod = std::chrono::milliseconds(100);
 const std::map<uint8_t, int64_t>& userDefaults() {
   using servo::ServoDataId;
   static const std::map<uint8_t, int64_t> defaults = {
-      {dataId(ServoDataId::kReserved32), 0},
-      {dataId(ServoDataId::kResponseSwitch), 0},
-      {dataId(ServoDataId::kReserved35), 0},
-      {dataId(ServoDataId::kBaudrate), 5},
-      {dataId(ServoDataId::kStallProtectMode), 1},
-      {dataId(ServoDataId::kStallPowerLimit), 4000},
-      {dataId(ServoDataId::kOverVoltLow), 4500},
-      {dataId(ServoDataId::kOverVoltHigh), 14000},
-      {dataId(ServoDataId::kOverTemperature), 65},
-      {dataId(ServoDataId::kOverPower), 12000},
-      {dataId(ServoDataId::kOverCurrent), 3000},
-      {dataId(ServoDataId::kAccelSwitch), 1},
-      {dataId(ServoDataId::kReserved45), 0},
-      {dataId(ServoDataId::kPoLockSwitch), 0},
-      {dataId(ServoDataId::kWbLockSwitch), 0},
-      {dataId(ServoDataId::kAngleLimitSwitch), 0},
-      {dataId(ServoDataId::kSoftStartSwitch), 0},
-      {dataId(ServoDataId::kSoftStartTime), 3000},
-      {dataId(ServoDataId::kAngleLimitHigh), 1800},
-      {dataId(ServoDataId::kAngleLimitLow), -1800},
+      {dataId(ServoDataId::kReserved32), 0},        {dataId(ServoDataId::kResponseSwitch), 0},
+      {dataId(ServoDataId::kReserved35), 0},        {dataId(ServoDataId::kBaudrate), 5},
+      {dataId(ServoDataId::kStallProtectMode), 1},  {dataId(ServoDataId::kStallPowerLimit), 4000},
+      {dataId(ServoDataId::kOverVoltLow), 4500},    {dataId(ServoDataId::kOverVoltHigh), 14000},
+      {dataId(ServoDataId::kOverTemperature), 65},  {dataId(ServoDataId::kOverPower), 12000},
+      {dataId(ServoDataId::kOverCurrent), 3000},    {dataId(ServoDataId::kAccelSwitch), 1},
+      {dataId(ServoDataId::kReserved45), 0},        {dataId(ServoDataId::kPoLockSwitch), 0},
+      {dataId(ServoDataId::kWbLockSwitch), 0},      {dataId(ServoDataId::kAngleLimitSwitch), 0},
+      {dataId(ServoDataId::kSoftStartSwitch), 0},   {dataId(ServoDataId::kSoftStartTime), 3000},
+      {dataId(ServoDataId::kAngleLimitHigh), 1800}, {dataId(ServoDataId::kAngleLimitLow), -1800},
       {dataId(ServoDataId::kAngleMidOffset), 0},
   };
   return defaults;
@@ -228,8 +218,8 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
     return;
   }
   // Nobody answers the broadcast id; a motion answers (on completion) only with response_switch 1.
-  const bool answers = !broadcast && (info.answers == servo::Answers::kAlways ||
-                                      param(*s, kResponseSwitch) == 1);
+  const bool answers =
+      !broadcast && (info.answers == servo::Answers::kAlways || param(*s, kResponseSwitch) == 1);
   const auto reply = [&](const std::vector<uint8_t>& answer_content) {
     if (answers) answer(due, cmd, answer_content);
   };

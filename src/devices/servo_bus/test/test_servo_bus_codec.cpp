@@ -7,10 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/protocol/byte_order.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/protocol/byte_order.h"
 #include "support/golden_frames.h"
-
 #include "support/probe_expectations.h"
 
 namespace serial_robot_driver::protocol::servo {
@@ -289,7 +288,6 @@ TEST(ServoBusCodec, RequestDecoderChecksSum) {
   EXPECT_EQ(packet.error(), DecodeError::kBadChecksum);
 }
 
-
 // --- probe (what the stream framer asks) -------------------------------------------------------
 
 using test_support::expectProbeFindsFrame;
@@ -305,7 +303,8 @@ TEST(ServoBusCodecProbe, FindsGoldenFramesAndNeedsMoreAtEveryTruncation) {
 }
 
 TEST(ServoBusCodecProbe, SaysWhyACandidateIsInvalid) {
-  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x01, 0x01, 0x03, 0x27}, DecodeError::kBadChecksum);
+  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x01, 0x01, 0x03, 0x27},
+                     DecodeError::kBadChecksum);
   expectProbeRejects(probeRequest, {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64}, DecodeError::kBadChecksum);
   // N = 34 exceeds the longest content (id + 32 bytes).
   expectProbeRejects(probeResponse, {0x05, 0x1C, 0x05, 0x22}, DecodeError::kBadLength);

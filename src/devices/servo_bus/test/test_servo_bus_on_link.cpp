@@ -16,8 +16,8 @@
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/sim/robot_sim.h"
-#include "support/test_helpers.h"
 #include "support/framer_configs.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::device {
 namespace {
@@ -136,8 +136,8 @@ TEST(ServoBusOnLink, ShutdownSaysItsLastWordsThroughTheRunningReader) {
   const uint64_t requests_before = rig.sim->stats().servo_bus.requests;
   rig.bus->shutdown();
   EXPECT_TRUE(rig.bus->movingIds().empty()) << "the SPIN stop went out";
-  ASSERT_TRUE(waitFor(
-      [&] { return rig.sim->stats().servo_bus.requests > requests_before; }, kWaitSeconds));
+  ASSERT_TRUE(
+      waitFor([&] { return rig.sim->stats().servo_bus.requests > requests_before; }, kWaitSeconds));
   EXPECT_EQ(rig.bus->client().ping(1).error, ServoError::kShutdown);
 }
 

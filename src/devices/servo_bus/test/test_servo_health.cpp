@@ -45,11 +45,13 @@ TEST(ServoHealth, TemperatureWithinTenPercentWarnsAndAtTheLimitIsAnError) {
   r.temperature_c = 59;
   auto assessment = assessHealth(3, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kWarn);
-  EXPECT_EQ(assessment.message, "servo 3: temperature 59 degC within 10 % of over_temperature 65 degC");
+  EXPECT_EQ(assessment.message,
+            "servo 3: temperature 59 degC within 10 % of over_temperature 65 degC");
   r.temperature_c = 65;
   assessment = assessHealth(3, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kError);
-  EXPECT_EQ(assessment.message, "servo 3: temperature 65 degC at or beyond over_temperature 65 degC");
+  EXPECT_EQ(assessment.message,
+            "servo 3: temperature 65 degC at or beyond over_temperature 65 degC");
 }
 
 TEST(ServoHealth, LowVoltageIsCheckedAgainstTheLowerLimit) {
@@ -69,7 +71,8 @@ TEST(ServoHealth, LowVoltageIsCheckedAgainstTheLowerLimit) {
 TEST(ServoHealth, HighVoltageCurrentAndPowerEachHaveTheirLimit) {
   ServoReadings r = nominal();
   r.voltage_mv = 14500;
-  EXPECT_NE(assessHealth(1, r, limits()).message.find("over_volt_high 14000 mV"), std::string::npos);
+  EXPECT_NE(assessHealth(1, r, limits()).message.find("over_volt_high 14000 mV"),
+            std::string::npos);
   r = nominal();
   r.current_ma = 2800;
   auto assessment = assessHealth(1, r, limits());
@@ -84,8 +87,8 @@ TEST(ServoHealth, HighVoltageCurrentAndPowerEachHaveTheirLimit) {
 
 TEST(ServoHealth, ErrorsComeBeforeWarningsAndTheWorstLevelWins) {
   ServoReadings r = nominal();
-  r.current_ma = 2900;     // warn
-  r.temperature_c = 70;    // error
+  r.current_ma = 2900;   // warn
+  r.temperature_c = 70;  // error
   const auto assessment = assessHealth(2, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kError);
   EXPECT_EQ(assessment.message,
