@@ -55,7 +55,9 @@ class DeviceSections {
   }
 
  private:
-  std::map<std::string, std::any> sections_;
+  // Mutable: the table's rows reach a section through any DriverParams, a const one included, and a
+  // section is created with its defaults on first use (validate() at start-up touches them all).
+  mutable std::map<std::string, std::any> sections_;
 };
 
 /// The tf frame name of a frame parameter under `tf_prefix`, as robot_state_publisher resolves its
