@@ -94,7 +94,7 @@ TEST(TurnCalibration, BothDirectionsCancelAConstantGyroBias) {
   ccw.gyro_bias = 0.1;
   SimulatedTurn cw = ccw;
   cw.ticks = -40;
-  cw.rest_seconds = 0.8;  // the turns need not take the same time
+  cw.rest_seconds = 2.0;  // the turns need not take the same time: the mean of both is off
   const MotionRecord a = record(ccw);
   const MotionRecord b = record(cw);
   const auto result = calibrateTurn(a, b, 0.40);
