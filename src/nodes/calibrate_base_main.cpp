@@ -215,12 +215,12 @@ class CalibrationRun {
     return found;
   }
 
-  /// The geometry in force: the node's parameters read as the node reads them (a key left out of
-  /// its config has the node's default), so ticks convert exactly as they were computed.
-  DiffDriveGeometry nodeGeometry() const {
+  /// The base's configuration in force: the node's parameters read as the node reads them (a key
+  /// left out of its config has the node's default), so ticks convert exactly as they were made.
+  serial_robot_driver::device::BaseConfig nodeBaseConfig() const {
     try {
       return serial_robot_driver::ros_layer::loadParams(ros::NodeHandle(node_), nullptr)
-          .base.controller.geometry;
+          .base.controller;
     } catch (const std::exception& error) {
       throw Abort{"cannot read the parameters of " + node_ + ": " + error.what()};
     }
@@ -230,7 +230,10 @@ class CalibrationRun {
   void prepare() {
     node_ = findNode();
     e_stop_status_name_ = node_.substr(1) + ": e_stop";  // the updater's prefix has no slash
-    geometry_ = nodeGeometry();
+    const serial_robot_driver::device::BaseConfig base = nodeBaseConfig();
+    geometry_ = base.geometry;
+    left_direction_ = base.left_wheel_direction;
+    right_direction_ = base.right_wheel_direction;
     say("driver " + node_ + ": wheel_separation " + fixed(geometry_.wheel_separation) +
         " m, wheel_diameter " + fixed(geometry_.wheel_diameter) + " m");
     if (!spinUntil(3.0, [&] { return last_frame_.toSec() > 0; })) {
@@ -297,7 +300,7 @@ class CalibrationRun {
   MotionRecord move(const std::string& what, double linear, double angular) {
     moved_ = true;
     holdStill(options_.settle);
-    recorder_.emplace(geometry_);
+    recorder_.emplace(geometry_, left_direction_, right_direction_);
     const double goal = angular != 0 ? options_.angle : options_.distance;
     const double speed = angular != 0 ? std::abs(angular) : std::abs(linear);
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(goal / speed * 2 + 3);
@@ -394,6 +397,8 @@ class CalibrationRun {
   std::string node_;
   std::string e_stop_status_name_;
   DiffDriveGeometry geometry_;
+  int left_direction_ = 1;
+  int right_direction_ = 1;
   std::optional<MotionRecorder> recorder_;
   std::optional<bool> e_stop_engaged_;
   ros::WallTime last_imu_, last_frame_;

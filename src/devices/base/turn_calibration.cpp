@@ -38,8 +38,11 @@ std::string checkTurn(const MotionRecord& turn, const char* name, double sign,
 }  // namespace
 
 MotionRecorder::MotionRecorder(const kinematics::DiffDriveGeometry& geometry,
-                               double max_frame_hold_s)
-    : geometry_(geometry), max_frame_hold_s_(max_frame_hold_s) {}
+                               int left_direction, int right_direction, double max_frame_hold_s)
+    : geometry_(geometry),
+      left_direction_(left_direction),
+      right_direction_(right_direction),
+      max_frame_hold_s_(max_frame_hold_s) {}
 
 double MotionRecorder::heldFor(double from, double to) const {
   return std::clamp(to - from, 0.0, max_frame_hold_s_);
@@ -53,8 +56,9 @@ void MotionRecorder::addWheelFrame(double stamp, int16_t left_ticks, int16_t rig
   }
   // Ticks per PID period -> m/s: the base runs pid_rate periods a second.
   const double mps_per_tick = geometry_.pid_rate / geometry_.ticksPerMeter();
-  const double left = left_ticks * mps_per_tick;
-  const double right = right_ticks * mps_per_tick;
+  // A direction of -1 negates a wheel's ticks on the wire; negating again gives the robot's.
+  const double left = left_ticks * left_direction_ * mps_per_tick;
+  const double right = right_ticks * right_direction_ * mps_per_tick;
   last_turn_rate_ = (right - left) / geometry_.wheel_separation;
   last_forward_speed_ = (left + right) / 2.0;
   last_frame_stamp_ = stamp;

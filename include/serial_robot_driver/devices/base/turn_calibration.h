@@ -32,13 +32,15 @@ struct MotionRecord {
 /// Integrates wheel frames and IMU yaw rates into a MotionRecord.
 class MotionRecorder {
  public:
-  /// `geometry` converts ticks per PID period into wheel speeds: the node's configured values.
+  /// `geometry` converts ticks per PID period into wheel speeds and `left_direction`,
+  /// `right_direction` (1 or -1) wire ticks into robot-side ones: the node's configured values.
   /// A frame's speeds hold until the next frame, at most `max_frame_hold_s` (the AP1 stops by
   /// itself after its 1 s heartbeat timeout).
-  explicit MotionRecorder(const kinematics::DiffDriveGeometry& geometry,
-                          double max_frame_hold_s = 1.0);
+  explicit MotionRecorder(const kinematics::DiffDriveGeometry& geometry, int left_direction = 1,
+                          int right_direction = 1, double max_frame_hold_s = 1.0);
 
-  /// A wheel frame with these ticks per PID period was written at `stamp` (s).
+  /// A wheel frame with these ticks per PID period, as on the wire (wheel directions applied, as
+  /// wheel_command carries them), was written at `stamp` (s).
   void addWheelFrame(double stamp, int16_t left_ticks, int16_t right_ticks);
   /// The IMU measured `yaw_rate` (rad/s, counter-clockwise > 0) at `stamp` (s).
   void addImuRate(double stamp, double yaw_rate);
@@ -51,6 +53,8 @@ class MotionRecorder {
   double heldFor(double from, double to) const;
 
   kinematics::DiffDriveGeometry geometry_;
+  int left_direction_;
+  int right_direction_;
   double max_frame_hold_s_;
   MotionRecord record_;
   std::optional<double> last_frame_stamp_;

@@ -61,7 +61,7 @@ TEST(MotionRecorder, IntegratesTheWheelFramesAndTheImuOverTheWindow) {
 }
 
 TEST(MotionRecorder, AFrameHoldsOnlyUntilTheBaseTimesOut) {
-  MotionRecorder recorder(kGeometry, 1.0);
+  MotionRecorder recorder(kGeometry, 1, 1, 1.0);
   recorder.addWheelFrame(0.0, 20, 20);
   recorder.addWheelFrame(5.0, 0, 0);  // the base stopped itself 1 s after the first frame
   const MotionRecord r = recorder.finish(6.0);
@@ -76,6 +76,16 @@ TEST(MotionRecorder, CommandedYawSoFarHoldsTheLastFrameUntilNow) {
   EXPECT_NEAR(recorder.commandedYawUntil(0.5), rate * 0.5, 1e-12);
   recorder.addWheelFrame(0.25, 0, 0);
   EXPECT_NEAR(recorder.commandedYawUntil(0.5), rate * 0.25, 1e-12);
+}
+
+TEST(MotionRecorder, WireTicksOfAReversedWheelTurnBackIntoTheRobotsOwn) {
+  // The left wheel is wired the other way round (~base/left_wheel_direction -1): a turn to the
+  // left, left wheel backward, goes out as +40 on both wheels.
+  MotionRecorder recorder(kGeometry, -1, 1);
+  recorder.addWheelFrame(0.0, 40, 40);
+  const MotionRecord r = recorder.finish(1.0);
+  EXPECT_NEAR(r.commanded_yaw, 2 * speedOf(40) / 0.40, 1e-12);
+  EXPECT_NEAR(r.commanded_distance, 0.0, 1e-12);
 }
 
 TEST(TurnCalibration, SlipGivesTheEffectiveSeparation) {
