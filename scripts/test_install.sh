@@ -37,7 +37,8 @@ rm -f "$prefix.install.log"
 
 share="$prefix/share/serial_robot_driver"
 for f in lib/serial_robot_driver/driver_node lib/serial_robot_driver/robot_sim lib/libsrd_nodelet.so \
-         lib/serial_robot_driver/robot_description share/serial_robot_driver/launch/description.launch \
+         lib/serial_robot_driver/robot_description lib/serial_robot_driver/calibrate_base \
+         share/serial_robot_driver/launch/description.launch \
          share/serial_robot_driver/launch/view.launch share/serial_robot_driver/config/view.rviz \
          share/serial_robot_driver/launch/fleet_sim.launch share/serial_robot_driver/config/fleet.rviz \
          lib/libsrd_core.a share/serial_robot_driver/package.xml \

@@ -2,8 +2,8 @@
 // its wheel frames commanded and prints the effective wheel separation (docs/calibration.md).
 // A client of the node's topics, never a node service: the user sees progress, Ctrl-C stops it,
 // it ties up none of the node's threads, and if it is killed hard the node's own
-// ~base/cmd_vel_timeout stops the base. The estimator is the core's (devices/base/turn_calibration);
-// this file only wires topics to it and sequences the run.
+// ~base/cmd_vel_timeout stops the base. The estimator is the core's
+// (devices/base/turn_calibration); this file only wires topics to it and sequences the run.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
@@ -146,6 +146,10 @@ class CalibrationRun {
       std::cerr << "calibrate_base: " << abort.message << std::endl;
       if (moved_) stopBase();
       return abort.exit_code;
+    } catch (const std::exception& error) {  // a ROS error mid-run: still stop the base
+      std::cerr << "calibrate_base: " << error.what() << std::endl;
+      if (moved_) stopBase();
+      return kExitRefused;
     }
   }
 
@@ -159,7 +163,8 @@ class CalibrationRun {
     last_frame_ = ros::WallTime::now();
     last_frame_zero_ = msg.left_ticks == 0 && msg.right_ticks == 0;
     if (last_frame_zero_) ++zero_frames_;
-    if (recorder_) recorder_->addWheelFrame(msg.header.stamp.toSec(), msg.left_ticks, msg.right_ticks);
+    if (recorder_)
+      recorder_->addWheelFrame(msg.header.stamp.toSec(), msg.left_ticks, msg.right_ticks);
   }
   void onDiagnostics(const diagnostic_msgs::DiagnosticArray& msg) {
     for (const auto& status : msg.status) {
@@ -240,12 +245,14 @@ class CalibrationRun {
       throw Abort{"no wheel_command from " + node_ + " in 3 s: is the base enabled and connected?"};
     }
     if (!spinUntil(3.0, [&] { return last_imu_.toSec() > 0; })) {
-      throw Abort{"refused: no telemetry on " + ros::names::resolve("imu/data") +
-                  " in 3 s; the turn is measured with the IMU (is the body enabled and streaming?)"};
+      throw Abort{
+          "refused: no telemetry on " + ros::names::resolve("imu/data") +
+          " in 3 s; the turn is measured with the IMU (is the body enabled and streaming?)"};
     }
     // The node's diagnostics come once a second.
     if (!spinUntil(3.0, [&] { return e_stop_engaged_.has_value(); })) {
-      throw Abort{"no e_stop status from " + node_ + " on /diagnostics in 3 s: cannot tell "
+      throw Abort{"no e_stop status from " + node_ +
+                  " on /diagnostics in 3 s: cannot tell "
                   "whether the e-stop is engaged"};
     }
     if (*e_stop_engaged_) {
@@ -286,11 +293,12 @@ class CalibrationRun {
         next_publish = ros::WallTime::now() + ros::WallDuration(0.05);
       }
     };
-    const bool stopped =
-        spinUntil(3.0, [&] { return keepZero(), zero_frames_ > zero_frames_before && last_frame_zero_; });
+    const bool stopped = spinUntil(
+        3.0, [&] { return keepZero(), zero_frames_ > zero_frames_before && last_frame_zero_; });
     if (!stopped) {
-      throw Abort{"no zero wheel frame written within 3 s of the stop; the node's "
-                  "~base/cmd_vel_timeout stops the base"};
+      throw Abort{
+          "no zero wheel frame written within 3 s of the stop; the node's "
+          "~base/cmd_vel_timeout stops the base"};
     }
     spinUntil(rest, [&] { return keepZero(), false; });
   }
@@ -318,9 +326,8 @@ class CalibrationRun {
       const MotionRecord so_far = recorder_->finish(ros::Time::now().toSec());
       done = angular != 0 ? std::abs(so_far.commanded_yaw) : so_far.commanded_distance;
       if (ros::WallTime::now() >= next_progress) {
-        say(what + ": " + fixed(done, 2) + " / " + fixed(goal, 2) +
-            (angular != 0 ? " rad" : " m") + " commanded, IMU " +
-            fixed(so_far.measured_yaw, 2) + " rad");
+        say(what + ": " + fixed(done, 2) + " / " + fixed(goal, 2) + (angular != 0 ? " rad" : " m") +
+            " commanded, IMU " + fixed(so_far.measured_yaw, 2) + " rad");
         next_progress += ros::WallDuration(0.5);
       }
       ros::WallDuration(0.02).sleep();
@@ -329,9 +336,13 @@ class CalibrationRun {
     checkRunning();
     const MotionRecord record = recorder_->finish(last_imu_stamp_);
     recorder_.reset();
-    say(what + ": done, commanded " + fixed(record.commanded_yaw, 3) + " rad, IMU measured " +
-        fixed(record.measured_yaw, 3) + " rad (" + std::to_string(record.imu_samples) +
-        " samples)");
+    if (angular != 0) {
+      say(what + ": done, commanded " + fixed(record.commanded_yaw, 3) + " rad, IMU measured " +
+          fixed(record.measured_yaw, 3) + " rad (" + std::to_string(record.imu_samples) +
+          " samples)");
+    } else {
+      say(what + ": done, commanded " + fixed(record.commanded_distance, 3) + " m");
+    }
     return record;
   }
 
@@ -339,7 +350,10 @@ class CalibrationRun {
     if (options_.measured) return *options_.measured;
     std::cout << "measure the distance the robot travelled and type it in metres: " << std::flush;
     double measured = 0;
-    if (!(std::cin >> measured)) throw Abort{"no distance typed: no wheel_diameter"};
+    if (!(std::cin >> measured)) {
+      checkSignal();  // Ctrl-C at the prompt interrupts the read (no SA_RESTART)
+      throw Abort{"no distance typed: no wheel_diameter"};
+    }
     return measured;
   }
 
@@ -355,14 +369,14 @@ class CalibrationRun {
 
     const MotionRecord straight = move("driving straight", options_.speed, 0.0);
     holdStill(0.1);
-    const auto diameter =
-        calibrateDiameter(straight, measuredDistance(), geometry_.wheel_diameter);
+    const auto diameter = calibrateDiameter(straight, measuredDistance(), geometry_.wheel_diameter);
     if (!diameter.value) throw Abort{"refused: " + diameter.error};
+    say("measured/commanded distance " + fixed(diameter.value->ratio, 3));
     printSetting("wheel_diameter", diameter.value->effective_diameter, geometry_.wheel_diameter);
     const double scale = diameter.value->effective_diameter / geometry_.wheel_diameter;
     say("with that wheel_diameter, the turns give wheel_separation " +
-        fixed(calibrateTurn(ccw, cw, geometry_.wheel_separation, scale)
-                  .value->effective_separation) +
+        fixed(
+            calibrateTurn(ccw, cw, geometry_.wheel_separation, scale).value->effective_separation) +
         " (set both)");
   }
 
@@ -421,8 +435,12 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!options) return kExitUsage;
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  // Without SA_RESTART, so that a signal also ends a wait for typed input.
+  struct sigaction action {};
+  action.sa_handler = onSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
   const int status = CalibrationRun(*options).run();
   ros::shutdown();
   return status;

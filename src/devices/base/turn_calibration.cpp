@@ -19,8 +19,8 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0) {
 std::string checkTurn(const MotionRecord& turn, const char* name, double sign,
                       const CalibrationLimits& limits) {
   if (turn.imu_samples < limits.min_imu_samples) {
-    return std::string("too few IMU samples in the ") + name + " turn: " +
-           std::to_string(turn.imu_samples) + " (at least " +
+    return std::string("too few IMU samples in the ") + name +
+           " turn: " + std::to_string(turn.imu_samples) + " (at least " +
            std::to_string(limits.min_imu_samples) + "; is telemetry streaming?)";
   }
   if (turn.longest_imu_gap > limits.max_imu_gap) {
@@ -37,8 +37,8 @@ std::string checkTurn(const MotionRecord& turn, const char* name, double sign,
 
 }  // namespace
 
-MotionRecorder::MotionRecorder(const kinematics::DiffDriveGeometry& geometry,
-                               int left_direction, int right_direction, double max_frame_hold_s)
+MotionRecorder::MotionRecorder(const kinematics::DiffDriveGeometry& geometry, int left_direction,
+                               int right_direction, double max_frame_hold_s)
     : geometry_(geometry),
       left_direction_(left_direction),
       right_direction_(right_direction),
@@ -115,9 +115,10 @@ Checked<TurnCalibration> calibrateTurn(const MotionRecord& ccw, const MotionReco
   }
   // measured = ratio * commanded + bias * duration, once per direction: two equations, two
   // unknowns. The commanded turns have opposite signs, so the determinant is never zero.
-  const double determinant = ccw.commanded_yaw * cw.imu_duration - cw.commanded_yaw * ccw.imu_duration;
-  result.ratio = (ccw.measured_yaw * cw.imu_duration - cw.measured_yaw * ccw.imu_duration) /
-                 determinant;
+  const double determinant =
+      ccw.commanded_yaw * cw.imu_duration - cw.commanded_yaw * ccw.imu_duration;
+  result.ratio =
+      (ccw.measured_yaw * cw.imu_duration - cw.measured_yaw * ccw.imu_duration) / determinant;
   result.gyro_bias =
       (ccw.commanded_yaw * cw.measured_yaw - cw.commanded_yaw * ccw.measured_yaw) / determinant;
   if (std::abs(result.ratio_ccw - result.ratio_cw) > limits.max_direction_disagreement) {
@@ -138,8 +139,7 @@ Checked<TurnCalibration> calibrateTurn(const MotionRecord& ccw, const MotionReco
 }
 
 Checked<DiameterCalibration> calibrateDiameter(const MotionRecord& straight,
-                                               double measured_distance,
-                                               double configured_diameter,
+                                               double measured_distance, double configured_diameter,
                                                const CalibrationLimits& limits) {
   if (straight.commanded_distance < limits.min_commanded_distance) {
     return {std::nullopt, format("the base was hardly commanded forward (%.3f m from the wheel "
@@ -149,11 +149,10 @@ Checked<DiameterCalibration> calibrateDiameter(const MotionRecord& straight,
   DiameterCalibration result;
   result.ratio = measured_distance / straight.commanded_distance;
   if (!(result.ratio >= limits.min_ratio && result.ratio <= limits.max_ratio)) {
-    return {std::nullopt, format("measured %.3f m for %.3f m commanded: a ratio outside %.2f",
-                                 measured_distance, straight.commanded_distance,
-                                 limits.min_ratio) +
-                              format("..%.2f is a measuring mistake, not the wheels",
-                                     limits.max_ratio)};
+    return {std::nullopt,
+            format("measured %.3f m for %.3f m commanded: a ratio outside %.2f", measured_distance,
+                   straight.commanded_distance, limits.min_ratio) +
+                format("..%.2f is a measuring mistake, not the wheels", limits.max_ratio)};
   }
   result.effective_diameter = configured_diameter * result.ratio;
   return {result, ""};

@@ -58,8 +58,8 @@ class MotionRecorder {
   double max_frame_hold_s_;
   MotionRecord record_;
   std::optional<double> last_frame_stamp_;
-  double last_turn_rate_ = 0;     ///< rad/s of the last frame
-  double last_forward_speed_ = 0; ///< m/s of the last frame
+  double last_turn_rate_ = 0;      ///< rad/s of the last frame
+  double last_forward_speed_ = 0;  ///< m/s of the last frame
   std::optional<double> last_imu_stamp_;
   std::optional<double> first_imu_stamp_;
   double last_yaw_rate_ = 0;
@@ -69,23 +69,23 @@ class MotionRecorder {
 struct CalibrationLimits {
   double min_ratio = 0.5;  ///< measured / commanded
   double max_ratio = 1.5;
-  std::size_t min_imu_samples = 20;         ///< per turn
-  double max_imu_gap = 0.5;                 ///< s without an IMU sample inside a turn
-  double min_commanded_turn = 0.5;          ///< rad per turn
-  double max_direction_disagreement = 0.15; ///< |ratio ccw - ratio cw|
-  double min_commanded_distance = 0.1;      ///< m
+  std::size_t min_imu_samples = 20;          ///< per turn
+  double max_imu_gap = 0.5;                  ///< s without an IMU sample inside a turn
+  double min_commanded_turn = 0.5;           ///< rad per turn
+  double max_direction_disagreement = 0.15;  ///< |ratio ccw - ratio cw|
+  double min_commanded_distance = 0.1;       ///< m
 };
 
 struct TurnCalibration {
-  double ratio = 0;        ///< measured / commanded turn, the gyro's constant bias removed
-  double ratio_ccw = 0;    ///< each direction alone (bias included)
+  double ratio = 0;      ///< measured / commanded turn, the gyro's constant bias removed
+  double ratio_ccw = 0;  ///< each direction alone (bias included)
   double ratio_cw = 0;
-  double gyro_bias = 0;    ///< rad/s, the constant bias both turns together reveal
+  double gyro_bias = 0;             ///< rad/s, the constant bias both turns together reveal
   double effective_separation = 0;  ///< m
 };
 
 struct DiameterCalibration {
-  double ratio = 0;  ///< measured / commanded distance
+  double ratio = 0;               ///< measured / commanded distance
   double effective_diameter = 0;  ///< m
 };
 
@@ -107,8 +107,7 @@ Checked<TurnCalibration> calibrateTurn(const MotionRecord& ccw, const MotionReco
 
 /// The straight-line check: the commanded distance against the one the user measured (m).
 Checked<DiameterCalibration> calibrateDiameter(const MotionRecord& straight,
-                                               double measured_distance,
-                                               double configured_diameter,
+                                               double measured_distance, double configured_diameter,
                                                const CalibrationLimits& limits = {});
 
 }  // namespace serial_robot_driver::device

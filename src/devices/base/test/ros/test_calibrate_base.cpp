@@ -61,8 +61,8 @@ class CalibrateBase : public ::testing::Test {
     ASSERT_EQ(::access(toolPath().c_str(), X_OK), 0) << toolPath();
     ASSERT_TRUE(frames_.waitForCount(10, 30.0)) << "no wheel_command from the driver";
     ASSERT_TRUE(diagnostics_.waitFor(
-        "e_stop", 0, [](const DiagnosticsWatch::Status&) { return true; },
-        [] { return ros::ok(); }, 10.0));
+        "e_stop", 0, [](const DiagnosticsWatch::Status&) { return true; }, [] { return ros::ok(); },
+        10.0));
   }
 
   /// Runs the tool to its end; its exit status (-1: it did not end in time).
@@ -82,14 +82,15 @@ TEST_F(CalibrateBase, RecoversTheEffectiveSeparationOfASlippingBase) {
   ASSERT_EQ(runTool(tool, 60.0), 0) << tool.output();
   const std::string output = tool.output();
   std::smatch match;
-  ASSERT_TRUE(std::regex_search(output, match,
-                                std::regex(R"(effective wheel_separation: ([0-9.]+) m)")))
+  ASSERT_TRUE(
+      std::regex_search(output, match, std::regex(R"(effective wheel_separation: ([0-9.]+) m)")))
       << output;
   const std::string value = match[1];
   EXPECT_NEAR(std::stod(value), kEffectiveSeparation, kEffectiveSeparation * 0.02) << output;
   // What the user types next: the node's real name, and the YAML line under base:.
   EXPECT_NE(output.find("rosrun dynamic_reconfigure dynparam set /driver_node/base "
-                        "wheel_separation " + value),
+                        "wheel_separation " +
+                        value),
             std::string::npos)
       << output;
   EXPECT_NE(output.find("under base:   wheel_separation: " + value), std::string::npos) << output;
@@ -130,8 +131,8 @@ TEST_F(CalibrateBase, SigintMidTurnStopsTheBaseAndExitsNonZero) {
   const uint64_t before = frames_.count();
   ChildProcess tool(toolPath(), {"--angle", "30", "--rate", "1.0"});
   // Mid-turn: the base has been turning for a while.
-  ASSERT_TRUE(test_support::waitFor([&] { return movingFrames(frames_.since(before)) >= 25; },
-                                    30.0))
+  ASSERT_TRUE(
+      test_support::waitFor([&] { return movingFrames(frames_.since(before)) >= 25; }, 30.0))
       << tool.output();
   ASSERT_TRUE(tool.running());
   const uint64_t at_signal = frames_.count();
@@ -143,8 +144,7 @@ TEST_F(CalibrateBase, SigintMidTurnStopsTheBaseAndExitsNonZero) {
   ASSERT_TRUE(WIFEXITED(*status)) << tool.output();
   EXPECT_NE(WEXITSTATUS(*status), 0) << tool.output();
   EXPECT_LT(took, 3.0);
-  EXPECT_NE(tool.output().find("base stopped (a zero wheel frame was written)"),
-            std::string::npos)
+  EXPECT_NE(tool.output().find("base stopped (a zero wheel frame was written)"), std::string::npos)
       << tool.output();
   // A zero frame went out well before the driver's own 5 s cmd_vel timeout, and stayed.
   const auto after = frames_.since(at_signal);
