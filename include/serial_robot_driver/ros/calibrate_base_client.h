@@ -1,0 +1,36 @@
+// calibrate_base's ROS wiring (src/nodes/calibrate_base_main.cpp): finding the driver, and the
+// topics converted into the inputs of the core's TurnCalibrationRun.
+#pragma once
+
+#include <ros/ros.h>
+
+#include <atomic>
+#include <optional>
+#include <string>
+
+#include "serial_robot_driver/devices/base/turn_calibration_run.h"
+
+namespace serial_robot_driver::ros_layer {
+
+/// The driver's resolved name: `named` when given, else the one node publishing wheel_command,
+/// waited for up to 5 s (a signal in `stop_signal` or ROS shutting down ends the wait). Unset with
+/// `why` set when there is none, or several.
+std::optional<std::string> findCalibrationDriver(const std::string& named,
+                                                 const std::atomic<int>& stop_signal,
+                                                 std::string* why);
+
+/// imu/data, wheel_command and the driver's e-stop status on /diagnostics into the run; cmd_vel
+/// out. Messages arrive in ros::spinOnce().
+class CalibrationTopics {
+ public:
+  explicit CalibrationTopics(device::TurnCalibrationRun& run);
+  void command(const device::BaseTwist& twist);
+  bool commandSubscribed() const { return cmd_vel_.getNumSubscribers() > 0; }
+
+ private:
+  ros::NodeHandle nh_;
+  ros::Publisher cmd_vel_;
+  ros::Subscriber imu_, frames_, diagnostics_;
+};
+
+}  // namespace serial_robot_driver::ros_layer
