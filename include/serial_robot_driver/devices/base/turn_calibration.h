@@ -5,7 +5,7 @@
 // wheel-separation multiplier. The straight-line check does the same for the wheel diameter
 // against a distance the user measures.
 //
-// ROS-free: the tool (src/nodes/calibrate_base_main.cpp) feeds it stamps in seconds.
+// ROS-free: calibrate_base's run (turn_calibration_run.h) feeds it stamps in seconds.
 #pragma once
 
 #include <cstddef>
