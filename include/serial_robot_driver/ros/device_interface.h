@@ -6,12 +6,12 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 
-#include "serial_robot_driver/ros/driver_params.h"
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::trajectory {
 struct TrajectoryJoints;

@@ -121,8 +121,8 @@ GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, Clock::time_point
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!session_ && start_report_ && !cancelled_ && not_still.empty()) {
-      session_ = Session{"calibrate_on_start", arrival, arrival + fromSeconds(seconds), seconds,
-                         {}, {}, true};
+      session_ = Session{
+          "calibrate_on_start", arrival, arrival + fromSeconds(seconds), seconds, {}, {}, true};
     }
     if (session_ && arrival >= session_->begin) {
       if (!not_still.empty() && session_->not_still.empty()) session_->not_still = not_still;
@@ -249,8 +249,8 @@ GyroCalibrationOutcome GyroBiasCalibrator::finishLocked(const Session& session,
   return {true,
           "gyro bias " + describeGyroBias(*decision.bias, units) + " from " +
               std::to_string(session.stats.count()) + " samples over " +
-              format("%g", session.seconds) + " s, subtracted from imu/data from now on; before: " +
-              before,
+              format("%g", session.seconds) +
+              " s, subtracted from imu/data from now on; before: " + before,
           false};
 }
 

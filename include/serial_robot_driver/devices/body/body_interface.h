@@ -73,7 +73,7 @@ class BodyInterface : public DeviceInterface {
   std::shared_ptr<const ImuParams> imu_params_;
   // Set before the links start, read on the reader and calibration threads.
   MotionQuery motion_query_;
-  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
+  device::EStop* e_stop_ = nullptr;             // the node's, set before start()
   device::GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   device::BodyController controller_;
   // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).

@@ -131,11 +131,11 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, *imu), arrival);
   // Every frame feeds the calibration, subscribers or not (calibrate_on_start, imu/calibrate).
   namespace body = protocol::body;
-  const device::GyroVector gyro_bias = gyro_calibrator_.onSample(
-      {static_cast<double>(telemetry.imu[body::kGyroX]),
-       static_cast<double>(telemetry.imu[body::kGyroY]),
-       static_cast<double>(telemetry.imu[body::kGyroZ])},
-      arrival, gyroUnits(*imu), imu->calibration_time);
+  const device::GyroVector gyro_bias =
+      gyro_calibrator_.onSample({static_cast<double>(telemetry.imu[body::kGyroX]),
+                                 static_cast<double>(telemetry.imu[body::kGyroY]),
+                                 static_cast<double>(telemetry.imu[body::kGyroZ])},
+                                arrival, gyroUnits(*imu), imu->calibration_time);
   if (imu_pub_.getNumSubscribers() > 0) {
     imu_pub_.publish(
         boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp, gyro_bias)));
@@ -172,8 +172,8 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
 
 void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
-  device::BodyStatus::Update update = status_.update(
-      controller_.stats(), link_.stats().framer, {link_.options().path, link_.connected()});
+  device::BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
+                                                     {link_.options().path, link_.connected()});
   gyro_calibrator_.report(update.report, gyroUnits(*std::atomic_load(&imu_params_)));
   writeStatusReport(update.report, status, SummaryWrite::kMerge);
   // Once per outage, not once per period.

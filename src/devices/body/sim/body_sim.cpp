@@ -115,8 +115,7 @@ std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
   const auto& bias = config_.gyro_bias;
   telemetry.imu[body::kGyroX] = clipToInt16(bias[0] * lsb_per_rad_s + noise());
   telemetry.imu[body::kGyroY] = clipToInt16(bias[1] * lsb_per_rad_s + noise());
-  telemetry.imu[body::kGyroZ] =
-      clipToInt16((chassis.yaw_rate + bias[2]) * lsb_per_rad_s + noise());
+  telemetry.imu[body::kGyroZ] = clipToInt16((chassis.yaw_rate + bias[2]) * lsb_per_rad_s + noise());
   telemetry.imu[body::kRoll] = noise();
   telemetry.imu[body::kPitch] = noise();
   telemetry.imu[body::kYaw] = clipToInt16(stats_.yaw_rad * kRadToDeg * config_.angle_lsb_per_deg);

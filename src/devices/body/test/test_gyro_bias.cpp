@@ -137,7 +137,8 @@ class GyroCalibratorTest : public ::testing::Test {
 TEST_F(GyroCalibratorTest, RefusedWithoutTelemetryAndNothingChanges) {
   const GyroCalibrationOutcome outcome = calibrator_.calibrate(0.3, kUnits, "imu/calibrate");
   EXPECT_FALSE(outcome.success);
-  EXPECT_TRUE(contains(outcome.message, "imu/calibrate refused: no IMU telemetry")) << outcome.message;
+  EXPECT_TRUE(contains(outcome.message, "imu/calibrate refused: no IMU telemetry"))
+      << outcome.message;
   EXPECT_TRUE(contains(outcome.message, "unchanged: not calibrated")) << outcome.message;
   EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
 }
@@ -147,8 +148,9 @@ TEST_F(GyroCalibratorTest, AveragesWhileStillThenSubtractsAndSaysWhatWasBefore) 
   GyroCalibrationOutcome outcome = calibrator_.calibrate(0.3, kUnits, "imu/calibrate");
   ASSERT_TRUE(outcome.success) << outcome.message;
   EXPECT_EQ(calibrator_.bias(), (GyroVector{20, -15, 30}));
-  EXPECT_TRUE(contains(outcome.message, "gyro bias (0.02, -0.015, 0.03) rad/s = (1.146, -0.8594, "
-                                        "1.719) deg/s from "))
+  EXPECT_TRUE(contains(outcome.message,
+                       "gyro bias (0.02, -0.015, 0.03) rad/s = (1.146, -0.8594, "
+                       "1.719) deg/s from "))
       << outcome.message;
   EXPECT_TRUE(contains(outcome.message, "samples over 0.3 s")) << outcome.message;
   EXPECT_TRUE(contains(outcome.message, "before: not calibrated")) << outcome.message;
@@ -169,7 +171,8 @@ TEST_F(GyroCalibratorTest, RefusedWhileNotStillAndWhenMotionStartsDuringTheAvera
   GyroCalibrationOutcome outcome = calibrator_.calibrate(0.3, kUnits, "imu/calibrate");
   EXPECT_FALSE(outcome.success);
   EXPECT_TRUE(outcome.not_still);
-  EXPECT_TRUE(contains(outcome.message, "not held still (base: cmd_vel of 0.2 m/s")) << outcome.message;
+  EXPECT_TRUE(contains(outcome.message, "not held still (base: cmd_vel of 0.2 m/s"))
+      << outcome.message;
   EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
 
   setNotStill("");
@@ -192,7 +195,8 @@ TEST_F(GyroCalibratorTest, AnAbsurdMeanIsRefusedAndTheBiasInForceKept) {
   const GyroCalibrationOutcome outcome = calibrator_.calibrate(0.3, kUnits, "imu/calibrate");
   EXPECT_FALSE(outcome.success);
   EXPECT_TRUE(contains(outcome.message, "too large to be a bias")) << outcome.message;
-  EXPECT_TRUE(contains(outcome.message, "unchanged: (0.02, -0.015, 0.03) rad/s")) << outcome.message;
+  EXPECT_TRUE(contains(outcome.message, "unchanged: (0.02, -0.015, 0.03) rad/s"))
+      << outcome.message;
   EXPECT_EQ(calibrator_.bias(), (GyroVector{20, -15, 30}));
 }
 
@@ -271,7 +275,8 @@ TEST(GyroCalibrateOnStart, ARefusalOtherThanMotionIsReportedOnceAndNotRetried) {
     calibrator.onSample({0, 0, 200}, Clock::time_point{} + milliseconds(10 * i), kUnits, 0.5);
   }
   EXPECT_EQ(reports, 1);
-  EXPECT_TRUE(contains(message, "calibrate_on_start refused: the mean z rate 0.2 rad/s")) << message;
+  EXPECT_TRUE(contains(message, "calibrate_on_start refused: the mean z rate 0.2 rad/s"))
+      << message;
   EXPECT_EQ(calibrator.bias(), (GyroVector{0, 0, 0}));
 }
 

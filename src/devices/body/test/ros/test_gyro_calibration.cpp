@@ -111,7 +111,8 @@ struct Robot {
 void expectNear(const Rates& actual, const Rates& expected, double tolerance,
                 const std::string& what) {
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_NEAR(actual[i], expected[i], tolerance) << what << ", axis " << "xyz"[i];
+    EXPECT_NEAR(actual[i], expected[i], tolerance) << what << ", axis "
+                                                   << "xyz"[i];
   }
 }
 
