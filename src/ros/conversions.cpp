@@ -120,7 +120,7 @@ double imuYaw(const body::Telemetry& telemetry, const ImuParams& params) {
 }
 
 sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params,
-                       const ros::Time& stamp) {
+                       const ros::Time& stamp, const std::array<double, 3>& gyro_bias) {
   sensor_msgs::Imu msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = params.frame_id;
@@ -132,7 +132,9 @@ sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const ImuParams& params
       map * Eigen::Vector3d(raw[body::kAccelX], raw[body::kAccelY], raw[body::kAccelZ]) *
       params.accel_scale;
   const Eigen::Vector3d gyro =
-      map * Eigen::Vector3d(raw[body::kGyroX], raw[body::kGyroY], raw[body::kGyroZ]) *
+      map *
+      (Eigen::Vector3d(raw[body::kGyroX], raw[body::kGyroY], raw[body::kGyroZ]) -
+       Eigen::Vector3d(gyro_bias[0], gyro_bias[1], gyro_bias[2])) *
       params.gyro_scale;
   msg.linear_acceleration.x = accel.x();
   msg.linear_acceleration.y = accel.y();

@@ -126,6 +126,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   }
   // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
   connectImuHeading();
+  connectMotionQuery();
   // One trajectory server for the joints of every device, so one goal may span them.
   std::vector<TrajectoryJoints> trajectory_joints;
   for (auto& device : devices_) {
@@ -170,6 +171,25 @@ void DriverNode::connectImuHeading() {
     // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
     base->onImuYaw(yaw, replaying ? device::Clock::now() : arrival);
   });
+}
+
+void DriverNode::connectMotionQuery() {
+  // Whether the robot is held still, for a sensor's calibration (the body's imu/calibrate): asked
+  // on that device's reader and service threads; each device answers under its own short lock.
+  // devices_ is complete here and outlives the links' threads and the devices' spinners.
+  std::vector<std::pair<std::string, const DeviceInterface*>> named;
+  auto device = devices_.begin();
+  for (const device::DeviceModule* module : device::registeredDevices()) {
+    if (params_.enabled(*module)) named.emplace_back(module->name, (device++)->get());
+  }
+  const DeviceInterface::MotionQuery query = [named] {
+    for (const auto& [name, interface] : named) {
+      const std::string why = interface->motionInForce();
+      if (!why.empty()) return name + ": " + why;
+    }
+    return std::string();
+  };
+  for (auto& each : devices_) each->setMotionQuery(query);
 }
 
 void DriverNode::connectEStop() {

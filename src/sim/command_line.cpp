@@ -262,6 +262,16 @@ const std::vector<Flag>& flags() {
           [](SimOptions& o) -> double& { return o.body.servo_speed; }, true),
       toggle("--imu-noise", "+-2 LSB noise on the IMU values",
              [](SimOptions& o) { o.body.imu_noise = true; }),
+      Flag{"--gyro-bias", "X,Y,Z", "rad/s added to the gyro's sensor axes",
+           [](const std::string& value, SimOptions& o) {
+             const auto bias = parseGyroBias(value);
+             if (bias) o.body.gyro_bias = *bias;
+             return bias ? std::string() : badValue("--gyro-bias", value) + " (X,Y,Z in rad/s)";
+           },
+           [](const SimOptions& o) {
+             const auto& b = o.body.gyro_bias;
+             return show(b[0]) + "," + show(b[1]) + "," + show(b[2]);
+           }},
       number(
           "--turn-slip", "FRACTION",
           "wheel slip: the base turns by (1 - FRACTION) of the commanded yaw rate (0..1); the IMU "

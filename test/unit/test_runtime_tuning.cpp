@@ -127,7 +127,7 @@ TEST(RuntimeTuningTable, BaseServerHasEveryBaseTunableAsTheTableHasIt) {
 
 TEST(RuntimeTuningTable, ImuServerHasTheScalesAsTheTableHasThem) {
   expectAgreesWithTheTable<serial_robot_driver::ImuTuningConfig>(
-      "imu", {"accel_scale", "gyro_scale", "angle_scale"});
+      "imu", {"accel_scale", "gyro_scale", "angle_scale", "calibration_time"});
 }
 
 TEST(RuntimeTuningTable, ServoBusServerHasEveryBusTunableAsTheTableHasIt) {

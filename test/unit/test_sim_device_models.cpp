@@ -84,6 +84,35 @@ TEST(RobotSimBodyDevice, ImuReportsTheChassisHeadingAndYawRate) {
   EXPECT_EQ(wrapped->imu[protocol::body::kYaw], -23814);  // -2.2832 rad * 32768 / pi
 }
 
+TEST(RobotSimBodyDevice, GyroBiasIsAddedToEachGyroAxis) {
+  const TimePoint t0{};
+  BodySimConfig config;
+  config.telemetry_rate_hz = 50;
+  config.gyro_bias = {0.02, -0.015, 0.03};  // rad/s, as --gyro-bias 0.02,-0.015,0.03
+  BodySim body(config, t0);
+  Outbox out;
+  body.tick(t0 + milliseconds(20), ChassisMotion{0.0, 0.5}, &out);
+  ASSERT_EQ(out.size(), 1u);
+  const auto telemetry =
+      protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+  ASSERT_TRUE(telemetry.ok());
+  // 938.734 LSB per rad/s (2000 deg/s / 32768): 18.77, -14.08 and (0.5 + 0.03) * 938.734 = 497.5.
+  EXPECT_EQ(telemetry->imu[protocol::body::kGyroX], 19);
+  EXPECT_EQ(telemetry->imu[protocol::body::kGyroY], -14);
+  EXPECT_EQ(telemetry->imu[protocol::body::kGyroZ], 498);
+  EXPECT_EQ(telemetry->imu[protocol::body::kAccelX], 0) << "the accelerometer is left alone";
+  EXPECT_EQ(telemetry->imu[protocol::body::kRoll], 0) << "and so are the angles";
+
+  const char* args[] = {"robot_sim", "--gyro-bias", "0.02,-0.015,0.03"};
+  const CommandLine line = parseCommandLine(3, args);
+  ASSERT_TRUE(line.error.empty()) << line.error;
+  EXPECT_EQ(line.options.body.gyro_bias, (std::array<double, 3>{0.02, -0.015, 0.03}));
+  for (const char* bad : {"0.02,0.01", "1,2,3,4", "a,b,c", "0.1,,0.2", "1,2,nan"}) {
+    EXPECT_FALSE(parseGyroBias(bad).has_value()) << bad;
+  }
+  EXPECT_NE(usage().find("--gyro-bias X,Y,Z"), std::string::npos);
+}
+
 TEST(RobotSimBodyDevice, ServoMovesAtTheBoundedSpeed) {
   const TimePoint t0{};
   BodySimConfig config;

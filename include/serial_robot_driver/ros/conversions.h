@@ -11,6 +11,7 @@
 #include <serial_robot_driver/Telemetry.h>
 
 #include <Eigen/Core>
+#include <array>
 #include <chrono>
 #include <optional>
 #include <string>
@@ -64,9 +65,10 @@ sensor_msgs::JointState toJointState(const protocol::body::Telemetry& telemetry,
 
 /// REP-145 IMU message: accel (m/s^2) and gyro (rad/s) scaled from raw LSB, orientation from the
 /// attitude angles, diagonal covariances from `params`. A negative orientation_variance marks the
-/// orientation as unknown (orientation_covariance[0] = -1).
+/// orientation as unknown (orientation_covariance[0] = -1). `gyro_bias` (raw LSB, the sensor's
+/// axes) is subtracted from the gyro before it is scaled and mapped.
 sensor_msgs::Imu toImu(const protocol::body::Telemetry& telemetry, const ImuParams& params,
-                       const ros::Time& stamp);
+                       const ros::Time& stamp, const std::array<double, 3>& gyro_bias = {});
 
 /// The yaw (rad, [-pi, pi]) of the orientation toImu() publishes: the board's attitude through
 /// ~imu/axis_map, i.e. the heading of the imu frame (~base/use_imu_heading feeds it to odometry).

@@ -6,10 +6,12 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 
-#include "serial_robot_driver/ros/driver_params.h"
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::trajectory {
 struct TrajectoryJoints;
@@ -42,6 +44,14 @@ class DeviceInterface {
   /// The node's one e-stop, given before start(): the device registers what engaging it means
   /// for its actuators and refuses motion commands while it holds. It outlives the device.
   virtual void attachEStop(device::EStop& /*e_stop*/) {}
+  /// Why this device's actuators may be moving the robot now (a command in force, a ramp not yet
+  /// at rest), "" when they are held still. Any thread, cheap: a sensor being calibrated asks it
+  /// once per frame.
+  virtual std::string motionInForce() const { return {}; }
+  /// Asks every device of the node motionInForce() ("<device>: <why>", or ""). Given before the
+  /// links start to a device whose sensor must only be calibrated while the robot is still.
+  using MotionQuery = std::function<std::string()>;
+  virtual void setMotionQuery(MotionQuery /*query*/) {}
   /// Statuses of its own beyond the device's one (e.g. one per bus servo), added to `updater`
   /// once, at construction of the node.
   virtual void addDiagnostics(diagnostic_updater::Updater& /*updater*/) {}

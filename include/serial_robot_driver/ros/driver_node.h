@@ -76,6 +76,8 @@ class DriverNode {
   device::SerialLink& portFor(const std::string& path);
   /// ~base/use_imu_heading: feeds the body's IMU yaw to the base's odometry.
   void connectImuHeading();
+  /// Gives every device a way to ask whether the others hold the robot still (motionInForce()).
+  void connectMotionQuery();
   /// One line for the log: ports, the devices on each, rates.
   std::string startupSummary() const;
   void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);

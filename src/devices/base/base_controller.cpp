@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace serial_robot_driver::device {
@@ -88,6 +89,24 @@ void BaseController::setEStop(bool engaged) {
     }
   }
   wake_.notify_all();
+}
+
+std::string BaseController::motionInForce() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  char text[128];
+  const bool command_live = !e_stop_ && last_command_ &&
+                            seconds(clock_->now() - *last_command_) <= config_.cmd_vel_timeout;
+  if (command_live && (linear_x_ != 0.0 || angular_z_ != 0.0)) {
+    std::snprintf(text, sizeof text, "cmd_vel of %.3g m/s, %.3g rad/s in force", linear_x_,
+                  angular_z_);
+    return text;
+  }
+  const WheelSpeeds& ramp = limiter_.current();
+  if (!e_stop_ && !ramp.isZero(0.0)) {
+    std::snprintf(text, sizeof text, "wheels still ramping (%.3g, %.3g m/s)", ramp.x(), ramp.y());
+    return text;
+  }
+  return {};
 }
 
 void BaseController::resetOdometry() {

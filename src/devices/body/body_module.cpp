@@ -63,7 +63,9 @@ void addParameters(std::vector<params::ParamSpec>& table) {
       .add("orientation_variance", &I::orientation_variance, params::finiteNumber)
       .add("angular_velocity_variance", &I::angular_velocity_variance, params::nonNegativeNumber)
       .add("linear_acceleration_variance", &I::linear_acceleration_variance,
-           params::nonNegativeNumber);
+           params::nonNegativeNumber)
+      .add("calibration_time", &I::calibration_time, params::numberWithin(0.1, 60.0, "s"))
+      .add("calibrate_on_start", &I::calibrate_on_start);
 }
 
 void validate(const DriverParams& p) {

@@ -31,6 +31,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -168,6 +169,9 @@ class BaseController : public LinkListener {
   /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
   /// the port's baud (10 bits per byte) divided by immediate_line_share.
   Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
+  /// Why the wheels may be moving now, or "" when they are commanded still: a non-zero cmd_vel in
+  /// force (not timed out, no e-stop) or wheels still ramping toward zero. Any thread.
+  std::string motionInForce() const;
   /// Writes a Reset now (base/reset). False when the port is down.
   bool sendReset();
   /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.

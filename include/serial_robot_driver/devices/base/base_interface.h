@@ -38,6 +38,8 @@ class BaseInterface : public DeviceInterface {
   void attachEStop(device::EStop& e_stop) override;
   /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
   void onImuYaw(double yaw, device::Clock::time_point stamp) { controller_.onImuYaw(yaw, stamp); }
+  /// A cmd_vel in force or wheels still ramping down.
+  std::string motionInForce() const override { return controller_.motionInForce(); }
 
  private:
   device::BaseEvents events();

@@ -1,21 +1,28 @@
 // ROS face of the servo controller board: joint_states, imu/data, foot_pressure and telemetry out
 // (published on the link's reader thread as each frame is decoded, stamped with the frame's
-// arrival time); joint_commands in (one sync-write frame per message); one diagnostic status.
+// arrival time); joint_commands in (one sync-write frame per message); imu/calibrate (the gyro
+// bias, device::GyroBiasCalibrator: it waits ~imu/calibration_time, so it runs on a queue and
+// spinner thread of its own, never holding up the reader or the global queue); one diagnostic
+// status.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
+#include <std_srvs/Trigger.h>
 
 #include <functional>
 #include <memory>
 
 #include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/devices/body/body_status.h"
+#include "serial_robot_driver/devices/body/gyro_bias.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/queue_spinner.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -25,10 +32,12 @@ class BodyInterface : public DeviceInterface {
   /// Registers the controller on `link` (before the link starts) and advertises the topics.
   /// `link` must outlive this object.
   BodyInterface(ros::NodeHandle& nh, const DriverParams& params, device::SerialLink& link);
+  ~BodyInterface() override;
 
-  /// Nothing to start: the body speaks when the link's reader hands it a frame.
-  void start() override {}
-  /// Stops taking joint commands. Frames that still arrive before the link stops are published.
+  /// Starts imu/calibrate's spinner; the rest speaks when the link's reader hands it a frame.
+  void start() override;
+  /// Stops taking joint commands and calibrations (one under way is refused). Frames that still
+  /// arrive before the link stops are published.
   void shutdown() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
   /// The ~imu tunables (accel_scale, gyro_scale, angle_scale) from the next telemetry frame on.
@@ -46,17 +55,26 @@ class BodyInterface : public DeviceInterface {
   /// Engaged: the controller's motion gate is locked, so no sync-write goes out from then on,
   /// even one already waiting; joint_commands are refused and counted.
   void attachEStop(device::EStop& e_stop) override;
+  /// The gyro is calibrated only while no device moves the robot (nor the e-stop is engaged).
+  void setMotionQuery(MotionQuery query) override { motion_query_ = std::move(query); }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,
                         device::Clock::time_point arrival);
   void onJointCommand(const sensor_msgs::JointState::ConstPtr& msg);
+  bool onCalibrate(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  /// Why the robot is not held still now, "" when it is (reader and calibration threads).
+  std::string notStill() const;
 
   device::SerialLink& link_;
   const ArrivalStamps arrival_stamps_;
   /// Swapped whole by retune() (~imu scales) and loaded once per frame by the reader thread, so
   /// a frame is converted with one set of scales (std::atomic_load / atomic_store).
   std::shared_ptr<const ImuParams> imu_params_;
+  // Set before the links start, read on the reader and calibration threads.
+  MotionQuery motion_query_;
+  device::EStop* e_stop_ = nullptr;             // the node's, set before start()
+  device::GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   device::BodyController controller_;
   // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
   double min_rate_ = 1.0;
@@ -70,8 +88,13 @@ class BodyInterface : public DeviceInterface {
   ImuYawListener imu_yaw_listener_;
   // The node's trajectory server (its own threading comment); set before the link starts.
   TrajectoryServer* trajectory_ = nullptr;
-  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
-  device::BodyStatus status_;        // diagnostics timer thread only
+  device::BodyStatus status_;  // diagnostics timer thread only
+  // imu/calibrate: its own queue and one thread, as a call blocks for ~imu/calibration_time.
+  ros::CallbackQueue calibration_queue_;
+  ros::NodeHandle calibration_nh_;  // the node's namespace, bound to calibration_queue_
+  ros::ServiceServer calibrate_srv_;
+  std::unique_ptr<QueueSpinner> calibration_spinner_;
+  bool shut_down_ = false;
 };
 
 }  // namespace serial_robot_driver::ros_layer

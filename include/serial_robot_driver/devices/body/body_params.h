@@ -43,6 +43,9 @@ struct ImuParams {
   double orientation_variance = 0.0003;        ///< rad^2 (about 1 deg std)
   double angular_velocity_variance = 0.0001;   ///< (rad/s)^2
   double linear_acceleration_variance = 0.01;  ///< (m/s^2)^2
+  double calibration_time = 2.0;               ///< s of gyro averaged by imu/calibrate
+  /// Calibrate the gyro bias once, when telemetry first arrives and the base is still.
+  bool calibrate_on_start = false;
 };
 
 }  // namespace serial_robot_driver::params

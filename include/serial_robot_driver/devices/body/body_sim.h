@@ -6,9 +6,12 @@
 // carries plausible pressure readings.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_codec.h"
@@ -27,12 +30,17 @@ struct BodySimConfig {
   uint16_t initial_position = 2048;
   uint16_t max_position = 4095;  ///< targets are clamped to 0..max_position
   bool imu_noise = false;        ///< add +-2 LSB of noise to the IMU values
+  /// rad/s added to the gyro on each sensor axis (x, y, z): a bias for imu/calibrate to find.
+  std::array<double, 3> gyro_bias{0.0, 0.0, 0.0};
   // IMU raw scales of docs/protocols.md (16 g, 2000 deg/s, 180 deg full scale over 32768).
   double accel_lsb_per_g = 32768.0 / 16.0;
   double gyro_lsb_per_dps = 32768.0 / 2000.0;
   double angle_lsb_per_deg = 32768.0 / 180.0;
   uint32_t seed = 1;
 };
+
+/// "X,Y,Z" (three finite numbers) as robot_sim's --gyro-bias reads it; nullopt when malformed.
+std::optional<std::array<double, 3>> parseGyroBias(const std::string& text);
 
 /// How the chassis the board is mounted on moves (the base's true motion; zero without a base).
 struct ChassisMotion {

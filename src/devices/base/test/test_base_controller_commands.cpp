@@ -260,5 +260,30 @@ TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
   controller.stop();
 }
 
+// What the body's gyro calibration asks: a non-zero cmd_vel in force, then the ramp down after its
+// timeout, until the wheels rest; an e-stop or a zero cmd_vel holds the robot still.
+TEST(BaseControllerMotion, MotionInForceNamesTheCommandThenTheRampUntilTheWheelsRest) {
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  config.max_wheel_accel = 1.0;  // 0.5 m/s takes 0.5 s to ramp down
+  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto controller = startOnManualClock(config, {}, clock);
+  EXPECT_EQ(controller->motionInForce(), "") << "never commanded";
+  clock->step([&] { controller->setCommand(0.5, 0.0); });
+  EXPECT_EQ(controller->motionInForce(), "cmd_vel of 0.5 m/s, 0 rad/s in force");
+  clock->tick(30);  // 600 ms: the command timed out after 0.5 s, the wheels are ramping down
+  EXPECT_NE(controller->motionInForce().find("wheels still ramping"), std::string::npos)
+      << controller->motionInForce();
+  clock->tick(40);
+  EXPECT_EQ(controller->motionInForce(), "") << "at rest";
+  clock->step([&] { controller->setCommand(0.0, 0.0); });
+  EXPECT_EQ(controller->motionInForce(), "") << "a zero cmd_vel commands stillness";
+  clock->step([&] { controller->setCommand(0.0, 0.3); });
+  EXPECT_NE(controller->motionInForce(), "");
+  controller->setEStop(true);
+  EXPECT_EQ(controller->motionInForce(), "") << "the e-stop holds zero at once";
+  controller->stop();
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::device

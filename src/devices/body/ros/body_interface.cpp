@@ -11,18 +11,29 @@
 
 namespace serial_robot_driver::ros_layer {
 
+namespace {
+
+device::GyroUnits gyroUnits(const ImuParams& imu) {
+  // validate() refused an axis map that does not parse at start-up.
+  return {imu.gyro_scale, params::parseAxisMap(imu.axis_map, nullptr).value_or(params::AxisMap{})};
+}
+
+}  // namespace
+
 BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)
     : link_(link),
       arrival_stamps_(params),
       imu_params_(std::make_shared<const ImuParams>(params.imu)),
+      gyro_calibrator_([this] { return notStill(); }),
       controller_(
           makeBodyJoints(params.body), link.writer(),
           {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
             publishTelemetry(telemetry, arrival);
           }}),
       telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
-                      "telemetry rate") {
+                      "telemetry rate"),
+      calibration_nh_(nh) {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
   joint_states_pub_ =
       nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
@@ -35,6 +46,44 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
                                      ros::TransportHints().tcpNoDelay());
   link.addListener(&controller_);
+  calibration_nh_.setCallbackQueue(&calibration_queue_);
+  calibrate_srv_ =
+      calibration_nh_.advertiseService("imu/calibrate", &BodyInterface::onCalibrate, this);
+  if (params.imu.calibrate_on_start) {
+    gyro_calibrator_.calibrateOnStart([](const device::GyroCalibrationOutcome& outcome) {
+      if (outcome.success) {
+        ROS_INFO("imu/calibrate_on_start: %s", outcome.message.c_str());
+      } else {
+        ROS_WARN("imu/calibrate_on_start: %s", outcome.message.c_str());
+      }
+    });
+  }
+}
+
+void BodyInterface::start() {
+  if (calibration_spinner_ || shut_down_) return;
+  calibration_spinner_ = std::make_unique<QueueSpinner>(&calibration_queue_, 1);
+  calibration_spinner_->start();
+}
+
+std::string BodyInterface::notStill() const {
+  if (e_stop_ && e_stop_->engaged()) return "the e-stop is engaged";
+  return motion_query_ ? motion_query_() : std::string();
+}
+
+bool BodyInterface::onCalibrate(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  // On calibration_queue_'s own thread: blocking here for the averaging holds up nothing else.
+  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
+  const device::GyroCalibrationOutcome outcome =
+      gyro_calibrator_.calibrate(imu->calibration_time, gyroUnits(*imu), "imu/calibrate");
+  res.success = outcome.success;
+  res.message = outcome.message;
+  if (outcome.success) {
+    ROS_INFO("%s", outcome.message.c_str());
+  } else {
+    ROS_WARN("%s", outcome.message.c_str());
+  }
+  return true;
 }
 
 void BodyInterface::retune(const DriverParams& params) {
@@ -44,7 +93,14 @@ void BodyInterface::retune(const DriverParams& params) {
 void BodyInterface::shutdown() {
   joint_commands_sub_.shutdown();
   controller_.gate().close();  // no position goes out once the node is shutting down
+  if (shut_down_) return;
+  shut_down_ = true;
+  gyro_calibrator_.cancel();  // a call waiting for its averaging returns now
+  calibrate_srv_.shutdown();
+  if (calibration_spinner_) calibration_spinner_->stop();
 }
+
+BodyInterface::~BodyInterface() { shutdown(); }
 
 void BodyInterface::attachEStop(device::EStop& e_stop) {
   e_stop_ = &e_stop;
@@ -73,8 +129,16 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   }
   const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
   if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, *imu), arrival);
+  // Every frame feeds the calibration, subscribers or not (calibrate_on_start, imu/calibrate).
+  namespace body = protocol::body;
+  const device::GyroVector gyro_bias =
+      gyro_calibrator_.onSample({static_cast<double>(telemetry.imu[body::kGyroX]),
+                                 static_cast<double>(telemetry.imu[body::kGyroY]),
+                                 static_cast<double>(telemetry.imu[body::kGyroZ])},
+                                arrival, gyroUnits(*imu), imu->calibration_time);
   if (imu_pub_.getNumSubscribers() > 0) {
-    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp)));
+    imu_pub_.publish(
+        boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp, gyro_bias)));
   }
   if (foot_pressure_pub_.getNumSubscribers() > 0) {
     if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
@@ -108,8 +172,9 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
 
 void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
-  const device::BodyStatus::Update update = status_.update(
-      controller_.stats(), link_.stats().framer, {link_.options().path, link_.connected()});
+  device::BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
+                                                     {link_.options().path, link_.connected()});
+  gyro_calibrator_.report(update.report, gyroUnits(*std::atomic_load(&imu_params_)));
   writeStatusReport(update.report, status, SummaryWrite::kMerge);
   // Once per outage, not once per period.
   if (update.flow == device::BodyStatus::FlowChange::kStopped) {

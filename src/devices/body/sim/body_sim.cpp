@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace serial_robot_driver::sim {
 
@@ -28,6 +29,24 @@ constexpr std::array<uint16_t, body::kFootSensorCount> kFootBaseline = {812, 790
                                                                         820, 775, 640, 690};
 
 }  // namespace
+
+std::optional<std::array<double, 3>> parseGyroBias(const std::string& text) {
+  std::array<double, 3> bias{};
+  std::istringstream stream(text);
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string item;
+    if (!std::getline(stream, item, ',') || item.empty()) return std::nullopt;
+    std::size_t used = 0;
+    try {
+      bias[i] = std::stod(item, &used);
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    if (used != item.size() || !std::isfinite(bias[i])) return std::nullopt;
+  }
+  if (stream.peek() != std::char_traits<char>::eof()) return std::nullopt;  // a fourth value
+  return bias;
+}
 
 BodySim::BodySim(const BodySimConfig& config, TimePoint now)
     : config_(config), last_step_(now), next_telemetry_(now), rng_(config.seed) {
@@ -92,10 +111,11 @@ std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
   telemetry.imu[body::kAccelX] = noise();
   telemetry.imu[body::kAccelY] = noise();
   telemetry.imu[body::kAccelZ] = clipToInt16(config_.accel_lsb_per_g + noise());
-  telemetry.imu[body::kGyroX] = noise();
-  telemetry.imu[body::kGyroY] = noise();
-  telemetry.imu[body::kGyroZ] =
-      clipToInt16(chassis.yaw_rate * kRadToDeg * config_.gyro_lsb_per_dps + noise());
+  const double lsb_per_rad_s = kRadToDeg * config_.gyro_lsb_per_dps;
+  const auto& bias = config_.gyro_bias;
+  telemetry.imu[body::kGyroX] = clipToInt16(bias[0] * lsb_per_rad_s + noise());
+  telemetry.imu[body::kGyroY] = clipToInt16(bias[1] * lsb_per_rad_s + noise());
+  telemetry.imu[body::kGyroZ] = clipToInt16((chassis.yaw_rate + bias[2]) * lsb_per_rad_s + noise());
   telemetry.imu[body::kRoll] = noise();
   telemetry.imu[body::kPitch] = noise();
   telemetry.imu[body::kYaw] = clipToInt16(stats_.yaw_rad * kRadToDeg * config_.angle_lsb_per_deg);

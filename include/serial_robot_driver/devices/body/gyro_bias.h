@@ -1,0 +1,155 @@
+// The board's gyro bias, ROS-free: averaging the gyro while the robot is held still (imu/calibrate,
+// ~imu/calibrate_on_start), deciding whether the mean is a believable bias, and keeping the bias in
+// force for the conversion to subtract.
+//
+// The bias is kept in the gyro's raw units (LSB) on the sensor's own axes, so a runtime change of
+// ~imu/gyro_scale or the axis map applies to it exactly as to the raw samples it came from.
+//
+// Threading: onSample() runs on the body port's reader thread; calibrate() blocks its caller (a
+// service thread) for the averaging time; bias(), report() and cancel() may be called from any
+// thread. One mutex guards everything; the stillness check is always called without it held, so
+// it may take another device's lock.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+
+namespace serial_robot_driver::device {
+
+/// One value per sensor axis (x, y, z).
+using GyroVector = std::array<double, 3>;
+
+/// How raw gyro values read in rad/s on imu/data's axes (~imu/gyro_scale and ~imu/axis_map).
+struct GyroUnits {
+  double gyro_scale = 0.0010653;  ///< rad/s per LSB
+  params::AxisMap axes;
+  /// `raw` (LSB, sensor axes) in rad/s on the imu frame's axes.
+  GyroVector toImuRadPerSecond(const GyroVector& raw) const;
+};
+
+struct GyroCalibrationLimits {
+  /// A mean above this on any axis (rad/s) is a turn, not a bias (gyro biases are a few mrad/s).
+  double max_bias = 0.1;
+  /// A standard deviation above this on any axis (rad/s) means the robot was shaken or bumped: a
+  /// still board's noise is far smaller.
+  double max_spread = 0.05;
+  std::size_t min_samples = 10;
+  /// The newest IMU frame must be younger than this for telemetry to count as flowing.
+  std::chrono::milliseconds max_telemetry_age{500};
+};
+
+/// Mean and spread per axis of raw gyro samples (Welford's running update: no catastrophic
+/// cancellation however many samples).
+class GyroSampleStats {
+ public:
+  void add(const GyroVector& raw);
+  std::size_t count() const { return count_; }
+  GyroVector mean() const { return mean_; }
+  /// Sample standard deviation per axis (0 with fewer than two samples).
+  GyroVector spread() const;
+
+ private:
+  std::size_t count_ = 0;
+  GyroVector mean_{};
+  GyroVector squares_{};  ///< sum of squared differences from the mean
+};
+
+/// The verdict on a set of samples: the bias (LSB, sensor axes) or why it is not one.
+struct GyroBiasDecision {
+  std::optional<GyroVector> bias;
+  std::string problem;  ///< empty when bias is set
+};
+GyroBiasDecision decideGyroBias(const GyroSampleStats& stats, const GyroUnits& units,
+                                const GyroCalibrationLimits& limits);
+
+/// "(0.02, -0.015, 0.03) rad/s = (1.15, -0.86, 1.72) deg/s" for `raw` on the imu frame's axes.
+std::string describeGyroBias(const GyroVector& raw, const GyroUnits& units);
+
+/// The result of one calibration, as the service answers it.
+struct GyroCalibrationOutcome {
+  bool success = false;
+  std::string message;
+  /// Refused because the robot was not held still (moving, ramping, e-stop): worth trying again
+  /// once it is.
+  bool not_still = false;
+};
+
+class GyroBiasCalibrator {
+ public:
+  /// Why the robot is not held still now (a motion command in force, wheels ramping, the e-stop
+  /// engaged), or "" when it is. Thread-safe and cheap: it is asked once per IMU frame while a
+  /// calibration runs.
+  using StillnessCheck = std::function<std::string()>;
+  /// calibrate_on_start's verdict, called once on the reader thread (log it).
+  using StartReport = std::function<void(const GyroCalibrationOutcome&)>;
+
+  explicit GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimits limits = {});
+
+  /// Reader thread: one frame's raw gyro (LSB, sensor axes) arrived at `arrival`. `units` and
+  /// `seconds` (~imu/calibration_time) are the ones in force for this frame. Returns the bias to
+  /// subtract from it.
+  GyroVector onSample(const GyroVector& raw, Clock::time_point arrival, const GyroUnits& units,
+                      double seconds);
+  /// Blocks the caller for `seconds` while the samples arrive, then keeps the bias found or
+  /// nothing (a refusal changes nothing in force). `how` names the request ("imu/calibrate").
+  GyroCalibrationOutcome calibrate(double seconds, const GyroUnits& units, const std::string& how);
+  /// Arms ~imu/calibrate_on_start: the first frames that arrive while the robot is still are
+  /// averaged for `seconds` (onSample's), the result or refusal reported once through `report`; a
+  /// motion during the averaging only starts it again once the robot is still.
+  void calibrateOnStart(StartReport report);
+  /// Shutdown: a calibration under way is refused at once, and so is every later one.
+  void cancel();
+
+  /// The bias in force (LSB, sensor axes; zero when never calibrated).
+  GyroVector bias() const;
+  /// The bias in force and the last calibration's verdict, added to the body's status: a refusal
+  /// since the last good calibration is a WARN.
+  void report(StatusReport& status, const GyroUnits& units) const;
+
+ private:
+  struct InForce {
+    GyroVector bias{};
+    std::size_t samples = 0;
+    double seconds = 0;
+    std::string how;
+    std::chrono::system_clock::time_point when;
+  };
+  struct Session {
+    std::string how;
+    Clock::time_point begin;
+    Clock::time_point end;
+    double seconds = 0;
+    GyroSampleStats stats;
+    std::string not_still;  ///< set when the robot moved during the averaging
+    bool automatic = false;
+  };
+
+  /// Requires mutex_: the outcome of `session` (over), applied when it is a bias.
+  GyroCalibrationOutcome finishLocked(const Session& session, const GyroUnits& units);
+  std::string inForceLocked(const GyroUnits& units) const;
+  GyroCalibrationOutcome refuseLocked(const std::string& how, const std::string& why,
+                                      const GyroUnits& units, bool not_still);
+
+  const StillnessCheck still_;
+  const GyroCalibrationLimits limits_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<InForce> in_force_;
+  std::optional<Session> session_;
+  std::optional<Clock::time_point> last_arrival_;
+  std::string last_refusal_;  ///< since the last good calibration
+  StartReport start_report_;  ///< set while calibrate_on_start waits for its result
+  bool cancelled_ = false;
+};
+
+}  // namespace serial_robot_driver::device
