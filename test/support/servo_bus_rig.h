@@ -151,7 +151,7 @@ class ServoBusTest : public ::testing::Test {
   std::vector<std::pair<uint8_t, std::chrono::milliseconds>> silent_;
   std::vector<std::pair<uint8_t, ServoError>> failed_moves_;
   std::vector<std::pair<uint8_t, ServoStatus>> stop_events_;
-  std::vector<ServoIdentityReport> identities_;  // on_identity reports
+  std::vector<ServoIdentityReport> identities_;          // on_identity reports
   std::map<Bytes, std::deque<Bytes>> scripted_answers_;  // before answers_, used up in order
   bool port_down_ = false;                               // guarded by mutex_
   std::unique_ptr<ServoBus> bus_;

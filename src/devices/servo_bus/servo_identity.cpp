@@ -115,8 +115,8 @@ ServoStatus readServoInfo(ServoBusClient& client, uint8_t id, const ServoIdentit
   ServoIdentity read;
   const ServoStatus status = readServoIdentity(client, id, BusPriority::kCaller, true, &read);
   if (!status.ok()) {
-    return {status.error, "servo " + std::to_string(id) + "'s identity could not be read: " +
-                              status.message};
+    return {status.error,
+            "servo " + std::to_string(id) + "'s identity could not be read: " + status.message};
   }
   *identity = read;
   const ServoLimits& limits = read.limits;

@@ -32,7 +32,8 @@ struct ServoBusConfig {
   /// OverheatGuard::kCoolDownC below it.
   bool protect = false;
   /// Each polled servo's identity and settings are read once when it first answers (background
-  /// work) and checked against `identity`. Off only where a test counts every frame the poll writes.
+  /// work) and checked against `identity`. Off only where a test counts every frame the poll
+  /// writes.
   bool read_identity = true;
   ServoIdentityChecks identity;
 };

@@ -24,11 +24,11 @@ struct ServoIdentity {
   /// 0: a motion command interrupts the one running and is not answered; 1: motion commands are
   /// queued behind each other and each is answered when it completes.
   uint8_t response_switch = 0;
-  bool angle_limit_on = false;     ///< angle_limit_switch: the servo clamps its moves
-  int64_t angle_limit_low = 0;     ///< 0.1 deg, read only while angle_limit_on
-  int64_t angle_limit_high = 0;    ///< 0.1 deg, read only while angle_limit_on
-  bool limits_known = false;       ///< `limits` read (readServoIdentity with `with_limits`)
-  ServoLimits limits;              ///< the protection limits, as the health poll reads them
+  bool angle_limit_on = false;   ///< angle_limit_switch: the servo clamps its moves
+  int64_t angle_limit_low = 0;   ///< 0.1 deg, read only while angle_limit_on
+  int64_t angle_limit_high = 0;  ///< 0.1 deg, read only while angle_limit_on
+  bool limits_known = false;     ///< `limits` read (readServoIdentity with `with_limits`)
+  ServoLimits limits;            ///< the protection limits, as the health poll reads them
 };
 
 /// What every configured servo should be; 0 is not checked (~servo_bus/expected_type,

@@ -2,8 +2,9 @@
 // servo that stops answering, and the health poll (voltage, current, power, temperature, status;
 // the servo's own limits read once when it first answers) with ~servo_bus/protect, which relaxes
 // a servo at its temperature limit, and the identity read (servo_identity.h: type, firmware,
-// serial, response_switch, angle limits), once per servo when it first answers. Every read is background work on the bus: it takes the bus
-// only while no caller waits for it, so a caller still waits for one transaction at most. ROS-free.
+// serial, response_switch, angle limits), once per servo when it first answers. Every read is
+// background work on the bus: it takes the bus only while no caller waits for it, so a caller still
+// waits for one transaction at most. ROS-free.
 //
 // Threading: the schedules are changed by the bus's worker thread (pollOnce) and by retune; they
 // are guarded by the bus's one mutex (given at construction), which the methods named ...Locked
