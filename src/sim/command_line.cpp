@@ -289,6 +289,17 @@ const std::vector<Flag>& flags() {
       heldValue(
           "--servo-voltage", "ID:MV", "hold a bus servo's voltage at MV (repeatable)",
           [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.voltage_mv; }),
+      heldValue(
+          "--servo-type", "ID:TYPE", "a bus servo's servo_type (repeatable; 257)",
+          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.servo_type; }),
+      heldValue("--servo-firmware", "ID:VERSION",
+                "a bus servo's firmware_version (repeatable; 258)",
+                [](SimOptions& o) -> std::map<uint8_t, int64_t>& {
+                  return o.servo_bus.firmware_version;
+                }),
+      heldValue(
+          "--servo-response-switch", "ID:0|1", "a bus servo's response_switch (repeatable; 0)",
+          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.response_switch; }),
       Flag{"--servo-latency-ms", "MS", "servo bus answer latency",
            [](const std::string& value, SimOptions& o) {
              double ms = 0;

@@ -39,14 +39,18 @@ inline bool waitFor(const std::function<bool()>& condition) {
 class ServoBusTest : public ::testing::Test {
  protected:
   /// A bus polling `polled_ids` at 10 Hz (every 100 ms) on the manual clock, without the health
-  /// poll (these tests count the frames of the moves and the angle polls).
-  void makeBus(std::vector<uint8_t> polled_ids) {
+  /// poll and the identity read (these tests count the frames of the moves and the angle polls)
+  /// unless `configure` turns them on.
+  void makeBus(std::vector<uint8_t> polled_ids,
+               const std::function<void(ServoBusConfig&)>& configure = {}) {
     ServoBusConfig config;
     config.health_rate = 0.0;
+    config.read_identity = false;
     config.client.timeout = std::chrono::milliseconds(5);  // a silent servo costs 5 ms of real time
     config.client.retries = 0;
     config.polled_ids = std::move(polled_ids);
     config.poll_rate = 10.0;
+    if (configure) configure(config);
     ServoBusEvents events;
     events.on_angle = [this](const ServoAngleSample& sample) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -64,6 +68,10 @@ class ServoBusTest : public ::testing::Test {
     events.on_stop = [this](uint8_t id, const ServoStatus& status) {
       std::lock_guard<std::mutex> lock(mutex_);
       stop_events_.push_back({id, status});
+    };
+    events.on_identity = [this](const ServoIdentityReport& report) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      identities_.push_back(report);
     };
     bus_ = std::make_unique<ServoBus>(
         config, [this](const Bytes& frame) { return write(frame); }, events, clock_);
@@ -143,6 +151,7 @@ class ServoBusTest : public ::testing::Test {
   std::vector<std::pair<uint8_t, std::chrono::milliseconds>> silent_;
   std::vector<std::pair<uint8_t, ServoError>> failed_moves_;
   std::vector<std::pair<uint8_t, ServoStatus>> stop_events_;
+  std::vector<ServoIdentityReport> identities_;          // on_identity reports
   std::map<Bytes, std::deque<Bytes>> scripted_answers_;  // before answers_, used up in order
   bool port_down_ = false;                               // guarded by mutex_
   std::unique_ptr<ServoBus> bus_;

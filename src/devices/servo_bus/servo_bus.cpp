@@ -263,5 +263,6 @@ std::vector<uint8_t> ServoBus::movingIds() const { return safety_.movingIds(); }
 std::vector<uint8_t> ServoBus::commandedIds() const { return safety_.commandedIds(); }
 std::vector<PendingStopReport> ServoBus::pendingStops() const { return stops_.reports(); }
 std::vector<ServoHealthReport> ServoBus::health() const { return poller_.health(); }
+std::vector<ServoIdentityReport> ServoBus::identities() const { return poller_.identities(); }
 
 }  // namespace serial_robot_driver::device

@@ -78,6 +78,9 @@ void addParameters(std::vector<params::ParamSpec>& table) {
       });
   bus.add("health_rate", &C::health_rate, params::numberWithin(0.0, 10.0, "Hz (0: off)"))
       .add("protect", &C::protect);
+  own.add("expected_type", &S::expected_type, params::integerWithin(0, 65535, "(0: not checked)"))
+      .add("expected_firmware", &S::expected_firmware,
+           params::integerWithin(0, 65535, "(0: not checked)"));
 }
 
 void validate(const DriverParams& p) {

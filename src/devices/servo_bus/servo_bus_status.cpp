@@ -54,6 +54,22 @@ StatusReport servoHealthStatus(uint8_t id, double health_rate, const ServoHealth
   return status;
 }
 
+void addServoIdentity(const ServoIdentityReport* found, StatusReport* status) {
+  if (!found || !found->known) {
+    status->add("identity", "not read yet (read once the servo answers)");
+    return;
+  }
+  const ServoIdentity& identity = found->identity;
+  status->add("servo_type", identity.servo_type);
+  status->add("firmware_version", identity.firmware_version);
+  status->add("serial_number", identity.serial_number);
+  status->add("response_switch", static_cast<int>(identity.response_switch));
+  status->add("angle limits", describeAngleLimits(identity));
+  for (const std::string& warning : found->warnings) {
+    status->mergeSummary(StatusLevel::kWarn, warning);
+  }
+}
+
 StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
                                     std::chrono::steady_clock::time_point now) {
   StatusReport status;

@@ -32,12 +32,14 @@ ServoPoller::ServoPoller(const std::vector<uint8_t>& ids, const ServoBusConfig& 
       clock_(clock),
       mutex_(mutex),
       hooks_(std::move(hooks)),
-      poll_period_(periodOf(settings.poll_rate)) {
+      poll_period_(periodOf(settings.poll_rate)),
+      read_identity_(settings.read_identity) {
   const Clock::time_point now = clock_.now();
   for (uint8_t id : ids) {
     PolledServo servo;
     servo.id = id;
     servo.next_poll = now;
+    servo.identity.id = id;
     polled_.push_back(servo);
   }
   // Every polled servo has a health entry, so a health_rate turned on at runtime finds them.
@@ -52,12 +54,22 @@ ServoPoller::ServoPoller(const std::vector<uint8_t>& ids, const ServoBusConfig& 
 
 Clock::time_point ServoPoller::nextPollLocked() const {
   Clock::time_point next = nextHealthPollLocked();
-  for (const PolledServo& servo : polled_) next = std::min(next, servo.next_poll);
+  for (const PolledServo& servo : polled_) {
+    next = std::min({next, servo.next_poll, servo.identity_due});
+  }
   return next;
 }
 
 void ServoPoller::pollDue(std::unique_lock<std::mutex>& lock) {
   const Clock::time_point now = clock_.now();
+  // A servo's identity first: read once, before its readings are judged.
+  if (auto identity_due = identityDueLocked(now); identity_due != polled_.end()) {
+    PolledServo& servo = *identity_due;
+    lock.unlock();
+    readIdentityOnce(servo);  // the schedule is only changed by this thread
+    lock.lock();
+    return;
+  }
   // Health polls are background work of a second kind, due at their own (lower) rate.
   if (nextHealthPollLocked() <= now) {
     const auto first = std::min_element(
@@ -134,6 +146,9 @@ void ServoPoller::pollAngleOnce(PolledServo& servo) {
       servo.next_poll = now + servo.backoff;
     } else {
       servo.backoff = std::chrono::milliseconds(0);
+      // It answers: its identity is read once, as soon as the bus has time for it.
+      if (read_identity_ && !servo.identity.known && servo.identity_due == Clock::time_point::max())
+        servo.identity_due = now;
       // Keep the rate without drifting; after a stall, start again from now.
       servo.next_poll = std::max(servo.next_poll + poll_period_, now);
       ++angles_polled_;
@@ -146,6 +161,55 @@ void ServoPoller::pollAngleOnce(PolledServo& servo) {
     return;
   }
   if (events_.on_angle) events_.on_angle(sample);
+}
+
+std::vector<ServoPoller::PolledServo>::iterator ServoPoller::identityDueLocked(
+    Clock::time_point now) {
+  auto due = std::min_element(
+      polled_.begin(), polled_.end(),
+      [](const PolledServo& a, const PolledServo& b) { return a.identity_due < b.identity_due; });
+  return due != polled_.end() && due->identity_due <= now ? due : polled_.end();
+}
+
+void ServoPoller::readIdentityOnce(PolledServo& servo) {
+  ServoIdentity identity;
+  // Background work: a service or a stop never waits for more than one of these reads. The
+  // protection limits are the health poll's to read.
+  const ServoStatus status =
+      readServoIdentity(client_, servo.id, BusPriority::kBackground, false, &identity);
+  // Shutting down, or a stop went first: due again as it was.
+  if (status.error == ServoError::kShutdown || status.error == ServoError::kPreempted) return;
+  ServoIdentityReport report;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Clock::time_point now = clock_.now();
+    if (status.error == ServoError::kNotConnected) {
+      servo.identity_due = now + kPortDownRetry;  // the port, not the servo
+      return;
+    }
+    if (!status.ok()) {
+      // Silent or garbled: asked again later, quietly (the angle poll reports a silent servo).
+      servo.identity_backoff = servo.identity_backoff.count() == 0
+                                   ? kFirstBackoff
+                                   : std::min(servo.identity_backoff * 2, kMaxBackoff);
+      servo.identity_due = now + servo.identity_backoff;
+      return;
+    }
+    servo.identity.known = true;
+    servo.identity.identity = identity;
+    servo.identity.warnings = identityWarnings(servo.id, identity, settings_.identity);
+    servo.identity_due = Clock::time_point::max();  // read once
+    report = servo.identity;
+  }
+  if (events_.on_identity) events_.on_identity(report);
+}
+
+std::vector<ServoIdentityReport> ServoPoller::identities() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<ServoIdentityReport> reports;
+  if (!read_identity_) return reports;
+  for (const PolledServo& servo : polled_) reports.push_back(servo.identity);
+  return reports;
 }
 
 Clock::time_point ServoPoller::nextHealthPollLocked() const {

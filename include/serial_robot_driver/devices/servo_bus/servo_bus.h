@@ -125,6 +125,9 @@ class ServoBus : public LinkListener, public LinkWorker {
   uint64_t motionRefusedAtWrite() const { return safety_.refusedAtWrite(); }
   /// One report per polled servo (empty when health_rate is 0).
   std::vector<ServoHealthReport> health() const;
+  /// One report per polled servo: its identity once read (empty when config().read_identity is
+  /// off).
+  std::vector<ServoIdentityReport> identities() const;
 
   /// Before start(): the worker runs on `link`'s reader thread (see the threading model), which
   /// the bus listens to. `link` must use the steady clock's time (no LoopClock of a test) and be

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/devices/servo_bus/servo_identity.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
 namespace serial_robot_driver::device {
@@ -30,6 +31,11 @@ struct ServoBusConfig {
   /// A servo at its own temperature limit is relaxed and its moves refused until it has cooled
   /// OverheatGuard::kCoolDownC below it.
   bool protect = false;
+  /// Each polled servo's identity and settings are read once when it first answers (background
+  /// work) and checked against `identity`. Off only where a test counts every frame the poll
+  /// writes.
+  bool read_identity = true;
+  ServoIdentityChecks identity;
 };
 
 }  // namespace serial_robot_driver::device

@@ -10,6 +10,7 @@
 
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/servo_health.h"
+#include "serial_robot_driver/devices/servo_bus/servo_identity.h"
 #include "serial_robot_driver/devices/servo_bus/servo_move.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
@@ -47,6 +48,9 @@ struct ServoBusEvents {
   /// A stop of servo `id`: ok once the servo is seen at rest after it; an error when an attempt
   /// failed (it is retried) or, at shutdown, when it could not be confirmed in time.
   std::function<void(uint8_t id, const ServoStatus& status)> on_stop;
+  /// A polled servo's identity was read (once per servo, when it first answered); its warnings
+  /// say what does not fit the configuration.
+  std::function<void(const ServoIdentityReport& report)> on_identity;
 };
 
 /// A stop not yet known to have reached its servo.

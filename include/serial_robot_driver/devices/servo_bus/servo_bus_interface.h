@@ -25,6 +25,7 @@
 
 #include "serial_robot_driver/ServoDamping.h"
 #include "serial_robot_driver/ServoHold.h"
+#include "serial_robot_driver/ServoInfo.h"
 #include "serial_robot_driver/ServoMove.h"
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/ServoRead.h"

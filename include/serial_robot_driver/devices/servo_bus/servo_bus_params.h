@@ -35,6 +35,10 @@ struct ServoBusParams : DevicePortParams {
   int relax_power_mw = device::ServoBusConfig{}.relax_power_mw;  ///< mW
   std::string on_shutdown =
       device::toString(device::ServoBusConfig{}.on_shutdown);  ///< stop | relax | none
+  // What every configured servo should report (0: not checked); kept as written, as an int could
+  // hold a bad value the core's uint16_t could not.
+  int expected_type = 0;
+  int expected_firmware = 0;
 
   /// `timeout` as the bus keeps it: whole milliseconds, rounded.
   std::chrono::milliseconds timeoutMs() const {

@@ -31,6 +31,13 @@ struct ServoBusSimConfig {
   /// Servos whose temperature (degC) or voltage (mV) is held at a value instead of drifting.
   std::map<uint8_t, int64_t> temperature_c;
   std::map<uint8_t, int64_t> voltage_mv;
+  /// A servo's identity and response_switch where they differ from every other's (servo_type
+  /// 257, firmware_version 258, serial_number 0x53520000 + id, response_switch 0): another model,
+  /// another firmware, or motions queued and answered (response_switch 1).
+  std::map<uint8_t, int64_t> servo_type;
+  std::map<uint8_t, int64_t> firmware_version;
+  std::map<uint8_t, int64_t> serial_number;
+  std::map<uint8_t, int64_t> response_switch;
   double answer_latency_s = 0.0015;
   /// The next this many SPIN stops (mode 0) addressed to a servo never reach it, as if lost on
   /// the line: the driver must notice the servo still moves and stop it again.

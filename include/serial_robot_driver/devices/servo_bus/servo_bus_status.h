@@ -1,6 +1,7 @@
 // The servo bus's diagnostic statuses: "servo_bus" (transactions, the poll's asked vs achieved
 // rate, the e-stop's lock and the stops not yet confirmed) and "servo_bus servo <id>", one per
-// polled servo (its health against its own limits).
+// polled servo (its health against its own limits, its identity and the settings the driver
+// depends on).
 #pragma once
 
 #include <chrono>
@@ -19,6 +20,10 @@ namespace serial_robot_driver::device {
 /// polled yet): its readings and limits, WARN within 10 % of a limit, ERROR beyond it, when it
 /// does not answer or when ~servo_bus/protect relaxed it.
 StatusReport servoHealthStatus(uint8_t id, double health_rate, const ServoHealthReport* report);
+/// Adds servo's identity to its status: servo_type, firmware_version, serial_number,
+/// response_switch and angle limits, and a WARN naming each setting that does not fit the
+/// configuration (identityWarnings). Null or not known yet: "not read yet".
+void addServoIdentity(const ServoIdentityReport* identity, StatusReport* status);
 
 /// What the "servo_bus" status is made of, read from the bus at one diagnostics update.
 struct ServoBusSnapshot {

@@ -1,8 +1,10 @@
 // A device::ServoBus's polls: the scheduled angle poll (servo_states), with the back-off of a
 // servo that stops answering, and the health poll (voltage, current, power, temperature, status;
 // the servo's own limits read once when it first answers) with ~servo_bus/protect, which relaxes
-// a servo at its temperature limit. Every read is background work on the bus: it takes the bus
-// only while no caller waits for it, so a caller still waits for one transaction at most. ROS-free.
+// a servo at its temperature limit, and the identity read (servo_identity.h: type, firmware,
+// serial, response_switch, angle limits), once per servo when it first answers. Every read is
+// background work on the bus: it takes the bus only while no caller waits for it, so a caller still
+// waits for one transaction at most. ROS-free.
 //
 // Threading: the schedules are changed by the bus's worker thread (pollOnce) and by retune; they
 // are guarded by the bus's one mutex (given at construction), which the methods named ...Locked
@@ -56,6 +58,8 @@ class ServoPoller {
 
   /// One report per polled servo (empty when health_rate is 0).
   std::vector<ServoHealthReport> health() const;
+  /// One report per polled servo (known once read; empty when settings.read_identity is off).
+  std::vector<ServoIdentityReport> identities() const;
   /// The report of `id` while protect keeps it relaxed; nullptr otherwise.
   const ServoHealthReport* overheatedLocked(uint8_t id) const;
   /// angles_polled, offline_ids and asked_poll_rate into `stats`.
@@ -67,6 +71,11 @@ class ServoPoller {
     uint8_t id = 0;
     Clock::time_point next_poll;
     std::chrono::milliseconds backoff{0};  ///< 0: online
+    /// Its identity: due once it answered the angle poll (max: not due), read once; after a
+    /// failed read due again after a back-off of its own, doubling like the angle poll's.
+    ServoIdentityReport identity;
+    Clock::time_point identity_due = Clock::time_point::max();
+    std::chrono::milliseconds identity_backoff{0};
   };
   /// Its health: one entry per polled servo, changed by the worker only (read under the mutex).
   struct HealthServo {
@@ -79,6 +88,9 @@ class ServoPoller {
   Clock::time_point nextHealthPollLocked() const;
   void pollAngleOnce(PolledServo& servo);
   void pollHealthOnce(std::size_t index);
+  /// The polled servo whose identity read is due first, or polled_.end().
+  std::vector<PolledServo>::iterator identityDueLocked(Clock::time_point now);
+  void readIdentityOnce(PolledServo& servo);
   /// Reads `names` in order into `values`; the first failure.
   ServoStatus readHealthParams(uint8_t id, const std::vector<const char*>& names,
                                std::vector<int64_t>* values);
@@ -94,6 +106,7 @@ class ServoPoller {
   std::vector<HealthServo> health_;  // one per polled servo; polled while health_period_ > 0
   Clock::duration health_period_{0};
   uint64_t angles_polled_ = 0;
+  const bool read_identity_;
 };
 
 }  // namespace serial_robot_driver::device

@@ -28,6 +28,12 @@ void ServoBusInterface::diagnoseServo(uint8_t id,
     if (report.id == id) found = &report;
   }
   device::StatusReport report = device::servoHealthStatus(id, health_rate, found);
+  const std::vector<device::ServoIdentityReport> identities = bus_.identities();
+  const device::ServoIdentityReport* identity = nullptr;
+  for (const device::ServoIdentityReport& candidate : identities) {
+    if (candidate.id == id) identity = &candidate;
+  }
+  device::addServoIdentity(identity, &report);
   report.hardware_id = link_.options().path;
   writeStatusReport(report, status);
 }

@@ -43,6 +43,12 @@ device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
   config.relax_power_mw = static_cast<uint16_t>(params.servo_bus.relax_power_mw);
   config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
                            .value_or(device::ShutdownAction::kStop);
+  // validate() accepted only 0..65535.
+  config.identity.expected_type = static_cast<uint16_t>(params.servo_bus.expected_type);
+  config.identity.expected_firmware = static_cast<uint16_t>(params.servo_bus.expected_firmware);
+  for (int id : params.servo_bus.joint_ids) {
+    config.identity.joint_ids.push_back(static_cast<uint8_t>(id));
+  }
   return config;
 }
 
@@ -73,6 +79,13 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
       ROS_INFO("servo_bus: %s has cooled to %ld degC: its moves are obeyed again",
                servoJointName(report.id).c_str(), static_cast<long>(report.readings.temperature_c));
     }
+  };
+  // Once per servo, when it first answered: what it is, and what does not fit (once each).
+  events.on_identity = [](const device::ServoIdentityReport& report) {
+    ROS_INFO("servo_bus: %s: %s, angle limits %s", servoJointName(report.id).c_str(),
+             device::describeIdentity(report.identity).c_str(),
+             device::describeAngleLimits(report.identity).c_str());
+    for (const std::string& warning : report.warnings) ROS_WARN("servo_bus: %s", warning.c_str());
   };
   events.on_move_failed = [](const device::MoveRequest& move, const device::ServoStatus& status) {
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands: %s not sent: %s",

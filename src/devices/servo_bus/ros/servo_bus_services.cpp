@@ -200,6 +200,18 @@ void ServoBusInterface::advertiseServices() {
                                      }
                                      return status;
                                    }),
+      // Reads only: allowed while the e-stop holds.
+      advertiseServo<ServoInfo>(nh_, "servo/info",
+                                [this](ServoInfo::Request& req, ServoInfo::Response& res) {
+                                  device::ServoIdentity identity;
+                                  const device::ServoStatus status = device::readServoInfo(
+                                      client_, req.id, bus_.config().identity, &identity);
+                                  res.servo_type = identity.servo_type;
+                                  res.firmware_version = identity.firmware_version;
+                                  res.serial_number = identity.serial_number;
+                                  res.response_switch = identity.response_switch;
+                                  return status;
+                                }),
       advertiseServo<ServoResetUserData>(
           nh_, "servo/reset_user_data",
           [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {

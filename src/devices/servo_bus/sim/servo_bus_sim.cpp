@@ -104,6 +104,14 @@ ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
     if (auto held = config_.voltage_mv.find(id); held != config_.voltage_mv.end()) {
       s.params[kVoltage] = held->second;
     }
+    // Its identity and response_switch where the configuration gives them (after the factory
+    // user block, which holds response_switch).
+    for (const auto& [data_id, values] : {std::pair{kServoType, &config_.servo_type},
+                                          {kFirmwareVersion, &config_.firmware_version},
+                                          {kSerialNumber, &config_.serial_number},
+                                          {kResponseSwitch, &config_.response_switch}}) {
+      if (auto given = values->find(id); given != values->end()) s.params[data_id] = given->second;
+    }
     servos_.push_back(std::move(s));
   }
 }
