@@ -207,6 +207,25 @@ TEST(ConversionsImu, AxisMapRemapsVectorsAndTurnsTheOrientation) {
   EXPECT_NEAR(msg.orientation.w, 0.0, 1e-9);
 }
 
+// The gyro bias is raw (LSB, sensor axes): subtracted before the scale and the axis map, so a new
+// gyro_scale scales it too. Golden gyro (0, 0, 100) minus (4, -2, 10) = (-4, 2, 90) LSB.
+TEST(ConversionsImu, GyroBiasIsSubtractedInRawUnitsBeforeTheScaleAndTheAxisMap) {
+  ImuParams params;
+  params.gyro_scale = 0.25;
+  params.axis_map = {"-y", "x", "z"};
+  const std::array<double, 3> bias{4, -2, 10};
+  sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time(), bias);
+  EXPECT_DOUBLE_EQ(msg.angular_velocity.x, -0.5);  // -(2 * 0.25)
+  EXPECT_DOUBLE_EQ(msg.angular_velocity.y, -1.0);  // -4 * 0.25
+  EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 22.5);  // 90 * 0.25
+  params.gyro_scale = 0.5;
+  msg = toImu(goldenTelemetry(), params, ros::Time(), bias);
+  EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 45.0);
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.z,
+                   toImu(goldenTelemetry(), params, ros::Time()).linear_acceleration.z)
+      << "the accelerometer is left alone";
+}
+
 TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
   ImuParams params;
   params.accel_scale = 1.0;

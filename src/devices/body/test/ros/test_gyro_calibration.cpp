@@ -83,6 +83,10 @@ struct Robot {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   }
+  /// Waits until the simulated wheels turn (the node obeys the cmd_vel being published).
+  bool waitMoving() {
+    return waitFor([&] { return robot->stats().base.last_left_speed != 0; }, 10);
+  }
   /// Waits until the simulated wheels stand still and the node's cmd_vel timeout has passed.
   bool waitStill() {
     const bool still = waitFor(
@@ -152,10 +156,11 @@ TEST_F(GyroCalibrationTest, CalibrateRemovesTheBiasAndRefusesWhenTheRobotIsNotSt
   std::thread driver([&] {
     while (driving) robot.drive(0.1);
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const bool moved = robot.waitMoving();
   std_srvs::Trigger::Response response = robot.calibrate();
   driving = false;
   driver.join();
+  ASSERT_TRUE(moved) << "the simulated base never drove";
   EXPECT_FALSE(response.success);
   EXPECT_TRUE(contains(response.message, "not held still (base: cmd_vel of 0.1 m/s, 0.3 rad/s"))
       << response.message;
@@ -164,7 +169,7 @@ TEST_F(GyroCalibrationTest, CalibrateRemovesTheBiasAndRefusesWhenTheRobotIsNotSt
 
   // The base starts driving during the averaging: refused.
   std::thread late_driver([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // of 2 s of averaging
     robot.drive(0.5);
   });
   response = robot.calibrate();
@@ -203,10 +208,11 @@ TEST_F(GyroCalibrationTest, CalibrateRemovesTheBiasAndRefusesWhenTheRobotIsNotSt
   std::thread driver_again([&] {
     while (driving_again) robot.drive(0.1);
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const bool moved_again = robot.waitMoving();
   response = robot.calibrate();
   driving_again = false;
   driver_again.join();
+  ASSERT_TRUE(moved_again) << "the simulated base never drove";
   EXPECT_FALSE(response.success);
   EXPECT_TRUE(contains(response.message, "unchanged: (0.02")) << response.message;
   ASSERT_TRUE(robot.waitStill());
