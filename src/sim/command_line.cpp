@@ -290,15 +290,16 @@ const std::vector<Flag>& flags() {
           "--servo-voltage", "ID:MV", "hold a bus servo's voltage at MV (repeatable)",
           [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.voltage_mv; }),
       heldValue(
-          "--servo-type", "ID:TYPE", "a bus servo's servo_type (repeatable; 257)",
+          "--servo-type", "ID:TYPE", "a bus servo's servo_type (repeatable; otherwise 257)",
           [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.servo_type; }),
       heldValue("--servo-firmware", "ID:VERSION",
-                "a bus servo's firmware_version (repeatable; 258)",
+                "a bus servo's firmware_version (repeatable; otherwise 258)",
                 [](SimOptions& o) -> std::map<uint8_t, int64_t>& {
                   return o.servo_bus.firmware_version;
                 }),
       heldValue(
-          "--servo-response-switch", "ID:0|1", "a bus servo's response_switch (repeatable; 0)",
+          "--servo-response-switch", "ID:0|1",
+          "a bus servo's response_switch (repeatable; otherwise 0)",
           [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.response_switch; }),
       Flag{"--servo-latency-ms", "MS", "servo bus answer latency",
            [](const std::string& value, SimOptions& o) {

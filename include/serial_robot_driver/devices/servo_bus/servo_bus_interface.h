@@ -86,7 +86,8 @@ class ServoBusInterface : public DeviceInterface {
   /// services and servo_commands refused until it is released (reads, pings, scans still work).
   void attachEStop(device::EStop& e_stop) override;
   /// With ~servo_bus/health_rate > 0: "servo_bus servo <id>", one status per polled servo (its
-  /// readings against its own limits; an offline servo is an ERROR).
+  /// readings against its own limits; an offline servo is an ERROR; its identity, a WARN for each
+  /// setting that does not fit).
   void addDiagnostics(diagnostic_updater::Updater& updater) override;
 
  private:
