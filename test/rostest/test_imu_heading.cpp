@@ -16,6 +16,8 @@
 #include <string>
 #include <thread>
 
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -48,9 +50,9 @@ struct Robot {
       : odom(nh, "/" + ns + "/odom", 5), diagnostics(nh, ns + "/driver_node"), ns_(ns) {
     sim::SimOptions options;
     options.link = test_support::nodeParam("/" + ns + "/driver_node", "port");
-    options.enable_servo_bus = false;
-    options.base.turn_slip = kTurnSlip;
-    options.body.telemetry_rate_hz = telemetry_rate;
+    options.device("servo_bus").enabled = false;
+    baseConfig(options).turn_slip = kTurnSlip;
+    bodyConfig(options).telemetry_rate_hz = telemetry_rate;
     robot = std::make_unique<sim::RobotSim>(options);
     robot->start();
     cmd_vel = nh.advertise<geometry_msgs::Twist>("/" + ns + "/cmd_vel", 10);
@@ -76,7 +78,7 @@ struct Robot {
     // A few more odom ticks, and telemetry periods, so odom has integrated up to the stop.
     return still && odom.waitForCount(odom.count() + 10, 10);
   }
-  double trueYaw() const { return robot->stats().base.yaw_rad; }
+  double trueYaw() const { return baseStats(robot->stats()).yaw_rad; }
   double odomYaw() const { return yawOf(odom.last()->pose.pose.orientation); }
 
   std::unique_ptr<sim::RobotSim> robot;
