@@ -92,21 +92,29 @@ std::string capitalized(std::string text) {
 void addDeviceFlags(std::vector<Flag>* table) {
   for (const SimDeviceModule* module : registeredSimDevices()) {
     const std::string name = module->name;
-    table->push_back(section(capitalized(module->description) + " (" + name +
-                             (module->hosted_by_default ? "" : "; none unless asked for") + "):"));
-    table->push_back(Flag{linkFlag(*module), "PATH", module->link_help,
-                          [module](const std::string& value, SimOptions& o) {
-                            mention(o, *module).link = value;
-                            return std::string();
-                          },
-                          nullptr});
     const bool by_default = module->hosted_by_default;
-    table->push_back(Flag{(by_default ? "--no-" : "--") + flagName(name), "", module->toggle_help,
-                          [module, by_default](const std::string&, SimOptions& o) {
-                            mention(o, *module).enabled = !by_default;
-                            return std::string();
-                          },
-                          nullptr});
+    table->push_back(section(capitalized(module->description) + " (" + name +
+                             (by_default ? "" : "; not simulated unless asked for") + "):"));
+    Flag link{linkFlag(*module), "PATH", module->link_help,
+              [module](const std::string& value, SimOptions& o) {
+                mention(o, *module).link = value;
+                return std::string();
+              },
+              nullptr};
+    Flag toggle{(by_default ? "--no-" : "--") + flagName(name), "", module->toggle_help,
+                [module, by_default](const std::string&, SimOptions& o) {
+                  mention(o, *module).enabled = !by_default;
+                  return std::string();
+                },
+                nullptr};
+    // As --help always listed them: a default device's pty first, an optional device's switch.
+    if (by_default) {
+      table->push_back(std::move(link));
+      table->push_back(std::move(toggle));
+    } else {
+      table->push_back(std::move(toggle));
+      table->push_back(std::move(link));
+    }
     for (const SimDeviceOption& option : module->options) {
       Flag flag{optionFlag(*module, option), option.value_name, option.help, nullptr, nullptr};
       flag.apply = [module, option](const std::string& value, SimOptions& o) {
@@ -143,8 +151,8 @@ const std::vector<Flag>& flags() {
              section("Faults (seeded):"),
              whole(
                  "--seed", "N", "random seed", 0xFFFFFFFFu,
-                 [](SimOptions& o, uint64_t v) { o.faults.seed = static_cast<uint32_t>(v); },
-                 [](const SimOptions& o) { return std::to_string(o.faults.seed); }),
+                 [](SimOptions&o, uint64_t v) { o.faults.seed = static_cast<uint32_t>(v); },
+                 [](const SimOptions&o) { return std::to_string(o.faults.seed); }),
              nonNegative("--garbage-rate", "HZ", "random junk bursts per second and port",
                          &FaultOptions::garbage_rate_hz),
              probability("--corrupt-rate", "probability a sent frame has its checksum byte flipped",
@@ -195,7 +203,8 @@ std::string usage() {
   std::ostringstream out;
   std::string robot;  // what it simulates unless told otherwise
   for (const SimDeviceModule* module : registeredSimDevices()) {
-    if (module->hosted_by_default) robot += (robot.empty() ? "" : ", ") + std::string(module->description);
+    if (module->hosted_by_default)
+      robot += (robot.empty() ? "" : ", ") + std::string(module->description);
   }
   out << "usage: robot_sim [options]\n"
          "A simulated robot ("
@@ -268,7 +277,8 @@ CommandLine parseCommandLine(int argc, const char* const* argv) {
   const bool hosts_any = std::any_of(modules.begin(), modules.end(), [&](const SimDeviceModule* m) {
     return options.hosts(m->name);
   });
-  if (!result.help && !hosts_any) return fail(leaveOutFlags() + " together leave nothing to simulate");
+  if (!result.help && !hosts_any)
+    return fail(leaveOutFlags() + " together leave nothing to simulate");
   return result;
 }
 

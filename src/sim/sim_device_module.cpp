@@ -34,7 +34,8 @@ HostedDeviceOptions& SimOptions::device(const std::string& name) {
   const auto found = devices_.find(name);
   if (found != devices_.end()) return found->second;
   const SimDeviceModule* module = findSimDevice(name);
-  if (module == nullptr) throw std::invalid_argument("robot_sim: no registered device '" + name + "'");
+  if (module == nullptr)
+    throw std::invalid_argument("robot_sim: no registered device '" + name + "'");
   HostedDeviceOptions& made = devices_[name];
   made.name = name;
   made.enabled = module->hosted_by_default;

@@ -68,11 +68,10 @@ std::string applyWhole(const std::string& flag, const std::string& value, uint64
 }
 
 std::string applyIdList(const std::string& flag, const std::string& value, std::size_t max_count,
-                        std::vector<uint8_t>* ids) {
+                        const std::string& limit, std::vector<uint8_t>* ids) {
   if (!parseIdList(value, ids)) return badValue(flag, value) + " (comma-separated ids 0..254)";
   if (ids->size() > max_count) {
-    return "too many " + flag + " (at most " + std::to_string(max_count) +
-           " fit in a telemetry frame)";
+    return "too many " + flag + " (at most " + std::to_string(max_count) + " " + limit + ")";
   }
   return "";
 }
@@ -82,9 +81,8 @@ std::string applyHeldValue(const std::string& flag, const std::string& value,
   const std::size_t colon = value.find(':');
   std::vector<uint8_t> ids;
   double number = 0;
-  if (colon == std::string::npos || !parseIdList(value.substr(0, colon), &ids) ||
-      ids.size() != 1 || !parseDouble(value.substr(colon + 1), &number) || number < 0 ||
-      number > 65535) {
+  if (colon == std::string::npos || !parseIdList(value.substr(0, colon), &ids) || ids.size() != 1 ||
+      !parseDouble(value.substr(colon + 1), &number) || number < 0 || number > 65535) {
     return badValue(flag, value) + " (ID:VALUE, id 0..254, value 0..65535)";
   }
   (*values)[ids.front()] = static_cast<int64_t>(number);

@@ -5,7 +5,7 @@
 
 namespace serial_robot_driver::sim {
 
-const SendCounters& SimStats::sentOf(const OutputKind& kind) const {
+const SendCounters& SimStats::sentOf(const OutputKind& kind) const& {
   static const SendCounters kNeverSent{};
   for (const auto& [sent_kind, counters] : sent) {
     if (sent_kind == &kind) return counters;

@@ -136,10 +136,12 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   for (const auto& msg : malformed) commands.publish(msg);
   // A good command last: once it is on the wire, every malformed one before it was handled.
   commands.publish(command({"joint_2"}, {0.5}));
-  ASSERT_TRUE(waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= writes_before + 1; }, 20));
+  ASSERT_TRUE(
+      waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= writes_before + 1; }, 20));
   test_support::sleepSeconds(0.3);
   sim::SimStats stats = robot.stats();
-  EXPECT_EQ(bodyStats(stats).sync_writes_ok, writes_before + 1) << "a malformed command reached the wire";
+  EXPECT_EQ(bodyStats(stats).sync_writes_ok, writes_before + 1)
+      << "a malformed command reached the wire";
   EXPECT_EQ(bodyStats(stats).sync_writes_malformed + bodyStats(stats).port_checksum_errors, 0u);
   ASSERT_EQ(bodyStats(stats).servos.size(), 2u);
   EXPECT_EQ(bodyStats(stats).servos[1].target, std::lround(2048 + 0.5 * 4096 / kTwoPi));
@@ -160,7 +162,8 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   commands.publish(command({"joint_1"}, {1e9}));
   commands.publish(command({"joint_1"}, {-1e300}));
   commands.publish(command({"joint_1", "joint_2"}, {4.0, 0.25}));  // joint_2 alone goes out
-  ASSERT_TRUE(waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= writes_before + 2; }, 20));
+  ASSERT_TRUE(
+      waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= writes_before + 2; }, 20));
   test_support::sleepSeconds(0.3);
   EXPECT_EQ(bodyStats(robot.stats()).sync_writes_ok, writes_before + 2);
   EXPECT_EQ(bodyStats(robot.stats()).servos[0].target, joint_1_target);

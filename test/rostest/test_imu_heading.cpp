@@ -71,7 +71,7 @@ struct Robot {
   bool waitStill() {
     const bool still = waitFor(
         [&] {
-          const auto base = robot->stats().base;
+          const auto base = baseStats(robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10);
@@ -139,8 +139,8 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   ASSERT_TRUE(commanded_->waitStill());
   ASSERT_TRUE(fused_->resetOdometry());
   ASSERT_TRUE(commanded_->resetOdometry());
-  const sim::BaseSimStats fused_start = fused_->robot->stats().base;
-  const sim::BaseSimStats commanded_start = commanded_->robot->stats().base;
+  const sim::BaseSimStats fused_start = baseStats(fused_->robot->stats());
+  const sim::BaseSimStats commanded_start = baseStats(commanded_->robot->stats());
   const double fused_true0 = fused_start.yaw_rad;
   const double commanded_true0 = commanded_start.yaw_rad;
 
@@ -169,9 +169,9 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   // commanded pose curves off with the heading it believes.
   const auto fused_pose = fused_->odom.last()->pose;
   const double fused_position_error =
-      positionError(fused_start, fused_->robot->stats().base, fused_pose.pose.position);
+      positionError(fused_start, baseStats(fused_->robot->stats()), fused_pose.pose.position);
   const double commanded_position_error =
-      positionError(commanded_start, commanded_->robot->stats().base,
+      positionError(commanded_start, baseStats(commanded_->robot->stats()),
                     commanded_->odom.last()->pose.pose.position);
   std::printf("position error after the arc: with the IMU %.4f m, without %.4f m\n",
               fused_position_error, commanded_position_error);

@@ -10,16 +10,16 @@
 // fails cleanly, and after the replug it answers again.
 //
 // The machine may be busy (2 shared cores): the tests count frames and use generous deadlines.
+#include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <geometry_msgs/Twist.h>
-#include <gtest/gtest.h>
-#include <ros/ros.h>
-#include <sensor_msgs/JointState.h>
 
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/WheelCommand.h"
@@ -151,7 +151,8 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   const std::vector<WheelCommand> first = node.wheels.since(0);
   EXPECT_TRUE(first.front().reset_before) << "the first wheel frame must follow a Reset";
   for (std::size_t i = 1; i < first.size(); ++i) EXPECT_FALSE(first[i].reset_before) << i;
-  ASSERT_TRUE(waitFor([&] { return baseStats(robot.base->stats()).speed_frames_applied >= 5; }, 20));
+  ASSERT_TRUE(
+      waitFor([&] { return baseStats(robot.base->stats()).speed_frames_applied >= 5; }, 20));
   EXPECT_GE(baseStats(robot.base->stats()).resets, 1u);
   EXPECT_EQ(baseStats(robot.base->stats()).speed_frames_ignored, 0u);
 
@@ -163,7 +164,7 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   const bool driving = waitFor(
       [&] {
         node.driveForward(0.3);
-        const sim::BaseSimStats base = robot.base->stats().base;
+        const sim::BaseSimStats base = baseStats(robot.base->stats());
         return std::abs(base.last_left_speed - expected_ticks) <= 1 &&
                std::abs(base.last_right_speed - expected_ticks) <= 1;
       },
@@ -175,7 +176,7 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   node.commandJoints({"joint_1", "joint_2"}, {0.25, -0.25});
   ASSERT_TRUE(waitFor([&] { return bodyStats(robot.body->stats()).sync_writes_ok >= 1; }, 20))
       << "the joint command never reached the simulated board";
-  const sim::BodySimStats body = robot.body->stats().body;
+  const sim::BodySimStats body = bodyStats(robot.body->stats());
   ASSERT_EQ(body.servos.size(), 2u);
   EXPECT_EQ(body.servos[0].target, ticksFor(0.25));
   EXPECT_EQ(body.servos[1].target, ticksFor(-0.25));
@@ -267,10 +268,8 @@ TEST_F(MultiPortTest, EachDeviceOnItsOwnPortAndServoBusUnplugAlone) {
   const sim::SimStats outage = robot.base->stats();
   const uint64_t wheels_during = node.wheels.count() - wheels_before;
   const uint64_t joints_during = node.joints.count() - joints_before;
-  const uint64_t telemetry_sent = outage.sentOf(sim::kTelemetryOutput)
-                                      .intact -
-                                  before.sentOf(sim::kTelemetryOutput)
-                                      .intact;
+  const uint64_t telemetry_sent =
+      outage.sentOf(sim::kTelemetryOutput).intact - before.sentOf(sim::kTelemetryOutput).intact;
   std::printf("servo bus unplugged: %llu wheel frames, %llu joint_states (simulator sent %llu "
               "telemetry frames)\n",
               static_cast<unsigned long long>(wheels_during),

@@ -68,7 +68,7 @@ class OdomTest : public ::testing::Test {
   void waitStill() {
     ASSERT_TRUE(waitFor(
         [] {
-          const auto base = g_robot->stats().base;
+          const auto base = baseStats(g_robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10));
@@ -92,12 +92,12 @@ class OdomTest : public ::testing::Test {
 
 TEST_F(OdomTest, PoseAfterADriveMatchesTheFramesTheBaseApplied) {
   waitStill();
-  const sim::BaseSimStats start = g_robot->stats().base;
+  const sim::BaseSimStats start = baseStats(g_robot->stats());
   const auto before = odom_.last();
   ASSERT_TRUE(before.has_value());
 
   drive(0.3, 0.3, 3.0);  // an arc: about 0.9 m and 0.9 rad
-  const sim::BaseSimStats end = g_robot->stats().base;
+  const sim::BaseSimStats end = baseStats(g_robot->stats());
   const auto after = odom_.last();
   ASSERT_TRUE(after.has_value());
 
@@ -177,7 +177,7 @@ TEST_F(OdomTest, LatchedEStopHoldsTheBaseUntilReleased) {
   for (int i = 0; i < 20; ++i) {  // 1 s of cmd_vel that must be ignored
     cmd_vel_.publish(twist);
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    const auto base = g_robot->stats().base;
+    const auto base = baseStats(g_robot->stats());
     ASSERT_EQ(base.last_left_speed, 0);
     ASSERT_EQ(base.last_right_speed, 0);
   }

@@ -50,7 +50,7 @@ std::unique_ptr<sim::RobotSim> makeBus(const std::string& port,
   sim::SimOptions options;
   options.device("base").enabled = false;
   options.device("body").enabled = false;
-  options.servo_bus = bus;
+  servoBusConfig(options) = bus;
   servoBusConfig(options).servo_ids = {0, 1, 2, 3};
   options.device("servo_bus").link = port;
   auto robot = std::make_unique<sim::RobotSim>(options);

@@ -183,16 +183,17 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   const double window_s = close.uptime_s - open.uptime_s;
   const uint64_t speed_frames = speedFramesReceived(close) - speedFramesReceived(open);
   const double expected_frames = window_s * kBaseLoopRateHz;
-  std::printf("base: window %.1f s, %llu speed frames received by the simulator (%.0f at %.0f Hz), "
-              "%llu resets, %llu FF errors sent, %llu heartbeat timeouts, %llu SEQ gaps; node: "
-              "loop overruns %s, worst loop period %s ms\n",
-              window_s, static_cast<unsigned long long>(speed_frames), expected_frames,
-              kBaseLoopRateHz, static_cast<unsigned long long>(baseStats(close).resets),
-              static_cast<unsigned long long>(baseStats(close).errors_sent),
-              static_cast<unsigned long long>(baseStats(close).timeouts),
-              static_cast<unsigned long long>(baseStats(close).seq_gaps),
-              base_status.value("loop overruns").c_str(),
-              base_status.value("worst loop period (ms)").c_str());
+  std::printf(
+      "base: window %.1f s, %llu speed frames received by the simulator (%.0f at %.0f Hz), "
+      "%llu resets, %llu FF errors sent, %llu heartbeat timeouts, %llu SEQ gaps; node: "
+      "loop overruns %s, worst loop period %s ms\n",
+      window_s, static_cast<unsigned long long>(speed_frames), expected_frames, kBaseLoopRateHz,
+      static_cast<unsigned long long>(baseStats(close).resets),
+      static_cast<unsigned long long>(baseStats(close).errors_sent),
+      static_cast<unsigned long long>(baseStats(close).timeouts),
+      static_cast<unsigned long long>(baseStats(close).seq_gaps),
+      base_status.value("loop overruns").c_str(),
+      base_status.value("worst loop period (ms)").c_str());
   EXPECT_EQ(baseStats(close).errors_sent, 0u) << "the base's heartbeat expired";
   EXPECT_EQ(baseStats(close).timeouts, 0u);
   EXPECT_EQ(baseStats(close).resets, 1u) << "a Reset after the first: the node saw its own 1 s gap";
@@ -209,8 +210,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   const int64_t received_total = static_cast<int64_t>(joints_close);
   const int64_t unread_bytes = static_cast<int64_t>(close.bytes_sent) -
                                static_cast<int64_t>(port_final->number("bytes in"));
-  const auto& telemetry_counters =
-      close.sentOf(sim::kTelemetryOutput);
+  const auto& telemetry_counters = close.sentOf(sim::kTelemetryOutput);
   std::printf("telemetry: window: %lld frames sent intact, %lld joint_states received (in flight "
               "at the opening: %lld); whole run: %lld sent, %lld received, %lld lost, %lld bytes "
               "never read by the node; discarded by the simulator %llu\n",
@@ -234,13 +234,13 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   EXPECT_EQ(body_status.number("decode errors"), 0u);
 
   // --- joint commands and the host -> robot direction ---
-  std::printf("joint commands: %llu published, %llu sync-writes applied by the board; cmd_vel: "
-              "%llu published; host frames: %s out, checksum errors at the simulator %llu\n",
-              static_cast<unsigned long long>(joint_commands),
-              static_cast<unsigned long long>(bodyStats(close).sync_writes_ok),
-              static_cast<unsigned long long>(motion.cmdVelSent()),
-              port_final->value("frames out").c_str(),
-              static_cast<unsigned long long>(close.framer.checksum_errors));
+  std::printf(
+      "joint commands: %llu published, %llu sync-writes applied by the board; cmd_vel: "
+      "%llu published; host frames: %s out, checksum errors at the simulator %llu\n",
+      static_cast<unsigned long long>(joint_commands),
+      static_cast<unsigned long long>(bodyStats(close).sync_writes_ok),
+      static_cast<unsigned long long>(motion.cmdVelSent()), port_final->value("frames out").c_str(),
+      static_cast<unsigned long long>(close.framer.checksum_errors));
   EXPECT_EQ(bodyStats(close).sync_writes_ok, joint_commands);
   EXPECT_EQ(close.framer.checksum_errors, 0u);
   EXPECT_EQ(close.framer.bad_lengths, 0u);

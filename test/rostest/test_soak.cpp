@@ -217,16 +217,18 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   // After every reconnect the Reset came before the first speed frame: the base, in its heartbeat
   // error state after each unplug, never had to ignore a speed frame.
   EXPECT_EQ(baseStats(last.sim).speed_frames_ignored, 0u);
-  EXPECT_GE(baseStats(last.sim).timeouts, last.unplugs - 1);  // every unplug outlasted the heartbeat
+  EXPECT_GE(baseStats(last.sim).timeouts,
+            last.unplugs - 1);  // every unplug outlasted the heartbeat
   EXPECT_GT(baseStats(last.sim).speed_frames_applied, 0u);
   EXPECT_LE(baseStats(last.sim).speed_frames_applied, wheels.count());
-  std::printf("base: %llu wheel frames published, %llu applied by the base, %llu resets received, "
-              "%llu heartbeat timeouts, %llu battery requests\n",
-              static_cast<unsigned long long>(wheels.count()),
-              static_cast<unsigned long long>(baseStats(last.sim).speed_frames_applied),
-              static_cast<unsigned long long>(baseStats(last.sim).resets),
-              static_cast<unsigned long long>(baseStats(last.sim).timeouts),
-              static_cast<unsigned long long>(baseStats(last.sim).battery_requests));
+  std::printf(
+      "base: %llu wheel frames published, %llu applied by the base, %llu resets received, "
+      "%llu heartbeat timeouts, %llu battery requests\n",
+      static_cast<unsigned long long>(wheels.count()),
+      static_cast<unsigned long long>(baseStats(last.sim).speed_frames_applied),
+      static_cast<unsigned long long>(baseStats(last.sim).resets),
+      static_cast<unsigned long long>(baseStats(last.sim).timeouts),
+      static_cast<unsigned long long>(baseStats(last.sim).battery_requests));
 
   // Every joint command is accounted for by the node (diagnostics once a second).
   const uint64_t commands = motion.jointCommandsSent();
@@ -240,14 +242,15 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
       [] { return true; }, 10);
   ASSERT_TRUE(body.has_value()) << "the node did not account for all " << commands
                                 << " joint commands";
-  std::printf("joint commands: %llu published, %llu sent, %llu failed (port down), %llu rejected; "
-              "simulator applied %llu; telemetry decode errors %s\n",
-              static_cast<unsigned long long>(commands),
-              static_cast<unsigned long long>(body->number("commands sent")),
-              static_cast<unsigned long long>(body->number("command write failures")),
-              static_cast<unsigned long long>(body->number("commands rejected")),
-              static_cast<unsigned long long>(bodyStats(robot.stats()).sync_writes_ok),
-              body->value("decode errors").c_str());
+  std::printf(
+      "joint commands: %llu published, %llu sent, %llu failed (port down), %llu rejected; "
+      "simulator applied %llu; telemetry decode errors %s\n",
+      static_cast<unsigned long long>(commands),
+      static_cast<unsigned long long>(body->number("commands sent")),
+      static_cast<unsigned long long>(body->number("command write failures")),
+      static_cast<unsigned long long>(body->number("commands rejected")),
+      static_cast<unsigned long long>(bodyStats(robot.stats()).sync_writes_ok),
+      body->value("decode errors").c_str());
   EXPECT_EQ(body->number("commands sent") + body->number("command write failures"), commands);
   EXPECT_EQ(body->number("commands rejected"), 0u);
   EXPECT_EQ(body->number("decode errors"), 0u);
@@ -255,19 +258,16 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
 
   // Every service call returned, and every failure said why.
   const sim::SimStats final_sim = robot.stats();
-  const uint64_t servo_answers =
-      final_sim.sentOf(sim::kServoAnswerOutput).intact;
-  std::printf("services: %llu calls, %llu succeeded, %llu failed with a reason, slowest %.0f ms; "
-              "servo answers sent intact %llu, garbled %llu, withheld %llu\n",
-              static_cast<unsigned long long>(services.calls),
-              static_cast<unsigned long long>(services.successes),
-              static_cast<unsigned long long>(services.failures), 1000 * services.slowest_s,
-              static_cast<unsigned long long>(servo_answers),
-              static_cast<unsigned long long>(
-                  final_sim.sentOf(sim::kServoAnswerOutput).damaged),
-              static_cast<unsigned long long>(
-                  final_sim.sentOf(sim::kServoAnswerOutput)
-                      .suppressed));
+  const uint64_t servo_answers = final_sim.sentOf(sim::kServoAnswerOutput).intact;
+  std::printf(
+      "services: %llu calls, %llu succeeded, %llu failed with a reason, slowest %.0f ms; "
+      "servo answers sent intact %llu, garbled %llu, withheld %llu\n",
+      static_cast<unsigned long long>(services.calls),
+      static_cast<unsigned long long>(services.successes),
+      static_cast<unsigned long long>(services.failures), 1000 * services.slowest_s,
+      static_cast<unsigned long long>(servo_answers),
+      static_cast<unsigned long long>(final_sim.sentOf(sim::kServoAnswerOutput).damaged),
+      static_cast<unsigned long long>(final_sim.sentOf(sim::kServoAnswerOutput).suppressed));
   EXPECT_EQ(services.call_failures, 0u);
   EXPECT_EQ(services.silent_failures, 0u);
   EXPECT_GT(services.answered_successes, 0u);

@@ -20,8 +20,8 @@
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
-#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/pty_tap.h"
 #include "support/ros_test_support.h"

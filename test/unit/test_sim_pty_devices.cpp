@@ -45,7 +45,8 @@ TEST(RobotSimBase, SpeedFramesIntegrateAndClearEncodersZeroes) {
   EXPECT_EQ(baseStats(stats).last_left_speed, 0);
 
   host.send(kClearEncodersSeq3);  // SEQ 03 after 01: one gap
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).encoder_clears == 1; }));
+  ASSERT_TRUE(
+      waitForStats(sim, [](const SimStats& s) { return baseStats(s).encoder_clears == 1; }));
   stats = sim.stats();
   EXPECT_EQ(baseStats(stats).left_ticks, 0);
   EXPECT_EQ(baseStats(stats).right_ticks, 0);
@@ -144,7 +145,8 @@ TEST(RobotSimBody, BadCrcAndUnknownIdsAreCounted) {
   bad_crc.back() ^= 0xFF;
   host.send(bad_crc);
   host.send(kSyncWrite2And3);  // id 3 is not on this board
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return bodyStats(s).sync_writes_ok == 1; }));
+  ASSERT_TRUE(
+      waitForStats(sim, [](const SimStats& s) { return bodyStats(s).sync_writes_ok == 1; }));
   const SimStats stats = sim.stats();
   EXPECT_EQ(bodyStats(stats).sync_write_unknown_ids, 1u);
   EXPECT_GE(bodyStats(stats).port_checksum_errors, 1u);

@@ -165,8 +165,7 @@ TEST(RobotSim, ServoFaultsGarbleOrSuppressAnswers) {
   ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return servoBusStats(s).answers == 20; }));
   for (int i = 0; i < 5; ++i) host.pump(20);
   host.feedPadding();
-  const SendCounters answers =
-      sim.stats().sentOf(kServoAnswerOutput);
+  const SendCounters answers = sim.stats().sentOf(kServoAnswerOutput);
   EXPECT_EQ(answers.intact, 0u);
   EXPECT_GT(answers.suppressed, 0u);
   EXPECT_GT(answers.damaged, 0u);

@@ -42,8 +42,8 @@ struct PortCounters {
   protocol::FramerStats all_ports;  ///< summed over every port
 };
 
-/// A device's counters in a stats snapshot: typed (read through the device's own accessor, e.g.
-/// baseStats(stats)) and as its stats-file lines.
+/// A device's counters in a stats snapshot: typed (read through the device's own accessor,
+/// <name>Stats(stats) in its <name>_sim.h) and as its stats-file lines.
 struct DeviceSimStats {
   std::string name;
   std::any counters;
@@ -72,7 +72,7 @@ struct HostedDeviceOptions {
   std::optional<std::string> link;  ///< its own pty; none: the shared one (SimOptions::link)
   /// Values of its options that have no apply function, as given (option -> text).
   std::map<std::string, std::string> settings;
-  /// Its typed settings (e.g. BaseSimConfig), made with their defaults on first use.
+  /// Its typed settings (its <Name>SimConfig), made with their defaults on first use.
   std::any config;
 
   template <typename Config>
@@ -103,13 +103,13 @@ struct SimDeviceOption {
 struct SimDeviceModule {
   /// The core module's name (DeviceModule::name).
   const char* name;
-  /// What it is, for robot_sim's --help ("servo controller board").
+  /// What it is, for robot_sim's --help ("lidar on a UART").
   const char* description;
   /// True: simulated unless left out (--no-<name>); false: only when asked for (--<name>).
   bool hosted_by_default;
-  /// Help of that switch ("leave the base out" / "simulate the echo device").
+  /// Help of that switch ("leave the X out" / "simulate the X").
   const char* toggle_help;
-  /// Its own-pty flag ("--servo-link"; empty: --<name>-link) and that flag's help.
+  /// Its own-pty flag (empty: --<name>-link; a device may keep a shorter one) and its help.
   const char* link_flag;
   const char* link_help;
   /// Its random seed is the --seed value plus this (the seeded tests' results depend on it).
@@ -127,7 +127,7 @@ struct SimDeviceModule {
 const std::vector<const SimDeviceModule*>& registeredSimDevices();
 /// The simulator part of the device called `name`, or null.
 const SimDeviceModule* findSimDevice(const std::string& name);
-/// The command-line spelling of a device name: "servo_bus" -> "servo-bus".
+/// The command-line spelling of a device name: "a_b" -> "a-b".
 std::string flagName(const std::string& device);
 /// The flag of `module`'s `option`: "--<name>-<option>", or the option itself when it is a flag.
 std::string optionFlag(const SimDeviceModule& module, const SimDeviceOption& option);

@@ -32,7 +32,7 @@ std::string applyNumber(const std::string& flag, const std::string& value, doubl
 std::string applyWhole(const std::string& flag, const std::string& value, uint64_t max,
                        uint64_t* parsed);
 std::string applyIdList(const std::string& flag, const std::string& value, std::size_t max_count,
-                        std::vector<uint8_t>* ids);
+                        const std::string& limit, std::vector<uint8_t>* ids);
 std::string applyHeldValue(const std::string& flag, const std::string& value,
                            std::map<uint8_t, int64_t>* values);
 }  // namespace option_detail
@@ -40,12 +40,11 @@ std::string applyHeldValue(const std::string& flag, const std::string& value,
 /// A flag whose value is a number in [min, max], into `field` of the device's `Config`.
 template <typename Config>
 SimDeviceOption numberOption(const std::string& flag, const std::string& value_name,
-                             const std::string& help, double min, double max,
-                             double Config::*field, bool show_default) {
+                             const std::string& help, double min, double max, double Config::*field,
+                             bool show_default) {
   SimDeviceOption option{flag, value_name, help, nullptr, nullptr};
   option.apply = [flag, min, max, field](const std::string& value, HostedDeviceOptions& device) {
-    return option_detail::applyNumber(flag, value, min, max,
-                                      &(device.configAs<Config>().*field));
+    return option_detail::applyNumber(flag, value, min, max, &(device.configAs<Config>().*field));
   };
   if (show_default) {
     option.shown_default = [field](const HostedDeviceOptions& defaults) {
@@ -75,14 +74,17 @@ SimDeviceOption wholeOption(const std::string& flag, const std::string& value_na
   return option;
 }
 
-/// A flag whose value is a comma-separated list of servo ids, at most `max_count` of them.
+/// A flag whose value is a comma-separated list of ids 0..254, at most `max_count` of them
+/// (`limit`: why, for the error).
 template <typename Config>
 SimDeviceOption idListOption(const std::string& flag, const std::string& value_name,
                              const std::string& help, std::size_t max_count,
-                             std::vector<uint8_t> Config::*field, bool show_default) {
+                             const std::string& limit, std::vector<uint8_t> Config::*field,
+                             bool show_default) {
   SimDeviceOption option{flag, value_name, help, nullptr, nullptr};
-  option.apply = [flag, max_count, field](const std::string& value, HostedDeviceOptions& device) {
-    return option_detail::applyIdList(flag, value, max_count,
+  option.apply = [flag, max_count, limit, field](const std::string& value,
+                                                 HostedDeviceOptions& device) {
+    return option_detail::applyIdList(flag, value, max_count, limit,
                                       &(device.configAs<Config>().*field));
   };
   if (show_default) {
@@ -93,7 +95,7 @@ SimDeviceOption idListOption(const std::string& flag, const std::string& value_n
   return option;
 }
 
-/// "ID:VALUE" into a per-servo map (a held reading); repeatable.
+/// "ID:VALUE" into a per-id map (a held reading); repeatable.
 template <typename Config>
 SimDeviceOption heldValueOption(const std::string& flag, const std::string& value_name,
                                 const std::string& help,

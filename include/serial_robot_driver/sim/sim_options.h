@@ -1,6 +1,6 @@
 // What the simulated robot runs: its devices, their ports and the faults it injects. Filled by
 // the robot_sim command line (command_line.h) or directly by tests; a device's typed settings are
-// read and written through its own accessor (e.g. baseConfig(options) in its <name>_sim.h).
+// read and written through its own accessor (<name>Config(options) in its <name>_sim.h).
 #pragma once
 
 #include <cstdint>

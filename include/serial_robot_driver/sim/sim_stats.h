@@ -1,6 +1,6 @@
 // The simulated robot's counters: the devices' own and those of the ports (what was sent, damaged,
 // dropped), and their "key value" text for the stats file and the exit summary. A device's typed
-// counters are read through its own accessor (e.g. baseStats(stats) in its <name>_sim.h).
+// counters are read through its own accessor (<name>Stats(stats) in its <name>_sim.h).
 #pragma once
 
 #include <any>
@@ -31,7 +31,7 @@ struct SimStats {
   protocol::FramerStats framer;  ///< summed over the ports (host -> sim direction)
   uint64_t bytes_received = 0;
   uint64_t bytes_sent = 0;
-  uint64_t frames_for_absent_device = 0;  ///< e.g. a sync-write on a port without the body
+  uint64_t frames_for_absent_device = 0;  ///< a frame on a port where no device reads it
   uint64_t garbage_bursts = 0;
   uint64_t garbage_bytes = 0;
   uint64_t unplugs = 0;
@@ -39,7 +39,9 @@ struct SimStats {
   double uptime_s = 0.0;
 
   /// The send counters of `kind` (zero when no hosted device sends it).
-  const SendCounters& sentOf(const OutputKind& kind) const;
+  const SendCounters& sentOf(const OutputKind& kind) const&;
+  /// The same of a temporary snapshot (robot.stats().sentOf(kind)): a copy, which outlives it.
+  SendCounters sentOf(const OutputKind& kind) && { return std::as_const(*this).sentOf(kind); }
   /// The counters of the hosted device `name`, or null when it was not simulated.
   const DeviceSimStats* findDevice(const std::string& name) const;
   /// The typed counters of the device `name` (all zero when it was not simulated).

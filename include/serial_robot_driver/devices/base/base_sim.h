@@ -95,5 +95,7 @@ class BaseSim {
 BaseSimConfig& baseConfig(SimOptions& options);
 /// The base's counters in a stats snapshot (all zero when it was not simulated).
 const BaseSimStats& baseStats(const SimStats& stats);
+/// The same of a temporary snapshot (baseStats(robot.stats())): a copy, which outlives it.
+BaseSimStats baseStats(SimStats&& stats);
 
 }  // namespace serial_robot_driver::sim

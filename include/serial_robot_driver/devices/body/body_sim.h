@@ -90,5 +90,7 @@ class BodySim {
 BodySimConfig& bodyConfig(SimOptions& options);
 /// The board's counters in a stats snapshot (all zero when it was not simulated).
 const BodySimStats& bodyStats(const SimStats& stats);
+/// The same of a temporary snapshot (bodyStats(robot.stats())): a copy, which outlives it.
+BodySimStats bodyStats(SimStats&& stats);
 
 }  // namespace serial_robot_driver::sim

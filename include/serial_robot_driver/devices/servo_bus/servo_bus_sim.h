@@ -139,5 +139,7 @@ class ServoBusSim {
 ServoBusSimConfig& servoBusConfig(SimOptions& options);
 /// The servo bus's counters in a stats snapshot (all zero when it was not simulated).
 const ServoBusSimStats& servoBusStats(const SimStats& stats);
+/// The same of a temporary snapshot (servoBusStats(robot.stats())): a copy, which outlives it.
+ServoBusSimStats servoBusStats(SimStats&& stats);
 
 }  // namespace serial_robot_driver::sim

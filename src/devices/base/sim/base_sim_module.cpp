@@ -73,6 +73,8 @@ const BaseSimStats& baseStats(const SimStats& stats) {
   return stats.countersOf<BaseSimStats>(kName);
 }
 
+BaseSimStats baseStats(SimStats&& stats) { return stats.countersOf<BaseSimStats>(kName); }
+
 }  // namespace serial_robot_driver::sim
 
 namespace serial_robot_driver::devices::base {

@@ -68,6 +68,8 @@ const BodySimStats& bodyStats(const SimStats& stats) {
   return stats.countersOf<BodySimStats>(kName);
 }
 
+BodySimStats bodyStats(SimStats&& stats) { return stats.countersOf<BodySimStats>(kName); }
+
 }  // namespace serial_robot_driver::sim
 
 namespace serial_robot_driver::devices::body {
@@ -84,8 +86,8 @@ extern const sim::SimDeviceModule kSimModule{
     sim::makeBodySim,
     {
         sim::idListOption("--servo-ids", "1,2", "body servo ids in telemetry order",
-                          protocol::body::kMaxTelemetryServos, &sim::BodySimConfig::servo_ids,
-                          true),
+                          protocol::body::kMaxTelemetryServos, "fit in a telemetry frame",
+                          &sim::BodySimConfig::servo_ids, true),
         sim::numberOption("--telemetry-rate", "HZ", "telemetry frames per second (0 = off)", 0.0,
                           HUGE_VAL, &sim::BodySimConfig::telemetry_rate_hz, true),
         sim::switchOption<sim::BodySimConfig>(

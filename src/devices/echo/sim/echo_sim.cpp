@@ -39,10 +39,10 @@ TimePoint EchoSim::nextEvent() const {
 }
 
 DeviceSimStats EchoSim::stats(const PortCounters& /*ports*/) const {
-  return DeviceSimStats{"echo",
-                        stats_,
-                        {statsLine("echo_requests", stats_.requests),
-                         statsLine("echo_answers", stats_.answers)}};
+  return DeviceSimStats{
+      "echo",
+      stats_,
+      {statsLine("echo_requests", stats_.requests), statsLine("echo_answers", stats_.answers)}};
 }
 
 }  // namespace serial_robot_driver::sim

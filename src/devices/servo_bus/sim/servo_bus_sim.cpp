@@ -455,8 +455,8 @@ void ServoBusSim::tick(TimePoint now, Outbox* out) {
     if (drift) driftReadOnly(&s);
   }
   while (!pending_.empty() && pending_.front().due <= now) {
-    out->push_back(Outgoing{&kServoAnswerOutput, std::move(pending_.front().bytes),
-                            pending_.front().due});
+    out->push_back(
+        Outgoing{&kServoAnswerOutput, std::move(pending_.front().bytes), pending_.front().due});
     pending_.pop_front();
     ++stats_.answers;
   }

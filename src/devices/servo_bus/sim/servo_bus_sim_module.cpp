@@ -43,8 +43,8 @@ class ServoBusSimDevice : public SimDevice {
         statsLine("servo_stops_lost", bus.stops_lost),
     };
     for (const BusServoSnapshot& servo : bus.servos) {
-      lines.push_back(statsLine("bus_servo_" + std::to_string(servo.id) + "_angle_deg",
-                                servo.angle_deg));
+      lines.push_back(
+          statsLine("bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
     }
     lines.push_back(statsLine("rx_frames_servo_request",
                               ports.all_ports.framesOf(protocol::servo::kRequestFrames)));
@@ -88,6 +88,8 @@ const ServoBusSimStats& servoBusStats(const SimStats& stats) {
   return stats.countersOf<ServoBusSimStats>(kName);
 }
 
+ServoBusSimStats servoBusStats(SimStats&& stats) { return stats.countersOf<ServoBusSimStats>(kName); }
+
 }  // namespace serial_robot_driver::sim
 
 namespace serial_robot_driver::devices::servo_bus {
@@ -103,9 +105,9 @@ extern const sim::SimDeviceModule kSimModule{
     {&sim::kServoAnswerOutput},
     sim::makeServoBusSim,
     {
-        sim::idListOption("--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX,
+        sim::idListOption("--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX, "",
                           &sim::ServoBusSimConfig::servo_ids, true),
-        sim::idListOption("--offline-ids", "7", "ids that never answer", SIZE_MAX,
+        sim::idListOption("--offline-ids", "7", "ids that never answer", SIZE_MAX, "",
                           &sim::ServoBusSimConfig::offline_ids, false),
         sim::heldValueOption("--servo-temperature", "ID:DEGC",
                              "hold a bus servo's temperature at DEGC (repeatable)",

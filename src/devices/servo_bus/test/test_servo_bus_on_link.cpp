@@ -137,8 +137,8 @@ TEST(ServoBusOnLink, ShutdownSaysItsLastWordsThroughTheRunningReader) {
   const uint64_t requests_before = servoBusStats(rig.sim->stats()).requests;
   rig.bus->shutdown();
   EXPECT_TRUE(rig.bus->movingIds().empty()) << "the SPIN stop went out";
-  ASSERT_TRUE(
-      waitFor([&] { return servoBusStats(rig.sim->stats()).requests > requests_before; }, kWaitSeconds));
+  ASSERT_TRUE(waitFor([&] { return servoBusStats(rig.sim->stats()).requests > requests_before; },
+                      kWaitSeconds));
   EXPECT_EQ(rig.bus->client().ping(1).error, ServoError::kShutdown);
 }
 
