@@ -36,7 +36,7 @@ struct OutputKind {
 };
 
 struct Outgoing {
-  const OutputKind* kind = nullptr;
+  const OutputKind* kind = nullptr;  ///< required: every frame is of a kind its device defines
   std::vector<uint8_t> bytes;
   /// When the device starts sending it (a paced line carries it from then on); {}: now.
   TimePoint ready_at{};

@@ -88,7 +88,9 @@ const ServoBusSimStats& servoBusStats(const SimStats& stats) {
   return stats.countersOf<ServoBusSimStats>(kName);
 }
 
-ServoBusSimStats servoBusStats(SimStats&& stats) { return stats.countersOf<ServoBusSimStats>(kName); }
+ServoBusSimStats servoBusStats(SimStats&& stats) {
+  return stats.countersOf<ServoBusSimStats>(kName);
+}
 
 }  // namespace serial_robot_driver::sim
 
