@@ -367,11 +367,17 @@ void RobotSim::run() {
 SimStats RobotSim::snapshotLocked() const {
   SimStats stats = counters_;
   for (const auto& port : ports_) stats.framer.add(port->framer->stats());
-  for (const Hosted& hosted : hosted_) {
+  for (const SimDeviceModule* module : registeredSimDevices()) {
     PortCounters seen;
-    seen.own_port = hosted.port->framer->stats();
     seen.all_ports = stats.framer;
-    stats.devices.push_back(hosted.device->stats(seen));
+    const auto hosted = std::find_if(hosted_.begin(), hosted_.end(),
+                                     [&](const Hosted& h) { return h.name == module->name; });
+    if (hosted != hosted_.end()) {
+      seen.own_port = hosted->port->framer->stats();
+      stats.devices.push_back(hosted->device->stats(seen));
+    } else if (module->left_out_stats != nullptr) {
+      stats.devices.push_back(module->left_out_stats(seen));  // its keys, at zero
+    }
   }
   stats.uptime_s = toSeconds(Clock::now() - started_at_);
   return stats;

@@ -10,7 +10,13 @@ namespace serial_robot_driver::sim {
 
 void RobotSim::startHosted(TimePoint now) {
   for (const SimDeviceModule* module : registeredSimDevices()) {
-    if (!options_.hosts(module->name)) continue;
+    if (!options_.hosts(module->name)) {
+      // Left out: a device that keeps its stats keys keeps its send counters too, at zero.
+      if (module->left_out_stats != nullptr) {
+        for (const OutputKind* kind : module->outputs) countersOf(kind);
+      }
+      continue;
+    }
     const device::DeviceModule* core = device::findDevice(module->name);
     if (module->make == nullptr || core == nullptr) {
       throw std::invalid_argument(std::string("robot_sim: no registered device '") + module->name +

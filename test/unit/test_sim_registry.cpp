@@ -36,15 +36,28 @@ TEST(SimRegistry, EveryRegisteredDeviceIsHostedAloneThroughItsModule) {
     ASSERT_EQ(sim.ports().size(), 1u);
     EXPECT_EQ(sim.ports()[0].devices, std::vector<std::string>{module->name});
     const SimStats stats = sim.stats();
-    ASSERT_EQ(stats.devices.size(), 1u);
-    EXPECT_EQ(stats.devices[0].name, module->name);
-    EXPECT_TRUE(stats.devices[0].counters.has_value());
-    EXPECT_FALSE(stats.devices[0].lines.empty());
+    const DeviceSimStats* own = stats.findDevice(module->name);
+    ASSERT_NE(own, nullptr);
+    EXPECT_TRUE(own->counters.has_value());
+    EXPECT_FALSE(own->lines.empty());
     for (const OutputKind* kind : module->outputs) {
       const std::string text = formatStats(stats);
       EXPECT_NE(text.find(std::string(kind->name) + "_sent_intact "), std::string::npos);
     }
   }
+}
+
+TEST(SimRegistry, LeftOutDevicesKeepTheirStatsKeysAtZero) {
+  RobotSim sim(only("servo_bus"));
+  sim.start();
+  const std::string text = formatStats(sim.stats());
+  for (const char* expected : {"\nbase_resets 0\n", "\nleft_ticks 0\n", "\nrx_frames_base 0\n",
+                               "\nbase_replies_sent_intact 0\n", "\nsync_writes_bad 0\n",
+                               "\ntelemetry_discarded 0\n", "\nservo_requests 0\n"}) {
+    EXPECT_NE(text.find(expected), std::string::npos) << expected << " missing from:\n" << text;
+  }
+  EXPECT_EQ(text.find("echo_"), std::string::npos) << "the tests' device has no keys unless hosted";
+  EXPECT_EQ(baseStats(sim.stats()).resets, 0u);
 }
 
 TEST(SimRegistry, UnknownDeviceNamesAreRejected) {

@@ -119,6 +119,9 @@ struct SimDeviceModule {
   /// Builds the hosted device; throws std::invalid_argument for a bad setting.
   std::unique_ptr<SimDevice> (*make)(const HostedDeviceOptions& options, uint32_t seed,
                                      TimePoint now);
+  /// Its counters while it is left out (all zero), so the stats file keeps the keys it always
+  /// had; null: it writes none then.
+  DeviceSimStats (*left_out_stats)(const PortCounters& ports);
   /// Its settings on the command line.
   std::vector<SimDeviceOption> options;
 };

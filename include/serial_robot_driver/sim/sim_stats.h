@@ -24,7 +24,8 @@ struct SendCounters {
 };
 
 struct SimStats {
-  /// The hosted devices' counters, in the order of the devices.
+  /// The devices' counters, in the order of the devices: the hosted ones, and those left out
+  /// that keep their stats keys (at zero).
   std::vector<DeviceSimStats> devices;
   /// Per kind of frame the hosted devices send, in the order they declare them.
   std::vector<std::pair<const OutputKind*, SendCounters>> sent;
@@ -42,7 +43,7 @@ struct SimStats {
   const SendCounters& sentOf(const OutputKind& kind) const&;
   /// The same of a temporary snapshot (robot.stats().sentOf(kind)): a copy, which outlives it.
   SendCounters sentOf(const OutputKind& kind) && { return std::as_const(*this).sentOf(kind); }
-  /// The counters of the hosted device `name`, or null when it was not simulated.
+  /// The counters of the device `name`, or null when it is neither hosted nor keeps its keys.
   const DeviceSimStats* findDevice(const std::string& name) const;
   /// The typed counters of the device `name` (all zero when it was not simulated).
   template <typename Counters>

@@ -11,6 +11,35 @@ namespace {
 
 constexpr const char* kName = "base";
 
+DeviceSimStats statsOf(const BaseSimStats& base, const PortCounters& ports) {
+  return DeviceSimStats{
+      kName,
+      base,
+      {
+          statsLine("base_frames_received", base.frames_received),
+          statsLine("base_seq_gaps", base.seq_gaps),
+          statsLine("base_resets", base.resets),
+          statsLine("base_speed_frames_applied", base.speed_frames_applied),
+          statsLine("base_speed_frames_ignored", base.speed_frames_ignored),
+          statsLine("base_errors_sent", base.errors_sent),
+          statsLine("base_timeouts", base.timeouts),
+          statsLine("base_battery_requests", base.battery_requests),
+          statsLine("base_encoder_clears", base.encoder_clears),
+          statsLine("base_unknown_frames", base.unknown_frames),
+          statsLine("base_in_error", base.in_error ? 1 : 0),
+          statsLine("left_ticks", base.left_ticks),
+          statsLine("right_ticks", base.right_ticks),
+          statsLine("base_x_m", base.x_m),
+          statsLine("base_y_m", base.y_m),
+          statsLine("base_yaw_rad", base.yaw_rad),
+          statsLine("last_left_speed", base.last_left_speed),
+          statsLine("last_right_speed", base.last_right_speed),
+          statsLine("rx_frames_base", ports.all_ports.framesOf(protocol::base::kFrames)),
+      }};
+}
+
+DeviceSimStats leftOutStats(const PortCounters& ports) { return statsOf(BaseSimStats{}, ports); }
+
 class BaseSimDevice : public SimDevice {
  public:
   BaseSimDevice(const BaseSimConfig& config, TimePoint now) : base_(config, now) {}
@@ -27,31 +56,7 @@ class BaseSimDevice : public SimDevice {
   TimePoint nextEvent() const override { return base_.nextEvent(); }
 
   DeviceSimStats stats(const PortCounters& ports) const override {
-    const BaseSimStats& base = base_.stats();
-    return DeviceSimStats{
-        kName,
-        base,
-        {
-            statsLine("base_frames_received", base.frames_received),
-            statsLine("base_seq_gaps", base.seq_gaps),
-            statsLine("base_resets", base.resets),
-            statsLine("base_speed_frames_applied", base.speed_frames_applied),
-            statsLine("base_speed_frames_ignored", base.speed_frames_ignored),
-            statsLine("base_errors_sent", base.errors_sent),
-            statsLine("base_timeouts", base.timeouts),
-            statsLine("base_battery_requests", base.battery_requests),
-            statsLine("base_encoder_clears", base.encoder_clears),
-            statsLine("base_unknown_frames", base.unknown_frames),
-            statsLine("base_in_error", base.in_error ? 1 : 0),
-            statsLine("left_ticks", base.left_ticks),
-            statsLine("right_ticks", base.right_ticks),
-            statsLine("base_x_m", base.x_m),
-            statsLine("base_y_m", base.y_m),
-            statsLine("base_yaw_rad", base.yaw_rad),
-            statsLine("last_left_speed", base.last_left_speed),
-            statsLine("last_right_speed", base.last_right_speed),
-            statsLine("rx_frames_base", ports.all_ports.framesOf(protocol::base::kFrames)),
-        }};
+    return statsOf(base_.stats(), ports);
   }
 
  private:
@@ -89,6 +94,7 @@ extern const sim::SimDeviceModule kSimModule{
     0,  // the base draws nothing at random
     {&sim::kBaseReplyOutput},
     sim::makeBaseSim,
+    sim::leftOutStats,
     {
         sim::wholeOption("--battery", "PCT", "battery percent the base reports", 100,
                          &sim::BaseSimConfig::battery_percent, true),

@@ -12,6 +12,30 @@ namespace {
 
 constexpr const char* kName = "body";
 
+/// `body` with what its port's framer saw, and its stats-file lines.
+DeviceSimStats statsOf(BodySimStats body, const PortCounters& ports) {
+  body.port_checksum_errors = ports.own_port.checksum_errors;
+  std::vector<StatsLine> lines{
+      statsLine("telemetry_generated", body.telemetry_generated),
+      statsLine("telemetry_with_foot", body.telemetry_with_foot),
+      statsLine("sync_writes_ok", body.sync_writes_ok),
+      statsLine("sync_writes_bad", body.sync_writes_malformed + body.port_checksum_errors),
+      statsLine("sync_write_unknown_ids", body.sync_write_unknown_ids),
+      statsLine("yaw_rad", body.yaw_rad),
+  };
+  for (const BodySimServoState& servo : body.servos) {
+    const std::string prefix = "servo_" + std::to_string(servo.id);
+    lines.push_back(statsLine(prefix + "_position", std::lround(servo.position)));
+    lines.push_back(statsLine(prefix + "_target", servo.target));
+    lines.push_back(statsLine(prefix + "_speed", servo.speed));
+  }
+  lines.push_back(statsLine("rx_frames_sync_write",
+                            ports.all_ports.framesOf(protocol::body::kSyncWriteFrames)));
+  return DeviceSimStats{kName, std::move(body), std::move(lines)};
+}
+
+DeviceSimStats leftOutStats(const PortCounters& ports) { return statsOf(BodySimStats{}, ports); }
+
 class BodySimDevice : public SimDevice {
  public:
   BodySimDevice(const BodySimConfig& config, TimePoint now) : body_(config, now) {}
@@ -26,25 +50,7 @@ class BodySimDevice : public SimDevice {
   TimePoint nextEvent() const override { return body_.nextEvent(); }
 
   DeviceSimStats stats(const PortCounters& ports) const override {
-    BodySimStats body = body_.stats();
-    body.port_checksum_errors = ports.own_port.checksum_errors;
-    std::vector<StatsLine> lines{
-        statsLine("telemetry_generated", body.telemetry_generated),
-        statsLine("telemetry_with_foot", body.telemetry_with_foot),
-        statsLine("sync_writes_ok", body.sync_writes_ok),
-        statsLine("sync_writes_bad", body.sync_writes_malformed + body.port_checksum_errors),
-        statsLine("sync_write_unknown_ids", body.sync_write_unknown_ids),
-        statsLine("yaw_rad", body.yaw_rad),
-    };
-    for (const BodySimServoState& servo : body.servos) {
-      const std::string prefix = "servo_" + std::to_string(servo.id);
-      lines.push_back(statsLine(prefix + "_position", std::lround(servo.position)));
-      lines.push_back(statsLine(prefix + "_target", servo.target));
-      lines.push_back(statsLine(prefix + "_speed", servo.speed));
-    }
-    lines.push_back(statsLine("rx_frames_sync_write",
-                              ports.all_ports.framesOf(protocol::body::kSyncWriteFrames)));
-    return DeviceSimStats{kName, std::move(body), std::move(lines)};
+    return statsOf(body_.stats(), ports);
   }
 
  private:
@@ -84,6 +90,7 @@ extern const sim::SimDeviceModule kSimModule{
     1,  // the IMU noise: seeded tests depend on --seed + 1
     {&sim::kTelemetryOutput},
     sim::makeBodySim,
+    sim::leftOutStats,
     {
         sim::idListOption("--servo-ids", "1,2", "body servo ids in telemetry order",
                           protocol::body::kMaxTelemetryServos, "fit in a telemetry frame",

@@ -77,6 +77,7 @@ extern const sim::SimDeviceModule kSimModule{
     10,  // draws nothing at random; kept apart from the robot's own devices' seeds
     {&sim::kEchoAnswerOutput},
     makeEchoSim,
+    nullptr,  // not one of the robot's own: no stats unless hosted
     {{"latency-ms", "MS", "echo answer latency (default 0)", nullptr, nullptr}}};
 
 }  // namespace serial_robot_driver::devices::echo

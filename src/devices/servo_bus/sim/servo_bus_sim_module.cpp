@@ -11,6 +11,30 @@ namespace {
 
 constexpr const char* kName = "servo_bus";
 
+DeviceSimStats statsOf(ServoBusSimStats bus, const PortCounters& ports) {
+  std::vector<StatsLine> lines{
+      statsLine("servo_requests", bus.requests),
+      statsLine("servo_answers", bus.answers),
+      statsLine("servo_broadcasts", bus.broadcasts),
+      statsLine("servo_unaddressed", bus.unaddressed),
+      statsLine("servo_unknown_data_ids", bus.unknown_data_ids),
+      statsLine("servo_malformed", bus.malformed),
+      statsLine("servo_writes_rejected", bus.writes_rejected),
+      statsLine("servo_stops_lost", bus.stops_lost),
+  };
+  for (const BusServoSnapshot& servo : bus.servos) {
+    lines.push_back(
+        statsLine("bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
+  }
+  lines.push_back(statsLine("rx_frames_servo_request",
+                            ports.all_ports.framesOf(protocol::servo::kRequestFrames)));
+  return DeviceSimStats{kName, std::move(bus), std::move(lines)};
+}
+
+DeviceSimStats leftOutStats(const PortCounters& ports) {
+  return statsOf(ServoBusSimStats{}, ports);
+}
+
 class ServoBusSimDevice : public SimDevice {
  public:
   ServoBusSimDevice(const ServoBusSimConfig& config, TimePoint now)
@@ -31,24 +55,7 @@ class ServoBusSimDevice : public SimDevice {
   TimePoint nextEvent() const override { return bus_.nextEvent(); }
 
   DeviceSimStats stats(const PortCounters& ports) const override {
-    ServoBusSimStats bus = bus_.stats();
-    std::vector<StatsLine> lines{
-        statsLine("servo_requests", bus.requests),
-        statsLine("servo_answers", bus.answers),
-        statsLine("servo_broadcasts", bus.broadcasts),
-        statsLine("servo_unaddressed", bus.unaddressed),
-        statsLine("servo_unknown_data_ids", bus.unknown_data_ids),
-        statsLine("servo_malformed", bus.malformed),
-        statsLine("servo_writes_rejected", bus.writes_rejected),
-        statsLine("servo_stops_lost", bus.stops_lost),
-    };
-    for (const BusServoSnapshot& servo : bus.servos) {
-      lines.push_back(
-          statsLine("bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
-    }
-    lines.push_back(statsLine("rx_frames_servo_request",
-                              ports.all_ports.framesOf(protocol::servo::kRequestFrames)));
-    return DeviceSimStats{kName, std::move(bus), std::move(lines)};
+    return statsOf(bus_.stats(), ports);
   }
 
  private:
@@ -106,6 +113,7 @@ extern const sim::SimDeviceModule kSimModule{
     2,  // the drifting readings: seeded tests depend on --seed + 2
     {&sim::kServoAnswerOutput},
     sim::makeServoBusSim,
+    sim::leftOutStats,
     {
         sim::idListOption("--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX, "",
                           &sim::ServoBusSimConfig::servo_ids, true),
