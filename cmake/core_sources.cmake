@@ -47,6 +47,7 @@ set(SRD_SIM_SOURCES
   src/sim/command_line.cpp
   src/sim/sim_stats.cpp
   src/sim/sim_device_module.cpp
+  src/sim/sim_option_builders.cpp
 )
 srd_device_sources(sim srd_device_sim_sources)
 list(APPEND SRD_SIM_SOURCES ${srd_device_sim_sources})

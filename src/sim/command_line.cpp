@@ -1,69 +1,24 @@
 #include "serial_robot_driver/sim/command_line.h"
 
-#include <cerrno>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <functional>
 #include <iomanip>
-#include <map>
 #include <optional>
 #include <sstream>
 #include <vector>
 
-#include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/sim/sim_device_module.h"
+#include "serial_robot_driver/sim/sim_option_builders.h"
 
 namespace serial_robot_driver::sim {
 
 namespace {
 
-bool parseDouble(const std::string& text, double* value) {
-  char* end = nullptr;
-  errno = 0;
-  const double parsed = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || errno != 0 || !std::isfinite(parsed)) return false;
-  *value = parsed;
-  return true;
-}
-
-bool parseUnsigned(const std::string& text, uint64_t max, uint64_t* value) {
-  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return false;
-  errno = 0;
-  const unsigned long long parsed = std::strtoull(text.c_str(), nullptr, 10);
-  if (errno != 0 || parsed > max) return false;
-  *value = parsed;
-  return true;
-}
-
-bool parseIdList(const std::string& text, std::vector<uint8_t>* ids) {
-  ids->clear();
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
-    uint64_t id = 0;
-    if (!parseUnsigned(item, 254, &id)) return false;
-    ids->push_back(static_cast<uint8_t>(id));
-  }
-  return true;
-}
-
-template <typename T>
-std::string show(const T& value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-std::string show(const std::vector<uint8_t>& ids) {
-  std::string text;
-  for (uint8_t id : ids) text += (text.empty() ? "" : ",") + std::to_string(id);
-  return text;
-}
-
 /// One command-line flag: how it reads in --help and what it does to the options.
 struct Flag {
-  std::string name;        ///< "--battery"; empty: a section title in --help
+  std::string name;        ///< "--seed"; empty: a section title in --help
   std::string value_name;  ///< "" for a switch
   std::string help;
   /// Applies the value ("" for a switch); returns "" or what is wrong with the value.
@@ -74,20 +29,9 @@ struct Flag {
 
 Flag section(const std::string& title) { return Flag{"", "", title, nullptr, nullptr}; }
 
-Flag toggle(const std::string& name, const std::string& help,
-            std::function<void(SimOptions&)> set) {
-  return Flag{name, "", help,
-              [set](const std::string&, SimOptions& options) {
-                set(options);
-                return std::string();
-              },
-              nullptr};
-}
-
 /// A flag whose value is any text (a path).
-template <typename Text>  // std::string or std::optional<std::string>
 Flag text(const std::string& name, const std::string& value_name, const std::string& help,
-          Text SimOptions::*field) {
+          std::string SimOptions::*field) {
   return Flag{name, value_name, help,
               [field](const std::string& value, SimOptions& options) {
                 options.*field = value;
@@ -96,36 +40,24 @@ Flag text(const std::string& name, const std::string& value_name, const std::str
               nullptr};
 }
 
-std::string badValue(const std::string& name, const std::string& value) {
-  return "bad value for " + name + ": '" + value + "'";
-}
-
 /// A flag whose value is a number in [min, max].
 Flag number(const std::string& name, const std::string& value_name, const std::string& help,
-            double min, double max, std::function<double&(SimOptions&)> field,
-            std::function<std::string(const SimOptions&)> shown_default = nullptr) {
+            double min, double max, double FaultOptions::*field, bool show_default = false) {
+  std::function<std::string(const SimOptions&)> shown;
+  if (show_default) shown = [field](const SimOptions& o) { return showDefault(o.faults.*field); };
   return Flag{name, value_name, help,
               [name, min, max, field](const std::string& value, SimOptions& options) {
-                double parsed = 0;
-                if (!parseDouble(value, &parsed) || parsed < min || parsed > max) {
-                  return badValue(name, value);
-                }
-                field(options) = parsed;
-                return std::string();
+                return option_detail::applyNumber(name, value, min, max, &(options.faults.*field));
               },
-              shown_default};
+              shown};
 }
 
 Flag nonNegative(const std::string& name, const std::string& value_name, const std::string& help,
-                 std::function<double&(SimOptions&)> field, bool show_default = false) {
-  std::function<std::string(const SimOptions&)> shown;
-  if (show_default)
-    shown = [field](const SimOptions& o) { return show(field(const_cast<SimOptions&>(o))); };
-  return number(name, value_name, help, 0.0, HUGE_VAL, field, shown);
+                 double FaultOptions::*field, bool show_default = false) {
+  return number(name, value_name, help, 0.0, HUGE_VAL, field, show_default);
 }
 
-Flag probability(const std::string& name, const std::string& help,
-                 std::function<double&(SimOptions&)> field) {
+Flag probability(const std::string& name, const std::string& help, double FaultOptions::*field) {
   return number(name, "P", help, 0.0, 1.0, field);
 }
 
@@ -136,216 +68,126 @@ Flag whole(const std::string& name, const std::string& value_name, const std::st
   return Flag{name, value_name, help,
               [name, max, set](const std::string& value, SimOptions& options) {
                 uint64_t parsed = 0;
-                if (!parseUnsigned(value, max, &parsed)) return badValue(name, value);
-                set(options, parsed);
-                return std::string();
+                std::string problem = option_detail::applyWhole(name, value, max, &parsed);
+                if (problem.empty()) set(options, parsed);
+                return problem;
               },
               shown_default};
 }
 
-/// A flag whose value is a comma-separated list of servo ids; `max_count` is what a telemetry
-/// frame holds (SIZE_MAX for lists that do not go into telemetry).
-Flag idList(const std::string& name, const std::string& value_name, const std::string& help,
-            std::size_t max_count, std::function<std::vector<uint8_t>&(SimOptions&)> field,
-            bool show_default) {
-  std::function<std::string(const SimOptions&)> shown;
-  if (show_default)
-    shown = [field](const SimOptions& o) { return show(field(const_cast<SimOptions&>(o))); };
-  return Flag{name, value_name, help,
-              [name, max_count, field](const std::string& value, SimOptions& options) {
-                std::vector<uint8_t>& ids = field(options);
-                if (!parseIdList(value, &ids)) {
-                  return badValue(name, value) + " (comma-separated ids 0..254)";
-                }
-                if (ids.size() > max_count) {
-                  return "too many " + name + " (at most " + std::to_string(max_count) +
-                         " fit in a telemetry frame)";
-                }
-                return std::string();
-              },
-              shown};
+/// The settings of `module`'s device, which a mention hosts when it is not hosted by default.
+HostedDeviceOptions& mention(SimOptions& options, const SimDeviceModule& module) {
+  HostedDeviceOptions& device = options.device(module.name);
+  if (!module.hosted_by_default) device.enabled = true;
+  return device;
 }
 
-/// "ID:VALUE" into a per-servo map (a bus servo's held temperature or voltage); repeatable.
-Flag heldValue(const std::string& name, const std::string& value_name, const std::string& help,
-               std::function<std::map<uint8_t, int64_t>&(SimOptions&)> field) {
-  return Flag{name, value_name, help,
-              [name, field](const std::string& value, SimOptions& options) {
-                const std::size_t colon = value.find(':');
-                std::vector<uint8_t> ids;
-                double number = 0;
-                if (colon == std::string::npos || !parseIdList(value.substr(0, colon), &ids) ||
-                    ids.size() != 1 || !parseDouble(value.substr(colon + 1), &number) ||
-                    number < 0 || number > 65535) {
-                  return badValue(name, value) + " (ID:VALUE, id 0..254, value 0..65535)";
-                }
-                field(options)[ids.front()] = static_cast<int64_t>(number);
-                return std::string();
-              },
-              {}};
+std::string capitalized(std::string text) {
+  if (!text.empty() && text[0] >= 'a' && text[0] <= 'z') text[0] = static_cast<char>(text[0] - 32);
+  return text;
 }
 
-/// The hosted device `name` in `options`, added on first mention.
-HostedDeviceOptions& hostedDevice(SimOptions& options, const std::string& name) {
-  for (HostedDeviceOptions& hosted : options.hosted) {
-    if (hosted.name == name) return hosted;
-  }
-  options.hosted.push_back(HostedDeviceOptions{name, std::nullopt, {}});
-  return options.hosted.back();
-}
-
-/// The flags of every registered device robot_sim hosts through its SimDeviceModule (none of the
-/// built-in ones): --<name> hosts it, --<name>-link and --<name>-<option> too, with that setting.
-std::vector<Flag> withHostedDevices(std::vector<Flag> table) {
-  bool titled = false;
+/// Every registered device's flags, one --help section per device: its own pty, the switch that
+/// leaves it out (--no-<name>) or hosts it (--<name>), and the options it declares.
+void addDeviceFlags(std::vector<Flag>* table) {
   for (const SimDeviceModule* module : registeredSimDevices()) {
-    if (module->make == nullptr) continue;
-    if (!titled) table.push_back(section("Other devices (none unless asked for):"));
-    titled = true;
     const std::string name = module->name;
-    const std::string flag = "--" + flagName(name);
-    table.push_back(toggle(flag, "simulate the " + name + " device (on the shared pty)",
-                           [name](SimOptions& o) { hostedDevice(o, name); }));
-    table.push_back(Flag{flag + "-link", "PATH", "own pty for the " + name + " device (hosts it)",
-                         [name](const std::string& value, SimOptions& o) {
-                           hostedDevice(o, name).link = value;
-                           return std::string();
-                         },
-                         nullptr});
+    const bool by_default = module->hosted_by_default;
+    table->push_back(section(capitalized(module->description) + " (" + name +
+                             (by_default ? "" : "; not simulated unless asked for") + "):"));
+    Flag link{linkFlag(*module), "PATH", module->link_help,
+              [module](const std::string& value, SimOptions& o) {
+                mention(o, *module).link = value;
+                return std::string();
+              },
+              nullptr};
+    Flag toggle{(by_default ? "--no-" : "--") + flagName(name), "", module->toggle_help,
+                [module, by_default](const std::string&, SimOptions& o) {
+                  mention(o, *module).enabled = !by_default;
+                  return std::string();
+                },
+                nullptr};
+    // As --help always listed them: a default device's pty first, an optional device's switch.
+    if (by_default) {
+      table->push_back(std::move(link));
+      table->push_back(std::move(toggle));
+    } else {
+      table->push_back(std::move(toggle));
+      table->push_back(std::move(link));
+    }
     for (const SimDeviceOption& option : module->options) {
-      const std::string key = option.option;
-      table.push_back(Flag{flag + "-" + key, option.value_name, option.help,
-                           [name, key](const std::string& value, SimOptions& o) {
-                             hostedDevice(o, name).settings[key] = value;
-                             return std::string();
-                           },
-                           nullptr});
+      Flag flag{optionFlag(*module, option), option.value_name, option.help, nullptr, nullptr};
+      flag.apply = [module, option](const std::string& value, SimOptions& o) {
+        HostedDeviceOptions& device = mention(o, *module);
+        if (option.apply) return option.apply(value, device);
+        device.settings[option.option] = value;
+        return std::string();
+      };
+      if (option.shown_default) {
+        flag.shown_default = [option](const SimOptions&) {
+          return option.shown_default(HostedDeviceOptions{});
+        };
+      }
+      table->push_back(std::move(flag));
     }
   }
-  return table;
 }
 
 /// Every flag of robot_sim, in --help order.
 const std::vector<Flag>& flags() {
-  static const std::vector<Flag> table = withHostedDevices({
-      section("Ports:"),
-      text("--link", "PATH", "symlink to the shared pty (default: none, just print the path)",
-           &SimOptions::link),
-      text("--base-link", "PATH", "own pty for the base (devices naming the same link share a pty)",
-           &SimOptions::base_link),
-      text("--body-link", "PATH", "own pty for the servo controller board", &SimOptions::body_link),
-      text("--servo-link", "PATH", "own pty for the servo bus", &SimOptions::servo_link),
-      toggle("--no-base", "leave the base out", [](SimOptions& o) { o.enable_base = false; }),
-      toggle("--no-body", "leave the servo controller board out",
-             [](SimOptions& o) { o.enable_body = false; }),
-      toggle("--no-servo-bus", "leave the servo bus out",
-             [](SimOptions& o) { o.enable_servo_bus = false; }),
-
-      section("Devices:"),
-      whole(
-          "--battery", "PCT", "battery percent the base reports", 100,
-          [](SimOptions& o, uint64_t v) { o.base.battery_percent = static_cast<uint8_t>(v); },
-          [](const SimOptions& o) { return show(static_cast<int>(o.base.battery_percent)); }),
-      idList(
-          "--servo-ids", "1,2", "body servo ids in telemetry order",
-          protocol::body::kMaxTelemetryServos,
-          [](SimOptions& o) -> std::vector<uint8_t>& { return o.body.servo_ids; }, true),
-      nonNegative(
-          "--telemetry-rate", "HZ", "telemetry frames per second (0 = off)",
-          [](SimOptions& o) -> double& { return o.body.telemetry_rate_hz; }, true),
-      toggle("--foot", "every telemetry frame carries the foot block",
-             [](SimOptions& o) { o.body.foot_mode = FootMode::kAlways; }),
-      toggle("--foot-alternate", "every other telemetry frame carries it",
-             [](SimOptions& o) { o.body.foot_mode = FootMode::kAlternate; }),
-      nonNegative(
-          "--servo-speed", "TICKS_S", "body servo speed bound in ticks/s",
-          [](SimOptions& o) -> double& { return o.body.servo_speed; }, true),
-      toggle("--imu-noise", "+-2 LSB noise on the IMU values",
-             [](SimOptions& o) { o.body.imu_noise = true; }),
-      Flag{"--gyro-bias", "X,Y,Z", "rad/s added to the gyro's sensor axes",
-           [](const std::string& value, SimOptions& o) {
-             const auto bias = parseGyroBias(value);
-             if (bias) o.body.gyro_bias = *bias;
-             return bias ? std::string() : badValue("--gyro-bias", value) + " (X,Y,Z in rad/s)";
-           },
-           [](const SimOptions& o) {
-             const auto& b = o.body.gyro_bias;
-             return show(b[0]) + "," + show(b[1]) + "," + show(b[2]);
-           }},
-      number(
-          "--turn-slip", "FRACTION",
-          "wheel slip: the base turns by (1 - FRACTION) of the commanded yaw rate (0..1); the IMU "
-          "reports the true turn",
-          0.0, 1.0, [](SimOptions& o) -> double& { return o.base.turn_slip; }),
-      idList(
-          "--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX,
-          [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.servo_ids; }, true),
-      idList(
-          "--offline-ids", "7", "ids that never answer", SIZE_MAX,
-          [](SimOptions& o) -> std::vector<uint8_t>& { return o.servo_bus.offline_ids; }, false),
-      heldValue(
-          "--servo-temperature", "ID:DEGC", "hold a bus servo's temperature at DEGC (repeatable)",
-          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.temperature_c; }),
-      heldValue(
-          "--servo-voltage", "ID:MV", "hold a bus servo's voltage at MV (repeatable)",
-          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.voltage_mv; }),
-      heldValue(
-          "--servo-type", "ID:TYPE", "a bus servo's servo_type (repeatable; otherwise 257)",
-          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.servo_type; }),
-      heldValue("--servo-firmware", "ID:VERSION",
-                "a bus servo's firmware_version (repeatable; otherwise 258)",
-                [](SimOptions& o) -> std::map<uint8_t, int64_t>& {
-                  return o.servo_bus.firmware_version;
-                }),
-      heldValue(
-          "--servo-response-switch", "ID:0|1",
-          "a bus servo's response_switch (repeatable; otherwise 0)",
-          [](SimOptions& o) -> std::map<uint8_t, int64_t>& { return o.servo_bus.response_switch; }),
-      Flag{"--servo-latency-ms", "MS", "servo bus answer latency",
-           [](const std::string& value, SimOptions& o) {
-             double ms = 0;
-             if (!parseDouble(value, &ms) || ms < 0) return badValue("--servo-latency-ms", value);
-             o.servo_bus.answer_latency_s = ms / 1000.0;
-             return std::string();
-           },
-           [](const SimOptions& o) { return show(o.servo_bus.answer_latency_s * 1000.0); }},
-
-      whole(
-          "--pace-baud", "BAUD",
-          "send and receive at most BAUD/10 bytes/s per port, like a real line (0 = pty speed)",
-          4000000, [](SimOptions& o, uint64_t v) { o.pace_baud = static_cast<unsigned>(v); },
-          [](const SimOptions& o) { return show(o.pace_baud); }),
-
-      section("Faults (seeded):"),
-      whole(
-          "--seed", "N", "random seed", 0xFFFFFFFFu,
-          [](SimOptions& o, uint64_t v) { o.faults.seed = static_cast<uint32_t>(v); },
-          [](const SimOptions& o) { return show(o.faults.seed); }),
-      nonNegative("--garbage-rate", "HZ", "random junk bursts per second and port",
-                  [](SimOptions& o) -> double& { return o.faults.garbage_rate_hz; }),
-      probability("--corrupt-rate", "probability a sent frame has its checksum byte flipped",
-                  [](SimOptions& o) -> double& { return o.faults.corrupt_rate; }),
-      probability("--drop-rate", "probability a sent frame loses one byte",
-                  [](SimOptions& o) -> double& { return o.faults.drop_rate; }),
-      nonNegative("--unplug-every", "S", "close the pty (and its link) every S seconds...",
-                  [](SimOptions& o) -> double& { return o.faults.unplug_every_s; }),
-      nonNegative(
-          "--unplug-duration", "S", "...for S seconds, then recreate it at the same link",
-          [](SimOptions& o) -> double& { return o.faults.unplug_duration_s; }, true),
-      probability("--servo-fault-rate", "probability a servo answer is garbled or missing",
-                  [](SimOptions& o) -> double& { return o.faults.servo_fault_rate; }),
-      whole(
-          "--lose-servo-stops", "N",
-          "the next N SPIN stops to a bus servo are lost on the line: the servo keeps moving",
-          1000000,
-          [](SimOptions& o, uint64_t v) { o.servo_bus.lost_stops = static_cast<uint32_t>(v); },
-          [](const SimOptions& o) { return show(o.servo_bus.lost_stops); }),
-
-      section("Output:"),
-      text("--stats-file", "PATH", "\"key value\" counters, rewritten every second and at exit",
-           &SimOptions::stats_file),
-  });
+  static const std::vector<Flag> table = [] {
+    std::vector<Flag> all{
+        section("Ports:"),
+        text("--link", "PATH", "symlink to the shared pty (default: none, just print the path)",
+             &SimOptions::link),
+        whole(
+            "--pace-baud", "BAUD",
+            "send and receive at most BAUD/10 bytes/s per port, like a real line (0 = pty speed)",
+            4000000, [](SimOptions& o, uint64_t v) { o.pace_baud = static_cast<unsigned>(v); },
+            [](const SimOptions& o) { return std::to_string(o.pace_baud); }),
+    };
+    addDeviceFlags(&all);
+    for (Flag& flag : std::vector<Flag>{
+             section("Faults (seeded):"),
+             whole(
+                 "--seed", "N", "random seed", 0xFFFFFFFFu,
+                 [](SimOptions&o, uint64_t v) { o.faults.seed = static_cast<uint32_t>(v); },
+                 [](const SimOptions&o) { return std::to_string(o.faults.seed); }),
+             nonNegative("--garbage-rate", "HZ", "random junk bursts per second and port",
+                         &FaultOptions::garbage_rate_hz),
+             probability("--corrupt-rate", "probability a sent frame has its checksum byte flipped",
+                         &FaultOptions::corrupt_rate),
+             probability("--drop-rate", "probability a sent frame loses one byte",
+                         &FaultOptions::drop_rate),
+             nonNegative("--unplug-every", "S", "close the pty (and its link) every S seconds...",
+                         &FaultOptions::unplug_every_s),
+             nonNegative("--unplug-duration", "S",
+                         "...for S seconds, then recreate it at the same link",
+                         &FaultOptions::unplug_duration_s, true),
+             section("Output:"),
+             text("--stats-file", "PATH",
+                  "\"key value\" counters, rewritten every second and at exit",
+                  &SimOptions::stats_file),
+         }) {
+      all.push_back(std::move(flag));
+    }
+    return all;
+  }();
   return table;
+}
+
+/// "--no-a, --no-b and --no-c": the switches that leave the default devices out.
+std::string leaveOutFlags() {
+  std::vector<std::string> names;
+  for (const SimDeviceModule* module : registeredSimDevices()) {
+    if (module->hosted_by_default) names.push_back("--no-" + flagName(module->name));
+  }
+  std::string joined;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) joined += i + 1 == names.size() ? " and " : ", ";
+    joined += names[i];
+  }
+  return joined;
 }
 
 const Flag* findFlag(const std::string& name) {
@@ -359,9 +201,15 @@ const Flag* findFlag(const std::string& name) {
 
 std::string usage() {
   std::ostringstream out;
+  std::string robot;  // what it simulates unless told otherwise
+  for (const SimDeviceModule* module : registeredSimDevices()) {
+    if (module->hosted_by_default)
+      robot += (robot.empty() ? "" : ", ") + std::string(module->description);
+  }
   out << "usage: robot_sim [options]\n"
-         "A simulated robot (AP1 base, servo controller board, UART bus servos) on "
-         "pseudo-terminal(s).\n"
+         "A simulated robot ("
+      << robot
+      << ") on pseudo-terminal(s).\n"
          "Prints one line per pty: \"robot_sim: <devices> on <slave path> (link <link>)\".\n";
   const SimOptions defaults;
   const auto row = [&out](const std::string& left, const std::string& help) {
@@ -425,10 +273,12 @@ CommandLine parseCommandLine(int argc, const char* const* argv) {
     if (!problem.empty()) return fail(problem);
   }
   const SimOptions& options = result.options;
-  if (!result.help && !options.enable_base && !options.enable_body && !options.enable_servo_bus &&
-      options.hosted.empty()) {
-    return fail("--no-base, --no-body and --no-servo-bus together leave nothing to simulate");
-  }
+  const auto& modules = registeredSimDevices();
+  const bool hosts_any = std::any_of(modules.begin(), modules.end(), [&](const SimDeviceModule* m) {
+    return options.hosts(m->name);
+  });
+  if (!result.help && !hosts_any)
+    return fail(leaveOutFlags() + " together leave nothing to simulate");
   return result;
 }
 

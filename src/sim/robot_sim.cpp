@@ -38,10 +38,9 @@ constexpr std::size_t kMaxGarbageBurst = 24;
 /// whole once its last bit is through the line, as a UART reader would see it complete.
 constexpr auto kPaceSlice = std::chrono::milliseconds(2);
 
-/// Index of the checksum byte a corruption flips.
-std::size_t checksumIndex(OutputKind kind, std::size_t size) {
-  if (kind == OutputKind::kTelemetry && size >= 3) return size - 3;  // SUM precedes the 1F 2F tail
-  return size - 1;
+/// Index of the checksum byte a corruption flips (the kind says where its checksum is).
+std::size_t checksumIndex(const OutputKind& kind, std::size_t size) {
+  return size >= kind.checksum_from_end ? size - kind.checksum_from_end : size - 1;
 }
 
 }  // namespace
@@ -64,8 +63,9 @@ void RobotSim::event(const std::string& text) const {
 
 void RobotSim::start() {
   if (running_ || thread_.joinable()) return;
-  if (!options_.enable_base && !options_.enable_body && !options_.enable_servo_bus &&
-      options_.hosted.empty()) {
+  const auto& modules = registeredSimDevices();
+  if (std::none_of(modules.begin(), modules.end(),
+                   [&](const SimDeviceModule* module) { return options_.hosts(module->name); })) {
     throw std::invalid_argument("robot_sim: every device is disabled");
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -73,20 +73,10 @@ void RobotSim::start() {
   started_at_ = now;
   next_stats_write_ = now + fromSeconds(options_.stats_period_s);
   const FaultOptions& faults = options_.faults;
-  if (options_.enable_base) base_ = std::make_unique<BaseSim>(options_.base, now);
-  if (options_.enable_body) {
-    options_.body.seed = faults.seed + 1;
-    body_ = std::make_unique<BodySim>(options_.body, now);
-  }
-  if (options_.enable_servo_bus) {
-    options_.servo_bus.seed = faults.seed + 2;
-    servo_bus_ = std::make_unique<ServoBusSim>(options_.servo_bus, now);
-  }
+  startHosted(now);
 
   // Devices whose effective links are equal share one pty.
-  const auto portFor = [&](const std::optional<std::string>& own_link,
-                           const std::string& name) -> Port* {
-    const std::string link = own_link.value_or(options_.link);
+  const auto portFor = [&](const std::string& link, const std::string& name) -> Port* {
     for (auto& port : ports_) {
       if (port->link == link) {
         port->device_names.push_back(name);
@@ -96,24 +86,14 @@ void RobotSim::start() {
     auto port = std::make_unique<Port>();
     Port* raw = port.get();
     // The framer calls back into the devices on this port; a frame for a device that lives on
-    // another port (or is disabled) is only counted.
+    // another port (or is not hosted) is only counted.
     port->framer = std::make_unique<protocol::StreamFramer>(
         device::simulatorFramerFor(device::registeredDevices()),
         [this, raw](const FrameFamily& family, const uint8_t* data, std::size_t size) {
           // Paced: the request arrived when its last bit was through the line, not when this
           // thread woke up to feed it.
           const TimePoint at = rx_frame_end_ == TimePoint{} ? Clock::now() : rx_frame_end_;
-          Outbox outbox;
-          if (family == protocol::base::kFrames && base_port_ == raw) {
-            base_->handleFrame(data, size, at, &outbox);
-          } else if (family == protocol::body::kSyncWriteFrames && body_port_ == raw) {
-            body_->handleSyncWrite(data, size);
-          } else if (family == protocol::servo::kRequestFrames && servo_port_ == raw) {
-            servo_bus_->handleRequest(data, size, at);
-          } else if (!deliverToHosted(raw, family, data, size, at)) {
-            ++counters_.frames_for_absent_device;
-          }
-          for (Outgoing& frame : outbox) route(std::move(frame));
+          if (!deliverToHosted(raw, family, data, size, at)) ++counters_.frames_for_absent_device;
         });
     port->link = link;
     port->device_names.push_back(name);
@@ -121,11 +101,7 @@ void RobotSim::start() {
     ports_.push_back(std::move(port));
     return raw;
   };
-  // The ports named as the driver names its devices (the device set).
-  if (base_) base_port_ = portFor(options_.base_link, "base");
-  if (body_) body_port_ = portFor(options_.body_link, "body");
-  if (servo_bus_) servo_port_ = portFor(options_.servo_link, "servo_bus");
-  startHosted(now);
+  // The ports named as the driver names its devices (the device set), in the devices' order.
   for (Hosted& hosted : hosted_) hosted.port = portFor(hosted.port_link, hosted.name);
 
   for (auto& port : ports_) {
@@ -158,19 +134,8 @@ void RobotSim::stop() {
   writeStatsFile();
 }
 
-void RobotSim::route(Outgoing frame) {
-  switch (frame.kind) {
-    case OutputKind::kBaseReply:
-      return send(base_port_, std::move(frame));
-    case OutputKind::kTelemetry:
-      return send(body_port_, std::move(frame));
-    case OutputKind::kServoResponse:
-      return send(servo_port_, std::move(frame));
-  }
-}
-
 void RobotSim::send(Port* port, Outgoing frame) {
-  SendCounters& counters = counters_.sent[static_cast<std::size_t>(frame.kind)];
+  SendCounters& counters = countersOf(frame.kind);
   if (port == nullptr || !port->plugged || port->draining || frame.bytes.empty()) {
     ++counters.discarded;
     return;
@@ -179,8 +144,7 @@ void RobotSim::send(Port* port, Outgoing frame) {
   std::uniform_real_distribution<double> chance(0.0, 1.0);
   bool damaged = false;
   std::vector<uint8_t>& bytes = frame.bytes;
-  if (frame.kind == OutputKind::kServoResponse && faults.servo_fault_rate > 0 &&
-      chance(port->rng) < faults.servo_fault_rate) {
+  if (frame.garble_or_suppress_rate > 0 && chance(port->rng) < frame.garble_or_suppress_rate) {
     if (chance(port->rng) < 0.5) {
       ++counters.suppressed;
       return;
@@ -191,7 +155,7 @@ void RobotSim::send(Port* port, Outgoing frame) {
     damaged = true;
   }
   if (faults.corrupt_rate > 0 && chance(port->rng) < faults.corrupt_rate) {
-    bytes[checksumIndex(frame.kind, bytes.size())] ^= 0xFF;
+    bytes[checksumIndex(*frame.kind, bytes.size())] ^= 0xFF;
     damaged = true;
   }
   if (faults.drop_rate > 0 && chance(port->rng) < faults.drop_rate) {
@@ -257,7 +221,7 @@ void RobotSim::flush(Port* port) {
     pending.offset += static_cast<std::size_t>(written);
     if (pending.offset < pending.bytes.size()) continue;
     if (pending.is_frame) {
-      SendCounters& counters = counters_.sent[static_cast<std::size_t>(pending.kind)];
+      SendCounters& counters = countersOf(pending.kind);
       ++(pending.damaged ? counters.damaged : counters.intact);
     }
     port->backlog.pop_front();
@@ -276,21 +240,10 @@ void RobotSim::step(TimePoint now) {
       rx_frame_end_ = TimePoint{};
     }
   }
-  Outbox outbox;
-  if (base_) base_->tick(now, &outbox);
-  if (body_) {
-    // The board rides on the base: its IMU reports the base's true heading (slip included).
-    ChassisMotion chassis;
-    if (base_) chassis = ChassisMotion{base_->stats().yaw_rad, base_->yawRate()};
-    body_->tick(now, chassis, &outbox);
-  }
-  if (servo_bus_) servo_bus_->tick(now, &outbox);
-  for (Outgoing& frame : outbox) route(std::move(frame));
-  for (Hosted& hosted : hosted_) {
-    HostedOutbox hosted_out;
-    hosted.device->tick(now, &hosted_out);
-    sendHosted(hosted.port, &hosted_out);
-  }
+  // Every device ticks before any sends: what one writes into the world (the chassis it moves)
+  // reaches a later one in the same step.
+  for (Hosted& hosted : hosted_) hosted.device->tick(now, world_, &hosted.outbox);
+  for (Hosted& hosted : hosted_) sendAll(&hosted);
 
   const FaultOptions& faults = options_.faults;
   for (auto& owned : ports_) {
@@ -399,9 +352,6 @@ void RobotSim::run() {
     step(now);
 
     TimePoint next = now + std::chrono::milliseconds(100);
-    if (base_) next = std::min(next, base_->nextEvent());
-    if (body_) next = std::min(next, body_->nextEvent());
-    if (servo_bus_) next = std::min(next, servo_bus_->nextEvent());
     for (const Hosted& hosted : hosted_) next = std::min(next, hosted.device->nextEvent());
     next = std::min(next, next_stats_write_);
     for (auto& port : ports_) {
@@ -416,18 +366,18 @@ void RobotSim::run() {
 
 SimStats RobotSim::snapshotLocked() const {
   SimStats stats = counters_;
-  if (base_) stats.base = base_->stats();
-  if (body_) stats.body = body_->stats();
-  if (servo_bus_) stats.servo_bus = servo_bus_->stats();
-  for (const Hosted& hosted : hosted_) {
-    for (auto& line : hosted.device->statsLines()) stats.hosted.push_back(std::move(line));
-  }
-  for (const auto& port : ports_) {
-    const protocol::FramerStats& framer = port->framer->stats();
-    stats.framer.add(framer);
-    // Bad sync-writes: the CRC failures the body's framer saw (on a shared port this also counts
-    // bad frames of the other devices: the framer cannot tell whose a broken frame was).
-    if (port.get() == body_port_) stats.body_port_checksum_errors = framer.checksum_errors;
+  for (const auto& port : ports_) stats.framer.add(port->framer->stats());
+  for (const SimDeviceModule* module : registeredSimDevices()) {
+    PortCounters seen;
+    seen.all_ports = stats.framer;
+    const auto hosted = std::find_if(hosted_.begin(), hosted_.end(),
+                                     [&](const Hosted& h) { return h.name == module->name; });
+    if (hosted != hosted_.end()) {
+      seen.own_port = hosted->port->framer->stats();
+      stats.devices.push_back(hosted->device->stats(seen));
+    } else if (module->left_out_stats != nullptr) {
+      stats.devices.push_back(module->left_out_stats(seen));  // its keys, at zero
+    }
   }
   stats.uptime_s = toSeconds(Clock::now() - started_at_);
   return stats;

@@ -16,7 +16,7 @@ constexpr auto kReplugRetry = std::chrono::seconds(1);
 
 void RobotSim::unplug(Port* port, TimePoint now) {
   for (const Port::PendingWrite& pending : port->backlog) {
-    if (pending.is_frame) ++counters_.sent[static_cast<std::size_t>(pending.kind)].discarded;
+    if (pending.is_frame) ++countersOf(pending.kind).discarded;
   }
   port->backlog.clear();
   port->backlog_bytes = 0;

@@ -40,7 +40,7 @@ struct RobotSim::Port {
     std::vector<uint8_t> bytes;
     std::size_t offset = 0;
     bool is_frame = true;  ///< false for garbage bursts
-    OutputKind kind = OutputKind::kBaseReply;
+    const OutputKind* kind = nullptr;
     bool damaged = false;
     TimePoint ready_at{};  ///< --pace-baud: the line carries it from then on, not before
   };

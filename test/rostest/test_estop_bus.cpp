@@ -24,6 +24,7 @@
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/pty_tap.h"
 #include "support/ros_test_support.h"
@@ -59,7 +60,7 @@ std::unique_ptr<PtyTap> plugBus() {
 }
 
 std::optional<sim::BusServoSnapshot> simServo(uint8_t id) {
-  for (const sim::BusServoSnapshot& servo : g_robot->stats().servo_bus.servos) {
+  for (const sim::BusServoSnapshot& servo : servoBusStats(g_robot->stats()).servos) {
     if (servo.id == id) return servo;
   }
   return std::nullopt;
@@ -138,7 +139,7 @@ TEST_F(EStopBus, AStopEngagedWhileUnpluggedGoesFirstAfterTheReplugAndAgainWhenLo
       (*g_bus)->waitForFrames([](const auto& frames) { return !frames.empty(); }, kWaitSeconds));
   EXPECT_EQ((*g_bus)->frames().front().bytes, kSpin1Stop) << "the stop is the first frame";
   ASSERT_TRUE(waitMoving(1, false)) << "the lost stop was never written again";
-  EXPECT_EQ(g_robot->stats().servo_bus.stops_lost, 1u);
+  EXPECT_EQ(servoBusStats(g_robot->stats()).stops_lost, 1u);
   EXPECT_GE(count((*g_bus)->frames(), kSpin1Stop), 2u);
   EXPECT_TRUE(diagnostics_.waitFor(
       "servo_bus", diagnostics_.latest("servo_bus").received,
@@ -234,17 +235,17 @@ int main(int argc, char** argv) {
   g_bus_sim_port = g_bus_port + "_sim";
 
   sim::SimOptions options;
-  options.enable_body = false;
-  options.servo_bus.servo_ids = {0, 1, 2, 3};
-  options.servo_bus.lost_stops = 1;
-  options.servo_link = g_bus_sim_port;
-  options.base_link = base_port + "_sim";
+  options.device("body").enabled = false;
+  servoBusConfig(options).servo_ids = {0, 1, 2, 3};
+  servoBusConfig(options).lost_stops = 1;
+  options.device("servo_bus").link = g_bus_sim_port;
+  options.device("base").link = base_port + "_sim";
   sim::RobotSim robot(options);
   robot.start();
   g_robot = &robot;
   srd::protocol::FramerConfig base_framer;
   base_framer.accept(serial_robot_driver::protocol::base::kFrames);
-  PtyTap base(base_port, *options.base_link, base_framer);
+  PtyTap base(base_port, *options.device("base").link, base_framer);
   g_base = &base;
   std::unique_ptr<PtyTap> bus = plugBus();
   g_bus = &bus;

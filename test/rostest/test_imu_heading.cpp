@@ -16,6 +16,8 @@
 #include <string>
 #include <thread>
 
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -48,9 +50,9 @@ struct Robot {
       : odom(nh, "/" + ns + "/odom", 5), diagnostics(nh, ns + "/driver_node"), ns_(ns) {
     sim::SimOptions options;
     options.link = test_support::nodeParam("/" + ns + "/driver_node", "port");
-    options.enable_servo_bus = false;
-    options.base.turn_slip = kTurnSlip;
-    options.body.telemetry_rate_hz = telemetry_rate;
+    options.device("servo_bus").enabled = false;
+    baseConfig(options).turn_slip = kTurnSlip;
+    bodyConfig(options).telemetry_rate_hz = telemetry_rate;
     robot = std::make_unique<sim::RobotSim>(options);
     robot->start();
     cmd_vel = nh.advertise<geometry_msgs::Twist>("/" + ns + "/cmd_vel", 10);
@@ -69,14 +71,14 @@ struct Robot {
   bool waitStill() {
     const bool still = waitFor(
         [&] {
-          const auto base = robot->stats().base;
+          const auto base = baseStats(robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10);
     // A few more odom ticks, and telemetry periods, so odom has integrated up to the stop.
     return still && odom.waitForCount(odom.count() + 10, 10);
   }
-  double trueYaw() const { return robot->stats().base.yaw_rad; }
+  double trueYaw() const { return baseStats(robot->stats()).yaw_rad; }
   double odomYaw() const { return yawOf(odom.last()->pose.pose.orientation); }
 
   std::unique_ptr<sim::RobotSim> robot;
@@ -137,8 +139,8 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   ASSERT_TRUE(commanded_->waitStill());
   ASSERT_TRUE(fused_->resetOdometry());
   ASSERT_TRUE(commanded_->resetOdometry());
-  const sim::BaseSimStats fused_start = fused_->robot->stats().base;
-  const sim::BaseSimStats commanded_start = commanded_->robot->stats().base;
+  const sim::BaseSimStats fused_start = baseStats(fused_->robot->stats());
+  const sim::BaseSimStats commanded_start = baseStats(commanded_->robot->stats());
   const double fused_true0 = fused_start.yaw_rad;
   const double commanded_true0 = commanded_start.yaw_rad;
 
@@ -167,9 +169,9 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   // commanded pose curves off with the heading it believes.
   const auto fused_pose = fused_->odom.last()->pose;
   const double fused_position_error =
-      positionError(fused_start, fused_->robot->stats().base, fused_pose.pose.position);
+      positionError(fused_start, baseStats(fused_->robot->stats()), fused_pose.pose.position);
   const double commanded_position_error =
-      positionError(commanded_start, commanded_->robot->stats().base,
+      positionError(commanded_start, baseStats(commanded_->robot->stats()),
                     commanded_->odom.last()->pose.pose.position);
   std::printf("position error after the arc: with the IMU %.4f m, without %.4f m\n",
               fused_position_error, commanded_position_error);

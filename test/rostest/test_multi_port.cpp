@@ -10,19 +10,21 @@
 // fails cleanly, and after the replug it answers again.
 //
 // The machine may be busy (2 shared cores): the tests count frames and use generous deadlines.
+#include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <geometry_msgs/Twist.h>
-#include <gtest/gtest.h>
-#include <ros/ros.h>
-#include <sensor_msgs/JointState.h>
-
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -67,12 +69,12 @@ Layout readLayout(const std::string& ns) {
 std::unique_ptr<sim::RobotSim> startSim(const std::string& base_link, const std::string& body_link,
                                         const std::string& servo_link) {
   sim::SimOptions options;
-  options.enable_base = !base_link.empty();
-  options.enable_body = !body_link.empty();
-  options.enable_servo_bus = !servo_link.empty();
-  if (options.enable_base) options.base_link = base_link;
-  if (options.enable_body) options.body_link = body_link;
-  if (options.enable_servo_bus) options.servo_link = servo_link;
+  options.device("base").enabled = !base_link.empty();
+  options.device("body").enabled = !body_link.empty();
+  options.device("servo_bus").enabled = !servo_link.empty();
+  if (options.hosts("base")) options.device("base").link = base_link;
+  if (options.hosts("body")) options.device("body").link = body_link;
+  if (options.hosts("servo_bus")) options.device("servo_bus").link = servo_link;
   auto robot = std::make_unique<sim::RobotSim>(options);
   robot->start();
   return robot;
@@ -149,9 +151,10 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   const std::vector<WheelCommand> first = node.wheels.since(0);
   EXPECT_TRUE(first.front().reset_before) << "the first wheel frame must follow a Reset";
   for (std::size_t i = 1; i < first.size(); ++i) EXPECT_FALSE(first[i].reset_before) << i;
-  ASSERT_TRUE(waitFor([&] { return robot.base->stats().base.speed_frames_applied >= 5; }, 20));
-  EXPECT_GE(robot.base->stats().base.resets, 1u);
-  EXPECT_EQ(robot.base->stats().base.speed_frames_ignored, 0u);
+  ASSERT_TRUE(
+      waitFor([&] { return baseStats(robot.base->stats()).speed_frames_applied >= 5; }, 20));
+  EXPECT_GE(baseStats(robot.base->stats()).resets, 1u);
+  EXPECT_EQ(baseStats(robot.base->stats()).speed_frames_ignored, 0u);
 
   // Telemetry flows.
   EXPECT_TRUE(node.joints.waitForCount(10, 20)) << "no joint_states";
@@ -161,7 +164,7 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   const bool driving = waitFor(
       [&] {
         node.driveForward(0.3);
-        const sim::BaseSimStats base = robot.base->stats().base;
+        const sim::BaseSimStats base = baseStats(robot.base->stats());
         return std::abs(base.last_left_speed - expected_ticks) <= 1 &&
                std::abs(base.last_right_speed - expected_ticks) <= 1;
       },
@@ -171,9 +174,9 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
 
   // A joint command reaches the body's port as one sync-write.
   node.commandJoints({"joint_1", "joint_2"}, {0.25, -0.25});
-  ASSERT_TRUE(waitFor([&] { return robot.body->stats().body.sync_writes_ok >= 1; }, 20))
+  ASSERT_TRUE(waitFor([&] { return bodyStats(robot.body->stats()).sync_writes_ok >= 1; }, 20))
       << "the joint command never reached the simulated board";
-  const sim::BodySimStats body = robot.body->stats().body;
+  const sim::BodySimStats body = bodyStats(robot.body->stats());
   ASSERT_EQ(body.servos.size(), 2u);
   EXPECT_EQ(body.servos[0].target, ticksFor(0.25));
   EXPECT_EQ(body.servos[1].target, ticksFor(-0.25));
@@ -265,10 +268,8 @@ TEST_F(MultiPortTest, EachDeviceOnItsOwnPortAndServoBusUnplugAlone) {
   const sim::SimStats outage = robot.base->stats();
   const uint64_t wheels_during = node.wheels.count() - wheels_before;
   const uint64_t joints_during = node.joints.count() - joints_before;
-  const uint64_t telemetry_sent = outage.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)]
-                                      .intact -
-                                  before.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)]
-                                      .intact;
+  const uint64_t telemetry_sent =
+      outage.sentOf(sim::kTelemetryOutput).intact - before.sentOf(sim::kTelemetryOutput).intact;
   std::printf("servo bus unplugged: %llu wheel frames, %llu joint_states (simulator sent %llu "
               "telemetry frames)\n",
               static_cast<unsigned long long>(wheels_during),
@@ -278,11 +279,11 @@ TEST_F(MultiPortTest, EachDeviceOnItsOwnPortAndServoBusUnplugAlone) {
   for (const WheelCommand& wheel : node.wheels.since(wheels_before)) {
     EXPECT_FALSE(wheel.reset_before) << "the base port was disturbed (seq " << int(wheel.seq) << ")";
   }
-  EXPECT_EQ(outage.base.resets, before.base.resets);
-  EXPECT_EQ(outage.base.timeouts, before.base.timeouts);
-  EXPECT_FALSE(outage.base.in_error);
-  EXPECT_EQ(outage.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)].discarded,
-            before.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)].discarded);
+  EXPECT_EQ(baseStats(outage).resets, baseStats(before).resets);
+  EXPECT_EQ(baseStats(outage).timeouts, baseStats(before).timeouts);
+  EXPECT_FALSE(baseStats(outage).in_error);
+  EXPECT_EQ(outage.sentOf(sim::kTelemetryOutput).discarded,
+            before.sentOf(sim::kTelemetryOutput).discarded);
   // Every telemetry frame sent was published, give or take the ones in flight at either end of
   // the window (the soak test reconciles this exactly; here a loaded machine may delay a few).
   EXPECT_LE(std::llabs(static_cast<long long>(telemetry_sent) -

@@ -27,6 +27,7 @@
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/Telemetry.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -102,9 +103,9 @@ TEST(Replay, PublishesExactlyWhatWentOutLive) {
 
   sim::SimOptions options;
   options.link = port;
-  options.body.servo_ids = {1, 2, 3};
-  options.body.telemetry_rate_hz = 100;
-  options.body.foot_mode = sim::FootMode::kAlternate;
+  bodyConfig(options).servo_ids = {1, 2, 3};
+  bodyConfig(options).telemetry_rate_hz = 100;
+  bodyConfig(options).foot_mode = sim::FootMode::kAlternate;
   options.faults.seed = 12;
   options.faults.garbage_rate_hz = 4;
   options.faults.corrupt_rate = 0.05;

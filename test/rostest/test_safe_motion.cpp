@@ -29,6 +29,7 @@
 #include "serial_robot_driver/ServoRelax.h"
 #include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/ServoSpin.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
@@ -47,18 +48,18 @@ std::string g_port;
 std::unique_ptr<sim::RobotSim> makeBus(const std::string& port,
                                         const sim::ServoBusSimConfig& bus = {}) {
   sim::SimOptions options;
-  options.enable_base = false;
-  options.enable_body = false;
-  options.servo_bus = bus;
-  options.servo_bus.servo_ids = {0, 1, 2, 3};
-  options.servo_link = port;
+  options.device("base").enabled = false;
+  options.device("body").enabled = false;
+  servoBusConfig(options) = bus;
+  servoBusConfig(options).servo_ids = {0, 1, 2, 3};
+  options.device("servo_bus").link = port;
   auto robot = std::make_unique<sim::RobotSim>(options);
   robot->start();
   return robot;
 }
 
 std::optional<sim::BusServoSnapshot> simServo(const sim::RobotSim& robot, uint8_t id) {
-  for (const sim::BusServoSnapshot& servo : robot.stats().servo_bus.servos) {
+  for (const sim::BusServoSnapshot& servo : servoBusStats(robot.stats()).servos) {
     if (servo.id == id) return servo;
   }
   return std::nullopt;

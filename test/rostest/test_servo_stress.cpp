@@ -63,15 +63,15 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
 
   sim::SimOptions options;
   options.link = port;
-  options.body.telemetry_rate_hz = kTelemetryRateHz;
-  options.servo_bus.servo_ids = {kOnlineIds[0], kOnlineIds[1], kOnlineIds[2], kSilentId};
-  options.servo_bus.offline_ids = {kSilentId};
+  bodyConfig(options).telemetry_rate_hz = kTelemetryRateHz;
+  servoBusConfig(options).servo_ids = {kOnlineIds[0], kOnlineIds[1], kOnlineIds[2], kSilentId};
+  servoBusConfig(options).offline_ids = {kSilentId};
   sim::RobotSim robot(options);
   robot.start();
   ASSERT_EQ(robot.ports().size(), 1u);
 
   // Warm-up: the port is open, wheel frames and telemetry flow, the bus answers.
-  ASSERT_TRUE(waitFor([&] { return robot.stats().base.speed_frames_applied >= 5; }, 20))
+  ASSERT_TRUE(waitFor([&] { return baseStats(robot.stats()).speed_frames_applied >= 5; }, 20))
       << "no wheel frames reached the simulated base";
   ASSERT_TRUE(joints.waitForCount(20, 20)) << "no joint_states";
   srd::ServoPing first_ping;
@@ -103,7 +103,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   // Every joint command published has reached the board before the simulator stops.
   motion.stop();
   const uint64_t joint_commands = motion.jointCommandsSent();
-  waitFor([&] { return robot.stats().body.sync_writes_ok >= joint_commands; }, 10);
+  waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= joint_commands; }, 10);
 
   // --- the window closes: stop the simulator, wait until nothing is in flight any more ---
   robot.stop();
@@ -177,29 +177,30 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   EXPECT_EQ(not_returned, 0u);
   EXPECT_EQ(online_ok, online);
   EXPECT_EQ(offline_ok, offline);
-  EXPECT_EQ(close.servo_bus.malformed, 0u);
+  EXPECT_EQ(servoBusStats(close).malformed, 0u);
 
   // --- the wheel heartbeat, counted at the simulated base ---
   const double window_s = close.uptime_s - open.uptime_s;
   const uint64_t speed_frames = speedFramesReceived(close) - speedFramesReceived(open);
   const double expected_frames = window_s * kBaseLoopRateHz;
-  std::printf("base: window %.1f s, %llu speed frames received by the simulator (%.0f at %.0f Hz), "
-              "%llu resets, %llu FF errors sent, %llu heartbeat timeouts, %llu SEQ gaps; node: "
-              "loop overruns %s, worst loop period %s ms\n",
-              window_s, static_cast<unsigned long long>(speed_frames), expected_frames,
-              kBaseLoopRateHz, static_cast<unsigned long long>(close.base.resets),
-              static_cast<unsigned long long>(close.base.errors_sent),
-              static_cast<unsigned long long>(close.base.timeouts),
-              static_cast<unsigned long long>(close.base.seq_gaps),
-              base_status.value("loop overruns").c_str(),
-              base_status.value("worst loop period (ms)").c_str());
-  EXPECT_EQ(close.base.errors_sent, 0u) << "the base's heartbeat expired";
-  EXPECT_EQ(close.base.timeouts, 0u);
-  EXPECT_EQ(close.base.resets, 1u) << "a Reset after the first: the node saw its own 1 s gap";
-  EXPECT_EQ(close.base.speed_frames_ignored, 0u);
-  EXPECT_EQ(close.base.seq_gaps, 0u) << "a wheel frame went missing between node and base";
+  std::printf(
+      "base: window %.1f s, %llu speed frames received by the simulator (%.0f at %.0f Hz), "
+      "%llu resets, %llu FF errors sent, %llu heartbeat timeouts, %llu SEQ gaps; node: "
+      "loop overruns %s, worst loop period %s ms\n",
+      window_s, static_cast<unsigned long long>(speed_frames), expected_frames, kBaseLoopRateHz,
+      static_cast<unsigned long long>(baseStats(close).resets),
+      static_cast<unsigned long long>(baseStats(close).errors_sent),
+      static_cast<unsigned long long>(baseStats(close).timeouts),
+      static_cast<unsigned long long>(baseStats(close).seq_gaps),
+      base_status.value("loop overruns").c_str(),
+      base_status.value("worst loop period (ms)").c_str());
+  EXPECT_EQ(baseStats(close).errors_sent, 0u) << "the base's heartbeat expired";
+  EXPECT_EQ(baseStats(close).timeouts, 0u);
+  EXPECT_EQ(baseStats(close).resets, 1u) << "a Reset after the first: the node saw its own 1 s gap";
+  EXPECT_EQ(baseStats(close).speed_frames_ignored, 0u);
+  EXPECT_EQ(baseStats(close).seq_gaps, 0u) << "a wheel frame went missing between node and base";
   EXPECT_GE(static_cast<double>(speed_frames), 0.9 * expected_frames);
-  EXPECT_GT(close.base.speed_frames_applied, 0u);
+  EXPECT_GT(baseStats(close).speed_frames_applied, 0u);
 
   // --- telemetry ---
   const int64_t sent_in_window = static_cast<int64_t>(telemetryIntact(close) -
@@ -209,8 +210,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   const int64_t received_total = static_cast<int64_t>(joints_close);
   const int64_t unread_bytes = static_cast<int64_t>(close.bytes_sent) -
                                static_cast<int64_t>(port_final->number("bytes in"));
-  const auto& telemetry_counters =
-      close.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)];
+  const auto& telemetry_counters = close.sentOf(sim::kTelemetryOutput);
   std::printf("telemetry: window: %lld frames sent intact, %lld joint_states received (in flight "
               "at the opening: %lld); whole run: %lld sent, %lld received, %lld lost, %lld bytes "
               "never read by the node; discarded by the simulator %llu\n",
@@ -234,19 +234,19 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   EXPECT_EQ(body_status.number("decode errors"), 0u);
 
   // --- joint commands and the host -> robot direction ---
-  std::printf("joint commands: %llu published, %llu sync-writes applied by the board; cmd_vel: "
-              "%llu published; host frames: %s out, checksum errors at the simulator %llu\n",
-              static_cast<unsigned long long>(joint_commands),
-              static_cast<unsigned long long>(close.body.sync_writes_ok),
-              static_cast<unsigned long long>(motion.cmdVelSent()),
-              port_final->value("frames out").c_str(),
-              static_cast<unsigned long long>(close.framer.checksum_errors));
-  EXPECT_EQ(close.body.sync_writes_ok, joint_commands);
+  std::printf(
+      "joint commands: %llu published, %llu sync-writes applied by the board; cmd_vel: "
+      "%llu published; host frames: %s out, checksum errors at the simulator %llu\n",
+      static_cast<unsigned long long>(joint_commands),
+      static_cast<unsigned long long>(bodyStats(close).sync_writes_ok),
+      static_cast<unsigned long long>(motion.cmdVelSent()), port_final->value("frames out").c_str(),
+      static_cast<unsigned long long>(close.framer.checksum_errors));
+  EXPECT_EQ(bodyStats(close).sync_writes_ok, joint_commands);
   EXPECT_EQ(close.framer.checksum_errors, 0u);
   EXPECT_EQ(close.framer.bad_lengths, 0u);
   EXPECT_EQ(close.frames_for_absent_device, 0u);
-  EXPECT_EQ(close.base.unknown_frames, 0u);
-  EXPECT_EQ(close.body.sync_writes_malformed, 0u);
+  EXPECT_EQ(baseStats(close).unknown_frames, 0u);
+  EXPECT_EQ(bodyStats(close).sync_writes_malformed, 0u);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -30,7 +31,7 @@ const char* const kServoBusStatus = "servo_bus";
 sim::RobotSim* g_robot = nullptr;
 
 std::optional<double> simAngleDeg(uint8_t id) {
-  for (const sim::BusServoSnapshot& servo : g_robot->stats().servo_bus.servos) {
+  for (const sim::BusServoSnapshot& servo : servoBusStats(g_robot->stats()).servos) {
     if (servo.id == id) return servo.angle_deg;
   }
   return std::nullopt;
@@ -165,10 +166,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   sim::SimOptions options;
-  options.enable_base = false;
-  options.enable_body = false;
-  options.servo_bus.servo_ids = {0, 1, 2, 3};
-  options.servo_link = port;
+  options.device("base").enabled = false;
+  options.device("body").enabled = false;
+  servoBusConfig(options).servo_ids = {0, 1, 2, 3};
+  options.device("servo_bus").link = port;
   sim::RobotSim robot(options);
   robot.start();
   g_robot = &robot;

@@ -69,13 +69,13 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
 
   sim::SimOptions options;
   options.link = port;
-  options.body.foot_mode = sim::FootMode::kAlternate;
-  options.body.imu_noise = true;
+  bodyConfig(options).foot_mode = sim::FootMode::kAlternate;
+  bodyConfig(options).imu_noise = true;
   options.faults.seed = 20240611;
   options.faults.garbage_rate_hz = 5.0;
   options.faults.corrupt_rate = 0.02;
   options.faults.drop_rate = 0.02;
-  options.faults.servo_fault_rate = 0.1;
+  servoBusConfig(options).answer_fault_rate = 0.1;
   options.faults.unplug_every_s = kUnplugEvery;
   options.faults.unplug_duration_s = kUnplugDuration;
   sim::RobotSim robot(options);
@@ -184,7 +184,7 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
               static_cast<unsigned long long>(total_sent - total_received),
               static_cast<unsigned long long>(total_flushed),
               static_cast<unsigned long long>(exact_episodes), boundaries.size());
-  const auto tel = last.sim.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)];
+  const auto tel = last.sim.sentOf(sim::kTelemetryOutput);
   std::printf("simulator: telemetry damaged %llu, discarded %llu; garbage bursts %llu (%llu B); "
               "driver: checksum errors %s, bytes skipped %s\n",
               static_cast<unsigned long long>(tel.damaged),
@@ -211,22 +211,24 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   EXPECT_EQ(last.sim.framer.checksum_errors, 0u) << "a host frame arrived corrupted";
   EXPECT_EQ(last.sim.framer.bad_lengths, 0u);
   EXPECT_EQ(last.sim.frames_for_absent_device, 0u);
-  EXPECT_EQ(last.sim.base.unknown_frames, 0u);
-  EXPECT_EQ(last.sim.body.sync_writes_malformed, 0u);
-  EXPECT_EQ(last.sim.servo_bus.malformed, 0u);
+  EXPECT_EQ(baseStats(last.sim).unknown_frames, 0u);
+  EXPECT_EQ(bodyStats(last.sim).sync_writes_malformed, 0u);
+  EXPECT_EQ(servoBusStats(last.sim).malformed, 0u);
   // After every reconnect the Reset came before the first speed frame: the base, in its heartbeat
   // error state after each unplug, never had to ignore a speed frame.
-  EXPECT_EQ(last.sim.base.speed_frames_ignored, 0u);
-  EXPECT_GE(last.sim.base.timeouts, last.unplugs - 1);  // every unplug outlasted the heartbeat
-  EXPECT_GT(last.sim.base.speed_frames_applied, 0u);
-  EXPECT_LE(last.sim.base.speed_frames_applied, wheels.count());
-  std::printf("base: %llu wheel frames published, %llu applied by the base, %llu resets received, "
-              "%llu heartbeat timeouts, %llu battery requests\n",
-              static_cast<unsigned long long>(wheels.count()),
-              static_cast<unsigned long long>(last.sim.base.speed_frames_applied),
-              static_cast<unsigned long long>(last.sim.base.resets),
-              static_cast<unsigned long long>(last.sim.base.timeouts),
-              static_cast<unsigned long long>(last.sim.base.battery_requests));
+  EXPECT_EQ(baseStats(last.sim).speed_frames_ignored, 0u);
+  EXPECT_GE(baseStats(last.sim).timeouts,
+            last.unplugs - 1);  // every unplug outlasted the heartbeat
+  EXPECT_GT(baseStats(last.sim).speed_frames_applied, 0u);
+  EXPECT_LE(baseStats(last.sim).speed_frames_applied, wheels.count());
+  std::printf(
+      "base: %llu wheel frames published, %llu applied by the base, %llu resets received, "
+      "%llu heartbeat timeouts, %llu battery requests\n",
+      static_cast<unsigned long long>(wheels.count()),
+      static_cast<unsigned long long>(baseStats(last.sim).speed_frames_applied),
+      static_cast<unsigned long long>(baseStats(last.sim).resets),
+      static_cast<unsigned long long>(baseStats(last.sim).timeouts),
+      static_cast<unsigned long long>(baseStats(last.sim).battery_requests));
 
   // Every joint command is accounted for by the node (diagnostics once a second).
   const uint64_t commands = motion.jointCommandsSent();
@@ -240,34 +242,32 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
       [] { return true; }, 10);
   ASSERT_TRUE(body.has_value()) << "the node did not account for all " << commands
                                 << " joint commands";
-  std::printf("joint commands: %llu published, %llu sent, %llu failed (port down), %llu rejected; "
-              "simulator applied %llu; telemetry decode errors %s\n",
-              static_cast<unsigned long long>(commands),
-              static_cast<unsigned long long>(body->number("commands sent")),
-              static_cast<unsigned long long>(body->number("command write failures")),
-              static_cast<unsigned long long>(body->number("commands rejected")),
-              static_cast<unsigned long long>(robot.stats().body.sync_writes_ok),
-              body->value("decode errors").c_str());
+  std::printf(
+      "joint commands: %llu published, %llu sent, %llu failed (port down), %llu rejected; "
+      "simulator applied %llu; telemetry decode errors %s\n",
+      static_cast<unsigned long long>(commands),
+      static_cast<unsigned long long>(body->number("commands sent")),
+      static_cast<unsigned long long>(body->number("command write failures")),
+      static_cast<unsigned long long>(body->number("commands rejected")),
+      static_cast<unsigned long long>(bodyStats(robot.stats()).sync_writes_ok),
+      body->value("decode errors").c_str());
   EXPECT_EQ(body->number("commands sent") + body->number("command write failures"), commands);
   EXPECT_EQ(body->number("commands rejected"), 0u);
   EXPECT_EQ(body->number("decode errors"), 0u);
-  EXPECT_LE(robot.stats().body.sync_writes_ok, body->number("commands sent"));
+  EXPECT_LE(bodyStats(robot.stats()).sync_writes_ok, body->number("commands sent"));
 
   // Every service call returned, and every failure said why.
   const sim::SimStats final_sim = robot.stats();
-  const uint64_t servo_answers =
-      final_sim.sent[static_cast<std::size_t>(sim::OutputKind::kServoResponse)].intact;
-  std::printf("services: %llu calls, %llu succeeded, %llu failed with a reason, slowest %.0f ms; "
-              "servo answers sent intact %llu, garbled %llu, withheld %llu\n",
-              static_cast<unsigned long long>(services.calls),
-              static_cast<unsigned long long>(services.successes),
-              static_cast<unsigned long long>(services.failures), 1000 * services.slowest_s,
-              static_cast<unsigned long long>(servo_answers),
-              static_cast<unsigned long long>(
-                  final_sim.sent[static_cast<std::size_t>(sim::OutputKind::kServoResponse)].damaged),
-              static_cast<unsigned long long>(
-                  final_sim.sent[static_cast<std::size_t>(sim::OutputKind::kServoResponse)]
-                      .suppressed));
+  const uint64_t servo_answers = final_sim.sentOf(sim::kServoAnswerOutput).intact;
+  std::printf(
+      "services: %llu calls, %llu succeeded, %llu failed with a reason, slowest %.0f ms; "
+      "servo answers sent intact %llu, garbled %llu, withheld %llu\n",
+      static_cast<unsigned long long>(services.calls),
+      static_cast<unsigned long long>(services.successes),
+      static_cast<unsigned long long>(services.failures), 1000 * services.slowest_s,
+      static_cast<unsigned long long>(servo_answers),
+      static_cast<unsigned long long>(final_sim.sentOf(sim::kServoAnswerOutput).damaged),
+      static_cast<unsigned long long>(final_sim.sentOf(sim::kServoAnswerOutput).suppressed));
   EXPECT_EQ(services.call_failures, 0u);
   EXPECT_EQ(services.silent_failures, 0u);
   EXPECT_GT(services.answered_successes, 0u);

@@ -18,6 +18,8 @@
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/ServoRotate.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -39,13 +41,13 @@ sim::RobotSim* g_robot = nullptr;
 
 /// The simulated servo's position (rad) of joint_1 (index 0) or joint_2 (index 1).
 double simJoint(std::size_t index) {
-  return (g_robot->stats().body.servos.at(index).position - 2048.0) * kRadPerTick;
+  return (bodyStats(g_robot->stats()).servos.at(index).position - 2048.0) * kRadPerTick;
 }
-uint64_t syncWrites() { return g_robot->stats().body.sync_writes_ok; }
+uint64_t syncWrites() { return bodyStats(g_robot->stats()).sync_writes_ok; }
 
 /// The bus joint "pan": servo 2, zero at 30 deg, direction -1 (trajectory.test).
 double simPan() {
-  for (const auto& servo : g_robot->stats().servo_bus.servos) {
+  for (const auto& servo : servoBusStats(g_robot->stats()).servos) {
     if (servo.id == 2) return -(servo.angle_deg - 30.0) * M_PI / 180.0;
   }
   return std::nan("");
@@ -363,7 +365,7 @@ int main(int argc, char** argv) {
   test_support::RosTestNode node(argc, argv, "test_trajectory");
   sim::SimOptions options;
   options.link = test_support::nodeParam(kNode, "port");
-  options.enable_base = false;
-  options.enable_servo_bus = true;
+  options.device("base").enabled = false;
+  options.device("servo_bus").enabled = true;
   return test_support::runAllTestsWithSim(options, &g_robot);
 }

@@ -19,6 +19,7 @@
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/fake_device.h"
@@ -88,7 +89,7 @@ bool isMotionToAnAngle(const Bytes& request) {
 
 /// The simulated bus servo 2's angle (deg).
 double simServo2() {
-  for (const auto& servo : g_robot->stats().servo_bus.servos) {
+  for (const auto& servo : servoBusStats(g_robot->stats()).servos) {
     if (servo.id == 2) return servo.angle_deg;
   }
   return std::nan("");
@@ -243,7 +244,7 @@ TEST_F(TrajectoryStop, CancelStopsAFastBusJointWithoutAMoveBack) {
       << "no SPIN stop for servo 2 after the cancel";
   ASSERT_TRUE(waitFor(
       [] {
-        for (const auto& servo : g_robot->stats().servo_bus.servos) {
+        for (const auto& servo : servoBusStats(g_robot->stats()).servos) {
           if (servo.id == 2) return !servo.moving;
         }
         return false;
@@ -294,16 +295,16 @@ int main(int argc, char** argv) {
 
   const std::string bus_port = test_support::nodeParam(kNode, "servo_bus/port");
   sim::SimOptions options;
-  options.enable_base = false;
-  options.enable_body = false;
-  options.servo_bus.servo_ids = {2};
-  options.servo_link = bus_port + "_sim";
+  options.device("base").enabled = false;
+  options.device("body").enabled = false;
+  servoBusConfig(options).servo_ids = {2};
+  options.device("servo_bus").link = bus_port + "_sim";
   sim::RobotSim robot(options);
   robot.start();
   g_robot = &robot;
   serial_robot_driver::protocol::FramerConfig bus_framer;
   bus_framer.accept(serial_robot_driver::protocol::servo::kRequestFrames);
-  test_support::PtyTap tap(bus_port, *options.servo_link, bus_framer);
+  test_support::PtyTap tap(bus_port, *options.device("servo_bus").link, bus_framer);
   g_bus = &tap;
 
   const int result = RUN_ALL_TESTS();

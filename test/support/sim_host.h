@@ -192,22 +192,22 @@ class TempDir {
 
 inline SimOptions onlyBase() {
   SimOptions options;
-  options.enable_body = false;
-  options.enable_servo_bus = false;
+  options.device("body").enabled = false;
+  options.device("servo_bus").enabled = false;
   return options;
 }
 inline SimOptions onlyBody() {
   SimOptions options;
-  options.enable_base = false;
-  options.enable_servo_bus = false;
+  options.device("base").enabled = false;
+  options.device("servo_bus").enabled = false;
   return options;
 }
 inline SimOptions onlyServoBus() {
   SimOptions options;
-  options.enable_base = false;
-  options.enable_body = false;
-  options.servo_bus.servo_ids = {0, 1, 2, 3, 7};
-  options.servo_bus.offline_ids = {7};
+  options.device("base").enabled = false;
+  options.device("body").enabled = false;
+  servoBusConfig(options).servo_ids = {0, 1, 2, 3, 7};
+  servoBusConfig(options).offline_ids = {7};
   return options;
 }
 

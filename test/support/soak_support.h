@@ -28,6 +28,9 @@
 #include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/framer_configs.h"
@@ -60,7 +63,7 @@ inline double soakSeconds() {
 }
 
 inline uint64_t telemetryIntact(const sim::SimStats& s) {
-  return s.sent[static_cast<std::size_t>(sim::OutputKind::kTelemetry)].intact;
+  return s.sentOf(sim::kTelemetryOutput).intact;
 }
 inline uint64_t hostFramesReceived(const sim::SimStats& s) {
   using protocol::FrameFamily;

@@ -13,7 +13,7 @@ using namespace sim_test;  // NOLINT: the shared fixture
 
 TEST(RobotSimBase, AnswersBatteryRequestsAndCountsResets) {
   SimOptions options = onlyBase();
-  options.base.battery_percent = 64;
+  baseConfig(options).battery_percent = 64;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), baseHostConfig());
@@ -21,12 +21,12 @@ TEST(RobotSimBase, AnswersBatteryRequestsAndCountsResets) {
   host.send(kBatteryRequestSeq1);
   host.send(kResetSeq2);
   EXPECT_TRUE(host.waitForFrame(kBattery64ReplySeq0));
-  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.base.resets == 1; }));
+  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).resets == 1; }));
   const SimStats stats = sim.stats();
-  EXPECT_EQ(stats.base.frames_received, 2u);
-  EXPECT_EQ(stats.base.battery_requests, 1u);
-  EXPECT_EQ(stats.base.seq_gaps, 0u);
-  EXPECT_EQ(stats.sent[static_cast<std::size_t>(OutputKind::kBaseReply)].intact, 1u);
+  EXPECT_EQ(baseStats(stats).frames_received, 2u);
+  EXPECT_EQ(baseStats(stats).battery_requests, 1u);
+  EXPECT_EQ(baseStats(stats).seq_gaps, 0u);
+  EXPECT_EQ(stats.sentOf(kBaseReplyOutput).intact, 1u);
 }
 
 TEST(RobotSimBase, SpeedFramesIntegrateAndClearEncodersZeroes) {
@@ -35,28 +35,29 @@ TEST(RobotSimBase, SpeedFramesIntegrateAndClearEncodersZeroes) {
   Host host(slaveOf(sim), baseHostConfig());
   ASSERT_TRUE(host.ok());
   host.send(kBoth4Seq0);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.base.left_ticks >= 40; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).left_ticks >= 40; }));
   host.send(kBoth0Seq1);
   ASSERT_TRUE(
-      waitForStats(sim, [](const SimStats& s) { return s.base.speed_frames_applied == 2; }));
+      waitForStats(sim, [](const SimStats& s) { return baseStats(s).speed_frames_applied == 2; }));
   SimStats stats = sim.stats();
-  EXPECT_EQ(stats.base.left_ticks, stats.base.right_ticks);
-  EXPECT_EQ(stats.base.left_ticks % 4, 0);
-  EXPECT_EQ(stats.base.last_left_speed, 0);
+  EXPECT_EQ(baseStats(stats).left_ticks, baseStats(stats).right_ticks);
+  EXPECT_EQ(baseStats(stats).left_ticks % 4, 0);
+  EXPECT_EQ(baseStats(stats).last_left_speed, 0);
 
   host.send(kClearEncodersSeq3);  // SEQ 03 after 01: one gap
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.base.encoder_clears == 1; }));
+  ASSERT_TRUE(
+      waitForStats(sim, [](const SimStats& s) { return baseStats(s).encoder_clears == 1; }));
   stats = sim.stats();
-  EXPECT_EQ(stats.base.left_ticks, 0);
-  EXPECT_EQ(stats.base.right_ticks, 0);
-  EXPECT_EQ(stats.base.seq_gaps, 1u);
+  EXPECT_EQ(baseStats(stats).left_ticks, 0);
+  EXPECT_EQ(baseStats(stats).right_ticks, 0);
+  EXPECT_EQ(baseStats(stats).seq_gaps, 1u);
 
   host.send(kBothMinus6Seq0);  // SEQ 00 after 03: another gap
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.base.left_ticks <= -12; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).left_ticks <= -12; }));
   stats = sim.stats();
-  EXPECT_EQ(stats.base.last_left_speed, -6);
-  EXPECT_EQ(stats.base.last_right_speed, -6);
-  EXPECT_EQ(stats.base.seq_gaps, 2u);
+  EXPECT_EQ(baseStats(stats).last_left_speed, -6);
+  EXPECT_EQ(baseStats(stats).last_right_speed, -6);
+  EXPECT_EQ(baseStats(stats).seq_gaps, 2u);
 }
 
 TEST(RobotSimBase, SilenceRaisesTheTimeoutErrorAndSpeedIsIgnoredUntilReset) {
@@ -68,18 +69,18 @@ TEST(RobotSimBase, SilenceRaisesTheTimeoutErrorAndSpeedIsIgnoredUntilReset) {
   ASSERT_TRUE(host.waitForFrame(kErrorStatusSeq0));
   host.send(kBoth4Seq0);
   ASSERT_TRUE(
-      waitForStats(sim, [](const SimStats& s) { return s.base.speed_frames_ignored == 1; }));
-  EXPECT_EQ(sim.stats().base.left_ticks, 0);
-  EXPECT_TRUE(sim.stats().base.in_error);
+      waitForStats(sim, [](const SimStats& s) { return baseStats(s).speed_frames_ignored == 1; }));
+  EXPECT_EQ(baseStats(sim.stats()).left_ticks, 0);
+  EXPECT_TRUE(baseStats(sim.stats()).in_error);
 
   host.send(kResetSeq1);
   host.send(kBoth4Seq2);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.base.left_ticks > 0; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).left_ticks > 0; }));
   const SimStats stats = sim.stats();
-  EXPECT_FALSE(stats.base.in_error);
-  EXPECT_EQ(stats.base.resets, 1u);
-  EXPECT_EQ(stats.base.speed_frames_applied, 1u);
-  EXPECT_GE(stats.base.errors_sent, 1u);
+  EXPECT_FALSE(baseStats(stats).in_error);
+  EXPECT_EQ(baseStats(stats).resets, 1u);
+  EXPECT_EQ(baseStats(stats).speed_frames_applied, 1u);
+  EXPECT_GE(baseStats(stats).errors_sent, 1u);
 }
 
 // --- the body on a pty -----------------------------------------------------------------------
@@ -110,8 +111,8 @@ TEST(RobotSimBody, TelemetryDecodesWithGravityOnZ) {
 
 TEST(RobotSimBody, SyncWriteMovesTheServoTowardItsTarget) {
   SimOptions options = onlyBody();
-  options.body.servo_ids = {2, 3};
-  options.body.servo_speed = 4096;
+  bodyConfig(options).servo_ids = {2, 3};
+  bodyConfig(options).servo_speed = 4096;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
@@ -130,12 +131,12 @@ TEST(RobotSimBody, SyncWriteMovesTheServoTowardItsTarget) {
   };
   EXPECT_TRUE(host.waitUntil(reached));
   EXPECT_TRUE(saw_full_speed);
-  EXPECT_EQ(sim.stats().body.sync_writes_ok, 1u);
+  EXPECT_EQ(bodyStats(sim.stats()).sync_writes_ok, 1u);
 }
 
 TEST(RobotSimBody, BadCrcAndUnknownIdsAreCounted) {
   SimOptions options = onlyBody();
-  options.body.servo_ids = {2};
+  bodyConfig(options).servo_ids = {2};
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(1));
@@ -144,16 +145,17 @@ TEST(RobotSimBody, BadCrcAndUnknownIdsAreCounted) {
   bad_crc.back() ^= 0xFF;
   host.send(bad_crc);
   host.send(kSyncWrite2And3);  // id 3 is not on this board
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.body.sync_writes_ok == 1; }));
+  ASSERT_TRUE(
+      waitForStats(sim, [](const SimStats& s) { return bodyStats(s).sync_writes_ok == 1; }));
   const SimStats stats = sim.stats();
-  EXPECT_EQ(stats.body.sync_write_unknown_ids, 1u);
-  EXPECT_GE(stats.body_port_checksum_errors, 1u);
+  EXPECT_EQ(bodyStats(stats).sync_write_unknown_ids, 1u);
+  EXPECT_GE(bodyStats(stats).port_checksum_errors, 1u);
   EXPECT_NE(formatStats(stats).find("sync_writes_bad 1\n"), std::string::npos);
 }
 
 TEST(RobotSimBody, FootAlternateInterleavesFrameLengths) {
   SimOptions options = onlyBody();
-  options.body.foot_mode = FootMode::kAlternate;
+  bodyConfig(options).foot_mode = FootMode::kAlternate;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
@@ -206,9 +208,9 @@ TEST_F(RobotSimServoBus, PingAnswersOnlineServosOnly) {
   expectSilence(kPing7);  // configured offline
   expectReply(kPing3, kPing3Reply);
   const SimStats stats = sim_->stats();
-  EXPECT_EQ(stats.servo_bus.requests, 3u);
-  EXPECT_EQ(stats.servo_bus.unaddressed, 1u);
-  EXPECT_EQ(stats.servo_bus.answers, 2u);
+  EXPECT_EQ(servoBusStats(stats).requests, 3u);
+  EXPECT_EQ(servoBusStats(stats).unaddressed, 1u);
+  EXPECT_EQ(servoBusStats(stats).answers, 2u);
 }
 
 TEST_F(RobotSimServoBus, VoltageReadIsPlausible) {
@@ -228,7 +230,7 @@ TEST_F(RobotSimServoBus, WriteIsReadBackAndReadOnlyWritesFail) {
   expectReply(kReadLimitHigh1, kReadLimitHigh1Reply);
   expectReply(kWriteVoltage0, kWriteVoltage0Reply);
   expectSilence(kReadUnknown20);
-  EXPECT_EQ(sim_->stats().servo_bus.unknown_data_ids, 1u);
+  EXPECT_EQ(servoBusStats(sim_->stats()).unknown_data_ids, 1u);
 }
 
 TEST_F(RobotSimServoBus, RotateMovesTheAngleWithoutAnAnswerByDefault) {
@@ -262,7 +264,7 @@ TEST_F(RobotSimServoBus, ServoIdWriteMovesTheServoAndResetSendsItToIdZero) {
   // Like the servo: the reset restores the factory id 0, and the answer comes from there.
   expectReply(kResetUserData9, kResetUserDataOkFromId0);
   expectSilence(kPing9);
-  const auto servos = sim_->stats().servo_bus.servos;
+  const auto servos = servoBusStats(sim_->stats()).servos;
   EXPECT_EQ(std::count_if(servos.begin(), servos.end(),
                           [](const BusServoSnapshot& servo) { return servo.id == 0; }),
             2);
@@ -290,7 +292,7 @@ TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {
   host_->frames().clear();
   host_->send(protocol::servo::encodeWriteBatchData(0, new_block));
   EXPECT_TRUE(host_->waitForFrame({0x05, 0x1C, 0x06, 0x02, 0x00, 0x01, 0x2A}));
-  const auto servos = sim_->stats().servo_bus.servos;
+  const auto servos = servoBusStats(sim_->stats()).servos;
   ASSERT_FALSE(servos.empty());
   EXPECT_EQ(servos[0].params.at(51), 900);
 }
@@ -298,10 +300,10 @@ TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {
 TEST_F(RobotSimServoBus, BroadcastActsOnAllAndAnswersNone) {
   expectSilence(kRotateAllTo45);
   ASSERT_TRUE(waitForStats(*sim_, [](const SimStats& s) {
-    return std::all_of(s.servo_bus.servos.begin(), s.servo_bus.servos.end(),
+    return std::all_of(servoBusStats(s).servos.begin(), servoBusStats(s).servos.end(),
                        [](const BusServoSnapshot& servo) { return servo.angle_deg == 45.0; });
   }));
-  EXPECT_EQ(sim_->stats().servo_bus.broadcasts, 1u);
+  EXPECT_EQ(servoBusStats(sim_->stats()).broadcasts, 1u);
 }
 
 }  // namespace

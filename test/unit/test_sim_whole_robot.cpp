@@ -40,9 +40,9 @@ TEST(RobotSim, SharedPortCarriesAllThreeDevicesBehindTheLink) {
 TEST(RobotSim, DevicesWithTheirOwnLinksGetTheirOwnPtys) {
   TempDir dir;
   SimOptions options;
-  options.base_link = dir.file("base");
-  options.body_link = dir.file("body");
-  options.servo_link = dir.file("body");  // naming the same link: shared
+  options.device("base").link = dir.file("base");
+  options.device("body").link = dir.file("body");
+  options.device("servo_bus").link = dir.file("body");  // naming the same link: shared
   RobotSim sim(options);
   sim.start();
   const auto ports = sim.ports();
@@ -54,15 +54,15 @@ TEST(RobotSim, DevicesWithTheirOwnLinksGetTheirOwnPtys) {
   ASSERT_TRUE(base_host.ok());
   base_host.send(kSyncWrite2And3);  // the board is not on this port
   base_host.send(kResetSeq2);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.base.resets == 1; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).resets == 1; }));
   const SimStats stats = sim.stats();
   EXPECT_EQ(stats.frames_for_absent_device, 1u);
-  EXPECT_EQ(stats.body.sync_writes_ok, 0u);
+  EXPECT_EQ(bodyStats(stats).sync_writes_ok, 0u);
 }
 
 TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
   SimOptions options = onlyBody();
-  options.body.telemetry_rate_hz = 200;
+  bodyConfig(options).telemetry_rate_hz = 200;
   options.faults.seed = 7;
   options.faults.corrupt_rate = 0.2;
   options.faults.drop_rate = 0.2;
@@ -76,19 +76,19 @@ TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
   for (int i = 0; i < 10; ++i) host.pump(20);
   host.feedPadding();
   const SimStats stats = sim.stats();
-  const SendCounters& telemetry = stats.sent[static_cast<std::size_t>(OutputKind::kTelemetry)];
+  const SendCounters& telemetry = stats.sentOf(kTelemetryOutput);
   EXPECT_GT(telemetry.damaged, 0u);
   EXPECT_GT(stats.garbage_bursts, 0u);
   EXPECT_EQ(host.framesOf(protocol::body::kTelemetryFrames).size(), telemetry.intact);
   EXPECT_EQ(telemetry.intact + telemetry.damaged + telemetry.discarded,
-            stats.body.telemetry_generated);
+            bodyStats(stats).telemetry_generated);
 }
 
 // --pace-baud bounds can only be checked from one side without timing assertions: a paced line is
 // never faster than its baud rate, however slow or busy the machine is.
 TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
   SimOptions options = onlyBody();
-  options.body.telemetry_rate_hz = 200;  // several times what 9600 baud carries
+  bodyConfig(options).telemetry_rate_hz = 200;  // several times what 9600 baud carries
   options.pace_baud = 9600;              // 960 bytes/s
   RobotSim sim(options);
   sim.start();
@@ -113,8 +113,8 @@ TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
 
 TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
   SimOptions options = onlyBody();
-  options.body.servo_ids = {2, 3};
-  options.body.telemetry_rate_hz = 0;
+  bodyConfig(options).servo_ids = {2, 3};
+  bodyConfig(options).telemetry_rate_hz = 0;
   options.pace_baud = 9600;
   RobotSim sim(options);
   sim.start();
@@ -124,7 +124,7 @@ TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
   const auto start = Clock::now();
   for (int i = 0; i < kFrames; ++i) host.send(kSyncWrite2And3);
   ASSERT_TRUE(waitForStats(
-      sim, [](const SimStats& s) { return s.body.sync_writes_ok == kFrames; },
+      sim, [](const SimStats& s) { return bodyStats(s).sync_writes_ok == kFrames; },
       milliseconds(10000)));
   const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
   // The last frame reached the board only once all its bits were through the line.
@@ -138,7 +138,7 @@ TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
 TEST(RobotSim, PacedServoAnswersAfterTheRequestTheLatencyAndTheAnswerOnTheLine) {
   SimOptions options = onlyServoBus();
   options.pace_baud = 9600;
-  options.servo_bus.answer_latency_s = 0.005;
+  servoBusConfig(options).answer_latency_s = 0.005;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), servoHostConfig());
@@ -156,17 +156,16 @@ TEST(RobotSim, PacedServoAnswersAfterTheRequestTheLatencyAndTheAnswerOnTheLine) 
 
 TEST(RobotSim, ServoFaultsGarbleOrSuppressAnswers) {
   SimOptions options = onlyServoBus();
-  options.faults.servo_fault_rate = 1.0;
+  servoBusConfig(options).answer_fault_rate = 1.0;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), servoHostConfig());
   ASSERT_TRUE(host.ok());
   for (int i = 0; i < 20; ++i) host.send(kPing3);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.servo_bus.answers == 20; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return servoBusStats(s).answers == 20; }));
   for (int i = 0; i < 5; ++i) host.pump(20);
   host.feedPadding();
-  const SendCounters answers =
-      sim.stats().sent[static_cast<std::size_t>(OutputKind::kServoResponse)];
+  const SendCounters answers = sim.stats().sentOf(kServoAnswerOutput);
   EXPECT_EQ(answers.intact, 0u);
   EXPECT_GT(answers.suppressed, 0u);
   EXPECT_GT(answers.damaged, 0u);
@@ -216,7 +215,7 @@ TEST(RobotSim, StatsFileHasKeyValueLines) {
     ASSERT_TRUE(host.ok());
     host.send(kResetSeq2);
     ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) {
-      return s.base.resets == 1 && s.body.telemetry_generated > 2;
+      return baseStats(s).resets == 1 && bodyStats(s).telemetry_generated > 2;
     }));
   }
   sim.stop();

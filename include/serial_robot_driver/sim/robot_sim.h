@@ -1,7 +1,7 @@
-// The simulated robot: the three devices of docs/protocols.md on one or more pseudo-terminals,
-// speaking the real bytes, with optional fault injection, and any other registered device asked
-// for (SimOptions::hosted, through its sim/sim_device_module.h). ROS-free; `robot_sim` is a thin
-// main around it (its flags: command_line.h) and tests run it in-process.
+// The simulated robot: every registered device it is asked to host (sim/sim_device_module.h; by
+// default the robot's own) on one or more pseudo-terminals, speaking the real bytes, with optional
+// fault injection. ROS-free; `robot_sim` is a thin main around it (its flags: command_line.h) and
+// tests run it in-process.
 //
 // Threading: start() spawns one thread that owns the ptys and the devices. It polls the pty master
 // fds, feeds each port's StreamFramer, runs the device timers on the steady clock and writes the
@@ -17,9 +17,6 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/devices/base/base_sim.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/sim_device_module.h"
 #include "serial_robot_driver/sim/sim_options.h"
 #include "serial_robot_driver/sim/sim_stats.h"
@@ -28,7 +25,7 @@ namespace serial_robot_driver::sim {
 
 /// One pty and the devices on it.
 struct SimPort {
-  std::vector<std::string> devices;  ///< "base", "body", "servo_bus", hosted devices' names
+  std::vector<std::string> devices;  ///< the hosted devices' names
   std::string link;                  ///< "" when none
   std::string slave_path;            ///< changes after a replug
   bool plugged = true;
@@ -61,17 +58,19 @@ class RobotSim {
     std::unique_ptr<SimDevice> device;
     std::string port_link;  ///< its effective link
     Port* port = nullptr;
+    Outbox outbox;  ///< what it emitted in this step, not yet sent
   };
+  /// Builds every device SimOptions hosts, in the order of the devices, and its send counters.
   void startHosted(TimePoint now);
   /// Hands a frame to the hosted device on `port` that reads `family`; false when none does.
   bool deliverToHosted(Port* port, const protocol::FrameFamily& family, const uint8_t* data,
                        std::size_t size, TimePoint at);
-  /// Writes what a hosted device emitted on its port (faults apply as to every frame there).
-  void sendHosted(Port* port, HostedOutbox* outbox);
   void run();
   void step(TimePoint now);
-  void route(Outgoing frame);  ///< to the port of the device that emitted it
+  /// Writes what `hosted` emitted on its port, in order.
+  void sendAll(Hosted* hosted);
   void send(Port* port, Outgoing frame);
+  SendCounters& countersOf(const OutputKind* kind);
   void flush(Port* port);
   /// How long the line takes to carry `bytes` at pace_baud (10 bits a byte).
   Clock::duration lineTime(std::size_t bytes) const;
@@ -86,14 +85,9 @@ class RobotSim {
   SimOptions options_;
   mutable std::mutex mutex_;  ///< guards everything below except running_/stop_requested_
   std::vector<std::unique_ptr<Port>> ports_;
-  Port* base_port_ = nullptr;
-  Port* body_port_ = nullptr;
-  Port* servo_port_ = nullptr;
-  std::unique_ptr<BaseSim> base_;
-  std::unique_ptr<BodySim> body_;
-  std::unique_ptr<ServoBusSim> servo_bus_;
   std::vector<Hosted> hosted_;
-  SimStats counters_;  ///< the RobotSim-level fields only; devices keep their own
+  SimWorld world_;     ///< what the devices share (the chassis), handed to each tick
+  SimStats counters_;  ///< the RobotSim-level fields and send counters; devices keep their own
   TimePoint started_at_;
   TimePoint next_stats_write_;
   /// --pace-baud: when the frame being fed to a framer had its last bit through the line ({}: now).

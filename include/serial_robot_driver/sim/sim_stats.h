@@ -1,17 +1,16 @@
 // The simulated robot's counters: the devices' own and those of the ports (what was sent, damaged,
-// dropped), and their "key value" text for the stats file and the exit summary.
+// dropped), and their "key value" text for the stats file and the exit summary. A device's typed
+// counters are read through its own accessor (<name>Stats(stats) in its <name>_sim.h).
 #pragma once
 
-#include <array>
+#include <any>
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/devices/base/base_sim.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
+#include "serial_robot_driver/sim/sim_device_module.h"
 #include "serial_robot_driver/sim/sim_types.h"
 
 namespace serial_robot_driver::sim {
@@ -20,31 +19,40 @@ namespace serial_robot_driver::sim {
 struct SendCounters {
   uint64_t intact = 0;      ///< written whole and undamaged
   uint64_t damaged = 0;     ///< written with a flipped checksum, a missing byte or garbled
-  uint64_t suppressed = 0;  ///< not sent on purpose (servo fault "missing answer")
+  uint64_t suppressed = 0;  ///< not sent on purpose (a device's line fault: "missing answer")
   uint64_t discarded = 0;   ///< not sent: port unplugged or nobody reading (backlog full)
 };
 
 struct SimStats {
-  BaseSimStats base;
-  BodySimStats body;
-  ServoBusSimStats servo_bus;
-  std::array<SendCounters, kOutputKindCount> sent{};
+  /// The devices' counters, in the order of the devices: the hosted ones, and those left out
+  /// that keep their stats keys (at zero).
+  std::vector<DeviceSimStats> devices;
+  /// Per kind of frame the hosted devices send, in the order they declare them.
+  std::vector<std::pair<const OutputKind*, SendCounters>> sent;
   protocol::FramerStats framer;  ///< summed over the ports (host -> sim direction)
   uint64_t bytes_received = 0;
   uint64_t bytes_sent = 0;
-  /// CRC failures on the body's port: bad sync-writes (on a shared port the framer cannot tell
-  /// whose a broken frame was, so bad frames of the other devices count here too).
-  uint64_t body_port_checksum_errors = 0;
-  uint64_t frames_for_absent_device = 0;  ///< e.g. a sync-write on a port without the body
+  uint64_t frames_for_absent_device = 0;  ///< a frame on a port where no device reads it
   uint64_t garbage_bursts = 0;
   uint64_t garbage_bytes = 0;
   uint64_t unplugs = 0;
   uint64_t replugs = 0;
   double uptime_s = 0.0;
-  /// The hosted devices' own "key value" lines (SimDevice::statsLines), in hosting order.
-  std::vector<std::pair<std::string, std::string>> hosted;
-  /// Frames the hosted devices wanted sent but their port could not take (unplugged, full).
-  uint64_t hosted_frames_discarded = 0;
+
+  /// The send counters of `kind` (zero when no hosted device sends it).
+  const SendCounters& sentOf(const OutputKind& kind) const&;
+  /// The same of a temporary snapshot (robot.stats().sentOf(kind)): a copy, which outlives it.
+  SendCounters sentOf(const OutputKind& kind) && { return std::as_const(*this).sentOf(kind); }
+  /// The counters of the device `name`, or null when it is neither hosted nor keeps its keys.
+  const DeviceSimStats* findDevice(const std::string& name) const;
+  /// The typed counters of the device `name` (all zero when it was not simulated).
+  template <typename Counters>
+  const Counters& countersOf(const std::string& name) const {
+    static const Counters kNotSimulated{};
+    const DeviceSimStats* device = findDevice(name);
+    const Counters* counters = device ? std::any_cast<Counters>(&device->counters) : nullptr;
+    return counters ? *counters : kNotSimulated;
+  }
 };
 
 /// `key value` lines (one per line, stable key names) for the stats file and the exit summary.

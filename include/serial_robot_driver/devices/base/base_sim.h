@@ -10,6 +10,8 @@
 #include <cstdint>
 
 #include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/sim/sim_options.h"
+#include "serial_robot_driver/sim/sim_stats.h"
 #include "serial_robot_driver/sim/sim_types.h"
 
 namespace serial_robot_driver::sim {
@@ -53,6 +55,9 @@ struct BaseSimStats {
   bool in_error = false;
 };
 
+/// The base's replies (battery, error status): checksum in the last byte.
+extern const OutputKind kBaseReplyOutput;
+
 class BaseSim {
  public:
   BaseSim(const BaseSimConfig& config, TimePoint now);
@@ -85,5 +90,12 @@ class BaseSim {
   uint8_t expected_seq_ = 0;
   protocol::base::SequenceCounter reply_seq_;
 };
+
+/// The base's settings in robot_sim's options (made with their defaults on first use).
+BaseSimConfig& baseConfig(SimOptions& options);
+/// The base's counters in a stats snapshot (all zero when it was not simulated).
+const BaseSimStats& baseStats(const SimStats& stats);
+/// The same of a temporary snapshot (baseStats(robot.stats())): a copy, which outlives it.
+BaseSimStats baseStats(SimStats&& stats);
 
 }  // namespace serial_robot_driver::sim

@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/sim/sim_options.h"
+#include "serial_robot_driver/sim/sim_stats.h"
 #include "serial_robot_driver/sim/sim_types.h"
 
 namespace serial_robot_driver::sim {
@@ -42,12 +44,6 @@ struct BodySimConfig {
 /// "X,Y,Z" (three finite numbers) as robot_sim's --gyro-bias reads it; nullopt when malformed.
 std::optional<std::array<double, 3>> parseGyroBias(const std::string& text);
 
-/// How the chassis the board is mounted on moves (the base's true motion; zero without a base).
-struct ChassisMotion {
-  double yaw_rad = 0.0;   ///< heading, counter-clockwise
-  double yaw_rate = 0.0;  ///< rad/s
-};
-
 struct BodySimServoState {
   uint8_t id = 0;
   double position = 0.0;  ///< ticks
@@ -63,7 +59,14 @@ struct BodySimStats {
   uint64_t sync_write_unknown_ids = 0;  ///< targets for ids the board does not have
   double yaw_rad = 0.0;                 ///< the heading the IMU reports (the chassis')
   std::vector<BodySimServoState> servos;
+  /// CRC failures the framer of the board's port saw: bad sync-writes (on a shared port the
+  /// framer cannot tell whose a broken frame was, so bad frames of the other devices count too).
+  /// Filled by robot_sim.
+  uint64_t port_checksum_errors = 0;
 };
+
+/// Telemetry frames: their SUM byte precedes the 1F 2F tail.
+extern const OutputKind kTelemetryOutput;
 
 class BodySim {
  public:
@@ -72,7 +75,7 @@ class BodySim {
   /// A CRC-verified FF FF FD 00 frame from the host.
   void handleSyncWrite(const uint8_t* data, std::size_t size);
   /// Moves the servos up to `now`; emits the telemetry frames that are due, their IMU reporting
-  /// `chassis` (the base's true heading and yaw rate now).
+  /// `chassis` (the true heading and yaw rate now of what the board is mounted on).
   void tick(TimePoint now, const ChassisMotion& chassis, Outbox* out);
   TimePoint nextEvent() const;
 
@@ -90,5 +93,12 @@ class BodySim {
   Clock::duration telemetry_period_{};
   std::mt19937 rng_;
 };
+
+/// The board's settings in robot_sim's options (made with their defaults on first use).
+BodySimConfig& bodyConfig(SimOptions& options);
+/// The board's counters in a stats snapshot (all zero when it was not simulated).
+const BodySimStats& bodyStats(const SimStats& stats);
+/// The same of a temporary snapshot (bodyStats(robot.stats())): a copy, which outlives it.
+BodySimStats bodyStats(SimStats&& stats);
 
 }  // namespace serial_robot_driver::sim

@@ -12,6 +12,9 @@
 
 namespace serial_robot_driver::sim {
 
+/// Its answers: an XOR checksum in the last byte.
+extern const OutputKind kEchoAnswerOutput;
+
 struct EchoSimStats {
   uint64_t requests = 0;
   uint64_t answers = 0;
@@ -22,11 +25,11 @@ class EchoSim : public SimDevice {
   explicit EchoSim(Clock::duration latency) : latency_(latency) {}
 
   void handleFrame(const protocol::FrameFamily& family, const uint8_t* data, std::size_t size,
-                   TimePoint at, HostedOutbox* out) override;
+                   TimePoint at, Outbox* out) override;
   /// Sends the answers whose latency is over.
-  void tick(TimePoint now, HostedOutbox* out) override;
+  void tick(TimePoint now, SimWorld& world, Outbox* out) override;
   TimePoint nextEvent() const override;
-  std::vector<std::pair<std::string, std::string>> statsLines() const override;
+  DeviceSimStats stats(const PortCounters& ports) const override;
 
   const EchoSimStats& stats() const { return stats_; }
 

@@ -21,6 +21,8 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/sim/sim_options.h"
+#include "serial_robot_driver/sim/sim_stats.h"
 #include "serial_robot_driver/sim/sim_types.h"
 
 namespace serial_robot_driver::sim {
@@ -43,6 +45,9 @@ struct ServoBusSimConfig {
   /// the line: the driver must notice the servo still moves and stop it again.
   uint32_t lost_stops = 0;
   uint32_t seed = 1;
+  /// --servo-fault-rate: the probability robot_sim garbles an answer on the line (half the time)
+  /// or loses it (the other half).
+  double answer_fault_rate = 0.0;
 };
 
 struct BusServoSnapshot {
@@ -65,6 +70,9 @@ struct ServoBusSimStats {
   uint64_t stops_lost = 0;       ///< SPIN stops dropped by lost_stops
   std::vector<BusServoSnapshot> servos;
 };
+
+/// The servos' answers: checksum in the last byte.
+extern const OutputKind kServoAnswerOutput;
 
 class ServoBusSim {
  public:
@@ -133,5 +141,12 @@ class ServoBusSim {
   std::mt19937 rng_;
   TimePoint last_drift_;
 };
+
+/// The servo bus's settings in robot_sim's options (made with their defaults on first use).
+ServoBusSimConfig& servoBusConfig(SimOptions& options);
+/// The servo bus's counters in a stats snapshot (all zero when it was not simulated).
+const ServoBusSimStats& servoBusStats(const SimStats& stats);
+/// The same of a temporary snapshot (servoBusStats(robot.stats())): a copy, which outlives it.
+ServoBusSimStats servoBusStats(SimStats&& stats);
 
 }  // namespace serial_robot_driver::sim

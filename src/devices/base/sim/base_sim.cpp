@@ -7,6 +7,8 @@ namespace serial_robot_driver::sim {
 
 namespace base = protocol::base;
 
+const OutputKind kBaseReplyOutput{"base_replies", 1};
+
 BaseSim::BaseSim(const BaseSimConfig& config, TimePoint now)
     : config_(config),
       pid_period_(fromSeconds(1.0 / std::max(config.pid_rate_hz, 1e-3))),
@@ -15,7 +17,7 @@ BaseSim::BaseSim(const BaseSimConfig& config, TimePoint now)
       next_error_frame_(now) {}
 
 void BaseSim::emit(Outbox* out, std::vector<uint8_t> frame) {
-  out->push_back(Outgoing{OutputKind::kBaseReply, std::move(frame)});
+  out->push_back(Outgoing{&kBaseReplyOutput, std::move(frame)});
 }
 
 void BaseSim::handleFrame(const uint8_t* data, std::size_t size, TimePoint now, Outbox* out) {

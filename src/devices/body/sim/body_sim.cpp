@@ -9,6 +9,9 @@ namespace serial_robot_driver::sim {
 
 namespace body = protocol::body;
 
+// The SUM byte precedes the 1F 2F tail.
+const OutputKind kTelemetryOutput{"telemetry", 3};
+
 namespace {
 
 int16_t clipToInt16(double value) {
@@ -152,7 +155,7 @@ void BodySim::tick(TimePoint now, const ChassisMotion& chassis, Outbox* out) {
   if (now - next_telemetry_ > std::chrono::seconds(1)) next_telemetry_ = now;  // after a stall
   while (next_telemetry_ <= now) {
     advance(next_telemetry_);
-    out->push_back(Outgoing{OutputKind::kTelemetry, buildTelemetry(chassis)});
+    out->push_back(Outgoing{&kTelemetryOutput, buildTelemetry(chassis)});
     next_telemetry_ += telemetry_period_;
   }
   advance(now);

@@ -10,24 +10,26 @@ namespace serial_robot_driver::sim {
 
 namespace echo = protocol::echo;
 
+const OutputKind kEchoAnswerOutput{"echo_replies", 1};
+
 void EchoSim::handleFrame(const protocol::FrameFamily& family, const uint8_t* data,
-                          std::size_t size, TimePoint at, HostedOutbox* out) {
+                          std::size_t size, TimePoint at, Outbox* out) {
   if (family != echo::kRequestFrames) return;
   const auto payload = echo::decode(echo::kRequestType, data, size);
   if (!payload) return;  // the framer verified it; nothing else can fail
   ++stats_.requests;
   if (latency_ == Clock::duration::zero()) {
     ++stats_.answers;
-    out->push_back(echo::encodeAnswer(*payload));
+    out->push_back(Outgoing{&kEchoAnswerOutput, echo::encodeAnswer(*payload)});
     return;
   }
   pending_.emplace_back(at + latency_, echo::encodeAnswer(*payload));
 }
 
-void EchoSim::tick(TimePoint now, HostedOutbox* out) {
+void EchoSim::tick(TimePoint now, SimWorld& /*world*/, Outbox* out) {
   while (!pending_.empty() && pending_.front().first <= now) {
     ++stats_.answers;
-    out->push_back(std::move(pending_.front().second));
+    out->push_back(Outgoing{&kEchoAnswerOutput, std::move(pending_.front().second)});
     pending_.pop_front();
   }
 }
@@ -36,9 +38,11 @@ TimePoint EchoSim::nextEvent() const {
   return pending_.empty() ? TimePoint::max() : pending_.front().first;
 }
 
-std::vector<std::pair<std::string, std::string>> EchoSim::statsLines() const {
-  return {{"echo_requests", std::to_string(stats_.requests)},
-          {"echo_answers", std::to_string(stats_.answers)}};
+DeviceSimStats EchoSim::stats(const PortCounters& /*ports*/) const {
+  return DeviceSimStats{
+      "echo",
+      stats_,
+      {statsLine("echo_requests", stats_.requests), statsLine("echo_answers", stats_.answers)}};
 }
 
 }  // namespace serial_robot_driver::sim
@@ -64,6 +68,16 @@ std::unique_ptr<sim::SimDevice> makeEchoSim(const sim::HostedDeviceOptions& opti
 }  // namespace
 
 extern const sim::SimDeviceModule kSimModule{
-    "echo", makeEchoSim, {{"latency-ms", "MS", "echo answer latency (default 0)"}}};
+    "echo",
+    "echo device",
+    false,
+    "simulate the echo device (on the shared pty)",
+    "",
+    "own pty for the echo device (hosts it)",
+    10,  // draws nothing at random; kept apart from the robot's own devices' seeds
+    {&sim::kEchoAnswerOutput},
+    makeEchoSim,
+    nullptr,  // not one of the robot's own: no stats unless hosted
+    {{"latency-ms", "MS", "echo answer latency (default 0)", nullptr, nullptr}}};
 
 }  // namespace serial_robot_driver::devices::echo

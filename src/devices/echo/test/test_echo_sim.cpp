@@ -26,10 +26,10 @@ std::string statsLine(const std::string& text, const std::string& key) {
 
 TEST(EchoSim, AnswersEachRequestWithItsPayload) {
   EchoSim sim(Clock::duration::zero());
-  HostedOutbox out;
+  Outbox out;
   sim.handleFrame(echo::kRequestFrames, kRequest123.data(), kRequest123.size(), Clock::now(), &out);
   ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0], kAnswer123);
+  EXPECT_EQ(out[0].bytes, kAnswer123);
 
   EchoSim slow(std::chrono::milliseconds(5));
   out.clear();
@@ -37,15 +37,16 @@ TEST(EchoSim, AnswersEachRequestWithItsPayload) {
   slow.handleFrame(echo::kRequestFrames, kRequest123.data(), kRequest123.size(), at, &out);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(slow.nextEvent(), at + std::chrono::milliseconds(5));
-  slow.tick(at + std::chrono::milliseconds(5), &out);
+  SimWorld world;
+  slow.tick(at + std::chrono::milliseconds(5), world, &out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(slow.stats().answers, 1u);
 }
 
 TEST(EchoSim, RobotSimHostsItOnTheSharedPortNextToTheBase) {
   SimOptions options = onlyBase();
-  options.base.battery_percent = 64;
-  options.hosted.push_back(HostedDeviceOptions{"echo", std::nullopt, {}});
+  baseConfig(options).battery_percent = 64;
+  options.device("echo").enabled = true;
   RobotSim sim(options);
   sim.start();
   ASSERT_EQ(sim.ports().size(), 1u);
@@ -56,7 +57,7 @@ TEST(EchoSim, RobotSimHostsItOnTheSharedPortNextToTheBase) {
   host.send(kRequest123);
   EXPECT_TRUE(host.waitForFrame(kAnswer123));
   EXPECT_TRUE(host.waitForFrame(kBattery64ReplySeq0));
-  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return !s.hosted.empty(); }));
+  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.findDevice("echo") != nullptr; }));
   const std::string text = formatStats(sim.stats());
   EXPECT_EQ(statsLine(text, "echo_requests"), "echo_requests 1");
   EXPECT_EQ(statsLine(text, "echo_answers"), "echo_answers 1");
@@ -82,10 +83,10 @@ TEST(EchoSim, CommandLineHostsItAloneOnItsOwnLink) {
                         "--echo-link", link.c_str(), latency.c_str()};
   const CommandLine parsed = parseCommandLine(7, argv);
   ASSERT_EQ(parsed.error, "");
-  ASSERT_EQ(parsed.options.hosted.size(), 1u);
-  EXPECT_EQ(parsed.options.hosted[0].settings.at("latency-ms"), "2");
+  ASSERT_TRUE(parsed.options.hosts("echo"));
+  EXPECT_EQ(parsed.options.findDevice("echo")->settings.at("latency-ms"), "2");
   EXPECT_NE(usage().find("--echo-link PATH"), std::string::npos);
-  EXPECT_TRUE(parseCommandLine(1, argv).options.hosted.empty()) << "off by default";
+  EXPECT_FALSE(parseCommandLine(1, argv).options.hosts("echo")) << "off by default";
   const char* bad[] = {"robot_sim", "--echo-latency-ms", "soon"};
   EXPECT_THROW(RobotSim(parseCommandLine(3, bad).options).start(), std::invalid_argument);
 

@@ -10,6 +10,8 @@
 namespace serial_robot_driver::sim {
 
 namespace servo = protocol::servo;
+
+const OutputKind kServoAnswerOutput{"servo_answers", 1};
 using servo::Command;
 
 namespace {
@@ -461,8 +463,8 @@ void ServoBusSim::tick(TimePoint now, Outbox* out) {
     if (drift) driftReadOnly(&s);
   }
   while (!pending_.empty() && pending_.front().due <= now) {
-    out->push_back(Outgoing{OutputKind::kServoResponse, std::move(pending_.front().bytes),
-                            pending_.front().due});
+    out->push_back(
+        Outgoing{&kServoAnswerOutput, std::move(pending_.front().bytes), pending_.front().due});
     pending_.pop_front();
     ++stats_.answers;
   }

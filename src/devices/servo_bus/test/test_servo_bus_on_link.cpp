@@ -15,6 +15,7 @@
 
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/framer_configs.h"
 #include "support/test_helpers.h"
@@ -32,10 +33,10 @@ struct BusOnLink {
   explicit BusOnLink(const std::string& name, ServoBusConfig config,
                      std::vector<uint8_t> sim_ids = {1, 2, 3}) {
     sim::SimOptions options;
-    options.enable_base = false;
-    options.enable_body = false;
-    options.servo_bus.servo_ids = std::move(sim_ids);
-    options.servo_bus.answer_latency_s = 0.0;
+    options.device("base").enabled = false;
+    options.device("body").enabled = false;
+    servoBusConfig(options).servo_ids = std::move(sim_ids);
+    servoBusConfig(options).answer_latency_s = 0.0;
     options.link = "/tmp/srd_bus_on_link_" + name + "_" + std::to_string(::getpid());
     sim = std::make_unique<sim::RobotSim>(options);
     sim->start();
@@ -119,7 +120,7 @@ TEST(ServoBusOnLink, AMoveFromAnotherThreadWakesTheIdleReader) {
   move.angle_deg = 30.0;
   rig.bus->queueMoves({move});
   ASSERT_TRUE(waitFor([&] { return rig.bus->stats().moves_sent == 1; }, kWaitSeconds));
-  ASSERT_TRUE(waitFor([&] { return rig.sim->stats().servo_bus.requests >= 1; }, kWaitSeconds));
+  ASSERT_TRUE(waitFor([&] { return servoBusStats(rig.sim->stats()).requests >= 1; }, kWaitSeconds));
   EXPECT_EQ(rig.bus->stats().moves_failed, 0u);
 }
 
@@ -134,11 +135,11 @@ TEST(ServoBusOnLink, ShutdownSaysItsLastWordsThroughTheRunningReader) {
   spin.speed_dps = 90;
   ASSERT_TRUE(rig.bus->spin(spin).ok());
   EXPECT_EQ(rig.bus->movingIds(), std::vector<uint8_t>{1});
-  const uint64_t requests_before = rig.sim->stats().servo_bus.requests;
+  const uint64_t requests_before = servoBusStats(rig.sim->stats()).requests;
   rig.bus->shutdown();
   EXPECT_TRUE(rig.bus->movingIds().empty()) << "the SPIN stop went out";
-  ASSERT_TRUE(
-      waitFor([&] { return rig.sim->stats().servo_bus.requests > requests_before; }, kWaitSeconds));
+  ASSERT_TRUE(waitFor([&] { return servoBusStats(rig.sim->stats()).requests > requests_before; },
+                      kWaitSeconds));
   EXPECT_EQ(rig.bus->client().ping(1).error, ServoError::kShutdown);
 }
 

@@ -41,9 +41,9 @@ struct Robot {
       : imu(nh, "/" + ns + "/imu/data", 500), diagnostics(nh, ns + "/driver_node"), ns_(ns) {
     sim::SimOptions options;
     options.link = test_support::nodeParam("/" + ns + "/driver_node", "port");
-    options.enable_servo_bus = false;
-    options.body.telemetry_rate_hz = telemetry_rate;
-    options.body.gyro_bias = kBias;
+    options.device("servo_bus").enabled = false;
+    bodyConfig(options).telemetry_rate_hz = telemetry_rate;
+    bodyConfig(options).gyro_bias = kBias;
     robot = std::make_unique<sim::RobotSim>(options);
     robot->start();
     cmd_vel = nh.advertise<geometry_msgs::Twist>("/" + ns + "/cmd_vel", 10);
@@ -85,13 +85,13 @@ struct Robot {
   }
   /// Waits until the simulated wheels turn (the node obeys the cmd_vel being published).
   bool waitMoving() {
-    return waitFor([&] { return robot->stats().base.last_left_speed != 0; }, 10);
+    return waitFor([&] { return baseStats(robot->stats()).last_left_speed != 0; }, 10);
   }
   /// Waits until the simulated wheels stand still and the node's cmd_vel timeout has passed.
   bool waitStill() {
     const bool still = waitFor(
         [&] {
-          const auto base = robot->stats().base;
+          const auto base = baseStats(robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10);

@@ -124,12 +124,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   sim::SimOptions options;
-  options.enable_base = false;
-  options.enable_body = false;
-  options.servo_bus.servo_ids = {1, 2, 3, 4};
-  options.servo_bus.servo_type = {{2, 300}};
-  options.servo_bus.response_switch = {{3, 1}};
-  options.servo_bus.firmware_version = {{4, 300}};
-  options.servo_link = port;
+  options.device("base").enabled = false;
+  options.device("body").enabled = false;
+  servoBusConfig(options).servo_ids = {1, 2, 3, 4};
+  servoBusConfig(options).servo_type = {{2, 300}};
+  servoBusConfig(options).response_switch = {{3, 1}};
+  servoBusConfig(options).firmware_version = {{4, 300}};
+  options.device("servo_bus").link = port;
   return test_support::runAllTestsWithSim(options, &g_robot);
 }
