@@ -104,7 +104,7 @@ TEST(RobotSimBodyDevice, GyroBiasIsAddedToEachGyroAxis) {
   EXPECT_EQ(telemetry->imu[protocol::body::kRoll], 0) << "and so are the angles";
 
   const char* args[] = {"robot_sim", "--gyro-bias", "0.02,-0.015,0.03"};
-  const CommandLine line = parseCommandLine(3, args);
+  CommandLine line = parseCommandLine(3, args);
   ASSERT_TRUE(line.error.empty()) << line.error;
   EXPECT_EQ(bodyConfig(line.options).gyro_bias, (std::array<double, 3>{0.02, -0.015, 0.03}));
   for (const char* bad : {"0.02,0.01", "1,2,3,4", "a,b,c", "0.1,,0.2", "1,2,nan"}) {
