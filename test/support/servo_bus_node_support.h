@@ -30,6 +30,7 @@
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "support/fake_device.h"
