@@ -17,6 +17,8 @@
 #include <string>
 #include <thread>
 
+#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"

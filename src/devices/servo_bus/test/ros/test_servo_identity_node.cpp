@@ -11,6 +11,7 @@
 #include <string>
 
 #include "serial_robot_driver/ServoInfo.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
