@@ -49,7 +49,7 @@
 namespace serial_robot_driver::ros_layer {
 
 /// The bus device's configuration: what the parameters bound into ServoBusParams::bus, plus the
-/// polled servos (state_ids and the joint_ids servos) and the safe-motion values kept as written.
+/// polled servos (state_ids and the joint_ids servos).
 device::ServoBusConfig makeServoBusConfig(const DriverParams& params);
 
 // Joint names and servo_commands' checks are the core's (device/servo_joint_commands.h).

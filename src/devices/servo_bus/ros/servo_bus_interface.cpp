@@ -38,11 +38,6 @@ device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
       config.polled_ids.push_back(joint_id);
     }
   }
-  config.client.timeout = params.servo_bus.timeoutMs();
-  // validate() accepted only 0..65535 and the names shutdownActionFromString() knows.
-  config.relax_power_mw = static_cast<uint16_t>(params.servo_bus.relax_power_mw);
-  config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
-                           .value_or(device::ShutdownAction::kStop);
   return config;
 }
 
