@@ -14,8 +14,8 @@
 //           beyond the legal 57)
 //   rest    the frame, passed to the decoder in an exact-size heap buffer (ASan sees over-reads)
 //
-// Aborts when the family's probe and decoder disagree about the bytes (the framer hands a decoder
-// exactly what the probe framed), when a decoded frame does not re-encode to the same bytes
+// Aborts when a family's decoder refuses what its probe framed (the framer hands a decoder exactly
+// what the probe framed), when a decoded frame does not re-encode to the same bytes
 // (telemetry, servo response, sync write, ...), when decoded sizes contradict the input, or on any
 // sanitizer report.
 #include <cstddef>
@@ -238,12 +238,15 @@ void fixServoRequest(uint8_t* d, std::size_t n, Mode mode) {
 
 // --- what every family gets, and what some get beyond it -----------------------------------------
 
-/// The family's probe and decoder agree: the decoder takes exactly the bytes the probe frames whole.
+/// The family's probe and decoder agree: what the probe frames (within the bytes it was given) the
+/// decoder takes. Not the other way round: a decoder may take a frame the probe passes over (the
+/// sync write's decoder reads any Dynamixel frame; the probe finds only the driver's own).
 void runFamily(const FrameFamily& family, const uint8_t* d, std::size_t n, std::size_t expected) {
   const Probe probe = family.probe(d, n, expected);
-  const bool framed_whole = probe.status == Probe::Status::kFrame && probe.size == n;
-  check(probe.status != Probe::Status::kFrame || (probe.size > 0 && probe.size <= n));
-  check(family.decodes(d, n, expected) == framed_whole);
+  const bool decodes = family.decodes(d, n, expected);
+  if (probe.status != Probe::Status::kFrame) return;
+  check(probe.size > 0 && probe.size <= n);
+  if (probe.size == n) check(decodes);
 }
 
 /// A family's fix-ups and deeper checks (re-encoding, typed contents), by its name. A family with
