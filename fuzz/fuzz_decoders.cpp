@@ -5,7 +5,8 @@
 // as soon as it is registered.
 //
 // Input layout:
-//   byte 0  family = byte % F (F registered families, in registration order), mode = (byte / F) % 3:
+//   byte 0  family = byte % F (F registered families, in registration order), mode = (byte / F) %
+//   3:
 //           0 raw, 1 fix the checksum, 2 fix header/length/tail/checksum (fuzz_support::
 //           decoderSelector). Built with SRD_FUZZ_FAMILY="name", the target fuzzes that family only
 //           (one libFuzzer target per family: fuzz_base, fuzz_telemetry, ...), so coverage feedback
