@@ -164,6 +164,13 @@ device::ServoStatus ServoBusInterface::refuseWhileEStopped(const std::string& so
           "e_stop is engaged: no servo moves until it is released (publish false on e_stop)"};
 }
 
+device::ServoStatus ServoBusInterface::claimServos(const std::vector<uint8_t>& ids,
+                                                   const char* source) {
+  device::ServoStatus refused = refuseWhileEStopped(source);
+  if (refused.ok()) yieldJoints(ids, source);
+  return refused;
+}
+
 void ServoBusInterface::attachEStop(device::EStop& e_stop) {
   e_stop_ = &e_stop;
   // On the e_stop subscriber's thread: the SPIN stops take the bus as a caller, ahead of the poll.
