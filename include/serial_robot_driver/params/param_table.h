@@ -42,6 +42,8 @@ struct ParamSpec {
   /// values are range-checked only while the device is enabled.
   std::string device;
   std::function<ParamValue(const DriverParams&)> get;
+  /// Throws ParameterError(key, ...) for a value a converted row refuses as written
+  /// (makeConvertedRow); a plain row takes any value of its type and leaves it to `check`.
   std::function<void(DriverParams&, const ParamValue&)> set;
   /// Throws ParameterError(key, ...) when the field's value is out of range.
   std::function<void(const DriverParams&)> check;
