@@ -1,16 +1,24 @@
-// libFuzzer target: each decoder on raw bytes, and on bytes whose integrity fields were fixed up so
-// that malformed payloads get past the XOR / sum / CRC / tail and reach the field parsing.
+// libFuzzer target: the decoder of every frame family of the registered devices
+// (registered_families.h, FrameFamily::decodes), on raw bytes and, for the families this file
+// knows how to fix up, on bytes whose integrity fields were fixed so that malformed payloads get
+// past the XOR / sum / CRC / tail and reach the field parsing. A new device's families are fuzzed
+// as soon as it is registered.
 //
 // Input layout:
-//   byte 0  decoder = byte % 5 (base, telemetry, servo response, servo request, sync write),
-//           mode = (byte / 5) % 3: 0 raw, 1 fix the checksum, 2 fix header/length/tail/checksum.
-//           Built with SRD_FUZZ_DECODER=k, the target fuzzes decoder k only (one libFuzzer target per
-//           decoder: fuzz_base, fuzz_telemetry, ...), so coverage feedback stays per decoder.
-//   byte 1  telemetry servo count (used modulo 64, so also beyond the legal 57)
+//   byte 0  family = byte % F (F registered families, in registration order), mode = (byte / F) %
+//   3:
+//           0 raw, 1 fix the checksum, 2 fix header/length/tail/checksum (fuzz_support::
+//           decoderSelector). Built with SRD_FUZZ_FAMILY="name", the target fuzzes that family only
+//           (one libFuzzer target per family: fuzz_base, fuzz_telemetry, ...), so coverage feedback
+//           stays per decoder; byte 0 then only gives the mode.
+//   byte 1  the probe's and decoder's argument, modulo 64 (the telemetry's servo count, so also
+//           beyond the legal 57)
 //   rest    the frame, passed to the decoder in an exact-size heap buffer (ASan sees over-reads)
 //
-// Aborts when a decoded frame does not re-encode to the same bytes (telemetry, servo response,
-// sync write), when decoded sizes contradict the input, or on any sanitizer report.
+// Aborts when a family's decoder refuses what its probe framed (the framer hands a decoder exactly
+// what the probe framed), when a decoded frame does not re-encode to the same bytes
+// (telemetry, servo response, sync write, ...), when decoded sizes contradict the input, or on any
+// sanitizer report.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -19,6 +27,7 @@
 #include <optional>
 #include <vector>
 
+#include "registered_families.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
@@ -33,10 +42,12 @@ namespace base = serial_robot_driver::protocol::base;
 namespace body = serial_robot_driver::protocol::body;
 namespace servo = serial_robot_driver::protocol::servo;
 namespace wire = serial_robot_driver::protocol::wire;
+using serial_robot_driver::protocol::FrameFamily;
+using serial_robot_driver::protocol::Probe;
 using serial_robot_driver::protocol::writeLE16;
 
-enum class Target { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite, kCount };
-enum class Mode { kRaw, kFixChecksum, kFixEverything, kCount };
+enum class Mode { kRaw, kFixChecksum, kFixEverything };
+static_assert(fuzz_support::kDecoderModes == 3, "one mode per fix-up level");
 
 void check(bool condition) {
   if (!condition) std::abort();
@@ -218,49 +229,75 @@ void runSyncWrite(const uint8_t* d, std::size_t n) {
   check(sameBytes(body::encodeSyncWrite(*targets), d, n));
 }
 
+void fixServoResponse(uint8_t* d, std::size_t n, Mode mode) {
+  fixServo(d, n, mode, servo::kResponseHeader0, servo::kResponseHeader1);
+}
+
+void fixServoRequest(uint8_t* d, std::size_t n, Mode mode) {
+  fixServo(d, n, mode, servo::kRequestHeader0, servo::kRequestHeader1);
+}
+
+// --- what every family gets, and what some get beyond it -----------------------------------------
+
+/// The family's probe and decoder agree: what the probe frames (within the bytes it was given) the
+/// decoder takes. Not the other way round: a decoder may take a frame the probe passes over (the
+/// sync write's decoder reads any Dynamixel frame; the probe finds only the driver's own).
+void runFamily(const FrameFamily& family, const uint8_t* d, std::size_t n, std::size_t expected) {
+  const Probe probe = family.probe(d, n, expected);
+  const bool decodes = family.decodes(d, n, expected);
+  if (probe.status != Probe::Status::kFrame) return;
+  check(probe.size > 0 && probe.size <= n);
+  if (probe.size == n) check(decodes);
+}
+
+/// A family's fix-ups and deeper checks (re-encoding, typed contents), by its name. A family with
+/// none is fuzzed raw with runFamily's checks only.
+struct KnownFamily {
+  const char* name;
+  void (*fix)(uint8_t* d, std::size_t n, Mode mode);
+  void (*run)(const uint8_t* d, std::size_t n, std::size_t expected);
+};
+
+const KnownFamily kKnownFamilies[] = {
+    {"base", fixBase, [](const uint8_t* d, std::size_t n, std::size_t) { runBase(d, n); }},
+    {"telemetry", fixTelemetry, runTelemetry},
+    {"sync_write", fixSyncWrite,
+     [](const uint8_t* d, std::size_t n, std::size_t) { runSyncWrite(d, n); }},
+    {"servo_response", fixServoResponse,
+     [](const uint8_t* d, std::size_t n, std::size_t) { runServoResponse(d, n); }},
+    {"servo_request", fixServoRequest,
+     [](const uint8_t* d, std::size_t n, std::size_t) { runServoRequest(d, n); }},
+};
+
+const KnownFamily* knownFamily(const FrameFamily& family) {
+  for (const KnownFamily& known : kKnownFamilies) {
+    if (std::strcmp(known.name, family.name) == 0) return &known;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* input, std::size_t input_size) {
   constexpr std::size_t kPrefix = 2;
   if (input_size < kPrefix) return 0;
-#ifdef SRD_FUZZ_DECODER
-  constexpr auto target = static_cast<Target>(SRD_FUZZ_DECODER);
+  const auto& families = fuzz_support::registeredFamilies();
+#ifdef SRD_FUZZ_FAMILY
+  static const std::size_t kOnly = fuzz_support::familyIndex(SRD_FUZZ_FAMILY);
+  const FrameFamily& family = families[kOnly];
 #else
-  const auto target = static_cast<Target>(input[0] % static_cast<int>(Target::kCount));
+  const FrameFamily& family = families[input[0] % families.size()];
 #endif
-  const auto mode = static_cast<Mode>((input[0] / static_cast<int>(Target::kCount)) %
-                                      static_cast<int>(Mode::kCount));
-  const std::size_t servo_count = input[1] % 64;
+  const auto mode = static_cast<Mode>((input[0] / families.size()) % fuzz_support::kDecoderModes);
+  const std::size_t expected = input[1] % 64;
   const std::size_t n = input_size - kPrefix;
   std::unique_ptr<uint8_t[]> frame(new uint8_t[n]);  // n == 0: any access is an overflow
   if (n > 0) std::memcpy(frame.get(), input + kPrefix, n);
   uint8_t* d = frame.get();
 
-  switch (target) {
-    case Target::kBase:
-      if (mode != Mode::kRaw) fixBase(d, n, mode);
-      runBase(d, n);
-      break;
-    case Target::kTelemetry:
-      if (mode != Mode::kRaw) fixTelemetry(d, n, mode);
-      runTelemetry(d, n, servo_count);
-      break;
-    case Target::kServoResponse:
-      if (mode != Mode::kRaw) {
-        fixServo(d, n, mode, servo::kResponseHeader0, servo::kResponseHeader1);
-      }
-      runServoResponse(d, n);
-      break;
-    case Target::kServoRequest:
-      if (mode != Mode::kRaw) fixServo(d, n, mode, servo::kRequestHeader0, servo::kRequestHeader1);
-      runServoRequest(d, n);
-      break;
-    case Target::kSyncWrite:
-      if (mode != Mode::kRaw) fixSyncWrite(d, n, mode);
-      runSyncWrite(d, n);
-      break;
-    case Target::kCount:
-      break;
-  }
+  const KnownFamily* known = knownFamily(family);
+  if (known != nullptr && mode != Mode::kRaw) known->fix(d, n, mode);
+  runFamily(family, d, n, expected);
+  if (known != nullptr) known->run(d, n, expected);
   return 0;
 }

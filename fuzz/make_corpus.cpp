@@ -5,7 +5,7 @@
 //
 //   make_corpus OUT_DIR
 //     OUT_DIR/fuzz_framer/    3-byte prefix (families, servo count, max chunk) + byte stream
-//     OUT_DIR/fuzz_decoders/  1-byte selector (decoder + 5 * mode), servo count, frame
+//     OUT_DIR/fuzz_decoders/  1-byte selector (family index + families * mode), servo count, frame
 // (the input layouts of fuzz_framer.cpp and fuzz_decoders.cpp).
 #include <array>
 #include <cctype>
@@ -187,12 +187,12 @@ std::string seedName(const char* command_name) {
   return name;
 }
 
-// Selector bytes of fuzz_decoders.cpp: decoder index + 5 * mode (0 raw, 1 fix sum, 2 fix all).
-enum class Decoder : uint8_t { kBase, kTelemetry, kServoResponse, kServoRequest, kSyncWrite };
-uint8_t selector(Decoder decoder, uint8_t mode) {
-  return static_cast<uint8_t>(static_cast<uint8_t>(decoder) + 5 * mode);
+// Selector bytes of fuzz_decoders.cpp: the family's index + families * mode (0 raw, 1 fix sum,
+// 2 fix all), from the registered families, as the fuzzer reads them.
+uint8_t selector(const char* family, std::size_t mode) {
+  return fuzz_support::decoderSelector(family, mode);
 }
-constexpr uint8_t kRaw = 0, kFixSum = 1, kFixAll = 2;
+constexpr std::size_t kRaw = 0, kFixSum = 1, kFixAll = 2;
 
 void writeFramerSeeds(SeedWriter& seeds) {
   // Prefix bits of fuzz_framer.cpp: one per registered family (registered_families.h); asked
@@ -241,38 +241,38 @@ void writeFramerSeeds(SeedWriter& seeds) {
 }
 
 void writeDecoderSeeds(SeedWriter& seeds) {
-  seeds.write("base_reset_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseReset);
-  seeds.write("base_battery_request_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseBatteryRequest);
-  seeds.write("base_clear_encoders_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseClearEncoders);
-  seeds.write("base_wheels_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseBothMinus6);
-  seeds.write("base_error_status_raw", {selector(Decoder::kBase, kRaw), 2}, kBaseErrorStatus);
-  seeds.write("base_battery_fixsum", {selector(Decoder::kBase, kFixSum), 2}, kBaseBatteryReply);
-  seeds.write("base_fixall", {selector(Decoder::kBase, kFixAll), 2}, kBaseLeft4);
-  seeds.write("telemetry_raw", {selector(Decoder::kTelemetry, kRaw), 2}, kTelemetry);
-  seeds.write("telemetry_foot_raw", {selector(Decoder::kTelemetry, kRaw), 2}, kTelemetryFoot);
-  seeds.write("telemetry_fixsum", {selector(Decoder::kTelemetry, kFixSum), 2}, kTelemetry);
-  seeds.write("telemetry_fixall", {selector(Decoder::kTelemetry, kFixAll), 6}, kTelemetryFoot);
+  seeds.write("base_reset_raw", {selector("base", kRaw), 2}, kBaseReset);
+  seeds.write("base_battery_request_raw", {selector("base", kRaw), 2}, kBaseBatteryRequest);
+  seeds.write("base_clear_encoders_raw", {selector("base", kRaw), 2}, kBaseClearEncoders);
+  seeds.write("base_wheels_raw", {selector("base", kRaw), 2}, kBaseBothMinus6);
+  seeds.write("base_error_status_raw", {selector("base", kRaw), 2}, kBaseErrorStatus);
+  seeds.write("base_battery_fixsum", {selector("base", kFixSum), 2}, kBaseBatteryReply);
+  seeds.write("base_fixall", {selector("base", kFixAll), 2}, kBaseLeft4);
+  seeds.write("telemetry_raw", {selector("telemetry", kRaw), 2}, kTelemetry);
+  seeds.write("telemetry_foot_raw", {selector("telemetry", kRaw), 2}, kTelemetryFoot);
+  seeds.write("telemetry_fixsum", {selector("telemetry", kFixSum), 2}, kTelemetry);
+  seeds.write("telemetry_fixall", {selector("telemetry", kFixAll), 6}, kTelemetryFoot);
   for (const servo::CommandInfo& info : servo::commandTable()) {
     const std::string name = seedName(info.name);
-    seeds.write("servo_request_" + name + "_raw", {selector(Decoder::kServoRequest, kRaw), 0},
+    seeds.write("servo_request_" + name + "_raw", {selector("servo_request", kRaw), 0},
                 request(info.cmd));
-    seeds.write("servo_answer_" + name + "_raw", {selector(Decoder::kServoResponse, kRaw), 0},
+    seeds.write("servo_answer_" + name + "_raw", {selector("servo_response", kRaw), 0},
                 answer(info.cmd));
   }
-  seeds.write("servo_request_fixsum", {selector(Decoder::kServoRequest, kFixSum), 0},
+  seeds.write("servo_request_fixsum", {selector("servo_request", kFixSum), 0},
               request(servo::Command::kSpin));
-  seeds.write("servo_response_fixsum", {selector(Decoder::kServoResponse, kFixSum), 0},
+  seeds.write("servo_response_fixsum", {selector("servo_response", kFixSum), 0},
               answer(servo::Command::kPing));
-  seeds.write("servo_read_data_fixall", {selector(Decoder::kServoResponse, kFixAll), 0},
+  seeds.write("servo_read_data_fixall", {selector("servo_response", kFixAll), 0},
               answer(servo::Command::kReadData));
-  seeds.write("servo_read_batch_fixall", {selector(Decoder::kServoResponse, kFixAll), 0},
+  seeds.write("servo_read_batch_fixall", {selector("servo_response", kFixAll), 0},
               answer(servo::Command::kReadBatchData));
-  seeds.write("sync_write_raw", {selector(Decoder::kSyncWrite, kRaw), 0}, kSyncWrite);
-  seeds.write("sync_write_fixcrc", {selector(Decoder::kSyncWrite, kFixSum), 0}, kSyncWrite);
+  seeds.write("sync_write_raw", {selector("sync_write", kRaw), 0}, kSyncWrite);
+  seeds.write("sync_write_fixcrc", {selector("sync_write", kFixSum), 0}, kSyncWrite);
   // Three bytes more: with the fix-ups they become a third servo record.
-  seeds.write("sync_write_fixall", {selector(Decoder::kSyncWrite, kFixAll), 0},
+  seeds.write("sync_write_fixall", {selector("sync_write", kFixAll), 0},
               join({kSyncWrite, {5, 0, 8}}));
-  seeds.write("dynamixel_ping_raw", {selector(Decoder::kSyncWrite, kRaw), 0}, dynamixelPing());
+  seeds.write("dynamixel_ping_raw", {selector("sync_write", kRaw), 0}, dynamixelPing());
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 # spells a frame's bytes by hand.
 #   fuzz/make_corpus.sh [out_dir]     (default: $FUZZ_BUILD/seeds)
 #     out_dir/fuzz_framer/    3-byte prefix (families, servo count, max chunk) + byte stream
-#     out_dir/fuzz_decoders/  1-byte selector (decoder + 5 * mode), servo count, frame
+#     out_dir/fuzz_decoders/  1-byte selector (family index + families * mode), servo count, frame
 # Environment: FUZZ_BUILD (the clang fuzz build, default /tmp/fuzzbuild; configured if missing).
 set -euo pipefail
 

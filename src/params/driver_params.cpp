@@ -68,6 +68,10 @@ std::vector<ParamSpec> buildTable() {
 
 }  // namespace
 
+bool isChecked(const DriverParams& p, const std::string& device) {
+  return device.empty() || p.enabled(device);
+}
+
 const std::vector<ParamSpec>& parameterTable() {
   static const std::vector<ParamSpec> table = buildTable();
   return table;
@@ -114,7 +118,7 @@ void DriverParams::validate() const {
   // Single values first (the table; a device's only while it is enabled), then what relates
   // several parameters.
   for (const auto& spec : parameterTable()) {
-    if (spec.device.empty() || enabled(spec.device)) spec.check(*this);
+    if (isChecked(*this, spec.device)) spec.check(*this);
   }
 
   require(tf_prefix.find(' ') == std::string::npos, "tf_prefix", "must not contain spaces");
@@ -175,17 +179,25 @@ DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unk
 TuningResult tuneParams(const DriverParams& in_force,
                         const std::vector<ParamAssignment>& requested) {
   TuningResult result{in_force, {}, {}};
+  const auto refusal = [&](const std::string& key, const ParamValue& value,
+                           const std::string& why) {
+    result.refusals.push_back("~" + key + " = " + toText(value) + " refused (" + why +
+                              "); keeping " + toText(specFor(key).get(in_force)));
+  };
   for (const auto& [key, value] : requested) {
     const ParamSpec& spec = specFor(key);
     if (spec.get(in_force).index() != value.index()) {
       throw std::invalid_argument("~" + key + ": the value has another type than the parameter");
     }
-    spec.set(result.applied, value);
+    try {
+      spec.set(result.applied, value);
+    } catch (const ParameterError& error) {
+      refusal(key, value, error.what());  // a converted row's check: the field keeps its value
+    }
   }
   const auto refuse = [&](const std::string& key, const std::string& why) {
     const ParamSpec& spec = specFor(key);
-    result.refusals.push_back("~" + key + " = " + toText(spec.get(result.applied)) + " refused (" +
-                              why + "); keeping " + toText(spec.get(in_force)));
+    refusal(key, spec.get(result.applied), why);
     spec.set(result.applied, spec.get(in_force));
   };
   const auto describeChanges = [&] {

@@ -47,10 +47,9 @@ std::vector<device::BodyJoint> makeBodyJoints(const BodyParams& params) {
     device::BodyJoint& joint = joints[i];
     joint.servo_id = static_cast<uint8_t>(params.servo_ids[i]);
     joint.name = i < params.joint_names.size() ? params.joint_names[i] : "";
+    joint.calibration = params.calibration;  // what every joint shares, then its own
     if (i < params.zero_ticks.size()) joint.calibration.zero_ticks = params.zero_ticks[i];
     if (i < params.directions.size()) joint.calibration.direction = params.directions[i];
-    joint.calibration.ticks_per_revolution = params.ticks_per_revolution;
-    joint.calibration.velocity_scale = params.velocity_scale;
   }
   return joints;
 }

@@ -75,14 +75,9 @@ trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTr
   return command;
 }
 
-trajectory::GoalDefaults toGoalDefaults(const TrajectoryParams& params) {
-  return {params.goal_tolerance, params.goal_time_tolerance, params.path_tolerance,
-          params.max_velocity};
-}
-
 TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
                                    std::vector<TrajectoryJoints> groups)
-    : executor_(std::move(groups), toGoalDefaults(params.trajectory), trajectory::steadyNow,
+    : executor_(std::move(groups), params.trajectory, trajectory::steadyNow,
                 [](const std::string& text) { ROS_WARN("%s", text.c_str()); }),
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),

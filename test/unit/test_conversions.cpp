@@ -35,8 +35,8 @@ std::vector<device::BodyJoint> joints(int direction_of_second = 1, double veloci
   params.joint_names = {"hip", "knee"};
   params.zero_ticks = {2048, 2048};
   params.directions = {1, direction_of_second};
-  params.ticks_per_revolution = 4096;
-  params.velocity_scale = velocity_scale;
+  params.calibration.ticks_per_revolution = 4096;
+  params.calibration.velocity_scale = velocity_scale;
   return makeBodyJoints(params);
 }
 
@@ -74,8 +74,8 @@ TEST(ConversionsJoints, BodyParamsBecomeJointsInServoIdOrder) {
   params.joint_names = {"a", "b"};
   params.zero_ticks = {100, 200};
   params.directions = {-1, 1};
-  params.ticks_per_revolution = 1024;
-  params.velocity_scale = 0.5;
+  params.calibration.ticks_per_revolution = 1024;
+  params.calibration.velocity_scale = 0.5;
   const std::vector<device::BodyJoint> j = makeBodyJoints(params);
   ASSERT_EQ(j.size(), 2u);
   EXPECT_EQ(j[0].name, "a");

@@ -32,8 +32,8 @@ const ParamSpec& specFor(const std::string& key) {
 /// Whether the table's own check of `key` accepts `value` (other parameters at their defaults).
 bool tableAccepts(const std::string& key, const ParamValue& value) {
   DriverParams params;
-  specFor(key).set(params, value);
   try {
+    specFor(key).set(params, value);  // a converted row checks the value as written here
     specFor(key).check(params);
     return true;
   } catch (const ParameterError& error) {

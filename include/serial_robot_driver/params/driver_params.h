@@ -16,6 +16,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/params/param_table.h"
 #include "serial_robot_driver/params/port_params.h"
+#include "serial_robot_driver/trajectory/tolerances.h"
 #include "serial_robot_driver/transport/recorded_stream.h"
 
 namespace serial_robot_driver::device {
@@ -25,13 +26,8 @@ struct DeviceModule;
 namespace serial_robot_driver::params {
 
 /// Defaults of follow_joint_trajectory and joint_trajectory (a goal's own tolerances override
-/// them).
-struct TrajectoryParams {
-  double goal_tolerance = 0.05;      ///< rad, per joint
-  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
-  double path_tolerance = 0.0;       ///< rad; 0: not checked
-  double max_velocity = 0.0;  ///< rad/s per joint; a faster trajectory is refused; 0: no limit
-};
+/// them): the executor's own, bound straight to the ~trajectory/... rows.
+using TrajectoryParams = trajectory::GoalDefaults;
 
 /// The parameter sections of devices that DriverParams has no member for: each device keeps its
 /// own struct here under its name (a device added by its folder alone uses this).

@@ -42,6 +42,8 @@ struct ParamSpec {
   /// values are range-checked only while the device is enabled.
   std::string device;
   std::function<ParamValue(const DriverParams&)> get;
+  /// Throws ParameterError(key, ...) for a value a converted row refuses as written
+  /// (makeConvertedRow); a plain row takes any value of its type and leaves it to `check`.
   std::function<void(DriverParams&, const ParamValue&)> set;
   /// Throws ParameterError(key, ...) when the field's value is out of range.
   std::function<void(const DriverParams&)> check;
@@ -98,12 +100,17 @@ ParamSpec makeRow(std::string key, std::string device, Access access, Rule<T> ru
   return spec;
 }
 
+/// Whether the single-value checks of `device`'s rows apply to `p`: always for a node-wide row
+/// (empty `device`), for a device's only while it is enabled.
+bool isChecked(const DriverParams& p, const std::string& device);
+
 /// A row whose field (`access`: DriverParams& -> Core&) has another type than the parameter
 /// (`Param`): `to_core` converts a set value, `to_param` reads the field back. The check sees the
-/// value as the parameter reads it, so its message names the parameter in the parameter's unit.
-/// Only for conversions that keep every bad input bad: where one could not (seconds rounded to
-/// milliseconds, an int narrowed, a name parsed), the section keeps the value as written and the
-/// ROS layer converts it where it builds the core's configuration.
+/// value as the user wrote it, before the conversion (which may lose what makes it bad: -0.0004 s
+/// is 0 ms, "halt" is no shutdown action): setting a value the check refuses throws its
+/// ParameterError and leaves the field as it was. validate() checks the value read back, which
+/// catches a field set in code. `to_core` must take any value (a disabled device's values are
+/// not checked).
 template <typename Param, typename Access, typename ToCore, typename ToParam>
 ParamSpec makeConvertedRow(std::string key, std::string device, Access access, ToCore to_core,
                            ToParam to_param, Rule<Param> rule) {
@@ -113,8 +120,11 @@ ParamSpec makeConvertedRow(std::string key, std::string device, Access access, T
   spec.get = [access, to_param](const DriverParams& p) {
     return ParamValue(Param(to_param(access(const_cast<DriverParams&>(p)))));
   };
-  spec.set = [access, to_core](DriverParams& p, const ParamValue& value) {
-    access(p) = to_core(std::get<Param>(value));
+  spec.set = [access, to_core, rule, name = spec.key, owner = spec.device](
+                 DriverParams& p, const ParamValue& value) {
+    const Param& given = std::get<Param>(value);
+    if (rule && isChecked(p, owner)) rule(given, name);
+    access(p) = to_core(given);
   };
   spec.check = [access, to_param, rule, name = spec.key](const DriverParams& p) {
     if (rule) rule(Param(to_param(access(const_cast<DriverParams&>(p)))), name);
@@ -158,7 +168,8 @@ class SectionRows {
   }
 
   /// A field reached by `access` (Section& -> Core&) whose type differs from the parameter's
-  /// `Param` (see makeConvertedRow), e.g. a whole number of ticks the core keeps as a double.
+  /// `Param` (see makeConvertedRow), e.g. a whole number of ticks the core keeps as a double, or
+  /// seconds it keeps as milliseconds.
   template <typename Param, typename Access, typename ToCore, typename ToParam>
   SectionRows& addConverted(const char* name, Access access, ToCore to_core, ToParam to_param,
                             typename NoDeduce<Rule<Param>>::type rule = {}) {

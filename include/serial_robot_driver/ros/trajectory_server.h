@@ -37,9 +37,6 @@ double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& r
 /// A ROS-free command from a JointTrajectory message (stamps are left to the caller).
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg);
 
-/// The executor's defaults from ~trajectory.
-trajectory::GoalDefaults toGoalDefaults(const TrajectoryParams& params);
-
 class TrajectoryServer {
  public:
   using Action = serial_robot_driver::FollowJointTrajectoryAction;
@@ -51,7 +48,7 @@ class TrajectoryServer {
                    std::vector<TrajectoryJoints> groups);
   ~TrajectoryServer();
   /// See TrajectoryExecutor::retune().
-  void retune(const TrajectoryParams& defaults) { executor_.retune(toGoalDefaults(defaults)); }
+  void retune(const TrajectoryParams& defaults) { executor_.retune(defaults); }
   /// See TrajectoryExecutor::setStateTimeout().
   void setStateTimeout(const std::vector<std::string>& names, double seconds) {
     executor_.setStateTimeout(names, seconds);

@@ -48,14 +48,6 @@ constexpr int kPathToleranceViolated = -4;
 constexpr int kGoalToleranceViolated = -5;
 }  // namespace result_code
 
-/// The defaults of goals and messages (~trajectory/...).
-struct GoalDefaults {
-  double goal_tolerance = 0.05;      ///< rad, per joint
-  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
-  double path_tolerance = 0.0;       ///< rad; 0: not checked
-  double max_velocity = 0.0;         ///< rad/s per joint; faster is refused; 0: no limit
-};
-
 /// A follow_joint_trajectory goal.
 struct Goal {
   std::string id;  ///< what cancelGoal() names it by

@@ -10,6 +10,15 @@
 
 namespace serial_robot_driver::trajectory {
 
+/// The defaults of goals and messages; the ~trajectory/... rows bind straight to these fields
+/// (params::TrajectoryParams).
+struct GoalDefaults {
+  double goal_tolerance = 0.05;      ///< rad, per joint
+  double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
+  double path_tolerance = 0.0;       ///< rad; 0: not checked
+  double max_velocity = 0.0;         ///< rad/s per joint; faster is refused; 0: no limit
+};
+
 /// How far a joint may be from its set-point; 0: not checked. Acceleration is never checked: the
 /// servos report no acceleration.
 struct JointTolerance {

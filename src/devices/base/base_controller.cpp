@@ -168,32 +168,25 @@ void BaseController::stop() {
   if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
 }
 
-void BaseController::retune(const BaseConfig& next) {
+void BaseController::retune(const BaseTuning& next) {
   std::lock_guard<std::mutex> lock(mutex_);
   const Clock::time_point now = clock_->now();
-  kinematics::DiffDriveGeometry geometry = config_.geometry;
-  geometry.wheel_diameter = next.geometry.wheel_diameter;
-  geometry.wheel_separation = next.geometry.wheel_separation;
   // The motion so far with the geometry it ran under, from now on with the new one.
-  odometry_.retune(geometry, next.use_imu_heading, now);
-  config_.geometry = geometry;
-  config_.max_wheel_speed = next.max_wheel_speed;
-  config_.max_wheel_accel = next.max_wheel_accel;
-  config_.cmd_vel_timeout = next.cmd_vel_timeout;
-  config_.speed_dithering = next.speed_dithering;
+  odometry_.retune(next.geometry, next.use_imu_heading, now);
   limiter_.setMaxAccel(next.max_wheel_accel);
-  quantizer_.retune(geometry, next.speed_dithering);
-  config_.use_imu_heading = next.use_imu_heading;
-  if (next.battery_poll_rate != config_.battery_poll_rate) {
-    if (next.battery_poll_rate > 0) {
-      // A faster rate starts now, not after the slower period still pending.
-      next_battery_poll_ =
-          std::min(next_battery_poll_, now + fromSeconds(1.0 / next.battery_poll_rate));
-    } else {
-      unanswered_since_.reset();  // no requests, nothing unanswered
-      silent_reported_ = false;
-    }
-    config_.battery_poll_rate = next.battery_poll_rate;
+  quantizer_.retune(next.geometry, next.speed_dithering);
+  rescheduleBatteryPollLocked(next.battery_poll_rate, now);
+  static_cast<BaseTuning&>(config_) = next;
+}
+
+void BaseController::rescheduleBatteryPollLocked(double next_rate, Clock::time_point now) {
+  if (next_rate == config_.battery_poll_rate) return;
+  if (next_rate > 0) {
+    // A faster rate starts now, not after the slower period still pending.
+    next_battery_poll_ = std::min(next_battery_poll_, now + fromSeconds(1.0 / next_rate));
+  } else {
+    unanswered_since_.reset();  // no requests, nothing unanswered
+    silent_reported_ = false;
   }
 }
 

@@ -77,8 +77,7 @@ void BaseOdometry::retune(const kinematics::DiffDriveGeometry& geometry, bool us
   // The base goes on running the ticks it accepted last; with the new geometry they stand for
   // other speeds (a corrected diameter is the truth about what the wheels did all along).
   held_speeds_ *= geometry_.ticksPerPeriodPerMps() / geometry.ticksPerPeriodPerMps();
-  geometry_.wheel_diameter = geometry.wheel_diameter;
-  geometry_.wheel_separation = geometry.wheel_separation;
+  geometry_ = geometry;
   odometry_.setWheelSeparation(geometry.wheel_separation);
   if (use_imu_heading != use_imu_heading_) {
     // On: anchored where odometry stands now; off: the commanded turn goes on from the last fused

@@ -32,19 +32,24 @@ void servoIds(const std::vector<int>& ids, const std::string& key) {
 }
 
 void addParameters(std::vector<params::ParamSpec>& table) {
+  // The board's own values and the calibration every joint shares (BodyParams::calibration), in
+  // the documented order.
   using B = BodyParams;
-  params::SectionRows<B>(table, "body", "body", [](DriverParams& p) -> B& { return p.body; })
-      .add("servo_ids", &B::servo_ids, servoIds)
-      .add("joint_names", &B::joint_names, params::uniqueNames)
-      .add("ticks_per_revolution", &B::ticks_per_revolution,
-           [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); })
-      .add("zero_ticks", &B::zero_ticks,
-           [](const std::vector<int>& zeros, const std::string& key) {
-             for (int zero : zeros)
-               require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
-           })
-      .add("directions", &B::directions, params::directionList)
-      .add("velocity_scale", &B::velocity_scale, params::nonNegativeNumber);
+  using C = device::JointCalibration;
+  params::SectionRows<B> own(table, "body", "body", [](DriverParams& p) -> B& { return p.body; });
+  params::SectionRows<C> joints(table, "body", "body",
+                                [](DriverParams& p) -> C& { return p.body.calibration; });
+  own.add("servo_ids", &B::servo_ids, servoIds)
+      .add("joint_names", &B::joint_names, params::uniqueNames);
+  joints.add("ticks_per_revolution", &C::ticks_per_revolution,
+             [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); });
+  own.add("zero_ticks", &B::zero_ticks,
+          [](const std::vector<int>& zeros, const std::string& key) {
+            for (int zero : zeros)
+              require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
+          })
+      .add("directions", &B::directions, params::directionList);
+  joints.add("velocity_scale", &C::velocity_scale, params::nonNegativeNumber);
   // The IMU is the board's: its keys are checked while the body is enabled.
   using I = ImuParams;
   params::SectionRows<I>(table, "body", "imu", [](DriverParams& p) -> I& { return p.imu; })

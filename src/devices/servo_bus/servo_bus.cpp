@@ -62,16 +62,11 @@ void ServoBus::dropQueuedMovesLocked(uint8_t id) {
 }
 
 void ServoBus::retune(const ServoBusConfig& next) {
-  client_.retune(next.client.timeout, next.client.retries);
+  client_.retune(next.client);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    settings_.client.timeout = next.client.timeout;
-    settings_.client.retries = next.client.retries;
-    settings_.poll_rate = next.poll_rate;
-    settings_.health_rate = next.health_rate;
-    settings_.relax_power_mw = next.relax_power_mw;
-    settings_.protect = next.protect;
-    settings_.on_shutdown = next.on_shutdown;
+    static_cast<ServoClientTuning&>(settings_.client) = next.client;
+    static_cast<ServoBusTuning&>(settings_) = next;
     poller_.retuneLocked(next.poll_rate, next.health_rate);
   }
   wakeWorker();  // the worker may be waiting for a poll that is now due earlier

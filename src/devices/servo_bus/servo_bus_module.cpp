@@ -26,6 +26,13 @@ void busServoIds(const std::vector<int>& ids, const std::string& key) {
   }
 }
 
+/// Seconds as the bus waits them: whole milliseconds, rounded, and at least 1 ms for any positive
+/// value (0 ms would give up on every answer at once). The row's check refuses the rest before.
+std::chrono::milliseconds wholeMilliseconds(double seconds) {
+  const std::chrono::milliseconds rounded(std::llround(seconds * 1000.0));
+  return seconds > 0 ? std::max(rounded, std::chrono::milliseconds(1)) : rounded;
+}
+
 void addParameters(std::vector<params::ParamSpec>& table) {
   // Rows bound into the bus's configuration (ServoBusParams::bus and its client's options) and
   // the ROS layer's own values, in the documented order.
@@ -38,11 +45,16 @@ void addParameters(std::vector<params::ParamSpec>& table) {
                              [](DriverParams& p) -> C& { return p.servo_bus.bus; });
   params::SectionRows<S> own(table, "servo_bus", "servo_bus",
                              [](DriverParams& p) -> S& { return p.servo_bus; });
-  own.add("timeout", &S::timeout, [](const double& v, const std::string& key) {
-    params::positiveNumber(v, key);
-    require(v <= 5.0, key, "must be at most 5 s");
-  });
-  client.add("retries", &O::retries, params::integerWithin(0, 10))
+  client
+      .addConverted<double>(
+          "timeout", [](O& o) -> std::chrono::milliseconds& { return o.timeout; },
+          wholeMilliseconds,
+          [](std::chrono::milliseconds ms) { return std::chrono::duration<double>(ms).count(); },
+          [](const double& v, const std::string& key) {
+            params::positiveNumber(v, key);
+            require(v <= 5.0, key, "must be at most 5 s");
+          })
+      .add("retries", &O::retries, params::integerWithin(0, 10))
       .add("allow_dangerous_writes", &O::allow_dangerous_writes);
   own.add("state_ids", &S::state_ids, busServoIds);
   bus.add("state_rate", &C::poll_rate, [](const double& v, const std::string& key) {
@@ -69,18 +81,35 @@ void addParameters(std::vector<params::ParamSpec>& table) {
                        "must be servo angles within -180..180 deg");
              }
            })
-      .add("joint_directions", &S::joint_directions, params::directionList)
-      // Safe motion.
-      .add("relax_power_mw", &S::relax_power_mw, params::integerWithin(0, 65535, "mW"))
-      .add("on_shutdown", &S::on_shutdown, [](const std::string& v, const std::string& key) {
-        require(device::shutdownActionFromString(v).has_value(), key,
-                "must be stop, relax or none, got '" + v + "'");
-      });
+      .add("joint_directions", &S::joint_directions, params::directionList);
+  // Safe motion.
+  bus.addConverted<int>(
+         "relax_power_mw", [](C& c) -> uint16_t& { return c.relax_power_mw; },
+         [](int mw) { return static_cast<uint16_t>(mw); }, [](uint16_t mw) { return int{mw}; },
+         params::integerWithin(0, 65535, "mW"))
+      .addConverted<std::string>(
+          "on_shutdown", [](C& c) -> device::ShutdownAction& { return c.on_shutdown; },
+          // Checked before: only a disabled bus's value can be unknown, and it is never used.
+          [](const std::string& v) {
+            return device::shutdownActionFromString(v).value_or(device::ShutdownAction::kStop);
+          },
+          [](device::ShutdownAction action) { return std::string(device::toString(action)); },
+          [](const std::string& v, const std::string& key) {
+            require(device::shutdownActionFromString(v).has_value(), key,
+                    "must be stop, relax or none, got '" + v + "'");
+          });
   bus.add("health_rate", &C::health_rate, params::numberWithin(0.0, 10.0, "Hz (0: off)"))
       .add("protect", &C::protect);
-  own.add("expected_type", &S::expected_type, params::integerWithin(0, 65535, "(0: not checked)"))
-      .add("expected_firmware", &S::expected_firmware,
-           params::integerWithin(0, 65535, "(0: not checked)"));
+  // What every configured servo should report (0: not checked).
+  bus.addConverted<int>(
+         "expected_type", [](C& c) -> uint16_t& { return c.identity.expected_type; },
+         [](int type) { return static_cast<uint16_t>(type); }, [](uint16_t type) { return int{type}; },
+         params::integerWithin(0, 65535, "(0: not checked)"))
+      .addConverted<int>(
+          "expected_firmware", [](C& c) -> uint16_t& { return c.identity.expected_firmware; },
+          [](int version) { return static_cast<uint16_t>(version); },
+          [](uint16_t version) { return int{version}; },
+          params::integerWithin(0, 65535, "(0: not checked)"));
 }
 
 void validate(const DriverParams& p) {
@@ -118,7 +147,7 @@ extern const device::DeviceModule kModule{
     nullptr,
     // A servo answer must not wait behind a stray header longer than an answer may take.
     [](const DriverParams& p) {
-      return std::max(std::chrono::milliseconds(1), p.servo_bus.timeoutMs());
+      return std::max(std::chrono::milliseconds(1), p.servo_bus.bus.client.timeout);
     },
 };
 

@@ -271,10 +271,9 @@ ServoBusOptions ServoTransactions::options() const {
   return options_;
 }
 
-void ServoTransactions::retune(std::chrono::milliseconds timeout, int retries) {
+void ServoTransactions::retune(const ServoClientTuning& next) {
   std::lock_guard<std::mutex> lock(state_mutex_);
-  options_.timeout = timeout;
-  options_.retries = retries;
+  static_cast<ServoClientTuning&>(options_) = next;
 }
 
 ServoStatus ServoTransactions::exchangeLocked(const std::vector<uint8_t>& request,

@@ -45,16 +45,26 @@
 
 namespace serial_robot_driver::device {
 
-struct BaseConfig {
+/// The part of the configuration that can change while the loop runs (retune() takes it over
+/// whole). Each tunable parameter's row binds straight to its field here.
+struct BaseTuning {
+  /// Only wheel_diameter and wheel_separation are offered for runtime tuning (encoder_resolution
+  /// and pid_rate are the base's firmware), but the controller follows any geometry it is given.
   kinematics::DiffDriveGeometry geometry;
   double max_wheel_speed = 1.0;    ///< m/s; must be > 0 (no "no limit" value)
   double max_wheel_accel = 0.0;    ///< m/s^2; 0: no limit
   double cmd_vel_timeout = 0.5;    ///< s without a command: zero speed
   bool speed_dithering = true;     ///< carry the tick remainder (false: vendor truncation)
   double battery_poll_rate = 1.0;  ///< Hz; 0: never ask
-  double loop_rate = 50.0;         ///< Hz
-  double heartbeat_gap = 1.0;      ///< s; a gap this long in our sending means the base timed out
-  int baud = 115200;               ///< of the base's port: sets how closely immediate frames follow
+  /// Odometry's heading from the IMU yaw given to onImuYaw() while it is fresh (see
+  /// kinematics::HeadingFusion); the commanded turn otherwise.
+  bool use_imu_heading = false;
+};
+
+struct BaseConfig : BaseTuning {
+  double loop_rate = 50.0;     ///< Hz
+  double heartbeat_gap = 1.0;  ///< s; a gap this long in our sending means the base timed out
+  int baud = 115200;           ///< of the base's port: sets how closely immediate frames follow
   /// Largest share of the line's capacity immediate speed frames may take (a cmd_vel flood).
   double immediate_line_share = 0.5;
   int left_wheel_direction = 1;  ///< 1 or -1: sign between forward motion and the wire's ticks
@@ -62,9 +72,6 @@ struct BaseConfig {
   /// With battery polling on, this many poll periods without any reply mean the base is silent.
   double silent_after_polls = 3.0;
   kinematics::PoseCovarianceModel odometry_covariance;
-  /// Odometry's heading from the IMU yaw given to onImuYaw() while it is fresh (see
-  /// kinematics::HeadingFusion); the commanded turn otherwise.
-  bool use_imu_heading = false;
   double imu_yaw_variance = 0.0003;  ///< rad^2, odom's yaw variance while the IMU heading is used
   Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
 };
@@ -177,13 +184,13 @@ class BaseController : public LinkListener {
   /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.
   bool sendClearEncoders();
 
-  /// Applies the tunable part of `next` from the next frame on, all at once (under the loop's
-  /// lock): geometry.wheel_diameter and .wheel_separation, max_wheel_speed, max_wheel_accel,
-  /// cmd_vel_timeout, speed_dithering, battery_poll_rate, use_imu_heading. Everything else in
-  /// `next` is ignored (it needs a new controller). No Reset, the sequence goes on, the odometry
-  /// keeps its pose: the motion up to now is integrated with the geometry it ran under, from now on
-  /// with the new one. Expects validated values.
-  void retune(const BaseConfig& next);
+  /// Takes over `next` (a whole BaseConfig passes its BaseTuning part) from the next frame on,
+  /// all at once (under the loop's lock), and recomputes what derives from it: the acceleration
+  /// limiter, the tick quantizer, the odometry's geometry and heading source, the battery poll
+  /// schedule. The rest of the configuration needs a new controller. No Reset, the sequence goes
+  /// on, the odometry keeps its pose: the motion up to now is integrated with the geometry it ran
+  /// under, from now on with the new one. Expects validated values.
+  void retune(const BaseTuning& next);
   /// The configuration in force.
   BaseConfig config() const;
 
@@ -210,8 +217,10 @@ class BaseController : public LinkListener {
   /// `timed_out_now`: set when the cmd_vel timeout started with this call.
   kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now, bool* timed_out_now);
   kinematics::WheelTicks onWire(const kinematics::WheelTicks& ticks) const;
+  /// Requires mutex_, before the rate in force changes: the next poll for `next_rate`.
+  void rescheduleBatteryPollLocked(double next_rate, Clock::time_point now);
 
-  BaseConfig config_;  ///< its tunable part changes under mutex_ (retune)
+  BaseConfig config_;  ///< its BaseTuning part changes under mutex_ (retune)
   const FrameWriter writer_;
   const BaseEvents events_;
   const std::shared_ptr<LoopClock> clock_;

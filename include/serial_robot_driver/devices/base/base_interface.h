@@ -53,16 +53,9 @@ class BaseInterface : public DeviceInterface {
   device::SerialLink& link_;
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
   const BaseParams params_;       // as started: frames and joint names (the tunables: tuned())
-  /// The ~base tunables the interface itself uses, changed together by retune().
-  struct Tuned {
-    bool publish_tf = true;
-    double cmd_vel_timeout = 0;
-    int battery_warn_percent = 0;
-    int battery_error_percent = 0;
-  };
-  Tuned tuned() const;
-  mutable std::mutex tuned_mutex_;
-  Tuned tuned_;  // guarded by tuned_mutex_
+  /// ~base as last tuned, swapped whole by retune() (read on the loop and diagnostics threads).
+  std::shared_ptr<const BaseParams> tuned() const { return std::atomic_load(&tuned_); }
+  std::shared_ptr<const BaseParams> tuned_;
   // Before the controller: its loop publishes through them until it stops.
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
   ros::Publisher odom_pub_;

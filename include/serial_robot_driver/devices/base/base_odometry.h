@@ -37,9 +37,9 @@ class BaseOdometry {
   void baseStopped(Clock::time_point now);
   /// Puts the pose (and its covariance) back to zero at `now`; a fused heading restarts at zero.
   void reset(Clock::time_point now);
-  /// From `now` on: the wheel diameter and separation of `geometry`, and use_imu_heading. The
-  /// motion and the wheel angles up to `now` keep the geometry they ran under; the pose does not
-  /// jump.
+  /// From `now` on: `geometry` (the speeds the base holds are re-read through it), and
+  /// use_imu_heading. The motion and the wheel angles up to `now` keep the geometry they ran
+  /// under; the pose does not jump.
   void retune(const kinematics::DiffDriveGeometry& geometry, bool use_imu_heading,
               Clock::time_point now);
 
@@ -54,7 +54,7 @@ class BaseOdometry {
   std::optional<kinematics::HeadingSource> headingSourceChange();
 
  private:
-  kinematics::DiffDriveGeometry geometry_;  ///< its diameter and separation change in retune()
+  kinematics::DiffDriveGeometry geometry_;  ///< changes in retune()
   const double heartbeat_gap_;              ///< s
   bool use_imu_heading_;
   const double imu_yaw_variance_;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
@@ -14,11 +15,12 @@ namespace serial_robot_driver::params {
 struct BodyParams : DevicePortParams {
   std::vector<int> servo_ids{1, 2};
   std::vector<std::string> joint_names{"joint_1", "joint_2"};
-  int ticks_per_revolution = 4096;
+  /// What every joint shares: ticks_per_revolution and velocity_scale (0: unknown, and
+  /// joint_states carries no velocity) are bound here; each joint's zero and direction come from
+  /// the lists below (ros_layer::makeBodyJoints).
+  device::JointCalibration calibration;
   std::vector<int> zero_ticks{2048, 2048};
   std::vector<int> directions{1, 1};
-  /// rad/s per raw speed unit; 0: unknown, and joint_states carries no velocity.
-  double velocity_scale = 0.0;
 };
 
 /// Where each axis of imu/data comes from: axis i (x, y, z) is sign[i] * the sensor's axis

@@ -145,11 +145,11 @@ class ServoBus : public LinkListener, public LinkWorker {
   const ServoBusConfig& config() const { return config_; }
   /// The configuration in force: config() with what retune() changed since.
   ServoBusConfig settings() const;
-  /// Applies the tunable part of `next`: client.timeout and client.retries from the next bus
-  /// transaction on, poll_rate and health_rate from the next poll on (a faster rate does not wait
-  /// out the slower period still pending; health_rate 0 stops the health poll), relax_power_mw,
-  /// protect and on_shutdown from their next use. Never waits for the bus. Expects validated
-  /// values (poll_rate > 0).
+  /// Takes over the tunable part of `next` whole (its ServoBusTuning and its client's
+  /// ServoClientTuning): the client's timeout and retries from the next bus transaction on, the
+  /// poll and health rates from the next poll on (a faster rate does not wait out the slower
+  /// period still pending; health_rate 0 stops the health poll), the rest from its next use.
+  /// Never waits for the bus. Expects validated values (poll_rate > 0).
   void retune(const ServoBusConfig& next);
 
   // LinkListener (reader thread): handed on to the client; a reconnect re-arms the stops.

@@ -123,9 +123,7 @@ class ServoBusClient : public LinkListener {
   ServoBusOptions options() const { return transactions_.options(); }
   /// A new timeout and retry count for the transactions that start from now on; one that runs
   /// keeps what it started with. Never waits for the bus.
-  void retune(std::chrono::milliseconds timeout, int retries) {
-    transactions_.retune(timeout, retries);
-  }
+  void retune(const ServoClientTuning& next) { transactions_.retune(next); }
   /// Callers (not background work) waiting for the bus right now (for tests and diagnostics).
   int callersWaiting() { return transactions_.busMutex().foregroundWaiting(); }
   /// Before any call: waits on the pump's reader thread read the port (see servo_transactions.h).

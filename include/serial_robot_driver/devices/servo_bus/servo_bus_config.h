@@ -18,11 +18,11 @@ enum class ShutdownAction { kStop, kRelax, kNone };
 std::optional<ShutdownAction> shutdownActionFromString(const std::string& text);
 const char* toString(ShutdownAction action);
 
-struct ServoBusConfig {
-  ServoBusOptions client;
-  std::vector<uint8_t> polled_ids;  ///< servos whose angle is polled (servo_states)
-  double poll_rate = 10.0;          ///< polls per second of each polled servo, > 0
-  uint16_t relax_power_mw = 50;     ///< DAMPING power of relax()
+/// The part of the bus's configuration that can change while it runs (ServoBus::retune() takes it
+/// over whole, with the client's ServoClientTuning).
+struct ServoBusTuning {
+  double poll_rate = 10.0;       ///< polls per second of each polled servo, > 0
+  uint16_t relax_power_mw = 50;  ///< DAMPING power of relax()
   /// For each servo set spinning or moving: kStop a SPIN stop, kRelax relax(), kNone nothing.
   ShutdownAction on_shutdown = ShutdownAction::kStop;
   /// Health polls (voltage, current, power, temperature, status) per second of each polled
@@ -36,6 +36,11 @@ struct ServoBusConfig {
   /// writes.
   bool read_identity = true;
   ServoIdentityChecks identity;
+};
+
+struct ServoBusConfig : ServoBusTuning {
+  ServoBusOptions client;
+  std::vector<uint8_t> polled_ids;  ///< servos whose angle is polled (servo_states)
 };
 
 }  // namespace serial_robot_driver::device

@@ -50,7 +50,7 @@
 namespace serial_robot_driver::ros_layer {
 
 /// The bus device's configuration: what the parameters bound into ServoBusParams::bus, plus the
-/// polled servos (state_ids and the joint_ids servos) and the safe-motion values kept as written.
+/// polled servos (state_ids and the joint_ids servos).
 device::ServoBusConfig makeServoBusConfig(const DriverParams& params);
 
 // Joint names and servo_commands' checks are the core's (device/servo_joint_commands.h).
@@ -102,6 +102,9 @@ class ServoBusInterface : public DeviceInterface {
   void yieldJoints(const std::vector<uint8_t>& ids, const char* source);
   /// A motion service or topic while the e-stop holds: counted, and its refusal (else ok).
   device::ServoStatus refuseWhileEStopped(const std::string& source);
+  /// A motion service (`source`) taking servos `ids` (empty: every configured servo): refused
+  /// while the e-stop holds, else the joints among them yield (yieldJoints) and ok.
+  device::ServoStatus claimServos(const std::vector<uint8_t>& ids, const char* source);
   void diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status);
 
   // Bus servos as joints (trajectories): fixed before the bus starts, read on the worker thread.

@@ -67,10 +67,14 @@ struct ServoStatus {
   bool ok() const { return error == ServoError::kOk; }
 };
 
-struct ServoBusOptions {
+/// The options that can change while the bus runs (retune() takes them over whole).
+struct ServoClientTuning {
   std::chrono::milliseconds timeout{50};  ///< wait for one answer
   int retries = 1;                        ///< re-sends after a timeout (attempts = retries + 1)
-  bool allow_dangerous_writes = false;    ///< arms servo_id, baudrate and reset_user_data
+};
+
+struct ServoBusOptions : ServoClientTuning {
+  bool allow_dangerous_writes = false;  ///< arms servo_id, baudrate and reset_user_data
 };
 
 struct ServoBusStats {
@@ -148,7 +152,7 @@ class ServoTransactions : public LinkListener {
   ServoBusOptions options() const;
   /// A new timeout and retry count for the transactions that start from now on; one that runs
   /// keeps what it started with. Never waits for the bus.
-  void retune(std::chrono::milliseconds timeout, int retries);
+  void retune(const ServoClientTuning& next);
   /// Before any transaction: waits on the pump's reader thread read the port.
   void setReaderPump(ReaderPump pump);
   /// Before any transaction: the gate every motion frame passes when it is written (nullptr:

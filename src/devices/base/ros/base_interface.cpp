@@ -63,7 +63,7 @@ device::BaseEvents BaseInterface::events() {
   events.on_odometry = [this](const device::OdometrySample& sample) { publishOdometry(sample); };
   events.on_cmd_vel_timeout = [this] {
     ROS_INFO_THROTTLE(10.0, "no cmd_vel for %.2f s (base/cmd_vel_timeout): commanding zero speed",
-                      tuned().cmd_vel_timeout);
+                      tuned()->controller.cmd_vel_timeout);
   };
   events.on_silent = [this](double seconds) {
     ROS_ERROR_THROTTLE(10.0,
@@ -94,8 +94,7 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
     : link_(link),
       arrival_stamps_(params),
       params_(params.base),
-      tuned_{params.base.publish_tf, params.base.controller.cmd_vel_timeout,
-             params.base.battery_warn_percent, params.base.battery_error_percent},
+      tuned_(std::make_shared<const BaseParams>(params.base)),
       tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
                                              : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
@@ -164,7 +163,7 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   odom_pub_.publish(odom);
   publishWheelStates(sample, stamp);
 
-  if (!tuned().publish_tf) return;
+  if (!tuned()->publish_tf) return;
   // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
   if (!tf_broadcaster_) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
   geometry_msgs::TransformStamped transform;
@@ -189,16 +188,9 @@ void BaseInterface::publishWheelStates(const device::OdometrySample& sample,
   wheel_states_pub_.publish(wheels);
 }
 
-BaseInterface::Tuned BaseInterface::tuned() const {
-  std::lock_guard<std::mutex> lock(tuned_mutex_);
-  return tuned_;
-}
-
 void BaseInterface::retune(const DriverParams& params) {
   controller_.retune(makeBaseConfig(params));
-  std::lock_guard<std::mutex> lock(tuned_mutex_);
-  tuned_ = Tuned{params.base.publish_tf, params.base.controller.cmd_vel_timeout,
-                 params.base.battery_warn_percent, params.base.battery_error_percent};
+  std::atomic_store(&tuned_, std::make_shared<const BaseParams>(params.base));
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -225,10 +217,10 @@ bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigg
 }
 
 void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const Tuned limits = tuned();
+  const std::shared_ptr<const BaseParams> limits = tuned();
   writeStatusReport(
       device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
-                         {limits.battery_warn_percent, limits.battery_error_percent}),
+                         {limits->battery_warn_percent, limits->battery_error_percent}),
       status);
 }
 

@@ -96,6 +96,35 @@ TEST_F(BaseControllerTest, RetunedWheelDiameterChangesTheTicksAndKeepsTheWheelAn
   expectOneUnbrokenSequence(sent_);
 }
 
+// retune() takes the BaseTuning part over whole (the rows of every tunable bind there) and keeps
+// the rest of the configuration it was built with.
+TEST_F(BaseControllerTest, RetuneTakesTheTuningPartWholeAndKeepsTheRest) {
+  BaseConfig next = controller_.config();
+  next.geometry.wheel_diameter = 0.3;
+  next.geometry.wheel_separation = 0.5;
+  next.max_wheel_speed = 0.7;
+  next.max_wheel_accel = 2.0;
+  next.cmd_vel_timeout = 0.3;
+  next.speed_dithering = !next.speed_dithering;
+  next.battery_poll_rate = 2.0;
+  next.use_imu_heading = !next.use_imu_heading;
+  next.loop_rate = 10.0;  // not tunable: it needs a new controller
+  next.left_wheel_direction = -1;
+  const BaseConfig before = controller_.config();
+  controller_.retune(next);
+  const BaseConfig now = controller_.config();
+  EXPECT_EQ(now.geometry.wheel_diameter, 0.3);
+  EXPECT_EQ(now.geometry.wheel_separation, 0.5);
+  EXPECT_EQ(now.max_wheel_speed, 0.7);
+  EXPECT_EQ(now.max_wheel_accel, 2.0);
+  EXPECT_EQ(now.cmd_vel_timeout, 0.3);
+  EXPECT_EQ(now.speed_dithering, next.speed_dithering);
+  EXPECT_EQ(now.battery_poll_rate, 2.0);
+  EXPECT_EQ(now.use_imu_heading, next.use_imu_heading);
+  EXPECT_EQ(now.loop_rate, before.loop_rate);
+  EXPECT_EQ(now.left_wheel_direction, before.left_wheel_direction);
+}
+
 TEST(BaseControllerRetune, FasterBatteryPollStartsWithoutWaitingForTheSlowPeriod) {
   BaseConfig config;
   config.battery_poll_rate = 0.2;  // every 5 s

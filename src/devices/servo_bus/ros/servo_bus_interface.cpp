@@ -38,14 +38,6 @@ device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
       config.polled_ids.push_back(joint_id);
     }
   }
-  config.client.timeout = params.servo_bus.timeoutMs();
-  // validate() accepted only 0..65535 and the names shutdownActionFromString() knows.
-  config.relax_power_mw = static_cast<uint16_t>(params.servo_bus.relax_power_mw);
-  config.on_shutdown = device::shutdownActionFromString(params.servo_bus.on_shutdown)
-                           .value_or(device::ShutdownAction::kStop);
-  // validate() accepted only 0..65535.
-  config.identity.expected_type = static_cast<uint16_t>(params.servo_bus.expected_type);
-  config.identity.expected_firmware = static_cast<uint16_t>(params.servo_bus.expected_firmware);
   for (int id : params.servo_bus.joint_ids) {
     config.identity.joint_ids.push_back(static_cast<uint8_t>(id));
   }
@@ -180,6 +172,13 @@ device::ServoStatus ServoBusInterface::refuseWhileEStopped(const std::string& so
   if (!e_stop_ || !e_stop_->refuse(source)) return {};
   return {device::ServoError::kMotionRefused,
           "e_stop is engaged: no servo moves until it is released (publish false on e_stop)"};
+}
+
+device::ServoStatus ServoBusInterface::claimServos(const std::vector<uint8_t>& ids,
+                                                   const char* source) {
+  device::ServoStatus refused = refuseWhileEStopped(source);
+  if (refused.ok()) yieldJoints(ids, source);
+  return refused;
 }
 
 void ServoBusInterface::attachEStop(device::EStop& e_stop) {

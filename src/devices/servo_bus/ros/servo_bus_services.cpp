@@ -125,9 +125,9 @@ void ServoBusInterface::advertiseServices() {
                                   request.accel_ms = req.accel_ms;
                                   request.decel_ms = req.decel_ms;
                                   request.power_mw = req.power_mw;
-                                  device::ServoStatus refused = refuseWhileEStopped("servo/move");
-                                  if (!refused.ok()) return refused;
-                                  yieldJoint(req.id, "servo/move");
+                                  const device::ServoStatus claimed =
+                                      claimServos({req.id}, "servo/move");
+                                  if (!claimed.ok()) return claimed;
                                   return bus_.move(request);
                                 }),
       advertiseServo<ServoScan>(nh_, "servo/scan",
@@ -142,10 +142,9 @@ void ServoBusInterface::advertiseServices() {
                                     request.interval_ms = req.interval_ms;
                                     request.power_mw = req.power_mw;
                                     request.wait = req.wait;
-                                    device::ServoStatus refused =
-                                        refuseWhileEStopped("servo/rotate");
-                                    if (!refused.ok()) return refused;
-                                    yieldJoint(req.id, "servo/rotate");
+                                    const device::ServoStatus claimed =
+                                        claimServos({req.id}, "servo/rotate");
+                                    if (!claimed.ok()) return claimed;
                                     return bus_.rotate(request);
                                   }),
       advertiseServo<ServoSpin>(nh_, "servo/spin",
@@ -167,24 +166,23 @@ void ServoBusInterface::advertiseServices() {
                                 }),
       advertiseServo<ServoDamping>(nh_, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
-                                     device::ServoStatus refused =
-                                         refuseWhileEStopped("servo/damping");
-                                     if (!refused.ok()) return refused;
-                                     yieldJoint(req.id, "servo/damping");
+                                     const device::ServoStatus claimed =
+                                         claimServos({req.id}, "servo/damping");
+                                     if (!claimed.ok()) return claimed;
                                      return bus_.damping(req.id, req.power_mw, req.wait);
                                    }),
       advertiseServo<ServoRelax>(nh_, "servo/relax",
                                  [this](ServoRelax::Request& req, ServoRelax::Response&) {
-                                   device::ServoStatus refused = refuseWhileEStopped("servo/relax");
-                                   if (!refused.ok()) return refused;
-                                   yieldJoints(req.ids, "servo/relax");
+                                   const device::ServoStatus claimed =
+                                       claimServos(req.ids, "servo/relax");
+                                   if (!claimed.ok()) return claimed;
                                    return bus_.relax(req.ids);
                                  }),
       advertiseServo<ServoHold>(nh_, "servo/hold",
                                 [this](ServoHold::Request& req, ServoHold::Response&) {
-                                  device::ServoStatus refused = refuseWhileEStopped("servo/hold");
-                                  if (!refused.ok()) return refused;
-                                  yieldJoints(req.ids, "servo/hold");
+                                  const device::ServoStatus claimed =
+                                      claimServos(req.ids, "servo/hold");
+                                  if (!claimed.ok()) return claimed;
                                   return bus_.hold(req.ids);
                                 }),
       advertiseServo<ServoReadAll>(nh_, "servo/read_all",
