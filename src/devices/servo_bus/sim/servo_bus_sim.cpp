@@ -267,18 +267,7 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
       reply(servo::resultAnswerContent(kFactoryId, true));
       break;
 
-    case Command::kReadData: {
-      const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
-      if (!request) return malformed();
-      const servo::ParamInfo* param_info = servo::findParamById(request->data_id);
-      if (param_info == nullptr) {
-        ++stats_.unknown_data_ids;
-        return;
-      }
-      reply(servo::readDataAnswerContent(id, *param_info, param(*s, param_info->data_id)));
-      break;
-    }
-
+    case Command::kReadData:
     case Command::kWriteData: {
       const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
       if (!request) return malformed();
@@ -286,6 +275,10 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
       if (param_info == nullptr) {
         ++stats_.unknown_data_ids;
         return;
+      }
+      if (cmd == Command::kReadData) {
+        reply(servo::readDataAnswerContent(id, *param_info, param(*s, param_info->data_id)));
+        break;
       }
       const auto value = servo::readValue(*param_info, request->value.data(), request->value_size);
       if (!value) return malformed();
