@@ -103,7 +103,8 @@ void addParameters(std::vector<params::ParamSpec>& table) {
   // What every configured servo should report (0: not checked).
   bus.addConverted<int>(
          "expected_type", [](C& c) -> uint16_t& { return c.identity.expected_type; },
-         [](int type) { return static_cast<uint16_t>(type); }, [](uint16_t type) { return int{type}; },
+         [](int type) { return static_cast<uint16_t>(type); },
+         [](uint16_t type) { return int{type}; },
          params::integerWithin(0, 65535, "(0: not checked)"))
       .addConverted<int>(
           "expected_firmware", [](C& c) -> uint16_t& { return c.identity.expected_firmware; },
