@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # catkin build (catkin_tools), the other build tool the README promises next to catkin_make: builds
-# and installs the package once in a workspace of its own (.ws_catkin_tools/, git-ignored; kept
-# between runs, so a second run only rebuilds what changed), then runs sim.launch from that
+# and installs the package once in a workspace of its own (outside the repository, see
+# scratch_dir.sh; kept between runs, so a second run only rebuilds what changed), then runs sim.launch from that
 # install space alone and checks that joint_states flow and the servo/ping service is up.
 # Tests are not built here (scripts/build.sh's workspace runs them); ccache is used when present.
 # Usage: scripts/test_catkin_build.sh. Prints "catkin build test passed" or what failed.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
-ws="${SRD_CATKIN_TOOLS_WS:-$repo/.ws_catkin_tools}"
+source "$repo/scripts/scratch_dir.sh"
+ws="${SRD_CATKIN_TOOLS_WS:-$(scratch_dir "$repo" catkin_tools)}"
+rm -rf "$repo/.ws_catkin_tools"  # where earlier versions kept it: rosrun would find its copies
 export PATH="/usr/bin:/bin"
 set -m
 # stop_group, run, wait_for

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # ThreadSanitizer run: builds the package with -fsanitize=thread in a workspace of its own
-# (.ws_tsan/, kept between runs) and runs the core unit tests and the e-stop rostests under it.
+# (outside the repository, see scratch_dir.sh; kept between runs) and runs the core unit tests and the e-stop rostests under it.
 # Not part of CI (a second full build and a slow run); run it after touching threads or locks:
 #   bash scripts/tsan.sh            # core_tests, estop_bus.test, safe_motion.test
 #   bash scripts/tsan.sh --unit     # core_tests only
-# Reports go to .ws_tsan/reports/tsan.<pid>; the script prints the warnings in project code
+# Reports go to <its workspace>/reports/tsan.<pid>; the script prints the warnings in project code
 # (src/, include/, test/) and exits non-zero when there is one (or a test failed).
 set -uo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
-ws="$repo/.ws_tsan"
+source "$repo/scripts/scratch_dir.sh"
+ws="$(scratch_dir "$repo" tsan)"
+rm -rf "$repo/.ws_tsan"  # where earlier versions kept it: rosrun would find its copies
 export PATH="/usr/bin:$PATH"
 bash "$repo/scripts/install_deps.sh" || exit 1
 
