@@ -10,12 +10,15 @@ const char* toString(GateState state) {
       return "e_stop engaged";
     case GateState::kClosed:
       return "shutting down";
+    case GateState::kVoided:
+      return "e-stop engaged after this command was accepted";
   }
   return "?";
 }
 
 void MotionGate::setLocked(bool locked) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (locked && !locked_) ++generation_;
   locked_ = locked;
 }
 
@@ -34,9 +37,16 @@ GateState MotionGate::state() const {
   return stateLocked();
 }
 
-GateState MotionGate::writeIfOpen(const std::function<bool()>& write, bool* written) {
+MotionGate::Generation MotionGate::generation() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const GateState state = stateLocked();
+  return generation_;
+}
+
+GateState MotionGate::writeIfOpen(const std::function<bool()>& write, bool* written,
+                                  std::optional<Generation> accepted) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  GateState state = stateLocked();
+  if (state == GateState::kOpen && accepted && *accepted != generation_) state = GateState::kVoided;
   if (state != GateState::kOpen) {
     ++refused_;
     *written = false;

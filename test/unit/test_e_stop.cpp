@@ -6,10 +6,13 @@
 #include <vector>
 
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/device/motion_gate.h"
 
 namespace {
 
 using serial_robot_driver::device::EStop;
+using serial_robot_driver::device::GateState;
+using serial_robot_driver::device::MotionGate;
 
 TEST(EStop, ListenersRunOncePerChangeInOrder) {
   EStop e_stop;
@@ -38,6 +41,30 @@ TEST(EStop, RefusesAndCountsOnlyWhileEngaged) {
   const auto stats = e_stop.stats();
   EXPECT_EQ(stats.refused.at("cmd_vel"), 2u);
   EXPECT_EQ(stats.refused.at("servo/spin"), 1u);
+}
+
+// A command accepted before an e-stop never moves anything after it, even once released.
+TEST(MotionGate, AnEStopVoidsWhatWasAcceptedBeforeIt) {
+  MotionGate gate;
+  const MotionGate::Generation before = gate.generation();
+  int writes = 0;
+  const auto write = [&] { return ++writes > 0; };
+  bool written = false;
+  EXPECT_EQ(gate.writeIfOpen(write, &written, before), GateState::kOpen);
+  EXPECT_TRUE(written);
+  gate.setLocked(true);
+  EXPECT_EQ(gate.writeIfOpen(write, &written, before), GateState::kLocked);
+  gate.setLocked(true);  // a repeated engage is the same e-stop
+  gate.setLocked(false);
+  EXPECT_EQ(gate.writeIfOpen(write, &written, before), GateState::kVoided) << "released, still void";
+  EXPECT_FALSE(written);
+  EXPECT_EQ(gate.generation(), before + 1);
+  EXPECT_EQ(gate.writeIfOpen(write, &written, gate.generation()), GateState::kOpen);
+  EXPECT_EQ(gate.writeIfOpen(write, &written), GateState::kOpen) << "no generation: gate only";
+  EXPECT_EQ(writes, 3);
+  EXPECT_EQ(gate.refusedAtWrite(), 2u);
+  gate.close();
+  EXPECT_EQ(gate.writeIfOpen(write, &written, gate.generation()), GateState::kClosed);
 }
 
 }  // namespace
