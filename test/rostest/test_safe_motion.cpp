@@ -134,9 +134,6 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
   rotate.request.angle_deg = 90.0;
   ASSERT_TRUE(ros::service::call("servo/rotate", rotate));
   EXPECT_FALSE(rotate.response.success);
-  srd::ServoRelax relax;
-  ASSERT_TRUE(ros::service::call("servo/relax", relax));
-  EXPECT_FALSE(relax.response.success);
   srd::ServoHold hold;
   ASSERT_TRUE(ros::service::call("servo/hold", hold));
   EXPECT_FALSE(hold.response.success);
@@ -165,7 +162,6 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
   EXPECT_EQ(status->level, diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_GE(status->number("refused: servo/spin"), 1u);
   EXPECT_GE(status->number("refused: servo/rotate"), 1u);
-  EXPECT_GE(status->number("refused: servo/relax"), 1u);
   EXPECT_GE(status->number("refused: servo/hold"), 1u);
   EXPECT_FALSE(simServo(*g_robot, 1)->moving);
   EXPECT_EQ(simServo(*g_robot, 1)->angle_deg, stopped_at);

@@ -1,8 +1,10 @@
 #include "serial_robot_driver/devices/servo_bus/motion_safety.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -14,8 +16,27 @@ namespace serial_robot_driver::device {
 namespace {
 
 constexpr uint8_t kBroadcastId = 255;
+constexpr uint8_t kServoIdParam = protocol::servo::dataId(protocol::servo::ServoDataId::kServoId);
+constexpr uint8_t kIdAfterReset = 0;  // RESET_USER_DATA sets the servo's id to 0
 
 std::string servoLabel(uint8_t id) { return "servo " + std::to_string(id); }
+
+/// The parameters that change where or how a servo moves, or where its stop goes.
+bool affectsMotion(uint8_t data_id) {
+  using protocol::servo::ServoDataId;
+  constexpr std::array<ServoDataId, 10> kMotionParams = {
+      ServoDataId::kServoId,          ServoDataId::kBaudrate,        ServoDataId::kResponseSwitch,
+      ServoDataId::kStallProtectMode, ServoDataId::kStallPowerLimit, ServoDataId::kAccelSwitch,
+      ServoDataId::kAngleLimitSwitch, ServoDataId::kAngleLimitHigh,  ServoDataId::kAngleLimitLow,
+      ServoDataId::kAngleMidOffset};
+  return std::any_of(kMotionParams.begin(), kMotionParams.end(),
+                     [&](ServoDataId id) { return protocol::servo::dataId(id) == data_id; });
+}
+
+ServoStatus eStopRefusal(uint8_t id) {
+  return {ServoError::kMotionRefused,
+          "e_stop is engaged: " + servoLabel(id) + " does not move until it is released"};
+}
 
 }  // namespace
 
@@ -74,11 +95,22 @@ ServoStatus MotionSafety::refusal(uint8_t id) const {
   return refusalLocked(id);
 }
 
-ServoStatus MotionSafety::refusalLocked(uint8_t id) const {
-  if (motion_locked_) {
-    return {ServoError::kMotionRefused,
-            "e_stop is engaged: " + servoLabel(id) + " does not move until it is released"};
+ServoStatus MotionSafety::accept(uint8_t id, MotionGate::Generation* generation) const {
+  if (id == kBroadcastId) {
+    return {ServoError::kInvalidArgument,
+            "motions to id 255 (broadcast) are refused: nothing answers them, so the driver could "
+            "not tell which servos they set moving nor stop them one by one; command each servo "
+            "by its id (a broadcast SPIN stop or DAMPING is allowed)"};
   }
+  // The generation first: an e-stop engaged after this line voids the command at the write, one
+  // engaged before it is still engaged below (or was released: the command came after it).
+  *generation = gate_.generation();
+  if (gate_.state() == GateState::kLocked) return eStopRefusal(id);
+  return refusal(id);
+}
+
+ServoStatus MotionSafety::refusalLocked(uint8_t id) const {
+  if (motion_locked_) return eStopRefusal(id);
   if (const ServoHealthReport* overheated = poller_.overheatedLocked(id)) {
     const ServoHealthReport& report = *overheated;
     return {ServoError::kMotionRefused,
@@ -93,17 +125,19 @@ ServoStatus MotionSafety::refusalLocked(uint8_t id) const {
 }
 
 ServoStatus MotionSafety::move(const MoveRequest& request) {
-  ServoStatus status = refusal(request.id);
+  MotionGate::Generation generation = 0;
+  ServoStatus status = accept(request.id, &generation);
   if (!status.ok()) return status;
-  status = client_.move(request);
+  status = client_.move(request, BusPriority::kCaller, generation);
   if (status.ok()) noteMotion(request.id, true);
   return status;
 }
 
 ServoStatus MotionSafety::rotate(const RotateRequest& request) {
-  ServoStatus status = refusal(request.id);
+  MotionGate::Generation generation = 0;
+  ServoStatus status = accept(request.id, &generation);
   if (!status.ok()) return status;
-  status = client_.rotate(request);
+  status = client_.rotate(request, generation);
   if (status.ok()) noteMotion(request.id, true);
   return status;
 }
@@ -111,25 +145,24 @@ ServoStatus MotionSafety::rotate(const RotateRequest& request) {
 ServoStatus MotionSafety::spin(const SpinRequest& request) {
   // A SPIN stop is always let through: it is what the e-stop itself sends.
   const bool stop = request.mode == 0;
-  ServoStatus status = stop ? ServoStatus{} : refusal(request.id);
+  MotionGate::Generation generation = 0;
+  ServoStatus status = stop ? ServoStatus{} : accept(request.id, &generation);
   if (!status.ok()) return status;
-  status = client_.spin(request);
+  status = client_.spin(request, stop ? std::nullopt : std::optional(generation));
   if (status.ok()) noteMotion(request.id, !stop);
   return status;
 }
 
 ServoStatus MotionSafety::damping(uint8_t id, uint16_t power_mw, bool wait) {
-  ServoStatus status = refusal(id);
+  // Torque off moves nothing actively: a safety action, allowed while the e-stop holds.
+  const ServoStatus status = client_.damping(id, power_mw, wait, FrameGate::kSafetyAction);
   if (!status.ok()) return status;
-  status = client_.damping(id, power_mw, wait);
-  if (status.ok()) {
-    noteMotion(id, false);  // no holding torque: nothing keeps it moving or in place
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!motion_locked_) {
-      commanded_.erase(id);
-      stops_.eraseLocked(id);  // relaxed: there is nothing left to stop
-    }
-  }
+  noteMotion(id, false);  // no holding torque: nothing keeps it moving or in place
+  // A broadcast is not answered: which servos heard it is unknown, their stops stay.
+  if (id == kBroadcastId) return status;
+  std::lock_guard<std::mutex> lock(mutex_);
+  commanded_.erase(id);
+  stops_.eraseLocked(id);  // relaxed: its stop is satisfied (another would give it torque back)
   return status;
 }
 
@@ -159,16 +192,19 @@ ServoStatus MotionSafety::hold(const std::vector<uint8_t>& ids) {
             "no servo given and none configured (state_ids, joint_ids)"};
   }
   std::string held;
+  std::optional<MotionGate::Generation> accepted;  // the call's: noted at its first check
   for (uint8_t id : targets) {
-    ServoStatus status = refusal(id);
+    MotionGate::Generation generation = 0;
+    ServoStatus status = accept(id, &generation);
     if (!status.ok()) return status;
+    if (!accepted) accepted = generation;
     double angle_deg = 0.0;
     status = client_.readAngle(id, &angle_deg);
     if (!status.ok()) return status;
     RotateRequest request;
     request.id = id;
     request.angle_deg = angle_deg;
-    status = client_.rotate(request);
+    status = client_.rotate(request, accepted);
     if (!status.ok()) return status;
     noteMotion(id, false);  // holding where it is: not set moving
     char text[48];
@@ -176,6 +212,53 @@ ServoStatus MotionSafety::hold(const std::vector<uint8_t>& ids) {
     held += text;
   }
   return {ServoError::kOk, "holding servo(s) " + held};
+}
+
+ServoStatus MotionSafety::settingRefusal(uint8_t id, const std::string& what) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (motion_locked_) {
+    return {ServoError::kMotionRefused,
+            "e_stop is engaged: " + what + " of " + servoLabel(id) +
+                " is refused until it is released (it changes how or where the servo moves, or "
+                "where its stop goes)"};
+  }
+  if (moving_.count(id) > 0 || stops_.keptLocked(id)) {
+    return {ServoError::kMotionRefused,
+            what + " of " + servoLabel(id) +
+                " is refused while it moves (set moving and not stopped since, or its stop not "
+                "yet confirmed): stop it first (servo/spin mode 0, or servo/relax)"};
+  }
+  return {};
+}
+
+ServoStatus MotionSafety::writeParam(uint8_t id, std::string_view param, int64_t value) {
+  const protocol::servo::ParamInfo* info = protocol::servo::findParam(param);
+  if (info != nullptr && affectsMotion(info->data_id)) {
+    const ServoStatus refused = settingRefusal(id, "a write of '" + std::string(info->name) + "'");
+    if (!refused.ok()) return refused;
+  }
+  const ServoStatus status = client_.writeParam(id, param, value);
+  if (status.ok() && info != nullptr && info->data_id == kServoIdParam && value != id) {
+    followAddress(id, static_cast<uint8_t>(value));
+  }
+  return status;
+}
+
+ServoStatus MotionSafety::resetUserData(uint8_t id) {
+  // The reset restores the factory angle limits and id: as much a motion setting as any.
+  const ServoStatus refused = settingRefusal(id, "RESET_USER_DATA");
+  if (!refused.ok()) return refused;
+  const ServoStatus status = client_.resetUserData(id);
+  if (status.ok()) followAddress(id, kIdAfterReset);
+  return status;
+}
+
+void MotionSafety::followAddress(uint8_t from, uint8_t to) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (from == to) return;
+  if (commanded_.erase(from) > 0) commanded_.insert(to);
+  if (moving_.erase(from) > 0) moving_.insert(to);
+  stops_.renameLocked(from, to);
 }
 
 bool MotionSafety::motionLocked() const {
@@ -205,12 +288,12 @@ void MotionSafety::setMotionLocked(bool locked) {
     std::lock_guard<std::mutex> lock(mutex_);
     motion_locked_ = locked;
     if (!locked) {
-      stops_.clearLocked();  // released: nothing is to be held back any more
+      stops_.releaseLocked();  // the stops that went out are done; one never written still goes
       return;
     }
     hooks_.drop_queued_moves_locked();
     const Clock::time_point now = clock_.now();
-    for (uint8_t id : commanded_) stops_.armLocked(id, now);
+    for (uint8_t id : commanded_) stops_.armLocked(id, now, /*repeat=*/true);
     if (stops_.emptyLocked()) return;
   }
   hooks_.deliver_stops();
@@ -218,7 +301,7 @@ void MotionSafety::setMotionLocked(bool locked) {
 
 bool MotionSafety::rearmStopsLocked(Clock::time_point now) {
   if (motion_locked_) {
-    for (uint8_t id : commanded_) stops_.armLocked(id, now);
+    for (uint8_t id : commanded_) stops_.armLocked(id, now, /*repeat=*/true);
   }
   stops_.rearmAllLocked(now);
   return !stops_.emptyLocked();
@@ -240,6 +323,7 @@ void MotionSafety::finalWords() {
   switch (in_force.on_shutdown) {
     case ShutdownAction::kStop: {
       const Clock::time_point now = clock_.now();
+      stops_.endRepeatsLocked();  // each ends once seen at rest: the budget is short
       for (uint8_t id : commanded_) stops_.armLocked(id, now);
       // Back to back on this thread (the worker has stopped), until each is seen at rest.
       while (!stops_.emptyLocked() && std::chrono::steady_clock::now() < deadline) {

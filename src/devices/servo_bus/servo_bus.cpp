@@ -36,14 +36,16 @@ void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
     std::lock_guard<std::mutex> lock(mutex_);
     // The e-stop holds: the caller refused (and counted) it already.
     if (safety_.motionLockedLocked()) return;
+    // Under mutex_: an e-stop engaged after this note drops the queue (or voids the write).
+    const MotionGate::Generation accepted = safety_.gate().generation();
     for (const MoveRequest& move : moves) {
       auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
-                                 [&move](const MoveRequest& m) { return m.id == move.id; });
+                                 [&move](const QueuedMove& q) { return q.move.id == move.id; });
       if (queued != queued_moves_.end()) {
-        *queued = move;
+        *queued = {move, accepted};
         ++stats_.moves_replaced;
       } else {
-        queued_moves_.push_back(move);
+        queued_moves_.push_back({move, accepted});
       }
     }
   }
@@ -57,7 +59,7 @@ void ServoBus::dropQueuedMoves(uint8_t id) {
 
 void ServoBus::dropQueuedMovesLocked(uint8_t id) {
   queued_moves_.erase(std::remove_if(queued_moves_.begin(), queued_moves_.end(),
-                                     [id](const MoveRequest& m) { return m.id == id; }),
+                                     [id](const QueuedMove& q) { return q.move.id == id; }),
                       queued_moves_.end());
 }
 
@@ -166,29 +168,31 @@ void ServoBus::workOnce(std::unique_lock<std::mutex>& lock) {
   // Stops first: nothing else this bus does may go before them.
   if (stops_.workOnce(lock, StopPace::kScheduled)) return;
   if (!queued_moves_.empty()) {
-    const MoveRequest move = queued_moves_.front();
+    const QueuedMove queued = queued_moves_.front();
     queued_moves_.pop_front();
     lock.unlock();
-    sendMove(move);
+    sendMove(queued);
     lock.lock();
     return;
   }
   poller_.pollDue(lock);
 }
 
-void ServoBus::sendMove(const MoveRequest& move) {
+void ServoBus::sendMove(const QueuedMove& queued) {
+  const MoveRequest& move = queued.move;
   ServoStatus status = safety_.refusal(move.id);  // an overheated servo (protect)
   if (status.ok()) {
-    // Through the motion gate: refused if the e-stop came meanwhile.
-    status = client_.move(move, BusPriority::kWorker);
+    // Through the motion gate: refused if an e-stop engaged since it was queued.
+    status = client_.move(move, BusPriority::kWorker, queued.accepted);
   }
   if (status.error == ServoError::kPreempted) {
     // A stop goes first; the move goes after it unless a newer target or the e-stop replaced it.
     std::lock_guard<std::mutex> lock(mutex_);
-    const bool replaced = std::any_of(queued_moves_.begin(), queued_moves_.end(),
-                                      [&move](const MoveRequest& m) { return m.id == move.id; });
+    const bool replaced =
+        std::any_of(queued_moves_.begin(), queued_moves_.end(),
+                    [&move](const QueuedMove& q) { return q.move.id == move.id; });
     if (!replaced && !safety_.motionLockedLocked() && !stops_.keptLocked(move.id)) {
-      queued_moves_.push_front(move);
+      queued_moves_.push_front(queued);
     }
     return;
   }
@@ -212,7 +216,8 @@ void ServoBus::stopServo(uint8_t id) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     dropQueuedMovesLocked(id);
-    stops_.armLocked(id, clock_->now());
+    // Under the e-stop it is the e-stop's: repeated while it holds.
+    stops_.armLocked(id, clock_->now(), safety_.motionLockedLocked());
   }
   deliverStops();
 }
@@ -253,6 +258,10 @@ ServoStatus ServoBus::damping(uint8_t id, uint16_t power_mw, bool wait) {
 }
 ServoStatus ServoBus::relax(const std::vector<uint8_t>& ids) { return safety_.relax(ids); }
 ServoStatus ServoBus::hold(const std::vector<uint8_t>& ids) { return safety_.hold(ids); }
+ServoStatus ServoBus::writeParam(uint8_t id, std::string_view param, int64_t value) {
+  return safety_.writeParam(id, param, value);
+}
+ServoStatus ServoBus::resetUserData(uint8_t id) { return safety_.resetUserData(id); }
 bool ServoBus::motionLocked() const { return safety_.motionLocked(); }
 std::vector<uint8_t> ServoBus::movingIds() const { return safety_.movingIds(); }
 std::vector<uint8_t> ServoBus::commandedIds() const { return safety_.commandedIds(); }

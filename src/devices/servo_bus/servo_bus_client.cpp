@@ -326,7 +326,8 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
 
 // Motions: servo/move (CMD 8, 11..15), ROTATE, SPIN and DAMPING.
 
-ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priority) {
+ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priority,
+                                 std::optional<MotionGate::Generation> accepted) {
   servo::MoveCommand command;
   const ServoStatus checked = toMoveCommand(request, &command);
   if (!checked.ok()) return checked;
@@ -336,10 +337,11 @@ ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priorit
                                             servoName(request.id) + " gave way to a stop");
   }
   std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
-  return transactions_.sendCommand(frame, command.cmd, request.id, FrameGate::kMotion);
+  return transactions_.sendCommand(frame, command.cmd, request.id, FrameGate::kMotion, accepted);
 }
 
-ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
+ServoStatus ServoBusClient::rotate(const RotateRequest& request,
+                                   std::optional<MotionGate::Generation> accepted) {
   if (!std::isfinite(request.angle_deg)) {
     return fail(ServoError::kInvalidArgument, "angle is not a finite number");
   }
@@ -358,10 +360,11 @@ ServoStatus ServoBusClient::rotate(const RotateRequest& request) {
       request.id, static_cast<int16_t>(decidegrees), request.interval_ms, request.power_mw);
   std::lock_guard<BusMutex> bus(transactions_.busMutex());
   return sendMotion(frame, Command::kRotate, request.id, request.wait,
-                    std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion);
+                    std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion, accepted);
 }
 
-ServoStatus ServoBusClient::spin(const SpinRequest& request) {
+ServoStatus ServoBusClient::spin(const SpinRequest& request,
+                                 std::optional<MotionGate::Generation> accepted) {
   if (request.mode > kMaxSpinMode) {
     return fail(ServoError::kInvalidArgument,
                 "spin mode " + std::to_string(request.mode) +
@@ -394,7 +397,7 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request) {
   // A SPIN stop is what the e-stop itself sends: never held back.
   const FrameGate gate =
       mode == servo::SpinMode::kStop ? FrameGate::kSafetyAction : FrameGate::kMotion;
-  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time, gate);
+  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time, gate, accepted);
 }
 
 ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, FrameGate gate) {
@@ -403,19 +406,21 @@ ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, Fr
   }
   const std::vector<uint8_t> frame = servo::encodeDamping(id, power_mw);
   std::lock_guard<BusMutex> bus(transactions_.busMutex());
-  return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0), gate);
+  return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0), gate,
+                    std::nullopt);
 }
 
 ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
                                        bool wait, std::chrono::milliseconds motion_time,
-                                       FrameGate gate) {
-  if (!wait) return transactions_.sendCommand(request, cmd, id, gate);
+                                       FrameGate gate,
+                                       std::optional<MotionGate::Generation> accepted) {
+  if (!wait) return transactions_.sendCommand(request, cmd, id, gate, accepted);
   servo::Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
-  ServoStatus status =
-      transactions_.transact(request, Expectation(cmd, id),
-                             motion_time + transactions_.options().timeout, 1, &answer, gate);
+  ServoStatus status = transactions_.transact(request, Expectation(cmd, id),
+                                              motion_time + transactions_.options().timeout, 1,
+                                              &answer, gate, false, nullptr, accepted);
   if (!status.ok()) {
     if (status.error == ServoError::kTimeout) {
       status.message += "; the servo answers motion commands only when response_switch is 1";

@@ -158,9 +158,9 @@ void ServoTransactions::waitForAnswer(std::unique_lock<std::mutex>& lock,
   }
 }
 
-std::optional<ServoStatus> ServoTransactions::writeRequest(const std::vector<uint8_t>& request,
-                                                           Command cmd, uint8_t id,
-                                                           FrameGate gate) {
+std::optional<ServoStatus> ServoTransactions::writeRequest(
+    const std::vector<uint8_t>& request, Command cmd, uint8_t id, FrameGate gate,
+    std::optional<MotionGate::Generation> accepted) {
   bool written = false;
   if (gate == FrameGate::kMotion && gate_ != nullptr) {
     const GateState state = gate_->writeIfOpen(
@@ -169,7 +169,7 @@ std::optional<ServoStatus> ServoTransactions::writeRequest(const std::vector<uin
           if (out && on_motion_written_) on_motion_written_(id);
           return out;
         },
-        &written);
+        &written, accepted);
     if (state != GateState::kOpen) {
       return fail(ServoError::kMotionRefused,
                   std::string(toString(state)) + ": " + commandName(cmd) + " to " + servoName(id) +
@@ -186,7 +186,8 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
                                         const Expectation& expect,
                                         std::chrono::milliseconds timeout, int attempts,
                                         servo::Packet* answer, FrameGate gate, bool give_way,
-                                        Clock::time_point* arrival) {
+                                        Clock::time_point* arrival,
+                                        std::optional<MotionGate::Generation> accepted) {
   bool any_garbled = false;
   std::size_t garbled_size = 0;
   for (int attempt = 1; attempt <= attempts; ++attempt) {
@@ -208,7 +209,7 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
       motion_wait_ = gate == FrameGate::kMotion;
     }
     const Clock::time_point sent_at = Clock::now();
-    if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate)) {
+    if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate, accepted)) {
       std::lock_guard<std::mutex> lock(state_mutex_);
       pending_.active = false;
       motion_wait_ = false;
@@ -302,13 +303,14 @@ ServoStatus ServoTransactions::exchange(const std::vector<uint8_t>& request,
 }
 
 ServoStatus ServoTransactions::sendCommand(const std::vector<uint8_t>& request, Command cmd,
-                                           uint8_t id, FrameGate gate) {
+                                           uint8_t id, FrameGate gate,
+                                           std::optional<MotionGate::Generation> accepted) {
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
     last_request_ = request;
   }
-  if (auto refusal = writeRequest(request, cmd, id, gate)) return *refusal;
+  if (auto refusal = writeRequest(request, cmd, id, gate, accepted)) return *refusal;
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.commands;

@@ -28,19 +28,36 @@ StopKeeper::StopKeeper(ServoBusClient& client, const ServoBusEvents& events, Loo
       mutex_(mutex),
       on_written_locked_(std::move(on_written_locked)) {}
 
-void StopKeeper::armLocked(uint8_t id, Clock::time_point now) {
+void StopKeeper::armLocked(uint8_t id, Clock::time_point now, bool repeat) {
   PendingStop& stop = stops_[id];
   stop.phase = PendingStop::Phase::kWrite;
   stop.due = now;
+  stop.repeat = repeat;
+  stop.at_rest = false;  // seen at rest again before it is no longer pending
 }
 
 void StopKeeper::rearmAllLocked(Clock::time_point now) {
-  for (auto& [id, stop] : stops_) armLocked(id, now);
+  for (auto& [id, stop] : stops_) armLocked(id, now, stop.repeat);
 }
 
-void StopKeeper::clearLocked() {
-  stops_.clear();
-  endUrgentLocked();
+void StopKeeper::releaseLocked() {
+  for (auto it = stops_.begin(); it != stops_.end();) {
+    it->second.repeat = false;
+    // A stop that never went out (the port was down) still goes out: a release restarts nothing.
+    it = it->second.written > 0 ? stops_.erase(it) : std::next(it);
+  }
+  if (stops_.empty()) endUrgentLocked();
+}
+
+void StopKeeper::endRepeatsLocked() {
+  for (auto& [id, stop] : stops_) stop.repeat = false;
+}
+
+void StopKeeper::renameLocked(uint8_t from, uint8_t to) {
+  auto it = stops_.find(from);
+  if (it == stops_.end() || from == to) return;
+  stops_[to] = it->second;
+  stops_.erase(from);
 }
 
 bool StopKeeper::portDownLocked() const {
@@ -50,7 +67,9 @@ bool StopKeeper::portDownLocked() const {
 
 std::vector<std::pair<uint8_t, std::string>> StopKeeper::unconfirmedLocked() const {
   std::vector<std::pair<uint8_t, std::string>> unconfirmed;
-  for (const auto& [id, stop] : stops_) unconfirmed.push_back({id, stop.why});
+  for (const auto& [id, stop] : stops_) {
+    if (!stop.at_rest) unconfirmed.push_back({id, stop.why});
+  }
   return unconfirmed;
 }
 
@@ -78,7 +97,9 @@ Clock::time_point StopKeeper::nextWorkLocked() const {
 std::vector<PendingStopReport> StopKeeper::reports() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<PendingStopReport> reports;
-  for (const auto& [id, stop] : stops_) reports.push_back({id, stop.written, stop.why});
+  for (const auto& [id, stop] : stops_) {
+    if (!stop.at_rest) reports.push_back({id, stop.written, stop.why});
+  }
   return reports;
 }
 
@@ -124,6 +145,7 @@ void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
     PendingStop& stop = it->second;
     stop.port_down = !written[i];
     if (!written[i]) {
+      stop.at_rest = false;  // pending again until it went out and the servo was seen at rest
       stop.due = after + kStopRetry;
       stop.why = "not written: the servo bus port is down";
       failures.push_back({ids[i], {ServoError::kNotConnected, stop.why}});
@@ -133,6 +155,10 @@ void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
     on_written_locked_(ids[i]);
     if (ids[i] == protocol::servo::kBroadcastId) {
       stops_.erase(it);  // nothing answers a broadcast: written is all that can be known
+      continue;
+    }
+    if (stop.at_rest) {
+      stop.due = after + kStopRepeat;  // seen at rest already: written again while the e-stop holds
       continue;
     }
     stop.phase = PendingStop::Phase::kFirstLook;
@@ -149,6 +175,26 @@ void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
     if (events_.on_stop) events_.on_stop(id, status);
   }
   lock.lock();
+}
+
+ServoStatus StopKeeper::seenAtRestLocked(std::map<uint8_t, PendingStop>::iterator it,
+                                         double angle_deg, Clock::time_point now) {
+  PendingStop& stop = it->second;
+  char text[96];
+  std::snprintf(text, sizeof(text), "at rest at %.1f deg after %d stop(s)", angle_deg,
+                stop.written);
+  const ServoStatus outcome{ServoError::kOk, text};
+  if (!stop.repeat) {
+    stops_.erase(it);
+    return outcome;
+  }
+  // Rest and a slow motion look alike here: the e-stop's stop goes out again until released.
+  stop.at_rest = true;
+  stop.phase = PendingStop::Phase::kWrite;
+  stop.due = now + kStopRepeat;
+  stop.why = outcome.message + "; written again every " + std::to_string(kStopRepeat.count()) +
+             " ms while the e-stop holds";
+  return outcome;
 }
 
 void StopKeeper::lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t id, StopPace pace) {
@@ -189,11 +235,7 @@ void StopKeeper::lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t 
     stop.why = text;
     outcome = {ServoError::kMotionRefused, text};
   } else {
-    char text[96];
-    std::snprintf(text, sizeof(text), "at rest at %.1f deg after %d stop(s)", angle_deg,
-                  stop.written);
-    outcome = {ServoError::kOk, text};
-    stops_.erase(it);
+    outcome = seenAtRestLocked(it, angle_deg, now);
   }
   const bool rewrite = !outcome.ok() && outcome.error != ServoError::kTimeout &&
                        outcome.error != ServoError::kNotConnected;

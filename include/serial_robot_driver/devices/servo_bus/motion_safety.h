@@ -3,6 +3,25 @@
 // shutdown stop exactly those (their stops kept until confirmed by the StopKeeper,
 // stop_keeper.h), and the last words at shutdown. ROS-free.
 //
+// The rules:
+//  - An e-stop voids everything accepted before it. Each motion (move, rotate, spin, hold, a
+//    queued move) notes the gate's generation when it is accepted, before it waits for the bus,
+//    and is written with it: an e-stop engaged since drops it at the write, even once released
+//    (kMotionRefused, "e-stop engaged after this command was accepted").
+//  - Broadcast motions (id 255) are refused: nothing answers them, so the driver could not tell
+//    which servos they set moving nor confirm their stops. A broadcast SPIN stop or DAMPING is
+//    allowed.
+//  - Torque off (damping, relax) is a safety action: allowed while the e-stop holds, never held
+//    back by the gate. A servo relaxed by its id leaves the servos to stop: its kept stop is
+//    satisfied and no longer repeated (a SPIN stop would give it its holding torque back).
+//  - Writes that change where or how a servo moves, or where its stop goes (servo_id, baudrate,
+//    response_switch, stall protection, accel_switch, angle limits, mid offset) and
+//    RESET_USER_DATA are refused while the e-stop holds or while that servo moves (set moving
+//    and not stopped or relaxed since, or its stop not yet confirmed). An address change that is
+//    allowed takes the servo's bookkeeping (set moving, commanded, kept stop) to its new id.
+//  - While the e-stop holds, its stops are written again at a steady pace (StopKeeper::
+//    kStopRepeat); releasing it ends that, and keeps the stops never written.
+//
 // Threading: any thread. The motion operations run on their caller's thread. Every motion frame,
 // whoever writes it, passes the gate when it is written: the e-stop (setMotionLocked) and the
 // shutdown (closeGate) take the gate's lock, so no motion frame goes out after they return,
@@ -14,6 +33,8 @@
 #include <functional>
 #include <mutex>
 #include <set>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "serial_robot_driver/device/loop_clock.h"
@@ -52,8 +73,15 @@ class MotionSafety {
   ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait);
   ServoStatus relax(const std::vector<uint8_t>& ids);
   ServoStatus hold(const std::vector<uint8_t>& ids);
+  /// The client's WRITE_DATA and RESET_USER_DATA under the rules above.
+  ServoStatus writeParam(uint8_t id, std::string_view param, int64_t value);
+  ServoStatus resetUserData(uint8_t id);
   /// Why servo `id` may not move now (the e-stop, protect); ok when it may.
   ServoStatus refusal(uint8_t id) const;
+  /// Whether servo `id` may be set moving now (refusal(), and no broadcast), and the generation
+  /// the command is accepted under: noted before the e-stop is looked at, so an e-stop engaged
+  /// in between either refuses the command here or voids it at the write.
+  ServoStatus accept(uint8_t id, MotionGate::Generation* generation) const;
   /// A motion frame of servo `id` went out (told by the client under the gate's lock, so an
   /// e-stop engaged right after it finds the servo among those to stop). A pending stop of the
   /// servo (a hold's) is superseded.
@@ -84,6 +112,10 @@ class MotionSafety {
 
  private:
   ServoStatus refusalLocked(uint8_t id) const;
+  /// Why a write that changes how or where servo `id` moves (`what`) may not go out now.
+  ServoStatus settingRefusal(uint8_t id, const std::string& what) const;
+  /// Servo `from` now answers at `to`: what the driver knows of it follows.
+  void followAddress(uint8_t from, uint8_t to);
 
   const std::vector<uint8_t> polled_ids_;
   const ServoBusConfig& settings_;

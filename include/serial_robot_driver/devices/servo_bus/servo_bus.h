@@ -50,6 +50,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -84,7 +85,8 @@ class ServoBus : public LinkListener, public LinkWorker {
   ServoBusClient& client() { return client_; }
 
   /// Queues moves for the worker. The latest target of a servo replaces a queued one, so the
-  /// queue stays bounded (one entry per servo) while a long call holds the bus.
+  /// queue stays bounded (one entry per servo) while a long call holds the bus. Each is stamped
+  /// with the motion gate's generation here: an e-stop engaged before its write drops it.
   void queueMoves(const std::vector<MoveRequest>& moves);
   /// Drops a move of servo `id` still waiting in the queue (another command took the servo over).
   void dropQueuedMoves(uint8_t id);
@@ -107,11 +109,18 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Each of `ids` (empty: every polled servo) holds the angle it is at now: READ_ANGLE, then a
   /// ROTATE there. Stops at the first failure.
   ServoStatus hold(const std::vector<uint8_t>& ids);
+  /// The client's WRITE_DATA and RESET_USER_DATA, refused while they would change how or where a
+  /// moving servo moves, or while the e-stop holds; an address change takes the servo's stop
+  /// bookkeeping to its new id (see motion_safety.h).
+  ServoStatus writeParam(uint8_t id, std::string_view param, int64_t value);
+  ServoStatus resetUserData(uint8_t id);
 
   /// The e-stop: true locks the motion gate (no motion frame is written from its return on),
   /// drops the queued moves, refuses motion (queueMoves() included) and has every servo set
-  /// moving or positioned since start-up (commandedIds()) stopped until each is seen at rest;
-  /// false lets motion through again. Never waits for the bus (see the threading model).
+  /// moving or positioned since start-up (commandedIds()) stopped until each is seen at rest,
+  /// and its stop written again every StopKeeper::kStopRepeat for as long as it holds; false
+  /// lets new motion through again (nothing accepted before it moves) and keeps the stops never
+  /// written. Never waits for the bus (see the threading model).
   void setMotionLocked(bool locked);
   bool motionLocked() const;
   /// Servos set spinning or moving and not stopped or relaxed since (the broadcast id 255 too).
@@ -173,8 +182,14 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Asks the client for urgent work and wakes the worker, or, without a running worker, writes
   /// the stops itself.
   void deliverStops();
+  /// A queued move with the gate's generation it was accepted under.
+  struct QueuedMove {
+    MoveRequest move;
+    MotionGate::Generation accepted = 0;
+  };
+
   void dropQueuedMovesLocked(uint8_t id);  // mutex_ held
-  void sendMove(const MoveRequest& move);
+  void sendMove(const QueuedMove& queued);
 
   const ServoBusConfig config_;
   ServoBusConfig settings_;  // guarded by mutex_: config_ as retune() left it
@@ -188,7 +203,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   bool started_ = false;
   bool working_ = false;        // work() in progress on the link's reader thread
   SerialLink* link_ = nullptr;  // runOn(): the worker is the link's reader thread
-  std::deque<MoveRequest> queued_moves_;
+  std::deque<QueuedMove> queued_moves_;
   ServoPoller poller_;   // the angle and health polls
   StopKeeper stops_;     // stops not yet known to have reached their servo
   MotionSafety safety_;  // what may move; the servos set moving; the last words

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -87,7 +88,9 @@ class ServoBusClient : public LinkListener {
   /// CMD 16: the multi-turn angle and the turn count.
   ServoStatus readMultiTurnAngle(uint8_t id, MultiTurnReading* reading);
   /// CMD 8 or 11..15, chosen by the request (see MoveRequest); returns once the frame is written.
-  ServoStatus move(const MoveRequest& request, BusPriority priority = BusPriority::kCaller);
+  /// `accepted` (every motion): the motion gate's generation the command was accepted under.
+  ServoStatus move(const MoveRequest& request, BusPriority priority = BusPriority::kCaller,
+                   std::optional<MotionGate::Generation> accepted = std::nullopt);
   /// PINGs first_id..last_id, one attempt each (a silent id costs one timeout), and lists the ids
   /// that answered. The bus is taken per id, so other callers are served in between.
   ServoStatus scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids);
@@ -95,9 +98,12 @@ class ServoBusClient : public LinkListener {
   /// (broadcast) is accepted only without wait.
   /// Each motion frame is written through the motion gate (setMotionGate), decided when its turn
   /// on the bus comes: refused then (kMotionRefused), nothing is written. A SPIN stop, and a
-  /// DAMPING with FrameGate::kSafetyAction, always pass.
-  ServoStatus rotate(const RotateRequest& request);
-  ServoStatus spin(const SpinRequest& request);
+  /// DAMPING with FrameGate::kSafetyAction, always pass; one accepted under an earlier
+  /// generation than the gate's (`accepted`) is dropped (MotionGate::writeIfOpen).
+  ServoStatus rotate(const RotateRequest& request,
+                     std::optional<MotionGate::Generation> accepted = std::nullopt);
+  ServoStatus spin(const SpinRequest& request,
+                   std::optional<MotionGate::Generation> accepted = std::nullopt);
   ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait,
                       FrameGate gate = FrameGate::kMotion);
   /// READ_BATCH_DATA: the 22 user-block parameters (data_id 32..53) in table order.
@@ -148,7 +154,7 @@ class ServoBusClient : public LinkListener {
   /// The shared tail of ROTATE/SPIN/DAMPING: send, or transact and check the result byte.
   ServoStatus sendMotion(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
                          uint8_t id, bool wait, std::chrono::milliseconds motion_time,
-                         FrameGate gate);
+                         FrameGate gate, std::optional<MotionGate::Generation> accepted);
   ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
                               ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);

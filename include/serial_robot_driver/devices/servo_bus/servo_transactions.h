@@ -122,10 +122,12 @@ class ServoTransactions : public LinkListener {
   /// cut short); it is written through the motion gate.
   /// `give_way` (BusPriority::kWorker): urgent work asked before a re-send ends it (kPreempted).
   /// `arrival` (optional): when the answer's last byte was read.
+  /// `accepted` (a motion): the gate's generation it was accepted under (MotionGate::writeIfOpen).
   ServoStatus transact(const std::vector<uint8_t>& request, const Expectation& expect,
                        std::chrono::milliseconds timeout, int attempts,
                        protocol::servo::Packet* answer, FrameGate gate = FrameGate::kSafetyAction,
-                       bool give_way = false, Clock::time_point* arrival = nullptr);
+                       bool give_way = false, Clock::time_point* arrival = nullptr,
+                       std::optional<MotionGate::Generation> accepted = std::nullopt);
   /// transact() with the configured timeout and retries: the usual request/answer exchange.
   ServoStatus exchangeLocked(const std::vector<uint8_t>& request, const Expectation& expect,
                              protocol::servo::Packet* answer);
@@ -134,7 +136,8 @@ class ServoTransactions : public LinkListener {
                        protocol::servo::Packet* answer);
   /// Fire and forget: a motion command without wait.
   ServoStatus sendCommand(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
-                          uint8_t id, FrameGate gate);
+                          uint8_t id, FrameGate gate,
+                          std::optional<MotionGate::Generation> accepted = std::nullopt);
 
   /// SPIN stops to `ids` as urgent work (BusMutex::lockUrgent): written after the one transaction
   /// attempt in flight, before every waiting caller. `written[i]`: whether the stop of ids[i]
@@ -177,10 +180,12 @@ class ServoTransactions : public LinkListener {
     Clock::time_point arrival;
   };
 
-  /// Writes one request, through the motion gate when `gate` is kMotion. nullopt when written;
-  /// else why not (the gate's refusal, or the port is down).
+  /// Writes one request, through the motion gate when `gate` is kMotion (voided when an e-stop
+  /// engaged since generation `accepted`). nullopt when written; else why not (the gate's
+  /// refusal, or the port is down).
   std::optional<ServoStatus> writeRequest(const std::vector<uint8_t>& request,
-                                          protocol::servo::Command cmd, uint8_t id, FrameGate gate);
+                                          protocol::servo::Command cmd, uint8_t id, FrameGate gate,
+                                          std::optional<MotionGate::Generation> accepted);
   bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
   /// Waits (state_mutex_ held by `lock`) until the pending transaction is answered, garbled,
   /// lost or shut down, or `deadline` passes.

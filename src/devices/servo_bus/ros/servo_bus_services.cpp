@@ -92,7 +92,7 @@ void ServoBusInterface::advertiseServices() {
       advertiseServo<ServoWrite>(
           nh_, "servo/write",
           [this](ServoWrite::Request& req, ServoWrite::Response&) {
-            return client_.writeParam(req.id, req.param, req.value);
+            return bus_.writeParam(req.id, req.param, req.value);
           },
           Announce::kInfo),
       advertiseServo<ServoReadAngle>(
@@ -164,18 +164,15 @@ void ServoBusInterface::advertiseServices() {
                                   yieldJoint(req.id, "servo/spin");
                                   return bus_.spin(request);
                                 }),
+      // Torque off moves nothing actively: allowed while the e-stop holds (motion_safety.h).
       advertiseServo<ServoDamping>(nh_, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
-                                     const device::ServoStatus claimed =
-                                         claimServos({req.id}, "servo/damping");
-                                     if (!claimed.ok()) return claimed;
+                                     yieldJoint(req.id, "servo/damping");
                                      return bus_.damping(req.id, req.power_mw, req.wait);
                                    }),
       advertiseServo<ServoRelax>(nh_, "servo/relax",
                                  [this](ServoRelax::Request& req, ServoRelax::Response&) {
-                                   const device::ServoStatus claimed =
-                                       claimServos(req.ids, "servo/relax");
-                                   if (!claimed.ok()) return claimed;
+                                   yieldJoints(req.ids, "servo/relax");
                                    return bus_.relax(req.ids);
                                  }),
       advertiseServo<ServoHold>(nh_, "servo/hold",
@@ -213,7 +210,7 @@ void ServoBusInterface::advertiseServices() {
       advertiseServo<ServoResetUserData>(
           nh_, "servo/reset_user_data",
           [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
-            return client_.resetUserData(req.id);
+            return bus_.resetUserData(req.id);
           },
           Announce::kInfo),
   };
