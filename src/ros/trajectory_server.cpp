@@ -75,6 +75,11 @@ double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
   return static_cast<double>(seconds) + static_cast<double>(nanoseconds) * 1e-9;
 }
 
+bool actionlibCanTake(const ros::Time& stamp) {
+  constexpr uint32_t kSecondsLeft = 86400;
+  return stamp.nsec < 1000000000u && stamp.sec <= std::numeric_limits<uint32_t>::max() - kSecondsLeft;
+}
+
 double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
   if (stamp.isZero()) return steady_now;
   return steady_now + secondsBetween(stamp, ros_now);
@@ -99,12 +104,12 @@ TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& para
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),
       action_server_(
-          nh, "follow_joint_trajectory", [this](GoalHandle handle) { onGoalGuarded(handle); },
+          nh, "follow_joint_trajectory", input_refusals_,
+          [this](GoalHandle handle) { onGoalGuarded(handle); },
           [this](GoalHandle handle) {
             runGuarded(input_refusals_, "follow_joint_trajectory (cancel)",
                        [&] { executor_.cancelGoal(handle.getGoalID().id); });
-          },
-          false) {}
+          }) {}
 
 TrajectoryServer::~TrajectoryServer() { shutdown(); }
 

@@ -26,6 +26,7 @@
 #include "serial_robot_driver/device/e_stop.h"
 #include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/guarded_action_server.h"
 #include "serial_robot_driver/trajectory/executor.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -92,7 +93,7 @@ class TrajectoryServer {
   trajectory::TrajectoryExecutor executor_;
   const double loop_period_;
   ros::NodeHandle nh_;
-  actionlib::ActionServer<Action> action_server_;
+  GuardedActionServer<Action> action_server_;
   ros::Subscriber trajectory_sub_;
   ros::SteadyTimer timer_;
 };
