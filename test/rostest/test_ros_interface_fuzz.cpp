@@ -204,7 +204,7 @@ trajectory_msgs::JointTrajectory fuzzTrajectory(Extremes& x) {
       case 4: if (point) point->velocities = x.reals(x.chance(0.7) ? 2 : x.size()); break;
       case 5: if (point) point->accelerations = x.reals(x.chance(0.7) ? 2 : x.size()); break;
       case 6: msg.points.clear(); break;
-      default: if (point) point->positions.at(0) = x.real(); break;
+      default: if (point && !point->positions.empty()) point->positions[0] = x.real(); break;
     }
   }
   return msg;
@@ -220,7 +220,7 @@ sensor_msgs::JointState fuzzJointState(Extremes& x, const std::vector<std::strin
     case 1: msg.position = x.reals(x.chance(0.7) ? x.pick(5) : x.size()); break;
     case 2: msg.velocity = x.reals(x.chance(0.7) ? valid.size() : x.size()); break;
     case 3: msg.effort = x.reals(x.size()); break;
-    default: msg.position.at(0) = x.real(); break;
+    default: if (!msg.position.empty()) msg.position[0] = x.real(); break;
   }
   return msg;
 }
