@@ -10,8 +10,10 @@ cd "$(dirname "$0")/.."
 count="${1:-20000}"
 seed="${2:-$(date +%s)}"
 runs="${RUNS:-1}"
+set +u  # ROS's setup scripts read unset variables
 # shellcheck disable=SC1091
 source .ws/devel/setup.bash
+set -u
 for ((run = 0; run < runs; run++)); do
   this_seed=$((seed + run))
   echo "fuzz_ros_interface: run $((run + 1))/$runs, seed $this_seed, $count inputs"

@@ -17,7 +17,8 @@ bool runGuarded(device::InputRefusals& counters, const std::string& source,
   }
   counters.failed(source);
   // Throttled: a sender repeating the message must not flood the log; the count is exact.
-  ROS_ERROR_THROTTLE(1.0, "%s: internal error, this input was dropped (or answered as a failure): %s",
+  ROS_ERROR_THROTTLE(1.0,
+                     "%s: internal error, this input was dropped (or answered as a failure): %s",
                      source.c_str(), what.c_str());
   if (error) *error = what;
   return false;

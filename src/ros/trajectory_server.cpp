@@ -77,7 +77,8 @@ double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
 
 bool actionlibCanTake(const ros::Time& stamp) {
   constexpr uint32_t kSecondsLeft = 86400;
-  return stamp.nsec < 1000000000u && stamp.sec <= std::numeric_limits<uint32_t>::max() - kSecondsLeft;
+  return stamp.nsec < 1000000000u &&
+         stamp.sec <= std::numeric_limits<uint32_t>::max() - kSecondsLeft;
 }
 
 double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
@@ -121,9 +122,10 @@ void TrajectoryServer::start() {
       subscribeGuarded(nh_, input_refusals_, "joint_trajectory", 10,
                        &TrajectoryServer::onTrajectory, this, ros::TransportHints().tcpNoDelay());
   // Steady: a step of the ROS or wall clock must not skip or replay a trajectory.
-  timer_ = nh_.createSteadyTimer(ros::WallDuration(loop_period_), [this](const ros::SteadyTimerEvent&) {
-    runGuarded(input_refusals_, "trajectory loop", [this] { executor_.tick(); });
-  });
+  timer_ =
+      nh_.createSteadyTimer(ros::WallDuration(loop_period_), [this](const ros::SteadyTimerEvent&) {
+        runGuarded(input_refusals_, "trajectory loop", [this] { executor_.tick(); });
+      });
 }
 
 void TrajectoryServer::shutdown() {
@@ -139,7 +141,8 @@ std::optional<double> TrajectoryServer::startOf(const ros::Time& stamp) const {
 
 void TrajectoryServer::onGoalGuarded(GoalHandle handle) {
   std::string error;
-  if (runGuarded(input_refusals_, "follow_joint_trajectory", [&] { onGoal(handle); }, &error)) {
+  if (runGuarded(
+          input_refusals_, "follow_joint_trajectory", [&] { onGoal(handle); }, &error)) {
     return;
   }
   // The goal must still be answered, or its client waits forever.

@@ -86,7 +86,8 @@ bool busMotion(const PtyTap::Frame& f) {
 }
 
 /// Motion frames a tap saw arriving between `from` and `to`.
-std::size_t motionFramesBetween(const PtyTap& tap, const std::function<bool(const PtyTap::Frame&)>& motion,
+std::size_t motionFramesBetween(const PtyTap& tap,
+                                const std::function<bool(const PtyTap::Frame&)>& motion,
                                 PtyTap::Clock::time_point from, PtyTap::Clock::time_point to) {
   std::size_t count = 0;
   for (const PtyTap::Frame& f : tap.frames()) {
@@ -100,23 +101,45 @@ class Extremes {
  public:
   explicit Extremes(uint64_t seed) : rng_(seed) {}
 
-  std::size_t pick(std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n - 1)(rng_); }
+  std::size_t pick(std::size_t n) {
+    return std::uniform_int_distribution<std::size_t>(0, n - 1)(rng_);
+  }
   bool chance(double p) { return std::bernoulli_distribution(p)(rng_); }
 
   double real() {
     const double kMax = std::numeric_limits<double>::max();
     const double kInf = std::numeric_limits<double>::infinity();
-    const double values[] = {0.0, -0.0, 1.0, -1.0, std::numeric_limits<double>::quiet_NaN(), kInf,
-                             -kInf, 1e308, -1e308, kMax, -kMax, std::numeric_limits<double>::min(),
-                             std::numeric_limits<double>::denorm_min(), 0.5, 3.2, -3.2};
+    const double values[] = {0.0,
+                             -0.0,
+                             1.0,
+                             -1.0,
+                             std::numeric_limits<double>::quiet_NaN(),
+                             kInf,
+                             -kInf,
+                             1e308,
+                             -1e308,
+                             kMax,
+                             -kMax,
+                             std::numeric_limits<double>::min(),
+                             std::numeric_limits<double>::denorm_min(),
+                             0.5,
+                             3.2,
+                             -3.2};
     if (chance(0.3)) return std::uniform_real_distribution<double>(-4.0, 4.0)(rng_);
     return values[pick(sizeof(values) / sizeof(values[0]))];
   }
   template <typename Int>
   Int integer() {
     using L = std::numeric_limits<Int>;
-    const Int values[] = {0, 1, 2, L::max(), static_cast<Int>(L::max() - 1), L::min(),
-                          static_cast<Int>(L::min() + 1), static_cast<Int>(255), static_cast<Int>(254)};
+    const Int values[] = {0,
+                          1,
+                          2,
+                          L::max(),
+                          static_cast<Int>(L::max() - 1),
+                          L::min(),
+                          static_cast<Int>(L::min() + 1),
+                          static_cast<Int>(255),
+                          static_cast<Int>(254)};
     if (chance(0.3)) return static_cast<Int>(rng_());
     return values[pick(sizeof(values) / sizeof(values[0]))];
   }
@@ -127,11 +150,16 @@ class Extremes {
   /// A name: one of `known` (duplicates come from drawing twice), an unknown one, empty, long.
   std::string name(const std::vector<std::string>& known, bool short_only) {
     switch (pick(6)) {
-      case 0: return "";
-      case 1: return "no_such_joint";
-      case 2: return short_only ? "servo_999" : std::string(kLongString, 'x');
-      case 3: return "servo_" + std::to_string(integer<uint8_t>());
-      default: return known[pick(known.size())];
+      case 0:
+        return "";
+      case 1:
+        return "no_such_joint";
+      case 2:
+        return short_only ? "servo_999" : std::string(kLongString, 'x');
+      case 3:
+        return "servo_" + std::to_string(integer<uint8_t>());
+      default:
+        return known[pick(known.size())];
     }
   }
   std::vector<std::string> names(std::size_t n, const std::vector<std::string>& known) {
@@ -141,7 +169,8 @@ class Extremes {
   }
   std::vector<double> reals(std::size_t n) {
     std::vector<double> out(n);
-    for (double& each : out) each = chance(0.8) ? std::uniform_real_distribution<double>(-1, 1)(rng_) : real();
+    for (double& each : out)
+      each = chance(0.8) ? std::uniform_real_distribution<double>(-1, 1)(rng_) : real();
     return out;
   }
   /// A stamp: zero, now, just past, ahead within and beyond max_start_delay, the far future
@@ -150,27 +179,52 @@ class Extremes {
     const ros::Time now = ros::Time::now();
     ros::Time t;
     switch (pick(9)) {
-      case 0: return ros::Time();
-      case 1: return now;
-      case 2: return now - ros::Duration(1.0);
-      case 3: return now + ros::Duration(5.0);
-      case 4: return now + ros::Duration(11.0);
-      case 5: t.sec = 4000000000u; return t;
-      case 6: t.sec = t.nsec = std::numeric_limits<uint32_t>::max(); return t;
-      case 7: t.nsec = 1; return t;
-      default: t.sec = now.sec; t.nsec = std::numeric_limits<uint32_t>::max(); return t;
+      case 0:
+        return ros::Time();
+      case 1:
+        return now;
+      case 2:
+        return now - ros::Duration(1.0);
+      case 3:
+        return now + ros::Duration(5.0);
+      case 4:
+        return now + ros::Duration(11.0);
+      case 5:
+        t.sec = 4000000000u;
+        return t;
+      case 6:
+        t.sec = t.nsec = std::numeric_limits<uint32_t>::max();
+        return t;
+      case 7:
+        t.nsec = 1;
+        return t;
+      default:
+        t.sec = now.sec;
+        t.nsec = std::numeric_limits<uint32_t>::max();
+        return t;
     }
   }
   /// A duration: zero, negative, enormous, the ends of int32, unnormalised.
   ros::Duration duration() {
     ros::Duration d;
     switch (pick(6)) {
-      case 0: return ros::Duration(0.0);
-      case 1: d.sec = -1; return d;
-      case 2: d.sec = std::numeric_limits<int32_t>::max(); return d;
-      case 3: d.sec = std::numeric_limits<int32_t>::min(); return d;
-      case 4: d.nsec = std::numeric_limits<int32_t>::max(); return d;
-      default: d.nsec = std::numeric_limits<int32_t>::min(); return d;
+      case 0:
+        return ros::Duration(0.0);
+      case 1:
+        d.sec = -1;
+        return d;
+      case 2:
+        d.sec = std::numeric_limits<int32_t>::max();
+        return d;
+      case 3:
+        d.sec = std::numeric_limits<int32_t>::min();
+        return d;
+      case 4:
+        d.nsec = std::numeric_limits<int32_t>::max();
+        return d;
+      default:
+        d.nsec = std::numeric_limits<int32_t>::min();
+        return d;
     }
   }
 
@@ -195,16 +249,33 @@ trajectory_msgs::JointTrajectory fuzzTrajectory(Extremes& x) {
   }
   const std::size_t mutations = 1 + x.pick(3);
   for (std::size_t m = 0; m < mutations; ++m) {
-    trajectory_msgs::JointTrajectoryPoint* point = msg.points.empty() ? nullptr : &msg.points[x.pick(msg.points.size())];
+    trajectory_msgs::JointTrajectoryPoint* point =
+        msg.points.empty() ? nullptr : &msg.points[x.pick(msg.points.size())];
     switch (x.pick(8)) {
-      case 0: msg.header.stamp = x.stamp(); break;
-      case 1: msg.joint_names = x.names(x.chance(0.8) ? x.pick(4) : x.size(), kJointNames); break;
-      case 2: if (point) point->time_from_start = x.duration(); break;
-      case 3: if (point) point->positions = x.reals(x.chance(0.7) ? 2 : x.size()); break;
-      case 4: if (point) point->velocities = x.reals(x.chance(0.7) ? 2 : x.size()); break;
-      case 5: if (point) point->accelerations = x.reals(x.chance(0.7) ? 2 : x.size()); break;
-      case 6: msg.points.clear(); break;
-      default: if (point && !point->positions.empty()) point->positions[0] = x.real(); break;
+      case 0:
+        msg.header.stamp = x.stamp();
+        break;
+      case 1:
+        msg.joint_names = x.names(x.chance(0.8) ? x.pick(4) : x.size(), kJointNames);
+        break;
+      case 2:
+        if (point) point->time_from_start = x.duration();
+        break;
+      case 3:
+        if (point) point->positions = x.reals(x.chance(0.7) ? 2 : x.size());
+        break;
+      case 4:
+        if (point) point->velocities = x.reals(x.chance(0.7) ? 2 : x.size());
+        break;
+      case 5:
+        if (point) point->accelerations = x.reals(x.chance(0.7) ? 2 : x.size());
+        break;
+      case 6:
+        msg.points.clear();
+        break;
+      default:
+        if (point && !point->positions.empty()) point->positions[0] = x.real();
+        break;
     }
   }
   return msg;
@@ -216,11 +287,21 @@ sensor_msgs::JointState fuzzJointState(Extremes& x, const std::vector<std::strin
   msg.name = valid;
   msg.position = x.reals(valid.size());
   switch (x.pick(5)) {
-    case 0: msg.name = x.names(x.chance(0.8) ? x.pick(5) : x.size(), kJointNames); break;
-    case 1: msg.position = x.reals(x.chance(0.7) ? x.pick(5) : x.size()); break;
-    case 2: msg.velocity = x.reals(x.chance(0.7) ? valid.size() : x.size()); break;
-    case 3: msg.effort = x.reals(x.size()); break;
-    default: if (!msg.position.empty()) msg.position[0] = x.real(); break;
+    case 0:
+      msg.name = x.names(x.chance(0.8) ? x.pick(5) : x.size(), kJointNames);
+      break;
+    case 1:
+      msg.position = x.reals(x.chance(0.7) ? x.pick(5) : x.size());
+      break;
+    case 2:
+      msg.velocity = x.reals(x.chance(0.7) ? valid.size() : x.size());
+      break;
+    case 3:
+      msg.effort = x.reals(x.size());
+      break;
+    default:
+      if (!msg.position.empty()) msg.position[0] = x.real();
+      break;
   }
   return msg;
 }
@@ -232,10 +313,12 @@ struct Topics {
         joint_commands(nh.advertise<sensor_msgs::JointState>("joint_commands", 100)),
         servo_commands(nh.advertise<sensor_msgs::JointState>("servo_commands", 100)),
         joint_trajectory(nh.advertise<trajectory_msgs::JointTrajectory>("joint_trajectory", 100)),
-        goal(nh.advertise<srd::FollowJointTrajectoryActionGoal>("follow_joint_trajectory/goal", 100)),
+        goal(nh.advertise<srd::FollowJointTrajectoryActionGoal>("follow_joint_trajectory/goal",
+                                                                100)),
         cancel(nh.advertise<actionlib_msgs::GoalID>("follow_joint_trajectory/cancel", 100)) {}
   bool connected() const {
-    for (const ros::Publisher* p : {&cmd_vel, &joint_commands, &servo_commands, &joint_trajectory, &goal, &cancel}) {
+    for (const ros::Publisher* p :
+         {&cmd_vel, &joint_commands, &servo_commands, &joint_trajectory, &goal, &cancel}) {
       if (p->getNumSubscribers() == 0) return false;
     }
     return true;
@@ -251,41 +334,139 @@ void call(const std::string& name, Service& service) {
 
 /// One service request with its fields at extremes.
 void fuzzService(Extremes& x) {
-  const auto id = [&] { return x.chance(0.5) ? static_cast<uint8_t>(x.pick(4)) : x.integer<uint8_t>(); };
+  const auto id = [&] {
+    return x.chance(0.5) ? static_cast<uint8_t>(x.pick(4)) : x.integer<uint8_t>();
+  };
   const auto ids = [&] {
     std::vector<uint8_t> out(x.chance(0.8) ? x.pick(4) : x.size());
     for (uint8_t& each : out) each = id();
     return out;
   };
-  const std::string params[] = {"", "angle_limit_low", "servo_id", "51", "-1", "99999999999",
-                                "response_switch", std::string(kLongString, 'p'), "mid_offset"};
+  const std::string params[] = {
+      "",          "angle_limit_low", "servo_id",        "51",
+      "-1",        "99999999999",     "response_switch", std::string(kLongString, 'p'),
+      "mid_offset"};
   const std::string param = params[x.pick(sizeof(params) / sizeof(params[0]))];
   switch (x.pick(17)) {
-    case 0: { srd::ServoPing s; s.request.id = id(); call("servo/ping", s); break; }
-    case 1: { srd::ServoScan s; s.request.first_id = x.integer<uint8_t>(); s.request.last_id = x.integer<uint8_t>(); call("servo/scan", s); break; }
-    case 2: { srd::ServoRead s; s.request.id = id(); s.request.param = param; call("servo/read", s); break; }
-    case 3: { srd::ServoWrite s; s.request.id = id(); s.request.param = param; s.request.value = x.integer<int64_t>(); call("servo/write", s); break; }
-    case 4: { srd::ServoReadAll s; s.request.id = id(); call("servo/read_all", s); break; }
-    case 5: { srd::ServoResetUserData s; s.request.id = id(); call("servo/reset_user_data", s); break; }
-    case 6: { srd::ServoReadAngle s; s.request.id = id(); s.request.multi_turn = x.chance(0.5); call("servo/read_angle", s); break; }
-    case 7: { srd::ServoRotate s; s.request.id = id(); s.request.angle_deg = x.real(); s.request.interval_ms = x.integer<uint16_t>(); s.request.power_mw = x.integer<uint16_t>(); call("servo/rotate", s); break; }
+    case 0: {
+      srd::ServoPing s;
+      s.request.id = id();
+      call("servo/ping", s);
+      break;
+    }
+    case 1: {
+      srd::ServoScan s;
+      s.request.first_id = x.integer<uint8_t>();
+      s.request.last_id = x.integer<uint8_t>();
+      call("servo/scan", s);
+      break;
+    }
+    case 2: {
+      srd::ServoRead s;
+      s.request.id = id();
+      s.request.param = param;
+      call("servo/read", s);
+      break;
+    }
+    case 3: {
+      srd::ServoWrite s;
+      s.request.id = id();
+      s.request.param = param;
+      s.request.value = x.integer<int64_t>();
+      call("servo/write", s);
+      break;
+    }
+    case 4: {
+      srd::ServoReadAll s;
+      s.request.id = id();
+      call("servo/read_all", s);
+      break;
+    }
+    case 5: {
+      srd::ServoResetUserData s;
+      s.request.id = id();
+      call("servo/reset_user_data", s);
+      break;
+    }
+    case 6: {
+      srd::ServoReadAngle s;
+      s.request.id = id();
+      s.request.multi_turn = x.chance(0.5);
+      call("servo/read_angle", s);
+      break;
+    }
+    case 7: {
+      srd::ServoRotate s;
+      s.request.id = id();
+      s.request.angle_deg = x.real();
+      s.request.interval_ms = x.integer<uint16_t>();
+      s.request.power_mw = x.integer<uint16_t>();
+      call("servo/rotate", s);
+      break;
+    }
     case 8: {
       srd::ServoMove s;
-      s.request.id = id(); s.request.angle_deg = x.real(); s.request.multi_turn = x.chance(0.5);
-      s.request.interval_ms = x.integer<uint32_t>(); s.request.velocity_dps = x.real();
-      s.request.accel_ms = x.integer<uint16_t>(); s.request.decel_ms = x.integer<uint16_t>();
+      s.request.id = id();
+      s.request.angle_deg = x.real();
+      s.request.multi_turn = x.chance(0.5);
+      s.request.interval_ms = x.integer<uint32_t>();
+      s.request.velocity_dps = x.real();
+      s.request.accel_ms = x.integer<uint16_t>();
+      s.request.decel_ms = x.integer<uint16_t>();
       s.request.power_mw = x.integer<uint16_t>();
       call("servo/move", s);
       break;
     }
-    case 9: { srd::ServoSpin s; s.request.id = id(); s.request.clockwise = x.chance(0.5); s.request.mode = x.integer<uint8_t>(); s.request.speed_dps = x.integer<uint16_t>(); s.request.value = x.integer<uint16_t>(); call("servo/spin", s); break; }
-    case 10: { srd::ServoDamping s; s.request.id = id(); s.request.power_mw = x.integer<uint16_t>(); call("servo/damping", s); break; }
-    case 11: { srd::ServoRelax s; s.request.ids = ids(); call("servo/relax", s); break; }
-    case 12: { srd::ServoHold s; s.request.ids = ids(); call("servo/hold", s); break; }
-    case 13: { srd::ServoInfo s; s.request.id = id(); call("servo/info", s); break; }
-    case 14: { std_srvs::Trigger s; call("imu/calibrate", s); break; }
-    case 15: { std_srvs::Trigger s; call(x.chance(0.5) ? "base/reset" : "base/reset_odometry", s); break; }
-    default: { std_srvs::Trigger s; call("base/clear_encoders", s); break; }
+    case 9: {
+      srd::ServoSpin s;
+      s.request.id = id();
+      s.request.clockwise = x.chance(0.5);
+      s.request.mode = x.integer<uint8_t>();
+      s.request.speed_dps = x.integer<uint16_t>();
+      s.request.value = x.integer<uint16_t>();
+      call("servo/spin", s);
+      break;
+    }
+    case 10: {
+      srd::ServoDamping s;
+      s.request.id = id();
+      s.request.power_mw = x.integer<uint16_t>();
+      call("servo/damping", s);
+      break;
+    }
+    case 11: {
+      srd::ServoRelax s;
+      s.request.ids = ids();
+      call("servo/relax", s);
+      break;
+    }
+    case 12: {
+      srd::ServoHold s;
+      s.request.ids = ids();
+      call("servo/hold", s);
+      break;
+    }
+    case 13: {
+      srd::ServoInfo s;
+      s.request.id = id();
+      call("servo/info", s);
+      break;
+    }
+    case 14: {
+      std_srvs::Trigger s;
+      call("imu/calibrate", s);
+      break;
+    }
+    case 15: {
+      std_srvs::Trigger s;
+      call(x.chance(0.5) ? "base/reset" : "base/reset_odometry", s);
+      break;
+    }
+    default: {
+      std_srvs::Trigger s;
+      call("base/clear_encoders", s);
+      break;
+    }
   }
 }
 
@@ -300,14 +481,21 @@ void fuzzOne(Extremes& x, Topics& topics) {
       topics.cmd_vel.publish(twist);
       break;
     }
-    case 1: topics.joint_commands.publish(fuzzJointState(x, {"joint_1", "joint_2"})); break;
-    case 2: topics.servo_commands.publish(fuzzJointState(x, {"servo_1", "servo_3"})); break;
-    case 3: topics.joint_trajectory.publish(fuzzTrajectory(x)); break;
+    case 1:
+      topics.joint_commands.publish(fuzzJointState(x, {"joint_1", "joint_2"}));
+      break;
+    case 2:
+      topics.servo_commands.publish(fuzzJointState(x, {"servo_1", "servo_3"}));
+      break;
+    case 3:
+      topics.joint_trajectory.publish(fuzzTrajectory(x));
+      break;
     case 4: {
       srd::FollowJointTrajectoryActionGoal goal;
       goal.header.stamp = x.stamp();
       goal.goal_id.stamp = x.stamp();
-      goal.goal_id.id = x.chance(0.2) ? std::string(kLongString, 'g') : "fuzz_" + std::to_string(x.pick(5));
+      goal.goal_id.id =
+          x.chance(0.2) ? std::string(kLongString, 'g') : "fuzz_" + std::to_string(x.pick(5));
       goal.goal.trajectory = fuzzTrajectory(x);
       goal.goal.goal_time_tolerance = x.duration();
       srd::JointTolerance tolerance;
@@ -326,7 +514,9 @@ void fuzzOne(Extremes& x, Topics& topics) {
       topics.cancel.publish(cancel);
       break;
     }
-    default: fuzzService(x); break;
+    default:
+      fuzzService(x);
+      break;
   }
 }
 
@@ -341,19 +531,23 @@ TEST(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
   ros::Publisher e_stop = nh.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true);
   Topics topics(nh);
   test_support::TopicCounter<sensor_msgs::JointState> joint_states(nh, "joint_states", 1);
-  ASSERT_TRUE(waitFor([&] { return topics.connected() && e_stop.getNumSubscribers() > 0; }, kWaitSeconds));
+  ASSERT_TRUE(
+      waitFor([&] { return topics.connected() && e_stop.getNumSubscribers() > 0; }, kWaitSeconds));
   ASSERT_TRUE(ros::service::waitForService("servo/spin", 30000));
   ASSERT_TRUE(test_support::setEStopAndWait(e_stop, diagnostics, false, kWaitSeconds));
   int pid = -1;
-  ASSERT_TRUE(waitFor([&] { return (pid = test_support::nodePid("/driver_node")) > 0; }, kWaitSeconds));
+  ASSERT_TRUE(
+      waitFor([&] { return (pid = test_support::nodePid("/driver_node")) > 0; }, kWaitSeconds));
 
-  const uint64_t seed = envNumber("SRD_FUZZ_SEED", static_cast<uint64_t>(
-      std::chrono::system_clock::now().time_since_epoch().count()));
+  const uint64_t seed =
+      envNumber("SRD_FUZZ_SEED",
+                static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()));
   const uint64_t count = envNumber("SRD_FUZZ_COUNT", 1500);
-  std::printf("ros_interface_fuzz: seed %llu, %llu inputs (SRD_FUZZ_SEED=%llu SRD_FUZZ_COUNT=%llu "
-              "to repeat)\n",
-              static_cast<unsigned long long>(seed), static_cast<unsigned long long>(count),
-              static_cast<unsigned long long>(seed), static_cast<unsigned long long>(count));
+  std::printf(
+      "ros_interface_fuzz: seed %llu, %llu inputs (SRD_FUZZ_SEED=%llu SRD_FUZZ_COUNT=%llu "
+      "to repeat)\n",
+      static_cast<unsigned long long>(seed), static_cast<unsigned long long>(count),
+      static_cast<unsigned long long>(seed), static_cast<unsigned long long>(count));
   RecordProperty("seed", std::to_string(seed));
   Extremes x(seed);
 
@@ -362,7 +556,9 @@ TEST(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
   spin.request.id = 1;
   spin.request.mode = 1;
   spin.request.speed_dps = 90;
-  ASSERT_TRUE(waitFor([&] { return ros::service::call("servo/spin", spin) && spin.response.success; }, kWaitSeconds));
+  ASSERT_TRUE(
+      waitFor([&] { return ros::service::call("servo/spin", spin) && spin.response.success; },
+              kWaitSeconds));
 
   // A third before, a third under and a third after the e-stop.
   const uint64_t first = count / 3, second = count - count / 3;
@@ -379,7 +575,8 @@ TEST(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
     }
     fuzzOne(x, topics);
     pace.sleep();
-    ASSERT_TRUE(test_support::processAlive(pid)) << "driver_node died at input " << i << " (seed " << seed << ")";
+    ASSERT_TRUE(test_support::processAlive(pid))
+        << "driver_node died at input " << i << " (seed " << seed << ")";
   }
   if (count < 3) held_from = held_until = PtyTap::Clock::now();
 
@@ -388,12 +585,16 @@ TEST(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
   EXPECT_EQ(test_support::nodePid("/driver_node"), pid) << "driver_node was restarted";
   srd::ServoPing ping;
   ping.request.id = 1;
-  EXPECT_TRUE(waitFor([&] { return ros::service::call("servo/ping", ping) && ping.response.online; }, kWaitSeconds));
+  EXPECT_TRUE(
+      waitFor([&] { return ros::service::call("servo/ping", ping) && ping.response.online; },
+              kWaitSeconds));
   const uint64_t states = joint_states.count();
   EXPECT_TRUE(joint_states.waitForCount(states + 50, kWaitSeconds)) << "joint_states stopped";
 
   EXPECT_EQ(motionFramesBetween(*g_base, baseMotion, held_from, held_until), 0u) << "seed " << seed;
-  EXPECT_EQ(motionFramesBetween(*g_body, [](const PtyTap::Frame&) { return true; }, held_from, held_until), 0u)
+  EXPECT_EQ(motionFramesBetween(
+                *g_body, [](const PtyTap::Frame&) { return true; }, held_from, held_until),
+            0u)
       << "seed " << seed;
   EXPECT_EQ(motionFramesBetween(*g_bus, busMotion, held_from, held_until), 0u) << "seed " << seed;
 
@@ -401,7 +602,8 @@ TEST(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
       "e_stop", diagnostics.latest("e_stop").received, [](const auto&) { return true; },
       [] { return ros::ok(); }, kWaitSeconds);
   ASSERT_TRUE(status.has_value());
-  EXPECT_EQ(status->number("callback errors"), 0u) << "an input reached an unexpected error (seed " << seed << ")";
+  EXPECT_EQ(status->number("callback errors"), 0u)
+      << "an input reached an unexpected error (seed " << seed << ")";
   std::printf("ros_interface_fuzz: %llu inputs; inputs refused %s, callback errors %s\n",
               static_cast<unsigned long long>(count), status->value("inputs refused").c_str(),
               status->value("callback errors").c_str());

@@ -225,8 +225,7 @@ TEST_F(ExecutorRig, AStartFurtherAheadThanMaxStartDelayIsRefused) {
     ASSERT_TRUE(log.over());
     EXPECT_EQ(log.accepted, 0);
     EXPECT_EQ(log.outcome().error_code, result_code::kInvalidGoal);
-    EXPECT_NE(log.outcome().error_string.find("later than max_start_delay 10 s"),
-              std::string::npos)
+    EXPECT_NE(log.outcome().error_string.find("later than max_start_delay 10 s"), std::string::npos)
         << log.outcome().error_string;
     EXPECT_EQ(executor.submitTrajectory(goal.command, now + ahead), Submission::kInvalid);
   }
@@ -277,8 +276,7 @@ TEST_F(ExecutorRig, ALateStampBridgesInTheCommandsOwnTimeNeverInAJump) {
   executor.submitTrajectory(command, now - 1.4);
   measure({"arm_1", "arm_2"}, {0.5, 0.6});
   tickAt(now + 0.5);
-  EXPECT_NEAR(frames.back().first.back() == "arm_2" ? frames.back().second.back() : -1.0, 0.6,
-              1e-6)
+  EXPECT_NEAR(frames.back().first.back() == "arm_2" ? frames.back().second.back() : -1.0, 0.6, 1e-6)
       << "from 0 to 1.2 rad in 1 s: halfway after 0.5 s";
 }
 

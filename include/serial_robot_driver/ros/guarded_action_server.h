@@ -41,8 +41,8 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
       : Base(goal_cb, cancel_cb, false), node_(nh, name), name_(name), refusals_(refusals) {}
 
  private:
-  static constexpr uint32_t kQueue = 50;         // actionlib's default queue sizes
-  static constexpr double kStatusPeriod = 0.2;   // s: actionlib's default 5 Hz status
+  static constexpr uint32_t kQueue = 50;             // actionlib's default queue sizes
+  static constexpr double kStatusPeriod = 0.2;       // s: actionlib's default 5 Hz status
   static constexpr double kStatusListTimeout = 5.0;  // s: actionlib's default
 
   void initialize() override {
@@ -63,8 +63,8 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
         [this](const actionlib_msgs::GoalIDConstPtr& id) {
           if (checkedStamp(id->stamp)) this->cancelCallback(id);
         };
-    goal_sub_ = node_.subscribe<ActionGoal>("goal", kQueue,
-                                            guardedSubscriber(refusals_, name_, on_goal));
+    goal_sub_ =
+        node_.subscribe<ActionGoal>("goal", kQueue, guardedSubscriber(refusals_, name_, on_goal));
     cancel_sub_ = node_.subscribe<actionlib_msgs::GoalID>(
         "cancel", kQueue, guardedSubscriber(refusals_, name_ + " (cancel)", on_cancel));
   }
@@ -73,8 +73,10 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
   bool checkedStamp(const ros::Time& stamp) {
     if (actionlibCanTake(stamp)) return true;
     refusals_.refused(name_);
-    ROS_WARN_THROTTLE(1.0, "%s: goal or cancel refused: its goal_id.stamp (%u s, %u ns) is not a time "
-                      "the action server can compute with", name_.c_str(), stamp.sec, stamp.nsec);
+    ROS_WARN_THROTTLE(1.0,
+                      "%s: goal or cancel refused: its goal_id.stamp (%u s, %u ns) is not a time "
+                      "the action server can compute with",
+                      name_.c_str(), stamp.sec, stamp.nsec);
     return false;
   }
 

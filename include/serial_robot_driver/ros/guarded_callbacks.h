@@ -71,10 +71,8 @@ ros::Subscriber subscribeGuarded(ros::NodeHandle& nh, device::InputRefusals& cou
                                  void (Owner::*callback)(const boost::shared_ptr<const Message>&),
                                  Owner* owner,
                                  const ros::TransportHints& hints = ros::TransportHints()) {
-  const SubscriberCallback<Message> bound = [callback, owner](
-                                                const boost::shared_ptr<const Message>& msg) {
-    (owner->*callback)(msg);
-  };
+  const SubscriberCallback<Message> bound =
+      [callback, owner](const boost::shared_ptr<const Message>& msg) { (owner->*callback)(msg); };
   return nh.subscribe<Message>(topic, queue_size, guardedSubscriber(counters, topic, bound),
                                ros::VoidConstPtr(), hints);
 }
@@ -88,7 +86,8 @@ boost::function<bool(Request&, Response&)> guardedService(
   return [&counters, service, serve](Request& req, Response& res) {
     bool answered = true;
     std::string error;
-    if (runGuarded(counters, service, [&] { answered = serve(req, res); }, &error)) {
+    if (runGuarded(
+            counters, service, [&] { answered = serve(req, res); }, &error)) {
       return answered;
     }
     answerFailure(res, "internal error: " + error);
@@ -101,10 +100,8 @@ template <typename Owner, typename Request, typename Response>
 ros::ServiceServer advertiseGuarded(ros::NodeHandle& nh, device::InputRefusals& counters,
                                     const std::string& service,
                                     bool (Owner::*serve)(Request&, Response&), Owner* owner) {
-  const boost::function<bool(Request&, Response&)> bound = [serve, owner](Request& req,
-                                                                          Response& res) {
-    return (owner->*serve)(req, res);
-  };
+  const boost::function<bool(Request&, Response&)> bound =
+      [serve, owner](Request& req, Response& res) { return (owner->*serve)(req, res); };
   return nh.advertiseService<Request, Response>(
       service, guardedService<Request, Response>(counters, service, bound));
 }
