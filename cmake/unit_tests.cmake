@@ -39,7 +39,8 @@ target_compile_definitions(param_docs_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SO
 catkin_add_gtest(ros_layer_tests
   test/unit/test_conversions.cpp
   test/unit/test_driver_params.cpp
-  test/unit/test_bag_replay.cpp)
+  test/unit/test_bag_replay.cpp
+  test/unit/test_guarded_callbacks.cpp)
 target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(ros_layer_tests srd_ros gtest_main)
 

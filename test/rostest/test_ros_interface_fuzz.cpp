@@ -332,25 +332,32 @@ void call(const std::string& name, Service& service) {
   EXPECT_TRUE(ros::service::call(name, service)) << name << " gave no answer";
 }
 
-/// One service request with its fields at extremes.
-void fuzzService(Extremes& x) {
-  const auto id = [&] {
-    return x.chance(0.5) ? static_cast<uint8_t>(x.pick(4)) : x.integer<uint8_t>();
-  };
-  const auto ids = [&] {
-    std::vector<uint8_t> out(x.chance(0.8) ? x.pick(4) : x.size());
-    for (uint8_t& each : out) each = id();
-    return out;
-  };
+/// A servo id: mostly one that answers (0..3), else any, 255 (broadcast) included.
+uint8_t servoId(Extremes& x) {
+  return x.chance(0.5) ? static_cast<uint8_t>(x.pick(4)) : x.integer<uint8_t>();
+}
+
+std::vector<uint8_t> servoIds(Extremes& x) {
+  std::vector<uint8_t> out(x.chance(0.8) ? x.pick(4) : x.size());
+  for (uint8_t& each : out) each = servoId(x);
+  return out;
+}
+
+/// A parameter name: known, dangerous, numeric, negative, enormous, empty or long.
+std::string servoParam(Extremes& x) {
   const std::string params[] = {
       "",          "angle_limit_low", "servo_id",        "51",
       "-1",        "99999999999",     "response_switch", std::string(kLongString, 'p'),
       "mid_offset"};
-  const std::string param = params[x.pick(sizeof(params) / sizeof(params[0]))];
-  switch (x.pick(17)) {
+  return params[x.pick(sizeof(params) / sizeof(params[0]))];
+}
+
+/// The servo services that read or write settings.
+void fuzzSettingsService(Extremes& x) {
+  switch (x.pick(8)) {
     case 0: {
       srd::ServoPing s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       call("servo/ping", s);
       break;
     }
@@ -363,63 +370,78 @@ void fuzzService(Extremes& x) {
     }
     case 2: {
       srd::ServoRead s;
-      s.request.id = id();
-      s.request.param = param;
+      s.request.id = servoId(x);
+      s.request.param = servoParam(x);
       call("servo/read", s);
       break;
     }
     case 3: {
       srd::ServoWrite s;
-      s.request.id = id();
-      s.request.param = param;
+      s.request.id = servoId(x);
+      s.request.param = servoParam(x);
       s.request.value = x.integer<int64_t>();
       call("servo/write", s);
       break;
     }
     case 4: {
       srd::ServoReadAll s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       call("servo/read_all", s);
       break;
     }
     case 5: {
       srd::ServoResetUserData s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       call("servo/reset_user_data", s);
       break;
     }
     case 6: {
       srd::ServoReadAngle s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       s.request.multi_turn = x.chance(0.5);
       call("servo/read_angle", s);
       break;
     }
-    case 7: {
+    default: {
+      srd::ServoInfo s;
+      s.request.id = servoId(x);
+      call("servo/info", s);
+      break;
+    }
+  }
+}
+
+void fuzzMove(Extremes& x) {
+  srd::ServoMove s;
+  s.request.id = servoId(x);
+  s.request.angle_deg = x.real();
+  s.request.multi_turn = x.chance(0.5);
+  s.request.interval_ms = x.integer<uint32_t>();
+  s.request.velocity_dps = x.real();
+  s.request.accel_ms = x.integer<uint16_t>();
+  s.request.decel_ms = x.integer<uint16_t>();
+  s.request.power_mw = x.integer<uint16_t>();
+  call("servo/move", s);
+}
+
+/// The servo services that move or hold (`wait` false, see the top of the file).
+void fuzzMotionService(Extremes& x) {
+  switch (x.pick(6)) {
+    case 0: {
       srd::ServoRotate s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       s.request.angle_deg = x.real();
       s.request.interval_ms = x.integer<uint16_t>();
       s.request.power_mw = x.integer<uint16_t>();
       call("servo/rotate", s);
       break;
     }
-    case 8: {
-      srd::ServoMove s;
-      s.request.id = id();
-      s.request.angle_deg = x.real();
-      s.request.multi_turn = x.chance(0.5);
-      s.request.interval_ms = x.integer<uint32_t>();
-      s.request.velocity_dps = x.real();
-      s.request.accel_ms = x.integer<uint16_t>();
-      s.request.decel_ms = x.integer<uint16_t>();
-      s.request.power_mw = x.integer<uint16_t>();
-      call("servo/move", s);
+    case 1:
+      fuzzMove(x);
       break;
-    }
-    case 9: {
+    case 2: {
       srd::ServoSpin s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       s.request.clockwise = x.chance(0.5);
       s.request.mode = x.integer<uint8_t>();
       s.request.speed_dps = x.integer<uint16_t>();
@@ -427,44 +449,45 @@ void fuzzService(Extremes& x) {
       call("servo/spin", s);
       break;
     }
-    case 10: {
+    case 3: {
       srd::ServoDamping s;
-      s.request.id = id();
+      s.request.id = servoId(x);
       s.request.power_mw = x.integer<uint16_t>();
       call("servo/damping", s);
       break;
     }
-    case 11: {
+    case 4: {
       srd::ServoRelax s;
-      s.request.ids = ids();
+      s.request.ids = servoIds(x);
       call("servo/relax", s);
       break;
     }
-    case 12: {
+    default: {
       srd::ServoHold s;
-      s.request.ids = ids();
+      s.request.ids = servoIds(x);
       call("servo/hold", s);
       break;
     }
-    case 13: {
-      srd::ServoInfo s;
-      s.request.id = id();
-      call("servo/info", s);
+  }
+}
+
+/// One service request with its fields at extremes (the Trigger services have none).
+void fuzzService(Extremes& x) {
+  const char* triggers[] = {"imu/calibrate", "base/reset", "base/reset_odometry",
+                            "base/clear_encoders"};
+  switch (x.pick(4)) {
+    case 0:
+      fuzzSettingsService(x);
       break;
-    }
-    case 14: {
-      std_srvs::Trigger s;
-      call("imu/calibrate", s);
+    case 1:
+      fuzzMotionService(x);
       break;
-    }
-    case 15: {
-      std_srvs::Trigger s;
-      call(x.chance(0.5) ? "base/reset" : "base/reset_odometry", s);
+    case 2:
+      fuzzMotionService(x);
       break;
-    }
     default: {
       std_srvs::Trigger s;
-      call("base/clear_encoders", s);
+      call(triggers[x.pick(4)], s);
       break;
     }
   }
@@ -525,91 +548,125 @@ uint64_t envNumber(const char* name, uint64_t fallback) {
   return text && *text ? std::strtoull(text, nullptr, 10) : fallback;
 }
 
-TEST(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
-  ros::NodeHandle nh;
-  test_support::DiagnosticsWatch diagnostics(nh, kNode);
-  ros::Publisher e_stop = nh.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true);
-  Topics topics(nh);
-  test_support::TopicCounter<sensor_msgs::JointState> joint_states(nh, "joint_states", 1);
-  ASSERT_TRUE(
-      waitFor([&] { return topics.connected() && e_stop.getNumSubscribers() > 0; }, kWaitSeconds));
-  ASSERT_TRUE(ros::service::waitForService("servo/spin", 30000));
-  ASSERT_TRUE(test_support::setEStopAndWait(e_stop, diagnostics, false, kWaitSeconds));
-  int pid = -1;
-  ASSERT_TRUE(
-      waitFor([&] { return (pid = test_support::nodePid("/driver_node")) > 0; }, kWaitSeconds));
+/// The node, its topics and its e-stop as the fuzzer sees them; the run's seed and size.
+class RosInterfaceFuzz : public ::testing::Test {
+ protected:
+  RosInterfaceFuzz()
+      : diagnostics_(nh_, kNode),
+        e_stop_(nh_.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true)),
+        topics_(nh_),
+        joint_states_(nh_, "joint_states", 1),
+        seed_(envNumber(
+            "SRD_FUZZ_SEED",
+            static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()))),
+        count_(envNumber("SRD_FUZZ_COUNT", 1500)) {}
 
-  const uint64_t seed =
-      envNumber("SRD_FUZZ_SEED",
-                static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()));
-  const uint64_t count = envNumber("SRD_FUZZ_COUNT", 1500);
-  std::printf(
-      "ros_interface_fuzz: seed %llu, %llu inputs (SRD_FUZZ_SEED=%llu SRD_FUZZ_COUNT=%llu "
-      "to repeat)\n",
-      static_cast<unsigned long long>(seed), static_cast<unsigned long long>(count),
-      static_cast<unsigned long long>(seed), static_cast<unsigned long long>(count));
-  RecordProperty("seed", std::to_string(seed));
-  Extremes x(seed);
-
-  // Servo 1 spinning, as in the field when the bad message came.
-  srd::ServoSpin spin;
-  spin.request.id = 1;
-  spin.request.mode = 1;
-  spin.request.speed_dps = 90;
-  ASSERT_TRUE(
-      waitFor([&] { return ros::service::call("servo/spin", spin) && spin.response.success; },
-              kWaitSeconds));
-
-  // A third before, a third under and a third after the e-stop.
-  const uint64_t first = count / 3, second = count - count / 3;
-  ros::Rate pace(200);  // topic messages at most 200/s: their queues hold 10
-  PtyTap::Clock::time_point held_from, held_until;
-  for (uint64_t i = 0; i < count && ros::ok(); ++i) {
-    if (i == first) {
-      ASSERT_TRUE(test_support::setEStopAndWait(e_stop, diagnostics, true, kWaitSeconds));
-      held_from = PtyTap::Clock::now();
-    }
-    if (i == second) {
-      held_until = PtyTap::Clock::now();
-      ASSERT_TRUE(test_support::setEStopAndWait(e_stop, diagnostics, false, kWaitSeconds));
-    }
-    fuzzOne(x, topics);
-    pace.sleep();
-    ASSERT_TRUE(test_support::processAlive(pid))
-        << "driver_node died at input " << i << " (seed " << seed << ")";
+  void SetUp() override {
+    ASSERT_TRUE(waitFor([&] { return topics_.connected() && e_stop_.getNumSubscribers() > 0; },
+                        kWaitSeconds));
+    ASSERT_TRUE(ros::service::waitForService("servo/spin", 30000));
+    setEStop(false);
+    ASSERT_TRUE(
+        waitFor([&] { return (pid_ = test_support::nodePid("/driver_node")) > 0; }, kWaitSeconds));
+    std::printf(
+        "ros_interface_fuzz: seed %llu, %llu inputs (SRD_FUZZ_SEED=%llu SRD_FUZZ_COUNT=%llu "
+        "to repeat)\n",
+        static_cast<unsigned long long>(seed_), static_cast<unsigned long long>(count_),
+        static_cast<unsigned long long>(seed_), static_cast<unsigned long long>(count_));
+    RecordProperty("seed", std::to_string(seed_));
   }
-  if (count < 3) held_from = held_until = PtyTap::Clock::now();
 
-  // The same process, still serving and publishing.
-  ASSERT_TRUE(test_support::processAlive(pid)) << "seed " << seed;
-  EXPECT_EQ(test_support::nodePid("/driver_node"), pid) << "driver_node was restarted";
-  srd::ServoPing ping;
-  ping.request.id = 1;
-  EXPECT_TRUE(
-      waitFor([&] { return ros::service::call("servo/ping", ping) && ping.response.online; },
-              kWaitSeconds));
-  const uint64_t states = joint_states.count();
-  EXPECT_TRUE(joint_states.waitForCount(states + 50, kWaitSeconds)) << "joint_states stopped";
+  void setEStop(bool engaged) {
+    ASSERT_TRUE(test_support::setEStopAndWait(e_stop_, diagnostics_, engaged, kWaitSeconds));
+  }
 
-  EXPECT_EQ(motionFramesBetween(*g_base, baseMotion, held_from, held_until), 0u) << "seed " << seed;
-  EXPECT_EQ(motionFramesBetween(
-                *g_body, [](const PtyTap::Frame&) { return true; }, held_from, held_until),
-            0u)
-      << "seed " << seed;
-  EXPECT_EQ(motionFramesBetween(*g_bus, busMotion, held_from, held_until), 0u) << "seed " << seed;
+  void spinServo1(uint8_t mode) {
+    srd::ServoSpin spin;
+    spin.request.id = 1;
+    spin.request.mode = mode;
+    spin.request.speed_dps = 90;
+    ASSERT_TRUE(
+        waitFor([&] { return ros::service::call("servo/spin", spin) && spin.response.success; },
+                kWaitSeconds));
+  }
 
-  const auto status = diagnostics.waitFor(
-      "e_stop", diagnostics.latest("e_stop").received, [](const auto&) { return true; },
-      [] { return ros::ok(); }, kWaitSeconds);
-  ASSERT_TRUE(status.has_value());
-  EXPECT_EQ(status->number("callback errors"), 0u)
-      << "an input reached an unexpected error (seed " << seed << ")";
-  std::printf("ros_interface_fuzz: %llu inputs; inputs refused %s, callback errors %s\n",
-              static_cast<unsigned long long>(count), status->value("inputs refused").c_str(),
-              status->value("callback errors").c_str());
-  if (count >= 30) EXPECT_GT(status->number("inputs refused"), 0u) << "the checks refused nothing?";
-  spin.request.mode = 0;
-  ros::service::call("servo/spin", spin);
+  /// Sends the run's inputs, a third before, a third under and a third after the e-stop; sets
+  /// when the e-stop was known to hold. Stops at the first input after which the node is gone.
+  void sendInputs() {
+    Extremes x(seed_);
+    const uint64_t engage_at = count_ / 3, release_at = count_ - count_ / 3;
+    ros::Rate pace(200);  // topic messages at most 200/s: their queues hold 10
+    held_from_ = held_until_ = PtyTap::Clock::now();
+    for (uint64_t i = 0; i < count_ && ros::ok(); ++i) {
+      if (i == engage_at) {
+        setEStop(true);
+        held_from_ = PtyTap::Clock::now();
+      }
+      if (i == release_at) {
+        held_until_ = PtyTap::Clock::now();
+        setEStop(false);
+      }
+      fuzzOne(x, topics_);
+      pace.sleep();
+      ASSERT_TRUE(test_support::processAlive(pid_))
+          << "driver_node died at input " << i << " (seed " << seed_ << ")";
+    }
+  }
+
+  /// The same process, still answering and publishing.
+  void expectStillServing() {
+    ASSERT_TRUE(test_support::processAlive(pid_)) << "seed " << seed_;
+    EXPECT_EQ(test_support::nodePid("/driver_node"), pid_) << "driver_node was restarted";
+    srd::ServoPing ping;
+    ping.request.id = 1;
+    EXPECT_TRUE(
+        waitFor([&] { return ros::service::call("servo/ping", ping) && ping.response.online; },
+                kWaitSeconds));
+    const uint64_t states = joint_states_.count();
+    EXPECT_TRUE(joint_states_.waitForCount(states + 50, kWaitSeconds)) << "joint_states stopped";
+  }
+
+  void expectNoMotionUnderTheEStop() const {
+    const auto any = [](const PtyTap::Frame&) { return true; };
+    EXPECT_EQ(motionFramesBetween(*g_base, baseMotion, held_from_, held_until_), 0u)
+        << "seed " << seed_;
+    EXPECT_EQ(motionFramesBetween(*g_body, any, held_from_, held_until_), 0u) << "seed " << seed_;
+    EXPECT_EQ(motionFramesBetween(*g_bus, busMotion, held_from_, held_until_), 0u)
+        << "seed " << seed_;
+  }
+
+  /// The node's own count: inputs refused (some, in any run of size), no callback error.
+  void expectRefusalsAndNoCallbackError() {
+    const auto status = diagnostics_.waitFor(
+        "e_stop", diagnostics_.latest("e_stop").received, [](const auto&) { return true; },
+        [] { return ros::ok(); }, kWaitSeconds);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->number("callback errors"), 0u)
+        << "an input reached an unexpected error (seed " << seed_ << ")";
+    std::printf("ros_interface_fuzz: %llu inputs; inputs refused %s, callback errors %s\n",
+                static_cast<unsigned long long>(count_), status->value("inputs refused").c_str(),
+                status->value("callback errors").c_str());
+    if (count_ >= 30) EXPECT_GT(status->number("inputs refused"), 0u) << "nothing refused?";
+  }
+
+  ros::NodeHandle nh_;
+  test_support::DiagnosticsWatch diagnostics_;
+  ros::Publisher e_stop_;
+  Topics topics_;
+  test_support::TopicCounter<sensor_msgs::JointState> joint_states_;
+  const uint64_t seed_;
+  const uint64_t count_;
+  int pid_ = -1;
+  PtyTap::Clock::time_point held_from_, held_until_;
+};
+
+TEST_F(RosInterfaceFuzz, NoInputEndsTheNodeOrMovesAnythingUnderTheEStop) {
+  spinServo1(1);  // spinning, as in the field when the bad message came
+  sendInputs();
+  expectStillServing();
+  expectNoMotionUnderTheEStop();
+  expectRefusalsAndNoCallbackError();
+  spinServo1(0);
 }
 
 }  // namespace
