@@ -27,6 +27,7 @@ set(SRD_CORE_SOURCES
   src/device/status_report.cpp
   src/device/link_status.cpp
   src/device/e_stop_status.cpp
+  src/device/input_refusals.cpp
   src/device/wire_capture_status.cpp
 )
 

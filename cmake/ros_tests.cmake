@@ -158,6 +158,14 @@ add_rostest_gtest(test_estop_bus test/rostest/estop_bus.test test/rostest/test_e
 target_include_directories(test_estop_bus PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_estop_bus srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_estop_bus driver_node ${PROJECT_NAME}_generate_messages_cpp)
+# The ROS interface fuzzer: seeded extreme inputs on every topic and service, part of them under the
+# e-stop, with a bus servo spinning; the node must live on and write no motion frame under the
+# e-stop (SRD_FUZZ_SEED / SRD_FUZZ_COUNT, scripts/fuzz_ros_interface.sh for a long run).
+add_rostest_gtest(test_ros_interface_fuzz test/rostest/ros_interface_fuzz.test
+  test/rostest/test_ros_interface_fuzz.cpp)
+target_include_directories(test_ros_interface_fuzz PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_ros_interface_fuzz srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_ros_interface_fuzz driver_node ${PROJECT_NAME}_generate_messages_cpp)
 
 # Each device's own rostests, found by convention: src/devices/<name>/test/ros/<x>.test and the
 # gtest sources beside it named test_<x>*.cpp make the target test_<x> (run with

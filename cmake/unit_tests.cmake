@@ -22,6 +22,7 @@ catkin_add_gtest(core_tests
   test/unit/test_sim_registry.cpp
   test/unit/test_device_registry.cpp
   test/unit/test_e_stop.cpp
+  test/unit/test_input_refusals.cpp
   test/unit/test_status_report.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
@@ -38,7 +39,8 @@ target_compile_definitions(param_docs_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SO
 catkin_add_gtest(ros_layer_tests
   test/unit/test_conversions.cpp
   test/unit/test_driver_params.cpp
-  test/unit/test_bag_replay.cpp)
+  test/unit/test_bag_replay.cpp
+  test/unit/test_guarded_callbacks.cpp)
 target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(ros_layer_tests srd_ros gtest_main)
 

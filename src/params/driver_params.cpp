@@ -39,7 +39,8 @@ void addTrajectoryParameters(std::vector<ParamSpec>& table) {
       .add("goal_tolerance", &TrajectoryParams::goal_tolerance, nonNegativeNumber)
       .add("goal_time_tolerance", &TrajectoryParams::goal_time_tolerance, nonNegativeNumber)
       .add("path_tolerance", &TrajectoryParams::path_tolerance, nonNegativeNumber)
-      .add("max_velocity", &TrajectoryParams::max_velocity, nonNegativeNumber);
+      .add("max_velocity", &TrajectoryParams::max_velocity, nonNegativeNumber)
+      .add("max_start_delay", &TrajectoryParams::max_start_delay, positiveNumber);
 }
 
 std::vector<ParamSpec> buildTable() {

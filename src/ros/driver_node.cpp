@@ -11,6 +11,7 @@
 #include "serial_robot_driver/devices/base/base_interface.h"
 #include "serial_robot_driver/devices/body/body_interface.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
@@ -197,8 +198,8 @@ void DriverNode::connectEStop() {
   if (trajectory_) trajectory_->attachEStop(e_stop_);
   for (auto& device : devices_) device->attachEStop(e_stop_);
   // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
-  e_stop_sub_ = nh_.subscribe("e_stop", 10, &DriverNode::onEStop, this,
-                              ros::TransportHints().tcpNoDelay());
+  e_stop_sub_ = subscribeGuarded(nh_, input_refusals_, "e_stop", 10, &DriverNode::onEStop, this,
+                                 ros::TransportHints().tcpNoDelay());
   diagnostics_.add("e_stop", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
     diagnoseEStop(s);
   });
@@ -215,7 +216,13 @@ void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
 }
 
 void DriverNode::diagnoseEStop(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  writeStatusReport(device::eStopStatus(e_stop_.stats()), status);
+  device::StatusReport report = device::eStopStatus(e_stop_.stats());
+  // Node-wide, next to what the e-stop refused: what every input's checks refused.
+  device::InputRefusalStats refusals = input_refusals_.stats();
+  for (const auto& device : devices_) refusals += device->inputRefusalStats();
+  if (trajectory_) refusals += trajectory_->inputRefusalStats();
+  device::addInputRefusals(refusals, report);
+  writeStatusReport(report, status);
 }
 
 device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }

@@ -1,12 +1,19 @@
 #include "serial_robot_driver/ros/trajectory_server.h"
 
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <string>
+
 #include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
 
 namespace {
 
 using Result = serial_robot_driver::FollowJointTrajectoryResult;
+using Submission = trajectory::TrajectoryExecutor::Submission;
 namespace code = trajectory::result_code;
 static_assert(code::kSuccessful == Result::SUCCESSFUL &&
               code::kInvalidGoal == Result::INVALID_GOAL &&
@@ -26,8 +33,11 @@ serial_robot_driver::FollowJointTrajectoryFeedback toMsg(const trajectory::GoalF
   serial_robot_driver::FollowJointTrajectoryFeedback feedback;
   feedback.header.stamp = ros::Time::now();  // ROS time, as every stamp; the executor's is steady
   feedback.joint_names = in.joint_names;
+  // Clamped: ros::Duration throws beyond its 32-bit seconds (a goal may last that long).
+  constexpr double kLongestDuration = std::numeric_limits<int32_t>::max() - 1.0;
   feedback.desired.time_from_start = feedback.actual.time_from_start =
-      feedback.error.time_from_start = ros::Duration(in.time_from_start);
+      feedback.error.time_from_start =
+          ros::Duration(std::clamp(in.time_from_start, 0.0, kLongestDuration));
   for (const trajectory::JointSample& d : in.desired) {
     feedback.desired.positions.push_back(d.position);
     feedback.desired.velocities.push_back(d.velocity);
@@ -58,9 +68,22 @@ void report(TrajectoryServer::GoalHandle& handle, const trajectory::GoalOutcome&
 
 }  // namespace
 
+double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
+  // A message's nsec is not normalised (any uint32): each part on its own, in int64.
+  const int64_t seconds = static_cast<int64_t>(later.sec) - static_cast<int64_t>(earlier.sec);
+  const int64_t nanoseconds = static_cast<int64_t>(later.nsec) - static_cast<int64_t>(earlier.nsec);
+  return static_cast<double>(seconds) + static_cast<double>(nanoseconds) * 1e-9;
+}
+
+bool actionlibCanTake(const ros::Time& stamp) {
+  constexpr uint32_t kSecondsLeft = 86400;
+  return stamp.nsec < 1000000000u &&
+         stamp.sec <= std::numeric_limits<uint32_t>::max() - kSecondsLeft;
+}
+
 double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
   if (stamp.isZero()) return steady_now;
-  return steady_now + (stamp - ros_now).toSec();
+  return steady_now + secondsBetween(stamp, ros_now);
 }
 
 std::vector<TrajectoryJoints> DeviceInterface::trajectoryJoints() { return {}; }
@@ -82,8 +105,12 @@ TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& para
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),
       action_server_(
-          nh, "follow_joint_trajectory", [this](GoalHandle handle) { onGoal(handle); },
-          [this](GoalHandle handle) { executor_.cancelGoal(handle.getGoalID().id); }, false) {}
+          nh, "follow_joint_trajectory", input_refusals_,
+          [this](GoalHandle handle) { onGoalGuarded(handle); },
+          [this](GoalHandle handle) {
+            runGuarded(input_refusals_, "follow_joint_trajectory (cancel)",
+                       [&] { executor_.cancelGoal(handle.getGoalID().id); });
+          }) {}
 
 TrajectoryServer::~TrajectoryServer() { shutdown(); }
 
@@ -91,11 +118,14 @@ void TrajectoryServer::start() {
   if (!executor_.start()) return;
   action_server_.start();
   // tcpNoDelay: a trajectory must not wait in Nagle's buffer.
-  trajectory_sub_ = nh_.subscribe("joint_trajectory", 10, &TrajectoryServer::onTrajectory, this,
-                                  ros::TransportHints().tcpNoDelay());
+  trajectory_sub_ =
+      subscribeGuarded(nh_, input_refusals_, "joint_trajectory", 10,
+                       &TrajectoryServer::onTrajectory, this, ros::TransportHints().tcpNoDelay());
   // Steady: a step of the ROS or wall clock must not skip or replay a trajectory.
-  timer_ = nh_.createSteadyTimer(ros::WallDuration(loop_period_),
-                                 [this](const ros::SteadyTimerEvent&) { executor_.tick(); });
+  timer_ =
+      nh_.createSteadyTimer(ros::WallDuration(loop_period_), [this](const ros::SteadyTimerEvent&) {
+        runGuarded(input_refusals_, "trajectory loop", [this] { executor_.tick(); });
+      });
 }
 
 void TrajectoryServer::shutdown() {
@@ -107,6 +137,28 @@ void TrajectoryServer::shutdown() {
 std::optional<double> TrajectoryServer::startOf(const ros::Time& stamp) const {
   if (stamp.isZero()) return std::nullopt;
   return steadyStart(stamp, executor_.now(), ros::Time::now());
+}
+
+void TrajectoryServer::onGoalGuarded(GoalHandle handle) {
+  std::string error;
+  if (runGuarded(
+          input_refusals_, "follow_joint_trajectory", [&] { onGoal(handle); }, &error)) {
+    return;
+  }
+  // The goal must still be answered, or its client waits forever.
+  runGuarded(input_refusals_, "follow_joint_trajectory", [&] {
+    Result result;
+    result.error_code = Result::INVALID_GOAL;
+    result.error_string = "internal error: " + error;
+    const uint8_t status = handle.getGoalStatus().status;
+    if (status == actionlib_msgs::GoalStatus::PENDING ||
+        status == actionlib_msgs::GoalStatus::RECALLING) {
+      handle.setRejected(result, result.error_string);
+    } else if (status == actionlib_msgs::GoalStatus::ACTIVE ||
+               status == actionlib_msgs::GoalStatus::PREEMPTING) {
+      handle.setAborted(result, result.error_string);
+    }
+  });
 }
 
 void TrajectoryServer::onGoal(GoalHandle handle) {
@@ -126,11 +178,16 @@ void TrajectoryServer::onGoal(GoalHandle handle) {
   callbacks.finished = [handle](const trajectory::GoalOutcome& outcome) mutable {
     report(handle, outcome);
   };
-  executor_.submitGoal(converted, std::move(callbacks));
+  if (executor_.submitGoal(converted, std::move(callbacks)) == Submission::kInvalid) {
+    input_refusals_.refused("follow_joint_trajectory");
+  }
 }
 
 void TrajectoryServer::onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg) {
-  executor_.submitTrajectory(toTrajectoryCommand(*msg), startOf(msg->header.stamp));
+  if (executor_.submitTrajectory(toTrajectoryCommand(*msg), startOf(msg->header.stamp)) ==
+      Submission::kInvalid) {
+    input_refusals_.refused("joint_trajectory");
+  }
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -155,6 +155,23 @@ void TrajectoryExecutor::setStateTimeout(const std::vector<std::string>& names, 
   }
 }
 
+std::optional<double> TrajectoryExecutor::startOf(const TrajectoryCommand& command,
+                                                  std::optional<double> start_time, double now,
+                                                  CommandCheck* refusal) const {
+  if (!start_time) return now;
+  // NaN fails this test too; the ROS layer never gives one, the check is for any other caller.
+  if (!(*start_time - now <= defaults_.max_start_delay)) {
+    refusal->error = CommandError::kInvalidGoal;
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "its start (header.stamp) is %.3g s from now, later than max_start_delay %.3g s",
+                  *start_time - now, defaults_.max_start_delay);
+    refusal->message = text;
+    return std::nullopt;
+  }
+  return effectiveStart(command, *start_time, now);
+}
+
 CommandCheck TrajectoryExecutor::check(const TrajectoryCommand& command, double start, double now) {
   CommandCheck result = validate(command, ranges_, defaults_.max_velocity, start - now);
   if (!result.ok()) return result;
@@ -240,28 +257,31 @@ std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, dou
   return leftAloneText(left_alone);
 }
 
-void TrajectoryExecutor::submitGoal(const Goal& goal, GoalCallbacks callbacks) {
+TrajectoryExecutor::Submission TrajectoryExecutor::submitGoal(const Goal& goal,
+                                                              GoalCallbacks callbacks) {
   const TrajectoryCommand& command = goal.command;
   const double now = this->now();
-  const double start = goal.start_time.value_or(now);
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) {
     finish(callbacks,
            outcome(GoalStatus::kRejected, result_code::kInvalidGoal, "the driver is not running"));
-    return;
+    return Submission::kNotRunning;
   }
   if (e_stop_ && e_stop_->refuse("follow_joint_trajectory")) {
     warn("follow_joint_trajectory: goal rejected: e_stop is engaged");
     finish(callbacks,
            outcome(GoalStatus::kRejected, result_code::kInvalidGoal, "e_stop is engaged"));
-    return;
+    return Submission::kEStopped;
   }
-  const CommandCheck checked = check(command, start, now);
+  CommandCheck checked;
+  const std::optional<double> started = startOf(command, goal.start_time, now, &checked);
+  if (started) checked = check(command, *started, now);
   if (!checked.ok()) {
     warn("follow_joint_trajectory: goal rejected: " + checked.message);
     finish(callbacks, outcome(GoalStatus::kRejected, resultCode(checked.error), checked.message));
-    return;
+    return Submission::kInvalid;
   }
+  const double start = *started;
   if (callbacks.accepted) callbacks.accepted();
   endGoalsOn(checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
              "preempted by a new goal");
@@ -271,7 +291,7 @@ void TrajectoryExecutor::submitGoal(const Goal& goal, GoalCallbacks callbacks) {
     if (!left_alone.empty()) warn("follow_joint_trajectory: stop: " + left_alone);
     finish(callbacks, outcome(GoalStatus::kSucceeded, result_code::kSuccessful, left_alone,
                               withLeftAlone("stopped where they were last commanded", left_alone)));
-    return;
+    return Submission::kAccepted;
   }
   apply(command, checked.joint_indices, start, now);
 
@@ -290,6 +310,7 @@ void TrajectoryExecutor::submitGoal(const Goal& goal, GoalCallbacks callbacks) {
                                    ? defaults_.goal_time_tolerance
                                    : std::max(0.0, goal.goal_time_tolerance);
   goals_.push_back(std::move(active));
+  return Submission::kAccepted;
 }
 
 void TrajectoryExecutor::cancelGoal(const std::string& id) {
@@ -303,22 +324,23 @@ void TrajectoryExecutor::cancelGoal(const std::string& id) {
   goals_.erase(it);
 }
 
-void TrajectoryExecutor::submitTrajectory(const TrajectoryCommand& command,
-                                          std::optional<double> start_time) {
+TrajectoryExecutor::Submission TrajectoryExecutor::submitTrajectory(
+    const TrajectoryCommand& command, std::optional<double> start_time) {
   const double now = this->now();
-  const double start = start_time.value_or(now);
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!running_) return;
+  if (!running_) return Submission::kNotRunning;
   if (e_stop_ && e_stop_->refuse("joint_trajectory")) {
     warnThrottled(kMessageRefused,
                   "joint_trajectory: message ignored, nothing moves: e_stop is engaged", now);
-    return;
+    return Submission::kEStopped;
   }
-  const CommandCheck checked = check(command, start, now);
+  CommandCheck checked;
+  const std::optional<double> start = startOf(command, start_time, now, &checked);
+  if (start) checked = check(command, *start, now);
   if (!checked.ok()) {
     warnThrottled(kMessageInvalid,
                   "joint_trajectory: message ignored, nothing moves: " + checked.message, now);
-    return;
+    return Submission::kInvalid;
   }
   endGoalsOn(checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
              "preempted by a joint_trajectory message");
@@ -326,8 +348,9 @@ void TrajectoryExecutor::submitTrajectory(const TrajectoryCommand& command,
     const std::string left_alone = hold(checked.joint_indices, now);
     if (!left_alone.empty()) warn("joint_trajectory: stop: " + left_alone);
   } else {
-    apply(command, checked.joint_indices, start, now);
+    apply(command, checked.joint_indices, *start, now);
   }
+  return Submission::kAccepted;
 }
 
 void TrajectoryExecutor::takeOver(const std::vector<std::string>& names, const std::string& source,

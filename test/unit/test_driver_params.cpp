@@ -397,6 +397,9 @@ TEST(DriverParams, TrajectoryDefaultsMustNotBeNegative) {
        [](DriverParams& p) { p.trajectory.goal_time_tolerance = -1; }},
       {"trajectory/path_tolerance", [](DriverParams& p) { p.trajectory.path_tolerance = -1; }},
       {"trajectory/max_velocity", [](DriverParams& p) { p.trajectory.max_velocity = -2; }},
+      {"trajectory/max_start_delay", [](DriverParams& p) { p.trajectory.max_start_delay = 0; }},
+      {"trajectory/max_start_delay",
+       [](DriverParams& p) { p.trajectory.max_start_delay = std::nan(""); }},
   };
   for (const auto& [key, spoil] : cases) {
     DriverParams params;

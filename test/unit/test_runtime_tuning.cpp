@@ -138,7 +138,8 @@ TEST(RuntimeTuningTable, ServoBusServerHasEveryBusTunableAsTheTableHasIt) {
 
 TEST(RuntimeTuningTable, TrajectoryServerHasTheGoalDefaultsAsTheTableHasThem) {
   expectAgreesWithTheTable<serial_robot_driver::TrajectoryTuningConfig>(
-      "trajectory", {"goal_tolerance", "goal_time_tolerance", "path_tolerance", "max_velocity"});
+      "trajectory", {"goal_tolerance", "goal_time_tolerance", "path_tolerance", "max_velocity",
+                     "max_start_delay"});
 }
 
 // The .cfg files are where CMake looks for them (each device's src/devices/<name>/ros/, the node's

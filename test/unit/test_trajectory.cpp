@@ -228,6 +228,26 @@ TEST(Validate, NoPointsMeansStop) {
   EXPECT_TRUE(validate(command, kJoints, 0.0).ok());
 }
 
+TEST(EffectiveStart, KeepsAStartNowOrAhead) {
+  EXPECT_EQ(effectiveStart(twoPointCommand(), 10.0, 10.0), 10.0);
+  EXPECT_EQ(effectiveStart(twoPointCommand(), 12.5, 10.0), 12.5);
+}
+
+TEST(EffectiveStart, ALateStartNeverShortensTheBridgeBelowWhatTheCommandPlanned) {
+  // Points at 0.5 s and 1.0 s. Stamped 0.45 s ago: 0.05 s would be left to reach the first point
+  // (joint_trajectory_controller's bridge); it gets its own 0.5 s, as if stamped now.
+  EXPECT_NEAR(effectiveStart(twoPointCommand(), 9.55, 10.0), 10.0, 1e-12);
+  // Stamped 0.7 s ago: the first point is past and dropped; the second, 0.3 s away, was planned
+  // 0.5 s after the first: the command starts 0.2 s later, leaving the bridge 0.5 s.
+  EXPECT_NEAR(effectiveStart(twoPointCommand(), 9.3, 10.0), 9.5, 1e-12);
+  // In effect the segment running now runs whole from now: its start point is put at now.
+  TrajectoryCommand command = twoPointCommand();
+  command.points[0].time_from_start = 0.25;
+  EXPECT_NEAR(effectiveStart(command, 9.7, 10.0), 10.0 - 0.25, 1e-12);
+  // Every point past: as stamped (validate() says kOldTimestamp).
+  EXPECT_EQ(effectiveStart(twoPointCommand(), 5.0, 10.0), 5.0);
+}
+
 TEST(WaypointsFor, DropsPointsInThePast) {
   TrajectoryCommand command = twoPointCommand();
   command.points.insert(command.points.begin(), TrajectoryPoint{0.25, {0.0, 0.0}, {}, {}});

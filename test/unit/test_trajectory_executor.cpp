@@ -4,6 +4,7 @@
 // the tests step by hand.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -209,6 +210,74 @@ TEST_F(ExecutorRig, SamplesTheSplineEachTickAndSucceedsWithinTheGoalTolerance) {
   tickAt(101.1);
   tickAt(101.2);
   EXPECT_EQ(frames.size(), written + 1);
+}
+
+TEST_F(ExecutorRig, AStartFurtherAheadThanMaxStartDelayIsRefused) {
+  using Submission = TrajectoryExecutor::Submission;
+  measure({"arm_1"}, {0.0});
+  // 10 s by default: a stamp in the far future (4e9 s since 1970 is 2.3e9 s ahead) would
+  // otherwise hold the joints for decades.
+  for (const double ahead : {10.5, 2.3e9, std::numeric_limits<double>::quiet_NaN()}) {
+    Goal goal = goalTo({"arm_1"}, {0.5});
+    goal.start_time = now + ahead;
+    GoalLog log;
+    EXPECT_EQ(executor.submitGoal(goal, log.callbacks()), Submission::kInvalid) << ahead;
+    ASSERT_TRUE(log.over());
+    EXPECT_EQ(log.accepted, 0);
+    EXPECT_EQ(log.outcome().error_code, result_code::kInvalidGoal);
+    EXPECT_NE(log.outcome().error_string.find("later than max_start_delay 10 s"), std::string::npos)
+        << log.outcome().error_string;
+    EXPECT_EQ(executor.submitTrajectory(goal.command, now + ahead), Submission::kInvalid);
+  }
+  tickAt(now + 0.1);
+  EXPECT_TRUE(frames.empty()) << "nothing refused moves";
+
+  Goal soon = goalTo({"arm_1"}, {0.5});
+  soon.start_time = now + 9.5;
+  GoalLog accepted;
+  EXPECT_EQ(executor.submitGoal(soon, accepted.callbacks()), Submission::kAccepted);
+  EXPECT_EQ(accepted.accepted, 1);
+
+  GoalDefaults patient = defaults();
+  patient.max_start_delay = 20.0;
+  executor.retune(patient);
+  EXPECT_EQ(executor.submitTrajectory(goalTo({"arm_2"}, {0.5}).command, now + 15.0),
+            Submission::kInvalid)
+      << "arm_2 was never measured";
+  measure({"arm_2"}, {0.0});
+  EXPECT_EQ(executor.submitTrajectory(goalTo({"arm_2"}, {0.5}).command, now + 15.0),
+            Submission::kAccepted);
+}
+
+TEST_F(ExecutorRig, ALateStampBridgesInTheCommandsOwnTimeNeverInAJump) {
+  // max_velocity 0 (no limit to refuse a fast bridge). Stamped 1 s ago, first point 1.05 s after
+  // the stamp: joint_trajectory_controller would leave 0.05 s to go 1 rad. The bridge gets the
+  // point's own 1.05 s, as if the goal were stamped now.
+  measure({"arm_1"}, {0.0});
+  Goal late = goalTo({"arm_1"}, {1.0}, 1.05);
+  late.start_time = now - 1.0;
+  GoalLog log;
+  executor.submitGoal(late, log.callbacks());
+  ASSERT_EQ(log.accepted, 1);
+  tickAt(100.05);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_NEAR(frames[0].second.at(0), 0.05 / 1.05, 1e-6) << "linear from now over 1.05 s";
+  measure({"arm_1"}, {0.5});
+  tickAt(100.525);
+  EXPECT_NEAR(frames.back().second.at(0), 0.5, 1e-6);
+  EXPECT_FALSE(log.over()) << "it ends 1.05 s from now, not 0.05 s";
+
+  // A message too, and the rest of the command keeps its own timing after the bridge.
+  measure({"arm_2"}, {0.0});
+  TrajectoryCommand command;
+  command.joint_names = {"arm_2"};
+  command.points = {{0.5, {0.2}, {}, {}}, {1.5, {1.2}, {}, {}}, {2.0, {1.2}, {}, {}}};
+  // Stamped 1.4 s ago: the first point is past, 0.1 s left to the second (planned 1 s after it).
+  executor.submitTrajectory(command, now - 1.4);
+  measure({"arm_1", "arm_2"}, {0.5, 0.6});
+  tickAt(now + 0.5);
+  EXPECT_NEAR(frames.back().first.back() == "arm_2" ? frames.back().second.back() : -1.0, 0.6, 1e-6)
+      << "from 0 to 1.2 rad in 1 s: halfway after 0.5 s";
 }
 
 TEST_F(ExecutorRig, PathToleranceAbortHoldsWhereLastWritten) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,25 @@ TEST(TrajectoryRos, GoalStampBecomesASteadyStartOnce) {
   EXPECT_NEAR(steadyStart(ros::Time(1000.0), 500.0, ros::Time(998.0)), 502.0, 1e-9);
   // 1.5 s behind.
   EXPECT_NEAR(steadyStart(ros::Time(1000.0), 500.0, ros::Time(1001.5)), 498.5, 1e-9);
+}
+
+TEST(TrajectoryRos, AnyStampGivesAFiniteStartWithoutThrowing) {
+  // roscpp's Time - Time throws beyond 32-bit seconds ("Duration is out of dual 32-bit range"),
+  // which ended the node from a joint_trajectory callback. Stamps as a message may carry them:
+  // nsec not normalised, seconds at the ends of uint32.
+  const ros::Time now(1.7e9);
+  ros::Time far_future, epoch_start, unnormalised;
+  far_future.sec = 4000000000u;
+  epoch_start.nsec = 1;
+  unnormalised.sec = 1700000000u;
+  unnormalised.nsec = 4000000000u;  // 4 s more
+  EXPECT_NEAR(steadyStart(far_future, 500.0, now), 500.0 + 2.3e9, 1.0);
+  EXPECT_NEAR(steadyStart(epoch_start, 500.0, now), 500.0 - 1.7e9, 1.0);
+  EXPECT_NEAR(steadyStart(unnormalised, 500.0, now), 504.0, 1e-6);
+  ros::Time largest;
+  largest.sec = largest.nsec = std::numeric_limits<uint32_t>::max();
+  EXPECT_TRUE(std::isfinite(steadyStart(largest, 0.0, ros::Time(1.0))));
+  EXPECT_NEAR(secondsBetween(ros::Time(1.0), largest), 1.0 - 4294967295.0 - 4.294967295, 1e-3);
 }
 
 }  // namespace

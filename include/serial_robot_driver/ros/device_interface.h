@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::trajectory {
@@ -55,6 +56,14 @@ class DeviceInterface {
   /// Statuses of its own beyond the device's one (e.g. one per bus servo), added to `updater`
   /// once, at construction of the node.
   virtual void addDiagnostics(diagnostic_updater::Updater& /*updater*/) {}
+
+  /// The inputs of its topics and services it refused, and its callbacks' errors, by source
+  /// (ros/guarded_callbacks.h); the node reports them in its "e_stop" status. Any thread.
+  device::InputRefusals& inputRefusals() { return input_refusals_; }
+  device::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
+
+ private:
+  device::InputRefusals input_refusals_;
 };
 
 }  // namespace serial_robot_driver::ros_layer

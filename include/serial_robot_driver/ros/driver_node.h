@@ -40,6 +40,7 @@
 #include <std_msgs/Bool.h>
 
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
@@ -90,6 +91,7 @@ class DriverNode {
   DriverParams params_;
   /// The one e-stop of every actuator; outlives the devices and the trajectory server.
   device::EStop e_stop_;
+  device::InputRefusals input_refusals_;  // the node's own topic's (e_stop)
   ros::Subscriber e_stop_sub_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it

@@ -24,7 +24,9 @@
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/guarded_action_server.h"
 #include "serial_robot_driver/trajectory/executor.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -32,7 +34,11 @@ namespace serial_robot_driver::ros_layer {
 using trajectory::TrajectoryJoints;
 
 /// The steady time of a ROS `stamp` (zero: `steady_now`), given the two clocks read together.
+/// Computed in integers and doubles, never with ros::Duration, which throws beyond +-68 years:
+/// any stamp gives a finite time, and the executor refuses one too far ahead.
 double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now);
+/// `later` - `earlier` in seconds, for any two stamps (never throws).
+double secondsBetween(const ros::Time& later, const ros::Time& earlier);
 
 /// A ROS-free command from a JointTrajectory message (stamps are left to the caller).
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg);
@@ -72,17 +78,22 @@ class TrajectoryServer {
   void stopAll(const std::string& reason) { executor_.stopAll(reason); }
   /// See TrajectoryExecutor::attachEStop() (before start()).
   void attachEStop(device::EStop& e_stop) { executor_.attachEStop(e_stop); }
+  /// The goals and messages refused for what they ask, and its callbacks' errors, by source.
+  device::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
 
  private:
+  /// onGoal() guarded: an error rejects the goal (or aborts it, once accepted).
+  void onGoalGuarded(GoalHandle handle);
   void onGoal(GoalHandle handle);
   void onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg);
   /// The steady start of a message stamped `stamp`; nothing: at once.
   std::optional<double> startOf(const ros::Time& stamp) const;
 
+  device::InputRefusals input_refusals_;  // before the callbacks that count into it
   trajectory::TrajectoryExecutor executor_;
   const double loop_period_;
   ros::NodeHandle nh_;
-  actionlib::ActionServer<Action> action_server_;
+  GuardedActionServer<Action> action_server_;
   ros::Subscriber trajectory_sub_;
   ros::SteadyTimer timer_;
 };

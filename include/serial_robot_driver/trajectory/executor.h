@@ -115,13 +115,17 @@ class TrajectoryExecutor {
   void updateActual(const std::vector<std::string>& names, const std::vector<double>& positions,
                     const std::vector<double>& velocities);
 
+  /// What became of a goal or message: accepted, or why not (the goal's callbacks say it too).
+  enum class Submission { kAccepted, kNotRunning, kEStopped, kInvalid };
+
   /// A follow_joint_trajectory goal: rejected, or accepted (preempting the goals on its joints)
-  /// and run by tick(); an empty trajectory holds its joints and succeeds at once.
-  void submitGoal(const Goal& goal, GoalCallbacks callbacks);
+  /// and run by tick(); an empty trajectory holds its joints and succeeds at once. A start further
+  /// ahead than max_start_delay is invalid; a start in the past is effectiveStart()'s.
+  Submission submitGoal(const Goal& goal, GoalCallbacks callbacks);
   /// Cancels the running goal `id` (holding its joints); nothing when it is over.
   void cancelGoal(const std::string& id);
   /// A joint_trajectory message: as a goal nobody follows; one that fails its check is ignored.
-  void submitTrajectory(const TrajectoryCommand& command, std::optional<double> start_time);
+  Submission submitTrajectory(const TrajectoryCommand& command, std::optional<double> start_time);
 
   /// Another command (`source`, e.g. "joint_commands") for `names`: runs `write` under the lock
   /// and, when it wrote (returns true), stops the trajectories of those joints and aborts the
@@ -174,6 +178,10 @@ class TrajectoryExecutor {
   /// Checks `command` (starting at `start`, now `now`) against the joints and where they are;
   /// the indices of its joints in `check`. mutex_ held (so are all below).
   CommandCheck check(const TrajectoryCommand& command, double start, double now);
+  /// The start on which `command`, stamped `start_time` (nothing: now), runs: effectiveStart();
+  /// nothing, with `refusal` set, when it is further ahead than max_start_delay (or not a time).
+  std::optional<double> startOf(const TrajectoryCommand& command, std::optional<double> start_time,
+                                double now, CommandCheck* refusal) const;
   /// Ends the goals that drive any of `joints` with `status`, `code` and `message`.
   void endGoalsOn(const std::vector<std::size_t>& joints, GoalStatus status, int code,
                   const std::string& message);

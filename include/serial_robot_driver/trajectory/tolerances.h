@@ -17,6 +17,9 @@ struct GoalDefaults {
   double goal_time_tolerance = 0.5;  ///< s after the last point's time to get within goal_tolerance
   double path_tolerance = 0.0;       ///< rad; 0: not checked
   double max_velocity = 0.0;         ///< rad/s per joint; faster is refused; 0: no limit
+  /// s; a command whose start (header.stamp) is further ahead of now than this is refused, so a
+  /// stamp in the far future cannot pin the joints until then. > 0.
+  double max_start_delay = 10.0;
 };
 
 /// How far a joint may be from its set-point; 0: not checked. Acceleration is never checked: the

@@ -11,6 +11,7 @@
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/devices/base/base_status.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -106,19 +107,20 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
   link.addListener(&controller_);
 
   // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.
-  cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &BaseInterface::onCmdVel, this,
-                              ros::TransportHints().tcpNoDelay());
-  reset_srv_ = nh.advertiseService("base/reset", &BaseInterface::onReset, this);
-  reset_odometry_srv_ =
-      nh.advertiseService("base/reset_odometry", &BaseInterface::onResetOdometry, this);
-  clear_encoders_srv_ =
-      nh.advertiseService("base/clear_encoders", &BaseInterface::onClearEncoders, this);
+  cmd_vel_sub_ = subscribeGuarded(nh, inputRefusals(), "cmd_vel", 10, &BaseInterface::onCmdVel,
+                                  this, ros::TransportHints().tcpNoDelay());
+  reset_srv_ = advertiseGuarded(nh, inputRefusals(), "base/reset", &BaseInterface::onReset, this);
+  reset_odometry_srv_ = advertiseGuarded(nh, inputRefusals(), "base/reset_odometry",
+                                         &BaseInterface::onResetOdometry, this);
+  clear_encoders_srv_ = advertiseGuarded(nh, inputRefusals(), "base/clear_encoders",
+                                         &BaseInterface::onClearEncoders, this);
 }
 
 void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {
   // Counted with the other refused commands; the controller ignores it (and counts it) itself.
   if (e_stop_) e_stop_->refuse("cmd_vel");
   if (!controller_.setCommand(msg->linear.x, msg->angular.z)) {
+    inputRefusals().refused("cmd_vel");
     ROS_WARN_THROTTLE(
         1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
         msg->linear.x, msg->angular.z);

@@ -7,6 +7,7 @@
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 #include "serial_robot_driver/trajectory/joint_groups.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -43,12 +44,13 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   telemetry_pub_ =
       nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
   // tcpNoDelay: a joint command must not wait in Nagle's buffer.
-  joint_commands_sub_ = nh.subscribe("joint_commands", 10, &BodyInterface::onJointCommand, this,
-                                     ros::TransportHints().tcpNoDelay());
+  joint_commands_sub_ =
+      subscribeGuarded(nh, inputRefusals(), "joint_commands", 10, &BodyInterface::onJointCommand,
+                       this, ros::TransportHints().tcpNoDelay());
   link.addListener(&controller_);
   calibration_nh_.setCallbackQueue(&calibration_queue_);
-  calibrate_srv_ =
-      calibration_nh_.advertiseService("imu/calibrate", &BodyInterface::onCalibrate, this);
+  calibrate_srv_ = advertiseGuarded(calibration_nh_, inputRefusals(), "imu/calibrate",
+                                    &BodyInterface::onCalibrate, this);
   if (params.imu.calibrate_on_start) {
     gyro_calibrator_.calibrateOnStart([](const device::GyroCalibrationOutcome& outcome) {
       if (outcome.success) {
@@ -165,6 +167,7 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   } else {
     send();
   }
+  if (!result.ok()) inputRefusals().refused("joint_commands");
   if (!result.ok() || !result.out_of_range.empty()) {
     ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
   }

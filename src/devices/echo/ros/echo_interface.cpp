@@ -5,6 +5,7 @@
 #include "serial_robot_driver/devices/echo/echo_params.h"
 #include "serial_robot_driver/devices/echo/echo_status.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -15,7 +16,7 @@ EchoInterface::EchoInterface(ros::NodeHandle& nh, const DriverParams& params,
           link.writer(),
           std::chrono::milliseconds(
               params.sections.get<serial_robot_driver::params::EchoParams>("echo").timeout_ms)) {
-  ping_srv_ = nh.advertiseService("echo/ping", &EchoInterface::onPing, this);
+  ping_srv_ = advertiseGuarded(nh, inputRefusals(), "echo/ping", &EchoInterface::onPing, this);
   link.addListener(&controller_);
 }
 

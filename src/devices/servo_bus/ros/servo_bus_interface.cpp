@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -123,8 +124,9 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
   }
 
   states_pub_ = topics_nh_.advertise<sensor_msgs::JointState>("servo_states", 10);
-  commands_sub_ = topics_nh_.subscribe("servo_commands", 10, &ServoBusInterface::onServoCommands,
-                                       this, ros::TransportHints().tcpNoDelay());
+  commands_sub_ = subscribeGuarded(topics_nh_, inputRefusals(), "servo_commands", 10,
+                                   &ServoBusInterface::onServoCommands, this,
+                                   ros::TransportHints().tcpNoDelay());
 }
 
 void ServoBusInterface::retune(const DriverParams& params) {
@@ -146,6 +148,7 @@ void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr&
   const ServoCommandBatch batch = toServoMoves(*msg, command_interval_ms_.load());
   if (!batch.error.empty()) {
     commands_rejected_.fetch_add(1);
+    inputRefusals().refused("servo_commands");
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands rejected, nothing sent: the message %s",
                       batch.error.c_str());
     return;

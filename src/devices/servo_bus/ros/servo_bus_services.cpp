@@ -1,11 +1,11 @@
 // The servo/* services: each one a client or bus call behind the same outcome handling (logged,
 // never thrown through, the message always returned). Served from ServoBusInterface's own queue.
-#include <exception>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
+#include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -44,41 +44,53 @@ template <typename Service>
 using ServoCall =
     std::function<device::ServoStatus(typename Service::Request&, typename Service::Response&)>;
 
+/// A request the service refused for what it asks (not for what the bus or the servo did).
+bool refusedRequest(device::ServoError error) {
+  using device::ServoError;
+  return error == ServoError::kInvalidArgument || error == ServoError::kUnknownParam ||
+         error == ServoError::kReadOnly || error == ServoError::kOutOfRange ||
+         error == ServoError::kDangerous;
+}
+
+/// The node handle the servo/* services are advertised on, and where their refusals are counted.
+struct ServoServiceSite {
+  ros::NodeHandle& nh;
+  device::InputRefusals& refusals;
+};
+
 /// Advertises one servo/* service from its call. The service logs the outcome, never throws
-/// through to its caller and always returns true, so the caller gets the message instead of a bare
-/// "service call failed".
+/// through to its caller (guardedService) and always returns true, so the caller gets the message
+/// instead of a bare "service call failed".
 template <typename Service>
-ros::ServiceServer advertiseServo(ros::NodeHandle& nh, const std::string& name,
+ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name,
                                   ServoCall<Service> call, Announce announce = Announce::kDebug) {
   using Request = typename Service::Request;
   using Response = typename Service::Response;
-  const boost::function<bool(Request&, Response&)> serve = [name, call, announce](Request& req,
-                                                                                  Response& res) {
-    try {
-      const device::ServoStatus status = call(req, res);
-      logOutcome(name, status);
-      if (status.ok() && announce == Announce::kInfo) {
-        ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
-      }
-      setOutcome(res, status.ok(), servoStatusMessage(status));
-    } catch (const std::exception& error) {
-      ROS_ERROR("%s: internal error: %s", name.c_str(), error.what());
-      res = Response();
-      setOutcome(res, false, std::string("internal error: ") + error.what());
+  device::InputRefusals& refusals = site.refusals;
+  const boost::function<bool(Request&, Response&)> serve = [name, call, announce, &refusals](
+                                                               Request& req, Response& res) {
+    const device::ServoStatus status = call(req, res);
+    logOutcome(name, status);
+    if (refusedRequest(status.error)) refusals.refused(name);
+    if (status.ok() && announce == Announce::kInfo) {
+      ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
     }
+    setOutcome(res, status.ok(), servoStatusMessage(status));
     return true;
   };
-  return nh.advertiseService<Request, Response>(name, serve);
+  return site.nh.advertiseService<Request, Response>(
+      name, guardedService<Request, Response>(refusals, name, serve));
 }
 
 }  // namespace
 
 void ServoBusInterface::advertiseServices() {
+  const ServoServiceSite site{nh_, inputRefusals()};
   services_ = {
       advertiseServo<ServoPing>(
-          nh_, "servo/ping",
+          site, "servo/ping",
           [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }),
-      advertiseServo<ServoRead>(nh_, "servo/read",
+      advertiseServo<ServoRead>(site, "servo/read",
                                 [this](ServoRead::Request& req, ServoRead::Response& res) {
                                   device::ServoParamValue value;
                                   const device::ServoStatus status =
@@ -90,13 +102,13 @@ void ServoBusInterface::advertiseServices() {
                                   return status;
                                 }),
       advertiseServo<ServoWrite>(
-          nh_, "servo/write",
+          site, "servo/write",
           [this](ServoWrite::Request& req, ServoWrite::Response&) {
             return bus_.writeParam(req.id, req.param, req.value);
           },
           Announce::kInfo),
       advertiseServo<ServoReadAngle>(
-          nh_, "servo/read_angle",
+          site, "servo/read_angle",
           [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
             res.angle_deg = 0.0;
             res.turns = 0;
@@ -114,7 +126,7 @@ void ServoBusInterface::advertiseServices() {
             if (status.ok()) res.angle_deg = angle_deg;
             return status;
           }),
-      advertiseServo<ServoMove>(nh_, "servo/move",
+      advertiseServo<ServoMove>(site, "servo/move",
                                 [this](ServoMove::Request& req, ServoMove::Response&) {
                                   device::MoveRequest request;
                                   request.id = req.id;
@@ -130,11 +142,11 @@ void ServoBusInterface::advertiseServices() {
                                   if (!claimed.ok()) return claimed;
                                   return bus_.move(request);
                                 }),
-      advertiseServo<ServoScan>(nh_, "servo/scan",
+      advertiseServo<ServoScan>(site, "servo/scan",
                                 [this](ServoScan::Request& req, ServoScan::Response& res) {
                                   return client_.scan(req.first_id, req.last_id, &res.ids);
                                 }),
-      advertiseServo<ServoRotate>(nh_, "servo/rotate",
+      advertiseServo<ServoRotate>(site, "servo/rotate",
                                   [this](ServoRotate::Request& req, ServoRotate::Response&) {
                                     device::RotateRequest request;
                                     request.id = req.id;
@@ -147,7 +159,7 @@ void ServoBusInterface::advertiseServices() {
                                     if (!claimed.ok()) return claimed;
                                     return bus_.rotate(request);
                                   }),
-      advertiseServo<ServoSpin>(nh_, "servo/spin",
+      advertiseServo<ServoSpin>(site, "servo/spin",
                                 [this](ServoSpin::Request& req, ServoSpin::Response&) {
                                   device::SpinRequest request;
                                   request.id = req.id;
@@ -165,24 +177,24 @@ void ServoBusInterface::advertiseServices() {
                                   return bus_.spin(request);
                                 }),
       // Torque off moves nothing actively: allowed while the e-stop holds (motion_safety.h).
-      advertiseServo<ServoDamping>(nh_, "servo/damping",
+      advertiseServo<ServoDamping>(site, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
                                      yieldJoint(req.id, "servo/damping");
                                      return bus_.damping(req.id, req.power_mw, req.wait);
                                    }),
-      advertiseServo<ServoRelax>(nh_, "servo/relax",
+      advertiseServo<ServoRelax>(site, "servo/relax",
                                  [this](ServoRelax::Request& req, ServoRelax::Response&) {
                                    yieldJoints(req.ids, "servo/relax");
                                    return bus_.relax(req.ids);
                                  }),
-      advertiseServo<ServoHold>(nh_, "servo/hold",
+      advertiseServo<ServoHold>(site, "servo/hold",
                                 [this](ServoHold::Request& req, ServoHold::Response&) {
                                   const device::ServoStatus claimed =
                                       claimServos(req.ids, "servo/hold");
                                   if (!claimed.ok()) return claimed;
                                   return bus_.hold(req.ids);
                                 }),
-      advertiseServo<ServoReadAll>(nh_, "servo/read_all",
+      advertiseServo<ServoReadAll>(site, "servo/read_all",
                                    [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
                                      std::vector<device::ServoParamValue> values;
                                      const device::ServoStatus status =
@@ -196,7 +208,7 @@ void ServoBusInterface::advertiseServices() {
                                      return status;
                                    }),
       // Reads only: allowed while the e-stop holds.
-      advertiseServo<ServoInfo>(nh_, "servo/info",
+      advertiseServo<ServoInfo>(site, "servo/info",
                                 [this](ServoInfo::Request& req, ServoInfo::Response& res) {
                                   device::ServoIdentity identity;
                                   const device::ServoStatus status = device::readServoInfo(
@@ -208,7 +220,7 @@ void ServoBusInterface::advertiseServices() {
                                   return status;
                                 }),
       advertiseServo<ServoResetUserData>(
-          nh_, "servo/reset_user_data",
+          site, "servo/reset_user_data",
           [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
             return bus_.resetUserData(req.id);
           },
