@@ -143,7 +143,7 @@ void ServoTransactions::waitForAnswer(std::unique_lock<std::mutex>& lock,
                                       Clock::time_point deadline) {
   const auto settled = [this] {
     return pending_.answered || pending_.garbled || link_lost_ || stopping_ ||
-           (motion_wait_ && urgent_);
+           motionWaitCutLocked();
   };
   if (!pump_.pump || !pump_.on_reader_thread()) {
     answer_cv_.wait_until(lock, deadline, settled);
@@ -190,13 +190,14 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
   bool any_garbled = false;
   std::size_t garbled_size = 0;
   for (int attempt = 1; attempt <= attempts; ++attempt) {
-    // A stop asked during the last attempt goes out before this one: the worker that writes it
-    // ends here, a caller hands the bus over and goes on after it.
-    if (attempt > 1 && give_way && bus_mutex_.urgentRequested()) {
+    // A stop asked during the last attempt, or the last transaction of a holder that keeps the
+    // bus for several (a write and its read-back), goes out before this one: the worker that
+    // writes it ends here, a caller hands the bus over and goes on after it.
+    if (give_way && bus_mutex_.urgentRequested()) {
       return fail(ServoError::kPreempted,
                   servoName(expect.id) + "'s " + commandName(expect.cmd) + " gave way to a stop");
     }
-    if (attempt > 1) bus_mutex_.yieldToUrgent();
+    bus_mutex_.yieldToUrgent();
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
       if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
@@ -224,7 +225,7 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
     waitForAnswer(lock, sent_at + timeout);
     pending_.active = false;
     if (arrival != nullptr) *arrival = pending_.arrival;
-    const bool cut_short = motion_wait_ && urgent_ && !pending_.answered;
+    const bool cut_short = motionWaitCutLocked() && !pending_.answered;
     motion_wait_ = false;
 
     if (pending_.answered) {
@@ -282,10 +283,35 @@ ServoStatus ServoTransactions::exchangeLocked(const std::vector<uint8_t>& reques
   return transact(request, expect, options.timeout, options.retries + 1, answer);
 }
 
+bool ServoTransactions::motionWaitCutLocked() const {
+  return motion_wait_ &&
+         (urgent_ || stops_waiting_ > 0 || (stop_calls_queued_ && stop_calls_queued_()));
+}
+
+void ServoTransactions::lockUrgent() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    ++stops_waiting_;
+  }
+  answer_cv_.notify_all();  // a motion wait gives way
+  bus_mutex_.lockUrgent();
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  --stops_waiting_;
+}
+
+void ServoTransactions::stopCallQueued() {
+  // Taken and released after the queue changed: a wait that saw no call queued sleeps already.
+  { std::lock_guard<std::mutex> lock(state_mutex_); }
+  answer_cv_.notify_all();
+}
+
 bool ServoTransactions::takeBus(BusPriority priority) {
   switch (priority) {
     case BusPriority::kCaller:
       bus_mutex_.lock();
+      return true;
+    case BusPriority::kStop:
+      lockUrgent();
       return true;
     case BusPriority::kWorker:
       return bus_mutex_.lockUnlessUrgent();
@@ -319,7 +345,7 @@ ServoStatus ServoTransactions::sendCommand(const std::vector<uint8_t>& request, 
 
 void ServoTransactions::writeStops(const std::vector<uint8_t>& ids, std::vector<bool>* written) {
   written->assign(ids.size(), false);
-  bus_mutex_.lockUrgent();
+  lockUrgent();
   std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const std::vector<uint8_t> frame =

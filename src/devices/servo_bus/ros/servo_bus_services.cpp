@@ -1,5 +1,7 @@
 // The servo/* services: each one a client or bus call behind the same outcome handling (logged,
-// never thrown through, the message always returned). Served from ServoBusInterface's own queue.
+// never thrown through, the message always returned). Served from ServoBusInterface's own queues:
+// the stop services (servo/spin, servo/relax, servo/damping, servo/hold) from the stop queue
+// (stop_nh_), whose bus turns are urgent work, every other from the second one (nh_).
 #include <exception>
 #include <functional>
 #include <string>
@@ -147,7 +149,7 @@ void ServoBusInterface::advertiseServices() {
                                     if (!claimed.ok()) return claimed;
                                     return bus_.rotate(request);
                                   }),
-      advertiseServo<ServoSpin>(nh_, "servo/spin",
+      advertiseServo<ServoSpin>(stop_nh_, "servo/spin",
                                 [this](ServoSpin::Request& req, ServoSpin::Response&) {
                                   device::SpinRequest request;
                                   request.id = req.id;
@@ -156,6 +158,8 @@ void ServoBusInterface::advertiseServices() {
                                   request.speed_dps = req.speed_dps;
                                   request.value = req.value;
                                   request.wait = req.wait;
+                                  // Served with the stops: it must never wait behind a long call.
+                                  request.priority = device::BusPriority::kStop;
                                   // A SPIN stop is no motion: it works while the e-stop holds.
                                   if (req.mode != 0) {
                                     device::ServoStatus refused = refuseWhileEStopped("servo/spin");
@@ -164,21 +168,21 @@ void ServoBusInterface::advertiseServices() {
                                   yieldJoint(req.id, "servo/spin");
                                   return bus_.spin(request);
                                 }),
-      advertiseServo<ServoDamping>(nh_, "servo/damping",
+      advertiseServo<ServoDamping>(stop_nh_, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
                                      const device::ServoStatus claimed =
                                          claimServos({req.id}, "servo/damping");
                                      if (!claimed.ok()) return claimed;
                                      return bus_.damping(req.id, req.power_mw, req.wait);
                                    }),
-      advertiseServo<ServoRelax>(nh_, "servo/relax",
+      advertiseServo<ServoRelax>(stop_nh_, "servo/relax",
                                  [this](ServoRelax::Request& req, ServoRelax::Response&) {
                                    const device::ServoStatus claimed =
                                        claimServos(req.ids, "servo/relax");
                                    if (!claimed.ok()) return claimed;
                                    return bus_.relax(req.ids);
                                  }),
-      advertiseServo<ServoHold>(nh_, "servo/hold",
+      advertiseServo<ServoHold>(stop_nh_, "servo/hold",
                                 [this](ServoHold::Request& req, ServoHold::Response&) {
                                   const device::ServoStatus claimed =
                                       claimServos(req.ids, "servo/hold");
