@@ -205,6 +205,18 @@ ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
   return readParamLocked(id, *param, value);
 }
 
+ServoStatus ServoBusClient::checkIdFreeLocked(uint8_t id, uint8_t new_id) {
+  // Two servos with one id can no longer be told apart: make sure the new id is free.
+  const ServoStatus probe = pingLocked(new_id);
+  if (probe.ok()) {
+    return fail(ServoError::kIdInUse, "servo_id change of " + servoName(id) +
+                                          " refused: a servo already answers at id " +
+                                          std::to_string(new_id));
+  }
+  if (probe.error != ServoError::kTimeout) return probe;
+  return ok("");
+}
+
 ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, int64_t value) {
   const ParamInfo* param = servo::findParam(param_name);
   if (param == nullptr) {
@@ -223,14 +235,8 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
   const bool id_change = param->data_id == kServoIdParam && value != id;
   const uint8_t new_id = static_cast<uint8_t>(value);
   if (id_change) {
-    // Two servos with one id can no longer be told apart: make sure the new id is free.
-    const ServoStatus probe = pingLocked(new_id);
-    if (probe.ok()) {
-      return fail(ServoError::kIdInUse, "servo_id change of " + servoName(id) +
-                                            " refused: a servo already answers at id " +
-                                            std::to_string(new_id));
-    }
-    if (probe.error != ServoError::kTimeout) return probe;
+    const ServoStatus free = checkIdFreeLocked(id, new_id);
+    if (!free.ok()) return free;
   }
 
   Expectation expect(Command::kWriteData, id);

@@ -190,23 +190,15 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
   bool any_garbled = false;
   std::size_t garbled_size = 0;
   for (int attempt = 1; attempt <= attempts; ++attempt) {
-    // A stop asked during the last attempt, or the last transaction of a holder that keeps the
-    // bus for several (a write and its read-back), goes out before this one: the worker that
-    // writes it ends here, a caller hands the bus over and goes on after it.
+    // A stop asked during the last attempt or transaction (a holder may keep the bus for several)
+    // goes first: the worker that writes it ends here, a caller hands the bus over meanwhile.
     if (give_way && bus_mutex_.urgentRequested()) {
       return fail(ServoError::kPreempted,
                   servoName(expect.id) + "'s " + commandName(expect.cmd) + " gave way to a stop");
     }
     bus_mutex_.yieldToUrgent();
-    {
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
-      pending_ = Pending{};
-      pending_.active = true;
-      pending_.expect = expect;
-      last_request_ = request;
-      link_lost_ = false;
-      motion_wait_ = gate == FrameGate::kMotion;
+    if (!beginAttempt(request, expect, gate)) {
+      return fail(ServoError::kShutdown, "servo bus client is shutting down");
     }
     const Clock::time_point sent_at = Clock::now();
     if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate)) {
@@ -228,13 +220,7 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
     const bool cut_short = motionWaitCutLocked() && !pending_.answered;
     motion_wait_ = false;
 
-    if (pending_.answered) {
-      const double latency_ms = toMs(pending_.arrival - sent_at);
-      stats_.last_latency_ms = latency_ms;
-      stats_.max_latency_ms = std::max(stats_.max_latency_ms, latency_ms);
-      *answer = pending_.answer;
-      return ok("answered in " + formatMs(latency_ms));
-    }
+    if (pending_.answered) return answeredLocked(sent_at, answer);
     if (link_lost_) {
       return fail(ServoError::kNotConnected, "servo bus port was lost while waiting for " +
                                                  servoName(expect.id) + "'s " +
@@ -252,12 +238,40 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
     }
   }
 
-  if (any_garbled) {
-    return fail(ServoError::kBadAnswer,
-                servoName(expect.id) + " sent a malformed " + commandName(expect.cmd) +
-                    " answer (" + std::to_string(garbled_size) + " content bytes, expected " +
-                    std::to_string(expect.content_size) + ")");
-  }
+  if (any_garbled) return malformed(expect, garbled_size);
+  return timedOut(expect, timeout, attempts);
+}
+
+ServoStatus ServoTransactions::answeredLocked(Clock::time_point sent_at, servo::Packet* answer) {
+  const double latency_ms = toMs(pending_.arrival - sent_at);
+  stats_.last_latency_ms = latency_ms;
+  stats_.max_latency_ms = std::max(stats_.max_latency_ms, latency_ms);
+  *answer = pending_.answer;
+  return ok("answered in " + formatMs(latency_ms));
+}
+
+ServoStatus ServoTransactions::malformed(const Expectation& expect, std::size_t garbled_size) {
+  return fail(ServoError::kBadAnswer,
+              servoName(expect.id) + " sent a malformed " + commandName(expect.cmd) + " answer (" +
+                  std::to_string(garbled_size) + " content bytes, expected " +
+                  std::to_string(expect.content_size) + ")");
+}
+
+bool ServoTransactions::beginAttempt(const std::vector<uint8_t>& request, const Expectation& expect,
+                                     FrameGate gate) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (stopping_) return false;
+  pending_ = Pending{};
+  pending_.active = true;
+  pending_.expect = expect;
+  last_request_ = request;
+  link_lost_ = false;
+  motion_wait_ = gate == FrameGate::kMotion;
+  return true;
+}
+
+ServoStatus ServoTransactions::timedOut(const Expectation& expect,
+                                        std::chrono::milliseconds timeout, int attempts) {
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.timeouts;

@@ -168,6 +168,8 @@ class ServoBusClient : public LinkListener {
   ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
                               ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);
+  /// Before servo `id` moves to `new_id`: ok when nothing answers at `new_id`.
+  ServoStatus checkIdFreeLocked(uint8_t id, uint8_t new_id);
   /// One PING attempt, no retries (scan, and the check after a silent reset).
   ServoStatus pingOnceLocked(uint8_t id);
 

@@ -196,6 +196,14 @@ class ServoTransactions : public LinkListener {
   std::optional<ServoStatus> writeRequest(const std::vector<uint8_t>& request,
                                           protocol::servo::Command cmd, uint8_t id, FrameGate gate);
   bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
+  /// Sets up the pending transaction of one attempt; false when shutting down.
+  bool beginAttempt(const std::vector<uint8_t>& request, const Expectation& expect, FrameGate gate);
+  /// The pending transaction's answer, its latency counted (state_mutex_ held).
+  ServoStatus answeredLocked(Clock::time_point sent_at, protocol::servo::Packet* answer);
+  /// kBadAnswer: only malformed answers (the last one `garbled_size` content bytes).
+  static ServoStatus malformed(const Expectation& expect, std::size_t garbled_size);
+  /// kTimeout after `attempts` unanswered attempts, counted.
+  ServoStatus timedOut(const Expectation& expect, std::chrono::milliseconds timeout, int attempts);
   /// Whether a motion wait in progress gives way to a stop (state_mutex_ held).
   bool motionWaitCutLocked() const;
   /// BusMutex::lockUrgent, a motion wait cut short meanwhile.
