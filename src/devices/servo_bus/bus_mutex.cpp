@@ -34,14 +34,16 @@ void BusMutex::waitTurn(std::unique_lock<std::mutex>& lock, Predicate free) {
 void BusMutex::lock() {
   std::unique_lock<std::mutex> lock(mutex_);
   ++waiting_;
-  waitTurn(lock, [this] { return !held_ && !urgent_ && yielded_ == 0; });
+  waitTurn(lock, [this] { return !held_ && !urgentAhead() && yielded_ == 0; });
   --waiting_;
   held_ = true;
 }
 
 bool BusMutex::lockBackground() {
   std::unique_lock<std::mutex> lock(mutex_);
-  waitTurn(lock, [this] { return urgent_ || (!held_ && waiting_ == 0 && yielded_ == 0); });
+  waitTurn(lock, [this] {
+    return urgent_ || (!held_ && waiting_ == 0 && yielded_ == 0 && urgent_waiting_ == 0);
+  });
   if (urgent_) return false;  // a stop is coming: the poll gives way and is due again at once
   held_ = true;
   return true;
@@ -50,7 +52,7 @@ bool BusMutex::lockBackground() {
 bool BusMutex::lockUnlessUrgent() {
   std::unique_lock<std::mutex> lock(mutex_);
   ++waiting_;
-  waitTurn(lock, [this] { return urgent_ || (!held_ && yielded_ == 0); });
+  waitTurn(lock, [this] { return urgent_ || (!held_ && yielded_ == 0 && urgent_waiting_ == 0); });
   --waiting_;
   if (urgent_) return false;
   held_ = true;
@@ -59,7 +61,9 @@ bool BusMutex::lockUnlessUrgent() {
 
 void BusMutex::lockUrgent() {
   std::unique_lock<std::mutex> lock(mutex_);
+  ++urgent_waiting_;
   waitTurn(lock, [this] { return !held_; });
+  --urgent_waiting_;
   held_ = true;
 }
 
@@ -82,11 +86,11 @@ bool BusMutex::urgentRequested() {
 
 void BusMutex::yieldToUrgent() {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (!urgent_) return;
+  if (!urgentAhead()) return;
   held_ = false;
   ++yielded_;
   wakeWaiters(lock);
-  waitTurn(lock, [this] { return !held_ && !urgent_; });
+  waitTurn(lock, [this] { return !held_ && !urgentAhead(); });
   --yielded_;
   held_ = true;
 }
@@ -94,6 +98,11 @@ void BusMutex::yieldToUrgent() {
 int BusMutex::foregroundWaiting() {
   std::lock_guard<std::mutex> lock(mutex_);
   return waiting_;
+}
+
+int BusMutex::urgentWaiting() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return urgent_waiting_;
 }
 
 void BusMutex::unlock() {

@@ -199,11 +199,13 @@ ServoStatus MotionSafety::hold(const std::vector<uint8_t>& ids) {
     if (!status.ok()) return status;
     if (!accepted) accepted = generation;
     double angle_deg = 0.0;
-    status = client_.readAngle(id, &angle_deg);
+    // A hold is a stop: its bus turns are urgent work (BusPriority::kStop).
+    status = client_.readAngle(id, &angle_deg, nullptr, BusPriority::kStop);
     if (!status.ok()) return status;
     RotateRequest request;
     request.id = id;
     request.angle_deg = angle_deg;
+    request.priority = BusPriority::kStop;
     status = client_.rotate(request, accepted);
     if (!status.ok()) return status;
     noteMotion(id, false);  // holding where it is: not set moving

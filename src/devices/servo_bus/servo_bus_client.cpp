@@ -51,6 +51,11 @@ ServoParamValue toParamValue(const ParamInfo& param, int64_t raw) {
   return ServoParamValue{std::string(param.name), param.data_id, raw, std::string(param.unit)};
 }
 
+ServoStatus gaveWayToAStop(Command cmd, uint8_t id) {
+  return fail(ServoError::kPreempted,
+              std::string(commandName(cmd)) + " to " + servoName(id) + " gave way to a stop");
+}
+
 std::string valueText(const ServoParamValue& value) {
   std::string text = std::to_string(value.value);
   if (!value.unit.empty()) text += " " + value.unit;
@@ -200,6 +205,18 @@ ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
   return readParamLocked(id, *param, value);
 }
 
+ServoStatus ServoBusClient::checkIdFreeLocked(uint8_t id, uint8_t new_id) {
+  // Two servos with one id can no longer be told apart: make sure the new id is free.
+  const ServoStatus probe = pingLocked(new_id);
+  if (probe.ok()) {
+    return fail(ServoError::kIdInUse, "servo_id change of " + servoName(id) +
+                                          " refused: a servo already answers at id " +
+                                          std::to_string(new_id));
+  }
+  if (probe.error != ServoError::kTimeout) return probe;
+  return ok("");
+}
+
 ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, int64_t value) {
   const ParamInfo* param = servo::findParam(param_name);
   if (param == nullptr) {
@@ -212,18 +229,14 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
       servo::checkWrite(*param, value, transactions_.options().allow_dangerous_writes);
   if (check != servo::WriteCheck::kOk) return fromWriteCheck(check, *param, value);
 
+  // One lock for the probe, the write and the read-back: no other call comes between them, but
+  // each transaction hands the bus to a stop first (transact), so a stop waits for one attempt.
   std::lock_guard<BusMutex> bus(transactions_.busMutex());
   const bool id_change = param->data_id == kServoIdParam && value != id;
   const uint8_t new_id = static_cast<uint8_t>(value);
   if (id_change) {
-    // Two servos with one id can no longer be told apart: make sure the new id is free.
-    const ServoStatus probe = pingLocked(new_id);
-    if (probe.ok()) {
-      return fail(ServoError::kIdInUse, "servo_id change of " + servoName(id) +
-                                            " refused: a servo already answers at id " +
-                                            std::to_string(new_id));
-    }
-    if (probe.error != ServoError::kTimeout) return probe;
+    const ServoStatus free = checkIdFreeLocked(id, new_id);
+    if (!free.ok()) return free;
   }
 
   Expectation expect(Command::kWriteData, id);
@@ -292,6 +305,7 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
   }
   Expectation expect(Command::kResetUserData, id);
   expect.alt_id = kDefaultServoId;  // the reset moves the servo to id 0 and it may answer there
+  // One lock for every attempt and PING: a stop still goes first after the one in flight.
   std::lock_guard<BusMutex> bus(transactions_.busMutex());
   ServoStatus last;
   const ServoBusOptions options = transactions_.options();  // the same for every attempt
@@ -332,10 +346,7 @@ ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priorit
   const ServoStatus checked = toMoveCommand(request, &command);
   if (!checked.ok()) return checked;
   const std::vector<uint8_t> frame = servo::encodeMove(command);
-  if (!transactions_.takeBus(priority)) {
-    return fail(ServoError::kPreempted, std::string(commandName(command.cmd)) + " to " +
-                                            servoName(request.id) + " gave way to a stop");
-  }
+  if (!transactions_.takeBus(priority)) return gaveWayToAStop(command.cmd, request.id);
   std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
   return transactions_.sendCommand(frame, command.cmd, request.id, FrameGate::kMotion, accepted);
 }
@@ -358,9 +369,9 @@ ServoStatus ServoBusClient::rotate(const RotateRequest& request,
   }
   const std::vector<uint8_t> frame = servo::encodeRotate(
       request.id, static_cast<int16_t>(decidegrees), request.interval_ms, request.power_mw);
-  std::lock_guard<BusMutex> bus(transactions_.busMutex());
   return sendMotion(frame, Command::kRotate, request.id, request.wait,
-                    std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion, accepted);
+                    std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion,
+                    request.priority, accepted);
 }
 
 ServoStatus ServoBusClient::spin(const SpinRequest& request,
@@ -393,11 +404,11 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request,
   }
   const std::vector<uint8_t> frame =
       servo::encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
-  std::lock_guard<BusMutex> bus(transactions_.busMutex());
-  // A SPIN stop is what the e-stop itself sends: never held back.
-  const FrameGate gate =
-      mode == servo::SpinMode::kStop ? FrameGate::kSafetyAction : FrameGate::kMotion;
-  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time, gate, accepted);
+  // A SPIN stop is what the e-stop itself sends: never held back, and urgent work.
+  const bool stop = mode == servo::SpinMode::kStop;
+  return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time,
+                    stop ? FrameGate::kSafetyAction : FrameGate::kMotion,
+                    stop ? BusPriority::kStop : request.priority, accepted);
 }
 
 ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, FrameGate gate) {
@@ -405,15 +416,17 @@ ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, Fr
     if (auto rejection = rejectBroadcast(id, Command::kDamping)) return *rejection;
   }
   const std::vector<uint8_t> frame = servo::encodeDamping(id, power_mw);
-  std::lock_guard<BusMutex> bus(transactions_.busMutex());
+  // Torque off moves nothing: it goes out as a stop does.
   return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0), gate,
-                    std::nullopt);
+                    BusPriority::kStop, std::nullopt);
 }
 
 ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
                                        bool wait, std::chrono::milliseconds motion_time,
-                                       FrameGate gate,
+                                       FrameGate gate, BusPriority priority,
                                        std::optional<MotionGate::Generation> accepted) {
+  if (!transactions_.takeBus(priority)) return gaveWayToAStop(cmd, id);
+  std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
   if (!wait) return transactions_.sendCommand(request, cmd, id, gate, accepted);
   servo::Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy

@@ -143,7 +143,7 @@ void ServoTransactions::waitForAnswer(std::unique_lock<std::mutex>& lock,
                                       Clock::time_point deadline) {
   const auto settled = [this] {
     return pending_.answered || pending_.garbled || link_lost_ || stopping_ ||
-           (motion_wait_ && urgent_);
+           motionWaitCutLocked();
   };
   if (!pump_.pump || !pump_.on_reader_thread()) {
     answer_cv_.wait_until(lock, deadline, settled);
@@ -191,22 +191,15 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
   bool any_garbled = false;
   std::size_t garbled_size = 0;
   for (int attempt = 1; attempt <= attempts; ++attempt) {
-    // A stop asked during the last attempt goes out before this one: the worker that writes it
-    // ends here, a caller hands the bus over and goes on after it.
-    if (attempt > 1 && give_way && bus_mutex_.urgentRequested()) {
+    // A stop asked during the last attempt or transaction (a holder may keep the bus for several)
+    // goes first: the worker that writes it ends here, a caller hands the bus over meanwhile.
+    if (give_way && bus_mutex_.urgentRequested()) {
       return fail(ServoError::kPreempted,
                   servoName(expect.id) + "'s " + commandName(expect.cmd) + " gave way to a stop");
     }
-    if (attempt > 1) bus_mutex_.yieldToUrgent();
-    {
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
-      pending_ = Pending{};
-      pending_.active = true;
-      pending_.expect = expect;
-      last_request_ = request;
-      link_lost_ = false;
-      motion_wait_ = gate == FrameGate::kMotion;
+    bus_mutex_.yieldToUrgent();
+    if (!beginAttempt(request, expect, gate)) {
+      return fail(ServoError::kShutdown, "servo bus client is shutting down");
     }
     const Clock::time_point sent_at = Clock::now();
     if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate, accepted)) {
@@ -225,16 +218,10 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
     waitForAnswer(lock, sent_at + timeout);
     pending_.active = false;
     if (arrival != nullptr) *arrival = pending_.arrival;
-    const bool cut_short = motion_wait_ && urgent_ && !pending_.answered;
+    const bool cut_short = motionWaitCutLocked() && !pending_.answered;
     motion_wait_ = false;
 
-    if (pending_.answered) {
-      const double latency_ms = toMs(pending_.arrival - sent_at);
-      stats_.last_latency_ms = latency_ms;
-      stats_.max_latency_ms = std::max(stats_.max_latency_ms, latency_ms);
-      *answer = pending_.answer;
-      return ok("answered in " + formatMs(latency_ms));
-    }
+    if (pending_.answered) return answeredLocked(sent_at, answer);
     if (link_lost_) {
       return fail(ServoError::kNotConnected, "servo bus port was lost while waiting for " +
                                                  servoName(expect.id) + "'s " +
@@ -252,12 +239,40 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
     }
   }
 
-  if (any_garbled) {
-    return fail(ServoError::kBadAnswer,
-                servoName(expect.id) + " sent a malformed " + commandName(expect.cmd) +
-                    " answer (" + std::to_string(garbled_size) + " content bytes, expected " +
-                    std::to_string(expect.content_size) + ")");
-  }
+  if (any_garbled) return malformed(expect, garbled_size);
+  return timedOut(expect, timeout, attempts);
+}
+
+ServoStatus ServoTransactions::answeredLocked(Clock::time_point sent_at, servo::Packet* answer) {
+  const double latency_ms = toMs(pending_.arrival - sent_at);
+  stats_.last_latency_ms = latency_ms;
+  stats_.max_latency_ms = std::max(stats_.max_latency_ms, latency_ms);
+  *answer = pending_.answer;
+  return ok("answered in " + formatMs(latency_ms));
+}
+
+ServoStatus ServoTransactions::malformed(const Expectation& expect, std::size_t garbled_size) {
+  return fail(ServoError::kBadAnswer,
+              servoName(expect.id) + " sent a malformed " + commandName(expect.cmd) + " answer (" +
+                  std::to_string(garbled_size) + " content bytes, expected " +
+                  std::to_string(expect.content_size) + ")");
+}
+
+bool ServoTransactions::beginAttempt(const std::vector<uint8_t>& request, const Expectation& expect,
+                                     FrameGate gate) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (stopping_) return false;
+  pending_ = Pending{};
+  pending_.active = true;
+  pending_.expect = expect;
+  last_request_ = request;
+  link_lost_ = false;
+  motion_wait_ = gate == FrameGate::kMotion;
+  return true;
+}
+
+ServoStatus ServoTransactions::timedOut(const Expectation& expect,
+                                        std::chrono::milliseconds timeout, int attempts) {
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     ++stats_.timeouts;
@@ -283,10 +298,35 @@ ServoStatus ServoTransactions::exchangeLocked(const std::vector<uint8_t>& reques
   return transact(request, expect, options.timeout, options.retries + 1, answer);
 }
 
+bool ServoTransactions::motionWaitCutLocked() const {
+  return motion_wait_ &&
+         (urgent_ || stops_waiting_ > 0 || (stop_calls_queued_ && stop_calls_queued_()));
+}
+
+void ServoTransactions::lockUrgent() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    ++stops_waiting_;
+  }
+  answer_cv_.notify_all();  // a motion wait gives way
+  bus_mutex_.lockUrgent();
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  --stops_waiting_;
+}
+
+void ServoTransactions::stopCallQueued() {
+  // Taken and released after the queue changed: a wait that saw no call queued sleeps already.
+  { std::lock_guard<std::mutex> lock(state_mutex_); }
+  answer_cv_.notify_all();
+}
+
 bool ServoTransactions::takeBus(BusPriority priority) {
   switch (priority) {
     case BusPriority::kCaller:
       bus_mutex_.lock();
+      return true;
+    case BusPriority::kStop:
+      lockUrgent();
       return true;
     case BusPriority::kWorker:
       return bus_mutex_.lockUnlessUrgent();
@@ -321,7 +361,7 @@ ServoStatus ServoTransactions::sendCommand(const std::vector<uint8_t>& request, 
 
 void ServoTransactions::writeStops(const std::vector<uint8_t>& ids, std::vector<bool>* written) {
   written->assign(ids.size(), false);
-  bus_mutex_.lockUrgent();
+  lockUrgent();
   std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const std::vector<uint8_t> frame =

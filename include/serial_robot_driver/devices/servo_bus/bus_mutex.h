@@ -3,6 +3,10 @@
 // background work (the polls) only while nobody else waits. ROS-free; ServoTransactions
 // (servo_transactions.h) holds one.
 //
+// A holder may keep the bus across several transactions (a write and its read-back, a reset and
+// the PING after it), but it calls yieldToUrgent() before each transaction attempt
+// (ServoTransactions::transact does), so urgent work waits for the one attempt in flight only.
+//
 // Threading: any thread. With a ReaderPump, a wait on the link's reader thread pumps its port
 // instead of sleeping, so the holder's answer, which only that thread can read, still arrives.
 #pragma once
@@ -16,9 +20,12 @@
 namespace serial_robot_driver::device {
 
 /// Who waits for the bus: a caller (a service) goes before background work (the poll). kWorker
-/// is the bus's own worker, which writes the stops: it waits like a caller, but gives way to urgent
-/// work (kPreempted) instead of waiting for it, before the bus is taken and between attempts.
-enum class BusPriority { kCaller, kWorker, kBackground };
+/// is the bus's own worker, which writes the stops: it waits like a caller, but gives way to the
+/// stops it is asked for (requestUrgent: kPreempted) instead of waiting for them, before the bus
+/// is taken and between attempts. kStop is a stop service's call (a SPIN stop, a DAMPING, a hold):
+/// urgent work like the worker's stops (lockUrgent), after the attempt in flight, before everyone
+/// else.
+enum class BusPriority { kCaller, kWorker, kBackground, kStop };
 
 /// How the link's reader thread waits without sleeping on another thread: it reads its port
 /// (SerialLink::pump) and is woken by wake() when what it waits for may have changed.
@@ -41,17 +48,23 @@ class BusMutex {
   /// A caller that gives way: false, without the bus, when urgent work is asked while it waits.
   bool lockUnlessUrgent();
   /// A stop: waits for the holder only (one transaction attempt at most), never for a queue.
+  /// While it waits, the others wait behind it and the holder hands it the bus before its next
+  /// attempt (yieldToUrgent); it does not make the worker give way (urgentRequested()).
   void lockUrgent();
-  /// Urgent work is coming: from now until endUrgent(), lock() and lockBackground() wait (a
-  /// background wait gives up) and a holder between two attempts hands the bus over.
+  /// The worker's stops are coming: from now until endUrgent(), lock() and lockBackground() wait
+  /// (a background wait, and the worker's, gives up) and a holder before its next attempt hands
+  /// the bus over.
   void requestUrgent();
   void endUrgent();
+  /// Whether the worker's stops are asked (requestUrgent), not a lockUrgent() waiting.
   bool urgentRequested();
-  /// Between two attempts of one transaction: hands the bus to urgent work asked meanwhile and
-  /// takes it back before any other caller.
+  /// Before each transaction attempt of a holder: hands the bus to urgent work asked or waiting
+  /// meanwhile and takes it back before any other caller.
   void yieldToUrgent();
   /// Foreground callers waiting right now (for tests and diagnostics).
   int foregroundWaiting();
+  /// lockUrgent() calls waiting right now (for tests).
+  int urgentWaiting();
   /// Set before any use: the reader thread pumps its port while it waits for the bus.
   void setReaderPump(const ReaderPump* pump) { pump_ = pump; }
 
@@ -60,12 +73,15 @@ class BusMutex {
   template <typename Predicate>
   void waitTurn(std::unique_lock<std::mutex>& lock, Predicate free);
   void wakeWaiters(std::unique_lock<std::mutex>& lock);
+  /// Urgent work asked or waiting (mutex_ held): nobody but it may take the bus.
+  bool urgentAhead() const { return urgent_ || urgent_waiting_ > 0; }
 
   std::mutex mutex_;
   std::condition_variable released_;
   bool held_ = false;
   int waiting_ = 0;              ///< foreground callers waiting for the bus
   bool urgent_ = false;          ///< requestUrgent() .. endUrgent()
+  int urgent_waiting_ = 0;       ///< lockUrgent() calls waiting for the holder
   int yielded_ = 0;              ///< holders that handed the bus to urgent work
   bool reader_waiting_ = false;  ///< the pumping reader thread waits: unlock() wakes it
   const ReaderPump* pump_ = nullptr;

@@ -44,6 +44,8 @@ struct RotateRequest {
   /// Wait for the completion answer (sent only when response_switch = 1) up to
   /// interval_ms + timeout; never re-sent.
   bool wait = false;
+  /// kCaller, or kStop for a stop service (servo/hold): see BusPriority.
+  BusPriority priority = BusPriority::kCaller;
 };
 
 struct SpinRequest {
@@ -55,6 +57,8 @@ struct SpinRequest {
   /// Wait for the completion answer (response_switch = 1) up to the expected duration (mode 2:
   /// value * 360 / speed_dps s, mode 3: value ms, else 0) + timeout; never re-sent.
   bool wait = false;
+  /// kCaller, or kStop (servo/spin, served with the stops). A SPIN stop (mode 0) is always kStop.
+  BusPriority priority = BusPriority::kCaller;
 };
 
 /// A multi-turn angle (CMD 16).
@@ -100,6 +104,8 @@ class ServoBusClient : public LinkListener {
   /// on the bus comes: refused then (kMotionRefused), nothing is written. A SPIN stop, and a
   /// DAMPING with FrameGate::kSafetyAction, always pass; one accepted under an earlier
   /// generation than the gate's (`accepted`) is dropped (MotionGate::writeIfOpen).
+  /// A SPIN stop and every DAMPING (torque off) take the bus at BusPriority::kStop: after the one
+  /// attempt in flight, before every waiting call and poll.
   ServoStatus rotate(const RotateRequest& request,
                      std::optional<MotionGate::Generation> accepted = std::nullopt);
   ServoStatus spin(const SpinRequest& request,
@@ -132,6 +138,14 @@ class ServoBusClient : public LinkListener {
   void retune(const ServoClientTuning& next) { transactions_.retune(next); }
   /// Callers (not background work) waiting for the bus right now (for tests and diagnostics).
   int callersWaiting() { return transactions_.busMutex().foregroundWaiting(); }
+  /// Urgent work (stops, BusPriority::kStop calls) waiting for the bus right now (for tests).
+  int stopsWaiting() { return transactions_.busMutex().urgentWaiting(); }
+  /// Before any call: whether a stop call waits for its thread (see
+  /// ServoTransactions::setStopCallsQueued); stopCallQueued() when one was queued.
+  void setStopCallsQueued(std::function<bool()> queued) {
+    transactions_.setStopCallsQueued(std::move(queued));
+  }
+  void stopCallQueued() { transactions_.stopCallQueued(); }
   /// Before any call: waits on the pump's reader thread read the port (see servo_transactions.h).
   void setReaderPump(ReaderPump pump) { transactions_.setReaderPump(std::move(pump)); }
   /// Before any call: the gate every motion frame passes when it is written (nullptr: none), and
@@ -150,14 +164,19 @@ class ServoBusClient : public LinkListener {
  private:
   using Expectation = ServoTransactions::Expectation;
 
-  // The helpers below expect the bus to be held by the caller.
-  /// The shared tail of ROTATE/SPIN/DAMPING: send, or transact and check the result byte.
+  /// The shared tail of ROTATE/SPIN/DAMPING: takes the bus at `priority` (kCaller or kStop),
+  /// then sends, or transacts and checks the result byte.
   ServoStatus sendMotion(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
                          uint8_t id, bool wait, std::chrono::milliseconds motion_time,
-                         FrameGate gate, std::optional<MotionGate::Generation> accepted);
+                         FrameGate gate, BusPriority priority,
+                         std::optional<MotionGate::Generation> accepted);
+
+  // The helpers below expect the bus to be held by the caller.
   ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
                               ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);
+  /// Before servo `id` moves to `new_id`: ok when nothing answers at `new_id`.
+  ServoStatus checkIdFreeLocked(uint8_t id, uint8_t new_id);
   /// One PING attempt, no retries (scan, and the check after a silent reset).
   ServoStatus pingOnceLocked(uint8_t id);
 

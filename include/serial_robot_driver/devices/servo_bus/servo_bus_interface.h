@@ -2,13 +2,25 @@
 // "servo_bus" diagnostic status. The bus itself (transactions, validation, messages, the move
 // queue and the poll schedule) is device::ServoBus; this class only translates.
 //
-// Threading: the services are served from this class's OWN callback queue by its own QueueSpinner
-// (2 threads). A servo call blocks for up to timeout * (retries + 1), or for a whole motion when
-// `wait` is set; on the global queue that would hold up cmd_vel and joint_commands.
-// servo_commands arrive on the caller's (global) queue: the callback only checks the message and
-// queues the moves in device::ServoBus, whose worker thread writes them and runs the servo_states
-// poll (servo_states is published from that thread); both take the bus after any waiting service
-// call, so a service call waits for one transaction at most.
+// Threading model (the threads start in start()):
+//  - The services are served from this class's OWN callback queues, never the global one: a servo
+//    call blocks for up to timeout * (retries + 1), a scan or a reset for many of those, a call
+//    with `wait` for a whole motion, and on the global queue that would hold up cmd_vel and
+//    joint_commands.
+//  - The stop services (servo/spin, servo/relax, servo/damping, servo/hold) have a queue
+//    (StopCallQueue) and a thread of their own, so they never wait behind a long call on the
+//    other queue. Their bus turns are urgent work (BusPriority::kStop): after the one transaction
+//    attempt in flight, before every waiting call, queued move and poll; a holder that keeps the
+//    bus across several transactions (servo/write, servo/reset_user_data) hands it over before
+//    its next attempt. Their calls are short (a frame, or one transaction, per servo); the long
+//    one, a servo/spin with wait, gives way to a stop call queued behind it (and any call waiting
+//    for a motion's completion gives way to a stop waiting for the bus).
+//  - Every other service is served from the second queue by two threads: one call waits on the
+//    bus while another is accepted and queued behind the bus lock.
+//  - servo_commands arrive on the caller's (global) queue: the callback only checks the message
+//    and queues the moves in device::ServoBus, whose worker thread writes them and runs the
+//    servo_states poll (servo_states is published from that thread); both take the bus after any
+//    waiting service call, so a service call waits for one transaction at most.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -42,6 +54,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_status.h"
 #include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
+#include "serial_robot_driver/devices/servo_bus/stop_call_queue.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
@@ -71,7 +84,8 @@ class ServoBusInterface : public DeviceInterface {
   ServoBusInterface(const ServoBusInterface&) = delete;
   ServoBusInterface& operator=(const ServoBusInterface&) = delete;
 
-  /// Starts the service spinner: calls are served from here on.
+  /// Starts the service threads (the stop thread first) and the bus's worker: calls are served
+  /// from here on.
   void start() override;
   /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
   void shutdown() override;
@@ -92,7 +106,7 @@ class ServoBusInterface : public DeviceInterface {
 
  private:
   device::ServoBusEvents makeEvents();
-  /// servo/* on nh_ (servo_bus_services.cpp).
+  /// servo/* on nh_, the stop services on stop_nh_ (servo_bus_services.cpp).
   void advertiseServices();
   void onServoCommands(const sensor_msgs::JointState::ConstPtr& msg);
   /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
@@ -117,8 +131,11 @@ class ServoBusInterface : public DeviceInterface {
   device::ServoBusClient& client_;  // bus_'s
   ros::CallbackQueue queue_;
   ros::NodeHandle nh_;  // the caller's namespace, bound to queue_
+  StopCallQueue stop_queue_;
+  ros::NodeHandle stop_nh_;  // the caller's namespace, bound to stop_queue_
   std::vector<ros::ServiceServer> services_;
   std::unique_ptr<QueueSpinner> spinner_;
+  std::unique_ptr<QueueSpinner> stop_spinner_;
   bool shut_down_ = false;
 
   // servo_states / servo_commands

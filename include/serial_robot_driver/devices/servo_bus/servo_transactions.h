@@ -16,6 +16,12 @@
 //  - Background work (BusPriority::kBackground: the servo_states and health polls) takes the
 //    bus only when no foreground caller waits for it, so a service call waits at most for the one
 //    transaction in progress.
+//  - Urgent work (the worker's stops, writeStops; a stop service's call, BusPriority::kStop) waits
+//    for the one transaction attempt in flight, never longer: a holder that keeps the bus for
+//    several transactions (a write, its read-back; a reset, the PING after it) hands it over
+//    before each attempt (transact() calls BusMutex::yieldToUrgent), and a caller waiting for a
+//    motion's completion stops waiting (kPreempted) while urgent work is asked or waits, or while
+//    a stop call waits to be served (setStopCallsQueued: the ROS layer's stop queue).
 //  - With a ReaderPump (setReaderPump: device::ServoBus running on its link's reader thread), a
 //    wait on the link's reader thread never sleeps on another thread: waiting for an answer or for
 //    the bus, that thread reads the port itself (SerialLink::pump), so the answer it waits for,
@@ -115,12 +121,15 @@ class ServoTransactions : public LinkListener {
   // Taking the bus: every helper below expects it held by the caller (std::lock_guard on
   // busMutex(), or takeBus() adopted).
   BusMutex& busMutex() { return bus_mutex_; }
-  /// Takes the bus at `priority`; false (and nothing held) when it gave way to urgent work.
+  /// Takes the bus at `priority`; false (and nothing held) when it gave way to urgent work
+  /// (kWorker, kBackground only).
   bool takeBus(BusPriority priority);
 
   /// `gate` kMotion: the request is a motion frame (a wait for its completion, which a stop may
   /// cut short); it is written through the motion gate.
-  /// `give_way` (BusPriority::kWorker): urgent work asked before a re-send ends it (kPreempted).
+  /// Before each attempt the bus is handed to urgent work asked or waiting meanwhile (see
+  /// BusMutex::yieldToUrgent). `give_way` (BusPriority::kWorker): the worker's stops asked before
+  /// an attempt end it instead (kPreempted).
   /// `arrival` (optional): when the answer's last byte was read.
   /// `accepted` (a motion): the gate's generation it was accepted under (MotionGate::writeIfOpen).
   ServoStatus transact(const std::vector<uint8_t>& request, const Expectation& expect,
@@ -147,6 +156,11 @@ class ServoTransactions : public LinkListener {
   /// completion stops waiting (kPreempted: the motion went out, its end was not awaited).
   void requestUrgent();
   void endUrgent();
+  /// Before any call: whether a stop call waits to be served (`queued`, any thread): while it
+  /// does, a motion wait gives way (kPreempted), so the thread that serves stops is free for it.
+  /// stopCallQueued() tells a wait in progress to look again.
+  void setStopCallsQueued(std::function<bool()> queued) { stop_calls_queued_ = std::move(queued); }
+  void stopCallQueued();
 
   /// Wakes a waiting caller and fails every later transaction with kShutdown. Idempotent.
   void shutdown();
@@ -187,6 +201,18 @@ class ServoTransactions : public LinkListener {
                                           protocol::servo::Command cmd, uint8_t id, FrameGate gate,
                                           std::optional<MotionGate::Generation> accepted);
   bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
+  /// Sets up the pending transaction of one attempt; false when shutting down.
+  bool beginAttempt(const std::vector<uint8_t>& request, const Expectation& expect, FrameGate gate);
+  /// The pending transaction's answer, its latency counted (state_mutex_ held).
+  ServoStatus answeredLocked(Clock::time_point sent_at, protocol::servo::Packet* answer);
+  /// kBadAnswer: only malformed answers (the last one `garbled_size` content bytes).
+  static ServoStatus malformed(const Expectation& expect, std::size_t garbled_size);
+  /// kTimeout after `attempts` unanswered attempts, counted.
+  ServoStatus timedOut(const Expectation& expect, std::chrono::milliseconds timeout, int attempts);
+  /// Whether a motion wait in progress gives way to a stop (state_mutex_ held).
+  bool motionWaitCutLocked() const;
+  /// BusMutex::lockUrgent, a motion wait cut short meanwhile.
+  void lockUrgent();
   /// Waits (state_mutex_ held by `lock`) until the pending transaction is answered, garbled,
   /// lost or shut down, or `deadline` passes.
   void waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::time_point deadline);
@@ -197,6 +223,7 @@ class ServoTransactions : public LinkListener {
   ReaderPump pump_;             // set before any call; empty: every wait is on a condition variable
   MotionGate* gate_ = nullptr;  // set before any call
   std::function<void(uint8_t id)> on_motion_written_;
+  std::function<bool()> stop_calls_queued_;  // set before any call; empty: none
 
   BusMutex bus_mutex_;  // one transaction on the wire at a time
 
@@ -208,6 +235,7 @@ class ServoTransactions : public LinkListener {
   bool stopping_ = false;
   bool urgent_ = false;       // requestUrgent() .. endUrgent(): a motion wait gives way
   bool motion_wait_ = false;  // the pending transaction waits for a motion's completion
+  int stops_waiting_ = 0;     // lockUrgent() calls waiting for the bus
   ServoBusStats stats_;
 };
 

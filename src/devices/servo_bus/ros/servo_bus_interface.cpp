@@ -13,6 +13,7 @@ namespace serial_robot_driver::ros_layer {
 namespace {
 
 constexpr int kSpinnerThreads = 2;
+constexpr int kStopSpinnerThreads = 1;
 constexpr double kMsPerSecond = 1000.0;
 constexpr double kWarnThrottleS = 5.0;
 
@@ -106,15 +107,20 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
       bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
       client_(bus_.client()),
       nh_(nh),
+      stop_queue_([this] { client_.stopCallQueued(); }),
+      stop_nh_(nh),
       topics_nh_(nh),
       command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
   // The bus's worker (the poll, the queued moves) runs on the port's reader thread: a poll writes
   // its request and reads the answer itself, with no second thread to wake per transaction.
   bus_.runOn(link_);
 
-  // Own queue: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion with
-  // wait = true) and must never hold up cmd_vel or joint_commands on the global queue.
+  // Own queues: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion
+  // with wait = true) and must never hold up cmd_vel or joint_commands on the global queue; a stop
+  // must never wait behind such a call (see the threading model in the header).
   nh_.setCallbackQueue(&queue_);
+  stop_nh_.setCallbackQueue(&stop_queue_);
+  client_.setStopCallsQueued([this] { return stop_queue_.waiting(); });
   advertiseServices();
 
   if (params.servo_bus.bus.client.allow_dangerous_writes) {
@@ -236,6 +242,9 @@ std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
 
 void ServoBusInterface::start() {
   if (spinner_ || shut_down_) return;
+  // The stop services' thread first: from the first call on, a stop never waits behind another.
+  stop_spinner_ = std::make_unique<QueueSpinner>(&stop_queue_, kStopSpinnerThreads);
+  stop_spinner_->start();
   // Two threads: one call waits on the bus while another is accepted and queued behind the bus
   // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
   spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
@@ -252,6 +261,7 @@ void ServoBusInterface::shutdown() {
   bus_.shutdown();  // fails a call waiting on the bus, so the spinner can stop quickly
   for (ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
+  if (stop_spinner_) stop_spinner_->stop();
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -1,5 +1,7 @@
 // The servo/* services: each one a client or bus call behind the same outcome handling (logged,
-// never thrown through, the message always returned). Served from ServoBusInterface's own queue.
+// never thrown through, the message always returned). Served from ServoBusInterface's own queues:
+// the stop services (servo/spin, servo/relax, servo/damping, servo/hold) from the stop queue
+// (stop_nh_), whose bus turns are urgent work, every other from the second one (nh_).
 #include <functional>
 #include <string>
 #include <vector>
@@ -86,6 +88,7 @@ ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name
 
 void ServoBusInterface::advertiseServices() {
   const ServoServiceSite site{nh_, inputRefusals()};
+  const ServoServiceSite stop_site{stop_nh_, inputRefusals()};
   services_ = {
       advertiseServo<ServoPing>(
           site, "servo/ping",
@@ -159,7 +162,7 @@ void ServoBusInterface::advertiseServices() {
                                     if (!claimed.ok()) return claimed;
                                     return bus_.rotate(request);
                                   }),
-      advertiseServo<ServoSpin>(site, "servo/spin",
+      advertiseServo<ServoSpin>(stop_site, "servo/spin",
                                 [this](ServoSpin::Request& req, ServoSpin::Response&) {
                                   device::SpinRequest request;
                                   request.id = req.id;
@@ -168,6 +171,8 @@ void ServoBusInterface::advertiseServices() {
                                   request.speed_dps = req.speed_dps;
                                   request.value = req.value;
                                   request.wait = req.wait;
+                                  // Served with the stops: it must never wait behind a long call.
+                                  request.priority = device::BusPriority::kStop;
                                   // A SPIN stop is no motion: it works while the e-stop holds.
                                   if (req.mode != 0) {
                                     device::ServoStatus refused = refuseWhileEStopped("servo/spin");
@@ -177,17 +182,17 @@ void ServoBusInterface::advertiseServices() {
                                   return bus_.spin(request);
                                 }),
       // Torque off moves nothing actively: allowed while the e-stop holds (motion_safety.h).
-      advertiseServo<ServoDamping>(site, "servo/damping",
+      advertiseServo<ServoDamping>(stop_site, "servo/damping",
                                    [this](ServoDamping::Request& req, ServoDamping::Response&) {
                                      yieldJoint(req.id, "servo/damping");
                                      return bus_.damping(req.id, req.power_mw, req.wait);
                                    }),
-      advertiseServo<ServoRelax>(site, "servo/relax",
+      advertiseServo<ServoRelax>(stop_site, "servo/relax",
                                  [this](ServoRelax::Request& req, ServoRelax::Response&) {
                                    yieldJoints(req.ids, "servo/relax");
                                    return bus_.relax(req.ids);
                                  }),
-      advertiseServo<ServoHold>(site, "servo/hold",
+      advertiseServo<ServoHold>(stop_site, "servo/hold",
                                 [this](ServoHold::Request& req, ServoHold::Response&) {
                                   const device::ServoStatus claimed =
                                       claimServos(req.ids, "servo/hold");
