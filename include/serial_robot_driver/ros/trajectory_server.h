@@ -72,6 +72,8 @@ class TrajectoryServer {
   void stopAll(const std::string& reason) { executor_.stopAll(reason); }
   /// See TrajectoryExecutor::attachEStop() (before start()).
   void attachEStop(device::EStop& e_stop) { executor_.attachEStop(e_stop); }
+  /// See TrajectoryExecutor::motionInForce().
+  std::string motionInForce() { return executor_.motionInForce(); }
 
  private:
   void onGoal(GoalHandle handle);
