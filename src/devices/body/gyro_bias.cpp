@@ -166,6 +166,9 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
             false};
   }
   if (!not_still.empty()) {
+    // Seen moving now, between frames maybe: the settle time counts from after this too.
+    still_since_.reset();
+    last_motion_ = not_still;
     return refuseLocked(how, "the robot is not held still (" + not_still + ")", units, true);
   }
   const Clock::time_point now = Clock::now();

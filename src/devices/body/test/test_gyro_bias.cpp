@@ -193,6 +193,7 @@ TEST_F(GyroCalibratorTest, RefusedWhileNotStillAndWhenMotionStartsDuringTheAvera
   EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
 
   setNotStill("");
+  waitFrames(2);  // seen still again
   std::thread mover([this] {
     std::this_thread::sleep_for(milliseconds(100));
     setNotStill("the e-stop is engaged");
