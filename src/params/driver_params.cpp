@@ -46,6 +46,9 @@ void addTrajectoryParameters(std::vector<ParamSpec>& table) {
 std::vector<ParamSpec> buildTable() {
   std::vector<ParamSpec> table;
   addNodeParameters(table);
+  SectionRows<EStopParams>(table, "", "e_stop", [](DriverParams& p) -> EStopParams& {
+    return p.e_stop;
+  }).add("start_engaged", &EStopParams::start_engaged);
   for (const device::DeviceModule* device : device::registeredDevices()) {
     // Every device's port parameters, then its own.
     const auto port = [device](DriverParams& p) -> DevicePortParams& {

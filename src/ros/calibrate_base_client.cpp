@@ -3,6 +3,9 @@
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>
 #include <sensor_msgs/Imu.h>
+#include <std_msgs/Bool.h>
+
+#include <cstdlib>
 
 #include "serial_robot_driver/WheelCommand.h"
 
@@ -53,9 +56,17 @@ CalibrationTopics::CalibrationTopics(device::TurnCalibrationRun& run) {
           if (status.name != name) continue;
           for (const auto& value : status.values) {
             if (value.key == "engaged") run.setEStopEngaged(value.value == "True");
+            if (value.key == "engagements") {
+              run.setEStopEngagements(std::strtoull(value.value.c_str(), nullptr, 10));
+            }
           }
         }
       });
+  // The driver's own input: every engagement published on it, however short (the once-a-second
+  // status above would miss one shorter than its period; its count catches what this missed).
+  e_stop_ = nh_.subscribe<std_msgs::Bool>(
+      "e_stop", 10, [&run](const std_msgs::Bool::ConstPtr& msg) { run.setEStopEngaged(msg->data); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
 }
 
 void CalibrationTopics::command(const device::BaseTwist& twist) {

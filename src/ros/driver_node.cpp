@@ -127,7 +127,6 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   }
   // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
   connectImuHeading();
-  connectMotionQuery();
   // One trajectory server for the joints of every device, so one goal may span them.
   std::vector<TrajectoryJoints> trajectory_joints;
   for (auto& device : devices_) {
@@ -139,6 +138,7 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, std::move(trajectory_joints));
     for (auto& device : devices_) device->attachTrajectories(trajectory_.get());
   }
+  connectMotionQuery();
   connectEStop();
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
@@ -177,18 +177,20 @@ void DriverNode::connectImuHeading() {
 void DriverNode::connectMotionQuery() {
   // Whether the robot is held still, for a sensor's calibration (the body's imu/calibrate): asked
   // on that device's reader and service threads; each device answers under its own short lock.
-  // devices_ is complete here and outlives the links' threads and the devices' spinners.
+  // devices_ and trajectory_ are complete here and outlive the links' threads and the devices'
+  // spinners.
   std::vector<std::pair<std::string, const DeviceInterface*>> named;
   auto device = devices_.begin();
   for (const device::DeviceModule* module : device::registeredDevices()) {
     if (params_.enabled(*module)) named.emplace_back(module->name, (device++)->get());
   }
-  const DeviceInterface::MotionQuery query = [named] {
+  const DeviceInterface::MotionQuery query = [named, trajectory = trajectory_.get()] {
     for (const auto& [name, interface] : named) {
       const std::string why = interface->motionInForce();
       if (!why.empty()) return name + ": " + why;
     }
-    return std::string();
+    const std::string trajectories = trajectory ? trajectory->motionInForce() : std::string();
+    return trajectories.empty() ? trajectories : "trajectories: " + trajectories;
   };
   for (auto& each : devices_) each->setMotionQuery(query);
 }
@@ -203,6 +205,13 @@ void DriverNode::connectEStop() {
   diagnostics_.add("e_stop", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
     diagnoseEStop(s);
   });
+  if (params_.e_stop.start_engaged) {
+    // Before the ports start: the base's first frame is already a zero one.
+    e_stop_.set(true);
+    ROS_WARN(
+        "e_stop engaged at start-up (~e_stop/start_engaged): nothing moves until e_stop "
+        "false arrives");
+  }
 }
 
 void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {

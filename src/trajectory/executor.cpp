@@ -208,11 +208,36 @@ void TrajectoryExecutor::endGoalsOn(const std::vector<std::size_t>& joints, Goal
   }
 }
 
+TrajectoryExecutor::Generations TrajectoryExecutor::generations() const {
+  Generations now;
+  for (const TrajectoryJoints& group : groups_) {
+    now.push_back(group.generation ? std::optional<uint64_t>(group.generation()) : std::nullopt);
+  }
+  return now;
+}
+
+bool TrajectoryExecutor::voided(std::size_t j) const {
+  const Track& track = tracks_[j];
+  const TrajectoryJoints& group = groups_[track.group];
+  return group.generation && track.accepted && *track.accepted != group.generation();
+}
+
+void TrajectoryExecutor::dropVoided(const std::vector<std::size_t>& joints, double now) {
+  if (joints.empty()) return;
+  for (std::size_t j : joints) tracks_[j].writing = false;
+  const std::string message = "trajectory of joint '" + ranges_[joints.front()].name +
+                              "' dropped: e-stop engaged after this command was accepted";
+  warnThrottled(kTrajectoryError, message, now);
+  endGoalsOn(joints, GoalStatus::kAborted, result_code::kInvalidGoal, message);
+}
+
 void TrajectoryExecutor::apply(const TrajectoryCommand& command,
-                               const std::vector<std::size_t>& joints, double start, double now) {
+                               const std::vector<std::size_t>& joints, double start, double now,
+                               const Generations& accepted) {
   const std::vector<Measured> actual = measured();
   for (std::size_t column = 0; column < joints.size(); ++column) {
     Track& track = tracks_[joints[column]];
+    track.accepted = accepted[track.group];
     // A joint nobody drives starts from where it is; a driven one from where it is meant to be.
     if (!track.writing) track.spline = JointSpline(actual[joints[column]].sample.position);
     track.spline.splice(std::max(start, now), waypointsFor(command, column, start, now));
@@ -223,10 +248,14 @@ void TrajectoryExecutor::apply(const TrajectoryCommand& command,
 
 std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, double now) {
   const std::vector<Measured> actual = measured();
+  // A hold is accepted now: the e-stop's own (stopAll) is voided by that e-stop, so it is never
+  // written once it is released.
+  const Generations accepted = generations();
   std::vector<std::string> left_alone;
   for (std::size_t j : joints) {
     Track& track = tracks_[j];
     const TrajectoryJoints& group = groups_[track.group];
+    track.accepted = accepted[track.group];
     if (group.move) {
       // Per-segment: a stop where the servo is, never a move to an angle that may be stale. The
       // desired state is the spline now (feedback, and where a later goal bridges from).
@@ -260,6 +289,8 @@ std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, dou
 TrajectoryExecutor::Submission TrajectoryExecutor::submitGoal(const Goal& goal,
                                                               GoalCallbacks callbacks) {
   const TrajectoryCommand& command = goal.command;
+  // Accepted now: noted before the e-stop check, so an e-stop from here on voids it.
+  const Generations accepted = generations();
   const double now = this->now();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) {
@@ -293,7 +324,7 @@ TrajectoryExecutor::Submission TrajectoryExecutor::submitGoal(const Goal& goal,
                               withLeftAlone("stopped where they were last commanded", left_alone)));
     return Submission::kAccepted;
   }
-  apply(command, checked.joint_indices, start, now);
+  apply(command, checked.joint_indices, start, now, accepted);
 
   ActiveGoal active;
   active.id = goal.id;
@@ -326,6 +357,7 @@ void TrajectoryExecutor::cancelGoal(const std::string& id) {
 
 TrajectoryExecutor::Submission TrajectoryExecutor::submitTrajectory(
     const TrajectoryCommand& command, std::optional<double> start_time) {
+  const Generations accepted = generations();  // before the e-stop check, as submitGoal()
   const double now = this->now();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return Submission::kNotRunning;
@@ -348,7 +380,7 @@ TrajectoryExecutor::Submission TrajectoryExecutor::submitTrajectory(
     const std::string left_alone = hold(checked.joint_indices, now);
     if (!left_alone.empty()) warn("joint_trajectory: stop: " + left_alone);
   } else {
-    apply(command, checked.joint_indices, *start, now);
+    apply(command, checked.joint_indices, *start, now, accepted);
   }
   return Submission::kAccepted;
 }
@@ -417,10 +449,20 @@ void TrajectoryExecutor::writeTracks(double now) {
   // position (streamed), then left to its servo.
   std::vector<std::vector<std::string>> names(groups_.size());
   std::vector<std::vector<double>> positions(groups_.size());
+  std::vector<std::optional<uint64_t>> frame_accepted(groups_.size());  // the oldest in the frame
+  std::vector<std::size_t> voided_joints;
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
     Track& track = tracks_[j];
     if (!track.writing) continue;
     const TrajectoryJoints& group = groups_[track.group];
+    if (voided(j)) {
+      voided_joints.push_back(j);
+      continue;
+    }
+    if (track.accepted) {
+      std::optional<uint64_t>& oldest = frame_accepted[track.group];
+      oldest = oldest ? std::min(*oldest, *track.accepted) : *track.accepted;
+    }
     if (group.move) {
       if (const auto move = segmentMoveAt(track.spline, now, track.sent_segment)) {
         const std::string error = group.move(track.local, move->position, move->duration);
@@ -440,15 +482,36 @@ void TrajectoryExecutor::writeTracks(double now) {
   }
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     if (names[g].empty() || !groups_[g].write) continue;
-    const std::string error = groups_[g].write(names[g], positions[g]);
+    // Through the device's gate with the generation it was accepted under: an e-stop engaged
+    // since this check (after the tracks were read) still voids the frame.
+    const std::string error = groups_[g].write(names[g], positions[g], frame_accepted[g]);
     if (!error.empty()) {
       warnThrottled(kTrajectoryError, "trajectory: " + error, now);
+      for (const std::string& name : names[g]) {
+        if (voided(index_.at(name))) voided_joints.push_back(index_.at(name));
+      }
       continue;
     }
     for (std::size_t k = 0; k < names[g].size(); ++k) {
       tracks_[index_.at(names[g][k])].last_written = positions[g][k];
     }
   }
+  dropVoided(voided_joints, now);
+}
+
+std::string TrajectoryExecutor::motionInForce() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> moving;
+  for (std::size_t j = 0; j < tracks_.size(); ++j) {
+    const bool in_goal = std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
+      return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
+    });
+    if (tracks_[j].writing || in_goal) moving.push_back(ranges_[j].name);
+  }
+  if (moving.empty()) return {};
+  std::string text = "trajectory in progress (";
+  for (std::size_t i = 0; i < moving.size(); ++i) text += (i ? ", '" : "'") + moving[i] + "'";
+  return text + ")";
 }
 
 bool TrajectoryExecutor::superviseGoal(ActiveGoal& goal, double now,

@@ -69,6 +69,9 @@ INSTANTIATE_TEST_SUITE_P(
                 [](DriverParams& p) { p.base.controller.max_wheel_accel = -1; }},
         BadCase{"base/cmd_vel_timeout",
                 [](DriverParams& p) { p.base.controller.cmd_vel_timeout = 0; }},
+        // Bounded: the deadman that stops the base when cmd_vel stops cannot be tuned away.
+        BadCase{"base/cmd_vel_timeout",
+                [](DriverParams& p) { p.base.controller.cmd_vel_timeout = 5.01; }},
         BadCase{"base/battery_poll_rate",
                 [](DriverParams& p) { p.base.controller.battery_poll_rate = -1; }},
         BadCase{"base/baud", [](DriverParams& p) { p.base.baud = 7; }},

@@ -4,6 +4,7 @@
 // the tests step by hand.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -55,10 +56,16 @@ class ExecutorRig : public ::testing::Test {
   std::vector<TrajectoryJoints> groups() {
     TrajectoryJoints body;
     body.joints = {{"arm_1", -3.0, 3.0}, {"arm_2", -3.0, 3.0}};
-    body.write = [this](const std::vector<std::string>& names, const std::vector<double>& p) {
+    body.write = [this](const std::vector<std::string>& names, const std::vector<double>& p,
+                        std::optional<uint64_t> accepted) {
+      if (during_write) during_write();
       frames.emplace_back(names, p);
+      frame_generations.push_back(accepted);
+      // As the body's gate: a frame accepted before the last e-stop is not written.
+      if (accepted && *accepted != body_generation) return std::string("voided");
       return write_error;
     };
+    body.generation = [this] { return body_generation; };
     body.last_commanded = [this](std::size_t) { return body_last_commanded; };
     TrajectoryJoints bus;
     bus.joints = {{"pan", -3.0, 3.0}};
@@ -99,7 +106,10 @@ class ExecutorRig : public ::testing::Test {
   }
 
   double now = 100.0;
+  uint64_t body_generation = 0;        ///< the body gate's e-stop generation
+  std::function<void()> during_write;  ///< runs inside each body write
   std::vector<Frame> frames;
+  std::vector<std::optional<uint64_t>> frame_generations;  ///< what each frame was written with
   std::string write_error;
   std::optional<double> body_last_commanded;
   std::vector<std::tuple<std::size_t, double, double>> moves;
@@ -452,6 +462,66 @@ TEST_F(ExecutorRig, EStopAbortsHoldsAndRefuses) {
   EXPECT_EQ(warnings.back(), "joint_trajectory: message ignored, nothing moves: e_stop is engaged");
   EXPECT_EQ(e_stop.stats().refused.at("follow_joint_trajectory"), 1u);
   EXPECT_EQ(e_stop.stats().refused.at("joint_trajectory"), 2u);
+}
+
+// An e-stop voids everything accepted before it: a goal, or a joint_trajectory still waiting for
+// its start, accepted before an e-stop that was engaged and released between two ticks never
+// moves a joint after the release; the goal is aborted, saying why.
+TEST_F(ExecutorRig, TrajectoriesAcceptedBeforeAnEStopNeverMoveAfterItsRelease) {
+  device::EStop e_stop;
+  executor.attachEStop(e_stop);
+  // As the node's body: its gate starts a new generation after the trajectories stopped.
+  e_stop.addListener([this](bool engaged) { body_generation += engaged ? 1 : 0; });
+  measure({"arm_1", "arm_2"}, {0.0, 0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  TrajectoryCommand later;  // starts in 0.5 s: queued
+  later.joint_names = {"arm_2"};
+  later.points.push_back({1.0, {1.0}, {}, {}});
+  executor.submitTrajectory(later, now + 0.5);
+  tickAt(100.1);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frame_generations.back(), std::optional<uint64_t>(0));
+
+  e_stop.set(true);
+  e_stop.set(false);  // no tick while it held
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kAborted);
+  for (double t = 100.2; t < 102.0; t += 0.1) tickAt(t);
+  // Whatever was tried after the release was voided (the rig's gate writes nothing for it).
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    EXPECT_EQ(frame_generations[i], std::optional<uint64_t>(0)) << "frame " << i;
+  }
+  EXPECT_LE(frames.size(), 2u) << "at most the hold was tried once, and voided";
+  EXPECT_EQ(executor.motionInForce(), "");
+}
+
+// The e-stop's hook missed (an e-stop engaged while the executor was writing): the device's gate
+// voids the frame, and the executor drops the trajectory and aborts its goal instead of retrying.
+TEST_F(ExecutorRig, AFrameTheGateVoidedDropsItsTrajectory) {
+  measure({"arm_1"}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}, 2.0), log.callbacks());
+  EXPECT_EQ(executor.motionInForce(), "trajectory in progress ('arm_1')");
+  during_write = [this] { body_generation = 1; };  // engaged (and released) meanwhile
+  tickAt(100.1);
+  during_write = nullptr;
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().status, GoalStatus::kAborted);
+  EXPECT_EQ(log.outcome().text,
+            "trajectory of joint 'arm_1' dropped: e-stop engaged after this command was accepted");
+  const std::size_t tried = frames.size();
+  tickAt(100.2);
+  tickAt(100.3);
+  EXPECT_EQ(frames.size(), tried) << "never written again";
+  EXPECT_EQ(executor.motionInForce(), "");
+
+  // A trajectory accepted after it moves.
+  GoalLog fresh;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}, 2.0), fresh.callbacks());
+  tickAt(100.4);
+  EXPECT_EQ(frame_generations.back(), std::optional<uint64_t>(1));
+  EXPECT_FALSE(fresh.over());
 }
 
 TEST_F(ExecutorRig, StaleBusJointAbortsAndStopsItsServo) {

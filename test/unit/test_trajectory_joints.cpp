@@ -67,11 +67,32 @@ TEST(TrajectoryStop, BodyJointsOfferTheLastCommandToTheServer) {
   ASSERT_TRUE(group.last_commanded);
   EXPECT_FALSE(group.stop);
   EXPECT_FALSE(group.last_commanded(0).has_value());
-  ASSERT_TRUE(group.write({"joint_1"}, {-0.5}).empty());
+  ASSERT_TRUE(group.write({"joint_1"}, {-0.5}, std::nullopt).empty());
   // -0.5 rad = 2048 - 326 ticks (round(0.5 / kRadPerTick) = 326).
   ASSERT_TRUE(group.last_commanded(0).has_value());
   EXPECT_NEAR(*group.last_commanded(0), -326 * kRadPerTick, 1e-12);
   EXPECT_FALSE(group.last_commanded(1).has_value());
+}
+
+// A body frame carries the e-stop generation its trajectory was accepted under, to the gate.
+TEST(TrajectoryStop, BodyJointsWriteThroughTheGateWithTheAcceptedGeneration) {
+  std::vector<device::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, {}}};
+  int frames = 0;
+  device::BodyController controller(joints, [&frames](const std::vector<uint8_t>&) {
+    ++frames;
+    return true;
+  });
+  const TrajectoryJoints group = bodyTrajectoryJoints(controller);
+  ASSERT_TRUE(group.generation);
+  const uint64_t accepted = group.generation();
+  controller.gate().setLocked(true);
+  controller.gate().setLocked(false);
+  EXPECT_EQ(group.generation(), accepted + 1);
+  EXPECT_EQ(group.write({"joint_1"}, {-0.5}, accepted),
+            "joint command not written: e-stop engaged after this command was accepted");
+  EXPECT_EQ(frames, 0);
+  EXPECT_TRUE(group.write({"joint_1"}, {-0.5}, group.generation()).empty());
+  EXPECT_EQ(frames, 1);
 }
 
 TEST(TrajectoryStop, BusJointStopIsAStopOfItsServoNeverAMove) {

@@ -29,6 +29,13 @@ namespace serial_robot_driver::params {
 /// them): the executor's own, bound straight to the ~trajectory/... rows.
 using TrajectoryParams = trajectory::GoalDefaults;
 
+/// ~e_stop: the node's one emergency stop.
+struct EStopParams {
+  /// The node starts with the e-stop engaged (a respawned driver comes back stopped) until an
+  /// e_stop false arrives.
+  bool start_engaged = false;
+};
+
 /// The parameter sections of devices that DriverParams has no member for: each device keeps its
 /// own struct here under its name (a device added by its folder alone uses this).
 class DeviceSections {
@@ -81,6 +88,7 @@ struct DriverParams {
   /// Sections of other registered devices.
   DeviceSections sections;
   TrajectoryParams trajectory;
+  EStopParams e_stop;
   /// Not a ~ parameter: `tf_prefix` searched upward from the node's namespace (as
   /// robot_state_publisher does), so one value in a robot's namespace serves all its nodes.
   std::string tf_prefix;

@@ -19,8 +19,9 @@ std::optional<std::string> findCalibrationDriver(const std::string& named,
                                                  const std::atomic<int>& stop_signal,
                                                  std::string* why);
 
-/// imu/data, wheel_command and the driver's e-stop status on /diagnostics into the run; cmd_vel
-/// out. Messages arrive in ros::spinOnce().
+/// imu/data, wheel_command, e_stop (the driver's input topic: every engagement published) and the
+/// driver's e-stop status on /diagnostics (its state and count of engagements) into the run;
+/// cmd_vel out. Messages arrive in ros::spinOnce().
 class CalibrationTopics {
  public:
   explicit CalibrationTopics(device::TurnCalibrationRun& run);
@@ -30,7 +31,7 @@ class CalibrationTopics {
  private:
   ros::NodeHandle nh_;
   ros::Publisher cmd_vel_;
-  ros::Subscriber imu_, frames_, diagnostics_;
+  ros::Subscriber imu_, frames_, diagnostics_, e_stop_;
 };
 
 }  // namespace serial_robot_driver::ros_layer

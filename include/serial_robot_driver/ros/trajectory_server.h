@@ -80,6 +80,8 @@ class TrajectoryServer {
   void attachEStop(device::EStop& e_stop) { executor_.attachEStop(e_stop); }
   /// The goals and messages refused for what they ask, and its callbacks' errors, by source.
   device::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
+  /// See TrajectoryExecutor::motionInForce().
+  std::string motionInForce() { return executor_.motionInForce(); }
 
  private:
   /// onGoal() guarded: an error rejects the goal (or aborts it, once accepted).

@@ -143,6 +143,10 @@ class TrajectoryExecutor {
   /// queues what the splines ask for.
   void tick();
 
+  /// Why trajectories may be moving joints now: a goal in progress or joints still being written
+  /// or moved; "" when none. Any thread (a sensor calibration asks it once per frame).
+  std::string motionInForce();
+
  private:
   struct Track {
     std::size_t group = 0;  ///< index into groups_
@@ -155,7 +159,12 @@ class TrajectoryExecutor {
     /// command takes the joint over.
     std::optional<double> last_written;
     bool moved = false;  ///< per-segment joints: a move of this joint was queued
+    /// The group's e-stop generation when what the track runs was accepted (or held): an e-stop
+    /// since voids it (TrajectoryJoints::generation).
+    std::optional<uint64_t> accepted;
   };
+  /// Each group's e-stop generation now (unset where the group has none).
+  using Generations = std::vector<std::optional<uint64_t>>;
   struct Measured {
     JointSample sample;
     bool velocity_known = false;
@@ -185,9 +194,15 @@ class TrajectoryExecutor {
   /// Ends the goals that drive any of `joints` with `status`, `code` and `message`.
   void endGoalsOn(const std::vector<std::size_t>& joints, GoalStatus status, int code,
                   const std::string& message);
-  /// Splices the command into the joints' splines.
+  /// Splices the command, accepted under `accepted`, into the joints' splines.
   void apply(const TrajectoryCommand& command, const std::vector<std::size_t>& joints, double start,
-             double now);
+             double now, const Generations& accepted);
+  /// The groups' generations now (no lock needed: the groups are fixed).
+  Generations generations() const;
+  /// Whether an e-stop engaged since track `j`'s command was accepted.
+  bool voided(std::size_t j) const;
+  /// Stops `joints` (their commands were voided by an e-stop) and aborts their goals.
+  void dropVoided(const std::vector<std::size_t>& joints, double now);
   /// Holds `joints` where they were last commanded (see the top of this file); returns the text
   /// naming the joints left alone ("" when none).
   std::string hold(const std::vector<std::size_t>& joints, double now);

@@ -23,10 +23,16 @@ struct TrajectoryJoints {
   std::vector<JointRange> joints;
   /// A goal aborts when one of its joints has had no measurement for this long (s).
   double state_timeout = 0.5;
-  /// Writes one frame setting these joints (rad); returns an error text, empty when written.
+  /// Writes one frame setting these joints (rad), accepted under e-stop generation `accepted`
+  /// (see `generation`; unset: now): a frame an e-stop voided is not written. Returns an error
+  /// text, empty when written.
   std::function<std::string(const std::vector<std::string>& names,
-                            const std::vector<double>& positions)>
+                            const std::vector<double>& positions, std::optional<uint64_t> accepted)>
       write;
+  /// The device's e-stop generation now (device::MotionGate::generation()): noted when a
+  /// trajectory is accepted and handed to `write`, so that one accepted before an e-stop never
+  /// moves a joint after it. May be empty (nothing is voided by generation).
+  std::function<uint64_t()> generation;
   /// Instead of `write`: moves joint `index` (into `joints`) to `position` (rad) in `duration` s;
   /// must not block (queue the frame). Returns an error text, empty when queued.
   std::function<std::string(std::size_t index, double position, double duration)> move;

@@ -56,13 +56,18 @@ BaseController::~BaseController() {
   if (loop_.joinable()) loop_.join();
 }
 
-bool BaseController::setCommand(double linear_x, double angular_z) {
+CommandOutcome BaseController::submitCommand(double linear_x, double angular_z,
+                                             std::optional<Generation> accepted) {
   const bool valid = std::isfinite(linear_x) && std::isfinite(angular_z);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (e_stop_) {
       ++stats_.ignored_commands_e_stop;
-      return valid;
+      return CommandOutcome::kEStopEngaged;
+    }
+    if (accepted && *accepted != generation_) {
+      ++stats_.voided_commands;
+      return CommandOutcome::kVoided;
     }
     linear_x_ = valid ? linear_x : 0.0;
     angular_z_ = valid ? angular_z : 0.0;
@@ -71,7 +76,12 @@ bool BaseController::setCommand(double linear_x, double angular_z) {
     if (!valid) ++stats_.rejected_commands;
   }
   wake_.notify_all();
-  return valid;
+  return valid ? CommandOutcome::kStored : CommandOutcome::kNotFinite;
+}
+
+BaseController::Generation BaseController::generation() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return generation_;
 }
 
 void BaseController::setEStop(bool engaged) {
@@ -81,12 +91,13 @@ void BaseController::setEStop(bool engaged) {
     e_stop_ = engaged;
     stats_.e_stop = engaged;
     if (engaged) {
+      ++generation_;
       command_pending_ = true;  // the zero frame goes out now, not at the next tick
-    } else {
-      // Obey cmd_vel from the next message only: the command from before the stop is forgotten.
-      last_command_.reset();
-      linear_x_ = angular_z_ = 0.0;
     }
+    // Dropped on the engagement (and again on the release): only a cmd_vel accepted after the
+    // release drives the base.
+    last_command_.reset();
+    linear_x_ = angular_z_ = 0.0;
   }
   wake_.notify_all();
 }

@@ -39,7 +39,13 @@ void addParameters(std::vector<params::ParamSpec>& table) {
   // and the speed field's own range (int16 ticks per PID period) depends on tunable geometry.
   controller.add("max_wheel_speed", &C::max_wheel_speed, params::positiveNumber)
       .add("max_wheel_accel", &C::max_wheel_accel, params::nonNegativeNumber)
-      .add("cmd_vel_timeout", &C::cmd_vel_timeout, params::positiveNumber)
+      .add("cmd_vel_timeout", &C::cmd_vel_timeout,
+           [](const double& value, const std::string& key) {
+             // Bounded: the deadman that stops the base when its client dies is not tuned away.
+             params::positiveNumber(value, key);
+             params::numberWithin(0.0, C::kMaxCmdVelTimeout,
+                                  "s (at most: the deadman that stops the base)")(value, key);
+           })
       .add("speed_dithering", &C::speed_dithering)
       .add("battery_poll_rate", &C::battery_poll_rate, params::nonNegativeNumber);
   own.add("battery_warn_percent", &B::battery_warn_percent, params::percent)

@@ -50,6 +50,7 @@ StatusReport baseStatus(const BaseStats& s, const PortState& port, BatteryLimits
   status.add("immediate frames (new cmd_vel)", s.immediate_frames);
   status.add("e-stop engaged", s.e_stop);
   status.add("cmd_vel ignored (e-stop)", s.ignored_commands_e_stop);
+  status.add("cmd_vel voided (e-stop engaged after it was accepted)", s.voided_commands);
   status.add("resets sent", s.resets_sent);
   status.add("FF timeout errors received", s.timeout_errors_received);
   status.add("FF timeout errors while running", s.timeout_errors_while_running);

@@ -59,7 +59,17 @@ void TurnCalibrationRun::addWheelFrame(double stamp, int16_t left_ticks, int16_t
   if (recorder_) recorder_->addWheelFrame(stamp, left_ticks, right_ticks);
 }
 
-void TurnCalibrationRun::setEStopEngaged(bool engaged) { e_stop_engaged_ = engaged; }
+void TurnCalibrationRun::setEStopEngaged(bool engaged) {
+  e_stop_engaged_ = engaged;
+  if (engaged && e_stop_checked_) e_stop_engaged_since_check_ = true;
+}
+
+void TurnCalibrationRun::setEStopEngagements(uint64_t count) { engagements_ = count; }
+
+bool TurnCalibrationRun::eStopEngagedSinceCheck() const {
+  return e_stop_engaged_since_check_ ||
+         (engagements_ && engagements_at_check_ && *engagements_ > *engagements_at_check_);
+}
 
 void TurnCalibrationRun::setMeasuredDistance(std::optional<double> metres) {
   measured_distance_ = metres;
@@ -93,6 +103,12 @@ CalibrationStep TurnCalibrationRun::step(const CalibrationTick& tick) {
     }
   } else if (!tick.connected && phase_ != Phase::kDone && !stopping) {
     abort("ROS shut down", kCalibrationExitRefused);
+  } else if (eStopEngagedSinceCheck() && phase_ != Phase::kDone && !stopping) {
+    // Whatever the phase (a hold between motions too), and even when already released.
+    abort(
+        "aborted: the e-stop engaged; the run never resumes after a release: run "
+        "calibrate_base again once it is safe",
+        kCalibrationExitRefused);
   }
   // A phase that ends hands over at once, as a sequential run would: the stop on an abort is
   // commanded in the same step that found the reason.
@@ -125,10 +141,16 @@ void TurnCalibrationRun::runPhase(const CalibrationTick& tick, CalibrationStep& 
         abort("refused: the e-stop is engaged; release it (e_stop false) and run again",
               kCalibrationExitRefused);
       } else {
-        // The node's diagnostics come once a second.
-        waitFor(e_stop_engaged_.has_value(), kArrivalWait, Phase::kWaitSubscriber,
+        // The node's diagnostics come once a second, with its count of engagements: from here on
+        // any engagement (a message on e_stop, or the count rising) ends the run.
+        waitFor(e_stop_engaged_.has_value() && engagements_.has_value(), kArrivalWait,
+                Phase::kWaitSubscriber,
                 "no e_stop status from " + node_ +
                     " on /diagnostics in 3 s: cannot tell whether the e-stop is engaged");
+        if (phase_ == Phase::kWaitSubscriber) {
+          e_stop_checked_ = true;
+          engagements_at_check_ = engagements_;
+        }
       }
       break;
     case Phase::kWaitSubscriber:

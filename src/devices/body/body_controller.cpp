@@ -80,6 +80,8 @@ std::string JointCommandResult::message() const {
       return "joint command not written: the body port is not connected";
     case JointCommandStatus::kMotionRefused:
       return "joint command not written: e_stop engaged or shutting down";
+    case JointCommandStatus::kMotionVoided:
+      return std::string("joint command not written: ") + toString(GateState::kVoided);
   }
   return "unknown joint command status";
 }
@@ -107,8 +109,11 @@ void BodyController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
   if (events_.on_telemetry) events_.on_telemetry(*telemetry, arrival);
 }
 
-JointCommandResult BodyController::sendJointCommand(const std::vector<std::string>& names,
-                                                    const std::vector<double>& positions) {
+JointCommandResult BodyController::sendJointCommand(
+    const std::vector<std::string>& names, const std::vector<double>& positions,
+    std::optional<MotionGate::Generation> accepted) {
+  // Noted before waiting for the lock: an e-stop while this command waits voids it.
+  const MotionGate::Generation generation = accepted.value_or(gate_.generation());
   JointCommandResult result;
   std::vector<std::optional<uint16_t>> requested(joints_.size());
 
@@ -171,10 +176,13 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
   // gate, so a command that waited for this lock is refused if the e-stop came meanwhile.
   bool written = false;
   const GateState gate = gate_.writeIfOpen(
-      [&] { return writer_ && writer_(protocol::body::encodeSyncWrite(targets)); }, &written);
+      [&] { return writer_ && writer_(protocol::body::encodeSyncWrite(targets)); }, &written,
+      generation);
   if (gate != GateState::kOpen) {
     ++stats_.motion_refused;
-    result.status = JointCommandStatus::kMotionRefused;
+    const bool voided = gate == GateState::kVoided;
+    if (voided) ++stats_.motion_voided;
+    result.status = voided ? JointCommandStatus::kMotionVoided : JointCommandStatus::kMotionRefused;
     return result;
   }
   if (!written) {
@@ -185,8 +193,18 @@ JointCommandResult BodyController::sendJointCommand(const std::vector<std::strin
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     if (requested[i]) last_commanded_ticks_[i] = requested[i];
   }
+  last_written_ = Clock::now();
   ++stats_.commands_sent;
   return result;
+}
+
+std::string BodyController::motionInForce(Clock::time_point now) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!last_written_ || now - *last_written_ >= kJointCommandMotion) return {};
+  char text[96];
+  std::snprintf(text, sizeof text, "joint command written %.2f s ago",
+                std::chrono::duration<double>(now - *last_written_).count());
+  return text;
 }
 
 std::optional<double> BodyController::lastCommandedPosition(std::size_t joint_index) const {

@@ -41,6 +41,7 @@ BodyStatus::Update BodyStatus::update(const BodyStats& stats, const protocol::Fr
   status.add("joint targets out of range", stats.joints_out_of_range);
   status.add("command write failures", stats.write_failures);
   status.add("commands refused when written (e_stop)", stats.motion_refused);
+  status.add("commands voided (e_stop engaged after they were accepted)", stats.motion_voided);
   status.add("port checksum errors", framer.checksum_errors);
   status.add("port bad tails", framer.bad_tails);
   status.add("port bytes skipped (resync)", framer.bytes_skipped);

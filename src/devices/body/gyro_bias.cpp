@@ -107,20 +107,28 @@ GyroBiasCalibrator::GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimi
 
 GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, Clock::time_point arrival,
                                         const GyroUnits& units, double seconds) {
-  bool wants_stillness = false;
+  bool after_gap = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    after_gap = !last_arrival_ || arrival - *last_arrival_ > limits_.max_telemetry_age;
     last_arrival_ = arrival;
-    wants_stillness = session_.has_value() || start_report_ != nullptr;
   }
-  // Asked without mutex_ held: the check takes the other devices' locks.
-  const std::string not_still = wants_stillness ? still_() : std::string();
+  // Asked on every frame, calibrating or not: the settle time counts from the end of a motion.
+  // Without mutex_ held: the check takes the other devices' locks.
+  const std::string not_still = still_();
   std::optional<GyroCalibrationOutcome> start_outcome;
   StartReport report;
   GyroVector bias{};
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!session_ && start_report_ && !cancelled_ && not_still.empty()) {
+    if (!not_still.empty()) {
+      still_since_.reset();
+      last_motion_ = not_still;
+    } else if (!still_since_ || after_gap) {
+      if (after_gap) last_motion_.clear();  // still since the gap, for all anyone knows
+      still_since_ = arrival;
+    }
+    if (!session_ && start_report_ && !cancelled_ && not_still.empty() && settledLocked(arrival)) {
       session_ = Session{
           "calibrate_on_start", arrival, arrival + fromSeconds(seconds), seconds, {}, {}, true};
     }
@@ -158,6 +166,9 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
             false};
   }
   if (!not_still.empty()) {
+    // Seen moving now, between frames maybe: the settle time counts from after this too.
+    still_since_.reset();
+    last_motion_ = not_still;
     return refuseLocked(how, "the robot is not held still (" + not_still + ")", units, true);
   }
   const Clock::time_point now = Clock::now();
@@ -170,6 +181,7 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
             : std::string("no frame received yet");
     return refuseLocked(how, "no IMU telemetry (" + since + ")", units, false);
   }
+  if (!settledLocked(now)) return refuseLocked(how, unsettledLocked(now), units, true);
   session_ = Session{how, now, now + fromSeconds(seconds), seconds, {}, {}, false};
   // Between frames too the robot may start moving (or telemetry stop while it moves): look every
   // 50 ms, not only when a frame arrives.
@@ -252,6 +264,26 @@ GyroCalibrationOutcome GyroBiasCalibrator::finishLocked(const Session& session,
               format("%g", session.seconds) +
               " s, subtracted from imu/data from now on; before: " + before,
           false};
+}
+
+bool GyroBiasCalibrator::settledLocked(Clock::time_point now) const {
+  return still_since_ && now - *still_since_ >= limits_.settle;
+}
+
+std::string GyroBiasCalibrator::unsettledLocked(Clock::time_point now) const {
+  const std::string settle =
+      format("%g", std::chrono::duration<double>(limits_.settle).count()) + " s";
+  // Unset: no frame has found it still since the motion the last one saw.
+  const std::string until =
+      still_since_
+          ? format("%.2f", std::chrono::duration<double>(now - *still_since_).count()) + " s ago"
+          : std::string("just now");
+  if (last_motion_.empty()) {
+    return "IMU telemetry (re)started only " + until + ": the robot must be seen still for " +
+           settle + " first (settle time)";
+  }
+  return "the robot was moving until " + until + " (" + last_motion_ + "); it must be still for " +
+         settle + " after the last motion (settle time)";
 }
 
 std::string GyroBiasCalibrator::inForceLocked(const GyroUnits& units) const {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
+
 namespace serial_robot_driver::device {
 
 ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events,
@@ -264,6 +266,13 @@ ServoStatus ServoBus::writeParam(uint8_t id, std::string_view param, int64_t val
 ServoStatus ServoBus::resetUserData(uint8_t id) { return safety_.resetUserData(id); }
 bool ServoBus::motionLocked() const { return safety_.motionLocked(); }
 std::vector<uint8_t> ServoBus::movingIds() const { return safety_.movingIds(); }
+std::string ServoBus::motionInForce() const {
+  const std::vector<uint8_t> moving = movingIds();
+  if (moving.empty()) return {};
+  return "servo(s) " + servoIdList(moving) +
+         " set moving and not stopped since (servo/spin mode 0, servo/hold or servo/relax stops "
+         "them)";
+}
 std::vector<uint8_t> ServoBus::commandedIds() const { return safety_.commandedIds(); }
 std::vector<PendingStopReport> ServoBus::pendingStops() const { return stops_.reports(); }
 std::vector<ServoHealthReport> ServoBus::health() const { return poller_.health(); }

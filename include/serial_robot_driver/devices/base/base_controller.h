@@ -53,7 +53,10 @@ struct BaseTuning {
   kinematics::DiffDriveGeometry geometry;
   double max_wheel_speed = 1.0;    ///< m/s; must be > 0 (no "no limit" value)
   double max_wheel_accel = 0.0;    ///< m/s^2; 0: no limit
-  double cmd_vel_timeout = 0.5;    ///< s without a command: zero speed
+  double cmd_vel_timeout = 0.5;    ///< s without a command: zero speed; > 0, <= the maximum
+  /// The longest cmd_vel_timeout (s): the deadman that stops the base when its client dies
+  /// (calibrate_base killed hard included) cannot be tuned away.
+  static constexpr double kMaxCmdVelTimeout = 5.0;
   bool speed_dithering = true;     ///< carry the tick remainder (false: vendor truncation)
   double battery_poll_rate = 1.0;  ///< Hz; 0: never ask
   /// Odometry's heading from the IMU yaw given to onImuYaw() while it is fresh (see
@@ -122,6 +125,8 @@ struct BaseStats {
   uint64_t cmd_vel_timeouts = 0;
   uint64_t rejected_commands = 0;             ///< NaN/Inf cmd_vel
   uint64_t ignored_commands_e_stop = 0;       ///< cmd_vel received while the e-stop was engaged
+  /// cmd_vel accepted before an e-stop that engaged before it was stored (even one released since)
+  uint64_t voided_commands = 0;
   uint64_t timeout_errors_while_running = 0;  ///< FF after the base had accepted our Reset
   std::optional<double> seconds_since_running_timeout_error;
   /// Battery polling on and requests unanswered: seconds since the first unanswered request.
@@ -154,18 +159,38 @@ struct BaseEvents {
   std::function<void(kinematics::HeadingSource)> on_heading_source;
 };
 
+/// What became of a cmd_vel (submitCommand()).
+enum class CommandOutcome {
+  kStored,        ///< obeyed from the next frame on
+  kNotFinite,     ///< NaN/Inf: zero speed commanded instead
+  kEStopEngaged,  ///< ignored: the e-stop is engaged
+  kVoided,        ///< ignored: an e-stop engaged after it was accepted (even if released since)
+};
+
 class BaseController : public LinkListener {
  public:
+  /// Counts the e-stop's engagements: a cmd_vel accepted under one never drives under a later one.
+  using Generation = uint64_t;
+
   /// `clock` empty: the steady clock.
   BaseController(BaseConfig config, FrameWriter writer, BaseEvents events = {},
                  std::shared_ptr<LoopClock> clock = {});
   ~BaseController() override;
 
-  /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded and false returned.
-  /// Ignored (and counted) while the e-stop is engaged.
-  bool setCommand(double linear_x, double angular_z);
-  /// Engaged: a zero-speed frame goes out at once (no ramp) and zero is held; frames keep flowing.
-  /// Released: the wheels stay still until the next cmd_vel.
+  /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded. Ignored (and
+  /// counted) while the e-stop is engaged, and when `accepted` (generation() when the command was
+  /// accepted, noted before its e-stop check) is older than the last engagement.
+  CommandOutcome submitCommand(double linear_x, double angular_z,
+                               std::optional<Generation> accepted = std::nullopt);
+  /// submitCommand() accepted now; false for NaN/Inf components.
+  bool setCommand(double linear_x, double angular_z) {
+    return submitCommand(linear_x, angular_z) != CommandOutcome::kNotFinite;
+  }
+  /// The e-stop generation a cmd_vel accepted now belongs to.
+  Generation generation() const;
+  /// Engaged: the command in force is dropped, a zero-speed frame goes out at once (no ramp) and
+  /// zero is held; frames keep flowing. Released: the wheels stay still until a cmd_vel accepted
+  /// after the release.
   void setEStop(bool engaged);
   /// Puts the odometry pose (and its covariance) back to zero; a fused heading restarts at zero
   /// too.
@@ -246,6 +271,7 @@ class BaseController : public LinkListener {
   std::optional<Clock::time_point> last_tick_;
   Clock::time_point next_battery_poll_{};
   bool e_stop_ = false;
+  Generation generation_ = 0;  ///< e-stop engagements so far
   BaseOdometry odometry_;  ///< not thread-safe: used under mutex_ (onImuYaw excepted)
   std::optional<Clock::time_point> last_reset_sent_;
   std::optional<Clock::time_point> unanswered_since_;  ///< first battery request with no reply yet

@@ -64,7 +64,13 @@ class TurnCalibrationRun {
   // What arrived since the last step (stamps in s of the tick's stamp_now clock).
   void addImuRate(double stamp, double yaw_rate);
   void addWheelFrame(double stamp, int16_t left_ticks, int16_t right_ticks);
+  /// The e-stop's state, from the e_stop topic (every message published on it) and the driver's
+  /// e_stop status. An engagement once the run has checked the e-stop, however short, ends it
+  /// with the base stopped: it never resumes after a release.
   void setEStopEngaged(bool engaged);
+  /// The driver's count of e-stop engagements (its e_stop status): a rise after the check is an
+  /// engagement the topic did not show (published before the tool subscribed, say).
+  void setEStopEngagements(uint64_t count);
   /// The distance the user typed; unset when none could be read.
   void setMeasuredDistance(std::optional<double> metres);
   /// An error outside the run (ROS): aborts, stopping the base if it may have moved.
@@ -105,6 +111,8 @@ class TurnCalibrationRun {
   void reportDiameter(double measured);
   /// Why a motion must not go on ("" when it may).
   std::string runningProblem() const;
+  /// Whether an e-stop engaged since the check (by its message or the driver's count).
+  bool eStopEngagedSinceCheck() const;
   void abort(const std::string& message, int exit_status);
   void finish(int exit_status);
   void enterPhase(Phase phase);
@@ -134,6 +142,10 @@ class TurnCalibrationRun {
   bool last_frame_zero_ = false;
   uint64_t zero_frames_ = 0;
   std::optional<bool> e_stop_engaged_;
+  bool e_stop_checked_ = false;  ///< the e-stop was found released before the first motion
+  bool e_stop_engaged_since_check_ = false;
+  std::optional<uint64_t> engagements_;           ///< the driver's count, latest
+  std::optional<uint64_t> engagements_at_check_;  ///< the driver's count when it was checked
   std::optional<std::optional<double>> measured_distance_;  ///< outer unset: not answered yet
 
   // The current hold.

@@ -7,6 +7,7 @@
 // stats (stats() returns a snapshot).
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -57,6 +58,9 @@ struct BodyStats {
   uint64_t commands_rejected = 0;    ///< invalid commands: nothing was written
   uint64_t write_failures = 0;       ///< valid commands the link refused (port down)
   uint64_t motion_refused = 0;       ///< valid commands the motion gate refused (e-stop, shutdown)
+  /// Of motion_refused: accepted before an e-stop that engaged before their write (even one
+  /// released since): an e-stop voids everything accepted before it.
+  uint64_t motion_voided = 0;
   uint64_t joints_out_of_range = 0;  ///< joint targets left out: beyond what the servo can reach
 };
 
@@ -70,6 +74,7 @@ enum class JointCommandStatus {
   kOutOfRange,      ///< every named joint was beyond its servo's reach: nothing written
   kWriteFailed,     ///< valid, but the link refused the frame (port down)
   kMotionRefused,   ///< valid, but the motion gate was locked (e-stop) or closed when written
+  kMotionVoided,    ///< valid, but an e-stop engaged after it was accepted (even if released)
 };
 
 /// What became of one joint command: the ROS layer logs message() (throttled) when !ok().
@@ -111,8 +116,12 @@ class BodyController : public LinkListener {
   /// addressed keeps whatever it is doing. An invalid command writes nothing and changes no stored
   /// position. A joint whose target the servo cannot reach is left out (its servo keeps its last
   /// commanded position) and listed in out_of_range; the other joints are sent.
+  ///
+  /// `accepted`: the gate's generation() when the command was accepted (before its e-stop check);
+  /// an e-stop engaged since voids it (kMotionVoided), released or not. Unset: accepted now.
   JointCommandResult sendJointCommand(const std::vector<std::string>& names,
-                                      const std::vector<double>& positions);
+                                      const std::vector<double>& positions,
+                                      std::optional<MotionGate::Generation> accepted = {});
 
   /// The gate every sync-write passes when it is written (see motion_gate.h): the e-stop locks
   /// it, the shutdown closes it.
@@ -120,6 +129,13 @@ class BodyController : public LinkListener {
   /// The position (rad) joint `joint_index` (frame order) was last commanded, i.e. what the
   /// board was last sent for it; nothing when it never was (or for an index beyond the joints).
   std::optional<double> lastCommandedPosition(std::size_t joint_index) const;
+
+  /// How long a written joint command counts as motion: the board's servos take their own time to
+  /// reach a target (a sensor calibration then waits its settle time on top).
+  static constexpr std::chrono::milliseconds kJointCommandMotion{500};
+  /// Why the joints may be moving at `now`: a joint command written less than kJointCommandMotion
+  /// before it; "" when none was. Any thread.
+  std::string motionInForce(Clock::time_point now) const;
 
   const std::vector<BodyJoint>& joints() const { return joints_; }
   std::size_t servoCount() const { return joints_.size(); }
@@ -134,6 +150,7 @@ class BodyController : public LinkListener {
 
   mutable std::mutex mutex_;  // guards the fields below
   std::vector<std::optional<uint16_t>> last_commanded_ticks_;
+  std::optional<Clock::time_point> last_written_;  ///< the last sync-write that went out
   BodyStats stats_;
 };
 

@@ -57,6 +57,11 @@ class BodyInterface : public DeviceInterface {
   void attachEStop(device::EStop& e_stop) override;
   /// The gyro is calibrated only while no device moves the robot (nor the e-stop is engaged).
   void setMotionQuery(MotionQuery query) override { motion_query_ = std::move(query); }
+  /// A joint command written lately (BodyController::motionInForce); trajectories answer for
+  /// themselves (the node asks its trajectory server).
+  std::string motionInForce() const override {
+    return controller_.motionInForce(device::Clock::now());
+  }
 
  private:
   void publishTelemetry(const protocol::body::Telemetry& telemetry,

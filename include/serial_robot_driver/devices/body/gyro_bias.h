@@ -37,6 +37,11 @@ struct GyroUnits {
   GyroVector toImuRadPerSecond(const GyroVector& raw) const;
 };
 
+/// How long the robot must have been seen still (nothing the node drives commanded to move, the
+/// e-stop released) before the gyro is averaged: a turn, a joint or a servo takes a moment to come
+/// to rest after its command ends, and a slow, smooth rotation would be stored as the bias.
+constexpr std::chrono::milliseconds kGyroSettleTime{1000};
+
 struct GyroCalibrationLimits {
   /// A mean above this on any axis (rad/s) is a turn, not a bias (gyro biases are a few mrad/s).
   double max_bias = 0.1;
@@ -46,6 +51,8 @@ struct GyroCalibrationLimits {
   std::size_t min_samples = 10;
   /// The newest IMU frame must be younger than this for telemetry to count as flowing.
   std::chrono::milliseconds max_telemetry_age{500};
+  /// Still for this long (every frame asks the stillness check) before the averaging starts.
+  std::chrono::milliseconds settle = kGyroSettleTime;
 };
 
 /// Mean and spread per axis of raw gyro samples (Welford's running update: no catastrophic
@@ -87,8 +94,8 @@ struct GyroCalibrationOutcome {
 class GyroBiasCalibrator {
  public:
   /// Why the robot is not held still now (a motion command in force, wheels ramping, the e-stop
-  /// engaged), or "" when it is. Thread-safe and cheap: it is asked once per IMU frame while a
-  /// calibration runs.
+  /// engaged), or "" when it is. Thread-safe and cheap: it is asked once per IMU frame (the
+  /// settle time counts from the first frame it answers "" after a motion).
   using StillnessCheck = std::function<std::string()>;
   /// calibrate_on_start's verdict, called once on the reader thread (log it).
   using StartReport = std::function<void(const GyroCalibrationOutcome&)>;
@@ -101,7 +108,8 @@ class GyroBiasCalibrator {
   GyroVector onSample(const GyroVector& raw, Clock::time_point arrival, const GyroUnits& units,
                       double seconds);
   /// Blocks the caller for `seconds` while the samples arrive, then keeps the bias found or
-  /// nothing (a refusal changes nothing in force). `how` names the request ("imu/calibrate").
+  /// nothing (a refusal changes nothing in force). Refused unless the robot has been seen still
+  /// for the settle time (limits). `how` names the request ("imu/calibrate").
   GyroCalibrationOutcome calibrate(double seconds, const GyroUnits& units, const std::string& how);
   /// Arms ~imu/calibrate_on_start: the first frames that arrive while the robot is still are
   /// averaged for `seconds` (onSample's), the result or refusal reported once through `report`; a
@@ -137,6 +145,10 @@ class GyroBiasCalibrator {
   /// Requires mutex_: the outcome of `session` (over), applied when it is a bias.
   GyroCalibrationOutcome finishLocked(const Session& session, const GyroUnits& units);
   std::string inForceLocked(const GyroUnits& units) const;
+  /// Whether the robot has been seen still for the settle time at `now`.
+  bool settledLocked(Clock::time_point now) const;
+  /// Why it has not (settledLocked() false).
+  std::string unsettledLocked(Clock::time_point now) const;
   GyroCalibrationOutcome refuseLocked(const std::string& how, const std::string& why,
                                       const GyroUnits& units, bool not_still);
 
@@ -147,6 +159,10 @@ class GyroBiasCalibrator {
   std::optional<InForce> in_force_;
   std::optional<Session> session_;
   std::optional<Clock::time_point> last_arrival_;
+  /// Since when every frame found the robot still (the end of the last motion, or the first frame
+  /// after a telemetry gap: what happened in the gap is unknown); unset while it moves.
+  std::optional<Clock::time_point> still_since_;
+  std::string last_motion_;   ///< what moved last, when still_since_ is the end of a motion
   std::string last_refusal_;  ///< since the last good calibration
   StartReport start_report_;  ///< set while calibrate_on_start waits for its result
   bool cancelled_ = false;

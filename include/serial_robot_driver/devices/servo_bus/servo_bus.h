@@ -50,6 +50,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <string_view>
 #include <thread>
 #include <vector>
@@ -125,6 +126,9 @@ class ServoBus : public LinkListener, public LinkWorker {
   bool motionLocked() const;
   /// Servos set spinning or moving and not stopped or relaxed since (the broadcast id 255 too).
   std::vector<uint8_t> movingIds() const;
+  /// Why the bus servos may be moving the robot: the servos set moving (movingIds()), "" when
+  /// none is. Any thread, cheap.
+  std::string motionInForce() const;
   /// Servos set moving or positioned since start-up and not relaxed since: what the e-stop and
   /// the shutdown stop.
   std::vector<uint8_t> commandedIds() const;

@@ -95,6 +95,8 @@ class ServoBusInterface : public DeviceInterface {
   void retune(const DriverParams& params) override;
   /// ~servo_bus/joint_ids as trajectory joints: one queued move per segment.
   std::vector<TrajectoryJoints> trajectoryJoints() override;
+  /// The servos set moving (device::ServoBus::motionInForce()).
+  std::string motionInForce() const override { return bus_.motionInForce(); }
   void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
   /// Engaged: queued moves dropped, a SPIN stop to every servo the driver set moving; motion
   /// services and servo_commands refused until it is released (reads, pings, scans still work).

@@ -117,13 +117,23 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
 }
 
 void BaseInterface::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg) {
+  // Accepted now: noted before the e-stop check, so an e-stop from here on voids it.
+  const device::BaseController::Generation accepted = controller_.generation();
   // Counted with the other refused commands; the controller ignores it (and counts it) itself.
   if (e_stop_) e_stop_->refuse("cmd_vel");
-  if (!controller_.setCommand(msg->linear.x, msg->angular.z)) {
-    inputRefusals().refused("cmd_vel");
-    ROS_WARN_THROTTLE(
-        1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
-        msg->linear.x, msg->angular.z);
+  switch (controller_.submitCommand(msg->linear.x, msg->angular.z, accepted)) {
+    case device::CommandOutcome::kNotFinite:
+      inputRefusals().refused("cmd_vel");
+      ROS_WARN_THROTTLE(
+          1.0, "cmd_vel rejected: linear.x=%f angular.z=%f is not finite; commanding zero speed",
+          msg->linear.x, msg->angular.z);
+      break;
+    case device::CommandOutcome::kVoided:
+      ROS_WARN_THROTTLE(1.0, "cmd_vel ignored: e-stop engaged after this command was accepted");
+      break;
+    case device::CommandOutcome::kStored:
+    case device::CommandOutcome::kEStopEngaged:
+      break;
   }
 }
 

@@ -30,6 +30,10 @@ struct FakeRobot {
   double slip = 0.15;         ///< the chassis turns by (1 - slip) of the commanded turn
   double gyro_bias = 0.01;    ///< rad/s in every IMU sample
   bool e_stop = false;        ///< the driver writes zero frames; reported on "diagnostics"
+  /// The tool sees the e-stop's state (false: it always looks released; an engagement only the
+  /// driver's count shows).
+  bool e_stop_visible = true;
+  uint64_t engagements = 0;   ///< the driver's count of engagements (its e_stop status)
   bool telemetry = true;      ///< IMU samples arrive
   bool frames = true;         ///< the driver writes wheel frames
   bool ignores_zero = false;  ///< a wedged driver: keeps writing the last moving frame
@@ -61,7 +65,10 @@ struct FakeRobot {
       const double commanded_rate = (right - left) / kTicksPerPeriodPerMps / kSeparation;
       if (telemetry) run.addImuRate(next_imu_, commanded_rate * (1 - slip) + gyro_bias);
     }
-    run.setEStopEngaged(e_stop);
+    if (e_stop && !was_engaged_) ++engagements;
+    was_engaged_ = e_stop;
+    run.setEStopEngaged(e_stop && e_stop_visible);
+    run.setEStopEngagements(engagements);
   }
   /// Seconds the base has been moving at `t` (0 before).
   double movingFor(double t) const { return first_moving_frame ? t - *first_moving_frame : 0; }
@@ -69,6 +76,7 @@ struct FakeRobot {
  private:
   double next_frame_ = 0.0;
   double next_imu_ = 0.003;
+  bool was_engaged_ = false;
 };
 
 struct Outcome {

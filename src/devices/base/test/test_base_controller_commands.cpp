@@ -240,6 +240,37 @@ TEST_F(BaseControllerTest, EStopZeroesAtOnceIgnoresCmdVelAndKeepsTheHeartbeat) {
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{4, 4}));  // 4.07 ticks
 }
 
+// An e-stop voids everything accepted before it: the command in force is dropped when it engages
+// (however short it is), and a cmd_vel accepted before it (its generation noted before the e-stop
+// check) never drives after the release; only one accepted after the release does.
+TEST_F(BaseControllerTest, ACmdVelAcceptedBeforeAnEStopNeverDrivesAfterTheRelease) {
+  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
+  clock_->tick(2);
+  ASSERT_GT(sent_.back().ticks.left, 0);
+  const BaseController::Generation accepted = controller_.generation();
+  clock_->advance(milliseconds(5));
+  // Engaged and released between two ticks.
+  clock_->step([&] {
+    controller_.setEStop(true);
+    controller_.setEStop(false);
+  });
+  EXPECT_EQ(controller_.motionInForce(), "") << "the command in force was dropped";
+  clock_->advance(milliseconds(5));
+  // Voided: it does not even wake the loop.
+  CommandOutcome outcome = controller_.submitCommand(0.5, 0.0, accepted);
+  EXPECT_EQ(outcome, CommandOutcome::kVoided);
+  EXPECT_EQ(controller_.stats().voided_commands, 1u);
+  const std::size_t after_release = sent_.size();
+  clock_->tick(10);
+  for (std::size_t i = after_release; i < sent_.size(); ++i) {
+    EXPECT_EQ(sent_[i].ticks, (kinematics::WheelTicks{0, 0})) << "frame " << i;
+  }
+  clock_->advance(milliseconds(5));
+  clock_->step([&] { outcome = controller_.submitCommand(0.1, 0.0, controller_.generation()); });
+  EXPECT_EQ(outcome, CommandOutcome::kStored);
+  EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{4, 4}));
+}
+
 TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
   BaseConfig config;
   config.battery_poll_rate = 0;

@@ -36,6 +36,8 @@ TEST(BaseStatus, ARunningBaseIsDrivingWithEveryCounter) {
                                                       "immediate frames (new cmd_vel)",
                                                       "e-stop engaged",
                                                       "cmd_vel ignored (e-stop)",
+                                                      "cmd_vel voided (e-stop engaged after it "
+                                                      "was accepted)",
                                                       "resets sent",
                                                       "FF timeout errors received",
                                                       "FF timeout errors while running",

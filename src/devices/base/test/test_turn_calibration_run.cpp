@@ -134,6 +134,65 @@ TEST(TurnCalibrationRun, TheEStopMidTurnStopsAtOnceAndEndsRefused) {
   EXPECT_FALSE(contains(outcome.out, "effective wheel_separation"));
 }
 
+// An e-stop of 0.3 s mid-turn (far shorter than a diagnostics period): the run ends with the base
+// stopped and never resumes the turn after the release.
+TEST(TurnCalibrationRun, ABriefEStopMidTurnEndsTheRunForGood) {
+  FakeRobot robot;
+  MidTurn mid;
+  mid.act = [](FakeRobot& r) { r.e_stop = true; };
+  auto run = makeRun();
+  const Outcome outcome = runToEnd(run, robot, [&](double t, FakeRobot& r) {
+    if (mid.at >= 0 && t >= mid.at + 0.3) r.e_stop = false;  // released
+    return mid.script()(t, r);
+  });
+  ASSERT_GE(mid.at, 0);
+  EXPECT_EQ(outcome.exit_status, 1);
+  EXPECT_TRUE(contains(outcome.err,
+                       "calibrate_base: aborted: the e-stop engaged; the run never resumes after "
+                       "a release"))
+      << outcome.err;
+  expectStoppedAtOnce(outcome, mid.at);
+  EXPECT_FALSE(contains(outcome.out, "turning counter-clockwise: done"));
+}
+
+// Engaged and released between two of the tool's looks: only the driver's count of engagements
+// shows it. The run ends all the same.
+TEST(TurnCalibrationRun, AnEngagementOnlyTheDriversCountShowsEndsTheRun) {
+  FakeRobot robot;
+  robot.e_stop_visible = false;
+  MidTurn mid;
+  mid.act = [](FakeRobot& r) { ++r.engagements; };
+  auto run = makeRun();
+  const Outcome outcome = runToEnd(run, robot, mid.script());
+  ASSERT_GE(mid.at, 0);
+  EXPECT_EQ(outcome.exit_status, 1);
+  EXPECT_TRUE(contains(outcome.err, "calibrate_base: aborted: the e-stop engaged")) << outcome.err;
+  expectStoppedAtOnce(outcome, mid.at);
+}
+
+// Between the turns the run holds the base still; an e-stop then (engaged for one step) ends it
+// too: the clockwise turn never starts.
+TEST(TurnCalibrationRun, AnEStopDuringTheHoldBetweenTheTurnsEndsTheRun) {
+  FakeRobot robot;
+  double at = -1;
+  auto run = makeRun();
+  const Outcome outcome = runToEnd(run, robot, [&](double t, FakeRobot& r) {
+    const bool holding = r.first_moving_frame && r.command.angular == 0 && r.left == 0;
+    if (at < 0 && holding) {
+      at = t;
+      r.e_stop = true;
+    } else if (at >= 0) {
+      r.e_stop = false;
+    }
+    return 0;
+  });
+  ASSERT_GE(at, 0);
+  EXPECT_EQ(outcome.exit_status, 1);
+  EXPECT_TRUE(contains(outcome.err, "calibrate_base: aborted: the e-stop engaged")) << outcome.err;
+  EXPECT_FALSE(outcome.anyMovingCommandFrom(at));
+  EXPECT_FALSE(contains(outcome.out, "turning clockwise: done"));
+}
+
 TEST(TurnCalibrationRun, TelemetryLostMidTurnStopsAndEndsRefused) {
   FakeRobot robot;
   MidTurn mid;

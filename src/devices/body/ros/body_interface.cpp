@@ -151,6 +151,8 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
 }
 
 void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
+  // Accepted now: noted before the e-stop check, so an e-stop from here on voids it.
+  const device::MotionGate::Generation accepted = controller_.gate().generation();
   if (e_stop_ && e_stop_->refuse("joint_commands")) {
     ROS_WARN_THROTTLE(1.0, "joint_commands refused: e_stop is engaged");
     return;
@@ -158,7 +160,7 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   const JointCommand command = fromJointState(*msg);
   device::JointCommandResult result;
   const auto send = [&] {
-    result = controller_.sendJointCommand(command.names, command.positions);
+    result = controller_.sendJointCommand(command.names, command.positions, accepted);
     return result.ok();
   };
   // A joint under a trajectory is taken over by this command, and its goal aborted.

@@ -377,6 +377,41 @@ TEST_F(BodyControllerCommand, RefusedWriteIsReportedAndCounted) {
   EXPECT_EQ(stats.commands_rejected, 0u);
 }
 
+// An e-stop voids everything accepted before it: a command accepted before an e-stop and written
+// after its release is dropped, said and counted; one accepted after the release goes out.
+TEST_F(BodyControllerCommand, ACommandAcceptedBeforeAnEStopIsVoidedEvenAfterTheRelease) {
+  const MotionGate::Generation accepted = controller_.gate().generation();
+  controller_.gate().setLocked(true);
+  controller_.gate().setLocked(false);
+  const JointCommandResult result = controller_.sendJointCommand({"hip"}, {0.0}, accepted);
+  EXPECT_EQ(result.status, JointCommandStatus::kMotionVoided);
+  EXPECT_EQ(result.message(),
+            "joint command not written: e-stop engaged after this command was accepted");
+  EXPECT_TRUE(written_.empty());
+  EXPECT_EQ(controller_.stats().motion_refused, 1u);
+  EXPECT_EQ(controller_.stats().motion_voided, 1u);
+  EXPECT_EQ(controller_.gate().refusedAtWrite(), 1u);
+  EXPECT_FALSE(controller_.lastCommandedPosition(0)) << "nothing stored for a voided command";
+
+  const MotionGate::Generation fresh = controller_.gate().generation();
+  EXPECT_TRUE(controller_.sendJointCommand({"hip"}, {0.0}, fresh).ok());
+  EXPECT_TRUE(controller_.sendJointCommand({"hip"}, {0.1}).ok()) << "unset: accepted now";
+  EXPECT_EQ(written_.size(), 2u);
+}
+
+TEST_F(BodyControllerCommand, AWrittenCommandCountsAsMotionForAWhile) {
+  EXPECT_EQ(controller_.motionInForce(Clock::now()), "") << "never commanded";
+  ASSERT_TRUE(controller_.sendJointCommand({"hip"}, {0.0}).ok());
+  const Clock::time_point now = Clock::now();
+  EXPECT_EQ(controller_.motionInForce(now).rfind("joint command written 0.", 0), 0u)
+      << controller_.motionInForce(now);
+  EXPECT_EQ(controller_.motionInForce(now + BodyController::kJointCommandMotion), "");
+  controller_.gate().setLocked(true);
+  ASSERT_FALSE(controller_.sendJointCommand({"hip"}, {0.2}).ok());
+  EXPECT_EQ(controller_.motionInForce(now + BodyController::kJointCommandMotion), "")
+      << "a refused command moves nothing";
+}
+
 TEST(BodyControllerCommandNoSink, MissingWriterIsAWriteFailure) {
   BodyController controller(twoJoints(), nullptr);
   EXPECT_EQ(controller.sendJointCommand({"hip"}, {0.0}).status, JointCommandStatus::kWriteFailed);

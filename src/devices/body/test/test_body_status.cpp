@@ -83,6 +83,7 @@ TEST(BodyStatus, ListsTheCountersAndTheFramersErrors) {
                       "port", "connected", "frames decoded", "decode errors", "last decode error",
                       "commands sent", "commands rejected", "joint targets out of range",
                       "command write failures", "commands refused when written (e_stop)",
+                      "commands voided (e_stop engaged after they were accepted)",
                       "port checksum errors", "port bad tails", "port bytes skipped (resync)"}));
   EXPECT_EQ(*status.find("frames decoded"), "7");
   EXPECT_EQ(*status.find("last decode error"), "none");

@@ -82,10 +82,23 @@ TEST(GyroBiasDescription, InRadAndDegPerSecondOnTheImuAxes) {
             "(0.015, 0.02, 0.03) rad/s = (0.8594, 1.146, 1.719) deg/s");
 }
 
+/// Limits without the settle time, for the tests about everything else.
+GyroCalibrationLimits noSettle() {
+  GyroCalibrationLimits limits;
+  limits.settle = milliseconds(0);
+  return limits;
+}
+
 /// A calibrator whose stillness the test sets, fed by a thread that plays a board streaming at
 /// 200 Hz (arrival = now), the way the body port's reader thread does.
 class GyroCalibratorTest : public ::testing::Test {
  protected:
+  explicit GyroCalibratorTest(GyroCalibrationLimits limits = noSettle())
+      : calibrator_{[this] {
+                      std::lock_guard<std::mutex> lock(still_mutex_);
+                      return not_still_;
+                    },
+                    limits} {}
   ~GyroCalibratorTest() override { stopStreaming(); }
 
   void startStreaming(GyroVector raw) {
@@ -102,6 +115,7 @@ class GyroCalibratorTest : public ::testing::Test {
           raw = raw_;
         }
         in_force_seen_ = calibrator_.onSample(raw, Clock::now(), kUnits, 0.3)[2];
+        ++frames_fed_;
         std::this_thread::sleep_for(milliseconds(5));
       }
     });
@@ -121,13 +135,16 @@ class GyroCalibratorTest : public ::testing::Test {
   GyroVector raw_{};
   std::atomic<bool> streaming_{false};
   std::atomic<double> in_force_seen_{-1e9};  ///< z of the bias onSample returned last
+  std::atomic<int> frames_fed_{0};
+  /// Waits until `count` more frames have been fed.
+  void waitFrames(int count) {
+    const int until = frames_fed_ + count;
+    while (frames_fed_ < until) std::this_thread::yield();
+  }
   std::thread feeder_;
   std::mutex still_mutex_;
   std::string not_still_;  ///< what the stillness check answers
-  GyroBiasCalibrator calibrator_{[this] {
-    std::lock_guard<std::mutex> lock(still_mutex_);
-    return not_still_;
-  }};
+  GyroBiasCalibrator calibrator_;
   void setNotStill(const std::string& why) {
     std::lock_guard<std::mutex> lock(still_mutex_);
     not_still_ = why;
@@ -176,6 +193,7 @@ TEST_F(GyroCalibratorTest, RefusedWhileNotStillAndWhenMotionStartsDuringTheAvera
   EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
 
   setNotStill("");
+  waitFrames(2);  // seen still again
   std::thread mover([this] {
     std::this_thread::sleep_for(milliseconds(100));
     setNotStill("the e-stop is engaged");
@@ -229,9 +247,71 @@ TEST_F(GyroCalibratorTest, CancelEndsAWaitingCalibrationAtOnce) {
   EXPECT_LT(Clock::now() - start, std::chrono::seconds(20)) << "not the whole 30 s";
 }
 
+/// The same, with a settle time of 0.3 s.
+class GyroSettleTest : public GyroCalibratorTest {
+ protected:
+  static GyroCalibrationLimits settling() {
+    GyroCalibrationLimits limits;
+    limits.settle = milliseconds(300);
+    return limits;
+  }
+  GyroSettleTest() : GyroCalibratorTest(settling()) {}
+};
+
+// A slow rotation that just ended is not a bias: refused until the robot has been seen still for
+// the settle time, the refusal naming what moved last; then it calibrates.
+TEST_F(GyroSettleTest, RefusedRightAfterAMotionEndsUntilTheSettleTimeHasPassed) {
+  setNotStill("servo_bus: servo(s) 1 set moving");
+  startStreaming({20, -15, 30});
+  waitFrames(3);  // they see it moving
+  setNotStill("");
+  waitFrames(2);  // and then still
+  GyroCalibrationOutcome outcome = calibrator_.calibrate(0.1, kUnits, "imu/calibrate");
+  EXPECT_FALSE(outcome.success);
+  EXPECT_TRUE(outcome.not_still);
+  EXPECT_TRUE(contains(outcome.message, "the robot was moving until 0.")) << outcome.message;
+  EXPECT_TRUE(contains(outcome.message,
+                       "(servo_bus: servo(s) 1 set moving); it must be still for 0.3 s after the "
+                       "last motion (settle time)"))
+      << outcome.message;
+  EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
+  // Once settled it goes through (waited for, bounded).
+  const auto give_up = Clock::now() + std::chrono::seconds(10);
+  while (!outcome.success && outcome.not_still && Clock::now() < give_up) {
+    outcome = calibrator_.calibrate(0.1, kUnits, "imu/calibrate");
+  }
+  EXPECT_TRUE(outcome.success) << outcome.message;
+}
+
+TEST(GyroCalibrateOnStart, StartsOnlyOnceTheRobotHasBeenStillForTheSettleTime) {
+  std::string not_still = "body: joint command written 0.10 s ago";
+  GyroCalibrationLimits limits;
+  limits.settle = milliseconds(400);
+  GyroBiasCalibrator calibrator([&] { return not_still; }, limits);
+  int reports = 0;
+  calibrator.calibrateOnStart([&](const GyroCalibrationOutcome&) { ++reports; });
+  const Clock::time_point t0{};
+  int frame = 0;
+  const auto feed = [&](int count, GyroVector raw) {
+    for (int i = 0; i < count; ++i, ++frame) {
+      calibrator.onSample(raw, t0 + milliseconds(10 * frame), kUnits, 0.5);
+    }
+  };
+  feed(10, {300, 0, 0});  // moving
+  not_still = "";
+  // Still from frame 10 on: the settle time ends at frame 50, the averaging then takes 0.5 s;
+  // the samples before it (the slow end of the motion, 300) are not averaged.
+  feed(40, {300, 0, 0});
+  feed(50, {5, 6, 7});
+  EXPECT_EQ(reports, 0) << "the averaging has only just run its 0.5 s";
+  feed(5, {5, 6, 7});
+  ASSERT_EQ(reports, 1);
+  EXPECT_EQ(calibrator.bias(), (GyroVector{5, 6, 7}));
+}
+
 TEST(GyroCalibrateOnStart, WaitsForStillnessRestartsOnMotionAndReportsOnce) {
   std::string not_still = "base: wheels still ramping (0.1, 0.1 m/s)";
-  GyroBiasCalibrator calibrator([&] { return not_still; });
+  GyroBiasCalibrator calibrator([&] { return not_still; }, noSettle());
   int reports = 0;
   GyroCalibrationOutcome reported;
   calibrator.calibrateOnStart([&](const GyroCalibrationOutcome& outcome) {
@@ -264,7 +344,7 @@ TEST(GyroCalibrateOnStart, WaitsForStillnessRestartsOnMotionAndReportsOnce) {
 }
 
 TEST(GyroCalibrateOnStart, ARefusalOtherThanMotionIsReportedOnceAndNotRetried) {
-  GyroBiasCalibrator calibrator([] { return std::string(); });
+  GyroBiasCalibrator calibrator([] { return std::string(); }, noSettle());
   int reports = 0;
   std::string message;
   calibrator.calibrateOnStart([&](const GyroCalibrationOutcome& outcome) {
@@ -281,7 +361,7 @@ TEST(GyroCalibrateOnStart, ARefusalOtherThanMotionIsReportedOnceAndNotRetried) {
 }
 
 TEST(GyroBiasStatus, ShowsTheBiasInForceAndWarnsAboutARefusalUntilAGoodCalibration) {
-  GyroBiasCalibrator calibrator([] { return std::string(); });
+  GyroBiasCalibrator calibrator([] { return std::string(); }, noSettle());
   StatusReport before;
   calibrator.report(before, kUnits);
   EXPECT_EQ(before.level, StatusLevel::kOk);

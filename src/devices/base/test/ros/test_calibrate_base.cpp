@@ -2,7 +2,7 @@
 // 0.15: the real turn is 85 % of the commanded one) and driver_node. It recovers the effective
 // separation 0.40 / 0.85, is refused with the e-stop engaged and without telemetry, and a SIGINT
 // mid-turn stops the base (the tool's own stop: the driver's cmd_vel_timeout is 5 s here) and
-// ends the tool promptly with a non-zero status.
+// ends the tool promptly with a non-zero status, and so does a 0.3 s e-stop mid-turn, for good.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <std_msgs/Bool.h>
@@ -114,6 +114,46 @@ TEST_F(CalibrateBase, RefusedWithTheEStopEngaged) {
   EXPECT_EQ(tool.output().find("turning counter-clockwise"), std::string::npos) << tool.output();
   EXPECT_FALSE(frames.empty());
   EXPECT_EQ(movingFrames(frames), 0u);
+}
+
+// An e-stop of 0.3 s mid-turn, far shorter than a diagnostics period: the run ends, the base comes
+// to rest and stays there: no non-zero wheel frame from the engagement on, after the release too.
+TEST_F(CalibrateBase, ABriefEStopMidTurnEndsTheRunAndTheTurnNeverResumes) {
+  ros::Publisher e_stop = nh_.advertise<std_msgs::Bool>("e_stop", 10);
+  ASSERT_TRUE(test_support::waitFor([&] { return e_stop.getNumSubscribers() >= 1; }, 10.0));
+  const uint64_t before = frames_.count();
+  ChildProcess tool(toolPath(), {"--angle", "30", "--rate", "1.0"});
+  ASSERT_TRUE(
+      test_support::waitFor([&] { return movingFrames(frames_.since(before)) >= 25; }, 30.0))
+      << tool.output();
+  // The tool subscribes to e_stop too (the driver and the tool: two subscribers).
+  ASSERT_TRUE(test_support::waitFor([&] { return e_stop.getNumSubscribers() >= 2; }, 10.0));
+  std_msgs::Bool msg;
+  msg.data = true;
+  e_stop.publish(msg);
+  // The engagement reached the driver: its frames are zero from here on.
+  ASSERT_TRUE(test_support::waitFor(
+      [&] {
+        const auto last = frames_.last();
+        return last && isZero(*last);
+      },
+      5.0));
+  const uint64_t engaged = frames_.count();
+  ros::WallDuration(0.3).sleep();  // the e-stop's length, not a wait for a condition
+  msg.data = false;
+  e_stop.publish(msg);
+  const int status = runTool(tool, 10.0);
+  EXPECT_EQ(status, 1) << tool.output();
+  EXPECT_NE(tool.output().find("aborted: the e-stop engaged"), std::string::npos)
+      << tool.output();
+  EXPECT_NE(tool.output().find("base stopped (a zero wheel frame was written)"), std::string::npos)
+      << tool.output();
+  // 2 s of frames after the release (the base's own cmd_vel_timeout is 5 s here): all zero.
+  const uint64_t now = frames_.count();
+  ASSERT_TRUE(frames_.waitForCount(now + 100, 10.0));
+  EXPECT_EQ(movingFrames(frames_.since(engaged)), 0u);
+  EXPECT_EQ(simStat("last_left_speed"), 0.0);
+  EXPECT_EQ(simStat("last_right_speed"), 0.0);
 }
 
 TEST_F(CalibrateBase, RefusedWithoutTelemetry) {

@@ -9,6 +9,7 @@
 #include <sensor_msgs/Imu.h>
 #include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
+#include <trajectory_msgs/JointTrajectory.h>
 
 #include <array>
 #include <atomic>
@@ -18,6 +19,7 @@
 #include <thread>
 
 #include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/devices/body/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
@@ -39,16 +41,17 @@ bool contains(const std::string& text, const std::string& part) {
 
 /// One driver_node (in namespace `ns`) and the simulated robot on its port.
 struct Robot {
-  Robot(ros::NodeHandle& nh, const std::string& ns, double telemetry_rate)
+  Robot(ros::NodeHandle& nh, const std::string& ns, double telemetry_rate, bool servo_bus = false)
       : imu(nh, "/" + ns + "/imu/data", 500), diagnostics(nh, ns + "/driver_node"), ns_(ns) {
     sim::SimOptions options;
     options.link = test_support::nodeParam("/" + ns + "/driver_node", "port");
-    options.device("servo_bus").enabled = false;
+    options.device("servo_bus").enabled = servo_bus;
     bodyConfig(options).telemetry_rate_hz = telemetry_rate;
     bodyConfig(options).gyro_bias = kBias;
     robot = std::make_unique<sim::RobotSim>(options);
     robot->start();
     cmd_vel = nh.advertise<geometry_msgs::Twist>("/" + ns + "/cmd_vel", 10);
+    trajectory = nh.advertise<trajectory_msgs::JointTrajectory>("/" + ns + "/joint_trajectory", 10);
     e_stop = nh.advertise<std_msgs::Bool>("/" + ns + "/e_stop", 10, true);
   }
   ~Robot() { robot->stop(); }
@@ -89,6 +92,26 @@ struct Robot {
   bool waitMoving() {
     return waitFor([&] { return baseStats(robot->stats()).last_left_speed != 0; }, 10);
   }
+  /// servo/spin of servo 1: mode 1 spins, mode 0 stops.
+  bool spin(uint8_t mode) {
+    serial_robot_driver::ServoSpin call;
+    call.request.id = 1;
+    call.request.mode = mode;
+    call.request.speed_dps = 60;
+    EXPECT_TRUE(ros::service::waitForService("/" + ns_ + "/servo/spin", ros::Duration(20)));
+    return ros::service::call("/" + ns_ + "/servo/spin", call) && call.response.success;
+  }
+  /// Calls imu/calibrate until its answer contains `part` (each refusal answers at once).
+  std_srvs::Trigger::Response calibrateUntil(const std::string& part, double seconds) {
+    std_srvs::Trigger::Response response;
+    waitFor(
+        [&] {
+          response = calibrate();
+          return contains(response.message, part);
+        },
+        seconds);
+    return response;
+  }
   /// Waits until the simulated wheels stand still and the node's cmd_vel timeout has passed.
   bool waitStill() {
     const bool still = waitFor(
@@ -97,7 +120,8 @@ struct Robot {
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10);
-    std::this_thread::sleep_for(std::chrono::milliseconds(700));  // cmd_vel_timeout 0.5 s
+    // cmd_vel_timeout 0.5 s, then imu/calibrate's settle time of 1 s.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1700));
     return still;
   }
   std::string bodyValue(const std::string& key) const {
@@ -109,6 +133,7 @@ struct Robot {
   test_support::DiagnosticsWatch diagnostics;
   ros::Publisher cmd_vel;
   ros::Publisher e_stop;
+  ros::Publisher trajectory;
 
  private:
   std::string ns_;
@@ -127,23 +152,26 @@ class GyroCalibrationTest : public ::testing::Test {
   static void SetUpTestSuite() {
     nh_ = std::make_unique<ros::NodeHandle>();
     manual_ = std::make_unique<Robot>(*nh_, "manual", 50.0);
+    motion_ = std::make_unique<Robot>(*nh_, "motion", 50.0, true);
     on_start_ = std::make_unique<Robot>(*nh_, "on_start", 50.0);
     silent_ = std::make_unique<Robot>(*nh_, "silent", 0.0);
   }
   static void TearDownTestSuite() {
     manual_.reset();
+    motion_.reset();
     on_start_.reset();
     silent_.reset();
     nh_.reset();
   }
 
   static std::unique_ptr<ros::NodeHandle> nh_;
-  static std::unique_ptr<Robot> manual_, on_start_, silent_;
+  static std::unique_ptr<Robot> manual_, motion_, on_start_, silent_;
 };
 
 std::unique_ptr<ros::NodeHandle> GyroCalibrationTest::nh_;
 std::unique_ptr<Robot> GyroCalibrationTest::manual_;
 std::unique_ptr<Robot> GyroCalibrationTest::on_start_;
+std::unique_ptr<Robot> GyroCalibrationTest::motion_;
 std::unique_ptr<Robot> GyroCalibrationTest::silent_;
 
 TEST_F(GyroCalibrationTest, CalibrateRemovesTheBiasAndRefusesWhenTheRobotIsNotStill) {
@@ -189,7 +217,8 @@ TEST_F(GyroCalibrationTest, CalibrateRemovesTheBiasAndRefusesWhenTheRobotIsNotSt
   ASSERT_TRUE(waitFor([&] { return !robot.bodyValue("gyro calibration refused").empty(); }, 5));
   EXPECT_EQ(robot.diagnostics.latest("body").level, diagnostic_msgs::DiagnosticStatus::WARN);
   ASSERT_TRUE(test_support::setEStopAndWait(robot.e_stop, robot.diagnostics, false, 10));
-  expectNear(robot.meanRate(0.5), kBias, kLsbTolerance, "refusals changed nothing");
+  // Also the settle time (1 s) after the release.
+  expectNear(robot.meanRate(1.2), kBias, kLsbTolerance, "refusals changed nothing");
 
   // Still: the bias is found and subtracted from then on.
   response = robot.calibrate();
@@ -219,6 +248,48 @@ TEST_F(GyroCalibrationTest, CalibrateRemovesTheBiasAndRefusesWhenTheRobotIsNotSt
   EXPECT_TRUE(contains(response.message, "unchanged: (0.02")) << response.message;
   ASSERT_TRUE(robot.waitStill());
   expectNear(robot.meanRate(1.0), {0, 0, 0}, 1e-3, "after a refused calibration");
+}
+
+// Not only the base: a body trajectory and a spinning bus servo are motion too, and a motion that
+// just ended needs its settle time before the gyro is averaged.
+TEST_F(GyroCalibrationTest, RefusedDuringABodyTrajectoryAndABusSpinAndRightAfterTheSpinStops) {
+  Robot& robot = *motion_;
+  ASSERT_TRUE(robot.imu.waitForCount(10, 30)) << "no imu/data from motion/driver_node";
+  ASSERT_TRUE(waitFor([&] { return robot.trajectory.getNumSubscribers() > 0; }, 10));
+  trajectory_msgs::JointTrajectory slow;  // 3 s for 0.3 rad: a slow, smooth motion
+  slow.joint_names = {"joint_1"};
+  slow.points.resize(1);
+  slow.points[0].positions = {0.3};
+  slow.points[0].time_from_start = ros::Duration(3.0);
+  robot.trajectory.publish(slow);
+  std_srvs::Trigger::Response response = robot.calibrateUntil("not held still (", 5);
+  EXPECT_FALSE(response.success);
+  EXPECT_TRUE(contains(response.message, "body: joint command written") ||
+              contains(response.message, "trajectories: trajectory in progress ('joint_1')"))
+      << response.message;
+  // The trajectory ends (3 s), and its last joint command counts as motion for 0.5 s: then the
+  // settle time, naming what moved.
+  response = robot.calibrateUntil("the robot was moving until", 10);
+  EXPECT_FALSE(response.success);
+  EXPECT_TRUE(contains(response.message, "(body: joint command written")) << response.message;
+
+  ASSERT_TRUE(robot.spin(1));
+  response = robot.calibrateUntil("servo_bus: servo(s) 1 set moving", 10);
+  EXPECT_FALSE(response.success);
+  EXPECT_TRUE(contains(response.message, "not held still (servo_bus: servo(s) 1 set moving"))
+      << response.message;
+  // Stopped: refused at once all the same, for the settle time after the motion.
+  ASSERT_TRUE(robot.spin(0));
+  response = robot.calibrate();
+  EXPECT_FALSE(response.success);
+  EXPECT_TRUE(contains(response.message, "(servo_bus: servo(s) 1 set moving"))
+      << response.message;
+  EXPECT_TRUE(contains(response.message, "it must be still for 1 s after the last motion"))
+      << response.message;
+  EXPECT_TRUE(contains(response.message, "unchanged: not calibrated")) << response.message;
+  // Then it calibrates.
+  response = robot.calibrateUntil("gyro bias (0.02", 15);
+  EXPECT_TRUE(response.success) << response.message;
 }
 
 TEST_F(GyroCalibrationTest, CalibrateOnStartRemovesTheBiasWithoutAServiceCall) {
