@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # ThreadSanitizer run: builds the package with -fsanitize=thread in a workspace of its own
-# (outside the repository, see scratch_dir.sh; kept between runs) and runs the core unit tests and the e-stop rostests under it.
+# (outside the repository, see scratch_dir.sh; kept between runs) and runs the core unit tests and the e-stop rostests under it
+# (the bus's e-stop, stop and yield paths included).
 # Not part of CI (a second full build and a slow run); run it after touching threads or locks:
-#   bash scripts/tsan.sh            # core_tests, estop_bus.test, safe_motion.test
+#   bash scripts/tsan.sh            # core_tests, estop_bus, safe_motion, servo_estop, bus_yield
 #   bash scripts/tsan.sh --unit     # core_tests only
 # Reports go to <its workspace>/reports/tsan.<pid>; the script prints the warnings in project code
 # (src/, include/, test/) and exits non-zero when there is one (or a test failed).
@@ -20,7 +21,7 @@ flags="-fsanitize=thread -g -O1"
 (cd "$ws" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
    -DCATKIN_ENABLE_TESTING=ON -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread \
    -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread -j2 \
-   core_tests driver_node robot_sim test_estop_bus test_safe_motion) > "$ws.build.log" 2>&1 \
+   core_tests driver_node robot_sim test_estop_bus test_safe_motion test_servo_estop test_bus_yield) > "$ws.build.log" 2>&1 \
   || { tail -n 40 "$ws.build.log"; echo "tsan build failed"; exit 1; }
 set +u
 source "$ws/devel/setup.bash"
@@ -35,7 +36,7 @@ status=0
 "$ws/devel/lib/serial_robot_driver/core_tests" --gtest_brief=1 > "$ws/core_tests.log" 2>&1 || status=1
 tail -n 3 "$ws/core_tests.log"
 if [ "${1:-}" != "--unit" ]; then
-  for test in estop_bus.test safe_motion.test; do
+  for test in estop_bus.test safe_motion.test servo_estop.test bus_yield.test; do
     # An instrumented nodelet library cannot be loaded into the (uninstrumented) nodelet manager
     # ("cannot allocate memory in static TLS block"): that one case runs in CI, not here.
     GTEST_FILTER="-SafeMotionProcess.NodeletUnloadRelaxesASpinningServo" \

@@ -1,6 +1,8 @@
 // driver_node processes this test starts itself (base_node.test): a port that appears later, a bad
-// parameter, SIGINT while driving; and the main() of the test_base_node target.
+// parameter, SIGINT while driving, a node that starts with the e-stop engaged; and the main() of
+// the test_base_node target.
 #include <gtest/gtest.h>
+#include <std_msgs/Bool.h>
 
 #include "support/base_node_fixture.h"
 
@@ -94,6 +96,45 @@ TEST(BaseNodeProcess, SigintStopsTheWheelsBeforeExit) {
   EXPECT_FALSE(before_last.isZeroSpeed()) << "the wheels had already stopped before the SIGINT";
   EXPECT_EQ(base.frames().back().bytes, last.bytes);
   EXPECT_EQ(base.garbage(), 0u);
+}
+
+// 15. ~e_stop/start_engaged: a respawned driver comes back stopped. cmd_vel streams from the
+// start, yet every speed frame is zero until an e_stop false arrives; only then does it drive.
+TEST(BaseNodeProcess, StartEngagedHoldsTheBaseUntilReleased) {
+  ASSERT_FALSE(g_driver_path.empty());
+  const std::string port = g_port + "_engaged";
+  FakeBase base(port);
+  std::vector<std::string> args = driverArgs("/engaged", "driver_engaged", port);
+  args.push_back("_e_stop/start_engaged:=true");
+  ChildProcess node(g_driver_path, args);
+  ASSERT_TRUE(node.started());
+  ros::Publisher cmd_vel = g_ros->nh().advertise<geometry_msgs::Twist>("/engaged/cmd_vel", 10);
+  ros::Publisher e_stop = g_ros->nh().advertise<std_msgs::Bool>("/engaged/e_stop", 1, true);
+  ASSERT_TRUE(waitFor([&] { return cmd_vel.getNumSubscribers() > 0; }, 20.0)) << node.output();
+
+  CmdVelStreamer streamer(cmd_vel);
+  streamer.set(0.5, 0.0);
+  // 50 speed frames (1 s at 50 Hz) while cmd_vel streams: not one may move a wheel.
+  ASSERT_TRUE(base.waitUntil(
+      [](const std::vector<SeenFrame>& frames) { return speedCount(frames, 0) >= 50; }, 10.0))
+      << node.output();
+  EXPECT_FALSE(firstMoving(base.frames(), 0).has_value()) << "drove before the release";
+
+  const std::size_t released_at = base.count();
+  std_msgs::Bool release;
+  release.data = false;
+  e_stop.publish(release);
+  EXPECT_TRUE(base.waitUntil(
+      [&](const std::vector<SeenFrame>& frames) {
+        return firstMoving(frames, released_at).has_value();
+      },
+      10.0))
+      << "a cmd_vel after the release did not drive\n"
+      << node.output();
+
+  streamer.stop(true);
+  node.signal(SIGTERM);
+  EXPECT_TRUE(node.waitExit(10.0).has_value()) << "driver_node did not exit on SIGTERM";
 }
 
 }  // namespace
