@@ -1,13 +1,17 @@
-// What the servo_bus_node.test tests share: frames written out by hand from docs/protocols.md,
-// section 3, the bus servos this test plays on the nodes' ptys (/driver_node: dangerous writes
-// refused, echoing adapter; /armed/driver_node: allowed), and service-call helpers.
-//
-// "Nothing was written" is checked without timing: after a rejected call the test pings servo 3
-// and requires that the bytes the pty received in between are exactly that PING.
+// What the rostests of the bus servos share: frames written out by hand from docs/protocols.md,
+// section 3, and service-call helpers; then two rigs:
+//  - servo_bus_node.test: the bus servos this test plays on the nodes' ptys (/driver_node:
+//    dangerous writes refused, echoing adapter; /armed/driver_node: allowed). "Nothing was
+//    written" is checked without timing: after a rejected call the test pings servo 3 and requires
+//    that the bytes the pty received in between are exactly that PING.
+//  - estop_bus.test, servo_estop.test, bus_yield.test: robot_sim (in the test's process) plays the
+//    bus servos behind a tap that records every frame the node writes (the tap is the cable: it is
+//    pulled and plugged again), and the base behind a tap of its own when the test hosts it.
 #pragma once
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <std_msgs/Bool.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +20,9 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "serial_robot_driver/ServoDamping.h"
@@ -30,21 +36,28 @@
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
+#include "serial_robot_driver/sim/robot_sim.h"
 #include "support/fake_device.h"
 #include "support/golden_frames.h"
+#include "support/pty_tap.h"
 #include "support/ros_test_support.h"
 
 namespace servo_bus_node_test {
 
 namespace srd = serial_robot_driver;
 namespace protocol = serial_robot_driver::protocol;
+namespace sim = serial_robot_driver::sim;
 using test_support::Bytes;
 using test_support::Clock;
 using test_support::concat;
+using test_support::PtyTap;
 using test_support::secondsSince;
+using test_support::waitFor;
 
 using namespace golden::servo;  // NOLINT: the frames shared with the unit tests
 
@@ -82,6 +95,15 @@ template <typename Srv>
 Srv call(const std::string& service, Srv srv) {
   EXPECT_TRUE(ros::service::call(service, srv)) << service;
   return srv;
+}
+
+/// servo/spin of servo `id`: mode 0 stops it, any other mode turns it at 90 deg/s.
+inline srd::ServoSpin spinCall(uint8_t id, uint8_t mode) {
+  srd::ServoSpin srv;
+  srv.request.id = id;
+  srv.request.mode = mode;
+  srv.request.speed_dps = mode == 0 ? 0 : 90;
+  return call("servo/spin", srv);
 }
 
 inline srd::ServoPing ping(const std::string& service, uint8_t id) {
@@ -140,5 +162,155 @@ inline std::pair<bool, std::string> writeParam(const std::string& prefix, uint8_
   srv = call(prefix + "write", srv);
   return {srv.response.success, srv.response.message};
 }
+
+// --- robot_sim's bus servos behind a tap (estop_bus, servo_estop, bus_yield) ------------------
+
+inline sim::RobotSim* g_robot = nullptr;  // the simulated robot while the tests run
+inline std::unique_ptr<PtyTap> g_bus;     // the bus's tap (the cable): reset() pulls it
+inline std::string g_bus_port;            // what the node opens for the bus
+inline std::string g_bus_sim_port;        // the simulator's side of it
+
+/// A tap between the node's bus port and the simulator's: the cable plugged (again).
+inline std::unique_ptr<PtyTap> plugBus() {
+  protocol::FramerConfig framer;
+  framer.accept(protocol::servo::kRequestFrames);
+  return std::make_unique<PtyTap>(g_bus_port, g_bus_sim_port, framer);
+}
+
+/// The simulated servo at `id` now; none when no servo has that address.
+inline std::optional<sim::BusServoSnapshot> simServo(uint8_t id) {
+  for (const sim::BusServoSnapshot& servo : servoBusStats(g_robot->stats()).servos) {
+    if (servo.id == id) return servo;
+  }
+  return std::nullopt;
+}
+
+/// How many of `frames`, from the index `from` on, are `bytes`.
+inline std::size_t count(const std::vector<PtyTap::Frame>& frames, const Bytes& bytes,
+                         std::size_t from = 0) {
+  return static_cast<std::size_t>(
+      std::count_if(frames.begin() + static_cast<long>(std::min(from, frames.size())), frames.end(),
+                    [&](const PtyTap::Frame& f) { return f.bytes == bytes; }));
+}
+
+/// The options of a robot_sim that plays the bus servos `ids` for the node's bus port `bus_port`
+/// (its side at `<bus_port>_sim`), without the body; sets g_bus_port and g_bus_sim_port.
+inline sim::SimOptions simBusOptions(const std::string& bus_port, std::vector<uint8_t> ids) {
+  g_bus_port = bus_port;
+  g_bus_sim_port = bus_port + "_sim";
+  sim::SimOptions options;
+  options.device("body").enabled = false;
+  servoBusConfig(options).servo_ids = std::move(ids);
+  options.device("servo_bus").link = g_bus_sim_port;
+  return options;
+}
+
+/// The robot_sim of the e-stop tests: bus servos 0..3 for the node's servo_bus/port, the first
+/// SPIN stop lost on the line.
+inline sim::SimOptions firstStopLostOptions(const std::string& node) {
+  sim::SimOptions options =
+      simBusOptions(test_support::nodeParam(node, "servo_bus/port"), {0, 1, 2, 3});
+  servoBusConfig(options).lost_stops = 1;
+  return options;
+}
+
+/// RUN_ALL_TESTS() with the robot_sim of `options` running (g_robot) and the bus plugged (g_bus).
+/// A hosted base is played for the node's `base_port` behind a tap of its own, `*base_tap` while
+/// the tests run. Returns RUN_ALL_TESTS()'s result.
+inline int runAllTestsOnSimBus(sim::SimOptions options, const std::string& base_port = "",
+                               PtyTap** base_tap = nullptr) {
+  const bool base_hosted = options.hosts("base");
+  if (base_hosted) options.device("base").link = base_port + "_sim";
+  sim::RobotSim robot(options);
+  robot.start();
+  g_robot = &robot;
+  std::unique_ptr<PtyTap> base;
+  if (base_hosted) {
+    protocol::FramerConfig base_framer;
+    base_framer.accept(protocol::base::kFrames);
+    base = std::make_unique<PtyTap>(base_port, *options.device("base").link, base_framer);
+    if (base_tap != nullptr) *base_tap = base.get();
+  }
+  g_bus = plugBus();
+
+  const int result = RUN_ALL_TESTS();
+  g_bus.reset();
+  robot.stop();
+  g_robot = nullptr;
+  return result;
+}
+
+/// A test of the node `node` on the simulated bus: a latched e_stop publisher, the node's
+/// /diagnostics and waits of up to `wait_s`. SetUp() waits for the node and releases the e-stop;
+/// each test ends with the e-stop released and servo 1 stopped.
+class SimBusTest : public ::testing::Test {
+ protected:
+  SimBusTest(const std::string& node, double wait_s) : diagnostics_(nh_, node), wait_s_(wait_s) {
+    e_stop_ = nh_.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true);
+  }
+  ~SimBusTest() override {
+    if (reader_.joinable()) reader_.join();
+  }
+  void SetUp() override {
+    ASSERT_NO_FATAL_FAILURE(waitForTheNode());
+    setEStop(false);
+  }
+  void TearDown() override {
+    setEStop(false);
+    spinCall(1, 0);
+  }
+  /// Waits for the node's e_stop subscription and its services.
+  void waitForTheNode() {
+    ASSERT_TRUE(waitFor([&] { return e_stop_.getNumSubscribers() > 0; }, wait_s_));
+    ASSERT_TRUE(ros::service::waitForService("servo/spin", 30000));
+  }
+  void setEStop(bool engaged) {
+    ASSERT_TRUE(test_support::setEStopAndWait(e_stop_, diagnostics_, engaged, wait_s_));
+  }
+  bool waitMoving(uint8_t id, bool moving) const {
+    return waitFor([&] { return simServo(id) && simServo(id)->moving == moving; }, wait_s_);
+  }
+  /// Spins servo `id` once the port is open (the services come up before it).
+  void spinServo(uint8_t id) {
+    ASSERT_TRUE(waitFor([&] { return spinCall(id, 1).response.success; }, wait_s_));
+    ASSERT_TRUE(waitMoving(id, true));
+  }
+  /// Starts a servo/read of the absent servo 7 on reader_: it holds the bus for all its attempts.
+  /// True once its first frame is on the wire.
+  bool holdTheBusWithAReadOfServo7() {
+    reader_ = std::thread([] {
+      srd::ServoRead read;
+      read.request.id = 7;  // nobody answers
+      read.request.param = "voltage";
+      ros::service::call("servo/read", read);
+    });
+    return g_bus->waitForFrames(
+        [](const auto& frames) {
+          return !frames.empty() && frames.back().bytes.size() > 4 && frames.back().bytes[4] == 7;
+        },
+        wait_s_);
+  }
+  /// Pulls the bus's cable (its tap); true once the node reports the bus disconnected.
+  bool pullTheCable() {
+    g_bus.reset();
+    return diagnostics_
+        .waitFor(
+            "servo_bus", diagnostics_.latest("servo_bus").received,
+            [](const auto& s) { return s.value("connected") == "False"; }, [] { return ros::ok(); },
+            wait_s_)
+        .has_value();
+  }
+  /// Plugs the bus's cable back; true once the node wrote a frame on it.
+  bool plugTheCableBack() {
+    g_bus = plugBus();
+    return g_bus->waitForFrames([](const auto& frames) { return !frames.empty(); }, wait_s_);
+  }
+
+  ros::NodeHandle nh_;
+  test_support::DiagnosticsWatch diagnostics_;
+  ros::Publisher e_stop_;
+  const double wait_s_;
+  std::thread reader_;  // the read of holdTheBusWithAReadOfServo7()
+};
 
 }  // namespace servo_bus_node_test

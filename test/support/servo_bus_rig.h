@@ -35,6 +35,23 @@ inline bool waitFor(const std::function<bool()>& condition) {
   return condition();
 }
 
+inline SpinRequest continuousSpin0() {
+  SpinRequest spin;
+  spin.id = 0;
+  spin.mode = 1;
+  spin.speed_dps = 100;
+  return spin;
+}
+
+/// ROTATE servo 2 to 90.0 deg in 500 ms (golden::servo::kRotate2To90In500 on the wire).
+inline MoveRequest rotate2To90In500() {
+  MoveRequest move;
+  move.id = 2;
+  move.angle_deg = 90.0;
+  move.interval_ms = 500;
+  return move;
+}
+
 /// A ServoBus on a manual clock over a fake bus (see the file comment).
 class ServoBusTest : public ::testing::Test {
  protected:
@@ -131,9 +148,47 @@ class ServoBusTest : public ::testing::Test {
     }
     gate_opened_.notify_all();
   }
+  /// Runs `call` on a thread of its own while holdTheBusWithPing3() holds the bus; true once the
+  /// call waits for the bus. releaseTheWireAndJoin() lets both finish.
+  bool callWaitingBehindPing3(std::function<void()> call) {
+    holder_ = holdTheBusWithPing3();
+    caller_ = std::thread(std::move(call));
+    return waitFor([&] { return bus_->client().callersWaiting() == 1; });
+  }
+  /// Starts the bus with rotate2To90In500() queued while holdTheBusWithPing3() holds the bus; true
+  /// once the worker waits for the bus with the move. releaseTheWireAndJoin() lets it go on.
+  bool moveQueuedBehindPing3() {
+    holder_ = holdTheBusWithPing3();
+    bus_->start();
+    bus_->queueMoves({rotate2To90In500()});
+    return waitFor([&] { return bus_->client().callersWaiting() == 1; });
+  }
+  /// Opens the wire and joins the threads of callWaitingBehindPing3() / moveQueuedBehindPing3().
+  void releaseTheWireAndJoin() {
+    releaseTheWire();
+    holder_.join();
+    if (caller_.joinable()) caller_.join();
+  }
   void setPortDown(bool down) {
     std::lock_guard<std::mutex> lock(mutex_);
     port_down_ = down;
+  }
+  /// Starts the bus, spins servo 0 and engages the e-stop with the port down (its stop cannot be
+  /// written); false when the spin failed.
+  bool spinThenEStopWithThePortDown() {
+    makeBus({});
+    bus_->start();
+    clock_->waitForLoop();
+    if (!bus_->spin(continuousSpin0()).ok()) return false;
+    setPortDown(true);
+    clock_->step([&] { bus_->setMotionLocked(true); });
+    return true;
+  }
+  /// The port back up. The reader thread's onLinkUp comes before any write on the reopened port
+  /// can succeed.
+  void portBackUp() {
+    setPortDown(false);
+    clock_->step([&] { bus_->onLinkUp(); });
   }
   std::size_t countWritten(const Bytes& frame) {
     std::size_t count = 0;
@@ -157,14 +212,8 @@ class ServoBusTest : public ::testing::Test {
   std::unique_ptr<ServoBus> bus_;
   std::condition_variable gate_opened_;
   Bytes gated_frame_;  // guarded by mutex_
+  std::thread holder_;  // the held PING of callWaitingBehindPing3() / moveQueuedBehindPing3()
+  std::thread caller_;  // the call of callWaitingBehindPing3()
 };
-
-inline SpinRequest continuousSpin0() {
-  SpinRequest spin;
-  spin.id = 0;
-  spin.mode = 1;
-  spin.speed_dps = 100;
-  return spin;
-}
 
 }  // namespace serial_robot_driver::device

@@ -47,15 +47,11 @@ SpinRequest spinOf(uint8_t id, uint8_t mode) {
 TEST_F(ServoBusTest, ACallAcceptedBeforeAnEStopIsDroppedEvenWhenReleasedBeforeItsTurn) {
   makeBus({});
   bus_->start();
-  std::thread holder = holdTheBusWithPing3();
   ServoStatus spin;
-  std::thread caller([&] { spin = bus_->spin(continuousSpin0()); });
-  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
+  ASSERT_TRUE(callWaitingBehindPing3([&] { spin = bus_->spin(continuousSpin0()); }));
   bus_->setMotionLocked(true);
   bus_->setMotionLocked(false);
-  releaseTheWire();
-  holder.join();
-  caller.join();
+  releaseTheWireAndJoin();
   EXPECT_EQ(spin.error, ServoError::kMotionRefused);
   EXPECT_NE(spin.message.find("e-stop engaged after this command was accepted"), std::string::npos)
       << spin.message;
@@ -68,18 +64,10 @@ TEST_F(ServoBusTest, ACallAcceptedBeforeAnEStopIsDroppedEvenWhenReleasedBeforeIt
 // The same for a queued move (servo_commands, a trajectory segment) the worker waits to write.
 TEST_F(ServoBusTest, AQueuedMoveAcceptedBeforeAnEStopIsDroppedEvenWhenReleased) {
   makeBus({});
-  std::thread holder = holdTheBusWithPing3();
-  bus_->start();
-  MoveRequest move;
-  move.id = 2;
-  move.angle_deg = 90.0;
-  move.interval_ms = 500;
-  bus_->queueMoves({move});
-  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
+  ASSERT_TRUE(moveQueuedBehindPing3());
   bus_->setMotionLocked(true);
   bus_->setMotionLocked(false);
-  releaseTheWire();
-  holder.join();
+  releaseTheWireAndJoin();
   ASSERT_TRUE(waitFor([&] { return bus_->stats().moves_failed == 1; }));
   bus_->shutdown();
   EXPECT_EQ(countWritten(kRotate2To90In500), 0u);
@@ -112,17 +100,11 @@ TEST_F(ServoBusTest, TheEStopsStopIsWrittenAgainAtASteadyPaceWhileItHolds) {
 // Engaged and released while the cable is out: the stop never went out, so it is kept and is the
 // first frame once the port is back.
 TEST_F(ServoBusTest, AReleaseKeepsTheStopThatWasNeverWritten) {
-  makeBus({});
-  bus_->start();
-  clock_->waitForLoop();
-  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
-  setPortDown(true);
-  clock_->step([&] { bus_->setMotionLocked(true); });
+  ASSERT_TRUE(spinThenEStopWithThePortDown());
   bus_->setMotionLocked(false);
   ASSERT_EQ(bus_->pendingStops().size(), 1u) << "the release dropped a stop never written";
   EXPECT_EQ(countWritten(kSpin0StopSpeed0), 0u);
-  setPortDown(false);
-  clock_->step([&] { bus_->onLinkUp(); });
+  portBackUp();
   EXPECT_EQ(firstIndexOf(kSpin0StopSpeed0), 1u) << "right after the spin";
   clock_->advance(ServoBus::kStopSettle);
   EXPECT_TRUE(bus_->pendingStops().empty());

@@ -20,27 +20,15 @@ namespace {
 using std::chrono::milliseconds;
 using namespace golden::servo;  // NOLINT: the shared golden frames
 
-MoveRequest rotate2To90In500() {
-  MoveRequest move;
-  move.id = 2;
-  move.angle_deg = 90.0;
-  move.interval_ms = 500;
-  return move;
-}
-
 // The user's report: servo/spin waits for the bus behind a slow transaction, the e-stop comes, and
 // the SPIN went out after it. Now the frame is refused when its turn comes, and the call says so.
 TEST_F(ServoBusTest, ACallThatWaitedForTheBusIsRefusedWhenTheEStopCameMeanwhile) {
   makeBus({});
   bus_->start();
-  std::thread holder = holdTheBusWithPing3();
   ServoStatus spin;
-  std::thread caller([&] { spin = bus_->spin(continuousSpin0()); });
-  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
+  ASSERT_TRUE(callWaitingBehindPing3([&] { spin = bus_->spin(continuousSpin0()); }));
   bus_->setMotionLocked(true);  // returns at once: nothing to stop yet, the bus is still held
-  releaseTheWire();
-  holder.join();
-  caller.join();
+  releaseTheWireAndJoin();
   EXPECT_EQ(spin.error, ServoError::kMotionRefused);
   EXPECT_NE(spin.message.find("e_stop engaged"), std::string::npos) << spin.message;
   EXPECT_NE(spin.message.find("not written"), std::string::npos) << spin.message;
@@ -54,14 +42,9 @@ TEST_F(ServoBusTest, ACallThatWaitedForTheBusIsRefusedWhenTheEStopCameMeanwhile)
 // written after it: dropped at the write, reported as a failed move.
 TEST_F(ServoBusTest, AQueuedMoveThatWaitedForTheBusIsDroppedAtTheWrite) {
   makeBus({});
-  std::thread holder = holdTheBusWithPing3();
-  bus_->start();
-  bus_->queueMoves({rotate2To90In500()});
-  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }))
-      << "the worker waits for the bus with the move";
+  ASSERT_TRUE(moveQueuedBehindPing3()) << "the worker waits for the bus with the move";
   bus_->setMotionLocked(true);
-  releaseTheWire();
-  holder.join();
+  releaseTheWireAndJoin();
   ASSERT_TRUE(waitFor([&] { return bus_->stats().moves_failed == 1; }));
   bus_->shutdown();
   EXPECT_EQ(countWritten(kRotate2To90In500), 0u);
@@ -77,14 +60,10 @@ TEST_F(ServoBusTest, TheEStopsStopGoesBeforeTheCallsWaitingForTheBus) {
   makeBus({});
   bus_->start();
   ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
-  std::thread holder = holdTheBusWithPing3();
-  std::thread caller([&] { bus_->client().ping(5); });
-  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
+  ASSERT_TRUE(callWaitingBehindPing3([&] { bus_->client().ping(5); }));
   bus_->setMotionLocked(true);
   EXPECT_EQ(countWritten(kSpin0StopSpeed0), 0u) << "the e-stop waited for the bus";
-  releaseTheWire();
-  holder.join();
-  caller.join();
+  releaseTheWireAndJoin();
   ASSERT_TRUE(waitFor([&] { return countWritten(kSpin0StopSpeed0) == 1; }));
   EXPECT_LT(firstIndexOf(kSpin0StopSpeed0), firstIndexOf(kPing5)) << "the stop waited for a call";
   EXPECT_EQ(firstIndexOf(kSpin0StopSpeed0), firstIndexOf(kPing3) + 1);
@@ -120,18 +99,11 @@ TEST_F(ServoBusTest, AStopAfterWhichTheServoStillMovesIsWrittenAgain) {
 TEST_F(ServoBusTest, AStopThatCouldNotBeWrittenGoesFirstAfterTheReconnect) {
   const Bytes kPing5Reply = {0x05, 0x1C, 0x01, 0x01, 0x05, 0x28};
   answers_[kPing5] = kPing5Reply;
-  makeBus({});
-  bus_->start();
-  clock_->waitForLoop();
-  ASSERT_TRUE(bus_->spin(continuousSpin0()).ok());
-  setPortDown(true);
-  clock_->step([&] { bus_->setMotionLocked(true); });
+  ASSERT_TRUE(spinThenEStopWithThePortDown());
   ASSERT_EQ(bus_->pendingStops().size(), 1u);
   EXPECT_NE(bus_->pendingStops()[0].why.find("down"), std::string::npos);
   EXPECT_EQ(countWritten(kSpin0StopSpeed0), 0u);
-  setPortDown(false);
-  // The reader thread's onLinkUp comes before any write on the reopened port can succeed.
-  clock_->step([&] { bus_->onLinkUp(); });
+  portBackUp();
   std::thread caller([&] { bus_->client().ping(5); });
   caller.join();
   EXPECT_EQ(firstIndexOf(kSpin0StopSpeed0), 1u) << "right after the spin, before the PING";
@@ -210,15 +182,11 @@ TEST_F(ServoBusTest, AReleaseBeforeTheStopWentOutStillStopsAndLeavesTheBusFreeFo
 // From the moment shutdown() decides the last words, a motion still waiting for the bus is refused.
 TEST_F(ServoBusTest, ShutdownRefusesACallThatWaitedForTheBus) {
   makeBus({});
-  std::thread holder = holdTheBusWithPing3();
   ServoStatus spin;
-  std::thread caller([&] { spin = bus_->spin(continuousSpin0()); });
-  ASSERT_TRUE(waitFor([&] { return bus_->client().callersWaiting() == 1; }));
+  ASSERT_TRUE(callWaitingBehindPing3([&] { spin = bus_->spin(continuousSpin0()); }));
   std::thread closer([&] { bus_->shutdown(); });
   std::this_thread::sleep_for(milliseconds(20));  // shutdown() closes the gate first thing
-  releaseTheWire();
-  holder.join();
-  caller.join();
+  releaseTheWireAndJoin();
   closer.join();
   EXPECT_NE(spin.error, ServoError::kOk);
   EXPECT_EQ(countWritten(kSpin0CcwContinuous), 0u);

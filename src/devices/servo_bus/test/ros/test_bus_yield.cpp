@@ -10,7 +10,6 @@
 // Frames are written out by hand from docs/protocols.md, section 3 (SUM = byte sum mod 256).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <std_msgs/Bool.h>
 
 #include <algorithm>
 #include <atomic>
@@ -26,29 +25,18 @@
 #include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
-#include "serial_robot_driver/sim/robot_sim.h"
-#include "support/pty_tap.h"
-#include "support/ros_test_support.h"
+#include "support/servo_bus_node_support.h"
 
 namespace {
 
-namespace sim = serial_robot_driver::sim;
-namespace srd = serial_robot_driver;
-using test_support::PtyTap;
-using test_support::waitFor;
-using Bytes = std::vector<uint8_t>;
+using namespace servo_bus_node_test;  // NOLINT: the simulated bus behind its tap, the SPIN frames
 
 constexpr double kWaitSeconds = 30.0;
 constexpr char kNode[] = "driver_node";
 
-// RESET_USER_DATA id 7 (CMD 2): 12+4C+02+01+07 = 0x68. Nobody answers at 7, nor at 0 after it.
+// RESET_USER_DATA id 7 (CMD 2): 12+4C+02+01+07 = 0x68. Nobody answers at 7, nor at 0 after it
+// (kPing0: the reset's check that the servo moved to id 0).
 const Bytes kResetUserData7 = {0x12, 0x4C, 0x02, 0x01, 0x07, 0x68};
-// PING id 0: 12+4C+01+01+00 = 0x60 (the reset's check that the servo moved to id 0).
-const Bytes kPing0 = {0x12, 0x4C, 0x01, 0x01, 0x00, 0x60};
-// SPIN servo 1, mode 0 (stop), speed 0: 12+4C+07+06+01 = 0x6C.
-const Bytes kSpin1Stop = {0x12, 0x4C, 0x07, 0x06, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x6C};
 // Request bytes: 12 4C CMD N ID ...
 constexpr std::size_t kCmdByte = 2;
 constexpr std::size_t kIdByte = 4;
@@ -57,8 +45,6 @@ constexpr uint8_t kRotateCmd = 0x08;
 constexpr uint8_t kDampingCmd = 0x09;
 constexpr uint8_t kScanFirst = 10;
 constexpr uint8_t kScanLast = 25;  // 16 absent ids: 16 timeouts of 0.5 s
-
-PtyTap* g_bus = nullptr;
 
 bool isFrame(const PtyTap::Frame& frame, uint8_t cmd, uint8_t id) {
   return frame.bytes.size() > kIdByte && frame.bytes[kCmdByte] == cmd && frame.bytes[kIdByte] == id;
@@ -79,15 +65,6 @@ std::size_t waitForFrame(std::size_t from, const std::function<bool(const PtyTap
       [&](const auto& frames) { return indexOf(frames, from, match) < frames.size(); },
       kWaitSeconds));
   return indexOf(g_bus->frames(), from, match);
-}
-
-srd::ServoSpin spin(uint8_t id, uint8_t mode) {
-  srd::ServoSpin call;
-  call.request.id = id;
-  call.request.mode = mode;
-  call.request.speed_dps = mode == 0 ? 0 : 90;
-  EXPECT_TRUE(ros::service::call("servo/spin", call));
-  return call;
 }
 
 /// A service call on a thread of its own; done() once it answered.
@@ -130,28 +107,14 @@ std::size_t resetFramesBetween(std::size_t from, std::size_t to) {
       [](const PtyTap::Frame& f) { return f.bytes == kResetUserData7 || f.bytes == kPing0; }));
 }
 
-class BusYield : public ::testing::Test {
+class BusYield : public SimBusTest {
  protected:
-  BusYield() : diagnostics_(nh_, kNode) {
-    e_stop_ = nh_.advertise<std_msgs::Bool>("e_stop", 1, /*latch=*/true);
-  }
+  BusYield() : SimBusTest(kNode, kWaitSeconds) {}
   void SetUp() override {
-    ASSERT_TRUE(waitFor([&] { return e_stop_.getNumSubscribers() > 0; }, kWaitSeconds));
-    ASSERT_TRUE(ros::service::waitForService("servo/spin", 30000));
+    ASSERT_NO_FATAL_FAILURE(waitForTheNode());
     // The services come up before the port opens.
-    ASSERT_TRUE(waitFor([&] { return spin(1, 0).response.success; }, kWaitSeconds));
+    ASSERT_TRUE(waitFor([&] { return spinCall(1, 0).response.success; }, kWaitSeconds));
   }
-  void TearDown() override {
-    setEStop(false);
-    spin(1, 0);
-  }
-  void setEStop(bool engaged) {
-    ASSERT_TRUE(test_support::setEStopAndWait(e_stop_, diagnostics_, engaged, kWaitSeconds));
-  }
-
-  ros::NodeHandle nh_;
-  test_support::DiagnosticsWatch diagnostics_;
-  ros::Publisher e_stop_;
 };
 
 // The report: reset_user_data ran its RESET / PING 0 chain under one bus lock and a stop
@@ -159,9 +122,9 @@ class BusYield : public ::testing::Test {
 TEST_F(BusYield, AManualStopGoesBeforeTheRestOfAResetUserData) {
   auto reset = resetAbsentServo();
   const std::size_t asked = g_bus->frameCount();
-  EXPECT_TRUE(spin(1, 0).response.success);
+  EXPECT_TRUE(spinCall(1, 0).response.success);
   const std::size_t stop =
-      waitForFrame(asked, [](const PtyTap::Frame& f) { return f.bytes == kSpin1Stop; });
+      waitForFrame(asked, [](const PtyTap::Frame& f) { return f.bytes == kSpin1StopSpeed0; });
   EXPECT_LE(resetFramesBetween(asked, stop), 1u) << "the stop waited for the reset's chain";
   EXPECT_FALSE(reset->join().response.success) << "nothing answers at id 7 or 0";
   EXPECT_GT(resetFramesBetween(stop, g_bus->frameCount()), 0u) << "the reset went on after it";
@@ -169,12 +132,12 @@ TEST_F(BusYield, AManualStopGoesBeforeTheRestOfAResetUserData) {
 
 // The same with the e-stop: its stop of the spinning servo goes before the rest of the chain.
 TEST_F(BusYield, TheEStopsStopGoesBeforeTheRestOfAResetUserData) {
-  ASSERT_TRUE(spin(1, 1).response.success);
+  ASSERT_TRUE(spinCall(1, 1).response.success);
   auto reset = resetAbsentServo();
   const std::size_t asked = g_bus->frameCount();
   setEStop(true);
   const std::size_t stop =
-      waitForFrame(asked, [](const PtyTap::Frame& f) { return f.bytes == kSpin1Stop; });
+      waitForFrame(asked, [](const PtyTap::Frame& f) { return f.bytes == kSpin1StopSpeed0; });
   EXPECT_LE(resetFramesBetween(asked, stop), 1u) << "the stop waited for the reset's chain";
   reset->join();
 }
@@ -184,14 +147,14 @@ TEST_F(BusYield, TheEStopsStopGoesBeforeTheRestOfAResetUserData) {
 // their frames go out before the scan's last PING.
 TEST_F(BusYield, StopServicesAnswerWhileTwoLongCallsHoldTheOtherThreads) {
   const std::vector<std::pair<const char*, std::function<bool()>>> stop_calls = {
-      {"servo/spin mode 0", [] { return spin(1, 0).response.success; }},
+      {"servo/spin mode 0", [] { return spinCall(1, 0).response.success; }},
       {"servo/relax", [] {
          srd::ServoRelax relax;
          relax.request.ids = {1};
          return ros::service::call("servo/relax", relax) && relax.response.success;
        }}};
   const std::vector<std::function<bool(const PtyTap::Frame&)>> stop_frames = {
-      [](const PtyTap::Frame& f) { return f.bytes == kSpin1Stop; },
+      [](const PtyTap::Frame& f) { return f.bytes == kSpin1StopSpeed0; },
       [](const PtyTap::Frame& f) { return isFrame(f, kDampingCmd, 1); }};
   for (std::size_t i = 0; i < stop_calls.size(); ++i) {
     SCOPED_TRACE(stop_calls[i].first);
@@ -226,23 +189,8 @@ TEST_F(BusYield, StopServicesAnswerWhileTwoLongCallsHoldTheOtherThreads) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   test_support::RosTestNode node(argc, argv, "test_bus_yield");
-  const std::string port = test_support::nodeParam(kNode, "port");
-
-  sim::SimOptions options;
+  sim::SimOptions options = simBusOptions(test_support::nodeParam(kNode, "port"), {1, 2});
   options.device("base").enabled = false;
-  options.device("body").enabled = false;
-  servoBusConfig(options).servo_ids = {1, 2};
   servoBusConfig(options).response_switch = {{2, 1}};
-  options.device("servo_bus").link = port + "_sim";
-  sim::RobotSim robot(options);
-  robot.start();
-  srd::protocol::FramerConfig framer;
-  framer.accept(srd::protocol::servo::kRequestFrames);
-  PtyTap bus(port, *options.device("servo_bus").link, framer);
-  g_bus = &bus;
-
-  const int result = RUN_ALL_TESTS();
-  g_bus = nullptr;
-  robot.stop();
-  return result;
+  return runAllTestsOnSimBus(options);
 }
