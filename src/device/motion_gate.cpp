@@ -18,7 +18,7 @@ const char* toString(GateState state) {
 
 void MotionGate::setLocked(bool locked) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (locked && !locked_) ++generation_;
+  if (locked && !locked_) generation_.fetch_add(1);
   locked_ = locked;
 }
 
@@ -37,16 +37,13 @@ GateState MotionGate::state() const {
   return stateLocked();
 }
 
-MotionGate::Generation MotionGate::generation() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return generation_;
-}
-
 GateState MotionGate::writeIfOpen(const std::function<bool()>& write, bool* written,
                                   std::optional<Generation> accepted) {
   std::lock_guard<std::mutex> lock(mutex_);
   GateState state = stateLocked();
-  if (state == GateState::kOpen && accepted && *accepted != generation_) state = GateState::kVoided;
+  if (state == GateState::kOpen && accepted && *accepted != generation_.load()) {
+    state = GateState::kVoided;
+  }
   if (state != GateState::kOpen) {
     ++refused_;
     *written = false;

@@ -13,6 +13,7 @@
 // into the port, never a wait for an answer), so setLocked() waits microseconds at most.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <mutex>
@@ -40,7 +41,9 @@ class MotionGate {
   void close();
   GateState state() const;
   /// The generation a command accepted now belongs to (note it before waiting for the wire).
-  Generation generation() const;
+  /// Lock-free: callers note it while holding locks of their own that the gate's writer may take
+  /// (the servo bus's bookkeeping), so taking the gate's lock here could invert their order.
+  Generation generation() const { return generation_.load(); }
 
   /// Runs `write` (one motion frame onto the wire; returns whether it went out) only while the
   /// gate is open and, given `accepted`, no e-stop engaged since that generation, with the gate's
@@ -57,7 +60,7 @@ class MotionGate {
   mutable std::mutex mutex_;
   bool locked_ = false;
   bool closed_ = false;
-  Generation generation_ = 0;  // engagements so far
+  std::atomic<Generation> generation_{0};  // engagements so far; changed under mutex_
   uint64_t refused_ = 0;
 };
 
