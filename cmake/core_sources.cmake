@@ -18,9 +18,11 @@ set(SRD_CORE_SOURCES
   src/params/driver_params.cpp
   src/trajectory/spline.cpp
   src/trajectory/command.cpp
+  src/trajectory/command_start.cpp
   src/trajectory/tolerances.cpp
   src/trajectory/bus_joint.cpp
   src/trajectory/joint_groups.cpp
+  src/trajectory/goal.cpp
   src/trajectory/executor.cpp
   src/device/e_stop.cpp
   src/device/motion_gate.cpp

@@ -162,7 +162,7 @@ add_dependencies(test_estop_bus driver_node ${PROJECT_NAME}_generate_messages_cp
 # e-stop, with a bus servo spinning; the node must live on and write no motion frame under the
 # e-stop (SRD_FUZZ_SEED / SRD_FUZZ_COUNT, scripts/fuzz_ros_interface.sh for a long run).
 add_rostest_gtest(test_ros_interface_fuzz test/rostest/ros_interface_fuzz.test
-  test/rostest/test_ros_interface_fuzz.cpp)
+  test/rostest/test_ros_interface_fuzz.cpp test/support/ros_fuzz_inputs.cpp)
 target_include_directories(test_ros_interface_fuzz PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_ros_interface_fuzz srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_ros_interface_fuzz driver_node ${PROJECT_NAME}_generate_messages_cpp)

@@ -65,8 +65,11 @@ add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_mes
 # groups and the executor (goals, ticks, stops) on a clock the tests step.
 catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp
   test/unit/test_trajectory_joints.cpp
-  test/unit/test_trajectory_executor.cpp)
+  test/unit/test_trajectory_executor.cpp
+  test/unit/test_trajectory_executor_start.cpp)
 target_link_libraries(trajectory_tests srd_core gtest_main)
+# support/trajectory_executor_rig.h
+target_include_directories(trajectory_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)
 
 # Trajectories' ROS-side pure functions (messages, bus joints from parameters, stamps); no roscore.
 catkin_add_gtest(trajectory_ros_tests test/unit/test_trajectory_ros.cpp)

@@ -140,21 +140,6 @@ CommandCheck validate(const TrajectoryCommand& command, const std::vector<JointR
   return check;
 }
 
-double effectiveStart(const TrajectoryCommand& command, double start, double now) {
-  if (!(start < now)) return start;
-  const auto& points = command.points;
-  const auto first_ahead =
-      std::find_if(points.begin(), points.end(),
-                   [&](const TrajectoryPoint& p) { return start + p.time_from_start > now; });
-  if (first_ahead == points.end()) return start;
-  const double planned =
-      first_ahead == points.begin()
-          ? first_ahead->time_from_start
-          : first_ahead->time_from_start - std::prev(first_ahead)->time_from_start;
-  const double left = start + first_ahead->time_from_start - now;
-  return left < planned ? start + (planned - left) : start;
-}
-
 std::vector<Waypoint> waypointsFor(const TrajectoryCommand& command, std::size_t column,
                                    double start_time, double now) {
   std::vector<Waypoint> waypoints;

@@ -4,60 +4,9 @@
 #include <cstdio>
 #include <limits>
 
+#include "serial_robot_driver/trajectory/command_start.h"
+
 namespace serial_robot_driver::trajectory {
-
-namespace {
-
-int resultCode(CommandError error) {
-  switch (error) {
-    case CommandError::kNone:
-      return result_code::kSuccessful;
-    case CommandError::kInvalidJoints:
-      return result_code::kInvalidJoints;
-    case CommandError::kInvalidGoal:
-      return result_code::kInvalidGoal;
-    case CommandError::kOldTimestamp:
-      return result_code::kOldHeaderTimestamp;
-  }
-  return result_code::kInvalidGoal;
-}
-
-GoalOutcome outcome(GoalStatus status, int code, const std::string& error_string,
-                    const std::string& text) {
-  return {status, code, error_string, text};
-}
-
-/// The outcome whose result and status text are both `message`.
-GoalOutcome outcome(GoalStatus status, int code, const std::string& message) {
-  return outcome(status, code, message, message);
-}
-
-void finish(const GoalCallbacks& callbacks, const GoalOutcome& result) {
-  if (callbacks.finished) callbacks.finished(result);
-}
-
-bool overlaps(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) {
-  return std::any_of(a.begin(), a.end(),
-                     [&](std::size_t j) { return std::find(b.begin(), b.end(), j) != b.end(); });
-}
-
-/// "; joint 'a', 'b' left alone: ..." for the joints a stop could not hold, "" when none.
-std::string leftAloneText(const std::vector<std::string>& names) {
-  if (names.empty()) return "";
-  std::string text = names.size() == 1 ? "joint " : "joints ";
-  for (std::size_t i = 0; i < names.size(); ++i) text += (i ? ", '" : "'") + names[i] + "'";
-  return text +
-         " left alone: never commanded by the driver nor recently measured, so there is no "
-         "position to hold";
-}
-
-/// `base`, then `; left_alone` when there is one.
-std::string withLeftAlone(const std::string& base, const std::string& left_alone) {
-  if (left_alone.empty()) return base;
-  return base.empty() ? left_alone : base + "; " + left_alone;
-}
-
-}  // namespace
 
 TrajectoryExecutor::TrajectoryExecutor(std::vector<TrajectoryJoints> groups,
                                        const GoalDefaults& defaults, Clock clock, Warn warn)
@@ -155,23 +104,6 @@ void TrajectoryExecutor::setStateTimeout(const std::vector<std::string>& names, 
   }
 }
 
-std::optional<double> TrajectoryExecutor::startOf(const TrajectoryCommand& command,
-                                                  std::optional<double> start_time, double now,
-                                                  CommandCheck* refusal) const {
-  if (!start_time) return now;
-  // NaN fails this test too; the ROS layer never gives one, the check is for any other caller.
-  if (!(*start_time - now <= defaults_.max_start_delay)) {
-    refusal->error = CommandError::kInvalidGoal;
-    char text[200];
-    std::snprintf(text, sizeof(text),
-                  "its start (header.stamp) is %.3g s from now, later than max_start_delay %.3g s",
-                  *start_time - now, defaults_.max_start_delay);
-    refusal->message = text;
-    return std::nullopt;
-  }
-  return effectiveStart(command, *start_time, now);
-}
-
 CommandCheck TrajectoryExecutor::check(const TrajectoryCommand& command, double start, double now) {
   CommandCheck result = validate(command, ranges_, defaults_.max_velocity, start - now);
   if (!result.ok()) return result;
@@ -196,18 +128,6 @@ CommandCheck TrajectoryExecutor::check(const TrajectoryCommand& command, double 
   return result;
 }
 
-void TrajectoryExecutor::endGoalsOn(const std::vector<std::size_t>& joints, GoalStatus status,
-                                    int code, const std::string& message) {
-  for (auto it = goals_.begin(); it != goals_.end();) {
-    if (!overlaps(it->joints, joints)) {
-      ++it;
-      continue;
-    }
-    finish(it->callbacks, outcome(status, code, message));
-    it = goals_.erase(it);
-  }
-}
-
 TrajectoryExecutor::Generations TrajectoryExecutor::generations() const {
   Generations now;
   for (const TrajectoryJoints& group : groups_) {
@@ -228,7 +148,7 @@ void TrajectoryExecutor::dropVoided(const std::vector<std::size_t>& joints, doub
   const std::string message = "trajectory of joint '" + ranges_[joints.front()].name +
                               "' dropped: e-stop engaged after this command was accepted";
   warnThrottled(kTrajectoryError, message, now);
-  endGoalsOn(joints, GoalStatus::kAborted, result_code::kInvalidGoal, message);
+  endGoalsOn(goals_, joints, GoalStatus::kAborted, result_code::kInvalidGoal, message);
 }
 
 void TrajectoryExecutor::apply(const TrajectoryCommand& command,
@@ -305,7 +225,8 @@ TrajectoryExecutor::Submission TrajectoryExecutor::submitGoal(const Goal& goal,
     return Submission::kEStopped;
   }
   CommandCheck checked;
-  const std::optional<double> started = startOf(command, goal.start_time, now, &checked);
+  const std::optional<double> started =
+      startOf(command, goal.start_time, now, defaults_.max_start_delay, &checked);
   if (started) checked = check(command, *started, now);
   if (!checked.ok()) {
     warn("follow_joint_trajectory: goal rejected: " + checked.message);
@@ -314,7 +235,7 @@ TrajectoryExecutor::Submission TrajectoryExecutor::submitGoal(const Goal& goal,
   }
   const double start = *started;
   if (callbacks.accepted) callbacks.accepted();
-  endGoalsOn(checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
+  endGoalsOn(goals_, checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
              "preempted by a new goal");
   if (command.points.empty()) {
     // joint_trajectory_controller's "stop": hold where they are, and that is done at once.
@@ -326,21 +247,7 @@ TrajectoryExecutor::Submission TrajectoryExecutor::submitGoal(const Goal& goal,
   }
   apply(command, checked.joint_indices, start, now, accepted);
 
-  ActiveGoal active;
-  active.id = goal.id;
-  active.callbacks = std::move(callbacks);
-  active.joints = checked.joint_indices;
-  active.names = command.joint_names;
-  const JointTolerance path_defaults{defaults_.path_tolerance, 0.0};
-  const JointTolerance goal_defaults{defaults_.goal_tolerance, 0.0};
-  active.path_tolerances = resolveTolerances(active.names, path_defaults, goal.path_tolerance);
-  active.goal_tolerances = resolveTolerances(active.names, goal_defaults, goal.goal_tolerance);
-  active.start_time = start;
-  active.end_time = start + command.points.back().time_from_start;
-  active.goal_time_tolerance = goal.goal_time_tolerance == 0.0
-                                   ? defaults_.goal_time_tolerance
-                                   : std::max(0.0, goal.goal_time_tolerance);
-  goals_.push_back(std::move(active));
+  goals_.push_back(admitGoal(goal, std::move(callbacks), checked.joint_indices, start, defaults_));
   return Submission::kAccepted;
 }
 
@@ -367,14 +274,15 @@ TrajectoryExecutor::Submission TrajectoryExecutor::submitTrajectory(
     return Submission::kEStopped;
   }
   CommandCheck checked;
-  const std::optional<double> start = startOf(command, start_time, now, &checked);
+  const std::optional<double> start =
+      startOf(command, start_time, now, defaults_.max_start_delay, &checked);
   if (start) checked = check(command, *start, now);
   if (!checked.ok()) {
     warnThrottled(kMessageInvalid,
                   "joint_trajectory: message ignored, nothing moves: " + checked.message, now);
     return Submission::kInvalid;
   }
-  endGoalsOn(checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
+  endGoalsOn(goals_, checked.joint_indices, GoalStatus::kCanceled, result_code::kSuccessful,
              "preempted by a joint_trajectory message");
   if (command.points.empty()) {
     const std::string left_alone = hold(checked.joint_indices, now);
@@ -403,7 +311,7 @@ void TrajectoryExecutor::takeOver(const std::vector<std::string>& names, const s
   const std::string message = "joint '" + ranges_[taken.front()].name + "' taken over by " +
                               source + ": trajectory stopped";
   warn(message);
-  endGoalsOn(taken, GoalStatus::kAborted, result_code::kInvalidGoal, message);
+  endGoalsOn(goals_, taken, GoalStatus::kAborted, result_code::kInvalidGoal, message);
 }
 
 void TrajectoryExecutor::stopAll(const std::string& reason) {
@@ -417,7 +325,7 @@ void TrajectoryExecutor::stopAll(const std::string& reason) {
   std::sort(all.begin(), all.end());
   all.erase(std::unique(all.begin(), all.end()), all.end());
   const std::string left_alone = hold(all, now());
-  endGoalsOn(all, GoalStatus::kAborted, result_code::kInvalidGoal,
+  endGoalsOn(goals_, all, GoalStatus::kAborted, result_code::kInvalidGoal,
              withLeftAlone(reason, left_alone));
 }
 

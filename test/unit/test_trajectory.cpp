@@ -7,6 +7,7 @@
 
 #include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/command.h"
+#include "serial_robot_driver/trajectory/command_start.h"
 #include "serial_robot_driver/trajectory/spline.h"
 #include "serial_robot_driver/trajectory/tolerances.h"
 

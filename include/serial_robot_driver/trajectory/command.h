@@ -54,17 +54,6 @@ CommandCheck validate(const TrajectoryCommand& command, const std::vector<JointR
                       double max_velocity, double start_offset = 0.0,
                       const std::vector<double>& current_positions = {});
 
-/// When a command stamped to start at `start` really starts, received at `now` (one clock, s).
-/// A start not in the past is kept. A start in the past is taken as joint_trajectory_controller
-/// takes it (the points already past are dropped, the rest keep their spacing), except that the
-/// bridge from the joints' current set-point to the first point still ahead never gets less time
-/// than the command itself planned for reaching that point (its time_from_start when it is the
-/// first point, the gap from the point before it otherwise): the whole command starts that much
-/// later. In effect the segment running now is run whole from now (the first one: the command as
-/// if stamped now), so a late stamp never squeezes the bridge into a jump, with or without a
-/// ~trajectory/max_velocity to refuse one. Every point in the past: `start` (validate() refuses).
-double effectiveStart(const TrajectoryCommand& command, double start, double now);
-
 /// The waypoints of the command's joint `column` (its index in joint_names), in absolute time:
 /// start_time + time_from_start, leaving out the points not after `now` (joint_trajectory
 /// _controller drops them). The command must have passed validate().

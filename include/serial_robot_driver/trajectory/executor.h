@@ -32,60 +32,12 @@
 
 #include "serial_robot_driver/device/e_stop.h"
 #include "serial_robot_driver/trajectory/command.h"
+#include "serial_robot_driver/trajectory/goal.h"
 #include "serial_robot_driver/trajectory/joint_groups.h"
 #include "serial_robot_driver/trajectory/spline.h"
 #include "serial_robot_driver/trajectory/tolerances.h"
 
 namespace serial_robot_driver::trajectory {
-
-/// control_msgs/FollowJointTrajectoryResult's error codes (the ROS layer checks they agree).
-namespace result_code {
-constexpr int kSuccessful = 0;
-constexpr int kInvalidGoal = -1;
-constexpr int kInvalidJoints = -2;
-constexpr int kOldHeaderTimestamp = -3;
-constexpr int kPathToleranceViolated = -4;
-constexpr int kGoalToleranceViolated = -5;
-}  // namespace result_code
-
-/// A follow_joint_trajectory goal.
-struct Goal {
-  std::string id;  ///< what cancelGoal() names it by
-  TrajectoryCommand command;
-  std::optional<double> start_time;  ///< on the executor's clock; nothing: at once
-  std::vector<NamedTolerance> path_tolerance;
-  std::vector<NamedTolerance> goal_tolerance;
-  double goal_time_tolerance = 0.0;  ///< s; 0: the default; negative: none
-};
-
-enum class GoalStatus { kRejected, kSucceeded, kCanceled, kAborted };
-
-/// How a goal ended: its result (error_code, error_string) and the status text.
-struct GoalOutcome {
-  GoalStatus status = GoalStatus::kSucceeded;
-  int error_code = result_code::kSuccessful;
-  std::string error_string;
-  std::string text;
-};
-
-/// A running goal's state, once per tick; velocities of `actual` and `error` are empty unless
-/// every joint's velocity is measured.
-struct GoalFeedback {
-  std::vector<std::string> joint_names;
-  double time_from_start = 0.0;  ///< s since the goal's start (0 before it)
-  std::vector<JointSample> desired;
-  std::vector<double> actual_positions;
-  std::vector<double> actual_velocities;
-  std::vector<double> error_positions;
-  std::vector<double> error_velocities;
-};
-
-/// What a goal tells its client; all may be empty. Called with the executor's lock held.
-struct GoalCallbacks {
-  std::function<void()> accepted;  ///< before anything else that is told of an accepted goal
-  std::function<void(const GoalFeedback&)> feedback;
-  std::function<void(const GoalOutcome&)> finished;  ///< rejected or ended; once
-};
 
 class TrajectoryExecutor {
  public:
@@ -170,30 +122,12 @@ class TrajectoryExecutor {
     bool velocity_known = false;
     std::optional<double> received;  ///< clock time of receipt; nothing: never measured
   };
-  struct ActiveGoal {
-    std::string id;
-    GoalCallbacks callbacks;
-    std::vector<std::size_t> joints;
-    std::vector<std::string> names;
-    std::vector<JointTolerance> path_tolerances;
-    std::vector<JointTolerance> goal_tolerances;
-    double start_time = 0.0;
-    double end_time = 0.0;
-    double goal_time_tolerance = 0.0;
-  };
   /// The warnings throttled to one a second, each kind on its own.
   enum ThrottledWarning { kTrajectoryError, kMessageRefused, kMessageInvalid, kThrottledKinds };
 
   /// Checks `command` (starting at `start`, now `now`) against the joints and where they are;
   /// the indices of its joints in `check`. mutex_ held (so are all below).
   CommandCheck check(const TrajectoryCommand& command, double start, double now);
-  /// The start on which `command`, stamped `start_time` (nothing: now), runs: effectiveStart();
-  /// nothing, with `refusal` set, when it is further ahead than max_start_delay (or not a time).
-  std::optional<double> startOf(const TrajectoryCommand& command, std::optional<double> start_time,
-                                double now, CommandCheck* refusal) const;
-  /// Ends the goals that drive any of `joints` with `status`, `code` and `message`.
-  void endGoalsOn(const std::vector<std::size_t>& joints, GoalStatus status, int code,
-                  const std::string& message);
   /// Splices the command, accepted under `accepted`, into the joints' splines.
   void apply(const TrajectoryCommand& command, const std::vector<std::size_t>& joints, double start,
              double now, const Generations& accepted);
