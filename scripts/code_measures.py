@@ -9,6 +9,9 @@ import sys
 from collections import defaultdict
 
 MAX_FUNCTION_LINES = 60
+# A file that includes one of these belongs to the ROS layer wherever it sits.
+ROS_INCLUDE = re.compile(r"#include\s*<(ros|rosbag|nodelet|actionlib|tf2_ros|diagnostic_updater|"
+                         r"dynamic_reconfigure|\w+_msgs)/")
 DEVICE_NAMES = re.compile(
     r"\b(base|body|servo_bus|imu)\b|\b(Base|Body|ServoBus|Imu)[A-Z][A-Za-z]*"
     r"|\b(base|body|servo_bus)_[a-z]+")
@@ -110,7 +113,8 @@ def main():
         return sum(open(p, encoding="utf-8").read().count("\n") for p in paths)
 
     core_and_ros = [p for p in product if not p.startswith("bench/")]
-    ros = [p for p in core_and_ros if "/ros/" in p or p.startswith("src/nodes/")]
+    ros = [p for p in core_and_ros if "/ros/" in p or p.startswith("src/nodes/") or
+           ROS_INCLUDE.search(open(p, encoding="utf-8").read())]
     plumbing = [p for p in core_and_ros if not p.startswith(("src/devices/", "include/serial_robot_driver/devices/"))]
     casts = [p for p in plumbing if re.search(r"\bdynamic_cast\b|\bstd::any\b", code_lines(open(p, encoding="utf-8").read()))]
 
