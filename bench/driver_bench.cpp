@@ -722,69 +722,77 @@ struct ServoSessionResult {
   std::size_t failed_stress_calls = 0;
 };
 
-ServoSessionResult runServoSession(Context& context) {
-  const Options& options = context.options;
-  ServoSessionResult result;
-  {
-    // Round trips: the servo bus alone (robot_sim answers after its default 1.5 ms latency).
-    const std::string ns = "servo_event";
-    const std::string link = context.paths.link(ns);
-    const auto sim =
-        startRobotSim(context.paths, "robot_sim_" + ns, {"--link", link, "--no-base", "--no-body"});
-    ParamList params = commonParams(link, kEventDriven);
-    params.insert(params.end(), {{"base/enabled", false}, {"body/enabled", false}});
-    DriverProcess driver(context.paths, ns, params);
-    const std::string service = driver.topic("servo/read");
-    require(ros::service::waitForService(service, ros::Duration(30)),
-            service + " did not come up; see " + context.paths.log(ns));
-    require(waitUntil([&] { return readVoltage(service, nullptr); }, 20s),
-            "servo/read never succeeded against robot_sim");
-    result.new_connection = timeServoReads(context.nh, service, options.service_calls, false);
-    result.persistent = timeServoReads(context.nh, service, options.service_calls, true);
-  }
-  {
-    // The wheel loop, idle and under a stress of servo/read calls: every device simulated.
-    const std::string ns = "full_event";
-    const std::string link = context.paths.link(ns);
-    const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, {"--link", link});
-    DriverProcess driver(context.paths, ns, commonParams(link, kEventDriven));
-    WheelCommandLog wheel(context.nh, driver.topic("wheel_command"));
-    const std::string service = driver.topic("servo/read");
-    require(ros::service::waitForService(service, ros::Duration(30)),
-            service + " did not come up; see " + context.paths.log(ns));
-    require(waitUntil([&] { return wheel.count() > 0; }, 20s), "no wheel_command received");
-    require(sleepUntil(Clock::now() + 1s), "stopped");
+/// Round trips: the servo bus alone (robot_sim answers after its default 1.5 ms latency).
+void measureServoRoundTrips(Context& context, ServoSessionResult* result) {
+  const std::string ns = "servo_event";
+  const std::string link = context.paths.link(ns);
+  const auto sim =
+      startRobotSim(context.paths, "robot_sim_" + ns, {"--link", link, "--no-base", "--no-body"});
+  ParamList params = commonParams(link, kEventDriven);
+  params.insert(params.end(), {{"base/enabled", false}, {"body/enabled", false}});
+  DriverProcess driver(context.paths, ns, params);
+  const std::string service = driver.topic("servo/read");
+  require(ros::service::waitForService(service, ros::Duration(30)),
+          service + " did not come up; see " + context.paths.log(ns));
+  require(waitUntil([&] { return readVoltage(service, nullptr); }, 20s),
+          "servo/read never succeeded against robot_sim");
+  const std::size_t calls = context.options.service_calls;
+  result->new_connection = timeServoReads(context.nh, service, calls, false);
+  result->persistent = timeServoReads(context.nh, service, calls, true);
+}
 
-    const auto window = fromSeconds(options.stress_seconds);
-    std::size_t first = wheel.count();
-    require(sleepUntil(Clock::now() + window), "stopped");
-    result.idle = analyzePeriods(wheel.stamps(first, wheel.count()));
-
-    // Stress: three persistent clients back to back plus one opening a connection per call.
-    std::atomic<bool> stress_done{false};
-    std::atomic<std::size_t> calls{0}, failures{0};
-    std::vector<std::thread> clients;
-    for (int i = 0; i < 4; ++i) {
-      clients.emplace_back([&, persistent = i < 3] {
-        ros::ServiceClient client;
-        while (!stress_done) {
-          if (persistent && !client.isValid()) {
-            client = context.nh.serviceClient<ServoRead>(service, true);
-          }
-          ++(readVoltage(service, persistent ? &client : nullptr) ? calls : failures);
+/// Stress: three persistent clients back to back plus one opening a connection per call, for
+/// the window; the wheel loop's periods meanwhile.
+void stressServoReads(Context& context, const std::string& service, WheelCommandLog& wheel,
+                      ServoSessionResult* result) {
+  std::atomic<bool> stress_done{false};
+  std::atomic<std::size_t> calls{0}, failures{0};
+  std::vector<std::thread> clients;
+  for (int i = 0; i < 4; ++i) {
+    clients.emplace_back([&, persistent = i < 3] {
+      ros::ServiceClient client;
+      while (!stress_done) {
+        if (persistent && !client.isValid()) {
+          client = context.nh.serviceClient<ServoRead>(service, true);
         }
-      });
-    }
-    first = wheel.count();
-    const Clock::time_point start = Clock::now();
-    sleepUntil(start + window);
-    const std::size_t last = wheel.count();
-    result.calls_per_second = calls / toSeconds(Clock::now() - start);
-    stress_done = true;
-    for (auto& client : clients) client.join();
-    result.stress = analyzePeriods(wheel.stamps(first, last));
-    result.failed_stress_calls = failures;
+        ++(readVoltage(service, persistent ? &client : nullptr) ? calls : failures);
+      }
+    });
   }
+  const std::size_t first = wheel.count();
+  const Clock::time_point start = Clock::now();
+  sleepUntil(start + fromSeconds(context.options.stress_seconds));
+  const std::size_t last = wheel.count();
+  result->calls_per_second = calls / toSeconds(Clock::now() - start);
+  stress_done = true;
+  for (auto& client : clients) client.join();
+  result->stress = analyzePeriods(wheel.stamps(first, last));
+  result->failed_stress_calls = failures;
+}
+
+/// The wheel loop, idle and under a stress of servo/read calls: every device simulated.
+void measureWheelLoopUnderStress(Context& context, ServoSessionResult* result) {
+  const std::string ns = "full_event";
+  const std::string link = context.paths.link(ns);
+  const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, {"--link", link});
+  DriverProcess driver(context.paths, ns, commonParams(link, kEventDriven));
+  WheelCommandLog wheel(context.nh, driver.topic("wheel_command"));
+  const std::string service = driver.topic("servo/read");
+  require(ros::service::waitForService(service, ros::Duration(30)),
+          service + " did not come up; see " + context.paths.log(ns));
+  require(waitUntil([&] { return wheel.count() > 0; }, 20s), "no wheel_command received");
+  require(sleepUntil(Clock::now() + 1s), "stopped");
+
+  const std::size_t first = wheel.count();
+  require(sleepUntil(Clock::now() + fromSeconds(context.options.stress_seconds)), "stopped");
+  result->idle = analyzePeriods(wheel.stamps(first, wheel.count()));
+  stressServoReads(context, service, wheel, result);
+}
+
+ServoSessionResult runServoSession(Context& context) {
+  ServoSessionResult result;
+  measureServoRoundTrips(context, &result);
+  measureWheelLoopUnderStress(context, &result);
   return result;
 }
 
@@ -954,20 +962,37 @@ BusRun runServoStates(Context& context, const std::string& tag, double latency_m
                             context.paths.log(ns));
 }
 
-void runServoBusSection(Context& context) {
-  ResultTable& table = context.results;
-  // Side by side: each pair of runs back to back, so the machine's load is alike for both.
-  const BusRun floor_fast = runServoFloor(context, "fast", 0.0, false);
-  const BusRun node_fast = runServoStates(context, "fast", 0.0, false, 1000.0);
-  const BusRun floor_pub_fast = runPublishingServoFloor(context, "fast", 0.0, false);
-  const BusRun node_quiet = runServoStates(context, "quiet", 0.0, false, 1000.0, false);
-  const BusRun floor_paced = runServoFloor(context, "paced", kBusLatencyMs, true);
-  const BusRun node_paced = runServoStates(context, "paced", kBusLatencyMs, true, 1000.0);
-  const BusRun node_paced_health =
-      runServoStates(context, "paced_health", kBusLatencyMs, true, 1000.0, false, 1.0);
-  const BusRun floor_unpaced = runServoFloor(context, "latency", kBusLatencyMs, false);
-  const double wire_rate = 1000.0 / (kBusLineMs + kBusLatencyMs);
+/// The runs of section 10, each pair back to back so the machine's load is alike for both.
+struct BusRuns {
+  BusRun floor_fast, node_fast, floor_pub_fast, node_quiet;
+  BusRun floor_paced, node_paced, node_paced_health, floor_unpaced;
+};
 
+/// The line's own rate: READ_ANGLE's bytes at kBusBaud plus the servo's latency.
+constexpr double kBusWireRate = 1000.0 / (kBusLineMs + kBusLatencyMs);
+
+BusRuns runBusRuns(Context& context) {
+  BusRuns runs;
+  runs.floor_fast = runServoFloor(context, "fast", 0.0, false);
+  runs.node_fast = runServoStates(context, "fast", 0.0, false, 1000.0);
+  runs.floor_pub_fast = runPublishingServoFloor(context, "fast", 0.0, false);
+  runs.node_quiet = runServoStates(context, "quiet", 0.0, false, 1000.0, false);
+  runs.floor_paced = runServoFloor(context, "paced", kBusLatencyMs, true);
+  runs.node_paced = runServoStates(context, "paced", kBusLatencyMs, true, 1000.0);
+  runs.node_paced_health =
+      runServoStates(context, "paced_health", kBusLatencyMs, true, 1000.0, false, 1.0);
+  runs.floor_unpaced = runServoFloor(context, "latency", kBusLatencyMs, false);
+  return runs;
+}
+
+/// "0.95 of the rate, 1.20 of the CPU": a node's run against a floor's.
+std::string versus(const BusRun& node, const BusRun& floor) {
+  return format("%.2f of the rate, %.2f of the CPU", node.per_second / floor.per_second,
+                node.cpu_us / floor.cpu_us);
+}
+
+void addBusRunRows(ResultTable& table, const BusRuns& runs) {
+  const double wire_rate = kBusWireRate;
   table.section(format("10. The servo bus at the wire's pace: READ_ANGLE of %d servos, "
                        "servo_states (driver_node) vs servo_floor", kBusServos),
                 {"run", "transactions/s", "per transaction", "CPU per transaction", "CPU",
@@ -976,53 +1001,55 @@ void runServoBusSection(Context& context) {
     table.row({what, format("%.0f", run.per_second), format("%.3f ms", run.turnaround_ms),
                format("%.1f us", run.cpu_us), format("%.2f s per s", run.cpu_share), ratio_text});
   };
-  add("servo_floor, pty speed, latency 0", floor_fast, "");
-  add("driver_node, pty speed, latency 0, state_rate 1000", node_fast,
-      format("%.2f of the rate, %.2f of the CPU", node_fast.per_second / floor_fast.per_second,
-             node_fast.cpu_us / floor_fast.cpu_us));
+  add("servo_floor, pty speed, latency 0", runs.floor_fast, "");
+  add("driver_node, pty speed, latency 0, state_rate 1000", runs.node_fast,
+      versus(runs.node_fast, runs.floor_fast));
   add("servo_floor --publish (roscpp, one servo_states message per answer), pty speed",
-      floor_pub_fast, "");
-  add("driver_node against servo_floor --publish", node_fast,
-      format("%.2f of the rate, %.2f of the CPU", node_fast.per_second / floor_pub_fast.per_second,
-             node_fast.cpu_us / floor_pub_fast.cpu_us));
-  add("driver_node, the same, nobody subscribed to servo_states", node_quiet,
-      format("%.2f of the rate, %.2f of the CPU", node_quiet.per_second / floor_fast.per_second,
-             node_quiet.cpu_us / floor_fast.cpu_us));
+      runs.floor_pub_fast, "");
+  add("driver_node against servo_floor --publish", runs.node_fast,
+      versus(runs.node_fast, runs.floor_pub_fast));
+  add("driver_node, the same, nobody subscribed to servo_states", runs.node_quiet,
+      versus(runs.node_quiet, runs.floor_fast));
   add(format("servo_floor, --pace-baud %.0f, latency %.1f ms", kBusBaud, kBusLatencyMs),
-      floor_paced, "");
+      runs.floor_paced, "");
   add(format("driver_node, --pace-baud %.0f, latency %.1f ms, state_rate 1000", kBusBaud,
              kBusLatencyMs),
-      node_paced,
-      format("%.2f of the rate, %.2f of the CPU", node_paced.per_second / floor_paced.per_second,
-             node_paced.cpu_us / floor_paced.cpu_us));
+      runs.node_paced, versus(runs.node_paced, runs.floor_paced));
   add(format("driver_node, the same with health_rate 1 (the default), every transaction counted "
              "(READ_ANGLE and the health poll's READ_DATA)"),
-      node_paced_health,
-      format("%.2f of the floor's rate", node_paced_health.per_second / floor_paced.per_second));
+      runs.node_paced_health,
+      format("%.2f of the floor's rate",
+             runs.node_paced_health.per_second / runs.floor_paced.per_second));
   table.row({format("the line at %.0f baud + %.1f ms latency", kBusBaud, kBusLatencyMs),
              format("%.0f", wire_rate), format("%.3f ms", kBusLineMs + kBusLatencyMs), "", "", ""});
-  add(format("servo_floor, pty speed, latency %.1f ms", kBusLatencyMs), floor_unpaced, "");
+  add(format("servo_floor, pty speed, latency %.1f ms", kBusLatencyMs), runs.floor_unpaced, "");
+}
 
+void addBusGoals(ResultTable& table, const BusRuns& runs) {
+  const double wire_rate = kBusWireRate;
   table.section("10. Goals of the servo bus");
   table.row("driver_node's turnaround over the floor's, pty speed",
-            format("+%.3f ms", node_fast.turnaround_ms - floor_fast.turnaround_ms),
-            "<= the floor's own", node_fast.turnaround_ms <= 2 * floor_fast.turnaround_ms);
-  table.row("driver_node's CPU per transaction, pty speed", format("%.1f us", node_fast.cpu_us),
-            "<= 38 us (half of 77)", node_fast.cpu_us <= 38.5);
+            format("+%.3f ms", runs.node_fast.turnaround_ms - runs.floor_fast.turnaround_ms),
+            "<= the floor's own",
+            runs.node_fast.turnaround_ms <= 2 * runs.floor_fast.turnaround_ms);
+  table.row("driver_node's CPU per transaction, pty speed",
+            format("%.1f us", runs.node_fast.cpu_us), "<= 38 us (half of 77)",
+            runs.node_fast.cpu_us <= 38.5);
   table.row("driver_node's CPU per transaction over servo_floor --publish's, pty speed",
-            format("%+.1f us (%.1f vs %.1f)", node_fast.cpu_us - floor_pub_fast.cpu_us,
-                   node_fast.cpu_us, floor_pub_fast.cpu_us),
+            format("%+.1f us (%.1f vs %.1f)", runs.node_fast.cpu_us - runs.floor_pub_fast.cpu_us,
+                   runs.node_fast.cpu_us, runs.floor_pub_fast.cpu_us),
             "");
   table.row(format("servo_states at %.0f baud, share of the line's rate", kBusBaud),
-            format("%.0f of %.0f /s = %.0f %%", node_paced.per_second, wire_rate,
-                   100.0 * node_paced.per_second / wire_rate),
-            ">= 90 %", node_paced.per_second >= 0.9 * wire_rate);
-  const double paced_excess = floor_paced.turnaround_ms - floor_unpaced.turnaround_ms;
+            format("%.0f of %.0f /s = %.0f %%", runs.node_paced.per_second, wire_rate,
+                   100.0 * runs.node_paced.per_second / wire_rate),
+            ">= 90 %", runs.node_paced.per_second >= 0.9 * wire_rate);
+  const double paced_excess = runs.floor_paced.turnaround_ms - runs.floor_unpaced.turnaround_ms;
   table.row("paced robot_sim: floor turnaround paced - unpaced (same latency)",
             format("%.3f ms (the line: %.3f ms)", paced_excess, kBusLineMs),
             "line +- 0.1 ms", std::abs(paced_excess - kBusLineMs) <= 0.1);
-  table.row("paced robot_sim: floor turnaround vs line + latency",
-            format("%.3f ms vs %.3f ms", floor_paced.turnaround_ms, kBusLineMs + kBusLatencyMs));
+  table.row(
+      "paced robot_sim: floor turnaround vs line + latency",
+      format("%.3f ms vs %.3f ms", runs.floor_paced.turnaround_ms, kBusLineMs + kBusLatencyMs));
   table.note(
       "Each transaction is a READ_ANGLE of the next servo: servo_states asks for 1000 Hz of each "
       "of 20 servos, more than either line carries, so both clients run back to back. driver_node "
@@ -1033,6 +1060,12 @@ void runServoBusSection(Context& context) {
       "process's own clock over the window. The paced robot_sim's excess is the difference of two "
       "floor runs that differ only in --pace-baud, so the pty round trip (the same in both) "
       "cancels; the last row includes it.");
+}
+
+void runServoBusSection(Context& context) {
+  const BusRuns runs = runBusRuns(context);
+  addBusRunRows(context.results, runs);
+  addBusGoals(context.results, runs);
 }
 
 // --- the run ------------------------------------------------------------------------------------
@@ -1062,56 +1095,47 @@ std::string ratio(double polling, double event) {
 /// alternated (node first in even rounds, floor first in odd ones) so that a change of machine
 /// load falls on both. Each round takes its share of the commands, frames and idle window; a
 /// figure is the mean over the rounds.
-void runFloorComparison(Context& context) {
-  struct Figures {
-    std::vector<double> cmd_p50, cmd_p99, cmd_lost, telemetry_p50, telemetry_p99, cpu, idle_cpu,
-        jitter;
-  };
-  const Options saved = context.options;
-  const std::size_t rounds = saved.floor_rounds;
-  context.options.commands = std::max<std::size_t>(50, saved.commands / rounds);
-  context.options.telemetry_frames = std::max<std::size_t>(100, saved.telemetry_frames / rounds);
-  context.options.loop_seconds = std::max(5.0, saved.loop_seconds / rounds);
-  Figures node, floor;
-  for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
-    for (int k = 0; k < 2; ++k) {
-      const bool floor_turn = (k == 1) != (round % 2 == 1);
-      const Variant& variant = floor_turn ? kFloor : kEventDriven;
-      Figures& figures = floor_turn ? floor : node;
-      const Variant tagged{variant.name, variant.tag + "_r" + std::to_string(round),
-                           variant.program, variant.read_poll_interval, true};
-      attempt(context, format("8. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
-        const BaseSessionResult base = runBaseSession(context, tagged, true, true);
-        figures.cmd_p50.push_back(base.cmd_vel->ms.p50);
-        figures.cmd_p99.push_back(base.cmd_vel->ms.p99);
-        figures.cmd_lost.push_back(100.0 * base.cmd_vel->lost /
-                                   std::max<std::size_t>(1, base.cmd_vel->attempted));
-        figures.jitter.push_back(base.idle_loop->period_ms.stddev);
-        figures.idle_cpu.push_back(base.idle_loop->cpu_percent / 100.0);
-      });
-      attempt(
-          context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1), [&] {
-            const TelemetrySessionResult body = runTelemetrySession(context, tagged, true, false);
-            figures.telemetry_p50.push_back(body.latency->ms.p50);
-            figures.telemetry_p99.push_back(body.latency->ms.p99);
-            figures.cpu.push_back(body.cpu_percent / 100.0);
-          });
-    }
-  }
-  context.options = saved;
+/// Section 8's figures of one program (driver_node or the floor), one entry per round.
+struct FloorFigures {
+  std::vector<double> cmd_p50, cmd_p99, cmd_lost, telemetry_p50, telemetry_p99, cpu, idle_cpu,
+      jitter;
+};
 
-  auto mean = [](const std::vector<double>& values) -> std::optional<double> {
-    if (values.empty()) return std::nullopt;
-    double sum = 0;
-    for (double value : values) sum += value;
-    return sum / values.size();
-  };
-  ResultTable& table = context.results;
+/// One program's base and telemetry sessions in one round of section 8.
+void runFloorRound(Context& context, const Variant& variant, std::size_t round,
+                   FloorFigures* figures) {
+  const Variant tagged{variant.name, variant.tag + "_r" + std::to_string(round), variant.program,
+                       variant.read_poll_interval, true};
+  attempt(context, format("8. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
+    const BaseSessionResult base = runBaseSession(context, tagged, true, true);
+    figures->cmd_p50.push_back(base.cmd_vel->ms.p50);
+    figures->cmd_p99.push_back(base.cmd_vel->ms.p99);
+    figures->cmd_lost.push_back(100.0 * base.cmd_vel->lost /
+                                std::max<std::size_t>(1, base.cmd_vel->attempted));
+    figures->jitter.push_back(base.idle_loop->period_ms.stddev);
+    figures->idle_cpu.push_back(base.idle_loop->cpu_percent / 100.0);
+  });
+  attempt(context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1), [&] {
+    const TelemetrySessionResult body = runTelemetrySession(context, tagged, true, false);
+    figures->telemetry_p50.push_back(body.latency->ms.p50);
+    figures->telemetry_p99.push_back(body.latency->ms.p99);
+    figures->cpu.push_back(body.cpu_percent / 100.0);
+  });
+}
+
+std::optional<double> meanOf(const std::vector<double>& values) {
+  if (values.empty()) return std::nullopt;
+  double sum = 0;
+  for (double value : values) sum += value;
+  return sum / values.size();
+}
+
+void addFloorRows(ResultTable& table, const FloorFigures& node, const FloorFigures& floor) {
   table.section("8. driver_node vs the floor (bench/floor_node.cpp), runs alternated",
                 {"measurement", "driver_node", "floor", "node / floor"});
   auto compare = [&](const std::string& what, const std::vector<double>& node_values,
                      const std::vector<double>& floor_values, const char* unit, int decimals) {
-    const auto n = mean(node_values), f = mean(floor_values);
+    const auto n = meanOf(node_values), f = meanOf(floor_values);
     if (!n || !f) return;
     table.row({what, format("%.*f %s", decimals, *n, unit), format("%.*f %s", decimals, *f, unit),
                f > 0 ? format("%.2fx", *n / *f) : "-"});
@@ -1124,9 +1148,29 @@ void runFloorComparison(Context& context) {
   compare("CPU at 100 Hz telemetry", node.cpu, floor.cpu, "s/s", 4);
   compare("CPU idle, base loop 50 Hz", node.idle_cpu, floor.idle_cpu, "s/s", 4);
   compare("loop jitter std, idle 50 Hz", node.jitter, floor.jitter, "ms", 3);
-  table.note(format(
+}
+
+void runFloorComparison(Context& context) {
+  const Options saved = context.options;
+  const std::size_t rounds = saved.floor_rounds;
+  context.options.commands = std::max<std::size_t>(50, saved.commands / rounds);
+  context.options.telemetry_frames = std::max<std::size_t>(100, saved.telemetry_frames / rounds);
+  context.options.loop_seconds = std::max(5.0, saved.loop_seconds / rounds);
+  FloorFigures node, floor;
+  for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
+    for (int k = 0; k < 2; ++k) {
+      const bool floor_turn = (k == 1) != (round % 2 == 1);
+      runFloorRound(context, floor_turn ? kFloor : kEventDriven, round,
+                    floor_turn ? &floor : &node);
+    }
+  }
+  context.options = saved;
+
+  addFloorRows(context.results, node, floor);
+  context.results.note(format(
       "%zu rounds, node and floor alternated; per round %zu cmd_vel commands 10-40 ms apart "
-      "(uniform; a command overtaken before any frame carries it is not timed), %zu telemetry frames of 20 servos at 100 Hz with one "
+      "(uniform; a command overtaken before any frame carries it is not timed), %zu telemetry "
+      "frames of 20 servos at 100 Hz with one "
       "external joint_states subscriber, %.0f s idle window. Figures are means over the rounds. "
       "CPU from the process's kernel CPU clock (clock_getcpuclockid).",
       rounds, std::max<std::size_t>(50, saved.commands / rounds),
@@ -1134,12 +1178,17 @@ void runFloorComparison(Context& context) {
       std::max(5.0, saved.loop_seconds / rounds)));
 }
 
-void run(Context& context) {
-  const Options& o = context.options;
-  ResultTable& table = context.results;
+/// What the sessions of sections 1-5 measured, compared again in 7 and 9.
+struct SessionResults {
   BaseSessionResult base_event, base_polling;
   TelemetrySessionResult body_event, body_polling;
+};
 
+/// Sections 1-3: the event-driven node's base.
+void runBaseSections(Context& context, SessionResults* results) {
+  const Options& o = context.options;
+  ResultTable& table = context.results;
+  BaseSessionResult& base_event = results->base_event;
   if (o.runs(1) || o.runs(2) || o.runs(3)) {
     attempt(context, "base session (1-3)", [&] {
       base_event = runBaseSession(context, kEventDriven, o.runs(1), o.runs(2) || o.runs(3));
@@ -1163,7 +1212,30 @@ void run(Context& context) {
               base_event.idle_loop->cpu_percent <= 0.5);
     table.note("From the process's kernel CPU clock (clock_getcpuclockid, ns resolution).");
   }
+}
 
+// The goal applies to the node as shipped (event-driven); the polling variant is only compared.
+void addRateSteps(ResultTable& table, const std::string& title,
+                  const TelemetrySessionResult& session, bool with_goal, double step_seconds) {
+  table.section(
+      title, {"target", "achieved", "frames", "dropped at pty", "delivered", "ratio", ">= 99.9 %"});
+  for (const RateStep& step : session.steps) {
+    table.row({format("%.0f Hz", step.target_hz), format("%.0f Hz", step.achieved_hz),
+               format("%zu", step.attempted), format("%zu", step.dropped_at_pty),
+               format("%zu", step.delivered), format("%.2f %%", 100 * step.ratio()),
+               verdict(step.ratio() >= 0.999)});
+  }
+  const double best = session.max_rate_hz.value_or(0);
+  table.note(format("Highest rate with >= 99.9 %% published: %.0f Hz%s. Each step %g s.", best,
+                    with_goal ? (" (goal >= 1000 Hz: " + verdict(best >= 1000) + ")").c_str() : "",
+                    step_seconds));
+}
+
+/// Sections 4-5: the event-driven node's telemetry.
+void runTelemetrySections(Context& context, SessionResults* results) {
+  const Options& o = context.options;
+  ResultTable& table = context.results;
+  TelemetrySessionResult& body_event = results->body_event;
   if (o.runs(4) || o.runs(5)) {
     attempt(context, "telemetry session (4-5)",
             [&] { body_event = runTelemetrySession(context, kEventDriven, o.runs(4), o.runs(5)); });
@@ -1174,129 +1246,135 @@ void run(Context& context) {
     table.row("driver_node CPU at 100 Hz", percent(body_event.cpu_percent), "<= 0.5 %",
               body_event.cpu_percent <= 0.5);
   }
-  // The goal applies to the node as shipped (event-driven); the polling variant is only compared.
-  auto addRateSteps = [&](const std::string& title, const TelemetrySessionResult& session,
-                          bool with_goal) {
-    table.section(title, {"target", "achieved", "frames", "dropped at pty", "delivered", "ratio",
-                          ">= 99.9 %"});
-    for (const RateStep& step : session.steps) {
-      table.row({format("%.0f Hz", step.target_hz), format("%.0f Hz", step.achieved_hz),
-                 format("%zu", step.attempted), format("%zu", step.dropped_at_pty),
-                 format("%zu", step.delivered), format("%.2f %%", 100 * step.ratio()),
-                 verdict(step.ratio() >= 0.999)});
-    }
-    const double best = session.max_rate_hz.value_or(0);
-    table.note(
-        format("Highest rate with >= 99.9 %% published: %.0f Hz%s. Each step %g s.", best,
-               with_goal ? (" (goal >= 1000 Hz: " + verdict(best >= 1000) + ")").c_str() : "",
-               o.rate_step_seconds));
-  };
   if (!body_event.steps.empty()) {
-    addRateSteps("5. Telemetry rate steps: frames published as joint_states", body_event, true);
+    addRateSteps(table, "5. Telemetry rate steps: frames published as joint_states", body_event,
+                 true, o.rate_step_seconds);
   }
+}
 
-  if (o.runs(6)) {
-    attempt(context, "servo session (6)", [&] {
-      const ServoSessionResult servo = runServoSession(context);
-      table.section("6. servo/read round trip against robot_sim, and the wheel loop under calls");
-      addLatencyRows(table, "servo/read, new connection per call", servo.new_connection, {});
-      addLatencyRows(table, "servo/read, persistent client", servo.persistent, {});
-      addLoopRows(table, "wheel loop idle", servo.idle, false);
-      addLoopRows(table, "wheel loop under servo/read stress", servo.stress, false);
-      table.row("stress: servo/read calls completed",
-                format("%.0f /s (%zu failed)", servo.calls_per_second, servo.failed_stress_calls));
-      table.note(
-          "robot_sim answers after 1.5 ms (its default --servo-latency-ms). Wheel periods "
-          "from wheel_command header stamps; stress = 3 persistent clients + 1 opening a "
-          "connection per call, back to back.");
-    });
-  }
-
-  if (o.runs(7)) {
-    if (o.runs(1) && base_event.cmd_vel) {
-      attempt(context, "polling base session (7)",
-              [&] { base_polling = runBaseSession(context, kPolling, true, false); });
-    }
-    if ((o.runs(4) && body_event.latency) || (o.runs(5) && !body_event.steps.empty())) {
-      attempt(context, "polling telemetry session (7)",
-              [&] { body_polling = runTelemetrySession(context, kPolling, o.runs(4), o.runs(5)); });
-    }
-    table.section("7. Event-driven vs polling reads (~read_poll_interval 0.02)",
-                  {"measurement", kEventDriven.name, kPolling.name, "polling / event"});
-    auto compare = [&](const std::string& what, double event, double polling,
-                       const std::string& unit, int decimals) {
-      table.row({what, format("%.*f %s", decimals, event, unit.c_str()),
-                 format("%.*f %s", decimals, polling, unit.c_str()), ratio(polling, event)});
-    };
-    if (base_event.cmd_vel && base_polling.cmd_vel) {
-      compare("1. cmd_vel -> frame p50", base_event.cmd_vel->ms.p50, base_polling.cmd_vel->ms.p50,
-              "ms", 3);
-      compare("1. cmd_vel -> frame p99", base_event.cmd_vel->ms.p99, base_polling.cmd_vel->ms.p99,
-              "ms", 3);
-    }
-    if (body_event.latency && body_polling.latency) {
-      compare("4. telemetry -> joint_states p50", body_event.latency->ms.p50,
-              body_polling.latency->ms.p50, "ms", 3);
-      compare("4. telemetry -> joint_states p99", body_event.latency->ms.p99,
-              body_polling.latency->ms.p99, "ms", 3);
-      compare("4. node CPU at 100 Hz", body_event.cpu_percent, body_polling.cpu_percent, "%", 2);
-    }
-    if (!body_event.steps.empty() && !body_polling.steps.empty()) {
-      compare("5. highest rate >= 99.9 %", body_event.max_rate_hz.value_or(0),
-              body_polling.max_rate_hz.value_or(0), "Hz", 0);
-    }
+/// Section 6.
+void runServoSessionSection(Context& context) {
+  ResultTable& table = context.results;
+  attempt(context, "servo session (6)", [&] {
+    const ServoSessionResult servo = runServoSession(context);
+    table.section("6. servo/read round trip against robot_sim, and the wheel loop under calls");
+    addLatencyRows(table, "servo/read, new connection per call", servo.new_connection, {});
+    addLatencyRows(table, "servo/read, persistent client", servo.persistent, {});
+    addLoopRows(table, "wheel loop idle", servo.idle, false);
+    addLoopRows(table, "wheel loop under servo/read stress", servo.stress, false);
+    table.row("stress: servo/read calls completed",
+              format("%.0f /s (%zu failed)", servo.calls_per_second, servo.failed_stress_calls));
     table.note(
-        "cmd_vel -> frame does not go through the port reader, so polling should not "
-        "change it; telemetry does.");
-    if (!body_polling.steps.empty()) {
-      addRateSteps("7b. Telemetry rate steps, polling variant", body_polling, false);
-    }
-  }
+        "robot_sim answers after 1.5 ms (its default --servo-latency-ms). Wheel periods "
+        "from wheel_command header stamps; stress = 3 persistent clients + 1 opening a "
+        "connection per call, back to back.");
+  });
+}
 
+/// A row of a before/after comparison (7, 9): both values and after / before.
+void compareRow(ResultTable& table, const std::string& what, double before, double after,
+                const std::string& unit, int decimals) {
+  table.row({what, format("%.*f %s", decimals, before, unit.c_str()),
+             format("%.*f %s", decimals, after, unit.c_str()), ratio(after, before)});
+}
+
+/// Section 7: the polling variant against what 1-5 measured.
+void runPollingComparison(Context& context, SessionResults* results) {
+  const Options& o = context.options;
+  ResultTable& table = context.results;
+  const BaseSessionResult& base_event = results->base_event;
+  const TelemetrySessionResult& body_event = results->body_event;
+  BaseSessionResult& base_polling = results->base_polling;
+  TelemetrySessionResult& body_polling = results->body_polling;
+  if (o.runs(1) && base_event.cmd_vel) {
+    attempt(context, "polling base session (7)",
+            [&] { base_polling = runBaseSession(context, kPolling, true, false); });
+  }
+  if ((o.runs(4) && body_event.latency) || (o.runs(5) && !body_event.steps.empty())) {
+    attempt(context, "polling telemetry session (7)",
+            [&] { body_polling = runTelemetrySession(context, kPolling, o.runs(4), o.runs(5)); });
+  }
+  table.section("7. Event-driven vs polling reads (~read_poll_interval 0.02)",
+                {"measurement", kEventDriven.name, kPolling.name, "polling / event"});
+  if (base_event.cmd_vel && base_polling.cmd_vel) {
+    compareRow(table, "1. cmd_vel -> frame p50", base_event.cmd_vel->ms.p50,
+               base_polling.cmd_vel->ms.p50, "ms", 3);
+    compareRow(table, "1. cmd_vel -> frame p99", base_event.cmd_vel->ms.p99,
+               base_polling.cmd_vel->ms.p99, "ms", 3);
+  }
+  if (body_event.latency && body_polling.latency) {
+    compareRow(table, "4. telemetry -> joint_states p50", body_event.latency->ms.p50,
+               body_polling.latency->ms.p50, "ms", 3);
+    compareRow(table, "4. telemetry -> joint_states p99", body_event.latency->ms.p99,
+               body_polling.latency->ms.p99, "ms", 3);
+    compareRow(table, "4. node CPU at 100 Hz", body_event.cpu_percent, body_polling.cpu_percent,
+               "%", 2);
+  }
+  if (!body_event.steps.empty() && !body_polling.steps.empty()) {
+    compareRow(table, "5. highest rate >= 99.9 %", body_event.max_rate_hz.value_or(0),
+               body_polling.max_rate_hz.value_or(0), "Hz", 0);
+  }
+  table.note(
+      "cmd_vel -> frame does not go through the port reader, so polling should not "
+      "change it; telemetry does.");
+  if (!body_polling.steps.empty()) {
+    addRateSteps(table, "7b. Telemetry rate steps, polling variant", body_polling, false,
+                 o.rate_step_seconds);
+  }
+}
+
+/// Section 9: ~capture on against off (2-4's numbers when they ran, else measured here).
+void runCaptureComparison(Context& context, SessionResults* results) {
+  ResultTable& table = context.results;
+  BaseSessionResult& base_event = results->base_event;
+  TelemetrySessionResult& body_event = results->body_event;
+  if (!base_event.idle_loop) {
+    attempt(context, "base session without capture (9)",
+            [&] { base_event = runBaseSession(context, kEventDriven, false, true); });
+  }
+  if (!body_event.latency) {
+    attempt(context, "telemetry session without capture (9)",
+            [&] { body_event = runTelemetrySession(context, kEventDriven, true, false); });
+  }
+  BaseSessionResult base_capture;
+  TelemetrySessionResult body_capture;
+  attempt(context, "base session with capture (9)",
+          [&] { base_capture = runBaseSession(context, kCapturing, false, true); });
+  attempt(context, "telemetry session with capture (9)",
+          [&] { body_capture = runTelemetrySession(context, kCapturing, true, false); });
+  table.section("9. ~capture off vs on (serial_raw subscribed)",
+                {"measurement", "capture off", "capture on", "on / off"});
+  if (base_event.idle_loop && base_capture.idle_loop) {
+    const LoopResult& off = *base_event.idle_loop;
+    const LoopResult& on = *base_capture.idle_loop;
+    compareRow(table, "2. base loop period std", off.period_ms.stddev, on.period_ms.stddev, "ms",
+               3);
+    compareRow(table, "2. base loop worst period", off.period_ms.max, on.period_ms.max, "ms", 3);
+    compareRow(table, "2. missed ticks", off.missed_ticks, on.missed_ticks, "", 0);
+    compareRow(table, "3. node CPU idle at 50 Hz", off.cpu_percent, on.cpu_percent, "%", 2);
+  }
+  if (body_event.latency && body_capture.latency) {
+    compareRow(table, "4. telemetry -> joint_states p50", body_event.latency->ms.p50,
+               body_capture.latency->ms.p50, "ms", 3);
+    compareRow(table, "4. telemetry -> joint_states p99", body_event.latency->ms.p99,
+               body_capture.latency->ms.p99, "ms", 3);
+    compareRow(table, "4. node CPU at 100 Hz", body_event.cpu_percent, body_capture.cpu_percent,
+               "%", 2);
+  }
+  table.note(
+      "With capture every chunk read and every frame written is copied, stamped and queued; "
+      "a thread of its own publishes serial_raw, so the loop and the reader never wait for it.");
+}
+
+void run(Context& context) {
+  const Options& o = context.options;
+  SessionResults results;
+  runBaseSections(context, &results);
+  runTelemetrySections(context, &results);
+  if (o.runs(6)) runServoSessionSection(context);
+  if (o.runs(7)) runPollingComparison(context, &results);
   if (o.runs(8)) runFloorComparison(context);
-
-  if (o.runs(9)) {
-    // The capture-off numbers are those of 2-4 when they ran; otherwise measured here.
-    if (!base_event.idle_loop) {
-      attempt(context, "base session without capture (9)",
-              [&] { base_event = runBaseSession(context, kEventDriven, false, true); });
-    }
-    if (!body_event.latency) {
-      attempt(context, "telemetry session without capture (9)",
-              [&] { body_event = runTelemetrySession(context, kEventDriven, true, false); });
-    }
-    BaseSessionResult base_capture;
-    TelemetrySessionResult body_capture;
-    attempt(context, "base session with capture (9)",
-            [&] { base_capture = runBaseSession(context, kCapturing, false, true); });
-    attempt(context, "telemetry session with capture (9)",
-            [&] { body_capture = runTelemetrySession(context, kCapturing, true, false); });
-    table.section("9. ~capture off vs on (serial_raw subscribed)",
-                  {"measurement", "capture off", "capture on", "on / off"});
-    auto compare = [&](const std::string& what, double off, double on, const std::string& unit,
-                       int decimals) {
-      table.row({what, format("%.*f %s", decimals, off, unit.c_str()),
-                 format("%.*f %s", decimals, on, unit.c_str()), ratio(on, off)});
-    };
-    if (base_event.idle_loop && base_capture.idle_loop) {
-      const LoopResult& off = *base_event.idle_loop;
-      const LoopResult& on = *base_capture.idle_loop;
-      compare("2. base loop period std", off.period_ms.stddev, on.period_ms.stddev, "ms", 3);
-      compare("2. base loop worst period", off.period_ms.max, on.period_ms.max, "ms", 3);
-      compare("2. missed ticks", off.missed_ticks, on.missed_ticks, "", 0);
-      compare("3. node CPU idle at 50 Hz", off.cpu_percent, on.cpu_percent, "%", 2);
-    }
-    if (body_event.latency && body_capture.latency) {
-      compare("4. telemetry -> joint_states p50", body_event.latency->ms.p50,
-              body_capture.latency->ms.p50, "ms", 3);
-      compare("4. telemetry -> joint_states p99", body_event.latency->ms.p99,
-              body_capture.latency->ms.p99, "ms", 3);
-      compare("4. node CPU at 100 Hz", body_event.cpu_percent, body_capture.cpu_percent, "%", 2);
-    }
-    table.note(
-        "With capture every chunk read and every frame written is copied, stamped and queued; "
-        "a thread of its own publishes serial_raw, so the loop and the reader never wait for it.");
-  }
+  if (o.runs(9)) runCaptureComparison(context, &results);
   if (o.runs(10)) {
     attempt(context, "servo bus at the wire's pace (10)", [&] { runServoBusSection(context); });
   }
@@ -1321,6 +1399,64 @@ std::string header(const Options& options) {
                 options.long_run ? "long" : "default");
 }
 
+/// Whether every program the run starts is in paths.bin_dir (said on stderr when not).
+bool programsFound(const RunPaths& paths) {
+  for (const char* program :
+       {"driver_node", "polling_driver_node", "robot_sim", "floor_node", "servo_floor"}) {
+    if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
+      std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
+                << " not found: build the driver_bench target first\n";
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Runs the sections against a roscore of our own; the exit status, the report in `report`
+/// (empty when the run never got to it).
+int runWithMaster(int argc, char** argv, const Options& options, const RunPaths& paths,
+                  std::string* report) {
+  const std::string started = header(options);
+  int status = 0;
+  try {
+    RosMaster master(paths, options.master_port ? options.master_port : findFreeTcpPort());
+    ros::init(argc, argv, "driver_bench", ros::init_options::NoSigintHandler);
+    // Our own INFO lines (waitForService ...) would interleave with the table on stdout.
+    if (ros::console::set_logger_level("ros", ros::console::levels::Warn)) {
+      ros::console::notifyLoggerLevelsChanged();
+    }
+    std::cerr << "driver_bench: roscore at " << master.uri() << ", logs in " << paths.work_dir
+              << std::endl;
+    master.waitUntilUp(std::chrono::seconds(60));
+    Context context{options, paths, ros::NodeHandle(), {}};
+    ros::AsyncSpinner spinner(2);
+    spinner.start();
+    run(context);
+    spinner.stop();
+    *report = started + context.results.markdown();
+    if (stopRequested()) *report += "\n**Interrupted: partial results.**\n";
+    if (context.failures > 0) status = 1;
+    ros::shutdown();
+  } catch (const std::exception& error) {
+    std::cerr << "driver_bench: " << error.what() << std::endl;
+    status = 1;
+  }
+  return status;
+}
+
+/// The report with the load at the end, on stdout and in --output when given.
+void writeReport(const Options& options, const RunPaths& paths, std::string report) {
+  double load[3] = {0, 0, 0};
+  ::getloadavg(load, 3);
+  report += format("\nLoad average at the end: %.2f %.2f %.2f. Logs of the nodes: %s\n", load[0],
+                   load[1], load[2], paths.work_dir.c_str());
+  std::cout << report << std::flush;
+  if (!options.output.empty()) {
+    std::ofstream(options.output) << report;
+    std::cerr << "driver_bench: results written to " << options.output << std::endl;
+  }
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::bench
 
@@ -1337,59 +1473,17 @@ int main(int argc, char** argv) {
 
   bench::RunPaths paths;
   paths.bin_dir = options.bin_dir.empty() ? bench::executableDirectory() : options.bin_dir;
-  for (const char* program :
-       {"driver_node", "polling_driver_node", "robot_sim", "floor_node", "servo_floor"}) {
-    if (::access((paths.bin_dir + "/" + program).c_str(), X_OK) != 0) {
-      std::cerr << "driver_bench: " << paths.bin_dir << "/" << program
-                << " not found: build the driver_bench target first\n";
-      return 2;
-    }
-  }
+  if (!bench::programsFound(paths)) return 2;
   char work_dir[] = "/tmp/srd_bench_XXXXXX";
   if (::mkdtemp(work_dir) == nullptr) {
     std::cerr << "driver_bench: cannot create a work directory in /tmp\n";
     return 1;
   }
   paths.work_dir = work_dir;
-  const std::string started = bench::header(options);
 
-  int status = 0;
   std::string report;
-  try {
-    bench::RosMaster master(paths,
-                            options.master_port ? options.master_port : bench::findFreeTcpPort());
-    ros::init(argc, argv, "driver_bench", ros::init_options::NoSigintHandler);
-    // Our own INFO lines (waitForService ...) would interleave with the table on stdout.
-    if (ros::console::set_logger_level("ros", ros::console::levels::Warn)) {
-      ros::console::notifyLoggerLevelsChanged();
-    }
-    std::cerr << "driver_bench: roscore at " << master.uri() << ", logs in " << paths.work_dir
-              << std::endl;
-    master.waitUntilUp(std::chrono::seconds(60));
-    bench::Context context{options, paths, ros::NodeHandle(), {}};
-    ros::AsyncSpinner spinner(2);
-    spinner.start();
-    bench::run(context);
-    spinner.stop();
-    report = started + context.results.markdown();
-    if (bench::stopRequested()) report += "\n**Interrupted: partial results.**\n";
-    if (context.failures > 0) status = 1;
-    ros::shutdown();
-  } catch (const std::exception& error) {
-    std::cerr << "driver_bench: " << error.what() << std::endl;
-    status = 1;
-  }
+  int status = bench::runWithMaster(argc, argv, options, paths, &report);
   if (bench::stopRequested()) status = 130;
-  if (!report.empty()) {
-    double load[3] = {0, 0, 0};
-    ::getloadavg(load, 3);
-    report += bench::format("\nLoad average at the end: %.2f %.2f %.2f. Logs of the nodes: %s\n",
-                            load[0], load[1], load[2], paths.work_dir.c_str());
-    std::cout << report << std::flush;
-    if (!options.output.empty()) {
-      std::ofstream(options.output) << report;
-      std::cerr << "driver_bench: results written to " << options.output << std::endl;
-    }
-  }
+  if (!report.empty()) bench::writeReport(options, paths, report);
   return status;
 }

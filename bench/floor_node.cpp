@@ -46,6 +46,97 @@ void writeSpeedFrame() {
   }
 }
 
+/// The body's joints as ~body/* gives them.
+struct BodyJoints {
+  std::vector<int> ids;
+  std::vector<std::string> names;
+  std::vector<srd::device::JointCalibration> calibrations;
+};
+
+BodyJoints readBodyJoints(ros::NodeHandle& pnh) {
+  BodyJoints joints;
+  std::vector<int> zeros, directions;
+  pnh.getParam("body/servo_ids", joints.ids);
+  pnh.getParam("body/joint_names", joints.names);
+  pnh.getParam("body/zero_ticks", zeros);
+  pnh.getParam("body/directions", directions);
+  joints.calibrations.resize(joints.ids.size());
+  for (std::size_t i = 0; i < joints.ids.size(); ++i) {
+    if (i < zeros.size()) joints.calibrations[i].zero_ticks = zeros[i];
+    if (i < directions.size()) joints.calibrations[i].direction = directions[i];
+    joints.calibrations[i].ticks_per_revolution = pnh.param("body/ticks_per_revolution", 4096);
+  }
+  joints.names.resize(joints.ids.size());
+  return joints;
+}
+
+/// Opens the port raw, blocking reads of at least one byte; false when it cannot be opened.
+bool openRawPort(const std::string& port) {
+  g_fd = ::open(port.c_str(), O_RDWR | O_NOCTTY);
+  if (g_fd < 0) return false;
+  termios tio{};
+  ::tcgetattr(g_fd, &tio);
+  ::cfmakeraw(&tio);
+  tio.c_cc[VMIN] = 1;
+  tio.c_cc[VTIME] = 0;
+  ::tcsetattr(g_fd, TCSANOW, &tio);
+  return true;
+}
+
+/// cmd_vel: the wheel speeds, written at once.
+ros::Subscriber subscribeCmdVel(ros::NodeHandle& nh,
+                                const srd::kinematics::DiffDriveGeometry& geometry) {
+  return nh.subscribe<geometry_msgs::Twist>(
+      "cmd_vel", 10, [&geometry](const geometry_msgs::Twist::ConstPtr& twist) {
+        const auto speeds =
+            srd::kinematics::wheelSpeedsFromTwist(geometry, twist->linear.x, twist->angular.z);
+        g_left = static_cast<int16_t>(speeds[0] * geometry.ticksPerPeriodPerMps());
+        g_right = static_cast<int16_t>(speeds[1] * geometry.ticksPerPeriodPerMps());
+        writeSpeedFrame();
+      });
+}
+
+/// The reader thread: one JointState per telemetry frame, until g_running ends.
+void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states) {
+  const std::size_t count = joints.ids.size();
+  const auto config = test_support::driverFramer({"body"}, count);
+  srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
+                                                 std::size_t size) {
+    if (family != srd::protocol::body::kTelemetryFrames) return;
+    const auto telemetry = srd::protocol::body::decodeTelemetry(data, size, count);
+    if (!telemetry) return;
+    sensor_msgs::JointState msg;
+    msg.header.stamp = ros::Time::now();
+    msg.name = joints.names;
+    for (std::size_t i = 0; i < count; ++i) {
+      msg.position.push_back(joints.calibrations[i].toRadians(telemetry->servos[i].position));
+      msg.velocity.push_back(joints.calibrations[i].toRadiansPerSecond(telemetry->servos[i].speed));
+    }
+    joint_states.publish(msg);
+  });
+  uint8_t buffer[1024];
+  while (g_running) {
+    const ssize_t got = ::read(g_fd, buffer, sizeof(buffer));
+    if (got > 0) framer.feed(buffer, static_cast<std::size_t>(got));
+  }
+}
+
+/// The speed frame every loop period on absolute deadlines, until ROS shuts down.
+void runBaseLoop(double loop_rate) {
+  const long period_ns = static_cast<long>(1e9 / loop_rate);
+  timespec deadline{};
+  ::clock_gettime(CLOCK_MONOTONIC, &deadline);
+  while (ros::ok()) {
+    deadline.tv_nsec += period_ns;
+    while (deadline.tv_nsec >= 1000000000L) {
+      deadline.tv_nsec -= 1000000000L;
+      ++deadline.tv_sec;
+    }
+    ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
+    writeSpeedFrame();
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -55,87 +146,23 @@ int main(int argc, char** argv) {
   const double loop_rate = pnh.param("loop_rate", 50.0);
   const bool base = pnh.param("base/enabled", true);
   const bool body = pnh.param("body/enabled", true);
-  std::vector<int> ids, zeros, directions;
-  std::vector<std::string> names;
-  pnh.getParam("body/servo_ids", ids);
-  pnh.getParam("body/joint_names", names);
-  pnh.getParam("body/zero_ticks", zeros);
-  pnh.getParam("body/directions", directions);
-  std::vector<srd::device::JointCalibration> calibrations(ids.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (i < zeros.size()) calibrations[i].zero_ticks = zeros[i];
-    if (i < directions.size()) calibrations[i].direction = directions[i];
-    calibrations[i].ticks_per_revolution = pnh.param("body/ticks_per_revolution", 4096);
-  }
-  names.resize(ids.size());
-
-  g_fd = ::open(port.c_str(), O_RDWR | O_NOCTTY);
-  if (g_fd < 0) {
+  const BodyJoints joints = readBodyJoints(pnh);
+  if (!openRawPort(port)) {
     ROS_FATAL("floor: cannot open %s", port.c_str());
     return 1;
   }
-  termios tio{};
-  ::tcgetattr(g_fd, &tio);
-  ::cfmakeraw(&tio);
-  tio.c_cc[VMIN] = 1;
-  tio.c_cc[VTIME] = 0;
-  ::tcsetattr(g_fd, TCSANOW, &tio);
 
   ros::Publisher joint_states = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
   const srd::kinematics::DiffDriveGeometry geometry;
   ros::Subscriber cmd_vel;
-  if (base) {
-    cmd_vel = nh.subscribe<geometry_msgs::Twist>(
-        "cmd_vel", 10, [&geometry](const geometry_msgs::Twist::ConstPtr& twist) {
-          const auto speeds =
-              srd::kinematics::wheelSpeedsFromTwist(geometry, twist->linear.x, twist->angular.z);
-          g_left = static_cast<int16_t>(speeds[0] * geometry.ticksPerPeriodPerMps());
-          g_right = static_cast<int16_t>(speeds[1] * geometry.ticksPerPeriodPerMps());
-          writeSpeedFrame();
-        });
-  }
-
+  if (base) cmd_vel = subscribeCmdVel(nh, geometry);
   std::thread reader;
-  if (body) {
-    reader = std::thread([&] {
-      const auto config = test_support::driverFramer({"body"}, ids.size());
-      srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
-                                                     std::size_t size) {
-        if (family != srd::protocol::body::kTelemetryFrames) return;
-        const auto telemetry = srd::protocol::body::decodeTelemetry(data, size, ids.size());
-        if (!telemetry) return;
-        sensor_msgs::JointState msg;
-        msg.header.stamp = ros::Time::now();
-        msg.name = names;
-        for (std::size_t i = 0; i < ids.size(); ++i) {
-          msg.position.push_back(calibrations[i].toRadians(telemetry->servos[i].position));
-          msg.velocity.push_back(calibrations[i].toRadiansPerSecond(telemetry->servos[i].speed));
-        }
-        joint_states.publish(msg);
-      });
-      uint8_t buffer[1024];
-      while (g_running) {
-        const ssize_t got = ::read(g_fd, buffer, sizeof(buffer));
-        if (got > 0) framer.feed(buffer, static_cast<std::size_t>(got));
-      }
-    });
-  }
+  if (body) reader = std::thread([&] { publishTelemetry(joints, joint_states); });
 
   ros::AsyncSpinner spinner(1);
   spinner.start();
   if (base) {
-    const long period_ns = static_cast<long>(1e9 / loop_rate);
-    timespec deadline{};
-    ::clock_gettime(CLOCK_MONOTONIC, &deadline);
-    while (ros::ok()) {
-      deadline.tv_nsec += period_ns;
-      while (deadline.tv_nsec >= 1000000000L) {
-        deadline.tv_nsec -= 1000000000L;
-        ++deadline.tv_sec;
-      }
-      ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
-      writeSpeedFrame();
-    }
+    runBaseLoop(loop_rate);
   } else {
     ros::waitForShutdown();
   }

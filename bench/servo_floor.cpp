@@ -62,6 +62,60 @@ bool readAnswer(int fd, std::size_t size, servo::Packet* packet) {
   return true;
 }
 
+/// The port raw; -1 (said on stderr) when it cannot be opened.
+int openRawPort(const char* path) {
+  const int fd = ::open(path, O_RDWR | O_NOCTTY);
+  if (fd < 0) {
+    std::perror("servo_floor: open");
+    return -1;
+  }
+  termios tio{};
+  ::tcgetattr(fd, &tio);
+  ::cfmakeraw(&tio);
+  ::tcsetattr(fd, TCSANOW, &tio);
+  return fd;
+}
+
+/// What the window did.
+struct Totals {
+  uint64_t transactions = 0;
+  uint64_t lost = 0;
+  long angle_sum = 0;  // keeps the decode from being optimised away
+};
+
+/// One READ_ANGLE request and its answer (published as `name` when `states` is given).
+void transact(int fd, const std::vector<uint8_t>& request, const std::string& name,
+              ros::Publisher* states, Totals* totals) {
+  servo::Packet answer;
+  if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size()) ||
+      !readAnswer(fd, kAngleAnswerSize, &answer)) {
+    ++totals->lost;
+    ::tcflush(fd, TCIFLUSH);  // a late answer must not pass for the next one
+    return;
+  }
+  const auto angle = servo::decodeAngleAnswer(answer);
+  if (angle.ok()) {
+    totals->angle_sum += angle->angle_decidegrees;
+    if (states != nullptr) {
+      sensor_msgs::JointState message;
+      message.header.stamp = ros::Time::now();
+      message.name.push_back(name);
+      message.position.push_back(angle->angle_decidegrees * (M_PI / 1800.0));
+      states->publish(message);
+    }
+  }
+  ++totals->transactions;
+}
+
+/// Publishing: advertises servo_states and waits for its first subscriber.
+ros::Publisher advertiseStates(int argc, char** argv, std::unique_ptr<ros::NodeHandle>* nh) {
+  ros::init(argc, argv, "servo_floor");
+  *nh = std::make_unique<ros::NodeHandle>();
+  ros::Publisher states = (*nh)->advertise<sensor_msgs::JointState>("servo_states", 10);
+  while (ros::ok() && states.getNumSubscribers() == 0) ros::Duration(0.01).sleep();
+  return states;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -72,21 +126,9 @@ int main(int argc, char** argv) {
   }
   std::unique_ptr<ros::NodeHandle> nh;
   ros::Publisher states;
-  if (publish) {
-    ros::init(argc, argv, "servo_floor");
-    nh = std::make_unique<ros::NodeHandle>();
-    states = nh->advertise<sensor_msgs::JointState>("servo_states", 10);
-    while (ros::ok() && states.getNumSubscribers() == 0) ros::Duration(0.01).sleep();
-  }
-  const int fd = ::open(argv[1], O_RDWR | O_NOCTTY);
-  if (fd < 0) {
-    std::perror("servo_floor: open");
-    return 1;
-  }
-  termios tio{};
-  ::tcgetattr(fd, &tio);
-  ::cfmakeraw(&tio);
-  ::tcsetattr(fd, TCSANOW, &tio);
+  if (publish) states = advertiseStates(argc, argv, &nh);
+  const int fd = openRawPort(argv[1]);
+  if (fd < 0) return 1;
   const int servos = std::atoi(argv[2]);
   const auto window = std::chrono::duration<double>(std::atof(argv[3]));
 
@@ -97,39 +139,21 @@ int main(int argc, char** argv) {
     names.push_back("servo_" + std::to_string(id));
   }
 
-  uint64_t transactions = 0, lost = 0;
-  long angle_sum = 0;  // keeps the decode from being optimised away
+  Totals totals;
   const double cpu_start = processCpuSeconds();
   const Clock::time_point start = Clock::now();
   Clock::time_point now = start;
   for (std::size_t next = 0; now - start < window; next = (next + 1) % requests.size()) {
-    const std::vector<uint8_t>& request = requests[next];
-    servo::Packet answer;
-    if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size()) ||
-        !readAnswer(fd, kAngleAnswerSize, &answer)) {
-      ++lost;
-      ::tcflush(fd, TCIFLUSH);  // a late answer must not pass for the next one
-    } else {
-      const auto angle = servo::decodeAngleAnswer(answer);
-      if (angle.ok()) {
-        angle_sum += angle->angle_decidegrees;
-        if (publish) {
-          sensor_msgs::JointState message;
-          message.header.stamp = ros::Time::now();
-          message.name.push_back(names[next]);
-          message.position.push_back(angle->angle_decidegrees * (M_PI / 1800.0));
-          states.publish(message);
-        }
-      }
-      ++transactions;
-    }
+    transact(fd, requests[next], names[next], publish ? &states : nullptr, &totals);
     now = Clock::now();
   }
   const double seconds = std::chrono::duration<double>(now - start).count();
   const double cpu = processCpuSeconds() - cpu_start;
+  const uint64_t transactions = totals.transactions;
   std::printf("transactions=%llu seconds=%.3f cpu_s=%.4f lost=%llu mean_ms=%.4f checksum=%ld\n",
               static_cast<unsigned long long>(transactions), seconds, cpu,
-              static_cast<unsigned long long>(lost),
-              transactions ? seconds * 1000.0 / static_cast<double>(transactions) : 0.0, angle_sum);
+              static_cast<unsigned long long>(totals.lost),
+              transactions ? seconds * 1000.0 / static_cast<double>(transactions) : 0.0,
+              totals.angle_sum);
   return 0;
 }

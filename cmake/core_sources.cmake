@@ -45,6 +45,7 @@ set(SRD_CORE_GENERATED_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_dev
 set(SRD_SIM_SOURCES
   src/sim/pseudo_terminal.cpp
   src/sim/robot_sim.cpp
+  src/sim/robot_sim_line.cpp
   src/sim/robot_sim_plug.cpp
   src/sim/robot_sim_hosted.cpp
   src/sim/command_line.cpp

@@ -1,19 +1,21 @@
-// RobotSim hosting the registered devices (sim/sim_device_module.h): each on its own link or the
-// shared one, fed the frames of its simulator families, its frames sent with its send counters.
+#include "robot_sim_hosted.h"
+
 #include <algorithm>
 #include <stdexcept>
 
-#include "robot_sim_port.h"
 #include "serial_robot_driver/device/device_module.h"
 
-namespace serial_robot_driver::sim {
+namespace serial_robot_driver::sim::detail {
 
-void RobotSim::startHosted(TimePoint now) {
+HostedDevices::HostedDevices(SimOptions& options, SimStats& counters, Line& line)
+    : options_(options), counters_(counters), line_(line) {}
+
+void HostedDevices::start(TimePoint now) {
   for (const SimDeviceModule* module : registeredSimDevices()) {
     if (!options_.hosts(module->name)) {
       // Left out: a device that keeps its stats keys keeps its send counters too, at zero.
       if (module->left_out_stats != nullptr) {
-        for (const OutputKind* kind : module->outputs) countersOf(kind);
+        for (const OutputKind* kind : module->outputs) sendCounters(counters_, kind);
       }
       continue;
     }
@@ -31,12 +33,12 @@ void RobotSim::startHosted(TimePoint now) {
     hosted.device = module->make(options, options_.faults.seed + module->seed_offset, now);
     hosted.port_link = options.link.value_or(options_.link);
     hosted_.push_back(std::move(hosted));
-    for (const OutputKind* kind : module->outputs) countersOf(kind);
+    for (const OutputKind* kind : module->outputs) sendCounters(counters_, kind);
   }
 }
 
-bool RobotSim::deliverToHosted(Port* port, const protocol::FrameFamily& family, const uint8_t* data,
-                               std::size_t size, TimePoint at) {
+bool HostedDevices::deliver(Port* port, const protocol::FrameFamily& family, const uint8_t* data,
+                            std::size_t size, TimePoint at) {
   for (Hosted& hosted : hosted_) {
     if (hosted.port != port) continue;
     if (std::find(hosted.families.begin(), hosted.families.end(), family) ==
@@ -50,16 +52,37 @@ bool RobotSim::deliverToHosted(Port* port, const protocol::FrameFamily& family, 
   return false;
 }
 
-void RobotSim::sendAll(Hosted* hosted) {
-  for (Outgoing& frame : hosted->outbox) send(hosted->port, std::move(frame));
+void HostedDevices::tick(TimePoint now) {
+  // Every device ticks before any sends: what one writes into the world (the chassis it moves)
+  // reaches a later one in the same step.
+  for (Hosted& hosted : hosted_) hosted.device->tick(now, world_, &hosted.outbox);
+  for (Hosted& hosted : hosted_) sendAll(&hosted);
+}
+
+TimePoint HostedDevices::nextEvent() const {
+  TimePoint next = TimePoint::max();
+  for (const Hosted& hosted : hosted_) next = std::min(next, hosted.device->nextEvent());
+  return next;
+}
+
+void HostedDevices::addStats(SimStats* stats) const {
+  for (const SimDeviceModule* module : registeredSimDevices()) {
+    PortCounters seen;
+    seen.all_ports = stats->framer;
+    const auto hosted = std::find_if(hosted_.begin(), hosted_.end(),
+                                     [&](const Hosted& h) { return h.name == module->name; });
+    if (hosted != hosted_.end()) {
+      seen.own_port = hosted->port->framer->stats();
+      stats->devices.push_back(hosted->device->stats(seen));
+    } else if (module->left_out_stats != nullptr) {
+      stats->devices.push_back(module->left_out_stats(seen));  // its keys, at zero
+    }
+  }
+}
+
+void HostedDevices::sendAll(Hosted* hosted) {
+  for (Outgoing& frame : hosted->outbox) line_.send(hosted->port, std::move(frame));
   hosted->outbox.clear();
 }
 
-SendCounters& RobotSim::countersOf(const OutputKind* kind) {
-  for (auto& [sent_kind, counters] : counters_.sent) {
-    if (sent_kind == kind) return counters;
-  }
-  return counters_.sent.emplace_back(kind, SendCounters{}).second;
-}
-
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::sim::detail

@@ -1,5 +1,5 @@
-// RobotSim's private parts shared by its source files (robot_sim.cpp, robot_sim_plug.cpp,
-// robot_sim_hosted.cpp): one pty with its framer, backlog and fault timers.
+// RobotSim's private parts shared by its classes (robot_sim.cpp, robot_sim_line.cpp,
+// robot_sim_plug.cpp, robot_sim_hosted.cpp): one pty with its framer, backlog and fault timers.
 #pragma once
 
 #include <fcntl.h>
@@ -33,9 +33,15 @@ inline std::string joinNames(const std::vector<std::string>& names) {
   return joined;
 }
 
-}  // namespace detail
+/// The send counters of frames of `kind` in `counters` (made at zero on first use).
+inline SendCounters& sendCounters(SimStats& counters, const OutputKind* kind) {
+  for (auto& [sent_kind, sent] : counters.sent) {
+    if (sent_kind == kind) return sent;
+  }
+  return counters.sent.emplace_back(kind, SendCounters{}).second;
+}
 
-struct RobotSim::Port {
+struct Port {
   struct PendingWrite {
     std::vector<uint8_t> bytes;
     std::size_t offset = 0;
@@ -57,6 +63,9 @@ struct RobotSim::Port {
   TimePoint rx_line_free{};
   /// --pace-baud: bytes the host wrote, each chunk with the time its last bit is through the line.
   std::deque<std::pair<TimePoint, std::vector<uint8_t>>> rx_in_flight;
+  /// --pace-baud: when the chunk being fed to the framer had its last bit through the line ({}:
+  /// not paced, now).
+  TimePoint rx_frame_end{};
   bool plugged = true;
   bool draining = false;
   int drain_probe_fd = -1;  ///< our own handle on the slave, to see whether the host read it all
@@ -66,5 +75,7 @@ struct RobotSim::Port {
   TimePoint next_garbage = TimePoint::max();
   std::mt19937 rng;
 };
+
+}  // namespace detail
 
 }  // namespace serial_robot_driver::sim

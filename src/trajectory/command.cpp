@@ -35,11 +35,9 @@ std::string sizeProblem(const std::vector<double>& values, std::size_t joints, s
   return format("point %zu has %zu %s for %zu joints", point, values.size(), what, joints);
 }
 
-}  // namespace
-
-CommandCheck validate(const TrajectoryCommand& command, const std::vector<JointRange>& joints,
-                      double max_velocity, double start_offset,
-                      const std::vector<double>& current_positions) {
+/// The index in `joints` of every command joint; kInvalidJoints when one is unknown or repeated.
+CommandCheck resolveJoints(const TrajectoryCommand& command,
+                           const std::vector<JointRange>& joints) {
   CommandCheck check;
   const std::vector<std::string>& names = command.joint_names;
   if (names.empty() && !command.points.empty()) {
@@ -57,61 +55,97 @@ CommandCheck validate(const TrajectoryCommand& command, const std::vector<JointR
     }
     check.joint_indices.push_back(static_cast<std::size_t>(joint - joints.begin()));
   }
+  return check;
+}
 
-  const std::size_t n = names.size();
+/// Point p's value counts against the n joints and its time after the previous point's; "" if fine.
+std::string pointShapeProblem(const TrajectoryCommand& command, std::size_t p, std::size_t n) {
+  const TrajectoryPoint& point = command.points[p];
+  for (const std::string& problem :
+       {sizeProblem(point.positions, n, p, "positions", false),
+        sizeProblem(point.velocities, n, p, "velocities", true),
+        sizeProblem(point.accelerations, n, p, "accelerations", true)}) {
+    if (!problem.empty()) return problem;
+  }
+  if (!std::isfinite(point.time_from_start) || point.time_from_start < 0.0) {
+    return format("point %zu: time_from_start %g s is not a time from the start", p,
+                  point.time_from_start);
+  }
+  if (p > 0 && point.time_from_start <= command.points[p - 1].time_from_start) {
+    return format("point %zu: time_from_start %g s is not after point %zu's %g s", p,
+                  point.time_from_start, p - 1, command.points[p - 1].time_from_start);
+  }
+  return {};
+}
+
+/// Command joint j at point p: finite, within `range`, and (max_velocity > 0) neither its velocity
+/// nor the speed from the previous point above max_velocity; "" if fine.
+std::string jointValueProblem(const TrajectoryCommand& command, std::size_t p, std::size_t j,
+                              const JointRange& range, double max_velocity) {
+  const TrajectoryPoint& point = command.points[p];
+  const char* name = command.joint_names[j].c_str();
+  const double position = point.positions[j];
+  const double velocity = point.velocities.empty() ? 0.0 : point.velocities[j];
+  const double acceleration = point.accelerations.empty() ? 0.0 : point.accelerations[j];
+  if (!std::isfinite(position) || !std::isfinite(velocity) || !std::isfinite(acceleration)) {
+    return format("joint '%s', point %zu: NaN or infinite value", name, p);
+  }
+  if (position < range.min_position || position > range.max_position) {
+    return format("joint '%s', point %zu: %.4f rad is outside what it can reach (%.4f .. %.4f rad)",
+                  name, p, position, range.min_position, range.max_position);
+  }
+  if (max_velocity <= 0.0) return {};
+  if (std::abs(velocity) > max_velocity) {
+    return format("joint '%s', point %zu: velocity %.4f rad/s is above max_velocity %.4f rad/s",
+                  name, p, velocity, max_velocity);
+  }
+  if (p == 0) return {};
+  const TrajectoryPoint& previous = command.points[p - 1];
+  const double speed = std::abs(position - previous.positions[j]) /
+                       (point.time_from_start - previous.time_from_start);
+  if (speed > max_velocity) {
+    return format(
+        "joint '%s', point %zu: reaching it from point %zu takes %.4f rad/s, above "
+        "max_velocity %.4f rad/s",
+        name, p, p - 1, speed, max_velocity);
+  }
+  return {};
+}
+
+/// The bridge from `current_positions` to `first_ahead`, the first point not in the past: no
+/// joint faster than max_velocity; "" if fine.
+std::string bridgeProblem(const TrajectoryCommand& command, const TrajectoryPoint& first_ahead,
+                          double max_velocity, double start_offset,
+                          const std::vector<double>& current_positions) {
+  // Held until the start when stamped ahead, so the bridge lasts the first point's own time.
+  const double duration = first_ahead.time_from_start + std::min(start_offset, 0.0);
+  const std::size_t p = static_cast<std::size_t>(&first_ahead - command.points.data());
+  for (std::size_t j = 0; j < current_positions.size(); ++j) {
+    const double distance = std::abs(first_ahead.positions[j] - current_positions[j]);
+    if (distance > 0.0 && (duration <= 0.0 || distance / duration > max_velocity)) {
+      return format(
+          "joint '%s', point %zu: reaching it from where the joint is (%.4f rad) in "
+          "%.3f s is faster than max_velocity %.4f rad/s",
+          command.joint_names[j].c_str(), p, current_positions[j], duration, max_velocity);
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+CommandCheck validate(const TrajectoryCommand& command, const std::vector<JointRange>& joints,
+                      double max_velocity, double start_offset,
+                      const std::vector<double>& current_positions) {
+  CommandCheck check = resolveJoints(command, joints);
+  if (!check.ok()) return check;
+  const std::size_t n = command.joint_names.size();
   for (std::size_t p = 0; p < command.points.size(); ++p) {
-    const TrajectoryPoint& point = command.points[p];
-    for (const std::string& problem :
-         {sizeProblem(point.positions, n, p, "positions", false),
-          sizeProblem(point.velocities, n, p, "velocities", true),
-          sizeProblem(point.accelerations, n, p, "accelerations", true)}) {
-      if (!problem.empty()) return failure(CommandError::kInvalidGoal, problem);
+    std::string problem = pointShapeProblem(command, p, n);
+    for (std::size_t j = 0; j < n && problem.empty(); ++j) {
+      problem = jointValueProblem(command, p, j, joints[check.joint_indices[j]], max_velocity);
     }
-    if (!std::isfinite(point.time_from_start) || point.time_from_start < 0.0) {
-      return failure(CommandError::kInvalidGoal,
-                     format("point %zu: time_from_start %g s is not a time from the start", p,
-                            point.time_from_start));
-    }
-    if (p > 0 && point.time_from_start <= command.points[p - 1].time_from_start) {
-      return failure(CommandError::kInvalidGoal,
-                     format("point %zu: time_from_start %g s is not after point %zu's %g s", p,
-                            point.time_from_start, p - 1, command.points[p - 1].time_from_start));
-    }
-    for (std::size_t j = 0; j < n; ++j) {
-      const char* name = names[j].c_str();
-      const JointRange& range = joints[check.joint_indices[j]];
-      const double position = point.positions[j];
-      const double velocity = point.velocities.empty() ? 0.0 : point.velocities[j];
-      const double acceleration = point.accelerations.empty() ? 0.0 : point.accelerations[j];
-      if (!std::isfinite(position) || !std::isfinite(velocity) || !std::isfinite(acceleration)) {
-        return failure(CommandError::kInvalidGoal,
-                       format("joint '%s', point %zu: NaN or infinite value", name, p));
-      }
-      if (position < range.min_position || position > range.max_position) {
-        return failure(CommandError::kInvalidGoal,
-                       format("joint '%s', point %zu: %.4f rad is outside what it can reach "
-                              "(%.4f .. %.4f rad)",
-                              name, p, position, range.min_position, range.max_position));
-      }
-      if (max_velocity <= 0.0) continue;
-      if (std::abs(velocity) > max_velocity) {
-        return failure(CommandError::kInvalidGoal,
-                       format("joint '%s', point %zu: velocity %.4f rad/s is above max_velocity "
-                              "%.4f rad/s",
-                              name, p, velocity, max_velocity));
-      }
-      if (p > 0) {
-        const TrajectoryPoint& previous = command.points[p - 1];
-        const double speed = std::abs(position - previous.positions[j]) /
-                             (point.time_from_start - previous.time_from_start);
-        if (speed > max_velocity) {
-          return failure(CommandError::kInvalidGoal,
-                         format("joint '%s', point %zu: reaching it from point %zu takes %.4f "
-                                "rad/s, above max_velocity %.4f rad/s",
-                                name, p, p - 1, speed, max_velocity));
-        }
-      }
-    }
+    if (!problem.empty()) return failure(CommandError::kInvalidGoal, problem);
   }
 
   // The first point still ahead: where the bridge from the current state goes.
@@ -124,18 +158,9 @@ CommandCheck validate(const TrajectoryCommand& command, const std::vector<JointR
                           -(start_offset + command.points.back().time_from_start)));
   }
   if (max_velocity > 0.0 && current_positions.size() == n && first_ahead != command.points.end()) {
-    // Held until the start when stamped ahead, so the bridge lasts the first point's own time.
-    const double duration = first_ahead->time_from_start + std::min(start_offset, 0.0);
-    const std::size_t p = static_cast<std::size_t>(first_ahead - command.points.begin());
-    for (std::size_t j = 0; j < n; ++j) {
-      const double distance = std::abs(first_ahead->positions[j] - current_positions[j]);
-      if (distance > 0.0 && (duration <= 0.0 || distance / duration > max_velocity)) {
-        return failure(CommandError::kInvalidGoal,
-                       format("joint '%s', point %zu: reaching it from where the joint is (%.4f "
-                              "rad) in %.3f s is faster than max_velocity %.4f rad/s",
-                              names[j].c_str(), p, current_positions[j], duration, max_velocity));
-      }
-    }
+    const std::string problem =
+        bridgeProblem(command, *first_ahead, max_velocity, start_offset, current_positions);
+    if (!problem.empty()) return failure(CommandError::kInvalidGoal, problem);
   }
   return check;
 }

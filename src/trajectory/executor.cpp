@@ -424,21 +424,33 @@ std::string TrajectoryExecutor::motionInForce() {
 
 bool TrajectoryExecutor::superviseGoal(ActiveGoal& goal, double now,
                                        const std::vector<Measured>& actual) {
-  const long stale = staleJoint(actual, goal.joints, now);
-  if (stale >= 0) {
-    char text[200];
-    std::snprintf(text, sizeof(text),
-                  "telemetry lost: no state of joint '%s' for more than %.1f s, so nobody can tell "
-                  "whether it follows",
-                  ranges_[stale].name.c_str(), tracks_[stale].state_timeout);
-    // Held where last commanded: there is no measurement to stop at.
-    const std::string message = withLeftAlone(text, hold(goal.joints, now));
-    warn("follow_joint_trajectory: " + message);
-    finish(goal.callbacks,
-           outcome(GoalStatus::kAborted, result_code::kPathToleranceViolated, message));
-    return true;
-  }
+  if (abortIfTelemetryLost(goal, now, actual)) return true;
   std::vector<JointSample> desired, measured;
+  sampleAndReport(goal, now, actual, &desired, &measured);
+  return judgeTolerances(goal, now, desired, measured);
+}
+
+bool TrajectoryExecutor::abortIfTelemetryLost(ActiveGoal& goal, double now,
+                                              const std::vector<Measured>& actual) {
+  const long stale = staleJoint(actual, goal.joints, now);
+  if (stale < 0) return false;
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                "telemetry lost: no state of joint '%s' for more than %.1f s, so nobody can tell "
+                "whether it follows",
+                ranges_[stale].name.c_str(), tracks_[stale].state_timeout);
+  // Held where last commanded: there is no measurement to stop at.
+  const std::string message = withLeftAlone(text, hold(goal.joints, now));
+  warn("follow_joint_trajectory: " + message);
+  finish(goal.callbacks,
+         outcome(GoalStatus::kAborted, result_code::kPathToleranceViolated, message));
+  return true;
+}
+
+void TrajectoryExecutor::sampleAndReport(const ActiveGoal& goal, double now,
+                                         const std::vector<Measured>& actual,
+                                         std::vector<JointSample>* desired,
+                                         std::vector<JointSample>* measured) {
   GoalFeedback feedback;
   feedback.joint_names = goal.names;
   feedback.time_from_start = std::max(0.0, now - goal.start_time);
@@ -448,8 +460,8 @@ bool TrajectoryExecutor::superviseGoal(ActiveGoal& goal, double now,
     const JointSample d = tracks_[j].spline.sample(now);
     JointSample a = actual[j].sample;
     if (!actual[j].velocity_known) a.velocity = d.velocity;  // unmeasured: never a violation
-    desired.push_back(d);
-    measured.push_back(a);
+    desired->push_back(d);
+    measured->push_back(a);
     feedback.actual_positions.push_back(a.position);
     feedback.error_positions.push_back(d.position - a.position);
     if (velocity_known) {
@@ -457,9 +469,13 @@ bool TrajectoryExecutor::superviseGoal(ActiveGoal& goal, double now,
       feedback.error_velocities.push_back(d.velocity - a.velocity);
     }
   }
-  feedback.desired = desired;
+  feedback.desired = *desired;
   if (goal.callbacks.feedback) goal.callbacks.feedback(feedback);
+}
 
+bool TrajectoryExecutor::judgeTolerances(ActiveGoal& goal, double now,
+                                         const std::vector<JointSample>& desired,
+                                         const std::vector<JointSample>& measured) {
   if (now < goal.end_time) {
     const auto violation =
         findViolation(goal.names, goal.path_tolerances, desired, measured, "path");

@@ -23,6 +23,13 @@
 
 namespace serial_robot_driver::sim {
 
+namespace detail {  // RobotSim's parts (src/sim/robot_sim_*.h)
+struct Port;
+class Line;
+class HostedDevices;
+class PlugFaults;
+}  // namespace detail
+
 /// One pty and the devices on it.
 struct SimPort {
   std::vector<std::string> devices;  ///< the hosted devices' names
@@ -50,48 +57,35 @@ class RobotSim {
   SimStats stats() const;
 
  private:
-  struct Port;
-  /// A registered device hosted through its SimDeviceModule, on its port.
-  struct Hosted {
-    std::string name;
-    std::vector<protocol::FrameFamily> families;  ///< what it reads (simulator_frames)
-    std::unique_ptr<SimDevice> device;
-    std::string port_link;  ///< its effective link
-    Port* port = nullptr;
-    Outbox outbox;  ///< what it emitted in this step, not yet sent
-  };
-  /// Builds every device SimOptions hosts, in the order of the devices, and its send counters.
-  void startHosted(TimePoint now);
-  /// Hands a frame to the hosted device on `port` that reads `family`; false when none does.
-  bool deliverToHosted(Port* port, const protocol::FrameFamily& family, const uint8_t* data,
-                       std::size_t size, TimePoint at);
+  /// The fds one wait polls: the wake pipe first, then the ports it reads or writes.
+  struct PollSet;
+
+  void checkSomethingHosted() const;
+  /// The port of `link`, made (with its framer feeding the hosted devices) on first use.
+  detail::Port* portFor(const std::string& link, const std::string& device_name);
+  /// Opens the port's pty and schedules its faults.
+  void openPort(detail::Port* port, TimePoint now);
   void run();
+  /// The ports to poll now (mutex_ held while it reads them).
+  void preparePoll(PollSet* poll);
+  /// Reads what the host wrote on every port the poll found readable.
+  void readPorts(const PollSet& poll);
   void step(TimePoint now);
-  /// Writes what `hosted` emitted on its port, in order.
-  void sendAll(Hosted* hosted);
-  void send(Port* port, Outgoing frame);
-  SendCounters& countersOf(const OutputKind* kind);
-  void flush(Port* port);
-  /// How long the line takes to carry `bytes` at pace_baud (10 bits a byte).
-  Clock::duration lineTime(std::size_t bytes) const;
-  /// --pace-baud: when flush() has the next bytes of the backlog through the line (max: none).
-  TimePoint nextSendAt(const Port* port) const;
-  void unplug(Port* port, TimePoint now);
-  void replug(Port* port, TimePoint now);
+  /// The first of every device's, line's and fault's next event (a wake-up at least every 100 ms).
+  TimePoint nextWakeUp(TimePoint now) const;
   void writeStatsFile() const;
   SimStats snapshotLocked() const;
   void event(const std::string& text) const;
 
   SimOptions options_;
   mutable std::mutex mutex_;  ///< guards everything below except running_/stop_requested_
-  std::vector<std::unique_ptr<Port>> ports_;
-  std::vector<Hosted> hosted_;
-  SimWorld world_;     ///< what the devices share (the chassis), handed to each tick
+  std::vector<std::unique_ptr<detail::Port>> ports_;
   SimStats counters_;  ///< the RobotSim-level fields and send counters; devices keep their own
+  std::unique_ptr<detail::Line> line_;
+  std::unique_ptr<detail::HostedDevices> hosted_;
+  std::unique_ptr<detail::PlugFaults> plug_faults_;
   TimePoint started_at_;
   TimePoint next_stats_write_;
-  /// --pace-baud: when the frame being fed to a framer had its last bit through the line ({}: now).
-  TimePoint rx_frame_end_{};
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_requested_{false};

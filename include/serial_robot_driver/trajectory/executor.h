@@ -149,6 +149,14 @@ class TrajectoryExecutor {
   void writeTracks(double now);
   /// Ends a goal when its tolerances say so (true); gives its feedback otherwise.
   bool superviseGoal(ActiveGoal& goal, double now, const std::vector<Measured>& measured);
+  /// Aborts the goal (holding its joints) when a joint's state is older than its state_timeout.
+  bool abortIfTelemetryLost(ActiveGoal& goal, double now, const std::vector<Measured>& actual);
+  /// Where the goal's joints should be and are (an unmeasured velocity as desired), as feedback.
+  void sampleAndReport(const ActiveGoal& goal, double now, const std::vector<Measured>& actual,
+                       std::vector<JointSample>* desired, std::vector<JointSample>* measured);
+  /// The path tolerances until the end time, then the goal's: true when the goal is over.
+  bool judgeTolerances(ActiveGoal& goal, double now, const std::vector<JointSample>& desired,
+                       const std::vector<JointSample>& measured);
   void warn(const std::string& text) const;
   void warnThrottled(ThrottledWarning kind, const std::string& text, double now);
 

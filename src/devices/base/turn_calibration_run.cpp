@@ -137,39 +137,14 @@ void TurnCalibrationRun::runPhase(const CalibrationTick& tick, CalibrationStep& 
                   "streaming?)");
       break;
     case Phase::kWaitEStop:
-      if (e_stop_engaged_.value_or(false)) {
-        abort("refused: the e-stop is engaged; release it (e_stop false) and run again",
-              kCalibrationExitRefused);
-      } else {
-        // The node's diagnostics come once a second, with its count of engagements: from here on
-        // any engagement (a message on e_stop, or the count rising) ends the run.
-        waitFor(e_stop_engaged_.has_value() && engagements_.has_value(), kArrivalWait,
-                Phase::kWaitSubscriber,
-                "no e_stop status from " + node_ +
-                    " on /diagnostics in 3 s: cannot tell whether the e-stop is engaged");
-        if (phase_ == Phase::kWaitSubscriber) {
-          e_stop_checked_ = true;
-          engagements_at_check_ = engagements_;
-        }
-      }
+      checkEStopReleased();
       break;
     case Phase::kWaitSubscriber:
-      if (tick.command_subscribed || now_ - phase_started_ >= kSubscriberWait) {
-        say("turning in place " + fixed(options_.angle, 2) + " rad each way at " +
-            fixed(options_.rate, 2) + " rad/s; Ctrl-C stops the base");
-        moved_ = true;  // from the first command on, every way out stops the base
-        startHold(options_.settle, AfterHold::kMove);
-      }
+      startOnceSubscribed(tick);
       break;
     case Phase::kHold:
     case Phase::kStopping:
-      if (phase_ == Phase::kStopping && !tick.connected) {
-        say("calibrate_base: ROS is down; the node's ~base/cmd_vel_timeout stops the base",
-            CalibrationLine::Stream::kErr);
-        finish(exit_status_);
-      } else {
-        hold(out);
-      }
+      holdOrGiveUp(tick, out);
       break;
     case Phase::kMoving:
       move(tick, out);
@@ -178,16 +153,56 @@ void TurnCalibrationRun::runPhase(const CalibrationTick& tick, CalibrationStep& 
       reportTurn();
       break;
     case Phase::kAwaitDistance:
-      if (!measured_distance_) {
-        out.wants_measured_distance = true;
-      } else if (!*measured_distance_) {
-        abort("no distance typed: no wheel_diameter", kCalibrationExitRefused);
-      } else {
-        reportDiameter(**measured_distance_);
-      }
+      awaitDistance(out);
       break;
     case Phase::kDone:
       break;
+  }
+}
+
+void TurnCalibrationRun::checkEStopReleased() {
+  if (e_stop_engaged_.value_or(false)) {
+    abort("refused: the e-stop is engaged; release it (e_stop false) and run again",
+          kCalibrationExitRefused);
+    return;
+  }
+  // The node's diagnostics come once a second, with its count of engagements: from here on any
+  // engagement (a message on e_stop, or the count rising) ends the run.
+  waitFor(e_stop_engaged_.has_value() && engagements_.has_value(), kArrivalWait,
+          Phase::kWaitSubscriber,
+          "no e_stop status from " + node_ +
+              " on /diagnostics in 3 s: cannot tell whether the e-stop is engaged");
+  if (phase_ == Phase::kWaitSubscriber) {
+    e_stop_checked_ = true;
+    engagements_at_check_ = engagements_;
+  }
+}
+
+void TurnCalibrationRun::startOnceSubscribed(const CalibrationTick& tick) {
+  if (!tick.command_subscribed && now_ - phase_started_ < kSubscriberWait) return;
+  say("turning in place " + fixed(options_.angle, 2) + " rad each way at " +
+      fixed(options_.rate, 2) + " rad/s; Ctrl-C stops the base");
+  moved_ = true;  // from the first command on, every way out stops the base
+  startHold(options_.settle, AfterHold::kMove);
+}
+
+void TurnCalibrationRun::holdOrGiveUp(const CalibrationTick& tick, CalibrationStep& out) {
+  if (phase_ == Phase::kStopping && !tick.connected) {
+    say("calibrate_base: ROS is down; the node's ~base/cmd_vel_timeout stops the base",
+        CalibrationLine::Stream::kErr);
+    finish(exit_status_);
+  } else {
+    hold(out);
+  }
+}
+
+void TurnCalibrationRun::awaitDistance(CalibrationStep& out) {
+  if (!measured_distance_) {
+    out.wants_measured_distance = true;
+  } else if (!*measured_distance_) {
+    abort("no distance typed: no wheel_diameter", kCalibrationExitRefused);
+  } else {
+    reportDiameter(**measured_distance_);
   }
 }
 

@@ -109,56 +109,74 @@ void BodyController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
   if (events_.on_telemetry) events_.on_telemetry(*telemetry, arrival);
 }
 
+namespace {
+
+/// "head_pan: 4.000 rad is outside -3.142 .. 3.138 rad"
+std::string outOfReachText(const std::string& name, double position,
+                           const JointCalibration& calibration) {
+  const auto [low, high] = calibration.reachableRadians();
+  char text[160];
+  std::snprintf(text, sizeof(text), "%s: %.3f rad is outside %.3f .. %.3f rad", name.c_str(),
+                position, low, high);
+  return text;
+}
+
+/// Checks the whole command before anything is touched (a bad command must not half-apply) and
+/// fills `requested` by joint index with the ticks of every reachable target.
+JointCommandResult resolveTargets(const std::vector<BodyJoint>& joints,
+                                  const std::vector<std::string>& names,
+                                  const std::vector<double>& positions,
+                                  std::vector<std::optional<uint16_t>>* requested) {
+  JointCommandResult result;
+  if (names.empty()) {
+    result.status = JointCommandStatus::kEmpty;
+    return result;
+  }
+  if (names.size() != positions.size()) {
+    result.status = JointCommandStatus::kLengthMismatch;
+    return result;
+  }
+  // Every joint named so far, whatever its value: an out-of-range target leaves requested[]
+  // empty, so requested[] alone would let a second occurrence of that name through.
+  std::vector<bool> named(joints.size(), false);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto joint = std::find_if(joints.begin(), joints.end(),
+                                    [&](const BodyJoint& j) { return j.name == names[i]; });
+    result.joint = names[i];
+    if (joint == joints.end()) {
+      result.status = JointCommandStatus::kUnknownJoint;
+      return result;
+    }
+    const std::size_t index = static_cast<std::size_t>(joint - joints.begin());
+    if (named[index]) {
+      result.status = JointCommandStatus::kDuplicateJoint;
+      return result;
+    }
+    named[index] = true;
+    if (!std::isfinite(positions[i])) {
+      result.status = JointCommandStatus::kNotFinite;
+      return result;
+    }
+    (*requested)[index] = joint->calibration.toTicks(positions[i]);
+    if (!(*requested)[index]) {
+      // Left out, not clamped: the servo keeps its last target instead of an invented one.
+      result.out_of_range.push_back(outOfReachText(names[i], positions[i], joint->calibration));
+    }
+  }
+  result.joint.clear();
+  if (result.out_of_range.size() == names.size()) result.status = JointCommandStatus::kOutOfRange;
+  return result;
+}
+
+}  // namespace
+
 JointCommandResult BodyController::sendJointCommand(
     const std::vector<std::string>& names, const std::vector<double>& positions,
     std::optional<MotionGate::Generation> accepted) {
   // Noted before waiting for the lock: an e-stop while this command waits voids it.
   const MotionGate::Generation generation = accepted.value_or(gate_.generation());
-  JointCommandResult result;
   std::vector<std::optional<uint16_t>> requested(joints_.size());
-
-  // Validate the whole command before touching any state: a bad command must not half-apply.
-  if (names.empty()) {
-    result.status = JointCommandStatus::kEmpty;
-  } else if (names.size() != positions.size()) {
-    result.status = JointCommandStatus::kLengthMismatch;
-  } else {
-    // Every joint named so far, whatever its value: an out-of-range target leaves requested[]
-    // empty, so requested[] alone would let a second occurrence of that name through.
-    std::vector<bool> named(joints_.size(), false);
-    for (std::size_t i = 0; i < names.size() && result.ok(); ++i) {
-      const auto joint = std::find_if(joints_.begin(), joints_.end(),
-                                      [&](const BodyJoint& j) { return j.name == names[i]; });
-      result.joint = names[i];
-      if (joint == joints_.end()) {
-        result.status = JointCommandStatus::kUnknownJoint;
-        break;
-      }
-      const std::size_t index = static_cast<std::size_t>(joint - joints_.begin());
-      if (named[index]) {
-        result.status = JointCommandStatus::kDuplicateJoint;
-        break;
-      }
-      named[index] = true;
-      if (!std::isfinite(positions[i])) {
-        result.status = JointCommandStatus::kNotFinite;
-        break;
-      }
-      requested[index] = joint->calibration.toTicks(positions[i]);
-      if (!requested[index]) {
-        // Left out, not clamped: the servo keeps its last target instead of an invented one.
-        const auto [low, high] = joint->calibration.reachableRadians();
-        char text[160];
-        std::snprintf(text, sizeof(text), "%s: %.3f rad is outside %.3f .. %.3f rad",
-                      names[i].c_str(), positions[i], low, high);
-        result.out_of_range.push_back(text);
-      }
-    }
-    if (result.ok()) result.joint.clear();
-    if (result.ok() && result.out_of_range.size() == names.size()) {
-      result.status = JointCommandStatus::kOutOfRange;
-    }
-  }
+  JointCommandResult result = resolveTargets(joints_, names, positions, &requested);
 
   std::lock_guard<std::mutex> lock(mutex_);
   stats_.joints_out_of_range += result.out_of_range.size();
@@ -166,12 +184,25 @@ JointCommandResult BodyController::sendJointCommand(
     ++stats_.commands_rejected;
     return result;
   }
+  // A joint not in this command keeps the target last sent for it.
   std::vector<protocol::body::ServoTarget> targets;
   targets.reserve(joints_.size());
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     const std::optional<uint16_t> ticks = requested[i] ? requested[i] : last_commanded_ticks_[i];
     if (ticks) targets.push_back({joints_[i].servo_id, *ticks});
   }
+  result.status = writeTargetsLocked(targets, generation);
+  if (!result.ok()) return result;
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    if (requested[i]) last_commanded_ticks_[i] = requested[i];
+  }
+  last_written_ = Clock::now();
+  ++stats_.commands_sent;
+  return result;
+}
+
+JointCommandStatus BodyController::writeTargetsLocked(
+    const std::vector<protocol::body::ServoTarget>& targets, MotionGate::Generation generation) {
   // Writing under the lock keeps frames in the order their positions were stored; through the
   // gate, so a command that waited for this lock is refused if the e-stop came meanwhile.
   bool written = false;
@@ -182,20 +213,13 @@ JointCommandResult BodyController::sendJointCommand(
     ++stats_.motion_refused;
     const bool voided = gate == GateState::kVoided;
     if (voided) ++stats_.motion_voided;
-    result.status = voided ? JointCommandStatus::kMotionVoided : JointCommandStatus::kMotionRefused;
-    return result;
+    return voided ? JointCommandStatus::kMotionVoided : JointCommandStatus::kMotionRefused;
   }
   if (!written) {
     ++stats_.write_failures;
-    result.status = JointCommandStatus::kWriteFailed;
-    return result;
+    return JointCommandStatus::kWriteFailed;
   }
-  for (std::size_t i = 0; i < joints_.size(); ++i) {
-    if (requested[i]) last_commanded_ticks_[i] = requested[i];
-  }
-  last_written_ = Clock::now();
-  ++stats_.commands_sent;
-  return result;
+  return JointCommandStatus::kSent;
 }
 
 std::string BodyController::motionInForce(Clock::time_point now) const {

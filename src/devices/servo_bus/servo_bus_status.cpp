@@ -70,62 +70,80 @@ void addServoIdentity(const ServoIdentityReport* found, StatusReport* status) {
   }
 }
 
-StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
-                                    std::chrono::steady_clock::time_point now) {
-  StatusReport status;
-  const ServoBusStats& stats = bus.stats;
-  const bool connected = bus.port.connected;
-  if (connected) {
-    status.summary(StatusLevel::kOk, std::to_string(stats.transactions) + " transactions, " +
-                                         std::to_string(stats.timeouts) + " timeouts");
-  } else {
-    status.summary(StatusLevel::kWarn, "servo bus port is not connected");
-  }
-  status.hardware_id = bus.port.path;
-  status.add("port", bus.port.path);
-  status.add("connected", connected);
-  status.add("transactions", stats.transactions);
-  status.add("commands without answer", stats.commands);
-  status.add("timeouts", stats.timeouts);
-  status.add("retries", stats.retries);
-  status.add("mismatched answers", stats.mismatched);
-  status.add("garbled answers", stats.garbled);
-  status.add("echoes skipped", stats.echoes);
-  status.addf("last latency (ms)", "%.2f", stats.last_latency_ms);
-  status.addf("max latency (ms)", "%.2f", stats.max_latency_ms);
-  status.add("timeout (ms)", static_cast<int>(bus.options.timeout.count()));
-  status.add("retries per transaction", bus.options.retries);
-  status.add("dangerous writes armed", bus.options.allow_dangerous_writes);
+namespace {
 
+/// The summary by the port, its transaction counters and the options in force on it.
+void addLink(const ServoBusSnapshot& bus, StatusReport* status) {
+  const ServoBusStats& stats = bus.stats;
+  if (bus.port.connected) {
+    status->summary(StatusLevel::kOk, std::to_string(stats.transactions) + " transactions, " +
+                                          std::to_string(stats.timeouts) + " timeouts");
+  } else {
+    status->summary(StatusLevel::kWarn, "servo bus port is not connected");
+  }
+  status->hardware_id = bus.port.path;
+  status->add("port", bus.port.path);
+  status->add("connected", bus.port.connected);
+  status->add("transactions", stats.transactions);
+  status->add("commands without answer", stats.commands);
+  status->add("timeouts", stats.timeouts);
+  status->add("retries", stats.retries);
+  status->add("mismatched answers", stats.mismatched);
+  status->add("garbled answers", stats.garbled);
+  status->add("echoes skipped", stats.echoes);
+  status->addf("last latency (ms)", "%.2f", stats.last_latency_ms);
+  status->addf("max latency (ms)", "%.2f", stats.max_latency_ms);
+  status->add("timeout (ms)", static_cast<int>(bus.options.timeout.count()));
+  status->add("retries per transaction", bus.options.retries);
+  status->add("dangerous writes armed", bus.options.allow_dangerous_writes);
+}
+
+/// The polls, the moves, the e-stop's stops not yet confirmed and the settings in force.
+void addWorker(const ServoBusSnapshot& bus, StatusReport* status) {
   const ServoBusWorkerStats& worker = bus.worker;
   const std::string offline = servoIdList(worker.offline_ids);
-  status.add("servo_states published", worker.angles_polled);
-  status.add("polled servos offline", offline.empty() ? std::string("none") : offline);
-  status.add("servo_commands moves sent", worker.moves_sent);
-  status.add("servo_commands rejected", bus.commands_rejected);
-  status.add("servo_commands moves failed", worker.moves_failed);
+  status->add("servo_states published", worker.angles_polled);
+  status->add("polled servos offline", offline.empty() ? std::string("none") : offline);
+  status->add("servo_commands moves sent", worker.moves_sent);
+  status->add("servo_commands rejected", bus.commands_rejected);
+  status->add("servo_commands moves failed", worker.moves_failed);
   const std::string moving = servoIdList(bus.moving_ids);
-  status.add("servos set moving", moving.empty() ? std::string("none") : moving);
-  status.add("motion locked (e_stop)", bus.motion_locked);
-  status.add("motion frames refused when written", bus.motion_refused_at_write);
+  status->add("servos set moving", moving.empty() ? std::string("none") : moving);
+  status->add("motion locked (e_stop)", bus.motion_locked);
+  status->add("motion frames refused when written", bus.motion_refused_at_write);
   std::string unconfirmed;
   for (const PendingStopReport& stop : bus.pending_stops) {
     unconfirmed += (unconfirmed.empty() ? "" : "; ") + servoJointName(stop.id) + ": " + stop.why;
   }
-  status.add("stops not yet confirmed", unconfirmed.empty() ? std::string("none") : unconfirmed);
+  status->add("stops not yet confirmed", unconfirmed.empty() ? std::string("none") : unconfirmed);
   if (!unconfirmed.empty()) {
-    status.mergeSummary(StatusLevel::kError, "stop not yet known to have reached " + unconfirmed);
+    status->mergeSummary(StatusLevel::kError, "stop not yet known to have reached " + unconfirmed);
   }
-  status.add("on shutdown", toString(bus.in_force.on_shutdown));
-  status.add("health polls per second", bus.in_force.health_rate);
-  status.add("protect", bus.in_force.protect);
-  if (!offline.empty() && connected) {
-    status.mergeSummary(StatusLevel::kWarn, "polled servos not answering: " + offline);
+  status->add("on shutdown", toString(bus.in_force.on_shutdown));
+  status->add("health polls per second", bus.in_force.health_rate);
+  status->add("protect", bus.in_force.protect);
+  if (!offline.empty() && bus.port.connected) {
+    status->mergeSummary(StatusLevel::kWarn, "polled servos not answering: " + offline);
   }
+}
 
+}  // namespace
+
+StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
+                                    std::chrono::steady_clock::time_point now) {
+  StatusReport status;
+  addLink(bus, &status);
+  addWorker(bus, &status);
+  addPollRate(bus, now, &status);
+  return status;
+}
+
+void ServoBusStatus::addPollRate(const ServoBusSnapshot& bus,
+                                 std::chrono::steady_clock::time_point now, StatusReport* status) {
   // Asked vs achieved: the state_rate in force for every answering polled servo, against the
   // angles read over the window. A line too slow for what was asked (or service calls taking
   // the bus) shows here rather than as a silently lower rate.
+  const ServoBusWorkerStats& worker = bus.worker;
   const double asked = worker.asked_poll_rate;
   if (last_rate_check_ == std::chrono::steady_clock::time_point{}) {
     last_rate_check_ = now;
@@ -137,17 +155,16 @@ StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
     polls_at_last_check_ = worker.angles_polled;
     last_rate_check_ = now;
   }
-  status.addf("servo_states asked (per s)", "%.1f", asked);
-  if (achieved_rate_ < 0) return status;  // the first window is not over yet
-  status.addf("servo_states achieved (per s)", "%.1f", achieved_rate_);
-  if (connected && asked > 0 && achieved_rate_ < kRateSlack * asked) {
-    status.mergeSummaryf(StatusLevel::kWarn,
-                         "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
-                         "service calls are the limit: lower ~servo_bus/state_rate or raise the "
-                         "baud)",
-                         asked, achieved_rate_);
+  status->addf("servo_states asked (per s)", "%.1f", asked);
+  if (achieved_rate_ < 0) return;  // the first window is not over yet
+  status->addf("servo_states achieved (per s)", "%.1f", achieved_rate_);
+  if (bus.port.connected && asked > 0 && achieved_rate_ < kRateSlack * asked) {
+    status->mergeSummaryf(StatusLevel::kWarn,
+                          "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
+                          "service calls are the limit: lower ~servo_bus/state_rate or raise the "
+                          "baud)",
+                          asked, achieved_rate_);
   }
-  return status;
 }
 
 }  // namespace serial_robot_driver::device

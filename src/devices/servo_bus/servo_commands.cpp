@@ -50,7 +50,7 @@ constexpr std::array<CommandInfo, kMaxCommand> kTable = {{
 
 constexpr bool inCommandOrder() {
   for (std::size_t i = 0; i < kTable.size(); ++i) {
-    if (static_cast<std::size_t>(kTable[i].cmd) != i + kMinCommand) return false;
+    if (commandRow(kTable[i].cmd) != i) return false;
   }
   return true;
 }
@@ -69,8 +69,6 @@ static_assert(longestContent() == kMaxContent, "kMaxContent is the longest CONTE
 
 const std::array<CommandInfo, kMaxCommand>& commandTable() { return kTable; }
 
-const CommandInfo& commandInfo(Command cmd) {
-  return kTable[static_cast<std::size_t>(cmd) - kMinCommand];
-}
+const CommandInfo& commandInfo(Command cmd) { return kTable[commandRow(cmd)]; }
 
 }  // namespace serial_robot_driver::protocol::servo

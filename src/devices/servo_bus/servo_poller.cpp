@@ -248,15 +248,10 @@ void ServoPoller::pollHealthOnce(std::size_t index) {
     servo = health_[index];
   }
   const uint8_t id = servo.report.id;
-  bool silent = false;  // the angle poll has it in back-off: no bus time for a silent servo
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const PolledServo& polled : polled_)
-      silent |= polled.id == id && polled.backoff.count() > 0;
-  }
   std::vector<int64_t> values;
-  ServoStatus status = silent ? ServoStatus{ServoError::kTimeout, "does not answer the angle poll"}
-                              : readHealthParams(id, kReadingNames, &values);
+  ServoStatus status = silentOnAnglePoll(id)
+                           ? ServoStatus{ServoError::kTimeout, "does not answer the angle poll"}
+                           : readHealthParams(id, kReadingNames, &values);
   // Shutting down, or a stop went first: the poll is due again as it was.
   if (status.error == ServoError::kShutdown || status.error == ServoError::kPreempted) return;
   if (status.ok() && !servo.report.limits_known) {
@@ -266,27 +261,10 @@ void ServoPoller::pollHealthOnce(std::size_t index) {
       servo.report.limits_known = true;
     }
   }
-  bool overheat_changed = false;
   servo.report.polled = true;
   servo.report.online = status.ok();
   servo.report.last_error = status.ok() ? std::string() : status.message;
-  if (status.ok()) {
-    servo.report.readings = {values[0], values[1], values[2], values[3], values[4]};
-    servo.report.assessment = servo.report.limits_known
-                                  ? assessHealth(id, servo.report.readings, servo.report.limits)
-                                  : HealthAssessment{};
-    bool protect = false;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      protect = settings_.protect;
-    }
-    if (protect && servo.report.limits_known) {
-      const bool overheated = servo.guard.update(servo.report.readings.temperature_c,
-                                                 servo.report.limits.over_temperature_c);
-      overheat_changed = overheated != servo.report.overheated;
-      servo.report.overheated = overheated;
-    }
-  }
+  const bool overheat_changed = status.ok() && assessReadings(values, &servo);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     servo.next_poll = std::max(servo.next_poll + health_period_, clock_.now());
@@ -296,17 +274,44 @@ void ServoPoller::pollHealthOnce(std::size_t index) {
       hooks_.drop_queued_moves_locked(id);
     }
   }
-  if (overheat_changed && servo.report.overheated) {
-    // A safety action: let through whatever the gate says.
-    uint16_t relax_power_mw = 0;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      relax_power_mw = settings_.relax_power_mw;
-    }
-    client_.damping(id, relax_power_mw, false, FrameGate::kSafetyAction);
-    hooks_.relaxed(id);
-  }
+  if (overheat_changed && servo.report.overheated) relaxOverheated(id);
   if (overheat_changed && events_.on_overheat) events_.on_overheat(servo.report);
+}
+
+bool ServoPoller::silentOnAnglePoll(uint8_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  bool silent = false;
+  for (const PolledServo& polled : polled_) silent |= polled.id == id && polled.backoff.count() > 0;
+  return silent;
+}
+
+bool ServoPoller::assessReadings(const std::vector<int64_t>& values, HealthServo* servo) {
+  ServoHealthReport& report = servo->report;
+  report.readings = {values[0], values[1], values[2], values[3], values[4]};
+  report.assessment = report.limits_known ? assessHealth(report.id, report.readings, report.limits)
+                                          : HealthAssessment{};
+  bool protect = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    protect = settings_.protect;
+  }
+  if (!protect || !report.limits_known) return false;
+  const bool overheated =
+      servo->guard.update(report.readings.temperature_c, report.limits.over_temperature_c);
+  const bool changed = overheated != report.overheated;
+  report.overheated = overheated;
+  return changed;
+}
+
+void ServoPoller::relaxOverheated(uint8_t id) {
+  // A safety action: let through whatever the gate says.
+  uint16_t relax_power_mw = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    relax_power_mw = settings_.relax_power_mw;
+  }
+  client_.damping(id, relax_power_mw, false, FrameGate::kSafetyAction);
+  hooks_.relaxed(id);
 }
 
 }  // namespace serial_robot_driver::device

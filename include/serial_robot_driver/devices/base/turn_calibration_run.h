@@ -101,6 +101,14 @@ class TurnCalibrationRun {
   };
 
   void runPhase(const CalibrationTick& tick, CalibrationStep& out);
+  /// kWaitEStop: refuses an engaged e-stop, else waits for its status and engagement count.
+  void checkEStopReleased();
+  /// kWaitSubscriber: the first motion once the driver listens to our cmd_vel (or after a wait).
+  void startOnceSubscribed(const CalibrationTick& tick);
+  /// kHold, kStopping: holds still; a stop with ROS gone leaves it to ~base/cmd_vel_timeout.
+  void holdOrGiveUp(const CalibrationTick& tick, CalibrationStep& out);
+  /// kAwaitDistance: asks for the measured distance until it is typed (or refused).
+  void awaitDistance(CalibrationStep& out);
   void waitFor(bool arrived, double seconds, Phase next, const std::string& timeout_message);
   void startHold(double rest, AfterHold then);
   void hold(CalibrationStep& out);

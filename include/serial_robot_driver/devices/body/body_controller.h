@@ -142,6 +142,10 @@ class BodyController : public LinkListener {
   BodyStats stats() const;
 
  private:
+  /// Sync-writes `targets` through the motion gate (mutex_ held): kSent, or why not (counted).
+  JointCommandStatus writeTargetsLocked(const std::vector<protocol::body::ServoTarget>& targets,
+                                        MotionGate::Generation generation);
+
   const std::vector<BodyJoint> joints_;
   const FrameWriter writer_;
   const BodyEvents events_;

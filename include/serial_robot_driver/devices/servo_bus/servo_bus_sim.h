@@ -118,8 +118,46 @@ class ServoBusSim {
     std::vector<uint8_t> bytes;
   };
 
+  /// A request that fits its command, as one servo's handler sees it.
+  struct Request {
+    Servo* servo;
+    const protocol::servo::Packet& packet;
+    protocol::servo::Command cmd;
+    uint8_t id;      ///< as addressed (the broadcast id included)
+    bool broadcast;  ///< to every servo
+    bool answers;    ///< this servo answers it: not broadcast, and the command table says so
+    TimePoint now;
+    TimePoint due;  ///< when its answer leaves
+  };
+  using Handler = void (ServoBusSim::*)(const Request& request);
+  struct HandlerRow {
+    protocol::servo::Command cmd;
+    Handler handle;
+  };
+  /// The handler of each command, row for row as protocol::servo::commandTable().
+  static const std::array<HandlerRow, protocol::servo::kMaxCommand>& handlers();
+
   void resetUserData(Servo* servo) const;
+  /// Checks the request's size against the command table and hands it to its command's handler.
   void execute(Servo* servo, const protocol::servo::Packet& packet, bool broadcast, TimePoint now);
+  /// Queues the answer when the servo answers this request.
+  void reply(const Request& request, const std::vector<uint8_t>& content);
+  void onPing(const Request& request);
+  void onResetUserData(const Request& request);
+  /// READ_DATA / WRITE_DATA: the parameter the request names and its content; nullptr (counted)
+  /// when malformed or unknown.
+  const protocol::servo::ParamInfo* dataRequest(const Request& request,
+                                                protocol::servo::DataContent* content);
+  void onReadData(const Request& request);
+  void onWriteData(const Request& request);
+  void onReadBatchData(const Request& request);
+  void onWriteBatchData(const Request& request);
+  void onSpin(const Request& request);
+  /// ROTATE and CMD 11..15.
+  void onMove(const Request& request);
+  void onDamping(const Request& request);
+  void onReadAngle(const Request& request);
+  void onReadMultiTurnAngle(const Request& request);
   void answer(TimePoint due, protocol::servo::Command cmd, const std::vector<uint8_t>& content);
   /// Response_switch 0 interrupts whatever runs; 1 queues behind it and answers at completion.
   void startMotion(Servo* servo, Motion motion, TimePoint now);

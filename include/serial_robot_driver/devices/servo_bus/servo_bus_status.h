@@ -51,6 +51,10 @@ class ServoBusStatus {
   StatusReport update(const ServoBusSnapshot& bus, std::chrono::steady_clock::time_point now);
 
  private:
+  /// The state_rate asked against the angle reads achieved over the last window.
+  void addPollRate(const ServoBusSnapshot& bus, std::chrono::steady_clock::time_point now,
+                   StatusReport* status);
+
   uint64_t polls_at_last_check_ = 0;
   std::chrono::steady_clock::time_point last_rate_check_{};
   double achieved_rate_ = -1.0;  ///< reads/s over the last window; < 0: none yet

@@ -41,6 +41,11 @@ constexpr int kNoResult = -1;
 
 /// One row per command, in CMD order (kMinCommand .. kMaxCommand).
 const std::array<CommandInfo, kMaxCommand>& commandTable();
+/// A known command's row in commandTable(), and in every table kept in its order (the
+/// simulator's handlers).
+constexpr std::size_t commandRow(Command cmd) {
+  return static_cast<std::size_t>(cmd) - kMinCommand;
+}
 /// The row of a known command.
 const CommandInfo& commandInfo(Command cmd);
 

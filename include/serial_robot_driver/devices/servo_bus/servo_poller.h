@@ -88,6 +88,13 @@ class ServoPoller {
   Clock::time_point nextHealthPollLocked() const;
   void pollAngleOnce(PolledServo& servo);
   void pollHealthOnce(std::size_t index);
+  /// The angle poll has the servo in back-off: no bus time for a silent servo.
+  bool silentOnAnglePoll(uint8_t id) const;
+  /// Stores the readings and judges them (and, with protect, the overheat guard): true when the
+  /// servo's overheated state changed.
+  bool assessReadings(const std::vector<int64_t>& values, HealthServo* servo);
+  /// Relaxes a servo that overheated, as a safety action.
+  void relaxOverheated(uint8_t id);
   /// The polled servo whose identity read is due first, or polled_.end().
   std::vector<PolledServo>::iterator identityDueLocked(Clock::time_point now);
   void readIdentityOnce(PolledServo& servo);

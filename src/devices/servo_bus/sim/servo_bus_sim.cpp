@@ -217,10 +217,38 @@ void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint
   ++stats_.unaddressed;
 }
 
+const std::array<ServoBusSim::HandlerRow, servo::kMaxCommand>& ServoBusSim::handlers() {
+  static constexpr std::array<HandlerRow, servo::kMaxCommand> kRows = {{
+      {Command::kPing, &ServoBusSim::onPing},
+      {Command::kResetUserData, &ServoBusSim::onResetUserData},
+      {Command::kReadData, &ServoBusSim::onReadData},
+      {Command::kWriteData, &ServoBusSim::onWriteData},
+      {Command::kReadBatchData, &ServoBusSim::onReadBatchData},
+      {Command::kWriteBatchData, &ServoBusSim::onWriteBatchData},
+      {Command::kSpin, &ServoBusSim::onSpin},
+      {Command::kRotate, &ServoBusSim::onMove},
+      {Command::kDamping, &ServoBusSim::onDamping},
+      {Command::kReadAngle, &ServoBusSim::onReadAngle},
+      {Command::kMoveByInterval, &ServoBusSim::onMove},
+      {Command::kMoveByVelocity, &ServoBusSim::onMove},
+      {Command::kMultiTurnMove, &ServoBusSim::onMove},
+      {Command::kMultiTurnMoveByInterval, &ServoBusSim::onMove},
+      {Command::kMultiTurnMoveByVelocity, &ServoBusSim::onMove},
+      {Command::kReadMultiTurnAngle, &ServoBusSim::onReadMultiTurnAngle},
+  }};
+  static_assert(
+      [] {
+        for (std::size_t i = 0; i < kRows.size(); ++i) {
+          if (servo::commandRow(kRows[i].cmd) != i) return false;
+        }
+        return true;
+      }(),
+      "the handlers are in the order of servo::commandTable()");
+  return kRows;
+}
+
 void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast, TimePoint now) {
   runMotions(s, now);  // the angle and the queue as of this request
-  const uint8_t id = packet.id();
-  const TimePoint due = now + fromSeconds(config_.answer_latency_s);
   const auto cmd = static_cast<Command>(packet.cmd);
   const servo::CommandInfo& info = servo::commandInfo(cmd);
   if (!info.request.fits(packet.content_size)) {
@@ -230,151 +258,179 @@ void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast,
   // Nobody answers the broadcast id; a motion answers (on completion) only with response_switch 1.
   const bool answers =
       !broadcast && (info.answers == servo::Answers::kAlways || param(*s, kResponseSwitch) == 1);
-  const auto reply = [&](const std::vector<uint8_t>& answer_content) {
-    if (answers) answer(due, cmd, answer_content);
-  };
-  const auto malformed = [&]() { ++stats_.malformed; };
+  const Request request{s,         packet,  cmd, packet.id(),
+                        broadcast, answers, now, now + fromSeconds(config_.answer_latency_s)};
+  (this->*handlers()[servo::commandRow(cmd)].handle)(request);
+}
 
-  if (servo::isMove(cmd)) {
-    const protocol::Decoded<servo::MoveCommand> move = servo::decodeMove(packet);
-    if (!move) return malformed();
-    Motion motion;
-    motion.cmd = cmd;
-    motion.multi_turn = servo::isMultiTurn(cmd);
-    motion.target_angle = move->angle_decidegrees / 10.0;
-    if (servo::isByVelocity(cmd)) {
-      motion.velocity_dps = move->velocity_decidegrees_per_s / 10.0;
-      if (motion.velocity_dps <= 0) return malformed();
-    } else {
-      motion.duration_s = move->interval_ms / kMsPerSecond;
-    }
-    if (servo::hasRamps(cmd)) {
-      motion.accel_s = move->ramps.accel_ms / kMsPerSecond;
-      motion.decel_s = move->ramps.decel_ms / kMsPerSecond;
-    }
-    requestMove(s, motion, id, broadcast, now);
+void ServoBusSim::reply(const Request& request, const std::vector<uint8_t>& content) {
+  if (request.answers) answer(request.due, request.cmd, content);
+}
+
+void ServoBusSim::onMove(const Request& request) {
+  const Command cmd = request.cmd;
+  const protocol::Decoded<servo::MoveCommand> move = servo::decodeMove(request.packet);
+  if (!move) {
+    ++stats_.malformed;
     return;
   }
-
-  switch (cmd) {
-    case Command::kPing:
-      reply(servo::pingAnswerContent(id));
-      break;
-
-    case Command::kResetUserData:
-      resetUserData(s);
-      // The servo now has its factory id and answers from there.
-      reply(servo::resultAnswerContent(kFactoryId, true));
-      break;
-
-    case Command::kReadData:
-    case Command::kWriteData: {
-      const protocol::Decoded<servo::DataContent> request = servo::decodeDataContent(packet);
-      if (!request) return malformed();
-      const servo::ParamInfo* param_info = servo::findParamById(request->data_id);
-      if (param_info == nullptr) {
-        ++stats_.unknown_data_ids;
-        return;
-      }
-      if (cmd == Command::kReadData) {
-        reply(servo::readDataAnswerContent(id, *param_info, param(*s, param_info->data_id)));
-        break;
-      }
-      const auto value = servo::readValue(*param_info, request->value.data(), request->value_size);
-      if (!value) return malformed();
-      // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
-      const bool ok = servo::checkWrite(*param_info, *value, true) == servo::WriteCheck::kOk;
-      if (ok) {
-        s->params[param_info->data_id] = *value;
-      } else {
-        ++stats_.writes_rejected;
-      }
-      reply(servo::writeDataAnswerContent(id, param_info->data_id, ok));
-      break;
+  Motion motion;
+  motion.cmd = cmd;
+  motion.multi_turn = servo::isMultiTurn(cmd);
+  motion.target_angle = move->angle_decidegrees / 10.0;
+  if (servo::isByVelocity(cmd)) {
+    motion.velocity_dps = move->velocity_decidegrees_per_s / 10.0;
+    if (motion.velocity_dps <= 0) {
+      ++stats_.malformed;
+      return;
     }
+  } else {
+    motion.duration_s = move->interval_ms / kMsPerSecond;
+  }
+  if (servo::hasRamps(cmd)) {
+    motion.accel_s = move->ramps.accel_ms / kMsPerSecond;
+    motion.decel_s = move->ramps.decel_ms / kMsPerSecond;
+  }
+  requestMove(request.servo, motion, request.id, request.broadcast, request.now);
+}
 
-    case Command::kReadBatchData: {
-      const auto value_of = [&](const servo::ParamInfo& info) { return param(*s, info.data_id); };
-      reply(servo::userBlockAnswerContent(id, servo::packUserBlock(value_of)));
+void ServoBusSim::onPing(const Request& request) {
+  reply(request, servo::pingAnswerContent(request.id));
+}
+
+void ServoBusSim::onResetUserData(const Request& request) {
+  resetUserData(request.servo);
+  // The servo now has its factory id and answers from there.
+  reply(request, servo::resultAnswerContent(kFactoryId, true));
+}
+
+const servo::ParamInfo* ServoBusSim::dataRequest(const Request& request,
+                                                 servo::DataContent* content) {
+  const protocol::Decoded<servo::DataContent> decoded = servo::decodeDataContent(request.packet);
+  if (!decoded) {
+    ++stats_.malformed;
+    return nullptr;
+  }
+  const servo::ParamInfo* param_info = servo::findParamById(decoded->data_id);
+  if (param_info == nullptr) {
+    ++stats_.unknown_data_ids;
+    return nullptr;
+  }
+  *content = *decoded;
+  return param_info;
+}
+
+void ServoBusSim::onReadData(const Request& request) {
+  servo::DataContent content;
+  const servo::ParamInfo* param_info = dataRequest(request, &content);
+  if (param_info == nullptr) return;
+  reply(request, servo::readDataAnswerContent(request.id, *param_info,
+                                              param(*request.servo, param_info->data_id)));
+}
+
+void ServoBusSim::onWriteData(const Request& request) {
+  servo::DataContent content;
+  const servo::ParamInfo* param_info = dataRequest(request, &content);
+  if (param_info == nullptr) return;
+  const auto value = servo::readValue(*param_info, content.value.data(), content.value_size);
+  if (!value) {
+    ++stats_.malformed;
+    return;
+  }
+  // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
+  const bool ok = servo::checkWrite(*param_info, *value, true) == servo::WriteCheck::kOk;
+  if (ok) {
+    request.servo->params[param_info->data_id] = *value;
+  } else {
+    ++stats_.writes_rejected;
+  }
+  reply(request, servo::writeDataAnswerContent(request.id, param_info->data_id, ok));
+}
+
+void ServoBusSim::onReadBatchData(const Request& request) {
+  const auto value_of = [&](const servo::ParamInfo& info) {
+    return param(*request.servo, info.data_id);
+  };
+  reply(request, servo::userBlockAnswerContent(request.id, servo::packUserBlock(value_of)));
+}
+
+void ServoBusSim::onWriteBatchData(const Request& request) {
+  const auto block = servo::decodeUserBlock(request.packet);
+  if (!block) {
+    ++stats_.malformed;
+    return;
+  }
+  const auto values = servo::unpackUserBlock(*block);
+  // All or nothing: one bad cell rejects the block.
+  const bool ok = std::all_of(values.begin(), values.end(), [](const auto& cell) {
+    return servo::checkWrite(*cell.first, cell.second, true) == servo::WriteCheck::kOk;
+  });
+  if (ok) {
+    for (const auto& [param_info, value] : values)
+      request.servo->params[param_info->data_id] = value;
+  } else {
+    ++stats_.writes_rejected;
+  }
+  reply(request, servo::resultAnswerContent(request.id, ok));
+}
+
+void ServoBusSim::onSpin(const Request& request) {
+  const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(request.packet);
+  if (!spin) {
+    ++stats_.malformed;
+    return;
+  }
+  Servo* s = request.servo;
+  const double speed = spin->speed_dps;
+  const double rate = spin->clockwise ? -speed : speed;  // clockwise is negative
+  Motion motion;
+  motion.kind = Motion::Kind::kSpin;
+  motion.cmd = Command::kSpin;
+  motion.answer = request.answers;
+  motion.answer_id = request.id;
+  motion.rate_dps = rate;
+  switch (spin->mode) {
+    case servo::SpinMode::kStop:
+      stopAll(s);
+      reply(request, servo::resultAnswerContent(request.id, true));
+      return;
+    case servo::SpinMode::kContinuous:
+      stopAll(s);
+      s->relaxed = false;
+      s->spin_rate_dps = rate;
+      reply(request, servo::resultAnswerContent(request.id, true));
+      return;
+    case servo::SpinMode::kTurns:
+      motion.duration_s = speed > 0 ? spin->value * 360.0 / speed : 0.0;
       break;
-    }
-
-    case Command::kWriteBatchData: {
-      const auto block = servo::decodeUserBlock(packet);
-      if (!block) return malformed();
-      const auto values = servo::unpackUserBlock(*block);
-      // All or nothing: one bad cell rejects the block.
-      const bool ok = std::all_of(values.begin(), values.end(), [](const auto& cell) {
-        return servo::checkWrite(*cell.first, cell.second, true) == servo::WriteCheck::kOk;
-      });
-      if (ok) {
-        for (const auto& [param_info, value] : values) s->params[param_info->data_id] = value;
-      } else {
-        ++stats_.writes_rejected;
-      }
-      reply(servo::resultAnswerContent(id, ok));
-      break;
-    }
-
-    case Command::kSpin: {
-      const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(packet);
-      if (!spin) return malformed();
-      const double speed = spin->speed_dps;
-      const double rate = spin->clockwise ? -speed : speed;  // clockwise is negative
-      Motion motion;
-      motion.kind = Motion::Kind::kSpin;
-      motion.cmd = Command::kSpin;
-      motion.answer = answers;
-      motion.answer_id = id;
-      motion.rate_dps = rate;
-      switch (spin->mode) {
-        case servo::SpinMode::kStop:
-          stopAll(s);
-          reply(servo::resultAnswerContent(id, true));
-          return;
-        case servo::SpinMode::kContinuous:
-          stopAll(s);
-          s->relaxed = false;
-          s->spin_rate_dps = rate;
-          reply(servo::resultAnswerContent(id, true));
-          return;
-        case servo::SpinMode::kTurns:
-          motion.duration_s = speed > 0 ? spin->value * 360.0 / speed : 0.0;
-          break;
-        case servo::SpinMode::kDurationMs:
-          motion.duration_s = spin->value / 1000.0;
-          break;
-      }
-      startMotion(s, motion, now);
-      break;
-    }
-
-    case Command::kReadMultiTurnAngle: {
-      servo::MultiTurnAngle reading;
-      reading.id = id;
-      const double decidegrees =
-          std::clamp(std::round(s->angle_deg * 10.0), double(std::numeric_limits<int32_t>::min()),
-                     double(std::numeric_limits<int32_t>::max()));
-      reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
-      reading.turns = static_cast<int16_t>(std::trunc(s->angle_deg / kDegreesPerTurn));
-      reply(servo::multiTurnAngleContent(reading));
-      break;
-    }
-
-    case Command::kDamping:
-      stopAll(s);  // damping releases the holding torque: nothing keeps moving
-      s->relaxed = true;
-      reply(servo::resultAnswerContent(id, true));
-      break;
-
-    case Command::kReadAngle:
-      reply(servo::angleAnswerContent(
-          servo::AngleAnswer{id, toDecidegrees(foldDegrees(s->angle_deg))}));
-      break;
-
-    default:  // the moves, above
+    case servo::SpinMode::kDurationMs:
+      motion.duration_s = spin->value / 1000.0;
       break;
   }
+  startMotion(s, motion, request.now);
+}
+
+void ServoBusSim::onReadMultiTurnAngle(const Request& request) {
+  const double angle_deg = request.servo->angle_deg;
+  servo::MultiTurnAngle reading;
+  reading.id = request.id;
+  const double decidegrees =
+      std::clamp(std::round(angle_deg * 10.0), double(std::numeric_limits<int32_t>::min()),
+                 double(std::numeric_limits<int32_t>::max()));
+  reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
+  reading.turns = static_cast<int16_t>(std::trunc(angle_deg / kDegreesPerTurn));
+  reply(request, servo::multiTurnAngleContent(reading));
+}
+
+void ServoBusSim::onDamping(const Request& request) {
+  stopAll(request.servo);  // damping releases the holding torque: nothing keeps moving
+  request.servo->relaxed = true;
+  reply(request, servo::resultAnswerContent(request.id, true));
+}
+
+void ServoBusSim::onReadAngle(const Request& request) {
+  reply(request, servo::angleAnswerContent(servo::AngleAnswer{
+                     request.id, toDecidegrees(foldDegrees(request.servo->angle_deg))}));
 }
 
 void ServoBusSim::stopAll(Servo* s) {
