@@ -172,7 +172,7 @@ void DriverNode::makeDevices() {
     DeviceInterface* device = devices_.back().get();
     device_names_.emplace_back(module->name);
     diagnostics_.add(module->name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      device->diagnose(s);
+      writeStatusReport(device->status(), s);
     });
     for (device::Device::NamedStatus& extra : device->extraStatuses()) {
       diagnostics_.add(extra.name, [report = std::move(extra.report)](

@@ -5,7 +5,6 @@
 // accepted, not a measurement: the AP1 reports no encoder counts.
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>

@@ -6,8 +6,6 @@
 // status.
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <diagnostic_updater/update_functions.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -15,6 +13,7 @@
 
 #include <memory>
 
+#include "serial_robot_driver/device/event_rate.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/devices/body/body_status.h"
 #include "serial_robot_driver/devices/body/gyro_bias.h"
@@ -37,10 +36,9 @@ class BodyInterface : public DeviceInterface {
   /// Stops taking joint commands and calibrations (one under way is refused). Frames that still
   /// arrive before the link stops are published.
   void shutdown() override;
-  /// The frames' counters and the gyro calibration (logs telemetry stopping and resuming).
+  /// The telemetry rate, the frames' counters and the gyro calibration (logs telemetry stopping
+  /// and resuming).
   device::StatusReport status() override;
-  /// The telemetry rate (diagnostic_updater's FrequencyStatus), status() merged into it.
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
   /// The ~imu tunables (accel_scale, gyro_scale, angle_scale) from the next telemetry frame on.
   void retune(const DriverParams& params) override;
 
@@ -88,10 +86,7 @@ class BodyInterface : public DeviceInterface {
   device::EStop* e_stop_ = nullptr;             // the node's, set before start()
   device::GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   device::BodyController controller_;
-  // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
-  double min_rate_ = 1.0;
-  double max_rate_ = 1000.0;
-  diagnostic_updater::FrequencyStatus telemetry_rate_;  // ticked on the reader thread (locks)
+  device::EventRate telemetry_rate_;  // ticked on the reader thread (locks)
   ros::Publisher joint_states_pub_;
   ros::Publisher imu_pub_;
   ros::Publisher foot_pressure_pub_;

@@ -32,8 +32,8 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
           {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
             publishTelemetry(telemetry, arrival);
           }}),
-      telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
-                      "telemetry rate"),
+      // Expected telemetry rates; measured on ROS time, as diagnostic_updater's FrequencyStatus.
+      telemetry_rate_(1.0, 1000.0, [] { return ros::Time::now().toSec(); }),
       calibration_nh_(nh) {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
   joint_states_pub_ =
@@ -177,12 +177,11 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   }
 }
 
-void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
-  writeStatusReport(this->status(), status, SummaryWrite::kMerge);
-}
-
 device::StatusReport BodyInterface::status() {
+  // As diagnostic_updater starts every status: it stands while the rate's window has no length.
+  device::StatusReport report;
+  report.summary(device::StatusLevel::kError, "No message was set");
+  telemetry_rate_.addTo(report);  // OK / WARN from the telemetry rate, plus its own keys
   device::BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
                                                      {link_.options().path, link_.connected()});
   gyro_calibrator_.report(update.report, gyroUnits(*std::atomic_load(&imu_params_)));
@@ -195,7 +194,10 @@ device::StatusReport BodyInterface::status() {
   } else if (update.flow == device::BodyStatus::FlowChange::kResumed) {
     ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
   }
-  return update.report;
+  report.mergeSummary(update.report.level, update.report.message);
+  if (!update.report.hardware_id.empty()) report.hardware_id = update.report.hardware_id;
+  for (auto& value : update.report.values) report.values.push_back(std::move(value));
+  return report;
 }
 
 }  // namespace serial_robot_driver::ros_layer
