@@ -39,7 +39,8 @@ void EventRate::addTo(StatusReport& report) {
   report.addf("Duration of window (s)", "%f", window);
   if (window != 0) report.addf("Actual frequency (Hz)", "%f", hz);
   if (min_hz_ == max_hz_) report.addf("Target frequency (Hz)", "%f", min_hz_);
-  if (min_hz_ > 0) report.addf("Minimum acceptable frequency (Hz)", "%f", min_hz_ * (1 - kTolerance));
+  if (min_hz_ > 0)
+    report.addf("Minimum acceptable frequency (Hz)", "%f", min_hz_ * (1 - kTolerance));
   if (std::isfinite(max_hz_)) {
     report.addf("Maximum acceptable frequency (Hz)", "%f", max_hz_ * (1 + kTolerance));
   }

@@ -8,8 +8,8 @@
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/device/e_stop_status.h"
 #include "serial_robot_driver/device/link_status.h"
-#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
@@ -114,9 +114,9 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   for (auto& device : devices_) tunable.push_back(device.get());
   tuning_ = std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable),
                                             trajectory_executor_.get());
-  diagnostics_timer_ = nh_.createSteadyTimer(
-      ros::WallDuration(diagnostics_period_),
-      [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
+  diagnostics_timer_ =
+      nh_.createSteadyTimer(ros::WallDuration(diagnostics_period_),
+                            [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
 }
 
 DriverNode::~DriverNode() { shutdown(); }
@@ -204,7 +204,8 @@ void DriverNode::connectCapabilities() {
   // service threads; each device answers under its own short lock. devices_ and the executor are
   // complete here and outlive the links' threads and the devices' spinners.
   auto motion = std::make_unique<NodeMotion>();
-  for (std::size_t i = 0; i < devices_.size(); ++i) motion->add(device_names_[i], devices_[i].get());
+  for (std::size_t i = 0; i < devices_.size(); ++i)
+    motion->add(device_names_[i], devices_[i].get());
   motion->setTrajectories(trajectory_executor_.get());
   device::Capabilities capabilities;
   capabilities.offer<device::MotionQuery>(*motion);

@@ -58,11 +58,10 @@ std::unique_ptr<BagReplay> openReplay(DriverParams& params,
   params.replay_timeline = replay->timeline();
   // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
   params.reconnect_interval = 0.0;
-  ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(),
-           params.replay_bag.c_str(),
-           params.replay_rate > 0
-               ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
-               : "full speed");
+  ROS_INFO(
+      "replaying %s from %s at %s", replay->recording().topic.c_str(), params.replay_bag.c_str(),
+      params.replay_rate > 0 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
+                             : "full speed");
   return replay;
 }
 

@@ -29,15 +29,15 @@
 //    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <std_msgs/Bool.h>
+
 #include <atomic>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <ros/ros.h>
-#include <std_msgs/Bool.h>
 
 #include "serial_robot_driver/device/capabilities.h"
 #include "serial_robot_driver/device/device_module.h"
@@ -80,8 +80,8 @@ class DriverNode {
   /// One SerialLink per path the enabled devices name, with its monitor and status.
   void openPorts(const device::SerialLink::StreamFactory& stream_factory);
   /// The options of the port at `path` shared by `users`.
-  device::SerialLinkOptions linkOptions(const std::string& path,
-                                        const std::vector<const device::DeviceModule*>& users) const;
+  device::SerialLinkOptions linkOptions(
+      const std::string& path, const std::vector<const device::DeviceModule*>& users) const;
   device::SerialLink& portFor(const std::string& path);
   /// The ROS side of every enabled device on its port, with its statuses.
   void makeDevices();

@@ -1,7 +1,7 @@
 // follow_joint_trajectory (action) and joint_trajectory (topic) for the node's joints: messages
 // converted to and from the node's ROS-free trajectory::TrajectoryExecutor (trajectory/executor.h,
-// the one the devices attach to), which decides everything (acceptance, sampling, tolerances, preemption, stops), and a steady timer
-// that ticks it at the loop rate.
+// the one the devices attach to), which decides everything (acceptance, sampling, tolerances,
+// preemption, stops), and a steady timer that ticks it at the loop rate.
 //
 // Time: the executor runs on the steady clock (trajectory::steadyNow()); a goal's header.stamp
 // (ROS time) becomes a steady start once, on receipt, so a step of the ROS or wall clock changes

@@ -53,8 +53,8 @@ class BaseInterface : public DeviceInterface {
   bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
 
   device::SerialLink& link_;
-  const bool replaying_;     // ~replay_bag: headings arrive stamped with the recording's clock
-  const double loop_rate_;  // Hz, as started
+  const bool replaying_;          // ~replay_bag: headings arrive stamped with the recording's clock
+  const double loop_rate_;        // Hz, as started
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
   const BaseParams params_;       // as started: frames and joint names (the tunables: tuned())
   /// ~base as last tuned, swapped whole by retune() (read on the loop and diagnostics threads).

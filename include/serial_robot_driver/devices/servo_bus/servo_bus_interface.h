@@ -3,9 +3,9 @@
 // queue and the poll schedule) is device::ServoBus; this class only translates.
 //
 // Threading model (the threads start in start()):
-//  - The services are served from this class's OWN callback queues, never the global one: a servo
-//    call blocks for up to timeout * (retries + 1), a scan or a reset for many of those, a call
-//    with `wait` for a whole motion, and on the global queue that would hold up cmd_vel and
+//  - The services are served from OWN callback queues (ServoBusServices), never the global one: a
+//    servo call blocks for up to timeout * (retries + 1), a scan or a reset for many of those, a
+//    call with `wait` for a whole motion, and on the global queue that would hold up cmd_vel and
 //    joint_commands.
 //  - The stop services (servo/spin, servo/relax, servo/damping, servo/hold) have a queue
 //    (StopCallQueue) and a thread of their own, so they never wait behind a long call on the
@@ -53,8 +53,8 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_diagnostics.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_services.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_status.h"
-#include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
 #include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
+#include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/trajectory_bus_joints.h"

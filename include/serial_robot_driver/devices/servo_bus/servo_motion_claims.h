@@ -48,7 +48,7 @@ class ServoMotionClaims {
  private:
   ServoBus& bus_;
   const std::vector<trajectory::BusJoint>& joints_;
-  EStop* e_stop_ = nullptr;                                // the node's, set before start
+  EStop* e_stop_ = nullptr;                                 // the node's, set before start
   trajectory::TrajectoryExecutor* trajectories_ = nullptr;  // the node's, set before start
 };
 

@@ -1,8 +1,8 @@
+#include "serial_robot_driver/devices/servo_bus/servo_bus_services.h"
+
 #include <functional>
 #include <string>
 #include <vector>
-
-#include "serial_robot_driver/devices/servo_bus/servo_bus_services.h"
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
@@ -191,7 +191,8 @@ void ServoBusServices::advertiseReads() {
         return status;
       }));
   services_.push_back(advertiseServo<ServoReadAngle>(
-      site, "servo/read_angle", [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
+      site, "servo/read_angle",
+      [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
         return readAngle(client_, req, res);
       }));
   services_.push_back(advertiseServo<ServoScan>(
