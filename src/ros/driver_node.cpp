@@ -204,8 +204,9 @@ void DriverNode::connectCapabilities() {
   // service threads; each device answers under its own short lock. devices_ and the executor are
   // complete here and outlive the links' threads and the devices' spinners.
   auto motion = std::make_unique<NodeMotion>();
-  for (std::size_t i = 0; i < devices_.size(); ++i)
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
     motion->add(device_names_[i], devices_[i].get());
+  }
   motion->setTrajectories(trajectory_executor_.get());
   device::Capabilities capabilities;
   capabilities.offer<device::MotionQuery>(*motion);

@@ -104,6 +104,31 @@ device::ServoStatus readAngle(device::ServoBusClient& client, const ServoReadAng
   return status;
 }
 
+device::ServoStatus readAll(device::ServoBusClient& client, const ServoReadAll::Request& req,
+                            ServoReadAll::Response& res) {
+  std::vector<device::ServoParamValue> values;
+  const device::ServoStatus status = client.readAll(req.id, &values);
+  res.names.clear();
+  res.values.clear();
+  for (const device::ServoParamValue& value : values) {
+    res.names.push_back(value.name);
+    res.values.push_back(value.value);
+  }
+  return status;
+}
+
+device::ServoStatus readInfo(device::ServoBusClient& client,
+                             const device::ServoIdentityChecks& expected,
+                             const ServoInfo::Request& req, ServoInfo::Response& res) {
+  device::ServoIdentity identity;
+  const device::ServoStatus status = device::readServoInfo(client, req.id, expected, &identity);
+  res.servo_type = identity.servo_type;
+  res.firmware_version = identity.firmware_version;
+  res.serial_number = identity.serial_number;
+  res.response_switch = identity.response_switch;
+  return status;
+}
+
 device::MoveRequest toMoveRequest(const ServoMove::Request& req) {
   device::MoveRequest request;
   request.id = req.id;
@@ -201,26 +226,11 @@ void ServoBusServices::advertiseReads() {
       }));
   services_.push_back(advertiseServo<ServoReadAll>(
       site, "servo/read_all", [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
-        std::vector<device::ServoParamValue> values;
-        const device::ServoStatus status = client_.readAll(req.id, &values);
-        res.names.clear();
-        res.values.clear();
-        for (const device::ServoParamValue& value : values) {
-          res.names.push_back(value.name);
-          res.values.push_back(value.value);
-        }
-        return status;
+        return readAll(client_, req, res);
       }));
   services_.push_back(advertiseServo<ServoInfo>(
       site, "servo/info", [this](ServoInfo::Request& req, ServoInfo::Response& res) {
-        device::ServoIdentity identity;
-        const device::ServoStatus status =
-            device::readServoInfo(client_, req.id, bus_.config().identity, &identity);
-        res.servo_type = identity.servo_type;
-        res.firmware_version = identity.firmware_version;
-        res.serial_number = identity.serial_number;
-        res.response_switch = identity.response_switch;
-        return status;
+        return readInfo(client_, bus_.config().identity, req, res);
       }));
 }
 
