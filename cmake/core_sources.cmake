@@ -27,6 +27,7 @@ set(SRD_CORE_SOURCES
   src/device/e_stop.cpp
   src/device/motion_gate.cpp
   src/device/status_report.cpp
+  src/device/event_rate.cpp
   src/device/link_status.cpp
   src/device/e_stop_status.cpp
   src/device/input_refusals.cpp

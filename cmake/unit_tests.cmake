@@ -23,7 +23,9 @@ catkin_add_gtest(core_tests
   test/unit/test_device_registry.cpp
   test/unit/test_e_stop.cpp
   test/unit/test_input_refusals.cpp
-  test/unit/test_status_report.cpp)
+  test/unit/test_status_report.cpp
+  test/unit/test_capabilities.cpp
+  test/unit/test_event_rate.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
 # test_device_registry.cpp reads config/analyzers.yaml from the sources.

@@ -8,9 +8,8 @@
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/device/e_stop_status.h"
 #include "serial_robot_driver/device/link_status.h"
-#include "serial_robot_driver/devices/base/base_interface.h"
-#include "serial_robot_driver/devices/body/body_interface.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
@@ -63,6 +62,29 @@ class PortMonitor : public device::LinkListener {
 
 namespace {
 
+/// The node's MotionQuery (device/capabilities.h): each enabled device's motionInForce() under
+/// its registered name, in the devices' order, then the trajectories'.
+class NodeMotion : public device::MotionQuery {
+ public:
+  void add(std::string name, const device::Device* device) {
+    devices_.emplace_back(std::move(name), device);
+  }
+  void setTrajectories(trajectory::TrajectoryExecutor* executor) { trajectories_ = executor; }
+
+  std::string motionInForce() const override {
+    for (const auto& [name, device] : devices_) {
+      const std::string why = device->motionInForce();
+      if (!why.empty()) return name + ": " + why;
+    }
+    const std::string trajectories = trajectories_ ? trajectories_->motionInForce() : std::string();
+    return trajectories.empty() ? trajectories : "trajectories: " + trajectories;
+  }
+
+ private:
+  std::vector<std::pair<std::string, const device::Device*>> devices_;
+  trajectory::TrajectoryExecutor* trajectories_ = nullptr;
+};
+
 }  // namespace
 
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
@@ -72,35 +94,42 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
     : nh_(nh), params_(std::move(params)), diagnostics_(nh, private_nh, private_nh.getNamespace()) {
   // Each status names its own port as hardware_id; this is only the fallback.
   diagnostics_.setHardwareID(params_.port);
-
-  // Devices naming the same path share one port, one reader thread and one framer.
-  std::map<std::string, std::vector<const device::DeviceModule*>> users;
-  for (const device::DeviceModule* device : device::registeredDevices()) {
-    if (params_.enabled(*device)) users[params_.portOf(*device)].push_back(device);
-  }
   if (params_.capture) {
     capture_ = std::make_unique<WireCapture>(nh_, params_);
     diagnostics_.add("wire capture", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
       capture_->diagnose(s);
     });
   }
+  openPorts(stream_factory);
+  makeDevices();
+  connectTrajectories();
+  // The heading for odometry can be switched on at runtime: offered whenever a device measures it.
+  connectCapabilities();
+  connectEStop();
+  // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
+  // update: update() would skip a tick that fires a hair before the updater's own deadline.
+  diagnostics_period_ = diagnostics_.getPeriod();
+  // Runtime tuning: a server per group under ~ (~base, ~imu, ...), starting from params_.
+  std::vector<device::Device*> tunable;
+  for (auto& device : devices_) tunable.push_back(device.get());
+  tuning_ = std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable),
+                                            trajectory_executor_.get());
+  diagnostics_timer_ =
+      nh_.createSteadyTimer(ros::WallDuration(diagnostics_period_),
+                            [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
+}
+
+DriverNode::~DriverNode() { shutdown(); }
+
+void DriverNode::openPorts(const device::SerialLink::StreamFactory& stream_factory) {
+  // Devices naming the same path share one port, one reader thread and one framer.
+  std::map<std::string, std::vector<const device::DeviceModule*>> users;
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    if (params_.enabled(*device)) users[params_.portOf(*device)].push_back(device);
+  }
   for (const auto& [path, use] : users) {
-    device::SerialLinkOptions options;
-    options.path = path;
-    // validate() made every device on a shared port agree on the baud rate.
-    options.baud = static_cast<unsigned>(params_.baudOf(*use.front()));
-    options.reconnect_interval = params_.reconnect_interval;
-    options.framer = device::framerFor(use, params_);
-    for (const device::DeviceModule* device : use) {
-      if (!device->stale_frame_timeout) continue;
-      // The shortest any device on the port asks for.
-      const auto timeout = device->stale_frame_timeout(params_);
-      if (options.stale_frame_timeout.count() == 0 || timeout < options.stale_frame_timeout) {
-        options.stale_frame_timeout = timeout;
-      }
-    }
     Port port;
-    port.link = std::make_unique<device::SerialLink>(options, stream_factory);
+    port.link = std::make_unique<device::SerialLink>(linkOptions(path, use), stream_factory);
     port.monitor = std::make_unique<PortMonitor>(*port.link, shut_down_);
     port.link->addListener(port.monitor.get());
     port.link->setChunkObserver(capture_.get());
@@ -109,7 +138,28 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
       diagnosePort(stored, s);
     });
   }
+}
 
+device::SerialLinkOptions DriverNode::linkOptions(
+    const std::string& path, const std::vector<const device::DeviceModule*>& users) const {
+  device::SerialLinkOptions options;
+  options.path = path;
+  // validate() made every device on a shared port agree on the baud rate.
+  options.baud = static_cast<unsigned>(params_.baudOf(*users.front()));
+  options.reconnect_interval = params_.reconnect_interval;
+  options.framer = device::framerFor(users, params_);
+  for (const device::DeviceModule* device : users) {
+    if (!device->stale_frame_timeout) continue;
+    // The shortest any device on the port asks for.
+    const auto timeout = device->stale_frame_timeout(params_);
+    if (options.stale_frame_timeout.count() == 0 || timeout < options.stale_frame_timeout) {
+      options.stale_frame_timeout = timeout;
+    }
+  }
+  return options;
+}
+
+void DriverNode::makeDevices() {
   for (const device::DeviceModule* module : device::registeredDevices()) {
     if (!params_.enabled(*module)) continue;
     const RosDeviceModule* ros_side = findInterface(module->name);
@@ -118,86 +168,56 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
                            "the device has no ROS interface in this build");
     }
     devices_.push_back(ros_side->make(nh_, params_, portFor(params_.portOf(*module))));
-    // The device's status carries its registered name.
+    // The device's status carries its registered name; its own statuses theirs.
     DeviceInterface* device = devices_.back().get();
+    device_names_.emplace_back(module->name);
     diagnostics_.add(module->name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      device->diagnose(s);
+      writeStatusReport(device->status(), s);
     });
-    device->addDiagnostics(diagnostics_);
+    for (device::Device::NamedStatus& extra : device->extraStatuses()) {
+      diagnostics_.add(extra.name, [report = std::move(extra.report)](
+                                       diagnostic_updater::DiagnosticStatusWrapper& s) {
+        writeStatusReport(report(), s);
+      });
+    }
   }
-  // Connected whenever both devices run: ~base/use_imu_heading can be switched on at runtime.
-  connectImuHeading();
-  // One trajectory server for the joints of every device, so one goal may span them.
+}
+
+void DriverNode::connectTrajectories() {
+  // One executor for the joints of every device, so one goal may span them.
   std::vector<TrajectoryJoints> trajectory_joints;
   for (auto& device : devices_) {
     for (TrajectoryJoints& group : device->trajectoryJoints()) {
       if (!group.joints.empty()) trajectory_joints.push_back(std::move(group));
     }
   }
-  if (!trajectory_joints.empty()) {
-    trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, std::move(trajectory_joints));
-    for (auto& device : devices_) device->attachTrajectories(trajectory_.get());
-  }
-  connectMotionQuery();
-  connectEStop();
-  // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
-  // update: update() would skip a tick that fires a hair before the updater's own deadline.
-  diagnostics_period_ = diagnostics_.getPeriod();
-  // Runtime tuning: a server per group under ~ (~base, ~imu, ...), starting from params_.
-  std::vector<DeviceInterface*> tunable;
-  for (auto& device : devices_) tunable.push_back(device.get());
-  tuning_ =
-      std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable), trajectory_.get());
-  diagnostics_timer_ = nh_.createSteadyTimer(
-      ros::WallDuration(diagnostics_period_),
-      [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
+  if (trajectory_joints.empty()) return;
+  trajectory_executor_ = std::make_unique<trajectory::TrajectoryExecutor>(
+      std::move(trajectory_joints), params_.trajectory, trajectory::steadyNow,
+      TrajectoryServer::logWarning());
+  trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, *trajectory_executor_);
+  for (auto& device : devices_) device->attachTrajectories(*trajectory_executor_);
 }
 
-DriverNode::~DriverNode() { shutdown(); }
-
-void DriverNode::connectImuHeading() {
-  // ~base/use_imu_heading (validate() made sure the body is enabled): the body's reader thread
-  // hands each frame's IMU yaw straight to the base controller, which only stores it (see
-  // kinematics::HeadingFusion). Both interfaces live in devices_, which outlives the links'
-  // threads.
-  BaseInterface* base = nullptr;
-  BodyInterface* body = nullptr;
-  for (auto& device : devices_) {
-    if (!base) base = dynamic_cast<BaseInterface*>(device.get());
-    if (!body) body = dynamic_cast<BodyInterface*>(device.get());
+void DriverNode::connectCapabilities() {
+  // Whether the robot is held still, for a sensor's calibration: asked on that device's reader and
+  // service threads; each device answers under its own short lock. devices_ and the executor are
+  // complete here and outlive the links' threads and the devices' spinners.
+  auto motion = std::make_unique<NodeMotion>();
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
+    motion->add(device_names_[i], devices_[i].get());
   }
-  if (!base || !body) return;
-  const bool replaying = !params_.replay_bag.empty();
-  body->setImuYawListener([base, replaying](double yaw, device::Clock::time_point arrival) {
-    // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
-    base->onImuYaw(yaw, replaying ? device::Clock::now() : arrival);
-  });
-}
-
-void DriverNode::connectMotionQuery() {
-  // Whether the robot is held still, for a sensor's calibration (the body's imu/calibrate): asked
-  // on that device's reader and service threads; each device answers under its own short lock.
-  // devices_ and trajectory_ are complete here and outlive the links' threads and the devices'
-  // spinners.
-  std::vector<std::pair<std::string, const DeviceInterface*>> named;
-  auto device = devices_.begin();
-  for (const device::DeviceModule* module : device::registeredDevices()) {
-    if (params_.enabled(*module)) named.emplace_back(module->name, (device++)->get());
-  }
-  const DeviceInterface::MotionQuery query = [named, trajectory = trajectory_.get()] {
-    for (const auto& [name, interface] : named) {
-      const std::string why = interface->motionInForce();
-      if (!why.empty()) return name + ": " + why;
-    }
-    const std::string trajectories = trajectory ? trajectory->motionInForce() : std::string();
-    return trajectories.empty() ? trajectories : "trajectories: " + trajectories;
-  };
-  for (auto& each : devices_) each->setMotionQuery(query);
+  motion->setTrajectories(trajectory_executor_.get());
+  device::Capabilities capabilities;
+  capabilities.offer<device::MotionQuery>(*motion);
+  motion_query_ = std::move(motion);
+  for (auto& device : devices_) device->offerCapabilities(capabilities);
+  for (auto& device : devices_) device->useCapabilities(capabilities);
 }
 
 void DriverNode::connectEStop() {
   // The trajectories stop first, so no trajectory move follows a device's stop.
-  if (trajectory_) trajectory_->attachEStop(e_stop_);
+  if (trajectory_executor_) trajectory_executor_->attachEStop(e_stop_);
   for (auto& device : devices_) device->attachEStop(e_stop_);
   // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
   e_stop_sub_ = subscribeGuarded(nh_, input_refusals_, "e_stop", 10, &DriverNode::onEStop, this,
@@ -260,9 +280,9 @@ std::string DriverNode::startupSummary() const {
     text << ")";
     separator = ", port ";
   }
-  if (params_.base.enabled) {
-    text << "; loop " << params_.loop_rate << " Hz, battery poll "
-         << params_.base.controller.battery_poll_rate << " Hz";
+  for (const auto& device : devices_) {
+    const std::string rates = device->startupSummary();
+    if (!rates.empty()) text << "; " << rates;
   }
   text << "; diagnostics every " << diagnostics_period_ << " s";
   return text.str();

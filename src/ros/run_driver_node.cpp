@@ -47,51 +47,27 @@ DriverParams loadCheckedParams(const ros::NodeHandle& private_nh) {
   return params;
 }
 
-int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
-  // We take SIGINT ourselves: roscpp's handler would tear the node down before the zero-speed frame
-  // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
+namespace {
 
-  ros::NodeHandle nh;
-  ros::NodeHandle private_nh("~");
-  device::SerialLink::StreamFactory stream_factory;
-  DriverParams params;
-  try {
-    if (make_stream_factory) stream_factory = make_stream_factory(private_nh);
-    params = loadCheckedParams(private_nh);
-  } catch (const ParameterError& e) {
-    ROS_FATAL("%s", e.what());
-    ros::shutdown();
-    return 2;
-  }
+/// A replay is the same node on recorded ports: only the streams behind the links differ. Points
+/// `stream_factory` at the recording and paces `params` by it; throws ReplayError.
+std::unique_ptr<BagReplay> openReplay(DriverParams& params,
+                                      device::SerialLink::StreamFactory& stream_factory) {
+  auto replay = std::make_unique<BagReplay>(params);
+  stream_factory = replay->streamFactory();
+  params.replay_timeline = replay->timeline();
+  // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
+  params.reconnect_interval = 0.0;
+  ROS_INFO(
+      "replaying %s from %s at %s", replay->recording().topic.c_str(), params.replay_bag.c_str(),
+      params.replay_rate > 0 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
+                             : "full speed");
+  return replay;
+}
 
-  // A replay is the same node on recorded ports: only the streams behind the links differ.
-  std::unique_ptr<BagReplay> replay;
-  if (!params.replay_bag.empty()) {
-    try {
-      replay = std::make_unique<BagReplay>(params);
-    } catch (const ReplayError& e) {
-      ROS_FATAL("%s", e.what());
-      ros::shutdown();
-      return 1;
-    }
-    stream_factory = replay->streamFactory();
-    params.replay_timeline = replay->timeline();
-    // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
-    params.reconnect_interval = 0.0;
-    ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(),
-             params.replay_bag.c_str(),
-             params.replay_rate > 0
-                 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
-                 : "full speed");
-  }
-
-  DriverNode node(nh, private_nh, params, stream_factory);
+/// Starts `node` (and the replay's clock) and serves it until a stop is asked for or the replay
+/// ends, then shuts it down.
+void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_signals) {
   if (replay) {
     std::this_thread::sleep_for(kReplaySettle);
     replay->startClock();
@@ -113,6 +89,40 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   ROS_INFO("shutting down: stopping the wheels and the bus servos");
   node.shutdown();
   spinner.stop();
+}
+
+}  // namespace
+
+int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
+  // We take SIGINT ourselves: roscpp's handler would tear the node down before the zero-speed frame
+  // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
+
+  ros::NodeHandle nh;
+  ros::NodeHandle private_nh("~");
+  device::SerialLink::StreamFactory stream_factory;
+  DriverParams params;
+  std::unique_ptr<BagReplay> replay;
+  try {
+    if (make_stream_factory) stream_factory = make_stream_factory(private_nh);
+    params = loadCheckedParams(private_nh);
+    if (!params.replay_bag.empty()) replay = openReplay(params, stream_factory);
+  } catch (const ParameterError& e) {
+    ROS_FATAL("%s", e.what());
+    ros::shutdown();
+    return 2;
+  } catch (const ReplayError& e) {
+    ROS_FATAL("%s", e.what());
+    ros::shutdown();
+    return 1;
+  }
+  DriverNode node(nh, private_nh, params, stream_factory);
+  runUntilStopped(node, replay.get(), stop_signals);
   ros::shutdown();
   return 0;
 }

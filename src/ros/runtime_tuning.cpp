@@ -1,15 +1,14 @@
 #include "serial_robot_driver/ros/runtime_tuning.h"
 
 #include "serial_robot_driver/TrajectoryTuningConfig.h"
-#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
-#include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/ros/tuning_group_server.h"
 
 namespace serial_robot_driver::ros_layer {
 
 RuntimeTuning::RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
-                             std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory)
+                             std::vector<device::Device*> devices,
+                             trajectory::TrajectoryExecutor* trajectory)
     : in_force_(params), devices_(std::move(devices)), trajectory_(trajectory) {
   // Each enabled device starts its own groups; the trajectory group is the node's.
   for (const RosDeviceModule* module : registeredInterfaces()) {
@@ -50,7 +49,7 @@ DriverParams RuntimeTuning::apply(const std::string& group,
   }
   if (result.changes.empty()) return in_force_;
   in_force_ = result.applied;
-  for (DeviceInterface* device : devices_) device->retune(in_force_);
+  for (device::Device* device : devices_) device->retune(in_force_);
   if (trajectory_) trajectory_->retune(in_force_.trajectory);
   return in_force_;
 }

@@ -5,7 +5,6 @@
 #include <limits>
 #include <string>
 
-#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -86,8 +85,6 @@ double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& r
   return steady_now + secondsBetween(stamp, ros_now);
 }
 
-std::vector<TrajectoryJoints> DeviceInterface::trajectoryJoints() { return {}; }
-
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg) {
   trajectory::TrajectoryCommand command;
   command.joint_names = msg.joint_names;
@@ -99,9 +96,8 @@ trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTr
 }
 
 TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
-                                   std::vector<TrajectoryJoints> groups)
-    : executor_(std::move(groups), params.trajectory, trajectory::steadyNow,
-                [](const std::string& text) { ROS_WARN("%s", text.c_str()); }),
+                                   trajectory::TrajectoryExecutor& executor)
+    : executor_(executor),
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),
       action_server_(
@@ -132,6 +128,10 @@ void TrajectoryServer::shutdown() {
   timer_.stop();
   trajectory_sub_.shutdown();
   executor_.shutdown();
+}
+
+trajectory::TrajectoryExecutor::Warn TrajectoryServer::logWarning() {
+  return [](const std::string& text) { ROS_WARN("%s", text.c_str()); };
 }
 
 std::optional<double> TrajectoryServer::startOf(const ros::Time& stamp) const {

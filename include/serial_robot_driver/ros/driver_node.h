@@ -29,20 +29,23 @@
 //    tick) run on the global queue too (ros/trajectory_server.h).
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <std_msgs/Bool.h>
+
 #include <atomic>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <ros/ros.h>
-#include <std_msgs/Bool.h>
-
+#include "serial_robot_driver/device/capabilities.h"
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/device/e_stop.h"
 #include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/trajectory/executor.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -74,11 +77,19 @@ class DriverNode {
     std::unique_ptr<device::SerialLink> link;
     std::unique_ptr<PortMonitor> monitor;
   };
+  /// One SerialLink per path the enabled devices name, with its monitor and status.
+  void openPorts(const device::SerialLink::StreamFactory& stream_factory);
+  /// The options of the port at `path` shared by `users`.
+  device::SerialLinkOptions linkOptions(
+      const std::string& path, const std::vector<const device::DeviceModule*>& users) const;
   device::SerialLink& portFor(const std::string& path);
-  /// ~base/use_imu_heading: feeds the body's IMU yaw to the base's odometry.
-  void connectImuHeading();
-  /// Gives every device a way to ask whether the others hold the robot still (motionInForce()).
-  void connectMotionQuery();
+  /// The ROS side of every enabled device on its port, with its statuses.
+  void makeDevices();
+  /// One trajectory executor (and its ROS server) over every device's joints, attached to them.
+  void connectTrajectories();
+  /// Cross-device wiring by kind (device/capabilities.h): every device's offers, then its asks;
+  /// the node offers the MotionQuery over every device and the trajectories.
+  void connectCapabilities();
   /// One line for the log: ports, the devices on each, rates.
   std::string startupSummary() const;
   void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -96,11 +107,16 @@ class DriverNode {
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
   std::map<std::string, Port> ports_;
-  /// follow_joint_trajectory / joint_trajectory over every device's joints; null when none has
-  /// any. Outlives the devices, which hold a pointer to it.
+  /// The trajectories over every device's joints; null when none has any. Outlives the devices,
+  /// which hold a reference to it, and its server.
+  std::unique_ptr<trajectory::TrajectoryExecutor> trajectory_executor_;
+  /// follow_joint_trajectory / joint_trajectory for trajectory_executor_.
   std::unique_ptr<TrajectoryServer> trajectory_;
-  /// In start and shutdown order: base, body, servo bus.
+  /// The MotionQuery the devices were offered (connectCapabilities); outlives them.
+  std::unique_ptr<device::MotionQuery> motion_query_;
+  /// In start and shutdown order: the registered devices' order (cmake/devices.cmake).
   std::vector<std::unique_ptr<DeviceInterface>> devices_;
+  std::vector<std::string> device_names_;  ///< devices_' registered names
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
   /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after devices_ and

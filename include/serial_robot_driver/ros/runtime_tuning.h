@@ -22,12 +22,10 @@
 #include <utility>
 #include <vector>
 
+#include "serial_robot_driver/device/device.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
-
-class DeviceInterface;
-class TrajectoryServer;
 
 class RuntimeTuning {
  public:
@@ -36,7 +34,8 @@ class RuntimeTuning {
   /// `params` are the parameters in force; `devices` and `trajectory` get every accepted change
   /// and must outlive this object.
   RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
-                std::vector<DeviceInterface*> devices, TrajectoryServer* trajectory = nullptr);
+                std::vector<device::Device*> devices,
+                trajectory::TrajectoryExecutor* trajectory = nullptr);
   ~RuntimeTuning();
   RuntimeTuning(const RuntimeTuning&) = delete;
   RuntimeTuning& operator=(const RuntimeTuning&) = delete;
@@ -64,8 +63,8 @@ class RuntimeTuning {
   mutable std::mutex mutex_;
   DriverParams in_force_;
   bool stopped_ = false;
-  const std::vector<DeviceInterface*> devices_;
-  TrajectoryServer* const trajectory_;
+  const std::vector<device::Device*> devices_;
+  trajectory::TrajectoryExecutor* const trajectory_;
   Servers servers_;  // last: destroyed first
 };
 

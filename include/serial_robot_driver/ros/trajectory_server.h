@@ -1,7 +1,7 @@
 // follow_joint_trajectory (action) and joint_trajectory (topic) for the node's joints: messages
-// converted to and from the ROS-free trajectory::TrajectoryExecutor (trajectory/executor.h), which
-// decides everything (acceptance, sampling, tolerances, preemption, stops), and a steady timer
-// that ticks it at the loop rate.
+// converted to and from the node's ROS-free trajectory::TrajectoryExecutor (trajectory/executor.h,
+// the one the devices attach to), which decides everything (acceptance, sampling, tolerances,
+// preemption, stops), and a steady timer that ticks it at the loop rate.
 //
 // Time: the executor runs on the steady clock (trajectory::steadyNow()); a goal's header.stamp
 // (ROS time) becomes a steady start once, on receipt, so a step of the ROS or wall clock changes
@@ -17,13 +17,11 @@
 #include <sensor_msgs/JointState.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
-#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
-#include "serial_robot_driver/device/e_stop.h"
 #include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/guarded_action_server.h"
@@ -49,39 +47,20 @@ class TrajectoryServer {
   using GoalHandle = actionlib::ServerGoalHandle<Action>;
 
   /// Advertises follow_joint_trajectory and joint_trajectory in `nh`'s namespace (started by
-  /// start()).
+  /// start()) for `executor`, which outlives this object.
   TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
-                   std::vector<TrajectoryJoints> groups);
+                   trajectory::TrajectoryExecutor& executor);
   ~TrajectoryServer();
-  /// See TrajectoryExecutor::retune().
-  void retune(const TrajectoryParams& defaults) { executor_.retune(defaults); }
-  /// See TrajectoryExecutor::setStateTimeout().
-  void setStateTimeout(const std::vector<std::string>& names, double seconds) {
-    executor_.setStateTimeout(names, seconds);
-  }
+  /// The executor's warnings (a goal's stop, a late sample) for the ROS log.
+  static trajectory::TrajectoryExecutor::Warn logWarning();
 
+  /// Starts the executor, the action server, the topic and the loop timer.
   void start();
   /// Aborts every goal and stops the timer. Idempotent.
   void shutdown();
 
-  /// The measured state of some joints (names as in TrajectoryJoints; other names are ignored;
-  /// an empty velocity: unknown). Any thread.
-  void updateActual(const sensor_msgs::JointState& state) {
-    executor_.updateActual(state.name, state.position, state.velocity);
-  }
-  /// See TrajectoryExecutor::takeOver().
-  void takeOver(const std::vector<std::string>& names, const std::string& source,
-                const std::function<bool()>& write) {
-    executor_.takeOver(names, source, write);
-  }
-  /// See TrajectoryExecutor::stopAll().
-  void stopAll(const std::string& reason) { executor_.stopAll(reason); }
-  /// See TrajectoryExecutor::attachEStop() (before start()).
-  void attachEStop(device::EStop& e_stop) { executor_.attachEStop(e_stop); }
   /// The goals and messages refused for what they ask, and its callbacks' errors, by source.
   device::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
-  /// See TrajectoryExecutor::motionInForce().
-  std::string motionInForce() { return executor_.motionInForce(); }
 
  private:
   /// onGoal() guarded: an error rejects the goal (or aborts it, once accepted).
@@ -92,7 +71,7 @@ class TrajectoryServer {
   std::optional<double> startOf(const ros::Time& stamp) const;
 
   device::InputRefusals input_refusals_;  // before the callbacks that count into it
-  trajectory::TrajectoryExecutor executor_;
+  trajectory::TrajectoryExecutor& executor_;
   const double loop_period_;
   ros::NodeHandle nh_;
   GuardedActionServer<Action> action_server_;

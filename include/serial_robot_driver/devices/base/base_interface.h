@@ -5,7 +5,6 @@
 // accepted, not a measurement: the AP1 reports no encoder counts.
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
@@ -31,13 +30,16 @@ class BaseInterface : public DeviceInterface {
   void start() override { controller_.start(); }
   /// Stops the loop and writes a zero-speed frame (before the port closes).
   void shutdown() override { controller_.stop(); }
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  device::StatusReport status() override;
   /// The ~base tunables: the controller's from its next tick on, and the interface's own.
   void retune(const DriverParams& params) override;
   /// Engaged: zero speed held at once (frames keep flowing as the heartbeat), cmd_vel ignored.
   void attachEStop(device::EStop& e_stop) override;
-  /// Any thread (the body's reader): the IMU's yaw for ~base/use_imu_heading.
-  void onImuYaw(double yaw, device::Clock::time_point stamp) { controller_.onImuYaw(yaw, stamp); }
+  /// ~base/use_imu_heading: the heading another device measures (a HeadingSource, the IMU's yaw)
+  /// goes to the controller, which only stores it (kinematics::HeadingFusion).
+  void useCapabilities(const device::Capabilities& capabilities) override;
+  /// The loop and battery poll rates.
+  std::string startupSummary() const override;
   /// A cmd_vel in force or wheels still ramping down.
   std::string motionInForce() const override { return controller_.motionInForce(); }
 
@@ -51,6 +53,8 @@ class BaseInterface : public DeviceInterface {
   bool onClearEncoders(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
 
   device::SerialLink& link_;
+  const bool replaying_;          // ~replay_bag: headings arrive stamped with the recording's clock
+  const double loop_rate_;        // Hz, as started
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
   const BaseParams params_;       // as started: frames and joint names (the tunables: tuned())
   /// ~base as last tuned, swapped whole by retune() (read on the loop and diagnostics threads).

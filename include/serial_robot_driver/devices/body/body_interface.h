@@ -6,16 +6,14 @@
 // status.
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <diagnostic_updater/update_functions.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <std_srvs/Trigger.h>
 
-#include <functional>
 #include <memory>
 
+#include "serial_robot_driver/device/event_rate.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/devices/body/body_status.h"
 #include "serial_robot_driver/devices/body/gyro_bias.h"
@@ -23,7 +21,6 @@
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
-#include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -39,24 +36,32 @@ class BodyInterface : public DeviceInterface {
   /// Stops taking joint commands and calibrations (one under way is refused). Frames that still
   /// arrive before the link stops are published.
   void shutdown() override;
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// The telemetry rate, the frames' counters and the gyro calibration (logs telemetry stopping
+  /// and resuming).
+  device::StatusReport status() override;
   /// The ~imu tunables (accel_scale, gyro_scale, angle_scale) from the next telemetry frame on.
   void retune(const DriverParams& params) override;
 
   const device::BodyController& controller() const { return controller_; }
-  /// Called on the reader thread with every frame's IMU yaw (imuYaw()) and arrival time. Set it
-  /// before the link starts (~base/use_imu_heading: the base's odometry).
-  using ImuYawListener = std::function<void(double yaw, device::Clock::time_point arrival)>;
-  void setImuYawListener(ImuYawListener listener) { imu_yaw_listener_ = std::move(listener); }
+  /// Offers the IMU's yaw (imuYaw()) as a HeadingSource: its listeners are called on the reader
+  /// thread with every frame's yaw and arrival time (~base/use_imu_heading: the base's odometry).
+  void offerCapabilities(device::Capabilities& capabilities) override {
+    capabilities.offer<device::HeadingSource>(imu_heading_);
+  }
   /// The body's joints, streamed: one sync-write frame per loop tick.
   std::vector<TrajectoryJoints> trajectoryJoints() override;
-  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
+  void attachTrajectories(trajectory::TrajectoryExecutor& executor) override {
+    trajectory_ = &executor;
+  }
   /// joint_commands are refused while it holds.
   /// Engaged: the controller's motion gate is locked, so no sync-write goes out from then on,
   /// even one already waiting; joint_commands are refused and counted.
   void attachEStop(device::EStop& e_stop) override;
-  /// The gyro is calibrated only while no device moves the robot (nor the e-stop is engaged).
-  void setMotionQuery(MotionQuery query) override { motion_query_ = std::move(query); }
+  /// The gyro is calibrated only while nothing moves the robot (the node's MotionQuery) nor the
+  /// e-stop is engaged.
+  void useCapabilities(const device::Capabilities& capabilities) override {
+    motion_query_ = capabilities.find<device::MotionQuery>();
+  }
   /// A joint command written lately (BodyController::motionInForce); trajectories answer for
   /// themselves (the node asks its trajectory server).
   std::string motionInForce() const override {
@@ -77,22 +82,19 @@ class BodyInterface : public DeviceInterface {
   /// a frame is converted with one set of scales (std::atomic_load / atomic_store).
   std::shared_ptr<const ImuParams> imu_params_;
   // Set before the links start, read on the reader and calibration threads.
-  MotionQuery motion_query_;
+  const device::MotionQuery* motion_query_ = nullptr;
   device::EStop* e_stop_ = nullptr;             // the node's, set before start()
   device::GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   device::BodyController controller_;
-  // Expected telemetry rate window for the FrequencyStatus (it keeps pointers to these).
-  double min_rate_ = 1.0;
-  double max_rate_ = 1000.0;
-  diagnostic_updater::FrequencyStatus telemetry_rate_;  // ticked on the reader thread (locks)
+  device::EventRate telemetry_rate_;  // ticked on the reader thread (locks)
   ros::Publisher joint_states_pub_;
   ros::Publisher imu_pub_;
   ros::Publisher foot_pressure_pub_;
   ros::Publisher telemetry_pub_;
   ros::Subscriber joint_commands_sub_;
-  ImuYawListener imu_yaw_listener_;
-  // The node's trajectory server (its own threading comment); set before the link starts.
-  TrajectoryServer* trajectory_ = nullptr;
+  device::HeadingFeed imu_heading_;  // listeners added before the link starts
+  // The node's trajectory executor (its own threading comment); set before the link starts.
+  trajectory::TrajectoryExecutor* trajectory_ = nullptr;
   device::BodyStatus status_;  // diagnostics timer thread only
   // imu/calibrate: its own queue and one thread, as a call blocks for ~imu/calibration_time.
   ros::CallbackQueue calibration_queue_;

@@ -1,6 +1,6 @@
 // The body's diagnostic status ("body"): the link, whether telemetry flows, decode errors, the
-// joint commands and the framer's statistics. The telemetry rate itself is diagnostic_updater's
-// FrequencyStatus in the ROS layer; this report is merged into its verdict.
+// joint commands and the framer's statistics. The telemetry rate itself is a device::EventRate's
+// (device/event_rate.h); this report is merged into its verdict.
 #pragma once
 
 #include <cstdint>

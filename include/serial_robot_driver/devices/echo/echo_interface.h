@@ -19,7 +19,7 @@ class EchoInterface : public DeviceInterface {
   void start() override {}
   /// Stops taking pings.
   void shutdown() override;
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  device::StatusReport status() override;
 
  private:
   bool onPing(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);

@@ -3,9 +3,9 @@
 // queue and the poll schedule) is device::ServoBus; this class only translates.
 //
 // Threading model (the threads start in start()):
-//  - The services are served from this class's OWN callback queues, never the global one: a servo
-//    call blocks for up to timeout * (retries + 1), a scan or a reset for many of those, a call
-//    with `wait` for a whole motion, and on the global queue that would hold up cmd_vel and
+//  - The services are served from OWN callback queues (ServoBusServices), never the global one: a
+//    servo call blocks for up to timeout * (retries + 1), a scan or a reset for many of those, a
+//    call with `wait` for a whole motion, and on the global queue that would hold up cmd_vel and
 //    joint_commands.
 //  - The stop services (servo/spin, servo/relax, servo/damping, servo/hold) have a queue
 //    (StopCallQueue) and a thread of their own, so they never wait behind a long call on the
@@ -23,8 +23,6 @@
 //    waiting service call, so a service call waits for one transaction at most.
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
@@ -52,12 +50,13 @@
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_diagnostics.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_services.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_status.h"
 #include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
-#include "serial_robot_driver/devices/servo_bus/stop_call_queue.h"
+#include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
-#include "serial_robot_driver/ros/queue_spinner.h"
 #include "serial_robot_driver/ros/trajectory_bus_joints.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -89,7 +88,13 @@ class ServoBusInterface : public DeviceInterface {
   void start() override;
   /// Fails a call in progress, stops the services and joins the spinner threads. Idempotent.
   void shutdown() override;
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  device::StatusReport status() override {
+    return diagnostics_.busStatus(commands_rejected_.load());
+  }
+  /// "servo_bus servo <id>", one status per polled servo, also while ~servo_bus/health_rate is 0
+  /// (it may be tuned on): its readings against its own limits (an offline servo is an ERROR),
+  /// its identity, a WARN for each setting that does not fit.
+  std::vector<NamedStatus> extraStatuses() override;
   /// The ~servo_bus tunables: timeout and retries from the next transaction, state_rate from the
   /// next poll, command_interval_ms from the next servo_commands message.
   void retune(const DriverParams& params) override;
@@ -97,47 +102,26 @@ class ServoBusInterface : public DeviceInterface {
   std::vector<TrajectoryJoints> trajectoryJoints() override;
   /// The servos set moving (device::ServoBus::motionInForce()).
   std::string motionInForce() const override { return bus_.motionInForce(); }
-  void attachTrajectories(TrajectoryServer* server) override { trajectory_ = server; }
+  void attachTrajectories(trajectory::TrajectoryExecutor& executor) override {
+    claims_.attachTrajectories(executor);
+  }
   /// Engaged: queued moves dropped, a SPIN stop to every servo the driver set moving; motion
   /// services and servo_commands refused until it is released (reads, pings, scans still work).
   void attachEStop(device::EStop& e_stop) override;
-  /// With ~servo_bus/health_rate > 0: "servo_bus servo <id>", one status per polled servo (its
-  /// readings against its own limits; an offline servo is an ERROR; its identity, a WARN for each
-  /// setting that does not fit).
-  void addDiagnostics(diagnostic_updater::Updater& updater) override;
 
  private:
   device::ServoBusEvents makeEvents();
-  /// servo/* on nh_, the stop services on stop_nh_ (servo_bus_services.cpp).
-  void advertiseServices();
   void onServoCommands(const sensor_msgs::JointState::ConstPtr& msg);
-  /// A motion service (`source`) for servo `id`: when it is a joint under a trajectory, the
-  /// trajectory stops (its goal aborts) and its queued move is dropped.
-  void yieldJoint(uint8_t id, const char* source);
-  /// yieldJoint() for each of `ids`; empty: every configured servo (servo/relax, servo/hold).
-  void yieldJoints(const std::vector<uint8_t>& ids, const char* source);
-  /// A motion service or topic while the e-stop holds: counted, and its refusal (else ok).
-  device::ServoStatus refuseWhileEStopped(const std::string& source);
-  /// A motion service (`source`) taking servos `ids` (empty: every configured servo): refused
-  /// while the e-stop holds, else the joints among them yield (yieldJoints) and ok.
-  device::ServoStatus claimServos(const std::vector<uint8_t>& ids, const char* source);
-  void diagnoseServo(uint8_t id, diagnostic_updater::DiagnosticStatusWrapper& status);
 
   // Bus servos as joints (trajectories): fixed before the bus starts, read on the worker thread.
   const std::vector<trajectory::BusJoint> bus_joints_;
   const double state_rate_;
-  TrajectoryServer* trajectory_ = nullptr;  // set before start()
 
   device::SerialLink& link_;
   device::ServoBus bus_;
-  device::ServoBusClient& client_;  // bus_'s
-  ros::CallbackQueue queue_;
-  ros::NodeHandle nh_;  // the caller's namespace, bound to queue_
-  StopCallQueue stop_queue_;
-  ros::NodeHandle stop_nh_;  // the caller's namespace, bound to stop_queue_
-  std::vector<ros::ServiceServer> services_;
-  std::unique_ptr<QueueSpinner> spinner_;
-  std::unique_ptr<QueueSpinner> stop_spinner_;
+  device::ServoMotionClaims claims_;  // the e-stop and the trajectories, over bus_joints_
+  ServoBusServices services_;         // servo/*, on queues and threads of their own
+  bool started_ = false;
   bool shut_down_ = false;
 
   // servo_states / servo_commands
@@ -146,10 +130,9 @@ class ServoBusInterface : public DeviceInterface {
   ros::Subscriber commands_sub_;
   std::atomic<uint16_t> command_interval_ms_;  // retune() from the dynamic_reconfigure callback
   std::atomic<uint64_t> commands_rejected_{0};
-  device::EStop* e_stop_ = nullptr;  // the node's, set before start()
 
   // servo_states asked vs achieved, between two diagnostics updates (the diagnostics thread only).
-  device::ServoBusStatus status_;
+  device::ServoBusDiagnostics diagnostics_;
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/devices/base/base_status.h"
@@ -93,6 +94,8 @@ device::BaseEvents BaseInterface::events() {
 BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)
     : link_(link),
+      replaying_(!params.replay_bag.empty()),
+      loop_rate_(params.loop_rate),
       arrival_stamps_(params),
       params_(params.base),
       tuned_(std::make_shared<const BaseParams>(params.base)),
@@ -228,12 +231,27 @@ bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigg
   return true;
 }
 
-void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+device::StatusReport BaseInterface::status() {
   const std::shared_ptr<const BaseParams> limits = tuned();
-  writeStatusReport(
-      device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
-                         {limits->battery_warn_percent, limits->battery_error_percent}),
-      status);
+  return device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
+                            {limits->battery_warn_percent, limits->battery_error_percent});
+}
+
+void BaseInterface::useCapabilities(const device::Capabilities& capabilities) {
+  // Connected whenever a heading is measured: ~base/use_imu_heading can be switched on at runtime.
+  device::HeadingSource* heading = capabilities.find<device::HeadingSource>();
+  if (!heading) return;
+  heading->addHeadingListener([this](double yaw, device::Clock::time_point arrival) {
+    // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
+    controller_.onImuYaw(yaw, replaying_ ? device::Clock::now() : arrival);
+  });
+}
+
+std::string BaseInterface::startupSummary() const {
+  std::ostringstream text;
+  text << "loop " << loop_rate_ << " Hz, battery poll " << params_.controller.battery_poll_rate
+       << " Hz";
+  return text.str();
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -32,8 +32,8 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
           {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
             publishTelemetry(telemetry, arrival);
           }}),
-      telemetry_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_),
-                      "telemetry rate"),
+      // Expected telemetry rates; measured on ROS time, as diagnostic_updater's FrequencyStatus.
+      telemetry_rate_(1.0, 1000.0, [] { return ros::Time::now().toSec(); }),
       calibration_nh_(nh) {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
   joint_states_pub_ =
@@ -70,7 +70,7 @@ void BodyInterface::start() {
 
 std::string BodyInterface::notStill() const {
   if (e_stop_ && e_stop_->engaged()) return "the e-stop is engaged";
-  return motion_query_ ? motion_query_() : std::string();
+  return motion_query_ ? motion_query_->motionInForce() : std::string();
 }
 
 bool BodyInterface::onCalibrate(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -123,14 +123,16 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   // The trajectory server needs every frame: its goals are checked against it.
   const auto joint_state =
       boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
-  if (trajectory_) trajectory_->updateActual(*joint_state);
+  if (trajectory_) {
+    trajectory_->updateActual(joint_state->name, joint_state->position, joint_state->velocity);
+  }
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
   // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
     joint_states_pub_.publish(joint_state);
   }
   const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
-  if (imu_yaw_listener_) imu_yaw_listener_(imuYaw(telemetry, *imu), arrival);
+  if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);
   // Every frame feeds the calibration, subscribers or not (calibrate_on_start, imu/calibrate).
   namespace body = protocol::body;
   const device::GyroVector gyro_bias =
@@ -175,12 +177,14 @@ void BodyInterface::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg)
   }
 }
 
-void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  telemetry_rate_.run(status);  // OK / WARN from the telemetry rate, plus its own keys
+device::StatusReport BodyInterface::status() {
+  // As diagnostic_updater starts every status: it stands while the rate's window has no length.
+  device::StatusReport report;
+  report.summary(device::StatusLevel::kError, "No message was set");
+  telemetry_rate_.addTo(report);  // OK / WARN from the telemetry rate, plus its own keys
   device::BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
                                                      {link_.options().path, link_.connected()});
   gyro_calibrator_.report(update.report, gyroUnits(*std::atomic_load(&imu_params_)));
-  writeStatusReport(update.report, status, SummaryWrite::kMerge);
   // Once per outage, not once per period.
   if (update.flow == device::BodyStatus::FlowChange::kStopped) {
     ROS_WARN(
@@ -190,6 +194,10 @@ void BodyInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   } else if (update.flow == device::BodyStatus::FlowChange::kResumed) {
     ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
   }
+  report.mergeSummary(update.report.level, update.report.message);
+  if (!update.report.hardware_id.empty()) report.hardware_id = update.report.hardware_id;
+  for (auto& value : update.report.values) report.values.push_back(std::move(value));
+  return report;
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -4,7 +4,6 @@
 
 #include "serial_robot_driver/devices/echo/echo_params.h"
 #include "serial_robot_driver/devices/echo/echo_status.h"
-#include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -36,9 +35,8 @@ bool EchoInterface::onPing(std_srvs::Trigger::Request&, std_srvs::Trigger::Respo
   return true;
 }
 
-void EchoInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  writeStatusReport(
-      device::echoStatus(controller_.stats(), {link_.options().path, link_.connected()}), status);
+device::StatusReport EchoInterface::status() {
+  return device::echoStatus(controller_.stats(), {link_.options().path, link_.connected()});
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -12,8 +12,6 @@ namespace serial_robot_driver::ros_layer {
 
 namespace {
 
-constexpr int kSpinnerThreads = 2;
-constexpr int kStopSpinnerThreads = 1;
 constexpr double kMsPerSecond = 1000.0;
 constexpr double kWarnThrottleS = 5.0;
 
@@ -53,7 +51,9 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
     const sensor_msgs::JointState msg =
         busJointState(bus_joints_, sample.id, sample.angle_deg, toRosTime(sample.arrival));
     states_pub_.publish(msg);
-    if (trajectory_) trajectory_->updateActual(msg);
+    if (trajectory::TrajectoryExecutor* trajectories = claims_.trajectories()) {
+      trajectories->updateActual(msg.name, msg.position, msg.velocity);
+    }
   };
   events.on_servo_silent = [](uint8_t id, const device::ServoStatus& status,
                               std::chrono::milliseconds backoff) {
@@ -105,23 +105,14 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
       state_rate_(params.servo_bus.bus.poll_rate),
       link_(link),
       bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
-      client_(bus_.client()),
-      nh_(nh),
-      stop_queue_([this] { client_.stopCallQueued(); }),
-      stop_nh_(nh),
+      claims_(bus_, bus_joints_),
+      services_(nh, bus_, claims_, inputRefusals()),
       topics_nh_(nh),
-      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)) {
+      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)),
+      diagnostics_(bus_, link) {
   // The bus's worker (the poll, the queued moves) runs on the port's reader thread: a poll writes
   // its request and reads the answer itself, with no second thread to wake per transaction.
   bus_.runOn(link_);
-
-  // Own queues: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion
-  // with wait = true) and must never hold up cmd_vel or joint_commands on the global queue; a stop
-  // must never wait behind such a call (see the threading model in the header).
-  nh_.setCallbackQueue(&queue_);
-  stop_nh_.setCallbackQueue(&stop_queue_);
-  client_.setStopCallsQueued([this] { return stop_queue_.waiting(); });
-  advertiseServices();
 
   if (params.servo_bus.bus.client.allow_dangerous_writes) {
     ROS_WARN(
@@ -138,16 +129,11 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
 void ServoBusInterface::retune(const DriverParams& params) {
   bus_.retune(makeServoBusConfig(params));
   command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
-  // The joints' measurements come as often as the poll: their freshness limit follows it.
-  if (trajectory_ && !bus_joints_.empty()) {
-    std::vector<std::string> names;
-    for (const trajectory::BusJoint& joint : bus_joints_) names.push_back(joint.name);
-    trajectory_->setStateTimeout(names, busStateTimeout(params.servo_bus.bus.poll_rate));
-  }
+  claims_.followPollRate(params.servo_bus.bus.poll_rate);
 }
 
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {
-  if (!refuseWhileEStopped("servo_commands").ok()) {
+  if (!claims_.refuseWhileEStopped("servo_commands").ok()) {
     ROS_WARN_THROTTLE(kWarnThrottleS, "servo_commands refused, nothing sent: e_stop is engaged");
     return;
   }
@@ -160,38 +146,11 @@ void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr&
     return;
   }
   // A joint servo under a trajectory is taken over by this command, and its goal aborted.
-  std::vector<std::string> joints;
-  for (const device::MoveRequest& move : batch.moves) {
-    if (const trajectory::BusJoint* joint = findBusJoint(bus_joints_, move.id)) {
-      joints.push_back(joint->name);
-    }
-  }
-  const auto queue = [&] {
-    bus_.queueMoves(batch.moves);
-    return true;
-  };
-  if (trajectory_ && !joints.empty()) {
-    trajectory_->takeOver(joints, "servo_commands", queue);
-  } else {
-    queue();
-  }
-}
-
-device::ServoStatus ServoBusInterface::refuseWhileEStopped(const std::string& source) {
-  if (!e_stop_ || !e_stop_->refuse(source)) return {};
-  return {device::ServoError::kMotionRefused,
-          "e_stop is engaged: no servo moves until it is released (publish false on e_stop)"};
-}
-
-device::ServoStatus ServoBusInterface::claimServos(const std::vector<uint8_t>& ids,
-                                                   const char* source) {
-  device::ServoStatus refused = refuseWhileEStopped(source);
-  if (refused.ok()) yieldJoints(ids, source);
-  return refused;
+  claims_.queueCommand(batch.moves, "servo_commands");
 }
 
 void ServoBusInterface::attachEStop(device::EStop& e_stop) {
-  e_stop_ = &e_stop;
+  claims_.attachEStop(e_stop);
   // On the e_stop subscriber's thread: the SPIN stops take the bus as a caller, ahead of the poll.
   // On the e_stop subscriber's thread, and it never waits for the bus: the gate is locked (no
   // motion frame from now on) and the stops are handed to the bus's worker, which writes them
@@ -208,18 +167,13 @@ void ServoBusInterface::attachEStop(device::EStop& e_stop) {
   });
 }
 
-void ServoBusInterface::yieldJoints(const std::vector<uint8_t>& ids, const char* source) {
-  for (uint8_t id : ids.empty() ? bus_.config().polled_ids : ids) yieldJoint(id, source);
-}
-
-void ServoBusInterface::yieldJoint(uint8_t id, const char* source) {
-  const trajectory::BusJoint* joint = findBusJoint(bus_joints_, id);
-  if (!trajectory_ || !joint) return;
-  trajectory_->takeOver({joint->name}, source, [&] {
-    // A trajectory move still queued must not follow the service's command.
-    bus_.dropQueuedMoves(id);
-    return true;
-  });
+std::vector<device::Device::NamedStatus> ServoBusInterface::extraStatuses() {
+  std::vector<NamedStatus> statuses;
+  for (uint8_t id : bus_.config().polled_ids) {
+    statuses.push_back({"servo_bus servo " + std::to_string(id),
+                        [this, id] { return diagnostics_.servoStatus(id); }});
+  }
+  return statuses;
 }
 
 std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
@@ -241,14 +195,9 @@ std::vector<TrajectoryJoints> ServoBusInterface::trajectoryJoints() {
 }
 
 void ServoBusInterface::start() {
-  if (spinner_ || shut_down_) return;
-  // The stop services' thread first: from the first call on, a stop never waits behind another.
-  stop_spinner_ = std::make_unique<QueueSpinner>(&stop_queue_, kStopSpinnerThreads);
-  stop_spinner_->start();
-  // Two threads: one call waits on the bus while another is accepted and queued behind the bus
-  // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
-  spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
-  spinner_->start();
+  if (started_ || shut_down_) return;
+  started_ = true;
+  services_.start();
   bus_.start();
 }
 
@@ -258,10 +207,8 @@ void ServoBusInterface::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   commands_sub_.shutdown();
-  bus_.shutdown();  // fails a call waiting on the bus, so the spinner can stop quickly
-  for (ros::ServiceServer& service : services_) service.shutdown();
-  if (spinner_) spinner_->stop();
-  if (stop_spinner_) stop_spinner_->stop();
+  bus_.shutdown();  // fails a call waiting on the bus, so the spinners can stop quickly
+  services_.shutdown();
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -1,7 +1,5 @@
-// The servo/* services: each one a client or bus call behind the same outcome handling (logged,
-// never thrown through, the message always returned). Served from ServoBusInterface's own queues:
-// the stop services (servo/spin, servo/relax, servo/damping, servo/hold) from the stop queue
-// (stop_nh_), whose bus turns are urgent work, every other from the second one (nh_).
+#include "serial_robot_driver/devices/servo_bus/servo_bus_services.h"
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -12,6 +10,9 @@
 namespace serial_robot_driver::ros_layer {
 
 namespace {
+
+constexpr int kSpinnerThreads = 2;
+constexpr int kStopSpinnerThreads = 1;
 
 void logOutcome(const std::string& service, const device::ServoStatus& status) {
   if (status.ok()) {
@@ -84,153 +85,219 @@ ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name
       name, guardedService<Request, Response>(refusals, name, serve));
 }
 
+device::ServoStatus readAngle(device::ServoBusClient& client, const ServoReadAngle::Request& req,
+                              ServoReadAngle::Response& res) {
+  res.angle_deg = 0.0;
+  res.turns = 0;
+  if (req.multi_turn) {
+    device::MultiTurnReading reading;
+    const device::ServoStatus status = client.readMultiTurnAngle(req.id, &reading);
+    if (status.ok()) {
+      res.angle_deg = reading.angle_deg;
+      res.turns = reading.turns;
+    }
+    return status;
+  }
+  double angle_deg = 0.0;
+  const device::ServoStatus status = client.readAngle(req.id, &angle_deg);
+  if (status.ok()) res.angle_deg = angle_deg;
+  return status;
+}
+
+device::ServoStatus readAll(device::ServoBusClient& client, const ServoReadAll::Request& req,
+                            ServoReadAll::Response& res) {
+  std::vector<device::ServoParamValue> values;
+  const device::ServoStatus status = client.readAll(req.id, &values);
+  res.names.clear();
+  res.values.clear();
+  for (const device::ServoParamValue& value : values) {
+    res.names.push_back(value.name);
+    res.values.push_back(value.value);
+  }
+  return status;
+}
+
+device::ServoStatus readInfo(device::ServoBusClient& client,
+                             const device::ServoIdentityChecks& expected,
+                             const ServoInfo::Request& req, ServoInfo::Response& res) {
+  device::ServoIdentity identity;
+  const device::ServoStatus status = device::readServoInfo(client, req.id, expected, &identity);
+  res.servo_type = identity.servo_type;
+  res.firmware_version = identity.firmware_version;
+  res.serial_number = identity.serial_number;
+  res.response_switch = identity.response_switch;
+  return status;
+}
+
+device::MoveRequest toMoveRequest(const ServoMove::Request& req) {
+  device::MoveRequest request;
+  request.id = req.id;
+  request.angle_deg = req.angle_deg;
+  request.multi_turn = req.multi_turn;
+  request.interval_ms = req.interval_ms;
+  request.velocity_dps = req.velocity_dps;
+  request.accel_ms = req.accel_ms;
+  request.decel_ms = req.decel_ms;
+  request.power_mw = req.power_mw;
+  return request;
+}
+
+device::SpinRequest toSpinRequest(const ServoSpin::Request& req) {
+  device::SpinRequest request;
+  request.id = req.id;
+  request.clockwise = req.clockwise;
+  request.mode = req.mode;
+  request.speed_dps = req.speed_dps;
+  request.value = req.value;
+  request.wait = req.wait;
+  // Served with the stops: it must never wait behind a long call.
+  request.priority = device::BusPriority::kStop;
+  return request;
+}
+
 }  // namespace
 
-void ServoBusInterface::advertiseServices() {
-  const ServoServiceSite site{nh_, inputRefusals()};
-  const ServoServiceSite stop_site{stop_nh_, inputRefusals()};
-  services_ = {
-      advertiseServo<ServoPing>(
-          site, "servo/ping",
-          [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }),
-      advertiseServo<ServoRead>(site, "servo/read",
-                                [this](ServoRead::Request& req, ServoRead::Response& res) {
-                                  device::ServoParamValue value;
-                                  const device::ServoStatus status =
-                                      client_.readParam(req.id, req.param, &value);
-                                  if (status.ok()) {
-                                    res.value = value.value;
-                                    res.unit = value.unit;
-                                  }
-                                  return status;
-                                }),
-      advertiseServo<ServoWrite>(
-          site, "servo/write",
-          [this](ServoWrite::Request& req, ServoWrite::Response&) {
-            return bus_.writeParam(req.id, req.param, req.value);
-          },
-          Announce::kInfo),
-      advertiseServo<ServoReadAngle>(
-          site, "servo/read_angle",
-          [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
-            res.angle_deg = 0.0;
-            res.turns = 0;
-            if (req.multi_turn) {
-              device::MultiTurnReading reading;
-              const device::ServoStatus status = client_.readMultiTurnAngle(req.id, &reading);
-              if (status.ok()) {
-                res.angle_deg = reading.angle_deg;
-                res.turns = reading.turns;
-              }
-              return status;
-            }
-            double angle_deg = 0.0;
-            const device::ServoStatus status = client_.readAngle(req.id, &angle_deg);
-            if (status.ok()) res.angle_deg = angle_deg;
-            return status;
-          }),
-      advertiseServo<ServoMove>(site, "servo/move",
-                                [this](ServoMove::Request& req, ServoMove::Response&) {
-                                  device::MoveRequest request;
-                                  request.id = req.id;
-                                  request.angle_deg = req.angle_deg;
-                                  request.multi_turn = req.multi_turn;
-                                  request.interval_ms = req.interval_ms;
-                                  request.velocity_dps = req.velocity_dps;
-                                  request.accel_ms = req.accel_ms;
-                                  request.decel_ms = req.decel_ms;
-                                  request.power_mw = req.power_mw;
-                                  const device::ServoStatus claimed =
-                                      claimServos({req.id}, "servo/move");
-                                  if (!claimed.ok()) return claimed;
-                                  return bus_.move(request);
-                                }),
-      advertiseServo<ServoScan>(site, "servo/scan",
-                                [this](ServoScan::Request& req, ServoScan::Response& res) {
-                                  return client_.scan(req.first_id, req.last_id, &res.ids);
-                                }),
-      advertiseServo<ServoRotate>(site, "servo/rotate",
-                                  [this](ServoRotate::Request& req, ServoRotate::Response&) {
-                                    device::RotateRequest request;
-                                    request.id = req.id;
-                                    request.angle_deg = req.angle_deg;
-                                    request.interval_ms = req.interval_ms;
-                                    request.power_mw = req.power_mw;
-                                    request.wait = req.wait;
-                                    const device::ServoStatus claimed =
-                                        claimServos({req.id}, "servo/rotate");
-                                    if (!claimed.ok()) return claimed;
-                                    return bus_.rotate(request);
-                                  }),
-      advertiseServo<ServoSpin>(stop_site, "servo/spin",
-                                [this](ServoSpin::Request& req, ServoSpin::Response&) {
-                                  device::SpinRequest request;
-                                  request.id = req.id;
-                                  request.clockwise = req.clockwise;
-                                  request.mode = req.mode;
-                                  request.speed_dps = req.speed_dps;
-                                  request.value = req.value;
-                                  request.wait = req.wait;
-                                  // Served with the stops: it must never wait behind a long call.
-                                  request.priority = device::BusPriority::kStop;
-                                  // A SPIN stop is no motion: it works while the e-stop holds.
-                                  if (req.mode != 0) {
-                                    device::ServoStatus refused = refuseWhileEStopped("servo/spin");
-                                    if (!refused.ok()) return refused;
-                                  }
-                                  yieldJoint(req.id, "servo/spin");
-                                  return bus_.spin(request);
-                                }),
-      // Torque off moves nothing actively: allowed while the e-stop holds (motion_safety.h).
-      advertiseServo<ServoDamping>(stop_site, "servo/damping",
-                                   [this](ServoDamping::Request& req, ServoDamping::Response&) {
-                                     yieldJoint(req.id, "servo/damping");
-                                     return bus_.damping(req.id, req.power_mw, req.wait);
-                                   }),
-      advertiseServo<ServoRelax>(stop_site, "servo/relax",
-                                 [this](ServoRelax::Request& req, ServoRelax::Response&) {
-                                   yieldJoints(req.ids, "servo/relax");
-                                   return bus_.relax(req.ids);
-                                 }),
-      advertiseServo<ServoHold>(stop_site, "servo/hold",
-                                [this](ServoHold::Request& req, ServoHold::Response&) {
-                                  const device::ServoStatus claimed =
-                                      claimServos(req.ids, "servo/hold");
-                                  if (!claimed.ok()) return claimed;
-                                  return bus_.hold(req.ids);
-                                }),
-      advertiseServo<ServoReadAll>(site, "servo/read_all",
-                                   [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
-                                     std::vector<device::ServoParamValue> values;
-                                     const device::ServoStatus status =
-                                         client_.readAll(req.id, &values);
-                                     res.names.clear();
-                                     res.values.clear();
-                                     for (const device::ServoParamValue& value : values) {
-                                       res.names.push_back(value.name);
-                                       res.values.push_back(value.value);
-                                     }
-                                     return status;
-                                   }),
-      // Reads only: allowed while the e-stop holds.
-      advertiseServo<ServoInfo>(site, "servo/info",
-                                [this](ServoInfo::Request& req, ServoInfo::Response& res) {
-                                  device::ServoIdentity identity;
-                                  const device::ServoStatus status = device::readServoInfo(
-                                      client_, req.id, bus_.config().identity, &identity);
-                                  res.servo_type = identity.servo_type;
-                                  res.firmware_version = identity.firmware_version;
-                                  res.serial_number = identity.serial_number;
-                                  res.response_switch = identity.response_switch;
-                                  return status;
-                                }),
-      advertiseServo<ServoResetUserData>(
-          site, "servo/reset_user_data",
-          [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
-            return bus_.resetUserData(req.id);
-          },
-          Announce::kInfo),
-  };
+ServoBusServices::ServoBusServices(ros::NodeHandle& nh, device::ServoBus& bus,
+                                   device::ServoMotionClaims& claims,
+                                   device::InputRefusals& refusals)
+    : bus_(bus),
+      client_(bus.client()),
+      claims_(claims),
+      refusals_(refusals),
+      nh_(nh),
+      stop_queue_([this] { client_.stopCallQueued(); }),
+      stop_nh_(nh) {
+  // Own queues: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion
+  // with wait = true) and must never hold up cmd_vel or joint_commands on the global queue; a stop
+  // must never wait behind such a call (see the threading model in servo_bus_interface.h).
+  nh_.setCallbackQueue(&queue_);
+  stop_nh_.setCallbackQueue(&stop_queue_);
+  client_.setStopCallsQueued([this] { return stop_queue_.waiting(); });
+  advertiseReads();
+  advertiseWrites();
+  advertiseMoves();
+  advertiseStops();
+}
+
+ServoBusServices::~ServoBusServices() { shutdown(); }
+
+void ServoBusServices::start() {
+  if (spinner_ || shut_down_) return;
+  // The stop services' thread first: from the first call on, a stop never waits behind another.
+  stop_spinner_ = std::make_unique<QueueSpinner>(&stop_queue_, kStopSpinnerThreads);
+  stop_spinner_->start();
+  // Two threads: one call waits on the bus while another is accepted and queued behind the bus
+  // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
+  spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
+  spinner_->start();
+}
+
+void ServoBusServices::shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  for (ros::ServiceServer& service : services_) service.shutdown();
+  if (spinner_) spinner_->stop();
+  if (stop_spinner_) stop_spinner_->stop();
+}
+
+void ServoBusServices::advertiseReads() {
+  const ServoServiceSite site{nh_, refusals_};
+  services_.push_back(advertiseServo<ServoPing>(
+      site, "servo/ping",
+      [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }));
+  services_.push_back(advertiseServo<ServoRead>(
+      site, "servo/read", [this](ServoRead::Request& req, ServoRead::Response& res) {
+        device::ServoParamValue value;
+        const device::ServoStatus status = client_.readParam(req.id, req.param, &value);
+        if (status.ok()) {
+          res.value = value.value;
+          res.unit = value.unit;
+        }
+        return status;
+      }));
+  services_.push_back(advertiseServo<ServoReadAngle>(
+      site, "servo/read_angle",
+      [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
+        return readAngle(client_, req, res);
+      }));
+  services_.push_back(advertiseServo<ServoScan>(
+      site, "servo/scan", [this](ServoScan::Request& req, ServoScan::Response& res) {
+        return client_.scan(req.first_id, req.last_id, &res.ids);
+      }));
+  services_.push_back(advertiseServo<ServoReadAll>(
+      site, "servo/read_all", [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
+        return readAll(client_, req, res);
+      }));
+  services_.push_back(advertiseServo<ServoInfo>(
+      site, "servo/info", [this](ServoInfo::Request& req, ServoInfo::Response& res) {
+        return readInfo(client_, bus_.config().identity, req, res);
+      }));
+}
+
+void ServoBusServices::advertiseWrites() {
+  const ServoServiceSite site{nh_, refusals_};
+  services_.push_back(advertiseServo<ServoWrite>(
+      site, "servo/write",
+      [this](ServoWrite::Request& req, ServoWrite::Response&) {
+        return bus_.writeParam(req.id, req.param, req.value);
+      },
+      Announce::kInfo));
+  services_.push_back(advertiseServo<ServoResetUserData>(
+      site, "servo/reset_user_data",
+      [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
+        return bus_.resetUserData(req.id);
+      },
+      Announce::kInfo));
+}
+
+void ServoBusServices::advertiseMoves() {
+  const ServoServiceSite site{nh_, refusals_};
+  services_.push_back(advertiseServo<ServoMove>(
+      site, "servo/move", [this](ServoMove::Request& req, ServoMove::Response&) {
+        const device::ServoStatus claimed = claims_.claimServos({req.id}, "servo/move");
+        return claimed.ok() ? bus_.move(toMoveRequest(req)) : claimed;
+      }));
+  services_.push_back(advertiseServo<ServoRotate>(
+      site, "servo/rotate", [this](ServoRotate::Request& req, ServoRotate::Response&) {
+        device::RotateRequest request;
+        request.id = req.id;
+        request.angle_deg = req.angle_deg;
+        request.interval_ms = req.interval_ms;
+        request.power_mw = req.power_mw;
+        request.wait = req.wait;
+        const device::ServoStatus claimed = claims_.claimServos({req.id}, "servo/rotate");
+        return claimed.ok() ? bus_.rotate(request) : claimed;
+      }));
+}
+
+void ServoBusServices::advertiseStops() {
+  const ServoServiceSite site{stop_nh_, refusals_};
+  services_.push_back(advertiseServo<ServoSpin>(
+      site, "servo/spin", [this](ServoSpin::Request& req, ServoSpin::Response&) {
+        // A SPIN stop is no motion: it works while the e-stop holds.
+        if (req.mode != 0) {
+          device::ServoStatus refused = claims_.refuseWhileEStopped("servo/spin");
+          if (!refused.ok()) return refused;
+        }
+        claims_.yieldJoint(req.id, "servo/spin");
+        return bus_.spin(toSpinRequest(req));
+      }));
+  // Torque off moves nothing actively: allowed while the e-stop holds (motion_safety.h).
+  services_.push_back(advertiseServo<ServoDamping>(
+      site, "servo/damping", [this](ServoDamping::Request& req, ServoDamping::Response&) {
+        claims_.yieldJoint(req.id, "servo/damping");
+        return bus_.damping(req.id, req.power_mw, req.wait);
+      }));
+  services_.push_back(advertiseServo<ServoRelax>(
+      site, "servo/relax", [this](ServoRelax::Request& req, ServoRelax::Response&) {
+        claims_.yieldJoints(req.ids, "servo/relax");
+        return bus_.relax(req.ids);
+      }));
+  services_.push_back(advertiseServo<ServoHold>(
+      site, "servo/hold", [this](ServoHold::Request& req, ServoHold::Response&) {
+        const device::ServoStatus claimed = claims_.claimServos(req.ids, "servo/hold");
+        return claimed.ok() ? bus_.hold(req.ids) : claimed;
+      }));
 }
 
 }  // namespace serial_robot_driver::ros_layer
