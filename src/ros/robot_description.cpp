@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "serial_robot_driver/ros/conversions.h"
-#include "serial_robot_driver/ros/trajectory_bus_joints.h"
+#include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 

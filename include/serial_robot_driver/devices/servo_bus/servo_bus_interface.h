@@ -58,7 +58,7 @@
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
-#include "serial_robot_driver/ros/trajectory_bus_joints.h"
+#include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 

@@ -8,7 +8,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
-#include "serial_robot_driver/trajectory/joint_groups.h"
+#include "serial_robot_driver/devices/body/body_trajectory_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 
