@@ -9,6 +9,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 #include "serial_robot_driver/devices/body/body_trajectory_joints.h"
+#include "serial_robot_driver/devices/body/ros/body_conversions.h"
 
 namespace serial_robot_driver::ros_layer {
 
