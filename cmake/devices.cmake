@@ -60,3 +60,13 @@ function(srd_device_sources layer out)
   endforeach()
   set(${out} ${sources} PARENT_SCOPE)
 endfunction()
+
+# Includes each device's own CMake fragment, src/devices/<name>/<name>.cmake, when it has one: the
+# executables and install rules that belong to that device alone (the base's calibrate_base).
+macro(srd_include_device_cmake)
+  foreach(device ${SRD_DEVICES})
+    if(EXISTS "${SRD_ROOT}/src/devices/${device}/${device}.cmake")
+      include("${SRD_ROOT}/src/devices/${device}/${device}.cmake")
+    endif()
+  endforeach()
+endmacro()

@@ -5,10 +5,10 @@
 namespace serial_robot_driver::ros_layer {
 
 bool runGuarded(device::InputRefusals& counters, const std::string& source,
-                const std::function<void()>& body, std::string* error) {
+                const std::function<void()>& callback, std::string* error) {
   std::string what;
   try {
-    body();
+    callback();
     return true;
   } catch (const std::exception& e) {
     what = e.what();

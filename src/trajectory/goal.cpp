@@ -81,9 +81,9 @@ std::string leftAloneText(const std::vector<std::string>& names) {
          "position to hold";
 }
 
-std::string withLeftAlone(const std::string& base, const std::string& left_alone) {
-  if (left_alone.empty()) return base;
-  return base.empty() ? left_alone : base + "; " + left_alone;
+std::string withLeftAlone(const std::string& message, const std::string& left_alone) {
+  if (left_alone.empty()) return message;
+  return message.empty() ? left_alone : message + "; " + left_alone;
 }
 
 }  // namespace serial_robot_driver::trajectory

@@ -256,14 +256,14 @@ std::optional<long> readLockFilePid(const std::string& path) {
 
 std::optional<PortHolder> findPortHolder(const std::string& device_path) {
   // 1. A UUCP lock file (minicom, screen and ModemManager's neighbours write these).
-  const std::string base = device_path.substr(device_path.find_last_of('/') + 1);
+  const std::string name = device_path.substr(device_path.find_last_of('/') + 1);
   char resolved[PATH_MAX];
-  const std::string real_base =
+  const std::string real_name =
       ::realpath(device_path.c_str(), resolved)
           ? std::string(resolved).substr(std::string(resolved).find_last_of('/') + 1)
-          : base;
+          : name;
   for (const char* dir : {"/run/lock", "/var/lock"}) {
-    const std::string lock_file = std::string(dir) + "/LCK.." + real_base;
+    const std::string lock_file = std::string(dir) + "/LCK.." + real_name;
     const std::optional<long> pid = readLockFilePid(lock_file);
     if (pid && *pid != ::getpid() && processExists(*pid)) return PortHolder{*pid, lock_file};
   }

@@ -1,11 +1,13 @@
 // Conversions from the decoded telemetry to ROS messages (and JointState back to a command). Pure
-// functions: no roscore needed.
+// functions: no roscore needed. The values behind them (joint radians, the IMU in the robot's axes,
+// its heading) are tested in the core: src/devices/body/test/test_body_readings.cpp.
 #include <gtest/gtest.h>
 
-#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 
+#include "serial_robot_driver/devices/base/ros/base_conversions.h"
+#include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -64,67 +66,6 @@ TEST(ConversionsTime, FutureArrivalIsNowAndOldArrivalSaturatesAtZero) {
             ros::Time(10, 0));
   EXPECT_EQ(toRosTime(steady_now - std::chrono::seconds(20), ros::Time(10, 0), steady_now),
             ros::Time(0));
-}
-
-// --- parameters ----------------------------------------------------------------------------------
-
-TEST(ConversionsJoints, BodyParamsBecomeJointsInServoIdOrder) {
-  BodyParams params;
-  params.servo_ids = {7, 4};
-  params.joint_names = {"a", "b"};
-  params.zero_ticks = {100, 200};
-  params.directions = {-1, 1};
-  params.calibration.ticks_per_revolution = 1024;
-  params.calibration.velocity_scale = 0.5;
-  const std::vector<device::BodyJoint> j = makeBodyJoints(params);
-  ASSERT_EQ(j.size(), 2u);
-  EXPECT_EQ(j[0].name, "a");
-  EXPECT_EQ(j[0].servo_id, 7);
-  EXPECT_EQ(j[0].calibration.zero_ticks, 100);
-  EXPECT_EQ(j[0].calibration.direction, -1);
-  EXPECT_EQ(j[1].name, "b");
-  EXPECT_EQ(j[1].servo_id, 4);
-  EXPECT_EQ(j[1].calibration.zero_ticks, 200);
-  EXPECT_EQ(j[1].calibration.direction, 1);
-  EXPECT_EQ(j[1].calibration.ticks_per_revolution, 1024);
-  EXPECT_EQ(j[1].calibration.velocity_scale, 0.5);
-}
-
-// --- quaternion ----------------------------------------------------------------------------------
-
-TEST(ConversionsQuaternion, Identity) {
-  expectQuaternion(quaternionFromRollPitchYaw(0, 0, 0), 0, 0, 0, 1);
-}
-
-TEST(ConversionsQuaternion, YawOnly) {
-  expectQuaternion(quaternionFromRollPitchYaw(0, 0, M_PI / 2), 0, 0, kHalfSqrt2, kHalfSqrt2);
-  expectQuaternion(quaternionFromRollPitchYaw(0, 0, -M_PI / 2), 0, 0, -kHalfSqrt2, kHalfSqrt2);
-}
-
-TEST(ConversionsQuaternion, RollOnlyAndPitchOnly) {
-  expectQuaternion(quaternionFromRollPitchYaw(M_PI / 2, 0, 0), kHalfSqrt2, 0, 0, kHalfSqrt2);
-  expectQuaternion(quaternionFromRollPitchYaw(0, M_PI / 2, 0), 0, kHalfSqrt2, 0, kHalfSqrt2);
-}
-
-TEST(ConversionsQuaternion, CombinedAnglesAreYawThenPitchThenRoll) {
-  const double roll = 0.1, pitch = -0.2, yaw = 0.3;
-  const geometry_msgs::Quaternion q = quaternionFromRollPitchYaw(roll, pitch, yaw);
-  // Against Eigen's axis-angle composition Rz(yaw) Ry(pitch) Rx(roll) ...
-  const Eigen::Quaterniond expected = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                                      Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                                      Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
-  expectQuaternion(q, expected.x(), expected.y(), expected.z(), expected.w());
-  // ... and against the closed-form ZYX formula, which does not involve Eigen at all.
-  const double cr = std::cos(roll / 2), sr = std::sin(roll / 2);
-  const double cp = std::cos(pitch / 2), sp = std::sin(pitch / 2);
-  const double cy = std::cos(yaw / 2), sy = std::sin(yaw / 2);
-  expectQuaternion(q, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-                   cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy);
-  // The rotation is not the other order (roll applied last), which would differ here.
-  const Eigen::Quaterniond wrong_order = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()) *
-                                         Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                                         Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
-  EXPECT_GT(std::abs(q.x - wrong_order.x()) + std::abs(q.z - wrong_order.z()), 1e-3);
 }
 
 // --- JointState ----------------------------------------------------------------------------------
@@ -236,36 +177,12 @@ TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, -16384.0);
 }
 
-TEST(ConversionsImu, AxisMapMatrixIsTheSignedPermutation) {
-  Eigen::Matrix3d expected;
-  expected << 0, -1, 0, 1, 0, 0, 0, 0, 1;
-  EXPECT_TRUE(axisMapMatrix({"-y", "x", "z"}).isApprox(expected));
-  EXPECT_TRUE(axisMapMatrix({"x", "y", "z"}).isIdentity());
-}
-
 TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {
   ImuParams params;
   params.orientation_variance = -1;
   const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
   EXPECT_EQ(msg.orientation_covariance[0], -1.0);
   EXPECT_EQ(msg.orientation_covariance[4], 0.0);
-}
-
-// imuYaw (~base/use_imu_heading) is the yaw of the orientation imu/data carries, axis map included.
-TEST(ConversionsImu, ImuYawIsTheHeadingOfThePublishedOrientation) {
-  ImuParams params;
-  params.angle_scale = M_PI / 32768.0;
-  EXPECT_NEAR(imuYaw(goldenTelemetry(), params), -M_PI / 2, 1e-9);  // raw yaw -16384: -90 deg
-  // Board turned +90 deg about z ([-y, x, z]): the imu frame's heading is -180 deg.
-  params.axis_map = {"-y", "x", "z"};
-  EXPECT_NEAR(std::abs(imuYaw(goldenTelemetry(), params)), M_PI, 1e-9);
-  // Upside down ([x, -y, -z]) is a roll of 180 deg: the heading stays -90 deg.
-  params.axis_map = {"x", "-y", "-z"};
-  EXPECT_NEAR(imuYaw(goldenTelemetry(), params), -M_PI / 2, 1e-9);
-  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
-  const auto& q = msg.orientation;
-  EXPECT_NEAR(imuYaw(goldenTelemetry(), params),
-              std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z)), 1e-9);
 }
 
 // --- FootPressure and Telemetry ------------------------------------------------------------------
@@ -309,6 +226,55 @@ TEST(ConversionsJointCommand, NamesAndPositionsOnly) {
   const JointCommand command = fromJointState(msg);
   EXPECT_EQ(command.names, msg.name);
   EXPECT_EQ(command.positions, msg.position);
+}
+
+// --- the base's readings -------------------------------------------------------------------------
+
+TEST(ConversionsBattery, OnlyThePercentageIsKnown) {
+  const sensor_msgs::BatteryState msg = toBatteryState(device::batteryReading(57), ros::Time(2, 0));
+  EXPECT_EQ(msg.header.stamp, ros::Time(2, 0));
+  EXPECT_FLOAT_EQ(msg.percentage, 0.57f);
+  EXPECT_TRUE(std::isnan(msg.voltage));
+  EXPECT_TRUE(std::isnan(msg.design_capacity));
+  EXPECT_EQ(msg.power_supply_status, sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_UNKNOWN);
+  EXPECT_TRUE(msg.present);
+}
+
+TEST(ConversionsOdometry, PoseTwistFramesAndCovariances) {
+  device::OdometrySample sample;
+  sample.pose = {1.0, -2.0, M_PI / 2};
+  sample.linear = 0.3;
+  sample.angular = -0.4;
+  sample.position_variance = 0.5;
+  sample.yaw_variance = 0.6;
+  const nav_msgs::Odometry odom = toOdometry(sample, {"odom", "base_link"}, ros::Time(5, 0));
+  EXPECT_EQ(odom.header.stamp, ros::Time(5, 0));
+  EXPECT_EQ(odom.header.frame_id, "odom");
+  EXPECT_EQ(odom.child_frame_id, "base_link");
+  EXPECT_DOUBLE_EQ(odom.pose.pose.position.x, 1.0);
+  EXPECT_DOUBLE_EQ(odom.pose.pose.position.y, -2.0);
+  EXPECT_NEAR(odom.pose.pose.orientation.z, kHalfSqrt2, 1e-12);
+  EXPECT_NEAR(odom.pose.pose.orientation.w, kHalfSqrt2, 1e-12);
+  EXPECT_DOUBLE_EQ(odom.twist.twist.linear.x, 0.3);
+  EXPECT_DOUBLE_EQ(odom.twist.twist.angular.z, -0.4);
+  EXPECT_EQ(odom.pose.covariance[0], 0.5);
+  EXPECT_EQ(odom.pose.covariance[7], 0.5);
+  EXPECT_EQ(odom.pose.covariance[14], 1e6);
+  EXPECT_EQ(odom.pose.covariance[35], 0.6);
+  EXPECT_EQ(odom.twist.covariance[0], 0.0025);
+  EXPECT_EQ(odom.twist.covariance[7], 1e-6);
+  EXPECT_EQ(odom.twist.covariance[35], 0.01);
+}
+
+TEST(ConversionsOdometry, WheelStatesAreTheSamplesAnglesAndRates) {
+  device::OdometrySample sample;
+  sample.wheel_angles = {1.5, -0.5};
+  sample.wheel_rates = {0.25, -0.125};
+  const sensor_msgs::JointState msg = toWheelStates(sample, "base_link", "l", "r", ros::Time(1, 0));
+  EXPECT_EQ(msg.header.frame_id, "base_link");
+  EXPECT_EQ(msg.name, (std::vector<std::string>{"l", "r"}));
+  EXPECT_EQ(msg.position, (std::vector<double>{1.5, -0.5}));
+  EXPECT_EQ(msg.velocity, (std::vector<double>{0.25, -0.125}));
 }
 
 TEST(WriteStatusReport, ReplacesTheUpdatersPlaceholderSummaryAndAppendsTheValues) {

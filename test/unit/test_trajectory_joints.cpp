@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_controller.h"
-#include "serial_robot_driver/trajectory/joint_groups.h"
+#include "serial_robot_driver/devices/body/body_trajectory_joints.h"
+#include "serial_robot_driver/devices/servo_bus/bus_trajectory_joints.h"
 
 namespace serial_robot_driver::trajectory {
 namespace {

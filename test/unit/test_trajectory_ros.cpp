@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/ros/trajectory_bus_joints.h"
+#include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {

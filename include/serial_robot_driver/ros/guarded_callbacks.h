@@ -20,11 +20,11 @@
 
 namespace serial_robot_driver::ros_layer {
 
-/// Runs `body`, a callback of `source` (a topic, service or action name). An exception it throws
+/// Runs `callback` of `source` (a topic, service or action name). An exception it throws
 /// is logged (ROS_ERROR, at most once a second), counted (counters.failed(source)) and swallowed;
-/// `error` (may be null) gets its text. Returns whether `body` returned normally.
+/// `error` (may be null) gets its text. Returns whether `callback` returned normally.
 bool runGuarded(device::InputRefusals& counters, const std::string& source,
-                const std::function<void()>& body, std::string* error = nullptr);
+                const std::function<void()>& callback, std::string* error = nullptr);
 
 namespace detail {
 template <typename T, typename = void>

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/command.h"
 #include "serial_robot_driver/trajectory/goal.h"
 #include "serial_robot_driver/trajectory/joint_groups.h"

@@ -101,7 +101,7 @@ void finish(const GoalCallbacks& callbacks, const GoalOutcome& result);
 /// "; joint 'a', 'b' left alone: ..." for the joints a stop could not hold, "" when none.
 std::string leftAloneText(const std::vector<std::string>& names);
 
-/// `base`, then `; left_alone` when there is one.
-std::string withLeftAlone(const std::string& base, const std::string& left_alone);
+/// `message`, then `; left_alone` when there is one.
+std::string withLeftAlone(const std::string& message, const std::string& left_alone);
 
 }  // namespace serial_robot_driver::trajectory

@@ -1,7 +1,7 @@
 // The seam between the trajectory executor and a device, ROS-free: which joints a device has, what
-// they can reach and how they are set, either streamed (the body: one frame per loop tick) or one
-// move per segment (the UART bus servos used as joints, ~servo_bus/joint_ids ...). Also the steady
-// clock trajectories run on and where a stop holds a streamed joint.
+// they can reach and how they are set, either streamed (one frame per loop tick) or one move per
+// segment; each device builds its own in its folder. Also the steady clock trajectories run on and
+// where a stop holds a streamed joint.
 #pragma once
 
 #include <cstddef>
@@ -11,14 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/body/body_controller.h"
-#include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/command.h"
 
 namespace serial_robot_driver::trajectory {
 
 /// What a device gives the trajectory executor: its joints and how to set their positions, either
-/// streamed (`write` every loop tick: the body) or one move per segment (`move`: bus servos).
+/// streamed (`write` every loop tick) or one move per segment (`move`).
 struct TrajectoryJoints {
   std::vector<JointRange> joints;
   /// A goal aborts when one of its joints has had no measurement for this long (s).
@@ -53,32 +51,5 @@ double steadyNow();
 std::optional<double> streamedHoldPosition(std::optional<double> last_written,
                                            std::optional<double> last_commanded,
                                            std::optional<double> fresh_measurement);
-
-/// The body's joints (~body/joint_names) and their reach; a write is one sync-write frame through
-/// BodyController::sendJointCommand (ticks rounded as joint_commands rounds them). `controller`
-/// must outlive the result.
-TrajectoryJoints bodyTrajectoryJoints(device::BodyController& controller);
-
-/// The joint of bus servo `id`, if it is one.
-const BusJoint* findBusJoint(const std::vector<BusJoint>& joints, uint8_t id);
-
-/// Queues a move of servo `id` to `angle_deg` (single-turn) in `interval_ms`; must not block.
-/// Returns an error text, empty when queued.
-using QueueServoMove =
-    std::function<std::string(uint8_t id, double angle_deg, uint32_t interval_ms)>;
-
-/// Stops servo `id` where it is (a SPIN stop, no position); must not block. Returns an error
-/// text, empty when queued.
-using StopServo = std::function<std::string(uint8_t id)>;
-
-/// How long a bus joint may go without a poll answer before its goal aborts: three poll periods at
-/// `state_rate` (Hz), at least 0.5 s.
-double busStateTimeout(double state_rate);
-
-/// The bus joints for the trajectory executor: one ROTATE per segment, at its start, with the
-/// segment's remaining duration as interval; a stop holds a joint with `stop_servo` (may be
-/// empty: nothing is sent). Its state_timeout is busStateTimeout(state_rate).
-TrajectoryJoints busTrajectoryJoints(const std::vector<BusJoint>& joints, QueueServoMove queue_move,
-                                     double state_rate, StopServo stop_servo = {});
 
 }  // namespace serial_robot_driver::trajectory

@@ -17,7 +17,7 @@ struct BodyParams : DevicePortParams {
   std::vector<std::string> joint_names{"joint_1", "joint_2"};
   /// What every joint shares: ticks_per_revolution and velocity_scale (0: unknown, and
   /// joint_states carries no velocity) are bound here; each joint's zero and direction come from
-  /// the lists below (ros_layer::makeBodyJoints).
+  /// the lists below (device::makeBodyJoints).
   device::JointCalibration calibration;
   std::vector<int> zero_ticks{2048, 2048};
   std::vector<int> directions{1, 1};

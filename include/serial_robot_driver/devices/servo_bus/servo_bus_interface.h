@@ -48,6 +48,7 @@
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_diagnostics.h"
@@ -57,7 +58,6 @@
 #include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
-#include "serial_robot_driver/ros/trajectory_bus_joints.h"
 
 namespace serial_robot_driver::ros_layer {
 

@@ -11,17 +11,11 @@
 
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/devices/base/base_status.h"
+#include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
-
-namespace {
-// Twist variances of odom (see publishOdometry): (m/s)^2 and (rad/s)^2.
-constexpr double kTwistLinearVariance = 0.0025;  // std 0.05 m/s
-constexpr double kTwistLateralVariance = 1e-6;   // a differential drive cannot slide sideways
-constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
-}  // namespace
 
 device::BaseConfig makeBaseConfig(const DriverParams& params) {
   // The base's own parameters are bound into its configuration already (base_module.cpp); these
@@ -49,18 +43,7 @@ device::BaseEvents BaseInterface::events() {
     wheel_command_pub_.publish(msg);
   };
   events.on_battery = [this](uint8_t percent, device::Clock::time_point arrival) {
-    sensor_msgs::BatteryState msg;
-    msg.header.stamp = arrival_stamps_(arrival);
-    // The base reports only a percentage; everything else is unknown (NaN per the message docs).
-    const float unknown = std::numeric_limits<float>::quiet_NaN();
-    msg.voltage = msg.temperature = msg.current = unknown;
-    msg.charge = msg.capacity = msg.design_capacity = unknown;
-    msg.percentage = percent / 100.0f;
-    msg.power_supply_status = sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
-    msg.power_supply_health = sensor_msgs::BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;
-    msg.power_supply_technology = sensor_msgs::BatteryState::POWER_SUPPLY_TECHNOLOGY_UNKNOWN;
-    msg.present = true;
-    battery_pub_.publish(msg);
+    battery_pub_.publish(toBatteryState(device::batteryReading(percent), arrival_stamps_(arrival)));
   };
   events.on_odometry = [this](const device::OdometrySample& sample) { publishOdometry(sample); };
   events.on_cmd_vel_timeout = [this] {
@@ -148,33 +131,8 @@ void BaseInterface::attachEStop(device::EStop& e_stop) {
 void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   // Called on the control loop's thread once per tick; never touches the port.
   const ros::Time stamp = ros::Time::now();
-  const double half_yaw = sample.pose.yaw / 2.0;
-  geometry_msgs::Quaternion orientation;
-  orientation.z = std::sin(half_yaw);
-  orientation.w = std::cos(half_yaw);
-
-  nav_msgs::Odometry odom;
-  odom.header.stamp = stamp;
-  odom.header.frame_id = params_.odom_frame;
-  odom.child_frame_id = params_.base_frame;
-  odom.pose.pose.position.x = sample.pose.x;
-  odom.pose.pose.position.y = sample.pose.y;
-  odom.pose.pose.orientation = orientation;
-  odom.twist.twist.linear.x = sample.linear;
-  odom.twist.twist.angular.z = sample.angular;
-  // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
-  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
-  // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
-  constexpr double kNotEstimated = 1e6;
-  odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
-  odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
-  odom.pose.covariance[35] = sample.yaw_variance;
-  // The twist is what the base was told, good to about one tick per period (0.0245 m/s with the
-  // default geometry), plus what the wheels fail to follow.
-  odom.twist.covariance[0] = kTwistLinearVariance;
-  odom.twist.covariance[7] = kTwistLateralVariance;
-  odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
-  odom.twist.covariance[35] = kTwistAngularVariance;
+  const nav_msgs::Odometry odom =
+      toOdometry(sample, {params_.odom_frame, params_.base_frame}, stamp);
   odom_pub_.publish(odom);
   publishWheelStates(sample, stamp);
 
@@ -186,21 +144,15 @@ void BaseInterface::publishOdometry(const device::OdometrySample& sample) {
   transform.child_frame_id = odom.child_frame_id;
   transform.transform.translation.x = sample.pose.x;
   transform.transform.translation.y = sample.pose.y;
-  transform.transform.rotation = orientation;
+  transform.transform.rotation = odom.pose.pose.orientation;
   tf_broadcaster_->sendTransform(transform);
 }
 
 void BaseInterface::publishWheelStates(const device::OdometrySample& sample,
                                        const ros::Time& stamp) {
   // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
-  sensor_msgs::JointState wheels;
-  wheels.header.stamp = stamp;
-  wheels.header.frame_id = params_.base_frame;
-  wheels.name = {params_.left_wheel_joint, params_.right_wheel_joint};
-  // In rad, from the controller: with the diameter each stretch of travel ran under.
-  wheels.position = {sample.wheel_angles.x(), sample.wheel_angles.y()};
-  wheels.velocity = {sample.wheel_rates.x(), sample.wheel_rates.y()};
-  wheel_states_pub_.publish(wheels);
+  wheel_states_pub_.publish(toWheelStates(sample, params_.base_frame, params_.left_wheel_joint,
+                                          params_.right_wheel_joint, stamp));
 }
 
 void BaseInterface::retune(const DriverParams& params) {

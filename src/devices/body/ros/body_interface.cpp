@@ -6,9 +6,10 @@
 
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
+#include "serial_robot_driver/devices/body/body_trajectory_joints.h"
+#include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
-#include "serial_robot_driver/trajectory/joint_groups.h"
 
 namespace serial_robot_driver::ros_layer {
 

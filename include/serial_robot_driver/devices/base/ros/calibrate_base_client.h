@@ -1,4 +1,4 @@
-// calibrate_base's ROS wiring (src/nodes/calibrate_base_main.cpp): finding the driver, and the
+// calibrate_base's ROS wiring (calibrate_base_main.cpp): finding the driver, and the
 // topics converted into the inputs of the core's TurnCalibrationRun.
 #pragma once
 

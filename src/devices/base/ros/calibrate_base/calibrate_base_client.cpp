@@ -1,4 +1,4 @@
-#include "serial_robot_driver/ros/calibrate_base_client.h"
+#include "serial_robot_driver/devices/base/ros/calibrate_base_client.h"
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>

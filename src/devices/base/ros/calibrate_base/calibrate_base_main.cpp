@@ -4,7 +4,7 @@
 // it ties up none of the node's threads, and if it is killed hard the node's own
 // ~base/cmd_vel_timeout stops the base. The run itself (sequencing, aborts, the stop on every way
 // out, the report) is the core's devices/base/turn_calibration_run; this file finds the driver,
-// spins the run with the topics wired to it (ros/calibrate_base_client) and reads typed input.
+// spins the run with the topics wired to it (calibrate_base_client.cpp) and reads typed input.
 #include <ros/ros.h>
 
 #include <atomic>
@@ -13,7 +13,7 @@
 #include <string>
 
 #include "serial_robot_driver/devices/base/turn_calibration_run.h"
-#include "serial_robot_driver/ros/calibrate_base_client.h"
+#include "serial_robot_driver/devices/base/ros/calibrate_base_client.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace {

@@ -1,0 +1,31 @@
+// What the base's reports and odometry mean, in SI units (ROS-free): the battery's charge, the
+// heading as a rotation, and how far the odometry's twist is to be trusted. A front end copies
+// these fields into its messages.
+#pragma once
+
+#include <cstdint>
+
+namespace serial_robot_driver::device {
+
+/// The battery as the base reports it: only its charge; voltage, current and the rest are unknown.
+struct BatteryReading {
+  double fraction = 0.0;  ///< 0 .. 1
+};
+BatteryReading batteryReading(uint8_t percent);
+
+/// A heading (a rotation about z by `yaw` rad) as a unit quaternion; x and y are 0.
+struct YawRotation {
+  double z = 0.0;
+  double w = 1.0;
+};
+YawRotation yawRotation(double yaw);
+
+/// The odometry twist's variances: the twist is what the base was told, good to about one tick
+/// per period (0.0245 m/s with the default geometry), plus what the wheels fail to follow.
+constexpr double kTwistLinearVariance = 0.0025;  ///< (m/s)^2: std 0.05 m/s
+constexpr double kTwistLateralVariance = 1e-6;   ///< a differential drive cannot slide sideways
+constexpr double kTwistAngularVariance = 0.01;   ///< (rad/s)^2: std 0.1 rad/s
+/// The variance of what the odometry does not estimate at all (z, roll, pitch).
+constexpr double kNotEstimatedVariance = 1e6;
+
+}  // namespace serial_robot_driver::device

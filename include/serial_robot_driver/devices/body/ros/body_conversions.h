@@ -1,0 +1,45 @@
+// The body's telemetry as ROS messages: the core's readings (devices/body/body_readings.h) copied
+// into JointState and Imu, and the raw frame into FootPressure and Telemetry. No node, no I/O, so
+// they are unit-tested without a roscore.
+#pragma once
+
+#include <ros/time.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/JointState.h>
+#include <serial_robot_driver/FootPressure.h>
+#include <serial_robot_driver/Telemetry.h>
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "serial_robot_driver/devices/body/body_readings.h"
+
+namespace serial_robot_driver::ros_layer {
+
+using device::imuYaw;
+using device::makeBodyJoints;
+
+/// device::jointReadings() stamped: positions (rad) and velocities (rad/s, empty when unknown).
+sensor_msgs::JointState toJointState(const protocol::body::Telemetry& telemetry,
+                                     const std::vector<device::BodyJoint>& joints,
+                                     const ros::Time& stamp);
+
+/// REP-145 IMU message: device::imuReading() (the bias subtracted), with diagonal covariances
+/// from `params`. A negative orientation_variance marks the orientation as unknown
+/// (orientation_covariance[0] = -1).
+sensor_msgs::Imu toImu(const protocol::body::Telemetry& telemetry, const params::ImuParams& params,
+                       const ros::Time& stamp, const std::array<double, 3>& gyro_bias = {});
+
+/// The 8 raw foot readings, or nothing when the frame did not carry the foot block.
+std::optional<serial_robot_driver::FootPressure> toFootPressure(
+    const protocol::body::Telemetry& telemetry, const ros::Time& stamp,
+    const std::string& frame_id = "");
+
+/// The whole frame in raw units (for rosbag). `joints` give the servo ids in frame order.
+serial_robot_driver::Telemetry toTelemetryMsg(const protocol::body::Telemetry& telemetry,
+                                              const std::vector<device::BodyJoint>& joints,
+                                              const ros::Time& stamp);
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,63 @@
+#include "serial_robot_driver/devices/base/ros/base_conversions.h"
+
+#include <limits>
+
+namespace serial_robot_driver::ros_layer {
+
+sensor_msgs::BatteryState toBatteryState(const device::BatteryReading& battery,
+                                         const ros::Time& stamp) {
+  sensor_msgs::BatteryState msg;
+  msg.header.stamp = stamp;
+  // The base reports only a percentage; everything else is unknown (NaN per the message docs).
+  const float unknown = std::numeric_limits<float>::quiet_NaN();
+  msg.voltage = msg.temperature = msg.current = unknown;
+  msg.charge = msg.capacity = msg.design_capacity = unknown;
+  msg.percentage = static_cast<float>(battery.fraction);
+  msg.power_supply_status = sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
+  msg.power_supply_health = sensor_msgs::BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;
+  msg.power_supply_technology = sensor_msgs::BatteryState::POWER_SUPPLY_TECHNOLOGY_UNKNOWN;
+  msg.present = true;
+  return msg;
+}
+
+nav_msgs::Odometry toOdometry(const device::OdometrySample& sample, const OdomFrames& frames,
+                              const ros::Time& stamp) {
+  const device::YawRotation rotation = device::yawRotation(sample.pose.yaw);
+  nav_msgs::Odometry odom;
+  odom.header.stamp = stamp;
+  odom.header.frame_id = frames.odom;
+  odom.child_frame_id = frames.base;
+  odom.pose.pose.position.x = sample.pose.x;
+  odom.pose.pose.position.y = sample.pose.y;
+  odom.pose.pose.orientation.z = rotation.z;
+  odom.pose.pose.orientation.w = rotation.w;
+  odom.twist.twist.linear.x = sample.linear;
+  odom.twist.twist.angular.z = sample.angular;
+  // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
+  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
+  // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
+  constexpr double kNotEstimated = device::kNotEstimatedVariance;
+  odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
+  odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
+  odom.pose.covariance[35] = sample.yaw_variance;
+  odom.twist.covariance[0] = device::kTwistLinearVariance;
+  odom.twist.covariance[7] = device::kTwistLateralVariance;
+  odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
+  odom.twist.covariance[35] = device::kTwistAngularVariance;
+  return odom;
+}
+
+sensor_msgs::JointState toWheelStates(const device::OdometrySample& sample,
+                                      const std::string& frame, const std::string& left,
+                                      const std::string& right, const ros::Time& stamp) {
+  sensor_msgs::JointState wheels;
+  wheels.header.stamp = stamp;
+  wheels.header.frame_id = frame;
+  wheels.name = {left, right};
+  // In rad, from the controller: with the diameter each stretch of travel ran under.
+  wheels.position = {sample.wheel_angles.x(), sample.wheel_angles.y()};
+  wheels.velocity = {sample.wheel_rates.x(), sample.wheel_rates.y()};
+  return wheels;
+}
+
+}  // namespace serial_robot_driver::ros_layer

@@ -1,0 +1,102 @@
+#include "serial_robot_driver/devices/body/body_readings.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace serial_robot_driver::device {
+
+namespace body = protocol::body;
+
+std::vector<BodyJoint> makeBodyJoints(const params::BodyParams& params) {
+  std::vector<BodyJoint> joints(params.servo_ids.size());
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    BodyJoint& joint = joints[i];
+    joint.servo_id = static_cast<uint8_t>(params.servo_ids[i]);
+    joint.name = i < params.joint_names.size() ? params.joint_names[i] : "";
+    joint.calibration = params.calibration;  // what every joint shares, then its own
+    if (i < params.zero_ticks.size()) joint.calibration.zero_ticks = params.zero_ticks[i];
+    if (i < params.directions.size()) joint.calibration.direction = params.directions[i];
+  }
+  return joints;
+}
+
+JointReadings jointReadings(const body::Telemetry& telemetry,
+                            const std::vector<BodyJoint>& joints) {
+  JointReadings readings;
+  const std::size_t count = std::min(joints.size(), telemetry.servo_count);
+  readings.names.reserve(count);
+  readings.positions.reserve(count);
+  // The speed's unit is not documented: without a known scale the velocity stays empty rather
+  // than guessed.
+  const bool velocity_known = count > 0 && joints.front().calibration.velocity_scale > 0;
+  if (velocity_known) readings.velocities.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const JointCalibration& calibration = joints[i].calibration;
+    readings.names.push_back(joints[i].name);
+    readings.positions.push_back(calibration.toRadians(telemetry.servos[i].position));
+    if (velocity_known) {
+      readings.velocities.push_back(calibration.toRadiansPerSecond(telemetry.servos[i].speed));
+    }
+  }
+  return readings;
+}
+
+Quaternion quaternionFromRollPitchYaw(double roll, double pitch, double yaw) {
+  const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
+  return {q.x(), q.y(), q.z(), q.w()};
+}
+
+Eigen::Matrix3d axisMapMatrix(const std::vector<std::string>& axis_map) {
+  Eigen::Matrix3d matrix = Eigen::Matrix3d::Zero();
+  const std::optional<params::AxisMap> map = params::parseAxisMap(axis_map, nullptr);
+  if (!map) return Eigen::Matrix3d::Identity();  // validate() refuses such a map at start-up
+  for (int i = 0; i < 3; ++i) matrix(i, map->source[i]) = map->sign[i];
+  return matrix;
+}
+
+namespace {
+/// R_world_imu from the board's attitude angles and the axis map M (v_imu = M v_sensor).
+Eigen::Quaterniond imuOrientation(const body::Telemetry& telemetry, double angle_scale,
+                                  const Eigen::Matrix3d& map) {
+  const auto& raw = telemetry.imu;
+  const Quaternion sensor =
+      quaternionFromRollPitchYaw(raw[body::kRoll] * angle_scale, raw[body::kPitch] * angle_scale,
+                                 raw[body::kYaw] * angle_scale);
+  return Eigen::Quaterniond(sensor.w, sensor.x, sensor.y, sensor.z) *
+         Eigen::Quaterniond(map.transpose());
+}
+}  // namespace
+
+double imuYaw(const body::Telemetry& telemetry, const params::ImuParams& params) {
+  const Eigen::Quaterniond q =
+      imuOrientation(telemetry, params.angle_scale, axisMapMatrix(params.axis_map));
+  // The Z (yaw) angle of a Z-Y-X decomposition.
+  return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()),
+                    1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+}
+
+ImuReading imuReading(const body::Telemetry& telemetry, const params::ImuParams& params,
+                      const std::array<double, 3>& gyro_bias) {
+  const auto& raw = telemetry.imu;
+  // The axis map M turns sensor-frame vectors into imu-frame ones (v_imu = M v_sensor); the
+  // sensor's orientation R_world_sensor becomes R_world_imu = R_world_sensor * M^T.
+  const Eigen::Matrix3d map = axisMapMatrix(params.axis_map);
+  ImuReading reading;
+  reading.linear_acceleration =
+      map * Eigen::Vector3d(raw[body::kAccelX], raw[body::kAccelY], raw[body::kAccelZ]) *
+      params.accel_scale;
+  reading.angular_velocity =
+      map *
+      (Eigen::Vector3d(raw[body::kGyroX], raw[body::kGyroY], raw[body::kGyroZ]) -
+       Eigen::Vector3d(gyro_bias[0], gyro_bias[1], gyro_bias[2])) *
+      params.gyro_scale;
+  const Eigen::Quaterniond world_imu = imuOrientation(telemetry, params.angle_scale, map);
+  reading.orientation = {world_imu.x(), world_imu.y(), world_imu.z(), world_imu.w()};
+  return reading;
+}
+
+}  // namespace serial_robot_driver::device

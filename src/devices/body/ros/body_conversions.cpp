@@ -1,0 +1,93 @@
+#include "serial_robot_driver/devices/body/ros/body_conversions.h"
+
+namespace serial_robot_driver::ros_layer {
+
+namespace body = protocol::body;
+
+namespace {
+geometry_msgs::Vector3 toVector3(const Eigen::Vector3d& v) {
+  geometry_msgs::Vector3 msg;
+  msg.x = v.x();
+  msg.y = v.y();
+  msg.z = v.z();
+  return msg;
+}
+
+geometry_msgs::Quaternion toQuaternion(const device::Quaternion& q) {
+  geometry_msgs::Quaternion msg;
+  msg.x = q.x;
+  msg.y = q.y;
+  msg.z = q.z;
+  msg.w = q.w;
+  return msg;
+}
+}  // namespace
+
+sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
+                                     const std::vector<device::BodyJoint>& joints,
+                                     const ros::Time& stamp) {
+  device::JointReadings readings = device::jointReadings(telemetry, joints);
+  sensor_msgs::JointState msg;
+  msg.header.stamp = stamp;
+  msg.name = std::move(readings.names);
+  msg.position = std::move(readings.positions);
+  msg.velocity = std::move(readings.velocities);
+  return msg;
+}
+
+sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const params::ImuParams& params,
+                       const ros::Time& stamp, const std::array<double, 3>& gyro_bias) {
+  const device::ImuReading reading = device::imuReading(telemetry, params, gyro_bias);
+  sensor_msgs::Imu msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = params.frame_id;
+  msg.linear_acceleration = toVector3(reading.linear_acceleration);
+  msg.angular_velocity = toVector3(reading.angular_velocity);
+  msg.orientation = toQuaternion(reading.orientation);
+  // Row-major 3x3 matrices: the diagonal is elements 0, 4, 8.
+  for (std::size_t i = 0; i < 3; ++i) {
+    msg.orientation_covariance[4 * i] = params.orientation_variance;
+    msg.angular_velocity_covariance[4 * i] = params.angular_velocity_variance;
+    msg.linear_acceleration_covariance[4 * i] = params.linear_acceleration_variance;
+  }
+  if (params.orientation_variance < 0) {
+    // REP-145: element 0 = -1 says "no orientation estimate"; the rest is ignored.
+    msg.orientation_covariance = {};
+    msg.orientation_covariance[0] = -1.0;
+  }
+  return msg;
+}
+
+std::optional<serial_robot_driver::FootPressure> toFootPressure(const body::Telemetry& telemetry,
+                                                                const ros::Time& stamp,
+                                                                const std::string& frame_id) {
+  if (!telemetry.has_foot) return std::nullopt;
+  serial_robot_driver::FootPressure msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame_id;
+  for (std::size_t j = 0; j < body::kFootSensorCount; ++j) msg.pressure[j] = telemetry.foot[j];
+  return msg;
+}
+
+serial_robot_driver::Telemetry toTelemetryMsg(const body::Telemetry& telemetry,
+                                              const std::vector<device::BodyJoint>& joints,
+                                              const ros::Time& stamp) {
+  serial_robot_driver::Telemetry msg;
+  msg.header.stamp = stamp;
+  const std::size_t count = telemetry.servo_count;
+  msg.servo_ids.resize(count);
+  msg.positions.resize(count);
+  msg.speeds.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    // Ids come from the configuration: the frame itself does not carry them.
+    msg.servo_ids[i] = i < joints.size() ? joints[i].servo_id : 0;
+    msg.positions[i] = telemetry.servos[i].position;
+    msg.speeds[i] = telemetry.servos[i].speed;
+  }
+  for (std::size_t k = 0; k < body::kImuValueCount; ++k) msg.imu[k] = telemetry.imu[k];
+  msg.has_foot = telemetry.has_foot;
+  if (telemetry.has_foot) msg.foot.assign(telemetry.foot.begin(), telemetry.foot.end());
+  return msg;
+}
+
+}  // namespace serial_robot_driver::ros_layer
