@@ -1,6 +1,6 @@
 #include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
 
-#include "serial_robot_driver/trajectory/joint_groups.h"
+#include "serial_robot_driver/devices/servo_bus/bus_trajectory_joints.h"
 
 namespace serial_robot_driver::device {
 
