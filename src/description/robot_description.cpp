@@ -9,6 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+
 namespace serial_robot_driver::description {
 
 // --- the parameter file ----------------------------------------------------------------------
@@ -225,7 +228,7 @@ std::string makeRobotDescription(const DriverParams& params, const std::vector<S
                                  const ImuMount& imu, const std::string& robot_name) {
   // Simple shapes sized from the wheel geometry: base_link on the ground between the wheels
   // (REP-105), the axle at the wheel radius, a box chassis and a rear caster ball.
-  const ros_layer::BaseParams& base = params.base;
+  const params::BaseParams& base = params.section(params::kBaseSection);
   const kinematics::DiffDriveGeometry& wheels = base.controller.geometry;
   const double radius = wheels.wheel_diameter / 2.0;
   const double wheel_width = std::min(0.25 * wheels.wheel_diameter, 0.3 * wheels.wheel_separation);
@@ -255,7 +258,7 @@ std::string makeRobotDescription(const DriverParams& params, const std::vector<S
   wheel(base.left_wheel_joint, "base/left_wheel_joint", 1.0);
   wheel(base.right_wheel_joint, "base/right_wheel_joint", -1.0);
 
-  const std::string imu_link = linkName(params.imu.frame_id);
+  const std::string imu_link = linkName(params.section(params::kImuSection).frame_id);
   urdf.link(imu_link, "imu/frame_id", visual(box(0.03, 0.03, 0.01), "imu"));
   urdf.joint(imu_link + "_joint", "imu/frame_id", "fixed", base_link, imu_link,
              numbers({imu.xyz[0], imu.xyz[1], imu.xyz[2]}),

@@ -260,9 +260,9 @@ std::string DriverNode::startupSummary() const {
     text << ")";
     separator = ", port ";
   }
-  if (params_.base.enabled) {
+  if (params_.section(params::kBaseSection).enabled) {
     text << "; loop " << params_.loop_rate << " Hz, battery poll "
-         << params_.base.controller.battery_poll_rate << " Hz";
+         << params_.section(params::kBaseSection).controller.battery_poll_rate << " Hz";
   }
   text << "; diagnostics every " << diagnostics_period_ << " s";
   return text.str();

@@ -9,17 +9,19 @@ namespace serial_robot_driver::ros_layer {
 
 std::vector<description::ServoJoint> servoJoints(const DriverParams& params) {
   std::vector<description::ServoJoint> servos;
-  if (params.body.enabled) {
-    const std::vector<device::BodyJoint> joints = makeBodyJoints(params.body);
+  if (params.section(params::kBodySection).enabled) {
+    const std::vector<device::BodyJoint> joints =
+        makeBodyJoints(params.section(params::kBodySection));
     for (const device::BodyJoint& joint : joints) {
       const auto [lower, upper] = joint.calibration.reachableRadians();
       // The board's speed unit is not known (body/velocity_scale); one turn per second.
       servos.push_back({joint.name, "body/joint_names", lower, upper, 2.0 * M_PI});
     }
   }
-  if (params.servo_bus.enabled) {
+  if (params.section(params::kServoBusSection).enabled) {
     constexpr double kMaxBusServoSpeedDps = 750.0;  // servo/move's velocity limit
-    for (const trajectory::BusJoint& joint : makeBusJoints(params.servo_bus)) {
+    for (const trajectory::BusJoint& joint :
+         makeBusJoints(params.section(params::kServoBusSection))) {
       const trajectory::JointRange range = joint.range();
       servos.push_back({joint.name, "servo_bus/joint_names", range.min_position,
                         range.max_position, kMaxBusServoSpeedDps * M_PI / 180.0});

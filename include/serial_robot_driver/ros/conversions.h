@@ -20,9 +20,15 @@
 #include "serial_robot_driver/device/status_report.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
+
+using params::AxisMap;
+using params::BodyParams;
+using params::ImuParams;
+using params::parseAxisMap;
 
 /// The ROS time at which a steady_clock event happened: `ros_now` minus how long ago it was
 /// (`steady_now` - `event`). Saturates at ros::Time(0) instead of going negative.

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/trajectory_server.h"  // the server the bus joints report to
 #include "serial_robot_driver/trajectory/bus_joint.h"
@@ -16,6 +17,7 @@
 
 namespace serial_robot_driver::ros_layer {
 
+using params::ServoBusParams;
 using trajectory::busStateTimeout;
 using trajectory::busTrajectoryJoints;
 using trajectory::findBusJoint;

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/base/base_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
@@ -25,10 +26,10 @@ constexpr double kTwistAngularVariance = 0.01;   // std 0.1 rad/s
 device::BaseConfig makeBaseConfig(const DriverParams& params) {
   // The base's own parameters are bound into its configuration already (base_module.cpp); these
   // come from node-wide or other devices' parameters.
-  device::BaseConfig config = params.base.controller;
+  device::BaseConfig config = params.section(params::kBaseSection).controller;
   config.loop_rate = params.loop_rate;
-  config.baud = params.baseBaud();
-  config.imu_yaw_variance = params.imu.orientation_variance;
+  config.baud = params.baudOf(*device::findDevice("base"));
+  config.imu_yaw_variance = params.section(params::kImuSection).orientation_variance;
   return config;
 }
 
@@ -94,10 +95,11 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)
     : link_(link),
       arrival_stamps_(params),
-      params_(params.base),
-      tuned_(std::make_shared<const BaseParams>(params.base)),
-      tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
-                                             : nullptr),
+      params_(params.section(params::kBaseSection)),
+      tuned_(std::make_shared<const params::BaseParams>(params.section(params::kBaseSection))),
+      tf_broadcaster_(params.section(params::kBaseSection).publish_tf
+                          ? std::make_unique<tf2_ros::TransformBroadcaster>()
+                          : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
       controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
@@ -202,7 +204,8 @@ void BaseInterface::publishWheelStates(const device::OdometrySample& sample,
 
 void BaseInterface::retune(const DriverParams& params) {
   controller_.retune(makeBaseConfig(params));
-  std::atomic_store(&tuned_, std::make_shared<const BaseParams>(params.base));
+  std::atomic_store(
+      &tuned_, std::make_shared<const params::BaseParams>(params.section(params::kBaseSection)));
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -229,7 +232,7 @@ bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigg
 }
 
 void BaseInterface::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const std::shared_ptr<const BaseParams> limits = tuned();
+  const std::shared_ptr<const params::BaseParams> limits = tuned();
   writeStatusReport(
       device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
                          {limits->battery_warn_percent, limits->battery_error_percent}),
