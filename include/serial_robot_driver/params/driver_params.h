@@ -44,7 +44,7 @@ struct DriverParams {
 
   std::string port = "/dev/ttyUSB0";
   int baud = 115200;
-  double loop_rate = 50.0;  ///< Hz
+  double loop_rate = 50.0;  ///< Hz: the devices' control loop
   double reconnect_interval = 1.0;
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
