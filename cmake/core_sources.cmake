@@ -14,6 +14,7 @@ set(SRD_CORE_SOURCES
   src/device/serial_link.cpp
   src/device/loop_clock.cpp
   src/device/device_module.cpp
+  src/params/device_sections.cpp
   src/params/param_table.cpp
   src/params/driver_params.cpp
   src/trajectory/spline.cpp

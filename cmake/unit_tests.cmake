@@ -21,6 +21,7 @@ catkin_add_gtest(core_tests
   test/unit/test_sim_command_line.cpp
   test/unit/test_sim_registry.cpp
   test/unit/test_device_registry.cpp
+  test/unit/test_device_sections.cpp
   test/unit/test_e_stop.cpp
   test/unit/test_input_refusals.cpp
   test/unit/test_status_report.cpp

@@ -7,6 +7,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+
 namespace serial_robot_driver::description {
 
 // --- the parameter file ----------------------------------------------------------------------

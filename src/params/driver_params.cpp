@@ -52,7 +52,7 @@ std::vector<ParamSpec> buildTable() {
   for (const device::DeviceModule* device : device::registeredDevices()) {
     // Every device's port parameters, then its own.
     const auto port = [device](DriverParams& p) -> DevicePortParams& {
-      return device->port_params(p);
+      return p.portParams(*device);
     };
     SectionRows<DevicePortParams>(table, device->name, device->name, port)
         .add("enabled", &DevicePortParams::enabled)
@@ -89,18 +89,24 @@ std::string resolveFrame(const std::string& tf_prefix, const std::string& frame)
   return tf_prefix.substr(first, last - first + 1) + "/" + frame;
 }
 
+DriverParams::DriverParams() {
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    for (const AnySectionKey* key : device->sections) sections.add(*key);
+  }
+}
+
 void DriverParams::resolveFrames() {
-  base.odom_frame = resolveFrame(tf_prefix, base.odom_frame);
-  base.base_frame = resolveFrame(tf_prefix, base.base_frame);
-  imu.frame_id = resolveFrame(tf_prefix, imu.frame_id);
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    if (device->resolve_frames) device->resolve_frames(*this);
+  }
 }
 
 const DevicePortParams& DriverParams::portParams(const device::DeviceModule& device) const {
-  return device.port_params(const_cast<DriverParams&>(*this));
+  return sections.portParams(device.name);
 }
 
 DevicePortParams& DriverParams::portParams(const device::DeviceModule& device) {
-  return device.port_params(*this);
+  return sections.portParams(device.name);
 }
 
 bool DriverParams::enabled(const std::string& name) const {
@@ -180,66 +186,98 @@ DriverParams loadParams(const ParamSource& source, std::vector<std::string>* unk
   return params;
 }
 
+namespace {
+
+/// One tuneParams call: applies the request, then refuses what validate() rejects, round by round.
+class TuningRun {
+ public:
+  TuningRun(const DriverParams& in_force, const std::vector<ParamAssignment>& requested)
+      : in_force_(in_force), requested_(requested), result_{in_force, {}, {}} {}
+
+  TuningResult run() {
+    applyRequested();
+    // Each round refuses at least one changed value, and `in_force` itself passes validate().
+    for (std::size_t round = 0; round <= requested_.size(); ++round) {
+      try {
+        result_.applied.validate();
+        describeChanges();
+        return result_;
+      } catch (const ParameterError& error) {
+        refuseFor(error);
+      }
+    }
+    result_.applied.validate();  // unreachable unless `in_force` was invalid: throws then
+    describeChanges();
+    return result_;
+  }
+
+ private:
+  void applyRequested() {
+    for (const auto& [key, value] : requested_) {
+      const ParamSpec& spec = specFor(key);
+      if (spec.get(in_force_).index() != value.index()) {
+        throw std::invalid_argument("~" + key + ": the value has another type than the parameter");
+      }
+      try {
+        spec.set(result_.applied, value);
+      } catch (const ParameterError& error) {
+        addRefusal(key, value, error.what());  // a converted row's check: the field keeps its value
+      }
+    }
+  }
+
+  /// Refuses the value validate() named when the request changed it, else every changed value.
+  void refuseFor(const ParameterError& error) {
+    bool named_value_changed = false;
+    for (const auto& [key, value] : requested_) {
+      if (key == error.name() && changed(key)) named_value_changed = true;
+    }
+    if (named_value_changed) {
+      refuse(error.name(), error.what());
+      return;
+    }
+    // A rule between several values, broken by the change: refuse all of it.
+    for (const auto& [key, value] : requested_) {
+      if (changed(key)) refuse(key, error.what());
+    }
+  }
+
+  bool changed(const std::string& key) const {
+    const ParamSpec& spec = specFor(key);
+    return spec.get(result_.applied) != spec.get(in_force_);
+  }
+
+  void addRefusal(const std::string& key, const ParamValue& value, const std::string& why) {
+    result_.refusals.push_back("~" + key + " = " + toText(value) + " refused (" + why +
+                               "); keeping " + toText(specFor(key).get(in_force_)));
+  }
+
+  void refuse(const std::string& key, const std::string& why) {
+    const ParamSpec& spec = specFor(key);
+    addRefusal(key, spec.get(result_.applied), why);
+    spec.set(result_.applied, spec.get(in_force_));
+  }
+
+  void describeChanges() {
+    for (const auto& [key, value] : requested_) {
+      const ParamSpec& spec = specFor(key);
+      const ParamValue now = spec.get(result_.applied);
+      if (now == spec.get(in_force_)) continue;
+      result_.changes.push_back("~" + key + " = " + toText(now) + " (was " +
+                                toText(spec.get(in_force_)) + ")");
+    }
+  }
+
+  const DriverParams& in_force_;
+  const std::vector<ParamAssignment>& requested_;
+  TuningResult result_;
+};
+
+}  // namespace
+
 TuningResult tuneParams(const DriverParams& in_force,
                         const std::vector<ParamAssignment>& requested) {
-  TuningResult result{in_force, {}, {}};
-  const auto refusal = [&](const std::string& key, const ParamValue& value,
-                           const std::string& why) {
-    result.refusals.push_back("~" + key + " = " + toText(value) + " refused (" + why +
-                              "); keeping " + toText(specFor(key).get(in_force)));
-  };
-  for (const auto& [key, value] : requested) {
-    const ParamSpec& spec = specFor(key);
-    if (spec.get(in_force).index() != value.index()) {
-      throw std::invalid_argument("~" + key + ": the value has another type than the parameter");
-    }
-    try {
-      spec.set(result.applied, value);
-    } catch (const ParameterError& error) {
-      refusal(key, value, error.what());  // a converted row's check: the field keeps its value
-    }
-  }
-  const auto refuse = [&](const std::string& key, const std::string& why) {
-    const ParamSpec& spec = specFor(key);
-    refusal(key, spec.get(result.applied), why);
-    spec.set(result.applied, spec.get(in_force));
-  };
-  const auto describeChanges = [&] {
-    for (const auto& [key, value] : requested) {
-      const ParamSpec& spec = specFor(key);
-      const ParamValue now = spec.get(result.applied);
-      if (now == spec.get(in_force)) continue;
-      result.changes.push_back("~" + key + " = " + toText(now) + " (was " +
-                               toText(spec.get(in_force)) + ")");
-    }
-  };
-  // Each round refuses at least one changed value, and `in_force` itself passes validate().
-  for (std::size_t round = 0; round <= requested.size(); ++round) {
-    try {
-      result.applied.validate();
-      describeChanges();
-      return result;
-    } catch (const ParameterError& error) {
-      bool named_value_changed = false;
-      for (const auto& [key, value] : requested) {
-        if (key == error.name() && specFor(key).get(result.applied) != specFor(key).get(in_force)) {
-          named_value_changed = true;
-        }
-      }
-      if (named_value_changed) {
-        refuse(error.name(), error.what());
-        continue;
-      }
-      // A rule between several values, broken by the change: refuse all of it.
-      for (const auto& [key, value] : requested) {
-        if (specFor(key).get(result.applied) != specFor(key).get(in_force))
-          refuse(key, error.what());
-      }
-    }
-  }
-  result.applied.validate();  // unreachable unless `in_force` was invalid: throws then
-  describeChanges();
-  return result;
+  return TuningRun(in_force, requested).run();
 }
 
 }  // namespace serial_robot_driver::params

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace test_support {
@@ -27,7 +28,7 @@ inline protocol::FramerConfig driverFramer(const std::vector<std::string>& names
     devices.push_back(device);
   }
   params::DriverParams params;
-  params.body.servo_ids.assign(body_servos, 1);
+  params.section(params::kBodySection).servo_ids.assign(body_servos, 1);
   return device::framerFor(devices, params);
 }
 

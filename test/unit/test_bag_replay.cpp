@@ -12,6 +12,8 @@
 #include <string>
 
 #include "serial_robot_driver/SerialChunk.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/conversions.h"
 
@@ -159,15 +161,15 @@ TEST_F(BagReplayTest, AChunkOfAPortTheConfigurationLacksIsNamed) {
   EXPECT_NE(error.find("port /dev/ttyACM7"), std::string::npos) << error;
   EXPECT_NE(error.find("configuration does not have"), std::string::npos) << error;
 
-  params.servo_bus.port = "/dev/ttyACM7";  // now it has it
+  params.section(params::kServoBusSection).port = "/dev/ttyACM7";  // now it has it
   EXPECT_EQ(errorOf([&] { BagReplay replay(params); }), "no error");
 }
 
 TEST(ConfiguredPorts, AreTheEnabledDevicesPaths) {
   DriverParams params;
-  params.body.port = "/dev/ttyBODY";
-  params.servo_bus.enabled = false;
-  params.servo_bus.port = "/dev/ttySERVO";
+  params.section(params::kBodySection).port = "/dev/ttyBODY";
+  params.section(params::kServoBusSection).enabled = false;
+  params.section(params::kServoBusSection).port = "/dev/ttySERVO";
   EXPECT_EQ(configuredPorts(params), (std::set<std::string>{"/dev/ttyUSB0", "/dev/ttyBODY"}));
 }
 

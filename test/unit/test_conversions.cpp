@@ -14,6 +14,8 @@ namespace serial_robot_driver::ros_layer {
 namespace {
 
 using protocol::body::Telemetry;
+using params::BodyParams;
+using params::ImuParams;
 
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 constexpr double kHalfSqrt2 = 0.70710678118654752;

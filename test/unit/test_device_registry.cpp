@@ -10,6 +10,7 @@
 
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::device {
@@ -31,7 +32,7 @@ TEST(DeviceRegistry, UniqueNamesTheBaseFirst) {
     EXPECT_TRUE(names.insert(device->name).second) << device->name;
     EXPECT_EQ(findDevice(device->name), device);
     EXPECT_FALSE(device->driver_frames.empty()) << device->name;
-    EXPECT_NE(device->port_params, nullptr) << device->name;
+    EXPECT_NO_THROW(params::DriverParams().portParams(*device)) << device->name;
   }
   for (const char* name : {"base", "body", "servo_bus"}) EXPECT_EQ(names.count(name), 1u) << name;
   EXPECT_STREQ(registeredDevices().front()->name, "base") << "the base starts and stops first";
@@ -56,7 +57,7 @@ TEST(DeviceRegistry, FrameFamiliesHaveUniqueNames) {
 TEST(DeviceRegistry, FramerOfEachCombinationAcceptsItsDevicesFamilies) {
   const auto& all = registeredDevices();
   params::DriverParams params;
-  params.body.servo_ids = {1, 2, 3};
+  params.section(params::kBodySection).servo_ids = {1, 2, 3};
   for (std::size_t mask = 1; mask < (std::size_t{1} << all.size()); ++mask) {
     std::vector<const DeviceModule*> devices;
     std::set<std::string> expected;

@@ -8,6 +8,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/ros/robot_description.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -156,16 +159,17 @@ TEST(YamlParamSource, ReadsTheDriversParametersWithTheirDefaults) {
   const YamlParamSource source(kOtherConfig);
   std::vector<std::string> unknown;
   const DriverParams params = loadParams(source, &unknown);
-  EXPECT_DOUBLE_EQ(params.base.controller.geometry.wheel_diameter, 0.1);
-  EXPECT_EQ(params.base.left_wheel_joint, "wheel_l");
-  EXPECT_EQ(params.body.servo_ids, (std::vector<int>{3, 4}));
-  EXPECT_EQ(params.body.directions, (std::vector<int>{1, -1}));
+  EXPECT_DOUBLE_EQ(params.section(params::kBaseSection).controller.geometry.wheel_diameter, 0.1);
+  EXPECT_EQ(params.section(params::kBaseSection).left_wheel_joint, "wheel_l");
+  EXPECT_EQ(params.section(params::kBodySection).servo_ids, (std::vector<int>{3, 4}));
+  EXPECT_EQ(params.section(params::kBodySection).directions, (std::vector<int>{1, -1}));
   EXPECT_EQ(params.loop_rate, DriverParams().loop_rate) << "absent: the driver's default";
-  EXPECT_TRUE(params.base.publish_tf);
-  EXPECT_EQ(params.servo_bus.joint_ids, (std::vector<int>{5}));
-  EXPECT_EQ(params.servo_bus.joint_names, (std::vector<std::string>{"gripper"}));
-  EXPECT_EQ(params.servo_bus.joint_zero_deg, (std::vector<double>{90.0}));
-  EXPECT_EQ(params.servo_bus.joint_directions, (std::vector<int>{-1}));
+  EXPECT_TRUE(params.section(params::kBaseSection).publish_tf);
+  EXPECT_EQ(params.section(params::kServoBusSection).joint_ids, (std::vector<int>{5}));
+  EXPECT_EQ(params.section(params::kServoBusSection).joint_names,
+            (std::vector<std::string>{"gripper"}));
+  EXPECT_EQ(params.section(params::kServoBusSection).joint_zero_deg, (std::vector<double>{90.0}));
+  EXPECT_EQ(params.section(params::kServoBusSection).joint_directions, (std::vector<int>{-1}));
 }
 
 TEST(RobotDescription, LinkNamesDropALeadingSlash) {

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/transport/recorded_stream.h"
 #include "support/framer_configs.h"

@@ -9,9 +9,12 @@
 
 #include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 
 namespace serial_robot_driver::ros_layer {
 namespace {
+
+using params::ServoBusParams;
 
 TEST(TrajectoryRos, CommandFromMessageKeepsEveryField) {
   trajectory_msgs::JointTrajectory msg;

@@ -5,15 +5,11 @@
 // parameter server into it (ros/driver_params.h).
 #pragma once
 
-#include <any>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/base/base_params.h"
-#include "serial_robot_driver/devices/body/body_params.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
+#include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/param_table.h"
 #include "serial_robot_driver/params/port_params.h"
 #include "serial_robot_driver/trajectory/tolerances.h"
@@ -36,33 +32,6 @@ struct EStopParams {
   bool start_engaged = false;
 };
 
-/// The parameter sections of devices that DriverParams has no member for: each device keeps its
-/// own struct here under its name (a device added by its folder alone uses this).
-class DeviceSections {
- public:
-  /// The section of `device`, created with its defaults on first use.
-  template <typename Section>
-  Section& get(const std::string& device) {
-    std::any& section = sections_[device];
-    if (!section.has_value()) section = Section{};
-    return std::any_cast<Section&>(section);
-  }
-  template <typename Section>
-  const Section& get(const std::string& device) const {
-    const auto found = sections_.find(device);
-    if (found == sections_.end()) {
-      static const Section defaults{};
-      return defaults;
-    }
-    return std::any_cast<const Section&>(found->second);
-  }
-
- private:
-  // Mutable: the table's rows reach a section through any DriverParams, a const one included, and a
-  // section is created with its defaults on first use (validate() at start-up touches them all).
-  mutable std::map<std::string, std::any> sections_;
-};
-
 /// The tf frame name of a frame parameter under `tf_prefix`, as robot_state_publisher resolves its
 /// links: "<prefix>/<frame>" with the prefix's own leading and trailing slashes dropped
 /// ("/robot1/" and "robot1" alike); a frame written with a leading '/' is taken as it is, without
@@ -70,9 +39,12 @@ class DeviceSections {
 std::string resolveFrame(const std::string& tf_prefix, const std::string& frame);
 
 struct DriverParams {
+  /// Every registered device's sections (DeviceModule::sections) with their defaults.
+  DriverParams();
+
   std::string port = "/dev/ttyUSB0";
   int baud = 115200;
-  double loop_rate = device::BaseConfig{}.loop_rate;  ///< Hz; the base controller's default
+  double loop_rate = 50.0;  ///< Hz: the devices' control loop
   double reconnect_interval = 1.0;
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
@@ -80,12 +52,8 @@ struct DriverParams {
   /// Not a parameter: the running replay's timeline (set by the node once the bag is read), which
   /// maps the frames' arrival times back to their recorded stamps.
   std::shared_ptr<const transport::ReplayPacing> replay_timeline;
-  // The robot's own devices' sections (their rows: src/devices/<name>/<name>_module.cpp).
-  BaseParams base;
-  BodyParams body;
-  ImuParams imu;
-  ServoBusParams servo_bus;
-  /// Sections of other registered devices.
+  /// The devices' own sections (their rows: src/devices/<name>/<name>_module.cpp), reached by
+  /// the keys their modules declare: section(kBaseSection).
   DeviceSections sections;
   TrajectoryParams trajectory;
   EStopParams e_stop;
@@ -93,7 +61,18 @@ struct DriverParams {
   /// robot_state_publisher does), so one value in a robot's namespace serves all its nodes.
   std::string tf_prefix;
 
-  /// Puts every frame parameter (base/odom_frame, base/base_frame, imu/frame_id) under tf_prefix
+  /// The section of `key` (declared by the device that owns it); throws std::logic_error for a
+  /// key no registered device lists.
+  template <typename Section>
+  Section& section(const SectionKey<Section>& key) {
+    return sections.get(key);
+  }
+  template <typename Section>
+  const Section& section(const SectionKey<Section>& key) const {
+    return sections.get(key);
+  }
+
+  /// Puts every device's frame parameters (DeviceModule::resolve_frames) under tf_prefix
   /// (resolveFrame). Loading from the parameter server calls it once, after reading tf_prefix.
   void resolveFrames();
 
@@ -109,12 +88,6 @@ struct DriverParams {
   /// The device's own port or baud, or the node-wide one it inherits.
   std::string portOf(const device::DeviceModule& device) const;
   int baudOf(const device::DeviceModule& device) const;
-  std::string basePort() const { return base.port.empty() ? port : base.port; }
-  std::string bodyPort() const { return body.port.empty() ? port : body.port; }
-  std::string servoBusPort() const { return servo_bus.port.empty() ? port : servo_bus.port; }
-  int baseBaud() const { return base.baud > 0 ? base.baud : baud; }
-  int bodyBaud() const { return body.baud > 0 ? body.baud : baud; }
-  int servoBusBaud() const { return servo_bus.baud > 0 ? servo_bus.baud : baud; }
   /// A topic's publisher queue: `live` frames (a slow subscriber drops old ones), but unbounded
   /// while replaying, where a full-speed replay must not lose what subscribers have not read yet.
   int publisherQueue(int live) const { return replay_bag.empty() ? live : 0; }

@@ -16,6 +16,7 @@
 
 namespace serial_robot_driver::ros_layer {
 
+
 /// The ROS time at which a steady_clock event happened: `ros_now` minus how long ago it was
 /// (`steady_now` - `event`). Saturates at ros::Time(0) instead of going negative.
 ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time& ros_now,

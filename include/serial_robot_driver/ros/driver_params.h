@@ -13,13 +13,8 @@ class NodeHandle;
 namespace serial_robot_driver::ros_layer {
 
 // The ROS layer uses the core's parameter types under their own names.
-using params::AxisMap;
-using params::BaseParams;
-using params::BodyParams;
 using params::DevicePortParams;
 using params::DriverParams;
-using params::ImuParams;
-using params::kMinBaseLoopRate;
 using params::loadParams;
 using params::ParamAssignment;
 using params::ParameterError;
@@ -27,9 +22,7 @@ using params::parameterTable;
 using params::ParamSource;
 using params::ParamSpec;
 using params::ParamValue;
-using params::parseAxisMap;
 using params::resolveFrame;
-using params::ServoBusParams;
 using params::toText;
 using params::TrajectoryParams;
 using params::tuneParams;

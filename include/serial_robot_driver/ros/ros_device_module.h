@@ -14,17 +14,18 @@
 
 namespace serial_robot_driver::ros_layer {
 
+/// Declared with named fields (designated initialisers); a field left out is null.
 struct RosDeviceModule {
   /// The core module's name (DeviceModule::name).
-  const char* name;
+  const char* name = nullptr;
   /// Builds the device's interface on its port (before the ports start).
   std::unique_ptr<DeviceInterface> (*make)(ros::NodeHandle& nh, const DriverParams& params,
-                                           device::SerialLink& link);
+                                           device::SerialLink& link) = nullptr;
   /// Starts the device's runtime tuning servers (addGroupServer, ros/tuning_group_server.h) under
   /// `private_nh` into `servers`; RuntimeTuning calls it while the device is enabled. Null: the
   /// device has nothing to tune.
   void (*add_tuning)(RuntimeTuning& tuning, const ros::NodeHandle& private_nh,
-                     RuntimeTuning::Servers& servers);
+                     RuntimeTuning::Servers& servers) = nullptr;
 };
 
 /// The registered devices' ROS sides, in the order of the devices (cmake/devices.cmake).

@@ -6,7 +6,6 @@
 // registry.
 #pragma once
 
-#include <any>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -19,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "serial_robot_driver/device/typed_value.h"
 #include "serial_robot_driver/protocol/frame_family.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/sim_types.h"
@@ -42,11 +42,11 @@ struct PortCounters {
   protocol::FramerStats all_ports;  ///< summed over every port
 };
 
-/// A device's counters in a stats snapshot: typed (read through the device's own accessor,
-/// <name>Stats(stats) in its <name>_sim.h) and as its stats-file lines.
+/// A device's counters in a stats snapshot: typed (its own struct, read through the device's own
+/// accessor, <name>Stats(stats) in its <name>_sim.h) and as its stats-file lines.
 struct DeviceSimStats {
   std::string name;
-  std::any counters;
+  device::TypedValue counters;
   std::vector<StatsLine> lines;
 };
 
@@ -72,18 +72,19 @@ struct HostedDeviceOptions {
   std::optional<std::string> link;  ///< its own pty; none: the shared one (SimOptions::link)
   /// Values of its options that have no apply function, as given (option -> text).
   std::map<std::string, std::string> settings;
-  /// Its typed settings (its <Name>SimConfig), made with their defaults on first use.
-  std::any config;
+  /// Its typed settings (its <Name>SimConfig), made with their defaults on first use; reading
+  /// them as another type throws std::logic_error.
+  device::TypedValue config;
 
   template <typename Config>
   Config& configAs() {
-    if (!config.has_value()) config = Config{};
-    return std::any_cast<Config&>(config);
+    if (config.empty()) config = Config{};
+    return config.as<Config>();
   }
   /// The defaults when nothing was set.
   template <typename Config>
   Config configAs() const {
-    return config.has_value() ? std::any_cast<const Config&>(config) : Config{};
+    return config.empty() ? Config{} : config.as<Config>();
   }
 };
 
@@ -100,28 +101,29 @@ struct SimDeviceOption {
   std::function<std::string(const HostedDeviceOptions& defaults)> shown_default;
 };
 
+/// Declared with named fields (designated initialisers); a field left out is empty, false or null.
 struct SimDeviceModule {
   /// The core module's name (DeviceModule::name).
-  const char* name;
+  const char* name = nullptr;
   /// What it is, for robot_sim's --help ("lidar on a UART").
-  const char* description;
+  const char* description = nullptr;
   /// True: simulated unless left out (--no-<name>); false: only when asked for (--<name>).
-  bool hosted_by_default;
+  bool hosted_by_default = false;
   /// Help of that switch ("leave the X out" / "simulate the X").
-  const char* toggle_help;
+  const char* toggle_help = nullptr;
   /// Its own-pty flag (empty: --<name>-link; a device may keep a shorter one) and its help.
-  const char* link_flag;
-  const char* link_help;
+  const char* link_flag = "";
+  const char* link_help = nullptr;
   /// Its random seed is the --seed value plus this (the seeded tests' results depend on it).
-  uint32_t seed_offset;
+  uint32_t seed_offset = 0;
   /// What it sends: RobotSim keeps send counters for each (in this order) while it is hosted.
   std::vector<const OutputKind*> outputs;
   /// Builds the hosted device; throws std::invalid_argument for a bad setting.
   std::unique_ptr<SimDevice> (*make)(const HostedDeviceOptions& options, uint32_t seed,
-                                     TimePoint now);
+                                     TimePoint now) = nullptr;
   /// Its counters while it is left out (all zero), so the stats file keeps the keys it always
   /// had; null: it writes none then.
-  DeviceSimStats (*left_out_stats)(const PortCounters& ports);
+  DeviceSimStats (*left_out_stats)(const PortCounters& ports) = nullptr;
   /// Its settings on the command line.
   std::vector<SimDeviceOption> options;
 };

@@ -3,7 +3,6 @@
 // counters are read through its own accessor (<name>Stats(stats) in its <name>_sim.h).
 #pragma once
 
-#include <any>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -50,8 +49,8 @@ struct SimStats {
   const Counters& countersOf(const std::string& name) const {
     static const Counters kNotSimulated{};
     const DeviceSimStats* device = findDevice(name);
-    const Counters* counters = device ? std::any_cast<Counters>(&device->counters) : nullptr;
-    return counters ? *counters : kNotSimulated;
+    if (device == nullptr || device->counters.empty()) return kNotSimulated;
+    return device->counters.as<Counters>();
   }
 };
 

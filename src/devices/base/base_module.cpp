@@ -4,7 +4,13 @@
 
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
+
+namespace serial_robot_driver::params {
+extern const SectionKey<BaseParams> kBaseSection{"base"};
+}
 
 namespace serial_robot_driver::devices::base {
 
@@ -17,51 +23,55 @@ using params::require;
 void addParameters(std::vector<params::ParamSpec>& table) {
   // Three kinds of rows, in the documented order: the wheel geometry and the controller's other
   // settings (bound into BaseParams::controller), and the ROS layer's own values.
-  using B = BaseParams;
-  using C = device::BaseConfig;
-  using G = kinematics::DiffDriveGeometry;
-  params::SectionRows<G> geometry(table, "base", "base",
-                                  [](DriverParams& p) -> G& { return p.base.controller.geometry; });
-  params::SectionRows<C> controller(table, "base", "base",
-                                    [](DriverParams& p) -> C& { return p.base.controller; });
-  params::SectionRows<B> own(table, "base", "base", [](DriverParams& p) -> B& { return p.base; });
+  using Own = BaseParams;
+  using Controller = device::BaseConfig;
+  using Geometry = kinematics::DiffDriveGeometry;
+  params::SectionRows<Geometry> geometry(table, "base", "base", [](DriverParams& p) -> Geometry& {
+    return p.section(params::kBaseSection).controller.geometry;
+  });
+  params::SectionRows<Controller> controller(
+      table, "base", "base",
+      [](DriverParams& p) -> Controller& { return p.section(params::kBaseSection).controller; });
+  params::SectionRows<Own> own(table, "base", "base", [](DriverParams& p) -> Own& {
+    return p.section(params::kBaseSection);
+  });
   geometry
-      .add("wheel_diameter", &G::wheel_diameter, params::positiveNumber)
+      .add("wheel_diameter", &Geometry::wheel_diameter, params::positiveNumber)
       // A whole number of ticks, which the geometry's arithmetic keeps as a double.
       .addConverted<int>(
-          "encoder_resolution", [](G& g) -> double& { return g.encoder_resolution; },
+          "encoder_resolution", [](Geometry& g) -> double& { return g.encoder_resolution; },
           [](int ticks) { return static_cast<double>(ticks); },
           [](double ticks) { return static_cast<int>(std::lround(ticks)); },
           params::positiveInteger)
-      .add("pid_rate", &G::pid_rate, params::positiveNumber)
-      .add("wheel_separation", &G::wheel_separation, params::positiveNumber);
+      .add("pid_rate", &Geometry::pid_rate, params::positiveNumber)
+      .add("wheel_separation", &Geometry::wheel_separation, params::positiveNumber);
   // > 0: there is no "no limit" value. No maximum: the base's top speed is not documented,
   // and the speed field's own range (int16 ticks per PID period) depends on tunable geometry.
-  controller.add("max_wheel_speed", &C::max_wheel_speed, params::positiveNumber)
-      .add("max_wheel_accel", &C::max_wheel_accel, params::nonNegativeNumber)
-      .add("cmd_vel_timeout", &C::cmd_vel_timeout,
+  controller.add("max_wheel_speed", &Controller::max_wheel_speed, params::positiveNumber)
+      .add("max_wheel_accel", &Controller::max_wheel_accel, params::nonNegativeNumber)
+      .add("cmd_vel_timeout", &Controller::cmd_vel_timeout,
            [](const double& value, const std::string& key) {
              // Bounded: the deadman that stops the base when its client dies is not tuned away.
              params::positiveNumber(value, key);
-             params::numberWithin(0.0, C::kMaxCmdVelTimeout,
+             params::numberWithin(0.0, Controller::kMaxCmdVelTimeout,
                                   "s (at most: the deadman that stops the base)")(value, key);
            })
-      .add("speed_dithering", &C::speed_dithering)
-      .add("battery_poll_rate", &C::battery_poll_rate, params::nonNegativeNumber);
-  own.add("battery_warn_percent", &B::battery_warn_percent, params::percent)
-      .add("battery_error_percent", &B::battery_error_percent, params::percent)
-      .add("odom_frame", &B::odom_frame, params::frameId)
-      .add("base_frame", &B::base_frame, params::frameId)
-      .add("publish_tf", &B::publish_tf);
-  controller.add("left_wheel_direction", &C::left_wheel_direction, params::direction)
-      .add("right_wheel_direction", &C::right_wheel_direction, params::direction);
-  own.add("left_wheel_joint", &B::left_wheel_joint, params::frameId)
-      .add("right_wheel_joint", &B::right_wheel_joint, params::frameId);
-  controller.add("use_imu_heading", &C::use_imu_heading);
+      .add("speed_dithering", &Controller::speed_dithering)
+      .add("battery_poll_rate", &Controller::battery_poll_rate, params::nonNegativeNumber);
+  own.add("battery_warn_percent", &Own::battery_warn_percent, params::percent)
+      .add("battery_error_percent", &Own::battery_error_percent, params::percent)
+      .add("odom_frame", &Own::odom_frame, params::frameId)
+      .add("base_frame", &Own::base_frame, params::frameId)
+      .add("publish_tf", &Own::publish_tf);
+  controller.add("left_wheel_direction", &Controller::left_wheel_direction, params::direction)
+      .add("right_wheel_direction", &Controller::right_wheel_direction, params::direction);
+  own.add("left_wheel_joint", &Own::left_wheel_joint, params::frameId)
+      .add("right_wheel_joint", &Own::right_wheel_joint, params::frameId);
+  controller.add("use_imu_heading", &Controller::use_imu_heading);
 }
 
 void validate(const DriverParams& p) {
-  const BaseParams& base = p.base;
+  const BaseParams& base = p.section(params::kBaseSection);
   // Every tick's wheel frame is the base's heartbeat; it stops with a timeout error after 1 s
   // without one. 5 Hz leaves five frames in that second, so one lost frame is harmless.
   std::ostringstream rate;
@@ -80,26 +90,31 @@ void validate(const DriverParams& p) {
   require(base.left_wheel_joint != base.right_wheel_joint, "base/right_wheel_joint",
           "must differ from base/left_wheel_joint ('" + base.left_wheel_joint + "')");
   if (base.controller.use_imu_heading) {
-    require(p.body.enabled, "base/use_imu_heading",
+    require(p.enabled("body"), "base/use_imu_heading",
             "needs the servo controller board's IMU, but body/enabled is false");
     require(
-        p.imu.orientation_variance >= 0, "base/use_imu_heading",
+        p.section(params::kImuSection).orientation_variance >= 0, "base/use_imu_heading",
         "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
   }
+}
+
+void resolveFrames(DriverParams& p) {
+  BaseParams& base = p.section(params::kBaseSection);
+  base.odom_frame = params::resolveFrame(p.tf_prefix, base.odom_frame);
+  base.base_frame = params::resolveFrame(p.tf_prefix, base.base_frame);
 }
 
 }  // namespace
 
 extern const device::DeviceModule kModule{
-    "base",
-    "Base",
-    {protocol::base::kFrames},
-    {protocol::base::kFrames},
-    [](DriverParams& p) -> params::DevicePortParams& { return p.base; },
-    addParameters,
-    validate,
-    nullptr,
-    nullptr,
+    .name = "base",
+    .title = "Base",
+    .driver_frames = {protocol::base::kFrames},
+    .simulator_frames = {protocol::base::kFrames},
+    .sections = {&params::kBaseSection},
+    .add_parameters = addParameters,
+    .validate = validate,
+    .resolve_frames = resolveFrames,
 };
 
 }  // namespace serial_robot_driver::devices::base

@@ -5,7 +5,13 @@
 
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
+
+namespace serial_robot_driver::params {
+extern const SectionKey<BodyParams> kBodySection{"body"};
+extern const SectionKey<ImuParams> kImuSection{"imu"};
+}  // namespace serial_robot_driver::params
 
 namespace serial_robot_driver::devices::body {
 
@@ -34,69 +40,81 @@ void servoIds(const std::vector<int>& ids, const std::string& key) {
 void addParameters(std::vector<params::ParamSpec>& table) {
   // The board's own values and the calibration every joint shares (BodyParams::calibration), in
   // the documented order.
-  using B = BodyParams;
-  using C = device::JointCalibration;
-  params::SectionRows<B> own(table, "body", "body", [](DriverParams& p) -> B& { return p.body; });
-  params::SectionRows<C> joints(table, "body", "body",
-                                [](DriverParams& p) -> C& { return p.body.calibration; });
-  own.add("servo_ids", &B::servo_ids, servoIds)
-      .add("joint_names", &B::joint_names, params::uniqueNames);
-  joints.add("ticks_per_revolution", &C::ticks_per_revolution,
+  using Own = BodyParams;
+  using Calibration = device::JointCalibration;
+  params::SectionRows<Own> own(table, "body", "body", [](DriverParams& p) -> Own& {
+    return p.section(params::kBodySection);
+  });
+  params::SectionRows<Calibration> joints(
+      table, "body", "body",
+      [](DriverParams& p) -> Calibration& { return p.section(params::kBodySection).calibration; });
+  own.add("servo_ids", &Own::servo_ids, servoIds)
+      .add("joint_names", &Own::joint_names, params::uniqueNames);
+  joints.add("ticks_per_revolution", &Calibration::ticks_per_revolution,
              [](const int& v, const std::string& key) { require(v > 0, key, "must be > 0"); });
-  own.add("zero_ticks", &B::zero_ticks,
+  own.add("zero_ticks", &Own::zero_ticks,
           [](const std::vector<int>& zeros, const std::string& key) {
             for (int zero : zeros)
               require(zero >= 0 && zero <= 65535, key, "entries must be 0..65535");
           })
-      .add("directions", &B::directions, params::directionList);
-  joints.add("velocity_scale", &C::velocity_scale, params::nonNegativeNumber);
+      .add("directions", &Own::directions, params::directionList);
+  joints.add("velocity_scale", &Calibration::velocity_scale, params::nonNegativeNumber);
   // The IMU is the board's: its keys are checked while the body is enabled.
-  using I = ImuParams;
-  params::SectionRows<I>(table, "body", "imu", [](DriverParams& p) -> I& { return p.imu; })
-      .add("frame_id", &I::frame_id,
+  params::SectionRows<ImuParams>(
+      table, "body", "imu",
+      [](DriverParams& p) -> ImuParams& { return p.section(params::kImuSection); })
+      .add("frame_id", &ImuParams::frame_id,
            [](const std::string& v, const std::string& key) {
              require(!v.empty(), key, "must not be empty");
            })
-      .add("axis_map", &I::axis_map,
+      .add("axis_map", &ImuParams::axis_map,
            [](const std::vector<std::string>& entries, const std::string& key) {
              std::string problem;
              require(params::parseAxisMap(entries, &problem).has_value(), key, problem);
            })
-      .add("accel_scale", &I::accel_scale, params::positiveNumber)
-      .add("gyro_scale", &I::gyro_scale, params::positiveNumber)
-      .add("angle_scale", &I::angle_scale, params::positiveNumber)
-      .add("orientation_variance", &I::orientation_variance, params::finiteNumber)
-      .add("angular_velocity_variance", &I::angular_velocity_variance, params::nonNegativeNumber)
-      .add("linear_acceleration_variance", &I::linear_acceleration_variance,
+      .add("accel_scale", &ImuParams::accel_scale, params::positiveNumber)
+      .add("gyro_scale", &ImuParams::gyro_scale, params::positiveNumber)
+      .add("angle_scale", &ImuParams::angle_scale, params::positiveNumber)
+      .add("orientation_variance", &ImuParams::orientation_variance, params::finiteNumber)
+      .add("angular_velocity_variance", &ImuParams::angular_velocity_variance,
            params::nonNegativeNumber)
-      .add("calibration_time", &I::calibration_time, params::numberWithin(0.1, 60.0, "s"))
-      .add("calibrate_on_start", &I::calibrate_on_start);
+      .add("linear_acceleration_variance", &ImuParams::linear_acceleration_variance,
+           params::nonNegativeNumber)
+      .add("calibration_time", &ImuParams::calibration_time, params::numberWithin(0.1, 60.0, "s"))
+      .add("calibrate_on_start", &ImuParams::calibrate_on_start);
 }
 
 void validate(const DriverParams& p) {
-  const std::size_t n = p.body.servo_ids.size();
+  const BodyParams& body = p.section(params::kBodySection);
+  const std::size_t n = body.servo_ids.size();
   const auto requireOnePerServo = [n](std::size_t size, const std::string& name) {
     require(size == n, name,
             "has " + std::to_string(size) + " entries but body/servo_ids has " + std::to_string(n));
   };
-  requireOnePerServo(p.body.joint_names.size(), "body/joint_names");
-  requireOnePerServo(p.body.zero_ticks.size(), "body/zero_ticks");
-  requireOnePerServo(p.body.directions.size(), "body/directions");
+  requireOnePerServo(body.joint_names.size(), "body/joint_names");
+  requireOnePerServo(body.zero_ticks.size(), "body/zero_ticks");
+  requireOnePerServo(body.directions.size(), "body/directions");
+}
+
+void resolveFrames(DriverParams& p) {
+  ImuParams& imu = p.section(params::kImuSection);
+  imu.frame_id = params::resolveFrame(p.tf_prefix, imu.frame_id);
 }
 
 }  // namespace
 
 extern const device::DeviceModule kModule{
-    "body",
-    "Body",
-    {protocol::body::kTelemetryFrames},
-    {protocol::body::kSyncWriteFrames},
-    [](DriverParams& p) -> params::DevicePortParams& { return p.body; },
-    addParameters,
-    validate,
+    .name = "body",
+    .title = "Body",
+    .driver_frames = {protocol::body::kTelemetryFrames},
+    .simulator_frames = {protocol::body::kSyncWriteFrames},
+    .sections = {&params::kBodySection, &params::kImuSection},
+    .add_parameters = addParameters,
+    .validate = validate,
+    .resolve_frames = resolveFrames,
     // A telemetry frame's LEN depends on how many servos it carries.
-    [](const DriverParams& p) { return p.body.servo_ids.size(); },
-    nullptr,
+    .probe_argument =
+        [](const DriverParams& p) { return p.section(params::kBodySection).servo_ids.size(); },
 };
 
 }  // namespace serial_robot_driver::devices::body

@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "serial_robot_driver/devices/base/base_controller.h"
+#include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/driver_params.h"
@@ -56,10 +57,10 @@ class BaseInterface : public DeviceInterface {
   const bool replaying_;          // ~replay_bag: headings arrive stamped with the recording's clock
   const double loop_rate_;        // Hz, as started
   ArrivalStamps arrival_stamps_;  // before controller_: its events use it
-  const BaseParams params_;       // as started: frames and joint names (the tunables: tuned())
+  const params::BaseParams params_;  // as started: frames and joint names (the tunables: tuned())
   /// ~base as last tuned, swapped whole by retune() (read on the loop and diagnostics threads).
-  std::shared_ptr<const BaseParams> tuned() const { return std::atomic_load(&tuned_); }
-  std::shared_ptr<const BaseParams> tuned_;
+  std::shared_ptr<const params::BaseParams> tuned() const { return std::atomic_load(&tuned_); }
+  std::shared_ptr<const params::BaseParams> tuned_;
   // Before the controller: its loop publishes through them until it stops.
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
   ros::Publisher odom_pub_;

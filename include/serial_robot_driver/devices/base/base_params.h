@@ -4,6 +4,7 @@
 #include <string>
 
 #include "serial_robot_driver/devices/base/base_controller.h"
+#include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
@@ -23,6 +24,9 @@ struct BaseParams : DevicePortParams {
   std::string left_wheel_joint = "left_wheel_joint";  ///< wheel_states and robot description names
   std::string right_wheel_joint = "right_wheel_joint";
 };
+
+/// The key of the base's section (DeviceModule::sections): params.section(kBaseSection).
+extern const SectionKey<BaseParams> kBaseSection;
 
 /// Below this loop rate the base's 1 s heartbeat is at risk (the base's checks say so).
 constexpr double kMinBaseLoopRate = 5.0;

@@ -80,7 +80,7 @@ class BodyInterface : public DeviceInterface {
   const ArrivalStamps arrival_stamps_;
   /// Swapped whole by retune() (~imu scales) and loaded once per frame by the reader thread, so
   /// a frame is converted with one set of scales (std::atomic_load / atomic_store).
-  std::shared_ptr<const ImuParams> imu_params_;
+  std::shared_ptr<const params::ImuParams> imu_params_;
   // Set before the links start, read on the reader and calibration threads.
   const device::MotionQuery* motion_query_ = nullptr;
   device::EStop* e_stop_ = nullptr;             // the node's, set before start()

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
@@ -49,5 +50,9 @@ struct ImuParams {
   /// Calibrate the gyro bias once, when telemetry first arrives and the base is still.
   bool calibrate_on_start = false;
 };
+
+/// The keys of the body's sections (DeviceModule::sections): its own and its IMU's.
+extern const SectionKey<BodyParams> kBodySection;
+extern const SectionKey<ImuParams> kImuSection;
 
 }  // namespace serial_robot_driver::params

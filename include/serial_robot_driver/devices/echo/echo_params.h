@@ -1,7 +1,8 @@
-// The echo device's parameter section (~echo/...), kept in DriverParams::sections (it has no
-// member there): rows in src/devices/echo/echo_module.cpp.
+// The echo device's parameter section (~echo/...), reached like every device's through the key
+// its module declares: rows in src/devices/echo/echo_module.cpp.
 #pragma once
 
+#include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
@@ -12,5 +13,8 @@ struct EchoParams : DevicePortParams {
   /// ms an answer may take before a ping counts as timed out.
   int timeout_ms = 200;
 };
+
+/// The key of the echo device's section (DeviceModule::sections).
+extern const SectionKey<EchoParams> kEchoSection;
 
 }  // namespace serial_robot_driver::params

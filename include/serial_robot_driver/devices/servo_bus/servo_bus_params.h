@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
+#include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
@@ -25,5 +26,8 @@ struct ServoBusParams : DevicePortParams {
   std::vector<double> joint_zero_deg;  ///< servo angle at joint position 0; empty: all 0
   std::vector<int> joint_directions;   ///< 1 or -1; empty: all 1
 };
+
+/// The key of the bus's section (DeviceModule::sections): params.section(kServoBusSection).
+extern const SectionKey<ServoBusParams> kServoBusSection;
 
 }  // namespace serial_robot_driver::params

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "serial_robot_driver/description/robot_description.h"
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::devices::base {
 
@@ -30,7 +32,7 @@ void drawWheel(UrdfWriter& urdf, const std::string& base_link, const std::string
 Chassis drawChassis(const ros_layer::DriverParams& params, UrdfWriter& urdf) {
   // Simple shapes sized from the wheel geometry: base_link on the ground between the wheels
   // (REP-105), the axle at the wheel radius, a box chassis and a rear caster ball.
-  const ros_layer::BaseParams& section = params.base;
+  const params::BaseParams& section = params.section(params::kBaseSection);
   const kinematics::DiffDriveGeometry& wheels = section.controller.geometry;
   const double radius = wheels.wheel_diameter / 2.0;
   const double wheel_width = std::min(0.25 * wheels.wheel_diameter, 0.3 * wheels.wheel_separation);

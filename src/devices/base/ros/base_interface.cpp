@@ -10,7 +10,9 @@
 #include <sstream>
 
 #include "serial_robot_driver/WheelCommand.h"
+#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/base/base_status.h"
+#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
@@ -20,10 +22,10 @@ namespace serial_robot_driver::ros_layer {
 device::BaseConfig makeBaseConfig(const DriverParams& params) {
   // The base's own parameters are bound into its configuration already (base_module.cpp); these
   // come from node-wide or other devices' parameters.
-  device::BaseConfig config = params.base.controller;
+  device::BaseConfig config = params.section(params::kBaseSection).controller;
   config.loop_rate = params.loop_rate;
-  config.baud = params.baseBaud();
-  config.imu_yaw_variance = params.imu.orientation_variance;
+  config.baud = params.baudOf(*device::findDevice("base"));
+  config.imu_yaw_variance = params.section(params::kImuSection).orientation_variance;
   return config;
 }
 
@@ -80,10 +82,11 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
       replaying_(!params.replay_bag.empty()),
       loop_rate_(params.loop_rate),
       arrival_stamps_(params),
-      params_(params.base),
-      tuned_(std::make_shared<const BaseParams>(params.base)),
-      tf_broadcaster_(params.base.publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
-                                             : nullptr),
+      params_(params.section(params::kBaseSection)),
+      tuned_(std::make_shared<const params::BaseParams>(params.section(params::kBaseSection))),
+      tf_broadcaster_(params.section(params::kBaseSection).publish_tf
+                          ? std::make_unique<tf2_ros::TransformBroadcaster>()
+                          : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
       controller_(makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
@@ -157,7 +160,8 @@ void BaseInterface::publishWheelStates(const device::OdometrySample& sample,
 
 void BaseInterface::retune(const DriverParams& params) {
   controller_.retune(makeBaseConfig(params));
-  std::atomic_store(&tuned_, std::make_shared<const BaseParams>(params.base));
+  std::atomic_store(
+      &tuned_, std::make_shared<const params::BaseParams>(params.section(params::kBaseSection)));
 }
 
 bool BaseInterface::onResetOdometry(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -184,7 +188,7 @@ bool BaseInterface::onClearEncoders(std_srvs::Trigger::Request&, std_srvs::Trigg
 }
 
 device::StatusReport BaseInterface::status() {
-  const std::shared_ptr<const BaseParams> limits = tuned();
+  const std::shared_ptr<const params::BaseParams> limits = tuned();
   return device::baseStatus(controller_.stats(), {link_.options().path, link_.connected()},
                             {limits->battery_warn_percent, limits->battery_error_percent});
 }

@@ -16,6 +16,9 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_
 }  // namespace
 
 extern const ros_layer::RosDeviceModule kRosModule{
-    "base", ros_layer::makeInterface<ros_layer::BaseInterface>, addTuning};
+    .name = "base",
+    .make = ros_layer::makeInterface<ros_layer::BaseInterface>,
+    .add_tuning = addTuning,
+};
 
 }  // namespace serial_robot_driver::devices::base

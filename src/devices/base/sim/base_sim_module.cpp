@@ -85,17 +85,17 @@ BaseSimStats baseStats(SimStats&& stats) { return stats.countersOf<BaseSimStats>
 namespace serial_robot_driver::devices::base {
 
 extern const sim::SimDeviceModule kSimModule{
-    sim::kName,
-    "AP1 base",
-    true,
-    "leave the base out",
-    "--base-link",
-    "own pty for the base (devices naming the same link share a pty)",
-    0,  // the base draws nothing at random
-    {&sim::kBaseReplyOutput},
-    sim::makeBaseSim,
-    sim::leftOutStats,
-    {
+    .name = sim::kName,
+    .description = "AP1 base",
+    .hosted_by_default = true,
+    .toggle_help = "leave the base out",
+    .link_flag = "--base-link",
+    .link_help = "own pty for the base (devices naming the same link share a pty)",
+    .seed_offset = 0,  // the base draws nothing at random
+    .outputs = {&sim::kBaseReplyOutput},
+    .make = sim::makeBaseSim,
+    .left_out_stats = sim::leftOutStats,
+    .options = {
         sim::wholeOption("--battery", "PCT", "battery percent the base reports", 100,
                          &sim::BaseSimConfig::battery_percent, true),
         sim::numberOption("--turn-slip", "FRACTION",

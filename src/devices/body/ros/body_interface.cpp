@@ -15,7 +15,7 @@ namespace serial_robot_driver::ros_layer {
 
 namespace {
 
-device::GyroUnits gyroUnits(const ImuParams& imu) {
+device::GyroUnits gyroUnits(const params::ImuParams& imu) {
   // validate() refused an axis map that does not parse at start-up.
   return {imu.gyro_scale, params::parseAxisMap(imu.axis_map, nullptr).value_or(params::AxisMap{})};
 }
@@ -26,10 +26,10 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)
     : link_(link),
       arrival_stamps_(params),
-      imu_params_(std::make_shared<const ImuParams>(params.imu)),
+      imu_params_(std::make_shared<const params::ImuParams>(params.section(params::kImuSection))),
       gyro_calibrator_([this] { return notStill(); }),
       controller_(
-          makeBodyJoints(params.body), link.writer(),
+          makeBodyJoints(params.section(params::kBodySection)), link.writer(),
           {[this](const protocol::body::Telemetry& telemetry, device::Clock::time_point arrival) {
             publishTelemetry(telemetry, arrival);
           }}),
@@ -52,7 +52,7 @@ BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
   calibration_nh_.setCallbackQueue(&calibration_queue_);
   calibrate_srv_ = advertiseGuarded(calibration_nh_, inputRefusals(), "imu/calibrate",
                                     &BodyInterface::onCalibrate, this);
-  if (params.imu.calibrate_on_start) {
+  if (params.section(params::kImuSection).calibrate_on_start) {
     gyro_calibrator_.calibrateOnStart([](const device::GyroCalibrationOutcome& outcome) {
       if (outcome.success) {
         ROS_INFO("imu/calibrate_on_start: %s", outcome.message.c_str());
@@ -76,7 +76,7 @@ std::string BodyInterface::notStill() const {
 
 bool BodyInterface::onCalibrate(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   // On calibration_queue_'s own thread: blocking here for the averaging holds up nothing else.
-  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
+  const std::shared_ptr<const params::ImuParams> imu = std::atomic_load(&imu_params_);
   const device::GyroCalibrationOutcome outcome =
       gyro_calibrator_.calibrate(imu->calibration_time, gyroUnits(*imu), "imu/calibrate");
   res.success = outcome.success;
@@ -90,7 +90,8 @@ bool BodyInterface::onCalibrate(std_srvs::Trigger::Request&, std_srvs::Trigger::
 }
 
 void BodyInterface::retune(const DriverParams& params) {
-  std::atomic_store(&imu_params_, std::make_shared<const ImuParams>(params.imu));
+  std::atomic_store(&imu_params_,
+                    std::make_shared<const params::ImuParams>(params.section(params::kImuSection)));
 }
 
 void BodyInterface::shutdown() {
@@ -132,7 +133,7 @@ void BodyInterface::publishTelemetry(const protocol::body::Telemetry& telemetry,
   if (joint_states_pub_.getNumSubscribers() > 0) {
     joint_states_pub_.publish(joint_state);
   }
-  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
+  const std::shared_ptr<const params::ImuParams> imu = std::atomic_load(&imu_params_);
   if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);
   // Every frame feeds the calibration, subscribers or not (calibrate_on_start, imu/calibrate).
   namespace body = protocol::body;

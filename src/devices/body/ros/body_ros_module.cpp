@@ -16,6 +16,9 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_
 }  // namespace
 
 extern const ros_layer::RosDeviceModule kRosModule{
-    "body", ros_layer::makeInterface<ros_layer::BodyInterface>, addTuning};
+    .name = "body",
+    .make = ros_layer::makeInterface<ros_layer::BodyInterface>,
+    .add_tuning = addTuning,
+};
 
 }  // namespace serial_robot_driver::devices::body

@@ -98,17 +98,17 @@ BodySimStats bodyStats(SimStats&& stats) { return stats.countersOf<BodySimStats>
 namespace serial_robot_driver::devices::body {
 
 extern const sim::SimDeviceModule kSimModule{
-    sim::kName,
-    "servo controller board",
-    true,
-    "leave the servo controller board out",
-    "--body-link",
-    "own pty for the servo controller board",
-    1,  // the IMU noise: seeded tests depend on --seed + 1
-    {&sim::kTelemetryOutput},
-    sim::makeBodySim,
-    sim::leftOutStats,
-    {
+    .name = sim::kName,
+    .description = "servo controller board",
+    .hosted_by_default = true,
+    .toggle_help = "leave the servo controller board out",
+    .link_flag = "--body-link",
+    .link_help = "own pty for the servo controller board",
+    .seed_offset = 1,  // the IMU noise: seeded tests depend on --seed + 1
+    .outputs = {&sim::kTelemetryOutput},
+    .make = sim::makeBodySim,
+    .left_out_stats = sim::leftOutStats,
+    .options = {
         sim::idListOption("--servo-ids", "1,2", "body servo ids in telemetry order",
                           protocol::body::kMaxTelemetryServos, "fit in a telemetry frame",
                           &sim::BodySimConfig::servo_ids, true),

@@ -11,10 +11,8 @@ namespace serial_robot_driver::ros_layer {
 EchoInterface::EchoInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)
     : link_(link),
-      controller_(
-          link.writer(),
-          std::chrono::milliseconds(
-              params.sections.get<serial_robot_driver::params::EchoParams>("echo").timeout_ms)) {
+      controller_(link.writer(),
+                  std::chrono::milliseconds(params.section(params::kEchoSection).timeout_ms)) {
   ping_srv_ = advertiseGuarded(nh, inputRefusals(), "echo/ping", &EchoInterface::onPing, this);
   link.addListener(&controller_);
 }

@@ -3,7 +3,10 @@
 
 namespace serial_robot_driver::devices::echo {
 
+// Nothing to tune: no add_tuning.
 extern const ros_layer::RosDeviceModule kRosModule{
-    "echo", ros_layer::makeInterface<ros_layer::EchoInterface>, nullptr /* nothing to tune */};
+    .name = "echo",
+    .make = ros_layer::makeInterface<ros_layer::EchoInterface>,
+};
 
 }  // namespace serial_robot_driver::devices::echo

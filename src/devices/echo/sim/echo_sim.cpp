@@ -67,17 +67,16 @@ std::unique_ptr<sim::SimDevice> makeEchoSim(const sim::HostedDeviceOptions& opti
 
 }  // namespace
 
+// Not one of the robot's own: hosted only when asked for, and no stats unless hosted (no
+// left_out_stats).
 extern const sim::SimDeviceModule kSimModule{
-    "echo",
-    "echo device",
-    false,
-    "simulate the echo device (on the shared pty)",
-    "",
-    "own pty for the echo device (hosts it)",
-    10,  // draws nothing at random; kept apart from the robot's own devices' seeds
-    {&sim::kEchoAnswerOutput},
-    makeEchoSim,
-    nullptr,  // not one of the robot's own: no stats unless hosted
-    {{"latency-ms", "MS", "echo answer latency (default 0)", nullptr, nullptr}}};
+    .name = "echo",
+    .description = "echo device",
+    .toggle_help = "simulate the echo device (on the shared pty)",
+    .link_help = "own pty for the echo device (hosts it)",
+    .seed_offset = 10,  // draws nothing at random; kept apart from the robot's own devices' seeds
+    .outputs = {&sim::kEchoAnswerOutput},
+    .make = makeEchoSim,
+    .options = {{"latency-ms", "MS", "echo answer latency (default 0)", nullptr, nullptr}}};
 
 }  // namespace serial_robot_driver::devices::echo

@@ -146,7 +146,7 @@ TEST(EchoParameters, TheTableHasItsRowsAndItIsOffByDefault) {
   params::specFor("echo/enabled").set(on, true);
   params::specFor("echo/timeout").set(on, 50);
   EXPECT_TRUE(on.enabled("echo"));
-  EXPECT_EQ(on.sections.get<params::EchoParams>("echo").timeout_ms, 50);
+  EXPECT_EQ(on.section(params::kEchoSection).timeout_ms, 50);
   EXPECT_NO_THROW(on.validate());
   // 1 ms cannot carry a whole answer at 9600 baud.
   params::specFor("echo/baud").set(on, 9600);

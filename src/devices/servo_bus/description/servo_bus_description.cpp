@@ -4,6 +4,8 @@
 
 #include "serial_robot_driver/description/robot_description.h"
 #include "serial_robot_driver/devices/servo_bus/bus_trajectory_joints.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
+#include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::devices::servo_bus {
 
@@ -11,9 +13,9 @@ namespace {
 
 std::vector<description::ServoJoint> servoJoints(const ros_layer::DriverParams& params) {
   std::vector<description::ServoJoint> servos;
-  if (!params.servo_bus.enabled) return servos;
+  if (!params.section(params::kServoBusSection).enabled) return servos;
   constexpr double kMaxBusServoSpeedDps = 750.0;  // servo/move's velocity limit
-  for (const trajectory::BusJoint& joint : trajectory::makeBusJoints(params.servo_bus)) {
+  for (const trajectory::BusJoint& joint : trajectory::makeBusJoints(params.section(params::kServoBusSection))) {
     const trajectory::JointRange range = joint.range();
     servos.push_back({joint.name, "servo_bus/joint_names", range.min_position, range.max_position,
                       kMaxBusServoSpeedDps * M_PI / 180.0});

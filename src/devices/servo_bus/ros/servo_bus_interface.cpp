@@ -28,17 +28,18 @@ ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t inte
 }
 
 device::ServoBusConfig makeServoBusConfig(const DriverParams& params) {
-  device::ServoBusConfig config = params.servo_bus.bus;
-  for (int id : params.servo_bus.state_ids) config.polled_ids.push_back(static_cast<uint8_t>(id));
+  device::ServoBusConfig config = params.section(params::kServoBusSection).bus;
+  for (int id : params.section(params::kServoBusSection).state_ids)
+    config.polled_ids.push_back(static_cast<uint8_t>(id));
   // Joint servos are polled too: their angles are the trajectories' measurements.
-  for (int id : params.servo_bus.joint_ids) {
+  for (int id : params.section(params::kServoBusSection).joint_ids) {
     const auto joint_id = static_cast<uint8_t>(id);
     if (std::find(config.polled_ids.begin(), config.polled_ids.end(), joint_id) ==
         config.polled_ids.end()) {
       config.polled_ids.push_back(joint_id);
     }
   }
-  for (int id : params.servo_bus.joint_ids) {
+  for (int id : params.section(params::kServoBusSection).joint_ids) {
     config.identity.joint_ids.push_back(static_cast<uint8_t>(id));
   }
   return config;
@@ -101,20 +102,20 @@ device::ServoBusEvents ServoBusInterface::makeEvents() {
 
 ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& params,
                                      device::SerialLink& link)
-    : bus_joints_(makeBusJoints(params.servo_bus)),
-      state_rate_(params.servo_bus.bus.poll_rate),
+    : bus_joints_(makeBusJoints(params.section(params::kServoBusSection))),
+      state_rate_(params.section(params::kServoBusSection).bus.poll_rate),
       link_(link),
       bus_(makeServoBusConfig(params), link.writer(), makeEvents()),
       claims_(bus_, bus_joints_),
       services_(nh, bus_, claims_, inputRefusals()),
       topics_nh_(nh),
-      command_interval_ms_(static_cast<uint16_t>(params.servo_bus.command_interval_ms)),
+      command_interval_ms_(static_cast<uint16_t>(params.section(params::kServoBusSection).command_interval_ms)),
       diagnostics_(bus_, link) {
   // The bus's worker (the poll, the queued moves) runs on the port's reader thread: a poll writes
   // its request and reads the answer itself, with no second thread to wake per transaction.
   bus_.runOn(link_);
 
-  if (params.servo_bus.bus.client.allow_dangerous_writes) {
+  if (params.section(params::kServoBusSection).bus.client.allow_dangerous_writes) {
     ROS_WARN(
         "servo_bus: dangerous writes (servo_id, baudrate, response_switch, reserved cells, "
         "reset_user_data) are ARMED");
@@ -128,8 +129,8 @@ ServoBusInterface::ServoBusInterface(ros::NodeHandle& nh, const DriverParams& pa
 
 void ServoBusInterface::retune(const DriverParams& params) {
   bus_.retune(makeServoBusConfig(params));
-  command_interval_ms_.store(static_cast<uint16_t>(params.servo_bus.command_interval_ms));
-  claims_.followPollRate(params.servo_bus.bus.poll_rate);
+  command_interval_ms_.store(static_cast<uint16_t>(params.section(params::kServoBusSection).command_interval_ms));
+  claims_.followPollRate(params.section(params::kServoBusSection).bus.poll_rate);
 }
 
 void ServoBusInterface::onServoCommands(const sensor_msgs::JointState::ConstPtr& msg) {

@@ -16,6 +16,9 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_
 }  // namespace
 
 extern const ros_layer::RosDeviceModule kRosModule{
-    "servo_bus", ros_layer::makeInterface<ros_layer::ServoBusInterface>, addTuning};
+    .name = "servo_bus",
+    .make = ros_layer::makeInterface<ros_layer::ServoBusInterface>,
+    .add_tuning = addTuning,
+};
 
 }  // namespace serial_robot_driver::devices::servo_bus

@@ -104,17 +104,17 @@ ServoBusSimStats servoBusStats(SimStats&& stats) {
 namespace serial_robot_driver::devices::servo_bus {
 
 extern const sim::SimDeviceModule kSimModule{
-    sim::kName,
-    "UART bus servos",
-    true,
-    "leave the servo bus out",
-    "--servo-link",
-    "own pty for the servo bus",
-    2,  // the drifting readings: seeded tests depend on --seed + 2
-    {&sim::kServoAnswerOutput},
-    sim::makeServoBusSim,
-    sim::leftOutStats,
-    {
+    .name = sim::kName,
+    .description = "UART bus servos",
+    .hosted_by_default = true,
+    .toggle_help = "leave the servo bus out",
+    .link_flag = "--servo-link",
+    .link_help = "own pty for the servo bus",
+    .seed_offset = 2,  // the drifting readings: seeded tests depend on --seed + 2
+    .outputs = {&sim::kServoAnswerOutput},
+    .make = sim::makeServoBusSim,
+    .left_out_stats = sim::leftOutStats,
+    .options = {
         sim::idListOption("--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX, "",
                           &sim::ServoBusSimConfig::servo_ids, true),
         sim::idListOption("--offline-ids", "7", "ids that never answer", SIZE_MAX, "",

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <string>
 
+#include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::params {
@@ -28,7 +29,7 @@ TEST(ServoBusRows, TimeoutInSecondsIsTheClientsMilliseconds) {
   DriverParams p;
   EXPECT_EQ(specFor("servo_bus/timeout").get(p), ParamValue(0.05)) << "the client's default";
   specFor("servo_bus/timeout").set(p, 0.25);
-  EXPECT_EQ(p.servo_bus.bus.client.timeout, milliseconds(250));
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.client.timeout, milliseconds(250));
   EXPECT_EQ(specFor("servo_bus/timeout").get(p), ParamValue(0.25));
   EXPECT_NO_THROW(p.validate());
 }
@@ -41,7 +42,7 @@ TEST(ServoBusRows, ANonPositiveTimeoutIsRefusedAsWrittenAndTheFieldKeepsItsValue
     EXPECT_NE(why.find("~servo_bus/timeout"), std::string::npos) << why;
     // -0.0004 s rounds to 0 ms: the message must still show what the user wrote.
     EXPECT_NE(why.find("> 0 (got " + toText(seconds) + ")"), std::string::npos) << why;
-    EXPECT_EQ(p.servo_bus.bus.client.timeout, milliseconds(50));
+    EXPECT_EQ(p.section(params::kServoBusSection).bus.client.timeout, milliseconds(50));
   }
   DriverParams too_long;
   EXPECT_NE(refusalOfSetting(too_long, "servo_bus/timeout", 5.5).find("at most 5 s"),
@@ -51,17 +52,18 @@ TEST(ServoBusRows, ANonPositiveTimeoutIsRefusedAsWrittenAndTheFieldKeepsItsValue
 TEST(ServoBusRows, APositiveTimeoutNeverBecomesZeroMilliseconds) {
   DriverParams p;
   specFor("servo_bus/timeout").set(p, 0.0004);
-  EXPECT_EQ(p.servo_bus.bus.client.timeout, milliseconds(1));
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.client.timeout, milliseconds(1));
   specFor("servo_bus/timeout").set(p, 0.0126);
-  EXPECT_EQ(p.servo_bus.bus.client.timeout, milliseconds(13)) << "rounded to the nearest ms";
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.client.timeout, milliseconds(13))
+      << "rounded to the nearest ms";
 }
 
 TEST(ServoBusRows, ATimeoutSetInCodeIsCheckedByValidate) {
   DriverParams p;
-  p.servo_bus.bus.client.timeout = milliseconds(0);
+  p.section(params::kServoBusSection).bus.client.timeout = milliseconds(0);
   EXPECT_THROW(specFor("servo_bus/timeout").check(p), ParameterError);
   EXPECT_THROW(p.validate(), ParameterError);
-  p.servo_bus.bus.client.timeout = milliseconds(1);
+  p.section(params::kServoBusSection).bus.client.timeout = milliseconds(1);
   EXPECT_NO_THROW(p.validate());
 }
 
@@ -71,20 +73,21 @@ TEST(ServoBusRows, PowerAndShutdownActionAreCheckedBeforeTheyAreConverted) {
             std::string::npos);
   EXPECT_NE(refusalOfSetting(p, "servo_bus/relax_power_mw", 65536).find("0..65535 mW"),
             std::string::npos);
-  EXPECT_EQ(p.servo_bus.bus.relax_power_mw, 50) << "not wrapped into a uint16_t";
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.relax_power_mw, 50)
+      << "not wrapped into a uint16_t";
   EXPECT_NE(refusalOfSetting(p, "servo_bus/on_shutdown", std::string("halt")).find("got 'halt'"),
             std::string::npos);
-  EXPECT_EQ(p.servo_bus.bus.on_shutdown, device::ShutdownAction::kStop);
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.on_shutdown, device::ShutdownAction::kStop);
   specFor("servo_bus/on_shutdown").set(p, std::string("relax"));
   specFor("servo_bus/relax_power_mw").set(p, 500);
-  EXPECT_EQ(p.servo_bus.bus.on_shutdown, device::ShutdownAction::kRelax);
-  EXPECT_EQ(p.servo_bus.bus.relax_power_mw, 500);
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.on_shutdown, device::ShutdownAction::kRelax);
+  EXPECT_EQ(p.section(params::kServoBusSection).bus.relax_power_mw, 500);
   EXPECT_EQ(specFor("servo_bus/on_shutdown").get(p), ParamValue(std::string("relax")));
 }
 
 TEST(ServoBusRows, ADisabledBusValuesAreNotChecked) {
   DriverParams p;
-  p.servo_bus.enabled = false;
+  p.section(params::kServoBusSection).enabled = false;
   EXPECT_EQ(refusalOfSetting(p, "servo_bus/timeout", 0.0), "");
   EXPECT_EQ(refusalOfSetting(p, "servo_bus/on_shutdown", std::string("halt")), "");
   EXPECT_NO_THROW(p.validate());
@@ -95,8 +98,10 @@ TEST(ServoBusRows, TuningRefusesABadTimeoutAndKeepsTheOneInForce) {
   specFor("servo_bus/timeout").set(in_force, 0.2);
   const TuningResult refused =
       tuneParams(in_force, {{"servo_bus/timeout", 0.0}, {"servo_bus/retries", 3}});
-  EXPECT_EQ(refused.applied.servo_bus.bus.client.timeout, milliseconds(200));
-  EXPECT_EQ(refused.applied.servo_bus.bus.client.retries, 3) << "the valid part applies";
+  EXPECT_EQ(refused.applied.section(params::kServoBusSection).bus.client.timeout,
+            milliseconds(200));
+  EXPECT_EQ(refused.applied.section(params::kServoBusSection).bus.client.retries, 3)
+      << "the valid part applies";
   ASSERT_EQ(refused.refusals.size(), 1u);
   EXPECT_NE(refused.refusals[0].find("~servo_bus/timeout = 0 refused"), std::string::npos)
       << refused.refusals[0];
@@ -105,7 +110,8 @@ TEST(ServoBusRows, TuningRefusesABadTimeoutAndKeepsTheOneInForce) {
 
   const TuningResult applied = tuneParams(in_force, {{"servo_bus/timeout", 0.3}});
   EXPECT_TRUE(applied.refusals.empty());
-  EXPECT_EQ(applied.applied.servo_bus.bus.client.timeout, milliseconds(300));
+  EXPECT_EQ(applied.applied.section(params::kServoBusSection).bus.client.timeout,
+            milliseconds(300));
   EXPECT_EQ(applied.changes, std::vector<std::string>{"~servo_bus/timeout = 0.3 (was 0.2)"});
 }
 

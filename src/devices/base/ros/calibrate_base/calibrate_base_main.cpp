@@ -12,6 +12,7 @@
 #include <iostream>
 #include <string>
 
+#include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/devices/base/turn_calibration_run.h"
 #include "serial_robot_driver/devices/base/ros/calibrate_base_client.h"
 #include "serial_robot_driver/ros/driver_params.h"
@@ -95,8 +96,9 @@ int main(int argc, char** argv) {
   }
   BaseConfig base;
   try {  // the node's parameters read as the node reads them (its defaults for keys left out)
-    base =
-        serial_robot_driver::ros_layer::loadParams(ros::NodeHandle(*node), nullptr).base.controller;
+    base = serial_robot_driver::ros_layer::loadParams(ros::NodeHandle(*node), nullptr)
+               .section(serial_robot_driver::params::kBaseSection)
+               .controller;
   } catch (const std::exception& error) {
     std::cerr << "calibrate_base: cannot read the parameters of " << *node << ": " << error.what()
               << std::endl;

@@ -1,0 +1,76 @@
+// Every device's parameter section by one path (params/device_sections.h): a typed key the
+// module declares, copies that do not share, and a misused key refused loudly.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/device/typed_value.h"
+#include "serial_robot_driver/devices/base/base_params.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/echo/echo_params.h"
+#include "serial_robot_driver/params/driver_params.h"
+
+namespace serial_robot_driver::params {
+namespace {
+
+TEST(DeviceSections, EveryRegisteredDeviceHasItsOwnSectionWithItsPortParameters) {
+  DriverParams params;
+  for (const device::DeviceModule* device : device::registeredDevices()) {
+    ASSERT_FALSE(device->sections.empty()) << device->name;
+    EXPECT_STREQ(device->sections.front()->name(), device->name) << "its own section first";
+    EXPECT_NO_THROW(params.portParams(*device)) << device->name;
+  }
+  // The defaults are the sections' own: the echo device is off unless asked for.
+  EXPECT_FALSE(params.section(kEchoSection).enabled);
+  EXPECT_TRUE(params.section(kBaseSection).enabled);
+}
+
+TEST(DeviceSections, PortParametersAreTheDeviceSectionsOwn) {
+  DriverParams params;
+  params.portParams(*device::findDevice("base")).baud = 9600;
+  params.section(kEchoSection).port = "/dev/ttyECHO";
+  EXPECT_EQ(params.section(kBaseSection).baud, 9600);
+  EXPECT_EQ(params.portOf(*device::findDevice("echo")), "/dev/ttyECHO");
+}
+
+TEST(DeviceSections, ACopyHasSectionsOfItsOwn) {
+  DriverParams original;
+  DriverParams copy = original;
+  copy.section(kBodySection).joint_names = {"a", "b"};
+  copy.section(kImuSection).gyro_scale = 2.0;
+  EXPECT_EQ(original.section(kBodySection).joint_names,
+            (std::vector<std::string>{"joint_1", "joint_2"}));
+  EXPECT_EQ(original.section(kImuSection).gyro_scale, ImuParams().gyro_scale);
+  original = copy;
+  copy.section(kImuSection).gyro_scale = 3.0;
+  EXPECT_EQ(original.section(kImuSection).gyro_scale, 2.0) << "assignment copies too";
+}
+
+TEST(DeviceSections, AKeyOfAnotherTypeOrAnUndeclaredSectionIsAProgrammingError) {
+  DriverParams params;
+  const SectionKey<ImuParams> imu_under_the_base_name("base");
+  EXPECT_THROW(params.section(imu_under_the_base_name), std::logic_error);
+  const DriverParams& as_const = params;
+  EXPECT_THROW(as_const.section(imu_under_the_base_name), std::logic_error);
+  const SectionKey<BaseParams> undeclared("no_such_device");
+  EXPECT_THROW(params.section(undeclared), std::logic_error);
+  EXPECT_THROW(params.sections.portParams("imu"), std::logic_error) << "no port parameters";
+  EXPECT_THROW(params.sections.add(kBaseSection), std::logic_error) << "declared twice";
+}
+
+TEST(TypedValue, ReadsBackOnlyAsTheStoredTypeAndCopiesDoNotShare) {
+  device::TypedValue empty;
+  EXPECT_TRUE(empty.empty());
+  EXPECT_THROW(empty.as<int>(), std::logic_error);
+  device::TypedValue value = std::string("left");
+  EXPECT_TRUE(value.holds<std::string>());
+  EXPECT_THROW(value.as<int>(), std::logic_error);
+  device::TypedValue copy = value;
+  copy.as<std::string>() = "right";
+  EXPECT_EQ(value.as<std::string>(), "left");
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::params
