@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <std_srvs/Trigger.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -20,10 +21,12 @@
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
+#include "support/test_helpers.h"
 
 namespace ros_fuzz {
 namespace {
 
+constexpr double kAnswerSeconds = 10.0;  // an upper bound for a busy machine
 const std::vector<std::string> kJointNames = {"joint_1", "joint_2", "pan", "servo_1", "servo_2"};
 
 /// A valid trajectory of a random subset of the joints, then 1..3 fields at their extremes.
@@ -101,7 +104,15 @@ sensor_msgs::JointState fuzzJointState(Extremes& x, const std::vector<std::strin
 template <typename Service>
 void call(const std::string& name, Service& service) {
   // The answer's content is the node's business; that it answers at all is what counts here.
-  EXPECT_TRUE(ros::service::call(name, service)) << name << " gave no answer";
+  if (ros::service::call(name, service)) return;
+  // A non-persistent call is a lookup at the master and a new connection each time; on a busy
+  // machine (tests run side by side) one of those can fail before the node sees the request. The
+  // same request again: the node must answer it (a node that is gone or stuck still fails here).
+  std::printf("ros_interface_fuzz: %s: no answer to the first call (service %s), calling again\n",
+              name.c_str(), ros::service::exists(name, false) ? "still advertised" : "not found");
+  EXPECT_TRUE(test_support::waitFor([&] { return ros::service::call(name, service); },
+                                    kAnswerSeconds))
+      << name << " gave no answer";
 }
 
 /// A servo id: mostly one that answers (0..3), else any, 255 (broadcast) included.
