@@ -32,6 +32,7 @@ set(SRD_CORE_SOURCES
   src/device/link_status.cpp
   src/device/e_stop_status.cpp
   src/device/input_refusals.cpp
+  src/device/driver_core.cpp
   src/device/wire_capture_status.cpp
 )
 

@@ -10,6 +10,7 @@ catkin_add_gtest(core_tests
   test/unit/test_stream_framer_random_junk.cpp
   test/unit/test_diff_drive.cpp
   test/unit/test_odometry.cpp
+  test/unit/test_driver_core.cpp
   test/unit/test_transport_pty_io.cpp
   test/unit/test_transport_errors_and_links.cpp
   test/unit/test_transport_baud_and_lock.cpp

@@ -1,12 +1,8 @@
 #include "serial_robot_driver/ros/driver_node.h"
 
-#include <algorithm>
 #include <atomic>
-#include <functional>
-#include <sstream>
+#include <utility>
 
-#include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/device/e_stop_status.h"
 #include "serial_robot_driver/device/link_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
@@ -60,33 +56,6 @@ class PortMonitor : public device::LinkListener {
   bool waiting_logged_ = false;  // reader thread only
 };
 
-namespace {
-
-/// The node's MotionQuery (device/capabilities.h): each enabled device's motionInForce() under
-/// its registered name, in the devices' order, then the trajectories'.
-class NodeMotion : public device::MotionQuery {
- public:
-  void add(std::string name, const device::Device* device) {
-    devices_.emplace_back(std::move(name), device);
-  }
-  void setTrajectories(trajectory::TrajectoryExecutor* executor) { trajectories_ = executor; }
-
-  std::string motionInForce() const override {
-    for (const auto& [name, device] : devices_) {
-      const std::string why = device->motionInForce();
-      if (!why.empty()) return name + ": " + why;
-    }
-    const std::string trajectories = trajectories_ ? trajectories_->motionInForce() : std::string();
-    return trajectories.empty() ? trajectories : "trajectories: " + trajectories;
-  }
-
- private:
-  std::vector<std::pair<std::string, const device::Device*>> devices_;
-  trajectory::TrajectoryExecutor* trajectories_ = nullptr;
-};
-
-}  // namespace
-
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
                        device::SerialLink::StreamFactory stream_factory)
     // The updater prefixes every status with the node's name: the private namespace names the
@@ -100,20 +69,21 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
       capture_->diagnose(s);
     });
   }
-  openPorts(stream_factory);
-  makeDevices();
-  connectTrajectories();
-  // The heading for odometry can be switched on at runtime: offered whenever a device measures it.
-  connectCapabilities();
+  core_ = std::make_unique<device::DriverCore>(
+      params_,
+      [this](const device::DeviceModule& module, device::SerialLink& link) {
+        return makeDevice(module, link);
+      },
+      stream_factory, capture_.get(), TrajectoryServer::logWarning());
+  addPortsAndDevices();
+  serveTrajectories();
   connectEStop();
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
   // Runtime tuning: a server per group under ~ (~base, ~imu, ...), starting from params_.
-  std::vector<device::Device*> tunable;
-  for (auto& device : devices_) tunable.push_back(device.get());
-  tuning_ = std::make_unique<RuntimeTuning>(private_nh, params_, std::move(tunable),
-                                            trajectory_executor_.get());
+  tuning_ = std::make_unique<RuntimeTuning>(private_nh, params_, core_->devicePointers(),
+                                            core_->trajectories());
   diagnostics_timer_ =
       nh_.createSteadyTimer(ros::WallDuration(diagnostics_period_),
                             [this](const ros::SteadyTimerEvent&) { diagnostics_.force_update(); });
@@ -121,59 +91,32 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
 
 DriverNode::~DriverNode() { shutdown(); }
 
-void DriverNode::openPorts(const device::SerialLink::StreamFactory& stream_factory) {
-  // Devices naming the same path share one port, one reader thread and one framer.
-  std::map<std::string, std::vector<const device::DeviceModule*>> users;
-  for (const device::DeviceModule* device : device::registeredDevices()) {
-    if (params_.enabled(*device)) users[params_.portOf(*device)].push_back(device);
+std::unique_ptr<device::Device> DriverNode::makeDevice(const device::DeviceModule& module,
+                                                       device::SerialLink& link) {
+  const RosDeviceModule* ros_side = findInterface(module.name);
+  if (ros_side == nullptr) {
+    throw ParameterError(std::string(module.name) + "/enabled",
+                         "the device has no ROS interface in this build");
   }
-  for (const auto& [path, use] : users) {
-    Port port;
-    port.link = std::make_unique<device::SerialLink>(linkOptions(path, use), stream_factory);
-    port.monitor = std::make_unique<PortMonitor>(*port.link, shut_down_);
-    port.link->addListener(port.monitor.get());
-    port.link->setChunkObserver(capture_.get());
-    Port& stored = ports_[path] = std::move(port);
-    diagnostics_.add("port " + path, [this, &stored](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      diagnosePort(stored, s);
+  return ros_side->make(nh_, params_, link);
+}
+
+void DriverNode::addPortsAndDevices() {
+  for (const auto& [path, link_ptr] : core_->ports()) {
+    device::SerialLink& link = *link_ptr;
+    port_monitors_.push_back(std::make_unique<PortMonitor>(link, shut_down_));
+    link.addListener(port_monitors_.back().get());
+    diagnostics_.add("port " + path, [&link](diagnostic_updater::DiagnosticStatusWrapper& s) {
+      writeStatusReport(device::linkStatus(link.stats(), link.options()), s);
     });
   }
-}
-
-device::SerialLinkOptions DriverNode::linkOptions(
-    const std::string& path, const std::vector<const device::DeviceModule*>& users) const {
-  device::SerialLinkOptions options;
-  options.path = path;
-  // validate() made every device on a shared port agree on the baud rate.
-  options.baud = static_cast<unsigned>(params_.baudOf(*users.front()));
-  options.reconnect_interval = params_.reconnect_interval;
-  options.framer = device::framerFor(users, params_);
-  for (const device::DeviceModule* device : users) {
-    if (!device->stale_frame_timeout) continue;
-    // The shortest any device on the port asks for.
-    const auto timeout = device->stale_frame_timeout(params_);
-    if (options.stale_frame_timeout.count() == 0 || timeout < options.stale_frame_timeout) {
-      options.stale_frame_timeout = timeout;
-    }
-  }
-  return options;
-}
-
-void DriverNode::makeDevices() {
-  for (const device::DeviceModule* module : device::registeredDevices()) {
-    if (!params_.enabled(*module)) continue;
-    const RosDeviceModule* ros_side = findInterface(module->name);
-    if (ros_side == nullptr) {
-      throw ParameterError(std::string(module->name) + "/enabled",
-                           "the device has no ROS interface in this build");
-    }
-    devices_.push_back(ros_side->make(nh_, params_, portFor(params_.portOf(*module))));
+  for (std::size_t i = 0; i < core_->devices().size(); ++i) {
     // The device's status carries its registered name; its own statuses theirs.
-    DeviceInterface* device = devices_.back().get();
-    device_names_.emplace_back(module->name);
-    diagnostics_.add(module->name, [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      writeStatusReport(device->status(), s);
-    });
+    device::Device* device = core_->devices()[i].get();
+    diagnostics_.add(core_->deviceNames()[i],
+                     [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
+                       writeStatusReport(device->status(), s);
+                     });
     for (device::Device::NamedStatus& extra : device->extraStatuses()) {
       diagnostics_.add(extra.name, [report = std::move(extra.report)](
                                        diagnostic_updater::DiagnosticStatusWrapper& s) {
@@ -183,51 +126,21 @@ void DriverNode::makeDevices() {
   }
 }
 
-void DriverNode::connectTrajectories() {
-  // One executor for the joints of every device, so one goal may span them.
-  std::vector<TrajectoryJoints> trajectory_joints;
-  for (auto& device : devices_) {
-    for (TrajectoryJoints& group : device->trajectoryJoints()) {
-      if (!group.joints.empty()) trajectory_joints.push_back(std::move(group));
-    }
-  }
-  if (trajectory_joints.empty()) return;
-  trajectory_executor_ = std::make_unique<trajectory::TrajectoryExecutor>(
-      std::move(trajectory_joints), params_.trajectory, trajectory::steadyNow,
-      TrajectoryServer::logWarning());
-  trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, *trajectory_executor_);
-  for (auto& device : devices_) device->attachTrajectories(*trajectory_executor_);
-}
-
-void DriverNode::connectCapabilities() {
-  // Whether the robot is held still, for a sensor's calibration: asked on that device's reader and
-  // service threads; each device answers under its own short lock. devices_ and the executor are
-  // complete here and outlive the links' threads and the devices' spinners.
-  auto motion = std::make_unique<NodeMotion>();
-  for (std::size_t i = 0; i < devices_.size(); ++i) {
-    motion->add(device_names_[i], devices_[i].get());
-  }
-  motion->setTrajectories(trajectory_executor_.get());
-  device::Capabilities capabilities;
-  capabilities.offer<device::MotionQuery>(*motion);
-  motion_query_ = std::move(motion);
-  for (auto& device : devices_) device->offerCapabilities(capabilities);
-  for (auto& device : devices_) device->useCapabilities(capabilities);
+void DriverNode::serveTrajectories() {
+  if (core_->trajectories() == nullptr) return;
+  trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, *core_->trajectories());
 }
 
 void DriverNode::connectEStop() {
-  // The trajectories stop first, so no trajectory move follows a device's stop.
-  if (trajectory_executor_) trajectory_executor_->attachEStop(e_stop_);
-  for (auto& device : devices_) device->attachEStop(e_stop_);
   // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
   e_stop_sub_ = subscribeGuarded(nh_, input_refusals_, "e_stop", 10, &DriverNode::onEStop, this,
                                  ros::TransportHints().tcpNoDelay());
   diagnostics_.add("e_stop", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
-    diagnoseEStop(s);
+    device::InputRefusalStats own = input_refusals_.stats();
+    if (trajectory_) own += trajectory_->inputRefusalStats();
+    writeStatusReport(core_->eStopStatus(own), s);
   });
   if (params_.e_stop.start_engaged) {
-    // Before the ports start: the base's first frame is already a zero one.
-    e_stop_.set(true);
     ROS_WARN(
         "e_stop engaged at start-up (~e_stop/start_engaged): nothing moves until e_stop "
         "false arrives");
@@ -235,7 +148,7 @@ void DriverNode::connectEStop() {
 }
 
 void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
-  if (!e_stop_.set(msg->data)) return;
+  if (!core_->eStop().set(msg->data)) return;
   if (msg->data) {
     ROS_WARN("e_stop engaged: every actuator stopped (base at zero speed, trajectories aborted, "
              "bus servos stopped); motion commands refused until e_stop is false");
@@ -244,48 +157,10 @@ void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
   }
 }
 
-void DriverNode::diagnoseEStop(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  device::StatusReport report = device::eStopStatus(e_stop_.stats());
-  // Node-wide, next to what the e-stop refused: what every input's checks refused.
-  device::InputRefusalStats refusals = input_refusals_.stats();
-  for (const auto& device : devices_) refusals += device->inputRefusalStats();
-  if (trajectory_) refusals += trajectory_->inputRefusalStats();
-  device::addInputRefusals(refusals, report);
-  writeStatusReport(report, status);
-}
-
-device::SerialLink& DriverNode::portFor(const std::string& path) { return *ports_.at(path).link; }
-
 void DriverNode::start() {
-  for (auto& [path, port] : ports_) port.link->start();
-  for (auto& device : devices_) device->start();
+  core_->start();
   if (trajectory_) trajectory_->start();
-  ROS_INFO("%s", startupSummary().c_str());
-}
-
-std::string DriverNode::startupSummary() const {
-  // e.g. "driving port /dev/ttyUSB0 (115200 baud: base, body, servo_bus); loop 50 Hz, battery
-  // poll 1 Hz, diagnostics every 1 s"
-  std::ostringstream text;
-  text << "driving";
-  const char* separator = " port ";
-  for (const auto& [path, port] : ports_) {
-    text << separator << path << " (" << port.link->options().baud << " baud:";
-    const char* comma = " ";
-    for (const device::DeviceModule* device : device::registeredDevices()) {
-      if (!params_.enabled(*device) || params_.portOf(*device) != path) continue;
-      text << comma << device->name;
-      comma = ", ";
-    }
-    text << ")";
-    separator = ", port ";
-  }
-  for (const auto& device : devices_) {
-    const std::string rates = device->startupSummary();
-    if (!rates.empty()) text << "; " << rates;
-  }
-  text << "; diagnostics every " << diagnostics_period_ << " s";
-  return text.str();
+  ROS_INFO("%s; diagnostics every %g s", core_->startupSummary().c_str(), diagnostics_period_);
 }
 
 void DriverNode::shutdown() {
@@ -295,13 +170,7 @@ void DriverNode::shutdown() {
   diagnostics_timer_.stop();
   e_stop_sub_.shutdown();
   if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop
-  // Base first: its zero-speed frame goes out while the port is still open.
-  for (auto& device : devices_) device->shutdown();
-  for (auto& [path, port] : ports_) port.link->stop();
-}
-
-void DriverNode::diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status) {
-  writeStatusReport(device::linkStatus(port.link->stats(), port.link->options()), status);
+  core_->shutdown();
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -9,6 +9,7 @@
 #include "serial_robot_driver/device/typed_value.h"
 #include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/body/gyro_bias.h"
 #include "serial_robot_driver/devices/echo/echo_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
@@ -70,6 +71,29 @@ TEST(TypedValue, ReadsBackOnlyAsTheStoredTypeAndCopiesDoNotShare) {
   device::TypedValue copy = value;
   copy.as<std::string>() = "right";
   EXPECT_EQ(value.as<std::string>(), "left");
+}
+
+TEST(DeviceSections, TheBaseControllerTakesItsSectionAndTheNodeWideValues) {
+  DriverParams params;
+  params.section(kBaseSection).controller.cmd_vel_timeout = 0.25;
+  params.loop_rate = 40.0;
+  params.portParams(*device::findDevice("base")).baud = 9600;
+  params.section(kImuSection).orientation_variance = 0.04;
+  const device::BaseConfig config = makeBaseConfig(params);
+  EXPECT_EQ(config.cmd_vel_timeout, 0.25) << "the section's own";
+  EXPECT_EQ(config.loop_rate, 40.0);
+  EXPECT_EQ(config.baud, 9600);
+  EXPECT_EQ(config.imu_yaw_variance, 0.04) << "the IMU's";
+}
+
+TEST(DeviceSections, TheGyroUnitsAreTheImuSectionsScaleAndAxisMap) {
+  ImuParams imu;
+  imu.gyro_scale = 0.5;
+  imu.axis_map = {"y", "-x", "z"};
+  const device::GyroUnits units = gyroUnits(imu);
+  EXPECT_EQ(units.gyro_scale, 0.5);
+  EXPECT_EQ(units.axes.source, (std::array<int, 3>{1, 0, 2}));
+  EXPECT_EQ(units.axes.sign, (std::array<int, 3>{1, -1, 1}));
 }
 
 }  // namespace

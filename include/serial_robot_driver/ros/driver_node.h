@@ -34,22 +34,17 @@
 #include <std_msgs/Bool.h>
 
 #include <atomic>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/capabilities.h"
-#include "serial_robot_driver/device/device_module.h"
-#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/device/driver_core.h"
 #include "serial_robot_driver/device/input_refusals.h"
 #include "serial_robot_driver/device/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
-#include "serial_robot_driver/trajectory/executor.h"
 
 namespace serial_robot_driver::ros_layer {
 
-class DeviceInterface;
 class RuntimeTuning;
 class PortMonitor;
 class TrajectoryServer;
@@ -73,56 +68,35 @@ class DriverNode {
   void shutdown();
 
  private:
-  struct Port {
-    std::unique_ptr<device::SerialLink> link;
-    std::unique_ptr<PortMonitor> monitor;
-  };
-  /// One SerialLink per path the enabled devices name, with its monitor and status.
-  void openPorts(const device::SerialLink::StreamFactory& stream_factory);
-  /// The options of the port at `path` shared by `users`.
-  device::SerialLinkOptions linkOptions(
-      const std::string& path, const std::vector<const device::DeviceModule*>& users) const;
-  device::SerialLink& portFor(const std::string& path);
-  /// The ROS side of every enabled device on its port, with its statuses.
-  void makeDevices();
-  /// One trajectory executor (and its ROS server) over every device's joints, attached to them.
-  void connectTrajectories();
-  /// Cross-device wiring by kind (device/capabilities.h): every device's offers, then its asks;
-  /// the node offers the MotionQuery over every device and the trajectories.
-  void connectCapabilities();
-  /// One line for the log: ports, the devices on each, rates.
-  std::string startupSummary() const;
-  void diagnosePort(const Port& port, diagnostic_updater::DiagnosticStatusWrapper& status);
-  /// Hands the e-stop to the trajectories and the devices and subscribes e_stop.
+  /// The ROS side of `module`'s device on `link` (its RosDeviceModule).
+  std::unique_ptr<device::Device> makeDevice(const device::DeviceModule& module,
+                                             device::SerialLink& link);
+  /// A monitor and a status per port, a status (and its extras) per device.
+  void addPortsAndDevices();
+  /// follow_joint_trajectory / joint_trajectory when a device offers joints.
+  void serveTrajectories();
+  /// Subscribes e_stop and reports it.
   void connectEStop();
   void onEStop(const std_msgs::Bool::ConstPtr& msg);
-  void diagnoseEStop(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_;
   DriverParams params_;
-  /// The one e-stop of every actuator; outlives the devices and the trajectory server.
-  device::EStop e_stop_;
   device::InputRefusals input_refusals_;  // the node's own topic's (e_stop)
   ros::Subscriber e_stop_sub_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
-  std::map<std::string, Port> ports_;
-  /// The trajectories over every device's joints; null when none has any. Outlives the devices,
-  /// which hold a reference to it, and its server.
-  std::unique_ptr<trajectory::TrajectoryExecutor> trajectory_executor_;
-  /// follow_joint_trajectory / joint_trajectory for trajectory_executor_.
+  std::atomic<bool> shut_down_{false};    // read by the ports' monitors on the reader threads
+  /// One per port; outlive the ports' reader threads.
+  std::vector<std::unique_ptr<PortMonitor>> port_monitors_;
+  /// The ports, the devices, their wiring and their order.
+  std::unique_ptr<device::DriverCore> core_;
+  /// follow_joint_trajectory / joint_trajectory for the core's trajectories; null without joints.
   std::unique_ptr<TrajectoryServer> trajectory_;
-  /// The MotionQuery the devices were offered (connectCapabilities); outlives them.
-  std::unique_ptr<device::MotionQuery> motion_query_;
-  /// In start and shutdown order: the registered devices' order (cmake/devices.cmake).
-  std::vector<std::unique_ptr<DeviceInterface>> devices_;
-  std::vector<std::string> device_names_;  ///< devices_' registered names
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up
   ros::SteadyTimer diagnostics_timer_;
-  /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after devices_ and
-  /// trajectory_, destroyed first.
+  /// The dynamic_reconfigure servers (~base, ~imu, ...); declared after core_ and trajectory_,
+  /// destroyed first.
   std::unique_ptr<RuntimeTuning> tuning_;
-  std::atomic<bool> shut_down_{false};  // read by the ports' monitors on the reader threads
 };
 
 }  // namespace serial_robot_driver::ros_layer

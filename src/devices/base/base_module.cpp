@@ -10,6 +10,14 @@
 
 namespace serial_robot_driver::params {
 extern const SectionKey<BaseParams> kBaseSection{"base"};
+
+device::BaseConfig makeBaseConfig(const DriverParams& params) {
+  device::BaseConfig config = params.section(kBaseSection).controller;
+  config.loop_rate = params.loop_rate;
+  config.baud = params.baudOf(*device::findDevice("base"));
+  config.imu_yaw_variance = params.section(kImuSection).orientation_variance;
+  return config;
+}
 }
 
 namespace serial_robot_driver::devices::base {

@@ -6,6 +6,7 @@
 #include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/body/gyro_bias.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::params {
@@ -120,6 +121,10 @@ extern const device::DeviceModule kModule{
 }  // namespace serial_robot_driver::devices::body
 
 namespace serial_robot_driver::params {
+
+device::GyroUnits gyroUnits(const ImuParams& imu) {
+  return {imu.gyro_scale, parseAxisMap(imu.axis_map, nullptr).value_or(AxisMap{})};
+}
 
 std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std::string* problem) {
   const auto fail = [problem](const std::string& text) {

@@ -16,6 +16,43 @@ ServoStatus ServoMotionClaims::claimServos(const std::vector<uint8_t>& ids, cons
   return refused;
 }
 
+ServoStatus ServoMotionClaims::move(const MoveRequest& request, const char* source) {
+  const ServoStatus claimed = claimServos({request.id}, source);
+  return claimed.ok() ? bus_.move(request) : claimed;
+}
+
+ServoStatus ServoMotionClaims::rotate(const RotateRequest& request, const char* source) {
+  const ServoStatus claimed = claimServos({request.id}, source);
+  return claimed.ok() ? bus_.rotate(request) : claimed;
+}
+
+ServoStatus ServoMotionClaims::hold(const std::vector<uint8_t>& ids, const char* source) {
+  const ServoStatus claimed = claimServos(ids, source);
+  return claimed.ok() ? bus_.hold(ids) : claimed;
+}
+
+ServoStatus ServoMotionClaims::spin(SpinRequest request, const char* source) {
+  if (request.mode != 0) {
+    ServoStatus refused = refuseWhileEStopped(source);
+    if (!refused.ok()) return refused;
+  }
+  yieldJoint(request.id, source);
+  // Served with the stops: it must never wait behind a long call.
+  request.priority = BusPriority::kStop;
+  return bus_.spin(request);
+}
+
+ServoStatus ServoMotionClaims::damping(uint8_t id, uint16_t power_mw, bool wait,
+                                       const char* source) {
+  yieldJoint(id, source);
+  return bus_.damping(id, power_mw, wait);
+}
+
+ServoStatus ServoMotionClaims::relax(const std::vector<uint8_t>& ids, const char* source) {
+  yieldJoints(ids, source);
+  return bus_.relax(ids);
+}
+
 void ServoMotionClaims::yieldJoints(const std::vector<uint8_t>& ids, const char* source) {
   for (uint8_t id : ids.empty() ? bus_.config().polled_ids : ids) yieldJoint(id, source);
 }

@@ -20,6 +20,12 @@ double toMs(Clock::duration duration) {
 
 }  // namespace
 
+bool refusesRequest(ServoError error) {
+  return error == ServoError::kInvalidArgument || error == ServoError::kUnknownParam ||
+         error == ServoError::kReadOnly || error == ServoError::kOutOfRange ||
+         error == ServoError::kDangerous;
+}
+
 const char* toString(ServoError error) {
   switch (error) {
     case ServoError::kOk:

@@ -20,8 +20,6 @@
 
 namespace serial_robot_driver::ros_layer {
 
-device::BaseConfig makeBaseConfig(const DriverParams& params);
-
 class BaseInterface : public DeviceInterface {
  public:
   /// Registers the controller on `link` (before the link starts) and advertises the topics and

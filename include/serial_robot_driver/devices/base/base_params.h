@@ -13,8 +13,7 @@ namespace serial_robot_driver::params {
 /// `controller` (their defaults are its own); the rest are the ROS layer's and the checks'.
 struct BaseParams : DevicePortParams {
   /// The controller's configuration as the parameters set it. Not parameters of this section:
-  /// loop_rate, baud and imu_yaw_variance, which the ROS layer fills in from the node-wide values
-  /// (ros_layer::makeBaseConfig).
+  /// loop_rate, baud and imu_yaw_variance, which makeBaseConfig fills in from the node-wide values.
   device::BaseConfig controller;
   int battery_warn_percent = 20;   ///< below: diagnostics WARN
   int battery_error_percent = 10;  ///< below: diagnostics ERROR
@@ -27,6 +26,11 @@ struct BaseParams : DevicePortParams {
 
 /// The key of the base's section (DeviceModule::sections): params.section(kBaseSection).
 extern const SectionKey<BaseParams> kBaseSection;
+
+struct DriverParams;
+/// The controller's configuration in force: the base's own parameters (bound into `controller`
+/// already, base_module.cpp) plus those that come from node-wide or other devices' parameters.
+device::BaseConfig makeBaseConfig(const DriverParams& params);
 
 /// Below this loop rate the base's 1 s heartbeat is at risk (the base's checks say so).
 constexpr double kMinBaseLoopRate = 5.0;

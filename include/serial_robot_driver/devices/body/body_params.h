@@ -11,6 +11,10 @@
 #include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
+namespace serial_robot_driver::device {
+struct GyroUnits;
+}
+
 namespace serial_robot_driver::params {
 
 struct BodyParams : DevicePortParams {
@@ -54,5 +58,9 @@ struct ImuParams {
 /// The keys of the body's sections (DeviceModule::sections): its own and its IMU's.
 extern const SectionKey<BodyParams> kBodySection;
 extern const SectionKey<ImuParams> kImuSection;
+
+/// The gyro's units for the calibration: the scale and the axis map (validate() refused an axis
+/// map that does not parse at start-up; one that does not parse here is the identity).
+device::GyroUnits gyroUnits(const ImuParams& imu);
 
 }  // namespace serial_robot_driver::params

@@ -39,6 +39,18 @@ class ServoMotionClaims {
   void yieldJoint(uint8_t id, const char* source);
   /// yieldJoint() for each of `ids`; empty: every configured servo (servo/relax, servo/hold).
   void yieldJoints(const std::vector<uint8_t>& ids, const char* source);
+  /// servo/move, servo/rotate, servo/hold (`source`): the servos claimed (claimServos), then the
+  /// motion; refused while the e-stop holds.
+  ServoStatus move(const MoveRequest& request, const char* source);
+  ServoStatus rotate(const RotateRequest& request, const char* source);
+  ServoStatus hold(const std::vector<uint8_t>& ids, const char* source);
+  /// servo/spin, served with the stops (BusPriority::kStop): a SPIN stop (mode 0) is no motion and
+  /// works while the e-stop holds, any other mode is refused then; the joint yields either way.
+  ServoStatus spin(SpinRequest request, const char* source);
+  /// servo/damping, servo/relax: torque off moves nothing actively, so they work while the e-stop
+  /// holds (motion_safety.h); the joints yield.
+  ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait, const char* source);
+  ServoStatus relax(const std::vector<uint8_t>& ids, const char* source);
   /// Queues `moves` (servo_commands, already checked): the joint servos among them under a
   /// trajectory are taken over by them, and their goals aborted.
   void queueCommand(const std::vector<MoveRequest>& moves, const char* source);

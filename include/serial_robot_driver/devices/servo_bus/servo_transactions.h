@@ -65,6 +65,9 @@ enum class ServoError {
   kPreempted,         ///< gave way to a stop: a poll that did not run, a motion wait cut short
 };
 const char* toString(ServoError error);
+/// Whether `error` refuses the request for what it asks (counted as a refused input), not for
+/// what the bus or the servo did.
+bool refusesRequest(ServoError error);
 
 /// The outcome of an operation: a typed error plus one sentence for the user.
 struct ServoStatus {

@@ -10,24 +10,12 @@
 #include <sstream>
 
 #include "serial_robot_driver/WheelCommand.h"
-#include "serial_robot_driver/device/device_module.h"
 #include "serial_robot_driver/devices/base/base_status.h"
-#include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 
 namespace serial_robot_driver::ros_layer {
-
-device::BaseConfig makeBaseConfig(const DriverParams& params) {
-  // The base's own parameters are bound into its configuration already (base_module.cpp); these
-  // come from node-wide or other devices' parameters.
-  device::BaseConfig config = params.section(params::kBaseSection).controller;
-  config.loop_rate = params.loop_rate;
-  config.baud = params.baudOf(*device::findDevice("base"));
-  config.imu_yaw_variance = params.section(params::kImuSection).orientation_variance;
-  return config;
-}
 
 device::BaseEvents BaseInterface::events() {
   // The publishers are advertised in the constructor's body, before the controller can report.
@@ -88,7 +76,7 @@ BaseInterface::BaseInterface(ros::NodeHandle& nh, const DriverParams& params,
                           ? std::make_unique<tf2_ros::TransformBroadcaster>()
                           : nullptr),
       odom_pub_(nh.advertise<nav_msgs::Odometry>("odom", 50)),
-      controller_(makeBaseConfig(params), link.writer(), events()) {
+      controller_(params::makeBaseConfig(params), link.writer(), events()) {
   wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
   battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
   wheel_states_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
@@ -159,7 +147,7 @@ void BaseInterface::publishWheelStates(const device::OdometrySample& sample,
 }
 
 void BaseInterface::retune(const DriverParams& params) {
-  controller_.retune(makeBaseConfig(params));
+  controller_.retune(params::makeBaseConfig(params));
   std::atomic_store(
       &tuned_, std::make_shared<const params::BaseParams>(params.section(params::kBaseSection)));
 }

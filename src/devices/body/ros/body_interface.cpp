@@ -13,14 +13,7 @@
 
 namespace serial_robot_driver::ros_layer {
 
-namespace {
-
-device::GyroUnits gyroUnits(const params::ImuParams& imu) {
-  // validate() refused an axis map that does not parse at start-up.
-  return {imu.gyro_scale, params::parseAxisMap(imu.axis_map, nullptr).value_or(params::AxisMap{})};
-}
-
-}  // namespace
+using params::gyroUnits;
 
 BodyInterface::BodyInterface(ros::NodeHandle& nh, const DriverParams& params,
                              device::SerialLink& link)

@@ -47,14 +47,6 @@ template <typename Service>
 using ServoCall =
     std::function<device::ServoStatus(typename Service::Request&, typename Service::Response&)>;
 
-/// A request the service refused for what it asks (not for what the bus or the servo did).
-bool refusedRequest(device::ServoError error) {
-  using device::ServoError;
-  return error == ServoError::kInvalidArgument || error == ServoError::kUnknownParam ||
-         error == ServoError::kReadOnly || error == ServoError::kOutOfRange ||
-         error == ServoError::kDangerous;
-}
-
 /// The node handle the servo/* services are advertised on, and where their refusals are counted.
 struct ServoServiceSite {
   ros::NodeHandle& nh;
@@ -74,7 +66,7 @@ ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name
                                                                Request& req, Response& res) {
     const device::ServoStatus status = call(req, res);
     logOutcome(name, status);
-    if (refusedRequest(status.error)) refusals.refused(name);
+    if (device::refusesRequest(status.error)) refusals.refused(name);
     if (status.ok() && announce == Announce::kInfo) {
       ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
     }
@@ -150,8 +142,6 @@ device::SpinRequest toSpinRequest(const ServoSpin::Request& req) {
   request.speed_dps = req.speed_dps;
   request.value = req.value;
   request.wait = req.wait;
-  // Served with the stops: it must never wait behind a long call.
-  request.priority = device::BusPriority::kStop;
   return request;
 }
 
@@ -254,8 +244,7 @@ void ServoBusServices::advertiseMoves() {
   const ServoServiceSite site{nh_, refusals_};
   services_.push_back(advertiseServo<ServoMove>(
       site, "servo/move", [this](ServoMove::Request& req, ServoMove::Response&) {
-        const device::ServoStatus claimed = claims_.claimServos({req.id}, "servo/move");
-        return claimed.ok() ? bus_.move(toMoveRequest(req)) : claimed;
+        return claims_.move(toMoveRequest(req), "servo/move");
       }));
   services_.push_back(advertiseServo<ServoRotate>(
       site, "servo/rotate", [this](ServoRotate::Request& req, ServoRotate::Response&) {
@@ -265,8 +254,7 @@ void ServoBusServices::advertiseMoves() {
         request.interval_ms = req.interval_ms;
         request.power_mw = req.power_mw;
         request.wait = req.wait;
-        const device::ServoStatus claimed = claims_.claimServos({req.id}, "servo/rotate");
-        return claimed.ok() ? bus_.rotate(request) : claimed;
+        return claims_.rotate(request, "servo/rotate");
       }));
 }
 
@@ -274,29 +262,19 @@ void ServoBusServices::advertiseStops() {
   const ServoServiceSite site{stop_nh_, refusals_};
   services_.push_back(advertiseServo<ServoSpin>(
       site, "servo/spin", [this](ServoSpin::Request& req, ServoSpin::Response&) {
-        // A SPIN stop is no motion: it works while the e-stop holds.
-        if (req.mode != 0) {
-          device::ServoStatus refused = claims_.refuseWhileEStopped("servo/spin");
-          if (!refused.ok()) return refused;
-        }
-        claims_.yieldJoint(req.id, "servo/spin");
-        return bus_.spin(toSpinRequest(req));
+        return claims_.spin(toSpinRequest(req), "servo/spin");
       }));
-  // Torque off moves nothing actively: allowed while the e-stop holds (motion_safety.h).
   services_.push_back(advertiseServo<ServoDamping>(
       site, "servo/damping", [this](ServoDamping::Request& req, ServoDamping::Response&) {
-        claims_.yieldJoint(req.id, "servo/damping");
-        return bus_.damping(req.id, req.power_mw, req.wait);
+        return claims_.damping(req.id, req.power_mw, req.wait, "servo/damping");
       }));
   services_.push_back(advertiseServo<ServoRelax>(
       site, "servo/relax", [this](ServoRelax::Request& req, ServoRelax::Response&) {
-        claims_.yieldJoints(req.ids, "servo/relax");
-        return bus_.relax(req.ids);
+        return claims_.relax(req.ids, "servo/relax");
       }));
   services_.push_back(advertiseServo<ServoHold>(
       site, "servo/hold", [this](ServoHold::Request& req, ServoHold::Response&) {
-        const device::ServoStatus claimed = claims_.claimServos(req.ids, "servo/hold");
-        return claimed.ok() ? bus_.hold(req.ids) : claimed;
+        return claims_.hold(req.ids, "servo/hold");
       }));
 }
 
