@@ -42,9 +42,9 @@ namespace {
 using serial_robot_driver::protocol::FrameFamily;
 using serial_robot_driver::protocol::FramerConfig;
 using serial_robot_driver::protocol::StreamFramer;
-namespace base = serial_robot_driver::protocol::base;
-namespace body = serial_robot_driver::protocol::body;
-namespace servo = serial_robot_driver::protocol::servo;
+namespace base = serial_robot_driver::devices::base;
+namespace body = serial_robot_driver::devices::body;
+namespace servo_bus = serial_robot_driver::devices::servo_bus;
 
 using Bytes = std::vector<uint8_t>;
 
@@ -92,10 +92,10 @@ const MixedStream& mixedStream() {
         ++s.frames;
       }
       append(&s.bytes, base::encodeBatteryReply(static_cast<uint8_t>(step), 87));
-      append(&s.bytes, servo::encodeReadAngle(3));  // half-duplex echo
-      append(&s.bytes, servo::encodeResponse(servo::Command::kReadAngle, {3, 0x86, 0x03}));
-      append(&s.bytes, servo::encodePing(4));
-      append(&s.bytes, servo::encodeResponse(servo::Command::kPing, {4}));
+      append(&s.bytes, servo_bus::encodeReadAngle(3));  // half-duplex echo
+      append(&s.bytes, servo_bus::encodeResponse(servo_bus::Command::kReadAngle, {3, 0x86, 0x03}));
+      append(&s.bytes, servo_bus::encodePing(4));
+      append(&s.bytes, servo_bus::encodeResponse(servo_bus::Command::kPing, {4}));
       s.frames += 5;
       if (step % 32 == 0) {
         for (int i = 0; i < 3; ++i) s.bytes.push_back(static_cast<uint8_t>(noise(rng)));
@@ -155,10 +155,10 @@ void BM_FramerAndDecodeMixedStream(benchmark::State& state) {
                           decoded_ok += body::decodeTelemetry(data, size, kServoCount).ok();
                         } else if (family == base::kFrames) {
                           decoded_ok += base::decodeFrame(data, size).ok();
-                        } else if (family == servo::kResponseFrames) {
-                          decoded_ok += servo::decodeResponse(data, size).ok();
-                        } else if (family == servo::kRequestFrames) {
-                          decoded_ok += servo::decodeRequest(data, size).ok();
+                        } else if (family == servo_bus::kResponseFrames) {
+                          decoded_ok += servo_bus::decodeResponse(data, size).ok();
+                        } else if (family == servo_bus::kRequestFrames) {
+                          decoded_ok += servo_bus::decodeRequest(data, size).ok();
                         }
                       });
   constexpr std::size_t kChunk = 512;
@@ -237,8 +237,8 @@ void BM_DecodeBaseFrame(benchmark::State& state) {
 BENCHMARK(BM_DecodeBaseFrame);
 
 void BM_DecodeServoResponse(benchmark::State& state) {
-  runDecoder(state, servo::encodeResponse(servo::Command::kReadAngle, {3, 0x86, 0x03}),
-             servo::decodeResponse);
+  runDecoder(state, servo_bus::encodeResponse(servo_bus::Command::kReadAngle, {3, 0x86, 0x03}),
+             servo_bus::decodeResponse);
 }
 BENCHMARK(BM_DecodeServoResponse);
 

@@ -57,8 +57,8 @@
 namespace serial_robot_driver::bench {
 namespace {
 
-namespace base = protocol::base;
-namespace body = protocol::body;
+namespace base = devices::base;
+namespace body = devices::body;
 using namespace std::chrono_literals;
 using test_support::PtyFrameReader;
 
@@ -180,7 +180,7 @@ struct Variant {
   std::string name;
   std::string tag;  ///< part of the node namespace
   std::string program;
-  double read_poll_interval;  ///< 0: event-driven
+  double read_poll_interval;    ///< 0: event-driven
   bool spaced_cmd_vel = false;  ///< section 8: commands 10-40 ms apart instead of one per tick
   bool capture = false;         ///< ~capture on, with a subscriber on serial_raw
 };
@@ -203,7 +203,8 @@ void require(bool condition, const std::string& what) {
 
 ParamList commonParams(const std::string& port, const Variant& variant) {
   ParamList params = {{"port", port}, {"loop_rate", kLoopRate}, {"reconnect_interval", 0.2}};
-  if (variant.read_poll_interval > 0) params.emplace_back("read_poll_interval", variant.read_poll_interval);
+  if (variant.read_poll_interval > 0)
+    params.emplace_back("read_poll_interval", variant.read_poll_interval);
   if (variant.capture) params.emplace_back("capture", true);
   return params;
 }
@@ -285,7 +286,7 @@ class SpeedFrameLog {
  public:
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
                Clock::time_point arrival) {
-    if (family != protocol::base::kFrames) return;
+    if (family != devices::base::kFrames) return;
     const auto frame = base::decodeFrame(data, size);
     if (!frame || frame->msg_id != static_cast<uint8_t>(base::MsgId::kWheelSpeed)) return;
     const auto speed = base::interpretWheelSpeed(*frame);
@@ -443,7 +444,7 @@ BaseSessionResult runBaseSession(Context& context, const Variant& variant, bool 
   sim::PseudoTerminal pty(context.paths.link(ns));
   SpeedFrameLog log;
   protocol::FramerConfig framer;
-  framer.accept(protocol::base::kFrames);
+  framer.accept(devices::base::kFrames);
   PtyFrameReader reader(pty, framer, [&log](auto family, auto data, auto size, auto arrival) {
     log.onFrame(family, data, size, arrival);
   });
@@ -807,16 +808,17 @@ constexpr double kBusLineMs = (6 + 8) * 10.0 / kBusBaud * 1000.0;
 /// One run of READ_ANGLE transactions: by whom, how many per second, at what cost.
 struct BusRun {
   double per_second = 0;
-  double cpu_us = 0;      ///< CPU per transaction of the process doing them
-  double cpu_share = 0;   ///< CPU seconds per second
+  double cpu_us = 0;     ///< CPU per transaction of the process doing them
+  double cpu_share = 0;  ///< CPU seconds per second
   double turnaround_ms = 0;
 };
 
 std::vector<std::string> busSimFlags(const std::string& link, double latency_ms, bool paced) {
   std::string ids;
   for (int id = 0; id < kBusServos; ++id) ids += (id ? "," : "") + std::to_string(id);
-  std::vector<std::string> flags = {"--link", link, "--no-base", "--no-body", "--bus-servo-ids",
-                                    ids, "--servo-latency-ms", format("%.3f", latency_ms)};
+  std::vector<std::string> flags = {
+      "--link",          link, "--no-base",          "--no-body",
+      "--bus-servo-ids", ids,  "--servo-latency-ms", format("%.3f", latency_ms)};
   if (paced) flags.insert(flags.end(), {"--pace-baud", format("%.0f", kBusBaud)});
   return flags;
 }
@@ -829,13 +831,13 @@ BusRun runServoFloor(Context& context, const std::string& tag, double latency_ms
   require(waitUntil([&] { return ::access(link.c_str(), F_OK) == 0; }, 20s),
           "robot_sim did not create " + link);
   const std::string log = context.paths.log("servo_floor_" + tag);
-  ChildProcess floor("servo_floor", {context.paths.bin_dir + "/servo_floor", link,
-                                     std::to_string(kBusServos),
-                                     format("%.1f", context.options.bus_seconds)},
+  ChildProcess floor("servo_floor",
+                     {context.paths.bin_dir + "/servo_floor", link, std::to_string(kBusServos),
+                      format("%.1f", context.options.bus_seconds)},
                      log);
-  require(waitUntil([&] { return !floor.running(); },
-                    fromSeconds(context.options.bus_seconds + 30)),
-          "servo_floor did not finish; see " + log);
+  require(
+      waitUntil([&] { return !floor.running(); }, fromSeconds(context.options.bus_seconds + 30)),
+      "servo_floor did not finish; see " + log);
   std::ifstream in(log);
   std::string line, last;
   while (std::getline(in, line)) {
@@ -909,7 +911,8 @@ BusRun runPublishingServoFloor(Context& context, const std::string& tag, double 
                                bool paced) {
   const std::string ns = "bus_floor_pub_" + tag;
   const std::string link = context.paths.link(ns);
-  const auto sim = startRobotSim(context.paths, "robot_sim_" + ns, busSimFlags(link, latency_ms, paced));
+  const auto sim =
+      startRobotSim(context.paths, "robot_sim_" + ns, busSimFlags(link, latency_ms, paced));
   require(waitUntil([&] { return ::access(link.c_str(), F_OK) == 0; }, 20s),
           "robot_sim did not create " + link);
   const std::string log = context.paths.log("servo_floor_" + ns);
@@ -917,8 +920,8 @@ BusRun runPublishingServoFloor(Context& context, const std::string& tag, double 
   // measurement is the subscriber's, like driver_node's, and the floor is stopped after it.
   ChildProcess floor("servo_floor",
                      {context.paths.bin_dir + "/servo_floor", link, std::to_string(kBusServos),
-                      format("%.1f", context.options.bus_seconds + 60), "--publish",
-                      "__ns:=/" + ns, "__name:=servo_floor"},
+                      format("%.1f", context.options.bus_seconds + 60), "--publish", "__ns:=/" + ns,
+                      "__name:=servo_floor"},
                      log);
   return measureServoStates(context, "/" + ns + "/servo_states", floor.pid(), log);
 }
@@ -993,10 +996,11 @@ std::string versus(const BusRun& node, const BusRun& floor) {
 
 void addBusRunRows(ResultTable& table, const BusRuns& runs) {
   const double wire_rate = kBusWireRate;
-  table.section(format("10. The servo bus at the wire's pace: READ_ANGLE of %d servos, "
-                       "servo_states (driver_node) vs servo_floor", kBusServos),
-                {"run", "transactions/s", "per transaction", "CPU per transaction", "CPU",
-                 "node / floor"});
+  table.section(
+      format("10. The servo bus at the wire's pace: READ_ANGLE of %d servos, "
+             "servo_states (driver_node) vs servo_floor",
+             kBusServos),
+      {"run", "transactions/s", "per transaction", "CPU per transaction", "CPU", "node / floor"});
   auto add = [&](const std::string& what, const BusRun& run, const std::string& ratio_text) {
     table.row({what, format("%.0f", run.per_second), format("%.3f ms", run.turnaround_ms),
                format("%.1f us", run.cpu_us), format("%.2f s per s", run.cpu_share), ratio_text});
@@ -1045,8 +1049,8 @@ void addBusGoals(ResultTable& table, const BusRuns& runs) {
             ">= 90 %", runs.node_paced.per_second >= 0.9 * wire_rate);
   const double paced_excess = runs.floor_paced.turnaround_ms - runs.floor_unpaced.turnaround_ms;
   table.row("paced robot_sim: floor turnaround paced - unpaced (same latency)",
-            format("%.3f ms (the line: %.3f ms)", paced_excess, kBusLineMs),
-            "line +- 0.1 ms", std::abs(paced_excess - kBusLineMs) <= 0.1);
+            format("%.3f ms (the line: %.3f ms)", paced_excess, kBusLineMs), "line +- 0.1 ms",
+            std::abs(paced_excess - kBusLineMs) <= 0.1);
   table.row(
       "paced robot_sim: floor turnaround vs line + latency",
       format("%.3f ms vs %.3f ms", runs.floor_paced.turnaround_ms, kBusLineMs + kBusLatencyMs));

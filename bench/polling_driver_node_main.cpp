@@ -12,7 +12,7 @@
 
 namespace {
 
-serial_robot_driver::device::SerialLink::StreamFactory pollingStreams(ros::NodeHandle& private_nh) {
+serial_robot_driver::core::SerialLink::StreamFactory pollingStreams(ros::NodeHandle& private_nh) {
   using namespace serial_robot_driver;
   double interval = 0.0;
   private_nh.getParam("read_poll_interval", interval);

@@ -30,14 +30,14 @@
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 
-namespace servo = serial_robot_driver::protocol::servo;
+namespace servo_bus = serial_robot_driver::devices::servo_bus;
 using Clock = std::chrono::steady_clock;
 
 namespace {
 
 /// A lost answer (a fault, a restart) costs this wait; robot_sim never loses one unless told to.
 constexpr int kAnswerTimeoutMs = 50;
-constexpr std::size_t kAngleAnswerSize = servo::kOverhead + 3;  // id, i16 angle
+constexpr std::size_t kAngleAnswerSize = servo_bus::kOverhead + 3;  // id, i16 angle
 
 double processCpuSeconds() {
   timespec cpu{};
@@ -46,8 +46,8 @@ double processCpuSeconds() {
 }
 
 /// Reads one answer of `size` bytes (blocking); false after a timeout or a bad answer.
-bool readAnswer(int fd, std::size_t size, servo::Packet* packet) {
-  uint8_t buffer[servo::kMaxFrameSize];
+bool readAnswer(int fd, std::size_t size, servo_bus::Packet* packet) {
+  uint8_t buffer[servo_bus::kMaxFrameSize];
   std::size_t have = 0;
   while (have < size) {
     pollfd pfd{fd, POLLIN, 0};
@@ -56,7 +56,7 @@ bool readAnswer(int fd, std::size_t size, servo::Packet* packet) {
     if (n <= 0) return false;
     have += static_cast<std::size_t>(n);
   }
-  const auto decoded = servo::decodeResponse(buffer, have);
+  const auto decoded = servo_bus::decodeResponse(buffer, have);
   if (!decoded.ok()) return false;
   *packet = *decoded;
   return true;
@@ -86,14 +86,14 @@ struct Totals {
 /// One READ_ANGLE request and its answer (published as `name` when `states` is given).
 void transact(int fd, const std::vector<uint8_t>& request, const std::string& name,
               ros::Publisher* states, Totals* totals) {
-  servo::Packet answer;
+  servo_bus::Packet answer;
   if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size()) ||
       !readAnswer(fd, kAngleAnswerSize, &answer)) {
     ++totals->lost;
     ::tcflush(fd, TCIFLUSH);  // a late answer must not pass for the next one
     return;
   }
-  const auto angle = servo::decodeAngleAnswer(answer);
+  const auto angle = servo_bus::decodeAngleAnswer(answer);
   if (angle.ok()) {
     totals->angle_sum += angle->angle_decidegrees;
     if (states != nullptr) {
@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
   std::vector<std::vector<uint8_t>> requests;
   std::vector<std::string> names;
   for (int id = 0; id < servos; ++id) {
-    requests.push_back(servo::encodeReadAngle(id));
+    requests.push_back(servo_bus::encodeReadAngle(id));
     names.push_back("servo_" + std::to_string(id));
   }
 

@@ -11,9 +11,9 @@ set(SRD_CORE_SOURCES
   src/transport/serial_port.cpp
   src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
-  src/device/serial_link.cpp
-  src/device/loop_clock.cpp
-  src/device/device_module.cpp
+  src/core/serial_link.cpp
+  src/core/loop_clock.cpp
+  src/core/device_module.cpp
   src/params/device_sections.cpp
   src/params/param_table.cpp
   src/params/driver_params.cpp
@@ -25,22 +25,22 @@ set(SRD_CORE_SOURCES
   src/trajectory/joint_groups.cpp
   src/trajectory/goal.cpp
   src/trajectory/executor.cpp
-  src/device/e_stop.cpp
-  src/device/motion_gate.cpp
-  src/device/status_report.cpp
-  src/device/event_rate.cpp
-  src/device/link_status.cpp
-  src/device/e_stop_status.cpp
-  src/device/input_refusals.cpp
-  src/device/driver_core.cpp
-  src/device/wire_capture_status.cpp
+  src/core/e_stop.cpp
+  src/core/motion_gate.cpp
+  src/core/status_report.cpp
+  src/core/event_rate.cpp
+  src/core/link_status.cpp
+  src/core/e_stop_status.cpp
+  src/core/input_refusals.cpp
+  src/core/driver_core.cpp
+  src/core/wire_capture_status.cpp
 )
 
 srd_device_sources(core srd_device_core_sources)
 list(APPEND SRD_CORE_SOURCES ${srd_device_core_sources})
 srd_write_registry("${CMAKE_BINARY_DIR}/srd_generated/registered_devices.cpp"
-  "serial_robot_driver/device/device_module.h" "serial_robot_driver::device::DeviceModule" kModule
-  "serial_robot_driver::device::registeredDevices" "")
+  "serial_robot_driver/core/device_module.h" "serial_robot_driver::core::DeviceModule" kModule
+  "serial_robot_driver::core::registeredDevices" "")
 set(SRD_CORE_GENERATED_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_devices.cpp")
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,

@@ -38,9 +38,9 @@
 
 namespace {
 
-namespace base = serial_robot_driver::protocol::base;
-namespace body = serial_robot_driver::protocol::body;
-namespace servo = serial_robot_driver::protocol::servo;
+namespace base = serial_robot_driver::devices::base;
+namespace body = serial_robot_driver::devices::body;
+namespace servo_bus = serial_robot_driver::devices::servo_bus;
 namespace wire = serial_robot_driver::protocol::wire;
 using serial_robot_driver::protocol::FrameFamily;
 using serial_robot_driver::protocol::Probe;
@@ -81,12 +81,12 @@ void fixTelemetry(uint8_t* d, std::size_t n, Mode mode) {
 }
 
 void fixServo(uint8_t* d, std::size_t n, Mode mode, uint8_t header0, uint8_t header1) {
-  if (mode == Mode::kFixEverything && n >= servo::kOverhead) {
+  if (mode == Mode::kFixEverything && n >= servo_bus::kOverhead) {
     d[0] = header0;
     d[1] = header1;
-    d[3] = static_cast<uint8_t>(n - servo::kOverhead);
+    d[3] = static_cast<uint8_t>(n - servo_bus::kOverhead);
   }
-  if (n >= 1) d[n - 1] = servo::byteSum(d, n - 1);
+  if (n >= 1) d[n - 1] = servo_bus::byteSum(d, n - 1);
 }
 
 void fixSyncWrite(uint8_t* d, std::size_t n, Mode mode) {
@@ -125,100 +125,103 @@ void runTelemetry(const uint8_t* d, std::size_t n, std::size_t servo_count) {
   check(sameBytes(body::encodeTelemetry(*telemetry), d, n));
 }
 
-void runServoParams(const servo::Packet& packet) {
-  const auto cmd = static_cast<servo::Command>(packet.cmd);
-  if (cmd == servo::Command::kReadData) {
-    const auto data = servo::decodeDataContent(packet);
-    const servo::ParamInfo* param = data.ok() ? servo::findParamById(data->data_id) : nullptr;
-    if (param != nullptr) (void)servo::readValue(*param, data->value.data(), data->value_size);
+void runServoParams(const servo_bus::Packet& packet) {
+  const auto cmd = static_cast<servo_bus::Command>(packet.cmd);
+  if (cmd == servo_bus::Command::kReadData) {
+    const auto data = servo_bus::decodeDataContent(packet);
+    const servo_bus::ParamInfo* param =
+        data.ok() ? servo_bus::findParamById(data->data_id) : nullptr;
+    if (param != nullptr) (void)servo_bus::readValue(*param, data->value.data(), data->value_size);
   }
-  if (cmd == servo::Command::kReadBatchData) {
-    const auto block = servo::decodeUserBlock(packet);
+  if (cmd == servo_bus::Command::kReadBatchData) {
+    const auto block = servo_bus::decodeUserBlock(packet);
     if (!block.ok()) return;
     // The user parameters cover every byte of the block: unpacked and packed again, it is the same.
-    const auto values = servo::unpackUserBlock(*block);
-    const auto value_of = [&](const servo::ParamInfo& param) {
+    const auto values = servo_bus::unpackUserBlock(*block);
+    const auto value_of = [&](const servo_bus::ParamInfo& param) {
       for (const auto& [unpacked, value] : values) {
         if (unpacked == &param) return value;
       }
       std::abort();
     };
-    check(servo::packUserBlock(value_of) == *block);
+    check(servo_bus::packUserBlock(value_of) == *block);
   }
 }
 
 void runServoResponse(const uint8_t* d, std::size_t n) {
-  const auto packet = servo::decodeResponse(d, n);
+  const auto packet = servo_bus::decodeResponse(d, n);
   if (!packet.ok()) return;
   const std::vector<uint8_t> content(packet->content.begin(),
                                      packet->content.begin() + packet->content_size);
-  check(sameBytes(servo::encodeResponse(static_cast<servo::Command>(packet->cmd), content), d, n));
+  check(sameBytes(servo_bus::encodeResponse(static_cast<servo_bus::Command>(packet->cmd), content),
+                  d, n));
   runServoParams(*packet);
   // The typed answers of the command table: an answer of the size its row says decodes and
   // re-encodes to the same CONTENT.
-  const auto cmd = static_cast<servo::Command>(packet->cmd);
-  const servo::CommandInfo& info = servo::commandInfo(cmd);
+  const auto cmd = static_cast<servo_bus::Command>(packet->cmd);
+  const servo_bus::CommandInfo& info = servo_bus::commandInfo(cmd);
   if (!info.answer.fits(packet->content_size)) return;
-  if (info.result_index != servo::kNoResult) check(info.result_index < packet->content_size);
-  if (cmd == servo::Command::kReadAngle) {
-    const auto angle = servo::decodeAngleAnswer(*packet);
-    check(angle.ok() && servo::angleAnswerContent(*angle) == content);
+  if (info.result_index != servo_bus::kNoResult) check(info.result_index < packet->content_size);
+  if (cmd == servo_bus::Command::kReadAngle) {
+    const auto angle = servo_bus::decodeAngleAnswer(*packet);
+    check(angle.ok() && servo_bus::angleAnswerContent(*angle) == content);
   }
-  if (cmd == servo::Command::kReadMultiTurnAngle) {
-    const auto angle = servo::decodeMultiTurnAngle(*packet);
-    check(angle.ok() && servo::multiTurnAngleContent(*angle) == content);
+  if (cmd == servo_bus::Command::kReadMultiTurnAngle) {
+    const auto angle = servo_bus::decodeMultiTurnAngle(*packet);
+    check(angle.ok() && servo_bus::multiTurnAngleContent(*angle) == content);
   }
-  if (cmd == servo::Command::kPing) check(servo::pingAnswerContent(packet->id()) == content);
+  if (cmd == servo_bus::Command::kPing)
+    check(servo_bus::pingAnswerContent(packet->id()) == content);
   // The answers that are an id and a result byte re-encode when that byte is 0 or 1.
-  if (info.result_index != servo::kNoResult && cmd != servo::Command::kWriteData &&
+  if (info.result_index != servo_bus::kNoResult && cmd != servo_bus::Command::kWriteData &&
       content[info.result_index] <= 1) {
     const bool ok = content[info.result_index] == 1;
-    check(servo::resultAnswerContent(packet->id(), ok) == content);
+    check(servo_bus::resultAnswerContent(packet->id(), ok) == content);
   }
-  if (cmd == servo::Command::kReadData) check(servo::decodeDataContent(*packet).ok());
-  if (cmd == servo::Command::kReadBatchData) {
-    const auto block = servo::decodeUserBlock(*packet);
-    check(block.ok() && servo::userBlockAnswerContent(packet->id(), *block) == content);
+  if (cmd == servo_bus::Command::kReadData) check(servo_bus::decodeDataContent(*packet).ok());
+  if (cmd == servo_bus::Command::kReadBatchData) {
+    const auto block = servo_bus::decodeUserBlock(*packet);
+    check(block.ok() && servo_bus::userBlockAnswerContent(packet->id(), *block) == content);
   }
 }
 
 void runServoRequest(const uint8_t* d, std::size_t n) {
-  const auto packet = servo::decodeRequest(d, n);
+  const auto packet = servo_bus::decodeRequest(d, n);
   if (!packet.ok()) return;
-  check(packet->content_size + servo::kOverhead == n);
-  check(packet->cmd >= servo::kMinCommand && packet->cmd <= servo::kMaxCommand);
+  check(packet->content_size + servo_bus::kOverhead == n);
+  check(packet->cmd >= servo_bus::kMinCommand && packet->cmd <= servo_bus::kMaxCommand);
   // The typed requests of the command table (what the simulator reads): a request of the size
   // its row says decodes, and the moves and SPIN re-encode to the same bytes.
-  const auto cmd = static_cast<servo::Command>(packet->cmd);
-  if (!servo::commandInfo(cmd).request.fits(packet->content_size)) return;
-  if (servo::isMove(cmd)) {
-    const auto move = servo::decodeMove(*packet);
-    check(move.ok() && sameBytes(servo::encodeMove(*move), d, n));
+  const auto cmd = static_cast<servo_bus::Command>(packet->cmd);
+  if (!servo_bus::commandInfo(cmd).request.fits(packet->content_size)) return;
+  if (servo_bus::isMove(cmd)) {
+    const auto move = servo_bus::decodeMove(*packet);
+    check(move.ok() && sameBytes(servo_bus::encodeMove(*move), d, n));
   }
-  if (cmd == servo::Command::kReadData || cmd == servo::Command::kWriteData) {
-    const auto data = servo::decodeDataContent(*packet);
+  if (cmd == servo_bus::Command::kReadData || cmd == servo_bus::Command::kWriteData) {
+    const auto data = servo_bus::decodeDataContent(*packet);
     check(data.ok());
-    const servo::ParamInfo* param = servo::findParamById(data->data_id);
+    const servo_bus::ParamInfo* param = servo_bus::findParamById(data->data_id);
     const auto value = param != nullptr
-                           ? servo::readValue(*param, data->value.data(), data->value_size)
+                           ? servo_bus::readValue(*param, data->value.data(), data->value_size)
                            : std::nullopt;
-    if (cmd == servo::Command::kWriteData && value) {
-      check(sameBytes(servo::encodeWriteData(data->id, *param, *value), d, n));
+    if (cmd == servo_bus::Command::kWriteData && value) {
+      check(sameBytes(servo_bus::encodeWriteData(data->id, *param, *value), d, n));
     }
   }
-  if (cmd == servo::Command::kDamping) {
-    const auto power = servo::decodeDamping(*packet);
-    check(power.ok() && sameBytes(servo::encodeDamping(packet->id(), *power), d, n));
+  if (cmd == servo_bus::Command::kDamping) {
+    const auto power = servo_bus::decodeDamping(*packet);
+    check(power.ok() && sameBytes(servo_bus::encodeDamping(packet->id(), *power), d, n));
   }
-  if (cmd == servo::Command::kWriteBatchData) {
-    const auto block = servo::decodeUserBlock(*packet);
-    check(block.ok() && sameBytes(servo::encodeWriteBatchData(packet->id(), *block), d, n));
+  if (cmd == servo_bus::Command::kWriteBatchData) {
+    const auto block = servo_bus::decodeUserBlock(*packet);
+    check(block.ok() && sameBytes(servo_bus::encodeWriteBatchData(packet->id(), *block), d, n));
   }
-  if (cmd == servo::Command::kSpin) {
-    const auto spin = servo::decodeSpin(*packet);
+  if (cmd == servo_bus::Command::kSpin) {
+    const auto spin = servo_bus::decodeSpin(*packet);
     check(spin.ok());
     // Bits 6..2 of the method byte are not part of SPIN: only the frames without them re-encode.
-    if ((packet->content[1] & 0x7C) == 0) check(sameBytes(servo::encodeSpin(*spin), d, n));
+    if ((packet->content[1] & 0x7C) == 0) check(sameBytes(servo_bus::encodeSpin(*spin), d, n));
   }
 }
 
@@ -230,11 +233,11 @@ void runSyncWrite(const uint8_t* d, std::size_t n) {
 }
 
 void fixServoResponse(uint8_t* d, std::size_t n, Mode mode) {
-  fixServo(d, n, mode, servo::kResponseHeader0, servo::kResponseHeader1);
+  fixServo(d, n, mode, servo_bus::kResponseHeader0, servo_bus::kResponseHeader1);
 }
 
 void fixServoRequest(uint8_t* d, std::size_t n, Mode mode) {
-  fixServo(d, n, mode, servo::kRequestHeader0, servo::kRequestHeader1);
+  fixServo(d, n, mode, servo_bus::kRequestHeader0, servo_bus::kRequestHeader1);
 }
 
 // --- what every family gets, and what some get beyond it -----------------------------------------

@@ -26,9 +26,9 @@
 
 namespace {
 
-namespace base = serial_robot_driver::protocol::base;
-namespace body = serial_robot_driver::protocol::body;
-namespace servo = serial_robot_driver::protocol::servo;
+namespace base = serial_robot_driver::devices::base;
+namespace body = serial_robot_driver::devices::body;
+namespace servo_bus = serial_robot_driver::devices::servo_bus;
 using Bytes = std::vector<uint8_t>;
 
 Bytes join(std::initializer_list<Bytes> parts) {
@@ -98,85 +98,85 @@ Bytes dynamixelPing() {
 }
 
 // --- servo bus: one request and one answer per command ------------------------------------------
-const servo::ParamInfo& param(const char* name) { return *servo::findParam(name); }
+const servo_bus::ParamInfo& param(const char* name) { return *servo_bus::findParam(name); }
 
-servo::MoveRamps ramps(uint16_t accel_ms, uint16_t decel_ms) {
-  servo::MoveRamps result;
+servo_bus::MoveRamps ramps(uint16_t accel_ms, uint16_t decel_ms) {
+  servo_bus::MoveRamps result;
   result.accel_ms = accel_ms;
   result.decel_ms = decel_ms;
   return result;
 }
 
-std::array<uint8_t, servo::kUserBlockSize> userBlock() {
-  std::array<uint8_t, servo::kUserBlockSize> block{};
-  for (const servo::ParamInfo& info : servo::paramTable()) {
-    if (const auto offset = servo::userBlockOffset(info)) {
-      servo::writeValue(info, info.min + (info.max - info.min) / 2, &block[*offset]);
+std::array<uint8_t, servo_bus::kUserBlockSize> userBlock() {
+  std::array<uint8_t, servo_bus::kUserBlockSize> block{};
+  for (const servo_bus::ParamInfo& info : servo_bus::paramTable()) {
+    if (const auto offset = servo_bus::userBlockOffset(info)) {
+      servo_bus::writeValue(info, info.min + (info.max - info.min) / 2, &block[*offset]);
     }
   }
   return block;
 }
 
-Bytes request(servo::Command cmd) {
-  using servo::Command;
+Bytes request(servo_bus::Command cmd) {
+  using servo_bus::Command;
   switch (cmd) {
     case Command::kPing:
-      return servo::encodePing(3);
+      return servo_bus::encodePing(3);
     case Command::kResetUserData:
-      return servo::encodeResetUserData(3);
+      return servo_bus::encodeResetUserData(3);
     case Command::kReadData:
-      return servo::encodeReadData(3, param("voltage").data_id);
+      return servo_bus::encodeReadData(3, param("voltage").data_id);
     case Command::kWriteData:
-      return servo::encodeWriteData(3, param("angle_limit_low"), -900);
+      return servo_bus::encodeWriteData(3, param("angle_limit_low"), -900);
     case Command::kReadBatchData:
-      return servo::encodeReadBatchData(3);
+      return servo_bus::encodeReadBatchData(3);
     case Command::kWriteBatchData:
-      return servo::encodeWriteBatchData(3, userBlock());
+      return servo_bus::encodeWriteBatchData(3, userBlock());
     case Command::kSpin:
-      return servo::encodeSpin(0, true, servo::SpinMode::kDurationMs, 100, 1000);
+      return servo_bus::encodeSpin(0, true, servo_bus::SpinMode::kDurationMs, 100, 1000);
     case Command::kRotate:
-      return servo::encodeRotate(2, 900, 500, 0);
+      return servo_bus::encodeRotate(2, 900, 500, 0);
     case Command::kDamping:
-      return servo::encodeDamping(0, 500);
+      return servo_bus::encodeDamping(0, 500);
     case Command::kReadAngle:
-      return servo::encodeReadAngle(0);
+      return servo_bus::encodeReadAngle(0);
     case Command::kMoveByInterval:
-      return servo::encodeMoveByInterval(1, 900, 1000, ramps(100, 100));
+      return servo_bus::encodeMoveByInterval(1, 900, 1000, ramps(100, 100));
     case Command::kMoveByVelocity:
-      return servo::encodeMoveByVelocity(1, -900, 3600, ramps(100, 100));
+      return servo_bus::encodeMoveByVelocity(1, -900, 3600, ramps(100, 100));
     case Command::kMultiTurnMove:
-      return servo::encodeMultiTurnMove(1, 7200, 2000, 0);
+      return servo_bus::encodeMultiTurnMove(1, 7200, 2000, 0);
     case Command::kMultiTurnMoveByInterval:
-      return servo::encodeMultiTurnMoveByInterval(1, -3600, 1000, ramps(200, 200));
+      return servo_bus::encodeMultiTurnMoveByInterval(1, -3600, 1000, ramps(200, 200));
     case Command::kMultiTurnMoveByVelocity:
-      return servo::encodeMultiTurnMoveByVelocity(1, 36000, 3600, ramps(100, 100));
+      return servo_bus::encodeMultiTurnMoveByVelocity(1, 36000, 3600, ramps(100, 100));
     case Command::kReadMultiTurnAngle:
-      return servo::encodeReadMultiTurnAngle(1);
+      return servo_bus::encodeReadMultiTurnAngle(1);
   }
   return {};
 }
 
-Bytes answerContent(servo::Command cmd) {
-  using servo::Command;
+Bytes answerContent(servo_bus::Command cmd) {
+  using servo_bus::Command;
   switch (cmd) {
     case Command::kPing:
-      return servo::pingAnswerContent(3);
+      return servo_bus::pingAnswerContent(3);
     case Command::kReadData:
-      return servo::readDataAnswerContent(3, param("voltage"), 7400);
+      return servo_bus::readDataAnswerContent(3, param("voltage"), 7400);
     case Command::kWriteData:
-      return servo::writeDataAnswerContent(3, param("angle_limit_low").data_id, true);
+      return servo_bus::writeDataAnswerContent(3, param("angle_limit_low").data_id, true);
     case Command::kReadBatchData:
-      return servo::userBlockAnswerContent(3, userBlock());
+      return servo_bus::userBlockAnswerContent(3, userBlock());
     case Command::kReadAngle:
-      return servo::angleAnswerContent({0, 902});
+      return servo_bus::angleAnswerContent({0, 902});
     case Command::kReadMultiTurnAngle:
-      return servo::multiTurnAngleContent({1, 7200, 2});
+      return servo_bus::multiTurnAngleContent({1, 7200, 2});
     default:  // every other command answers with a result byte (see the command table)
-      return servo::resultAnswerContent(1, true);
+      return servo_bus::resultAnswerContent(1, true);
   }
 }
 
-Bytes answer(servo::Command cmd) { return servo::encodeResponse(cmd, answerContent(cmd)); }
+Bytes answer(servo_bus::Command cmd) { return servo_bus::encodeResponse(cmd, answerContent(cmd)); }
 
 // "MULTI_TURN_MOVE_BY_INTERVAL (CMD 14)" -> "multi_turn_move_by_interval"
 std::string seedName(const char* command_name) {
@@ -212,31 +212,31 @@ void writeFramerSeeds(SeedWriter& seeds) {
   seeds.write("telemetry", all, kTelemetry);
   seeds.write("telemetry_foot_chunked", {kTelemetryBit, 2, 5}, join({kTelemetryFoot, kTelemetry}));
   seeds.write("sync_write", all, kSyncWrite);
-  seeds.write("simulator_input",
-              {static_cast<uint8_t>(kBaseBit | kRequestBit | kSyncWriteBit), 0, 4},
-              join({dynamixelPing(), kSyncWrite, request(servo::Command::kRotate), kBaseReset}));
+  seeds.write(
+      "simulator_input", {static_cast<uint8_t>(kBaseBit | kRequestBit | kSyncWriteBit), 0, 4},
+      join({dynamixelPing(), kSyncWrite, request(servo_bus::Command::kRotate), kBaseReset}));
   Bytes requests, answers;
-  for (const servo::CommandInfo& info : servo::commandTable()) {
+  for (const servo_bus::CommandInfo& info : servo_bus::commandTable()) {
     requests = join({requests, request(info.cmd)});
     answers = join({answers, answer(info.cmd)});
   }
   seeds.write("servo_requests", all, requests);
   seeds.write("servo_responses", {static_cast<uint8_t>(kResponseBit | kRequestBit), 2, 1}, answers);
-  const Bytes junk = {0x00, base::kHeader0, servo::kRequestHeader0};
+  const Bytes junk = {0x00, base::kHeader0, servo_bus::kRequestHeader0};
   seeds.write("driver_mixed_with_junk",
               {static_cast<uint8_t>(kBaseBit | kTelemetryBit | kResponseBit | kRequestBit), 2, 7},
               join({junk,
                     kTelemetry,
-                    {servo::kResponseHeader0},
+                    {servo_bus::kResponseHeader0},
                     kBaseBatteryReply,
                     {body::kSyncWriteHeader[0], body::kSyncWriteHeader[1]},
-                    request(servo::Command::kReadAngle),
-                    answer(servo::Command::kReadAngle),
+                    request(servo_bus::Command::kReadAngle),
+                    answer(servo_bus::Command::kReadAngle),
                     {body::kTelemetryHeader0, body::kTelemetryHeader1},
                     kTelemetryFoot,
                     kBaseErrorStatus}));
   seeds.write("everything_reset", {static_cast<uint8_t>(kAllFamilies | kResetBit), 2, 3},
-              join({kTelemetry, kSyncWrite, kBaseClearEncoders, answer(servo::Command::kPing),
+              join({kTelemetry, kSyncWrite, kBaseClearEncoders, answer(servo_bus::Command::kPing),
                     kBaseBatteryRequest, kTelemetryFoot}));
 }
 
@@ -252,7 +252,7 @@ void writeDecoderSeeds(SeedWriter& seeds) {
   seeds.write("telemetry_foot_raw", {selector("telemetry", kRaw), 2}, kTelemetryFoot);
   seeds.write("telemetry_fixsum", {selector("telemetry", kFixSum), 2}, kTelemetry);
   seeds.write("telemetry_fixall", {selector("telemetry", kFixAll), 6}, kTelemetryFoot);
-  for (const servo::CommandInfo& info : servo::commandTable()) {
+  for (const servo_bus::CommandInfo& info : servo_bus::commandTable()) {
     const std::string name = seedName(info.name);
     seeds.write("servo_request_" + name + "_raw", {selector("servo_request", kRaw), 0},
                 request(info.cmd));
@@ -260,13 +260,13 @@ void writeDecoderSeeds(SeedWriter& seeds) {
                 answer(info.cmd));
   }
   seeds.write("servo_request_fixsum", {selector("servo_request", kFixSum), 0},
-              request(servo::Command::kSpin));
+              request(servo_bus::Command::kSpin));
   seeds.write("servo_response_fixsum", {selector("servo_response", kFixSum), 0},
-              answer(servo::Command::kPing));
+              answer(servo_bus::Command::kPing));
   seeds.write("servo_read_data_fixall", {selector("servo_response", kFixAll), 0},
-              answer(servo::Command::kReadData));
+              answer(servo_bus::Command::kReadData));
   seeds.write("servo_read_batch_fixall", {selector("servo_response", kFixAll), 0},
-              answer(servo::Command::kReadBatchData));
+              answer(servo_bus::Command::kReadBatchData));
   seeds.write("sync_write_raw", {selector("sync_write", kRaw), 0}, kSyncWrite);
   seeds.write("sync_write_fixcrc", {selector("sync_write", kFixSum), 0}, kSyncWrite);
   // Three bytes more: with the fix-ups they become a third servo record.

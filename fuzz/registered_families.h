@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 
 namespace fuzz_support {
 
@@ -23,7 +23,7 @@ inline const std::vector<serial_robot_driver::protocol::FrameFamily>& registered
       }
       all.push_back(family);
     };
-    for (const auto* device : serial_robot_driver::device::registeredDevices()) {
+    for (const auto* device : serial_robot_driver::core::registeredDevices()) {
       for (const auto& family : device->driver_frames) add(family);
       for (const auto& family : device->simulator_frames) add(family);
     }

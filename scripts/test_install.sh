@@ -51,8 +51,8 @@ for f in lib/serial_robot_driver/driver_node lib/serial_robot_driver/robot_sim l
   [ -e "$prefix/$f" ] || fail "missing $f"
 done
 for f in include/serial_robot_driver/ros include/serial_robot_driver/sim \
-         include/serial_robot_driver/devices/base/base_interface.h \
-         include/serial_robot_driver/devices/base/base_sim.h \
+         include/serial_robot_driver/devices/base/ros/base_ros.h \
+         include/serial_robot_driver/devices/base/sim/base_sim.h \
          lib/serial_robot_driver/driver_bench lib/serial_robot_driver/polling_driver_node \
          lib/serial_robot_driver/bench_framer lib/serial_robot_driver/run_benchmarks.sh; do
   [ ! -e "$prefix/$f" ] || fail "$f is installed but should not be"

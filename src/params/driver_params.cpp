@@ -3,7 +3,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 
 namespace serial_robot_driver::params {
 
@@ -49,7 +49,7 @@ std::vector<ParamSpec> buildTable() {
   SectionRows<EStopParams>(table, "", "e_stop", [](DriverParams& p) -> EStopParams& {
     return p.e_stop;
   }).add("start_engaged", &EStopParams::start_engaged);
-  for (const device::DeviceModule* device : device::registeredDevices()) {
+  for (const core::DeviceModule* device : core::registeredDevices()) {
     // Every device's port parameters, then its own.
     const auto port = [device](DriverParams& p) -> DevicePortParams& {
       return p.portParams(*device);
@@ -90,36 +90,36 @@ std::string resolveFrame(const std::string& tf_prefix, const std::string& frame)
 }
 
 DriverParams::DriverParams() {
-  for (const device::DeviceModule* device : device::registeredDevices()) {
+  for (const core::DeviceModule* device : core::registeredDevices()) {
     for (const AnySectionKey* key : device->sections) sections.add(*key);
   }
 }
 
 void DriverParams::resolveFrames() {
-  for (const device::DeviceModule* device : device::registeredDevices()) {
+  for (const core::DeviceModule* device : core::registeredDevices()) {
     if (device->resolve_frames) device->resolve_frames(*this);
   }
 }
 
-const DevicePortParams& DriverParams::portParams(const device::DeviceModule& device) const {
+const DevicePortParams& DriverParams::portParams(const core::DeviceModule& device) const {
   return sections.portParams(device.name);
 }
 
-DevicePortParams& DriverParams::portParams(const device::DeviceModule& device) {
+DevicePortParams& DriverParams::portParams(const core::DeviceModule& device) {
   return sections.portParams(device.name);
 }
 
 bool DriverParams::enabled(const std::string& name) const {
-  const device::DeviceModule* device = device::findDevice(name);
+  const core::DeviceModule* device = core::findDevice(name);
   return device != nullptr && enabled(*device);
 }
 
-std::string DriverParams::portOf(const device::DeviceModule& device) const {
+std::string DriverParams::portOf(const core::DeviceModule& device) const {
   const DevicePortParams& own = portParams(device);
   return own.port.empty() ? port : own.port;
 }
 
-int DriverParams::baudOf(const device::DeviceModule& device) const {
+int DriverParams::baudOf(const core::DeviceModule& device) const {
   const DevicePortParams& own = portParams(device);
   return own.baud > 0 ? own.baud : baud;
 }
@@ -134,16 +134,16 @@ void DriverParams::validate() const {
   require(tf_prefix.find(' ') == std::string::npos, "tf_prefix", "must not contain spaces");
   require(!capture || replay_bag.empty(), "capture",
           "cannot be combined with ~replay_bag: a replay reads a capture and writes nothing");
-  const auto& devices = device::registeredDevices();
+  const auto& devices = core::registeredDevices();
   std::string all_devices;
   bool any_enabled = false;
-  for (const device::DeviceModule* device : devices) {
+  for (const core::DeviceModule* device : devices) {
     all_devices += (all_devices.empty() ? "" : ", ") + std::string(device->name);
     any_enabled |= enabled(*device);
   }
   require(any_enabled, std::string(devices.front()->name) + "/enabled",
           "every device is disabled (" + all_devices + "): nothing to drive");
-  for (const device::DeviceModule* device : devices) {
+  for (const core::DeviceModule* device : devices) {
     if (enabled(*device) && device->validate) device->validate(*this);
   }
 
@@ -153,7 +153,7 @@ void DriverParams::validate() const {
     int baud;
   };
   std::vector<Use> uses;
-  for (const device::DeviceModule* device : devices) {
+  for (const core::DeviceModule* device : devices) {
     if (!enabled(*device)) continue;
     uses.push_back({device->name, portOf(*device), baudOf(*device)});
   }

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "serial_robot_driver/SerialChunk.h"
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -60,7 +60,8 @@ Recording readRecording(const std::string& path) {
     }
     recording.topic = *raw_topics.begin();
     // The recording lasts as long as the bag: a silence on the ports at its end counts too.
-    recording.end = transport::RecordedStamp(static_cast<int64_t>(everything.getEndTime().toNSec()));
+    recording.end =
+        transport::RecordedStamp(static_cast<int64_t>(everything.getEndTime().toNSec()));
     rosbag::View view(bag, rosbag::TopicQuery(recording.topic));
     for (const rosbag::MessageInstance& message : view) {
       const auto chunk = message.instantiate<serial_robot_driver::SerialChunk>();
@@ -88,7 +89,7 @@ Recording readRecording(const std::string& path) {
 
 std::set<std::string> configuredPorts(const DriverParams& params) {
   std::set<std::string> ports;
-  for (const device::DeviceModule* device : device::registeredDevices()) {
+  for (const core::DeviceModule* device : core::registeredDevices()) {
     if (params.enabled(*device)) ports.insert(params.portOf(*device));
   }
   return ports;
@@ -115,12 +116,11 @@ BagReplay::BagReplay(const DriverParams& params)
   }
 }
 
-device::SerialLink::StreamFactory BagReplay::streamFactory() const {
+core::SerialLink::StreamFactory BagReplay::streamFactory() const {
   const auto ports = ports_;
-  return
-      [ports](const device::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
-        return std::make_unique<transport::RecordedStream>(ports.at(options.path));
-      };
+  return [ports](const core::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
+    return std::make_unique<transport::RecordedStream>(ports.at(options.path));
+  };
 }
 
 bool BagReplay::finished() const {

@@ -41,13 +41,13 @@ JointCommand fromJointState(const sensor_msgs::JointState& msg) {
   return JointCommand{msg.name, msg.position};
 }
 
-void writeStatusReport(const device::StatusReport& report,
+void writeStatusReport(const core::StatusReport& report,
                        diagnostic_updater::DiagnosticStatusWrapper& status, SummaryWrite summary) {
-  static_assert(static_cast<unsigned char>(device::StatusLevel::kWarn) ==
+  static_assert(static_cast<unsigned char>(core::StatusLevel::kWarn) ==
                         diagnostic_msgs::DiagnosticStatus::WARN &&
-                    static_cast<unsigned char>(device::StatusLevel::kError) ==
+                    static_cast<unsigned char>(core::StatusLevel::kError) ==
                         diagnostic_msgs::DiagnosticStatus::ERROR &&
-                    static_cast<unsigned char>(device::StatusLevel::kStale) ==
+                    static_cast<unsigned char>(core::StatusLevel::kStale) ==
                         diagnostic_msgs::DiagnosticStatus::STALE,
                 "StatusLevel's values are DiagnosticStatus's levels");
   const auto level = static_cast<unsigned char>(report.level);

@@ -3,7 +3,7 @@
 #include <atomic>
 #include <utility>
 
-#include "serial_robot_driver/device/link_status.h"
+#include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
@@ -17,20 +17,21 @@ namespace serial_robot_driver::ros_layer {
 /// Logs a port's comings and goings once per event (reader thread), and the USB latency hint.
 /// Once the node shuts down, a port going down is the node closing it (or the robot's end going
 /// at the same moment): stopping is not losing, so nothing is logged as lost.
-class PortMonitor : public device::LinkListener {
+class PortMonitor : public core::LinkListener {
  public:
-  PortMonitor(const device::SerialLink& link, const std::atomic<bool>& shutting_down)
+  PortMonitor(const core::SerialLink& link, const std::atomic<bool>& shutting_down)
       : link_(link), shutting_down_(shutting_down) {}
 
   void onLinkUp() override {
     waiting_logged_ = false;
-    const device::LinkStats stats = link_.stats();
+    const core::LinkStats stats = link_.stats();
     ROS_INFO("port %s connected (low latency: %s)", link_.options().path.c_str(),
              stats.low_latency ? "yes" : "not supported");
     if (stats.latency_timer_ms && *stats.latency_timer_ms > 1) {
-      ROS_WARN("port %s: the USB-serial adapter's latency_timer is %d ms, which delays every frame; "
-               "set it to 1 ms with a udev rule (see config/99-serial-robot.rules)",
-               link_.options().path.c_str(), *stats.latency_timer_ms);
+      ROS_WARN(
+          "port %s: the USB-serial adapter's latency_timer is %d ms, which delays every frame; "
+          "set it to 1 ms with a udev rule (see config/99-serial-robot.rules)",
+          link_.options().path.c_str(), *stats.latency_timer_ms);
     }
   }
   void onLinkDown() override {
@@ -48,16 +49,17 @@ class PortMonitor : public device::LinkListener {
     ROS_WARN("waiting for port %s (%s); retrying every %.1f s", link_.options().path.c_str(),
              error.c_str(), link_.options().reconnect_interval);
   }
-  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t, device::Clock::time_point) override {}
+  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t,
+               core::Clock::time_point) override {}
 
  private:
-  const device::SerialLink& link_;
+  const core::SerialLink& link_;
   const std::atomic<bool>& shutting_down_;
   bool waiting_logged_ = false;  // reader thread only
 };
 
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
-                       device::SerialLink::StreamFactory stream_factory)
+                       core::SerialLink::StreamFactory stream_factory)
     // The updater prefixes every status with the node's name: the private namespace names the
     // driver both as a node and as a nodelet (whose process is the manager).
     : nh_(nh), params_(std::move(params)), diagnostics_(nh, private_nh, private_nh.getNamespace()) {
@@ -69,9 +71,9 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
       capture_->diagnose(s);
     });
   }
-  core_ = std::make_unique<device::DriverCore>(
+  core_ = std::make_unique<core::DriverCore>(
       params_,
-      [this](const device::DeviceModule& module, device::SerialLink& link) {
+      [this](const core::DeviceModule& module, core::SerialLink& link) {
         return makeDevice(module, link);
       },
       stream_factory, capture_.get(), TrajectoryServer::logWarning());
@@ -91,8 +93,8 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
 
 DriverNode::~DriverNode() { shutdown(); }
 
-std::unique_ptr<device::Device> DriverNode::makeDevice(const device::DeviceModule& module,
-                                                       device::SerialLink& link) {
+std::unique_ptr<core::Device> DriverNode::makeDevice(const core::DeviceModule& module,
+                                                     core::SerialLink& link) {
   const RosDeviceModule* ros_side = findInterface(module.name);
   if (ros_side == nullptr) {
     throw ParameterError(std::string(module.name) + "/enabled",
@@ -103,21 +105,21 @@ std::unique_ptr<device::Device> DriverNode::makeDevice(const device::DeviceModul
 
 void DriverNode::addPortsAndDevices() {
   for (const auto& [path, link_ptr] : core_->ports()) {
-    device::SerialLink& link = *link_ptr;
+    core::SerialLink& link = *link_ptr;
     port_monitors_.push_back(std::make_unique<PortMonitor>(link, shut_down_));
     link.addListener(port_monitors_.back().get());
     diagnostics_.add("port " + path, [&link](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      writeStatusReport(device::linkStatus(link.stats(), link.options()), s);
+      writeStatusReport(core::linkStatus(link.stats(), link.options()), s);
     });
   }
   for (std::size_t i = 0; i < core_->devices().size(); ++i) {
     // The device's status carries its registered name; its own statuses theirs.
-    device::Device* device = core_->devices()[i].get();
+    core::Device* device = core_->devices()[i].get();
     diagnostics_.add(core_->deviceNames()[i],
                      [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
                        writeStatusReport(device->status(), s);
                      });
-    for (device::Device::NamedStatus& extra : device->extraStatuses()) {
+    for (core::Device::NamedStatus& extra : device->extraStatuses()) {
       diagnostics_.add(extra.name, [report = std::move(extra.report)](
                                        diagnostic_updater::DiagnosticStatusWrapper& s) {
         writeStatusReport(report(), s);
@@ -136,7 +138,7 @@ void DriverNode::connectEStop() {
   e_stop_sub_ = subscribeGuarded(nh_, input_refusals_, "e_stop", 10, &DriverNode::onEStop, this,
                                  ros::TransportHints().tcpNoDelay());
   diagnostics_.add("e_stop", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
-    device::InputRefusalStats own = input_refusals_.stats();
+    core::InputRefusalStats own = input_refusals_.stats();
     if (trajectory_) own += trajectory_->inputRefusalStats();
     writeStatusReport(core_->eStopStatus(own), s);
   });
@@ -150,8 +152,9 @@ void DriverNode::connectEStop() {
 void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
   if (!core_->eStop().set(msg->data)) return;
   if (msg->data) {
-    ROS_WARN("e_stop engaged: every actuator stopped (base at zero speed, trajectories aborted, "
-             "bus servos stopped); motion commands refused until e_stop is false");
+    ROS_WARN(
+        "e_stop engaged: every actuator stopped (base at zero speed, trajectories aborted, "
+        "bus servos stopped); motion commands refused until e_stop is false");
   } else {
     ROS_INFO("e_stop released: motion commands obeyed from the next one");
   }

@@ -44,7 +44,7 @@ class DriverNodelet : public nodelet::Nodelet {
       NODELET_FATAL("%s; the driver does not start", e.what());
       return;
     }
-    device::SerialLink::StreamFactory stream_factory;
+    core::SerialLink::StreamFactory stream_factory;
     if (!params.replay_bag.empty()) {
       try {
         replay_ = std::make_unique<BagReplay>(params);

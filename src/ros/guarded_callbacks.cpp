@@ -4,7 +4,7 @@
 
 namespace serial_robot_driver::ros_layer {
 
-bool runGuarded(device::InputRefusals& counters, const std::string& source,
+bool runGuarded(core::InputRefusals& counters, const std::string& source,
                 const std::function<void()>& callback, std::string* error) {
   std::string what;
   try {

@@ -52,7 +52,7 @@ namespace {
 /// A replay is the same node on recorded ports: only the streams behind the links differ. Points
 /// `stream_factory` at the recording and paces `params` by it; throws ReplayError.
 std::unique_ptr<BagReplay> openReplay(DriverParams& params,
-                                      device::SerialLink::StreamFactory& stream_factory) {
+                                      core::SerialLink::StreamFactory& stream_factory) {
   auto replay = std::make_unique<BagReplay>(params);
   stream_factory = replay->streamFactory();
   params.replay_timeline = replay->timeline();
@@ -105,7 +105,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
 
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
-  device::SerialLink::StreamFactory stream_factory;
+  core::SerialLink::StreamFactory stream_factory;
   DriverParams params;
   std::unique_ptr<BagReplay> replay;
   try {

@@ -7,7 +7,7 @@
 namespace serial_robot_driver::ros_layer {
 
 RuntimeTuning::RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
-                             std::vector<device::Device*> devices,
+                             std::vector<core::Device*> devices,
                              trajectory::TrajectoryExecutor* trajectory)
     : in_force_(params), devices_(std::move(devices)), trajectory_(trajectory) {
   // Each enabled device starts its own groups; the trajectory group is the node's.
@@ -49,7 +49,7 @@ DriverParams RuntimeTuning::apply(const std::string& group,
   }
   if (result.changes.empty()) return in_force_;
   in_force_ = result.applied;
-  for (device::Device* device : devices_) device->retune(in_force_);
+  for (core::Device* device : devices_) device->retune(in_force_);
   if (trajectory_) trajectory_->retune(in_force_.trajectory);
   return in_force_;
 }

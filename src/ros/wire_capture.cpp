@@ -43,7 +43,7 @@ WireCapture::~WireCapture() {
   if (thread_.joinable()) thread_.join();
 }
 
-void WireCapture::onChunk(const device::WireChunk& chunk) {
+void WireCapture::onChunk(const core::WireChunk& chunk) {
   serial_robot_driver::SerialChunk msg;
   msg.header.stamp = stamps_(chunk.time);
   msg.port = chunk.port;
@@ -117,7 +117,7 @@ WireCaptureStats WireCapture::stats() const {
 }
 
 void WireCapture::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) const {
-  writeStatusReport(device::wireCaptureStatus(stats()), status);
+  writeStatusReport(core::wireCaptureStatus(stats()), status);
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -14,7 +14,7 @@
 #include "robot_sim_line.h"
 #include "robot_sim_plug.h"
 #include "robot_sim_port.h"
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 
 namespace serial_robot_driver::sim {
@@ -98,7 +98,7 @@ Port* RobotSim::portFor(const std::string& link, const std::string& device_name)
   // The framer calls back into the devices on this port; a frame for a device that lives on
   // another port (or is not hosted) is only counted.
   port->framer = std::make_unique<protocol::StreamFramer>(
-      device::simulatorFramerFor(device::registeredDevices()),
+      core::simulatorFramerFor(core::registeredDevices()),
       [this, raw](const FrameFamily& family, const uint8_t* data, std::size_t size) {
         // Paced: the request arrived when its last bit was through the line, not when this
         // thread woke up to feed it.

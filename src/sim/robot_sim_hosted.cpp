@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 
 namespace serial_robot_driver::sim::detail {
 
@@ -19,7 +19,7 @@ void HostedDevices::start(TimePoint now) {
       }
       continue;
     }
-    const device::DeviceModule* core = device::findDevice(module->name);
+    const core::DeviceModule* core = core::findDevice(module->name);
     if (module->make == nullptr || core == nullptr) {
       throw std::invalid_argument(std::string("robot_sim: no registered device '") + module->name +
                                   "' to host");

@@ -329,7 +329,7 @@ void TrajectoryExecutor::stopAll(const std::string& reason) {
              withLeftAlone(reason, left_alone));
 }
 
-void TrajectoryExecutor::attachEStop(device::EStop& e_stop) {
+void TrajectoryExecutor::attachEStop(core::EStop& e_stop) {
   e_stop_ = &e_stop;
   e_stop.addListener([this](bool engaged) {
     if (engaged) stopAll("e_stop engaged");

@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   Board board;
   // The pty first: the node keeps retrying its port until the symlink exists.
   serial_robot_driver::protocol::FramerConfig framer;
-  framer.accept(serial_robot_driver::protocol::body::kSyncWriteFrames);
+  framer.accept(serial_robot_driver::devices::body::kSyncWriteFrames);
   board.device = std::make_unique<test_support::FakeDevice>(port, framer);
   board.device->plug();
   board.subscribers.push_back(subscribe(nh, "joint_states", &board.joints));

@@ -54,7 +54,7 @@ TEST_F(EStopBus, AStopEngagedWhileUnpluggedGoesFirstAfterTheReplugAndAgainWhenLo
   ASSERT_TRUE(plugTheCableBack());
   EXPECT_EQ(g_bus->frames().front().bytes, kSpin1StopSpeed0) << "the stop is the first frame";
   ASSERT_TRUE(waitMoving(1, false)) << "the lost stop was never written again";
-  EXPECT_EQ(servoBusStats(g_robot->stats()).stops_lost, 1u);
+  EXPECT_EQ(srd::devices::servo_bus::sim::servoBusStats(g_robot->stats()).stops_lost, 1u);
   EXPECT_GE(count(g_bus->frames(), kSpin1StopSpeed0), 2u);
   EXPECT_TRUE(diagnostics_.waitFor(
       "servo_bus", diagnostics_.latest("servo_bus").received,

@@ -99,9 +99,9 @@ TEST_F(ExtremeInputs, CmdVelIsBoundedOrStops) {
   cmd_vel.publish(stop);
   // The base understood every frame it got.
   const sim::SimStats stats = extremeRobot().stats();
-  EXPECT_EQ(baseStats(stats).unknown_frames, 0u);
+  EXPECT_EQ(srd::devices::base::sim::baseStats(stats).unknown_frames, 0u);
   EXPECT_EQ(stats.framer.checksum_errors, 0u);
-  EXPECT_EQ(baseStats(stats).speed_frames_ignored, 0u);
+  EXPECT_EQ(srd::devices::base::sim::baseStats(stats).speed_frames_ignored, 0u);
 }
 
 TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
@@ -114,7 +114,7 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   ASSERT_TRUE(joints.waitForCount(5, 20)) << "no telemetry";
   ASSERT_TRUE(waitFor([&] { return diagnostics.latest("body").received > 0; }, 20));
   const uint64_t rejected_before = diagnostics.latest("body").number("commands rejected");
-  const uint64_t writes_before = bodyStats(robot.stats()).sync_writes_ok;
+  const uint64_t writes_before = srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok;
 
   const auto command = [](std::vector<std::string> names, std::vector<double> positions) {
     sensor_msgs::JointState msg;
@@ -136,15 +136,22 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
   for (const auto& msg : malformed) commands.publish(msg);
   // A good command last: once it is on the wire, every malformed one before it was handled.
   commands.publish(command({"joint_2"}, {0.5}));
-  ASSERT_TRUE(
-      waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= writes_before + 1; }, 20));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok >=
+               writes_before + 1;
+      },
+      20));
   test_support::sleepSeconds(0.3);
   sim::SimStats stats = robot.stats();
-  EXPECT_EQ(bodyStats(stats).sync_writes_ok, writes_before + 1)
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(stats).sync_writes_ok, writes_before + 1)
       << "a malformed command reached the wire";
-  EXPECT_EQ(bodyStats(stats).sync_writes_malformed + bodyStats(stats).port_checksum_errors, 0u);
-  ASSERT_EQ(bodyStats(stats).servos.size(), 2u);
-  EXPECT_EQ(bodyStats(stats).servos[1].target, std::lround(2048 + 0.5 * 4096 / kTwoPi));
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(stats).sync_writes_malformed +
+                srd::devices::body::sim::bodyStats(stats).port_checksum_errors,
+            0u);
+  ASSERT_EQ(srd::devices::body::sim::bodyStats(stats).servos.size(), 2u);
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(stats).servos[1].target,
+            std::lround(2048 + 0.5 * 4096 / kTwoPi));
 
   // Every one of them counted as rejected (diagnostics are published once a second).
   const auto counted = diagnostics.waitFor(
@@ -158,16 +165,21 @@ TEST_F(ExtremeInputs, MalformedJointCommandsAreRejectedWithoutBytes) {
 
   // Huge but finite positions are beyond what the servo can reach (0..4095 ticks): that joint is
   // left out, never clamped; a command with nothing reachable writes nothing.
-  const auto joint_1_target = bodyStats(robot.stats()).servos[0].target;
+  const auto joint_1_target = srd::devices::body::sim::bodyStats(robot.stats()).servos[0].target;
   commands.publish(command({"joint_1"}, {1e9}));
   commands.publish(command({"joint_1"}, {-1e300}));
   commands.publish(command({"joint_1", "joint_2"}, {4.0, 0.25}));  // joint_2 alone goes out
-  ASSERT_TRUE(
-      waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= writes_before + 2; }, 20));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok >=
+               writes_before + 2;
+      },
+      20));
   test_support::sleepSeconds(0.3);
-  EXPECT_EQ(bodyStats(robot.stats()).sync_writes_ok, writes_before + 2);
-  EXPECT_EQ(bodyStats(robot.stats()).servos[0].target, joint_1_target);
-  EXPECT_EQ(bodyStats(robot.stats()).servos[1].target, std::lround(2048 + 0.25 * 4096 / kTwoPi));
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok, writes_before + 2);
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(robot.stats()).servos[0].target, joint_1_target);
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(robot.stats()).servos[1].target,
+            std::lround(2048 + 0.25 * 4096 / kTwoPi));
   const auto out_of_range = diagnostics.waitFor(
       "body", 0,
       [](const test_support::DiagnosticsWatch::Status& s) {

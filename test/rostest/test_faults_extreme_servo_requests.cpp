@@ -37,10 +37,11 @@ TEST_F(ExtremeInputs, ServoRequestsOutOfRangeFailCleanlyWithoutBytes) {
 
   const auto requests_on_wire = [&] {
     const sim::SimStats s = robot.stats();
-    return s.framer.framesOf(protocol::servo::kRequestFrames);
+    return s.framer.framesOf(srd::devices::servo_bus::kRequestFrames);
   };
   const uint64_t wire_before = requests_on_wire();
-  const uint64_t sim_requests_before = servoBusStats(robot.stats()).requests;
+  const uint64_t sim_requests_before =
+      srd::devices::servo_bus::sim::servoBusStats(robot.stats()).requests;
 
   std::vector<Rejection> results;
   const auto record = [&](std::string what, bool call_ok, bool success, std::string message) {
@@ -156,7 +157,8 @@ TEST_F(ExtremeInputs, ServoRequestsOutOfRangeFailCleanlyWithoutBytes) {
   }
   // Not one of them put a byte on the bus.
   EXPECT_EQ(requests_on_wire(), wire_before);
-  EXPECT_EQ(servoBusStats(robot.stats()).requests, sim_requests_before);
+  EXPECT_EQ(srd::devices::servo_bus::sim::servoBusStats(robot.stats()).requests,
+            sim_requests_before);
 
   // And the bus still works.
   srd::ServoRead voltage;

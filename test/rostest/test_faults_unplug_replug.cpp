@@ -20,7 +20,7 @@ using namespace faults_test;  // NOLINT: the shared fixture
 /// the node writes in the current session.
 std::unique_ptr<test_support::FakeDevice> handPlayedRobot(const std::string& path) {
   protocol::FramerConfig config;
-  config.accept(protocol::base::kFrames);
+  config.accept(srd::devices::base::kFrames);
   return std::make_unique<test_support::FakeDevice>(path, config);
 }
 
@@ -28,19 +28,19 @@ std::unique_ptr<test_support::FakeDevice> handPlayedRobot(const std::string& pat
 std::vector<uint8_t> msgIds(const test_support::FakeDevice& robot) {
   std::vector<uint8_t> ids;
   for (const auto& frame : robot.frames()) {
-    if (frame.family != protocol::base::kFrames || frame.bytes.size() < 5) continue;
+    if (frame.family != srd::devices::base::kFrames || frame.bytes.size() < 5) continue;
     ids.push_back(frame.bytes[4]);  // 55 AA LEN SEQ MSGID ...
   }
   return ids;
 }
 
 void writeTelemetry(test_support::FakeDevice& robot, int frames) {
-  protocol::body::Telemetry telemetry;
+  srd::devices::body::Telemetry telemetry;
   telemetry.servo_count = 2;
   telemetry.servos[0].position = 2048;
   telemetry.servos[1].position = 1024;
-  telemetry.imu[protocol::body::kAccelZ] = 2048;
-  const std::vector<uint8_t> bytes = protocol::body::encodeTelemetry(telemetry);
+  telemetry.imu[srd::devices::body::kAccelZ] = 2048;
+  const std::vector<uint8_t> bytes = srd::devices::body::encodeTelemetry(telemetry);
   for (int i = 0; i < frames; ++i) robot.write(bytes);
 }
 

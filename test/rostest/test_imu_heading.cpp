@@ -16,8 +16,8 @@
 #include <string>
 #include <thread>
 
-#include "serial_robot_driver/devices/base/base_sim.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -37,7 +37,8 @@ double wrap(double angle) { return std::remainder(angle, 2.0 * M_PI); }
 
 /// How far odom's position (relative to the last odometry reset, taken at `start`) is from where
 /// the simulated base truly went from `start` to `end`, in the start's frame.
-double positionError(const sim::BaseSimStats& start, const sim::BaseSimStats& end,
+double positionError(const serial_robot_driver::devices::base::sim::BaseSimStats& start,
+                     const serial_robot_driver::devices::base::sim::BaseSimStats& end,
                      const geometry_msgs::Point& odom) {
   const double dx = end.x_m - start.x_m, dy = end.y_m - start.y_m;
   const double c = std::cos(start.yaw_rad), s = std::sin(start.yaw_rad);
@@ -51,8 +52,8 @@ struct Robot {
     sim::SimOptions options;
     options.link = test_support::nodeParam("/" + ns + "/driver_node", "port");
     options.device("servo_bus").enabled = false;
-    baseConfig(options).turn_slip = kTurnSlip;
-    bodyConfig(options).telemetry_rate_hz = telemetry_rate;
+    serial_robot_driver::devices::base::sim::baseConfig(options).turn_slip = kTurnSlip;
+    serial_robot_driver::devices::body::sim::bodyConfig(options).telemetry_rate_hz = telemetry_rate;
     robot = std::make_unique<sim::RobotSim>(options);
     robot->start();
     cmd_vel = nh.advertise<geometry_msgs::Twist>("/" + ns + "/cmd_vel", 10);
@@ -71,14 +72,16 @@ struct Robot {
   bool waitStill() {
     const bool still = waitFor(
         [&] {
-          const auto base = baseStats(robot->stats());
+          const auto base = serial_robot_driver::devices::base::sim::baseStats(robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10);
     // A few more odom ticks, and telemetry periods, so odom has integrated up to the stop.
     return still && odom.waitForCount(odom.count() + 10, 10);
   }
-  double trueYaw() const { return baseStats(robot->stats()).yaw_rad; }
+  double trueYaw() const {
+    return serial_robot_driver::devices::base::sim::baseStats(robot->stats()).yaw_rad;
+  }
   double odomYaw() const { return yawOf(odom.last()->pose.pose.orientation); }
 
   std::unique_ptr<sim::RobotSim> robot;
@@ -139,8 +142,10 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   ASSERT_TRUE(commanded_->waitStill());
   ASSERT_TRUE(fused_->resetOdometry());
   ASSERT_TRUE(commanded_->resetOdometry());
-  const sim::BaseSimStats fused_start = baseStats(fused_->robot->stats());
-  const sim::BaseSimStats commanded_start = baseStats(commanded_->robot->stats());
+  const serial_robot_driver::devices::base::sim::BaseSimStats fused_start =
+      serial_robot_driver::devices::base::sim::baseStats(fused_->robot->stats());
+  const serial_robot_driver::devices::base::sim::BaseSimStats commanded_start =
+      serial_robot_driver::devices::base::sim::baseStats(commanded_->robot->stats());
   const double fused_true0 = fused_start.yaw_rad;
   const double commanded_true0 = commanded_start.yaw_rad;
 
@@ -168,10 +173,12 @@ TEST_F(ImuHeadingTest, FusedOdomKeepsTheTrueHeadingThroughASlippingTurn) {
   // Position: integrated along the IMU's heading, the fused pose stays near the true one; the
   // commanded pose curves off with the heading it believes.
   const auto fused_pose = fused_->odom.last()->pose;
-  const double fused_position_error =
-      positionError(fused_start, baseStats(fused_->robot->stats()), fused_pose.pose.position);
+  const double fused_position_error = positionError(
+      fused_start, serial_robot_driver::devices::base::sim::baseStats(fused_->robot->stats()),
+      fused_pose.pose.position);
   const double commanded_position_error =
-      positionError(commanded_start, baseStats(commanded_->robot->stats()),
+      positionError(commanded_start,
+                    serial_robot_driver::devices::base::sim::baseStats(commanded_->robot->stats()),
                     commanded_->odom.last()->pose.pose.position);
   std::printf("position error after the arc: with the IMU %.4f m, without %.4f m\n",
               fused_position_error, commanded_position_error);

@@ -23,8 +23,8 @@
 
 #include "serial_robot_driver/ServoPing.h"
 #include "serial_robot_driver/WheelCommand.h"
-#include "serial_robot_driver/devices/base/base_sim.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -84,9 +84,7 @@ std::unique_ptr<sim::RobotSim> startSim(const std::string& base_link, const std:
 class NodeTraffic {
  public:
   explicit NodeTraffic(const Layout& layout)
-      : nh_(layout.ns),
-        wheels(nh_, "wheel_command"),
-        joints(nh_, "joint_states", 100) {
+      : nh_(layout.ns), wheels(nh_, "wheel_command"), joints(nh_, "joint_states", 100) {
     cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     joint_commands_ = nh_.advertise<sensor_msgs::JointState>("joint_commands", 10);
     ping_ = nh_.serviceClient<ServoPing>("servo/ping");
@@ -151,10 +149,16 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   const std::vector<WheelCommand> first = node.wheels.since(0);
   EXPECT_TRUE(first.front().reset_before) << "the first wheel frame must follow a Reset";
   for (std::size_t i = 1; i < first.size(); ++i) EXPECT_FALSE(first[i].reset_before) << i;
-  ASSERT_TRUE(
-      waitFor([&] { return baseStats(robot.base->stats()).speed_frames_applied >= 5; }, 20));
-  EXPECT_GE(baseStats(robot.base->stats()).resets, 1u);
-  EXPECT_EQ(baseStats(robot.base->stats()).speed_frames_ignored, 0u);
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return serial_robot_driver::devices::base::sim::baseStats(robot.base->stats())
+                   .speed_frames_applied >= 5;
+      },
+      20));
+  EXPECT_GE(serial_robot_driver::devices::base::sim::baseStats(robot.base->stats()).resets, 1u);
+  EXPECT_EQ(
+      serial_robot_driver::devices::base::sim::baseStats(robot.base->stats()).speed_frames_ignored,
+      0u);
 
   // Telemetry flows.
   EXPECT_TRUE(node.joints.waitForCount(10, 20)) << "no joint_states";
@@ -164,7 +168,8 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
   const bool driving = waitFor(
       [&] {
         node.driveForward(0.3);
-        const sim::BaseSimStats base = baseStats(robot.base->stats());
+        const serial_robot_driver::devices::base::sim::BaseSimStats base =
+            serial_robot_driver::devices::base::sim::baseStats(robot.base->stats());
         return std::abs(base.last_left_speed - expected_ticks) <= 1 &&
                std::abs(base.last_right_speed - expected_ticks) <= 1;
       },
@@ -174,9 +179,15 @@ void checkEveryDeviceWorks(NodeTraffic& node, const Robot& robot) {
 
   // A joint command reaches the body's port as one sync-write.
   node.commandJoints({"joint_1", "joint_2"}, {0.25, -0.25});
-  ASSERT_TRUE(waitFor([&] { return bodyStats(robot.body->stats()).sync_writes_ok >= 1; }, 20))
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return serial_robot_driver::devices::body::sim::bodyStats(robot.body->stats())
+                   .sync_writes_ok >= 1;
+      },
+      20))
       << "the joint command never reached the simulated board";
-  const sim::BodySimStats body = bodyStats(robot.body->stats());
+  const serial_robot_driver::devices::body::sim::BodySimStats body =
+      serial_robot_driver::devices::body::sim::bodyStats(robot.body->stats());
   ASSERT_EQ(body.servos.size(), 2u);
   EXPECT_EQ(body.servos[0].target, ticksFor(0.25));
   EXPECT_EQ(body.servos[1].target, ticksFor(-0.25));
@@ -269,26 +280,31 @@ TEST_F(MultiPortTest, EachDeviceOnItsOwnPortAndServoBusUnplugAlone) {
   const uint64_t wheels_during = node.wheels.count() - wheels_before;
   const uint64_t joints_during = node.joints.count() - joints_before;
   const uint64_t telemetry_sent =
-      outage.sentOf(sim::kTelemetryOutput).intact - before.sentOf(sim::kTelemetryOutput).intact;
-  std::printf("servo bus unplugged: %llu wheel frames, %llu joint_states (simulator sent %llu "
-              "telemetry frames)\n",
-              static_cast<unsigned long long>(wheels_during),
-              static_cast<unsigned long long>(joints_during),
-              static_cast<unsigned long long>(telemetry_sent));
+      outage.sentOf(serial_robot_driver::devices::body::sim::kTelemetryOutput).intact -
+      before.sentOf(serial_robot_driver::devices::body::sim::kTelemetryOutput).intact;
+  std::printf(
+      "servo bus unplugged: %llu wheel frames, %llu joint_states (simulator sent %llu "
+      "telemetry frames)\n",
+      static_cast<unsigned long long>(wheels_during),
+      static_cast<unsigned long long>(joints_during),
+      static_cast<unsigned long long>(telemetry_sent));
   // Undisturbed: no reconnect of the base (no Reset), no heartbeat lapse, no telemetry backlog.
   for (const WheelCommand& wheel : node.wheels.since(wheels_before)) {
-    EXPECT_FALSE(wheel.reset_before) << "the base port was disturbed (seq " << int(wheel.seq) << ")";
+    EXPECT_FALSE(wheel.reset_before)
+        << "the base port was disturbed (seq " << int(wheel.seq) << ")";
   }
-  EXPECT_EQ(baseStats(outage).resets, baseStats(before).resets);
-  EXPECT_EQ(baseStats(outage).timeouts, baseStats(before).timeouts);
-  EXPECT_FALSE(baseStats(outage).in_error);
-  EXPECT_EQ(outage.sentOf(sim::kTelemetryOutput).discarded,
-            before.sentOf(sim::kTelemetryOutput).discarded);
+  EXPECT_EQ(serial_robot_driver::devices::base::sim::baseStats(outage).resets,
+            serial_robot_driver::devices::base::sim::baseStats(before).resets);
+  EXPECT_EQ(serial_robot_driver::devices::base::sim::baseStats(outage).timeouts,
+            serial_robot_driver::devices::base::sim::baseStats(before).timeouts);
+  EXPECT_FALSE(serial_robot_driver::devices::base::sim::baseStats(outage).in_error);
+  EXPECT_EQ(outage.sentOf(serial_robot_driver::devices::body::sim::kTelemetryOutput).discarded,
+            before.sentOf(serial_robot_driver::devices::body::sim::kTelemetryOutput).discarded);
   // Every telemetry frame sent was published, give or take the ones in flight at either end of
   // the window (the soak test reconciles this exactly; here a loaded machine may delay a few).
-  EXPECT_LE(std::llabs(static_cast<long long>(telemetry_sent) -
-                       static_cast<long long>(joints_during)),
-            10);
+  EXPECT_LE(
+      std::llabs(static_cast<long long>(telemetry_sent) - static_cast<long long>(joints_during)),
+      10);
 
   // --- replug: the servo bus answers again ---
   robot.sims.push_back(startSim("", "", layout.servo_port));

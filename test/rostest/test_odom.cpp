@@ -17,7 +17,7 @@
 #include <string>
 #include <thread>
 
-#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -68,7 +68,7 @@ class OdomTest : public ::testing::Test {
   void waitStill() {
     ASSERT_TRUE(waitFor(
         [] {
-          const auto base = baseStats(g_robot->stats());
+          const auto base = serial_robot_driver::devices::base::sim::baseStats(g_robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10));
@@ -92,12 +92,14 @@ class OdomTest : public ::testing::Test {
 
 TEST_F(OdomTest, PoseAfterADriveMatchesTheFramesTheBaseApplied) {
   waitStill();
-  const sim::BaseSimStats start = baseStats(g_robot->stats());
+  const serial_robot_driver::devices::base::sim::BaseSimStats start =
+      serial_robot_driver::devices::base::sim::baseStats(g_robot->stats());
   const auto before = odom_.last();
   ASSERT_TRUE(before.has_value());
 
   drive(0.3, 0.3, 3.0);  // an arc: about 0.9 m and 0.9 rad
-  const sim::BaseSimStats end = baseStats(g_robot->stats());
+  const serial_robot_driver::devices::base::sim::BaseSimStats end =
+      serial_robot_driver::devices::base::sim::baseStats(g_robot->stats());
   const auto after = odom_.last();
   ASSERT_TRUE(after.has_value());
 
@@ -170,21 +172,24 @@ TEST_F(OdomTest, LatchedEStopHoldsTheBaseUntilReleased) {
   ASSERT_TRUE(waitFor([&] { return diagnostics_.latest("base").flag("e-stop engaged"); }, 10));
   EXPECT_EQ(diagnostics_.latest("base").level, 1) << "WARN while the e-stop holds the base";
 
-  const uint64_t frames_before = baseStats(g_robot->stats()).speed_frames_applied;
-  const double x_before = baseStats(g_robot->stats()).x_m;
+  const uint64_t frames_before =
+      serial_robot_driver::devices::base::sim::baseStats(g_robot->stats()).speed_frames_applied;
+  const double x_before = serial_robot_driver::devices::base::sim::baseStats(g_robot->stats()).x_m;
   geometry_msgs::Twist twist;
   twist.linear.x = 0.3;
   for (int i = 0; i < 20; ++i) {  // 1 s of cmd_vel that must be ignored
     cmd_vel_.publish(twist);
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    const auto base = baseStats(g_robot->stats());
+    const auto base = serial_robot_driver::devices::base::sim::baseStats(g_robot->stats());
     ASSERT_EQ(base.last_left_speed, 0);
     ASSERT_EQ(base.last_right_speed, 0);
   }
-  EXPECT_GT(baseStats(g_robot->stats()).speed_frames_applied, frames_before + 20)
+  EXPECT_GT(
+      serial_robot_driver::devices::base::sim::baseStats(g_robot->stats()).speed_frames_applied,
+      frames_before + 20)
       << "speed frames (the heartbeat) keep flowing during the e-stop";
-  EXPECT_EQ(baseStats(g_robot->stats()).x_m, x_before);
-  EXPECT_EQ(baseStats(g_robot->stats()).timeouts, 0u);
+  EXPECT_EQ(serial_robot_driver::devices::base::sim::baseStats(g_robot->stats()).x_m, x_before);
+  EXPECT_EQ(serial_robot_driver::devices::base::sim::baseStats(g_robot->stats()).timeouts, 0u);
   ASSERT_TRUE(waitFor(
       [&] { return diagnostics_.latest("base").number("cmd_vel ignored (e-stop)") >= 10; }, 10));
 
@@ -192,7 +197,12 @@ TEST_F(OdomTest, LatchedEStopHoldsTheBaseUntilReleased) {
   latched.publish(stop);
   ASSERT_TRUE(waitFor([&] { return !diagnostics_.latest("base").flag("e-stop engaged"); }, 10));
   cmd_vel_.publish(twist);
-  EXPECT_TRUE(waitFor([] { return baseStats(g_robot->stats()).last_left_speed > 0; }, 10))
+  EXPECT_TRUE(waitFor(
+      [] {
+        return serial_robot_driver::devices::base::sim::baseStats(g_robot->stats())
+                   .last_left_speed > 0;
+      },
+      10))
       << "cmd_vel obeyed again after the release";
   waitStill();
 }

@@ -27,7 +27,7 @@
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/Telemetry.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -103,9 +103,10 @@ TEST(Replay, PublishesExactlyWhatWentOutLive) {
 
   sim::SimOptions options;
   options.link = port;
-  bodyConfig(options).servo_ids = {1, 2, 3};
-  bodyConfig(options).telemetry_rate_hz = 100;
-  bodyConfig(options).foot_mode = sim::FootMode::kAlternate;
+  serial_robot_driver::devices::body::sim::bodyConfig(options).servo_ids = {1, 2, 3};
+  serial_robot_driver::devices::body::sim::bodyConfig(options).telemetry_rate_hz = 100;
+  serial_robot_driver::devices::body::sim::bodyConfig(options).foot_mode =
+      serial_robot_driver::devices::body::sim::FootMode::kAlternate;
   options.faults.seed = 12;
   options.faults.garbage_rate_hz = 4;
   options.faults.corrupt_rate = 0.05;

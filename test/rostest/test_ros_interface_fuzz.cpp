@@ -28,7 +28,7 @@
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/process_support.h"
 #include "support/pty_tap.h"
@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
   const std::string bus_port = test_support::nodeParam(kNode, "servo_bus/port");
 
   sim::SimOptions options;
-  sim::servoBusConfig(options).servo_ids = {1, 2};
+  srd::devices::servo_bus::sim::servoBusConfig(options).servo_ids = {1, 2};
   options.device("base").link = base_port + "_sim";
   options.device("body").link = body_port + "_sim";
   options.device("servo_bus").link = bus_port + "_sim";
@@ -223,9 +223,9 @@ int main(int argc, char** argv) {
   robot.start();
   g_robot = &robot;
   srd::protocol::FramerConfig base_framer, body_framer, bus_framer;
-  base_framer.accept(srd::protocol::base::kFrames);
-  body_framer.accept(srd::protocol::body::kSyncWriteFrames);
-  bus_framer.accept(srd::protocol::servo::kRequestFrames);
+  base_framer.accept(srd::devices::base::kFrames);
+  body_framer.accept(srd::devices::body::kSyncWriteFrames);
+  bus_framer.accept(srd::devices::servo_bus::kRequestFrames);
   PtyTap base(base_port, *options.device("base").link, base_framer);
   PtyTap body(body_port, *options.device("body").link, body_framer);
   PtyTap bus(bus_port, *options.device("servo_bus").link, bus_framer);

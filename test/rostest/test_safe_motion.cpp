@@ -29,7 +29,7 @@
 #include "serial_robot_driver/ServoRelax.h"
 #include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/ServoSpin.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/process_support.h"
 #include "support/ros_test_support.h"
@@ -45,21 +45,24 @@ constexpr double kWaitSeconds = 20.0;
 sim::RobotSim* g_robot = nullptr;
 std::string g_port;
 
-std::unique_ptr<sim::RobotSim> makeBus(const std::string& port,
-                                        const sim::ServoBusSimConfig& bus = {}) {
+std::unique_ptr<sim::RobotSim> makeBus(
+    const std::string& port,
+    const serial_robot_driver::devices::servo_bus::sim::ServoBusSimConfig& bus = {}) {
   sim::SimOptions options;
   options.device("base").enabled = false;
   options.device("body").enabled = false;
-  servoBusConfig(options) = bus;
-  servoBusConfig(options).servo_ids = {0, 1, 2, 3};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options) = bus;
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).servo_ids = {0, 1, 2, 3};
   options.device("servo_bus").link = port;
   auto robot = std::make_unique<sim::RobotSim>(options);
   robot->start();
   return robot;
 }
 
-std::optional<sim::BusServoSnapshot> simServo(const sim::RobotSim& robot, uint8_t id) {
-  for (const sim::BusServoSnapshot& servo : servoBusStats(robot.stats()).servos) {
+std::optional<serial_robot_driver::devices::servo_bus::sim::BusServoSnapshot> simServo(
+    const sim::RobotSim& robot, uint8_t id) {
+  for (const serial_robot_driver::devices::servo_bus::sim::BusServoSnapshot& servo :
+       serial_robot_driver::devices::servo_bus::sim::servoBusStats(robot.stats()).servos) {
     if (servo.id == id) return servo;
   }
   return std::nullopt;
@@ -155,8 +158,7 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
   // The refusals are counted, servo_commands among them, and nothing moved.
   const uint64_t seen = diagnostics_.latest("e_stop").received;
   const auto status = diagnostics_.waitFor(
-      "e_stop", seen,
-      [](const auto& s) { return s.number("refused: servo_commands") >= 1; },
+      "e_stop", seen, [](const auto& s) { return s.number("refused: servo_commands") >= 1; },
       [] { return ros::ok(); }, kWaitSeconds);
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->level, diagnostic_msgs::DiagnosticStatus::WARN);
@@ -178,8 +180,9 @@ TEST_F(SafeMotion, RelaxDampsEveryConfiguredServoAndHoldKeepsTheAngle) {
   srd::ServoRelax relax;  // no ids: every configured servo (1 and 2)
   ASSERT_TRUE(ros::service::call("servo/relax", relax));
   EXPECT_TRUE(relax.response.success) << relax.response.message;
-  EXPECT_TRUE(waitFor([&] { return simServo(*g_robot, 1)->relaxed && simServo(*g_robot, 2)->relaxed; },
-                      kWaitSeconds));
+  EXPECT_TRUE(
+      waitFor([&] { return simServo(*g_robot, 1)->relaxed && simServo(*g_robot, 2)->relaxed; },
+              kWaitSeconds));
   EXPECT_FALSE(simServo(*g_robot, 3)->relaxed) << "servo 3 is not configured";
 
   // A servo spinning is held where it is: it stops, and holds (no longer relaxed).
@@ -198,10 +201,10 @@ TEST_F(SafeMotion, RelaxDampsEveryConfiguredServoAndHoldKeepsTheAngle) {
 TEST(SafeMotionProcess, SigintStopsASpinningServo) {
   const std::string port = g_port + "_sigint";
   auto robot = makeBus(port);
-  test_support::ChildProcess node(test_support::findDriverNode(),
-                                  {"__ns:=/sig", "__name:=driver_sig", "_port:=" + port,
-                                   "_reconnect_interval:=0.2", "_base/enabled:=false",
-                                   "_body/enabled:=false"});
+  test_support::ChildProcess node(
+      test_support::findDriverNode(),
+      {"__ns:=/sig", "__name:=driver_sig", "_port:=" + port, "_reconnect_interval:=0.2",
+       "_base/enabled:=false", "_body/enabled:=false"});
   ASSERT_TRUE(node.started());
   ASSERT_TRUE(spinOnceConnected("/sig", 3)) << node.output();
   ASSERT_TRUE(waitMoving(*robot, 3, true)) << node.output();
@@ -252,7 +255,7 @@ TEST(SafeMotionProcess, NodeletUnloadRelaxesASpinningServo) {
 // refused, while servo 2 still moves.
 TEST(SafeMotionProcess, AHotServoIsReportedRelaxedAndRefused) {
   const std::string port = g_port + "_hot";
-  sim::ServoBusSimConfig bus;
+  serial_robot_driver::devices::servo_bus::sim::ServoBusSimConfig bus;
   bus.temperature_c[1] = 70;
   bus.voltage_mv[2] = 4900;
   auto robot = makeBus(port, bus);
@@ -263,10 +266,10 @@ TEST(SafeMotionProcess, AHotServoIsReportedRelaxedAndRefused) {
   ros::param::set("/hot/driver_hot/diagnostic_period", 0.2);
   ros::NodeHandle nh;
   test_support::DiagnosticsWatch diagnostics(nh, "hot/driver_hot");
-  test_support::ChildProcess node(test_support::findDriverNode(),
-                                  {"__ns:=/hot", "__name:=driver_hot", "_port:=" + port,
-                                   "_reconnect_interval:=0.2", "_base/enabled:=false",
-                                   "_body/enabled:=false"});
+  test_support::ChildProcess node(
+      test_support::findDriverNode(),
+      {"__ns:=/hot", "__name:=driver_hot", "_port:=" + port, "_reconnect_interval:=0.2",
+       "_base/enabled:=false", "_body/enabled:=false"});
   ASSERT_TRUE(node.started());
   using Status = test_support::DiagnosticsWatch::Status;
   const auto keep_waiting = [] { return ros::ok(); };

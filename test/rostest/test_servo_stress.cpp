@@ -63,15 +63,18 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
 
   sim::SimOptions options;
   options.link = port;
-  bodyConfig(options).telemetry_rate_hz = kTelemetryRateHz;
-  servoBusConfig(options).servo_ids = {kOnlineIds[0], kOnlineIds[1], kOnlineIds[2], kSilentId};
-  servoBusConfig(options).offline_ids = {kSilentId};
+  srd::devices::body::sim::bodyConfig(options).telemetry_rate_hz = kTelemetryRateHz;
+  srd::devices::servo_bus::sim::servoBusConfig(options).servo_ids = {kOnlineIds[0], kOnlineIds[1],
+                                                                     kOnlineIds[2], kSilentId};
+  srd::devices::servo_bus::sim::servoBusConfig(options).offline_ids = {kSilentId};
   sim::RobotSim robot(options);
   robot.start();
   ASSERT_EQ(robot.ports().size(), 1u);
 
   // Warm-up: the port is open, wheel frames and telemetry flow, the bus answers.
-  ASSERT_TRUE(waitFor([&] { return baseStats(robot.stats()).speed_frames_applied >= 5; }, 20))
+  ASSERT_TRUE(waitFor(
+      [&] { return srd::devices::base::sim::baseStats(robot.stats()).speed_frames_applied >= 5; },
+      20))
       << "no wheel frames reached the simulated base";
   ASSERT_TRUE(joints.waitForCount(20, 20)) << "no joint_states";
   srd::ServoPing first_ping;
@@ -103,7 +106,11 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   // Every joint command published has reached the board before the simulator stops.
   motion.stop();
   const uint64_t joint_commands = motion.jointCommandsSent();
-  waitFor([&] { return bodyStats(robot.stats()).sync_writes_ok >= joint_commands; }, 10);
+  waitFor(
+      [&] {
+        return srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok >= joint_commands;
+      },
+      10);
 
   // --- the window closes: stop the simulator, wait until nothing is in flight any more ---
   robot.stop();
@@ -126,8 +133,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   ASSERT_TRUE(port_final.has_value()) << "no diagnostics after the run";
   const DiagnosticsWatch::Status base_status = diagnostics.latest("base");
   const DiagnosticsWatch::Status body_status = diagnostics.latest("body");
-  const DiagnosticsWatch::Status servo_status =
-      diagnostics.latest("servo_bus");
+  const DiagnosticsWatch::Status servo_status = diagnostics.latest("servo_bus");
 
   // --- service calls ---
   std::vector<CallRecord> all;
@@ -155,29 +161,29 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   }
   std::sort(offline_s.begin(), offline_s.end());
   ASSERT_FALSE(offline_s.empty());
-  std::printf("service calls: %zu in %.1f s from %zu threads; online %llu, %llu succeeded (slowest "
-              "%.0f ms); offline %llu, %llu failed as expected\n",
-              all.size(), calls_s, callers.size(), static_cast<unsigned long long>(online),
-              static_cast<unsigned long long>(online_ok), 1000 * slowest_online_s,
-              static_cast<unsigned long long>(offline),
-              static_cast<unsigned long long>(offline_ok));
-  std::printf("offline call durations: min %.0f ms, median %.0f ms, max %.0f ms (bound %.0f ms = "
-              "%.0f ms x %d attempts + %.0f ms margin)\n",
-              1000 * offline_s.front(), 1000 * offline_s[offline_s.size() / 2],
-              1000 * offline_s.back(), 1000 * offline_bound, 1000 * servo_timeout,
-              servo_retries + 1, 1000 * kOfflineMargin);
-  std::printf("servo bus (node): %s transactions, %s timeouts, %s retries, %s mismatched, %s "
-              "garbled, max latency %s ms\n",
-              servo_status.value("transactions").c_str(), servo_status.value("timeouts").c_str(),
-              servo_status.value("retries").c_str(),
-              servo_status.value("mismatched answers").c_str(),
-              servo_status.value("garbled answers").c_str(),
-              servo_status.value("max latency (ms)").c_str());
+  std::printf(
+      "service calls: %zu in %.1f s from %zu threads; online %llu, %llu succeeded (slowest "
+      "%.0f ms); offline %llu, %llu failed as expected\n",
+      all.size(), calls_s, callers.size(), static_cast<unsigned long long>(online),
+      static_cast<unsigned long long>(online_ok), 1000 * slowest_online_s,
+      static_cast<unsigned long long>(offline), static_cast<unsigned long long>(offline_ok));
+  std::printf(
+      "offline call durations: min %.0f ms, median %.0f ms, max %.0f ms (bound %.0f ms = "
+      "%.0f ms x %d attempts + %.0f ms margin)\n",
+      1000 * offline_s.front(), 1000 * offline_s[offline_s.size() / 2], 1000 * offline_s.back(),
+      1000 * offline_bound, 1000 * servo_timeout, servo_retries + 1, 1000 * kOfflineMargin);
+  std::printf(
+      "servo bus (node): %s transactions, %s timeouts, %s retries, %s mismatched, %s "
+      "garbled, max latency %s ms\n",
+      servo_status.value("transactions").c_str(), servo_status.value("timeouts").c_str(),
+      servo_status.value("retries").c_str(), servo_status.value("mismatched answers").c_str(),
+      servo_status.value("garbled answers").c_str(),
+      servo_status.value("max latency (ms)").c_str());
   EXPECT_GE(all.size(), 300u);
   EXPECT_EQ(not_returned, 0u);
   EXPECT_EQ(online_ok, online);
   EXPECT_EQ(offline_ok, offline);
-  EXPECT_EQ(servoBusStats(close).malformed, 0u);
+  EXPECT_EQ(srd::devices::servo_bus::sim::servoBusStats(close).malformed, 0u);
 
   // --- the wheel heartbeat, counted at the simulated base ---
   const double window_s = close.uptime_s - open.uptime_s;
@@ -188,38 +194,41 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
       "%llu resets, %llu FF errors sent, %llu heartbeat timeouts, %llu SEQ gaps; node: "
       "loop overruns %s, worst loop period %s ms\n",
       window_s, static_cast<unsigned long long>(speed_frames), expected_frames, kBaseLoopRateHz,
-      static_cast<unsigned long long>(baseStats(close).resets),
-      static_cast<unsigned long long>(baseStats(close).errors_sent),
-      static_cast<unsigned long long>(baseStats(close).timeouts),
-      static_cast<unsigned long long>(baseStats(close).seq_gaps),
+      static_cast<unsigned long long>(srd::devices::base::sim::baseStats(close).resets),
+      static_cast<unsigned long long>(srd::devices::base::sim::baseStats(close).errors_sent),
+      static_cast<unsigned long long>(srd::devices::base::sim::baseStats(close).timeouts),
+      static_cast<unsigned long long>(srd::devices::base::sim::baseStats(close).seq_gaps),
       base_status.value("loop overruns").c_str(),
       base_status.value("worst loop period (ms)").c_str());
-  EXPECT_EQ(baseStats(close).errors_sent, 0u) << "the base's heartbeat expired";
-  EXPECT_EQ(baseStats(close).timeouts, 0u);
-  EXPECT_EQ(baseStats(close).resets, 1u) << "a Reset after the first: the node saw its own 1 s gap";
-  EXPECT_EQ(baseStats(close).speed_frames_ignored, 0u);
-  EXPECT_EQ(baseStats(close).seq_gaps, 0u) << "a wheel frame went missing between node and base";
+  EXPECT_EQ(srd::devices::base::sim::baseStats(close).errors_sent, 0u)
+      << "the base's heartbeat expired";
+  EXPECT_EQ(srd::devices::base::sim::baseStats(close).timeouts, 0u);
+  EXPECT_EQ(srd::devices::base::sim::baseStats(close).resets, 1u)
+      << "a Reset after the first: the node saw its own 1 s gap";
+  EXPECT_EQ(srd::devices::base::sim::baseStats(close).speed_frames_ignored, 0u);
+  EXPECT_EQ(srd::devices::base::sim::baseStats(close).seq_gaps, 0u)
+      << "a wheel frame went missing between node and base";
   EXPECT_GE(static_cast<double>(speed_frames), 0.9 * expected_frames);
-  EXPECT_GT(baseStats(close).speed_frames_applied, 0u);
+  EXPECT_GT(srd::devices::base::sim::baseStats(close).speed_frames_applied, 0u);
 
   // --- telemetry ---
-  const int64_t sent_in_window = static_cast<int64_t>(telemetryIntact(close) -
-                                                      telemetryIntact(open));
+  const int64_t sent_in_window =
+      static_cast<int64_t>(telemetryIntact(close) - telemetryIntact(open));
   const int64_t received_in_window = static_cast<int64_t>(joints_close - joints_open);
   const int64_t sent_total = static_cast<int64_t>(telemetryIntact(close));
   const int64_t received_total = static_cast<int64_t>(joints_close);
-  const int64_t unread_bytes = static_cast<int64_t>(close.bytes_sent) -
-                               static_cast<int64_t>(port_final->number("bytes in"));
-  const auto& telemetry_counters = close.sentOf(sim::kTelemetryOutput);
-  std::printf("telemetry: window: %lld frames sent intact, %lld joint_states received (in flight "
-              "at the opening: %lld); whole run: %lld sent, %lld received, %lld lost, %lld bytes "
-              "never read by the node; discarded by the simulator %llu\n",
-              static_cast<long long>(sent_in_window), static_cast<long long>(received_in_window),
-              static_cast<long long>(received_in_window - sent_in_window),
-              static_cast<long long>(sent_total), static_cast<long long>(received_total),
-              static_cast<long long>(sent_total - received_total),
-              static_cast<long long>(unread_bytes),
-              static_cast<unsigned long long>(telemetry_counters.discarded));
+  const int64_t unread_bytes =
+      static_cast<int64_t>(close.bytes_sent) - static_cast<int64_t>(port_final->number("bytes in"));
+  const auto& telemetry_counters = close.sentOf(srd::devices::body::sim::kTelemetryOutput);
+  std::printf(
+      "telemetry: window: %lld frames sent intact, %lld joint_states received (in flight "
+      "at the opening: %lld); whole run: %lld sent, %lld received, %lld lost, %lld bytes "
+      "never read by the node; discarded by the simulator %llu\n",
+      static_cast<long long>(sent_in_window), static_cast<long long>(received_in_window),
+      static_cast<long long>(received_in_window - sent_in_window),
+      static_cast<long long>(sent_total), static_cast<long long>(received_total),
+      static_cast<long long>(sent_total - received_total), static_cast<long long>(unread_bytes),
+      static_cast<unsigned long long>(telemetry_counters.discarded));
   EXPECT_GE(received_in_window, sent_in_window) << "telemetry frames were lost in the window";
   EXPECT_LE(received_in_window - sent_in_window, kOpeningInFlight);
   EXPECT_LE(received_total, sent_total) << "more joint_states than intact frames";
@@ -238,15 +247,15 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
       "joint commands: %llu published, %llu sync-writes applied by the board; cmd_vel: "
       "%llu published; host frames: %s out, checksum errors at the simulator %llu\n",
       static_cast<unsigned long long>(joint_commands),
-      static_cast<unsigned long long>(bodyStats(close).sync_writes_ok),
+      static_cast<unsigned long long>(srd::devices::body::sim::bodyStats(close).sync_writes_ok),
       static_cast<unsigned long long>(motion.cmdVelSent()), port_final->value("frames out").c_str(),
       static_cast<unsigned long long>(close.framer.checksum_errors));
-  EXPECT_EQ(bodyStats(close).sync_writes_ok, joint_commands);
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(close).sync_writes_ok, joint_commands);
   EXPECT_EQ(close.framer.checksum_errors, 0u);
   EXPECT_EQ(close.framer.bad_lengths, 0u);
   EXPECT_EQ(close.frames_for_absent_device, 0u);
-  EXPECT_EQ(baseStats(close).unknown_frames, 0u);
-  EXPECT_EQ(bodyStats(close).sync_writes_malformed, 0u);
+  EXPECT_EQ(srd::devices::base::sim::baseStats(close).unknown_frames, 0u);
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(close).sync_writes_malformed, 0u);
 }
 
 }  // namespace

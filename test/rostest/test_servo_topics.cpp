@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -31,7 +31,8 @@ const char* const kServoBusStatus = "servo_bus";
 sim::RobotSim* g_robot = nullptr;
 
 std::optional<double> simAngleDeg(uint8_t id) {
-  for (const sim::BusServoSnapshot& servo : servoBusStats(g_robot->stats()).servos) {
+  for (const serial_robot_driver::devices::servo_bus::sim::BusServoSnapshot& servo :
+       serial_robot_driver::devices::servo_bus::sim::servoBusStats(g_robot->stats()).servos) {
     if (servo.id == id) return servo.angle_deg;
   }
   return std::nullopt;
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
   sim::SimOptions options;
   options.device("base").enabled = false;
   options.device("body").enabled = false;
-  servoBusConfig(options).servo_ids = {0, 1, 2, 3};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).servo_ids = {0, 1, 2, 3};
   options.device("servo_bus").link = port;
   sim::RobotSim robot(options);
   robot.start();

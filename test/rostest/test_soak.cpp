@@ -69,13 +69,14 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
 
   sim::SimOptions options;
   options.link = port;
-  bodyConfig(options).foot_mode = sim::FootMode::kAlternate;
-  bodyConfig(options).imu_noise = true;
+  srd::devices::body::sim::bodyConfig(options).foot_mode =
+      srd::devices::body::sim::FootMode::kAlternate;
+  srd::devices::body::sim::bodyConfig(options).imu_noise = true;
   options.faults.seed = 20240611;
   options.faults.garbage_rate_hz = 5.0;
   options.faults.corrupt_rate = 0.02;
   options.faults.drop_rate = 0.02;
-  servoBusConfig(options).answer_fault_rate = 0.1;
+  srd::devices::servo_bus::sim::servoBusConfig(options).answer_fault_rate = 0.1;
   options.faults.unplug_every_s = kUnplugEvery;
   options.faults.unplug_duration_s = kUnplugDuration;
   sim::RobotSim robot(options);
@@ -150,14 +151,13 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
     const uint64_t sent = telemetryIntact(b.sim) - telemetryIntact(previous.sim);
     const uint64_t received = b.joint_states - previous.joint_states;
     const int64_t written = static_cast<int64_t>(b.sim.bytes_sent - previous.sim.bytes_sent);
-    const int64_t read = static_cast<int64_t>(b.port.number("bytes in") -
-                                              previous.port.number("bytes in"));
+    const int64_t read =
+        static_cast<int64_t>(b.port.number("bytes in") - previous.port.number("bytes in"));
     const int64_t flushed = written - read;
     const int64_t lost = static_cast<int64_t>(sent) - static_cast<int64_t>(received);
-    std::printf("%8llu %8llu %8llu %6lld %9lld %9llu\n",
-                static_cast<unsigned long long>(b.unplugs), static_cast<unsigned long long>(sent),
-                static_cast<unsigned long long>(received), static_cast<long long>(lost),
-                static_cast<long long>(flushed),
+    std::printf("%8llu %8llu %8llu %6lld %9lld %9llu\n", static_cast<unsigned long long>(b.unplugs),
+                static_cast<unsigned long long>(sent), static_cast<unsigned long long>(received),
+                static_cast<long long>(lost), static_cast<long long>(flushed),
                 static_cast<unsigned long long>(b.imu - previous.imu));
     EXPECT_LE(received, sent) << "episode ending at unplug " << b.unplugs
                               << ": more joint_states than intact frames";
@@ -177,22 +177,22 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
     previous = b;
   }
   const Boundary& last = boundaries.back();
-  std::printf("telemetry: %llu intact frames sent, %llu joint_states received, %llu lost to the "
-              "flush on open (%llu bytes unread); %llu of %zu episodes exact\n",
-              static_cast<unsigned long long>(total_sent),
-              static_cast<unsigned long long>(total_received),
-              static_cast<unsigned long long>(total_sent - total_received),
-              static_cast<unsigned long long>(total_flushed),
-              static_cast<unsigned long long>(exact_episodes), boundaries.size());
-  const auto tel = last.sim.sentOf(sim::kTelemetryOutput);
-  std::printf("simulator: telemetry damaged %llu, discarded %llu; garbage bursts %llu (%llu B); "
-              "driver: checksum errors %s, bytes skipped %s\n",
-              static_cast<unsigned long long>(tel.damaged),
-              static_cast<unsigned long long>(tel.discarded),
-              static_cast<unsigned long long>(last.sim.garbage_bursts),
-              static_cast<unsigned long long>(last.sim.garbage_bytes),
-              last.port.value("checksum errors").c_str(),
-              last.port.value("bytes skipped (resync)").c_str());
+  std::printf(
+      "telemetry: %llu intact frames sent, %llu joint_states received, %llu lost to the "
+      "flush on open (%llu bytes unread); %llu of %zu episodes exact\n",
+      static_cast<unsigned long long>(total_sent), static_cast<unsigned long long>(total_received),
+      static_cast<unsigned long long>(total_sent - total_received),
+      static_cast<unsigned long long>(total_flushed),
+      static_cast<unsigned long long>(exact_episodes), boundaries.size());
+  const auto tel = last.sim.sentOf(srd::devices::body::sim::kTelemetryOutput);
+  std::printf(
+      "simulator: telemetry damaged %llu, discarded %llu; garbage bursts %llu (%llu B); "
+      "driver: checksum errors %s, bytes skipped %s\n",
+      static_cast<unsigned long long>(tel.damaged), static_cast<unsigned long long>(tel.discarded),
+      static_cast<unsigned long long>(last.sim.garbage_bursts),
+      static_cast<unsigned long long>(last.sim.garbage_bytes),
+      last.port.value("checksum errors").c_str(),
+      last.port.value("bytes skipped (resync)").c_str());
   EXPECT_GT(tel.damaged, 0u) << "the faults did not happen";
   EXPECT_GT(last.sim.garbage_bursts, 0u);
   EXPECT_GT(total_received, 0u);
@@ -200,35 +200,38 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   // --- host -> robot ---
   const uint64_t frames_out = last.port.number("frames out");
   const uint64_t frames_in = hostFramesReceived(last.sim);
-  std::printf("host frames: driver wrote %llu, simulator received %llu (lost at %llu unplugs: "
-              "%lld)\n",
-              static_cast<unsigned long long>(frames_out),
-              static_cast<unsigned long long>(frames_in),
-              static_cast<unsigned long long>(last.unplugs),
-              static_cast<long long>(frames_out) - static_cast<long long>(frames_in));
+  std::printf(
+      "host frames: driver wrote %llu, simulator received %llu (lost at %llu unplugs: "
+      "%lld)\n",
+      static_cast<unsigned long long>(frames_out), static_cast<unsigned long long>(frames_in),
+      static_cast<unsigned long long>(last.unplugs),
+      static_cast<long long>(frames_out) - static_cast<long long>(frames_in));
   EXPECT_LE(frames_in, frames_out);
-  EXPECT_LE(frames_out - std::min(frames_out, frames_in), kMaxHostFramesLostPerUnplug * last.unplugs);
+  EXPECT_LE(frames_out - std::min(frames_out, frames_in),
+            kMaxHostFramesLostPerUnplug * last.unplugs);
   EXPECT_EQ(last.sim.framer.checksum_errors, 0u) << "a host frame arrived corrupted";
   EXPECT_EQ(last.sim.framer.bad_lengths, 0u);
   EXPECT_EQ(last.sim.frames_for_absent_device, 0u);
-  EXPECT_EQ(baseStats(last.sim).unknown_frames, 0u);
-  EXPECT_EQ(bodyStats(last.sim).sync_writes_malformed, 0u);
-  EXPECT_EQ(servoBusStats(last.sim).malformed, 0u);
+  EXPECT_EQ(srd::devices::base::sim::baseStats(last.sim).unknown_frames, 0u);
+  EXPECT_EQ(srd::devices::body::sim::bodyStats(last.sim).sync_writes_malformed, 0u);
+  EXPECT_EQ(srd::devices::servo_bus::sim::servoBusStats(last.sim).malformed, 0u);
   // After every reconnect the Reset came before the first speed frame: the base, in its heartbeat
   // error state after each unplug, never had to ignore a speed frame.
-  EXPECT_EQ(baseStats(last.sim).speed_frames_ignored, 0u);
-  EXPECT_GE(baseStats(last.sim).timeouts,
+  EXPECT_EQ(srd::devices::base::sim::baseStats(last.sim).speed_frames_ignored, 0u);
+  EXPECT_GE(srd::devices::base::sim::baseStats(last.sim).timeouts,
             last.unplugs - 1);  // every unplug outlasted the heartbeat
-  EXPECT_GT(baseStats(last.sim).speed_frames_applied, 0u);
-  EXPECT_LE(baseStats(last.sim).speed_frames_applied, wheels.count());
+  EXPECT_GT(srd::devices::base::sim::baseStats(last.sim).speed_frames_applied, 0u);
+  EXPECT_LE(srd::devices::base::sim::baseStats(last.sim).speed_frames_applied, wheels.count());
   std::printf(
       "base: %llu wheel frames published, %llu applied by the base, %llu resets received, "
       "%llu heartbeat timeouts, %llu battery requests\n",
       static_cast<unsigned long long>(wheels.count()),
-      static_cast<unsigned long long>(baseStats(last.sim).speed_frames_applied),
-      static_cast<unsigned long long>(baseStats(last.sim).resets),
-      static_cast<unsigned long long>(baseStats(last.sim).timeouts),
-      static_cast<unsigned long long>(baseStats(last.sim).battery_requests));
+      static_cast<unsigned long long>(
+          srd::devices::base::sim::baseStats(last.sim).speed_frames_applied),
+      static_cast<unsigned long long>(srd::devices::base::sim::baseStats(last.sim).resets),
+      static_cast<unsigned long long>(srd::devices::base::sim::baseStats(last.sim).timeouts),
+      static_cast<unsigned long long>(
+          srd::devices::base::sim::baseStats(last.sim).battery_requests));
 
   // Every joint command is accounted for by the node (diagnostics once a second).
   const uint64_t commands = motion.jointCommandsSent();
@@ -249,16 +252,19 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
       static_cast<unsigned long long>(body->number("commands sent")),
       static_cast<unsigned long long>(body->number("command write failures")),
       static_cast<unsigned long long>(body->number("commands rejected")),
-      static_cast<unsigned long long>(bodyStats(robot.stats()).sync_writes_ok),
+      static_cast<unsigned long long>(
+          srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok),
       body->value("decode errors").c_str());
   EXPECT_EQ(body->number("commands sent") + body->number("command write failures"), commands);
   EXPECT_EQ(body->number("commands rejected"), 0u);
   EXPECT_EQ(body->number("decode errors"), 0u);
-  EXPECT_LE(bodyStats(robot.stats()).sync_writes_ok, body->number("commands sent"));
+  EXPECT_LE(srd::devices::body::sim::bodyStats(robot.stats()).sync_writes_ok,
+            body->number("commands sent"));
 
   // Every service call returned, and every failure said why.
   const sim::SimStats final_sim = robot.stats();
-  const uint64_t servo_answers = final_sim.sentOf(sim::kServoAnswerOutput).intact;
+  const uint64_t servo_answers =
+      final_sim.sentOf(srd::devices::servo_bus::sim::kServoAnswerOutput).intact;
   std::printf(
       "services: %llu calls, %llu succeeded, %llu failed with a reason, slowest %.0f ms; "
       "servo answers sent intact %llu, garbled %llu, withheld %llu\n",
@@ -266,8 +272,10 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
       static_cast<unsigned long long>(services.successes),
       static_cast<unsigned long long>(services.failures), 1000 * services.slowest_s,
       static_cast<unsigned long long>(servo_answers),
-      static_cast<unsigned long long>(final_sim.sentOf(sim::kServoAnswerOutput).damaged),
-      static_cast<unsigned long long>(final_sim.sentOf(sim::kServoAnswerOutput).suppressed));
+      static_cast<unsigned long long>(
+          final_sim.sentOf(srd::devices::servo_bus::sim::kServoAnswerOutput).damaged),
+      static_cast<unsigned long long>(
+          final_sim.sentOf(srd::devices::servo_bus::sim::kServoAnswerOutput).suppressed));
   EXPECT_EQ(services.call_failures, 0u);
   EXPECT_EQ(services.silent_failures, 0u);
   EXPECT_GT(services.answered_successes, 0u);
@@ -276,10 +284,11 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   // Flat resources, compared at rest (port down) at the first and the last boundary.
   const test_support::ProcessSample& first = boundaries.front().process;
   const test_support::ProcessSample& end = last.process;
-  std::printf("driver_node (pid %d): RSS %ld -> %ld kB, fds %zu -> %zu, threads %zu -> %zu, "
-              "pty fds %zu -> %zu\n",
-              pid, first.rss_kb, end.rss_kb, first.fds, end.fds, first.threads, end.threads,
-              first.pty_fds, end.pty_fds);
+  std::printf(
+      "driver_node (pid %d): RSS %ld -> %ld kB, fds %zu -> %zu, threads %zu -> %zu, "
+      "pty fds %zu -> %zu\n",
+      pid, first.rss_kb, end.rss_kb, first.fds, end.fds, first.threads, end.threads, first.pty_fds,
+      end.pty_fds);
   EXPECT_GT(first.rss_kb, 0);
   EXPECT_LE(end.rss_kb, first.rss_kb + kRssSlackKb);
   EXPECT_LE(end.fds, first.fds + 2);  // a service connection may be open at either moment

@@ -18,8 +18,8 @@
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/ServoRotate.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -41,13 +41,20 @@ sim::RobotSim* g_robot = nullptr;
 
 /// The simulated servo's position (rad) of joint_1 (index 0) or joint_2 (index 1).
 double simJoint(std::size_t index) {
-  return (bodyStats(g_robot->stats()).servos.at(index).position - 2048.0) * kRadPerTick;
+  return (serial_robot_driver::devices::body::sim::bodyStats(g_robot->stats())
+              .servos.at(index)
+              .position -
+          2048.0) *
+         kRadPerTick;
 }
-uint64_t syncWrites() { return bodyStats(g_robot->stats()).sync_writes_ok; }
+uint64_t syncWrites() {
+  return serial_robot_driver::devices::body::sim::bodyStats(g_robot->stats()).sync_writes_ok;
+}
 
 /// The bus joint "pan": servo 2, zero at 30 deg, direction -1 (trajectory.test).
 double simPan() {
-  for (const auto& servo : servoBusStats(g_robot->stats()).servos) {
+  for (const auto& servo :
+       serial_robot_driver::devices::servo_bus::sim::servoBusStats(g_robot->stats()).servos) {
     if (servo.id == 2) return -(servo.angle_deg - 30.0) * M_PI / 180.0;
   }
   return std::nan("");
@@ -91,8 +98,7 @@ class TrajectoryTest : public ::testing::Test {
     client_.sendGoal(goal);
     EXPECT_TRUE(client_.waitForResult(ros::Duration(60)));
     EXPECT_EQ(client_.getState().state_, expected) << client_.getState().getText();
-    return client_.getResult() ? client_.getResult()->error_code
-                               : std::numeric_limits<int>::min();
+    return client_.getResult() ? client_.getResult()->error_code : std::numeric_limits<int>::min();
   }
 
   std::string errorString() const {
@@ -234,8 +240,8 @@ TEST_F(TrajectoryTest, TopicMovesTheJointsAndPreemptsAGoal) {
   msg.joint_names = {"joint_2", "joint_1"};
   msg.points = {point({0.3, 0.7}, 1.0)};
   topic_.publish(msg);
-  ASSERT_TRUE(waitFor([] { return std::abs(simJoint(0) - 0.7) < 0.01 && std::abs(simJoint(1) - 0.3) < 0.01; },
-                      30));
+  ASSERT_TRUE(waitFor(
+      [] { return std::abs(simJoint(0) - 0.7) < 0.01 && std::abs(simJoint(1) - 0.3) < 0.01; }, 30));
 
   client_.sendGoal(goalTo({-0.5, -0.5}, 4.0));
   ASSERT_TRUE(waitFor([&] { return client_.getState() == State::ACTIVE; }, 30));
@@ -243,7 +249,8 @@ TEST_F(TrajectoryTest, TopicMovesTheJointsAndPreemptsAGoal) {
   topic_.publish(msg);
   ASSERT_TRUE(client_.waitForResult(ros::Duration(30)));
   EXPECT_EQ(client_.getState(), State::PREEMPTED);
-  ASSERT_TRUE(waitFor([] { return std::abs(simJoint(0)) < 0.01 && std::abs(simJoint(1)) < 0.01; }, 30));
+  ASSERT_TRUE(
+      waitFor([] { return std::abs(simJoint(0)) < 0.01 && std::abs(simJoint(1)) < 0.01; }, 30));
 
   // A bad message is refused whole: nothing moves.
   waitStill();
@@ -312,7 +319,8 @@ TEST_F(TrajectoryTest, BusServoJointFollowsOneMovePerSegment) {
   test_support::TopicCounter<sensor_msgs::JointState> servo_states(nh_, "servo_states", 50);
   ASSERT_TRUE(servo_states.waitForCount(3, 30)) << "no servo_states";
   bool pan_named = false;
-  for (const auto& msg : servo_states.since(0)) pan_named |= !msg.name.empty() && msg.name[0] == "pan";
+  for (const auto& msg : servo_states.since(0))
+    pan_named |= !msg.name.empty() && msg.name[0] == "pan";
   EXPECT_TRUE(pan_named) << "servo_states does not name servo 2 'pan'";
 
   FollowJointTrajectoryGoal goal = goalTo({0.4}, 1.0, {"pan"});

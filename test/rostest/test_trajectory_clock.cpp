@@ -20,7 +20,7 @@
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/pty_tap.h"
@@ -76,7 +76,9 @@ class ClockPublisher {
 ClockPublisher* g_clock = nullptr;
 
 /// joint_1 (servo 2, the first of ~body/servo_ids) in the simulator, in ticks.
-double simJoint1Ticks() { return bodyStats(g_robot->stats()).servos.at(0).position; }
+double simJoint1Ticks() {
+  return serial_robot_driver::devices::body::sim::bodyStats(g_robot->stats()).servos.at(0).position;
+}
 
 /// The ticks of servo 2 in each sync-write (docs/protocols.md 2a: records (ID, POS_L, POS_H) from
 /// byte 12) from frame `from` on.
@@ -152,13 +154,13 @@ int main(int argc, char** argv) {
   sim::SimOptions options;
   options.device("base").enabled = false;
   options.device("servo_bus").enabled = false;
-  bodyConfig(options).servo_ids = {2, 3};
+  serial_robot_driver::devices::body::sim::bodyConfig(options).servo_ids = {2, 3};
   options.device("body").link = port + "_sim";
   sim::RobotSim robot(options);
   robot.start();
   g_robot = &robot;
   serial_robot_driver::protocol::FramerConfig framer;
-  framer.accept(serial_robot_driver::protocol::body::kSyncWriteFrames);
+  framer.accept(serial_robot_driver::devices::body::kSyncWriteFrames);
   test_support::PtyTap tap(port, *options.device("body").link, framer);
   g_tap = &tap;
 

@@ -19,7 +19,7 @@
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/fake_device.h"
@@ -89,7 +89,8 @@ bool isMotionToAnAngle(const Bytes& request) {
 
 /// The simulated bus servo 2's angle (deg).
 double simServo2() {
-  for (const auto& servo : servoBusStats(g_robot->stats()).servos) {
+  for (const auto& servo :
+       serial_robot_driver::devices::servo_bus::sim::servoBusStats(g_robot->stats()).servos) {
     if (servo.id == 2) return servo.angle_deg;
   }
   return std::nan("");
@@ -244,7 +245,8 @@ TEST_F(TrajectoryStop, CancelStopsAFastBusJointWithoutAMoveBack) {
       << "no SPIN stop for servo 2 after the cancel";
   ASSERT_TRUE(waitFor(
       [] {
-        for (const auto& servo : servoBusStats(g_robot->stats()).servos) {
+        for (const auto& servo :
+             serial_robot_driver::devices::servo_bus::sim::servoBusStats(g_robot->stats()).servos) {
           if (servo.id == 2) return !servo.moving;
         }
         return false;
@@ -288,7 +290,7 @@ int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   test_support::RosTestNode node(argc, argv, "test_trajectory_stop");
   serial_robot_driver::protocol::FramerConfig body_framer;
-  body_framer.accept(serial_robot_driver::protocol::body::kSyncWriteFrames);
+  body_framer.accept(serial_robot_driver::devices::body::kSyncWriteFrames);
   test_support::FakeDevice body(test_support::nodeParam(kNode, "port"), body_framer);
   body.plug();
   g_body = &body;
@@ -297,13 +299,13 @@ int main(int argc, char** argv) {
   sim::SimOptions options;
   options.device("base").enabled = false;
   options.device("body").enabled = false;
-  servoBusConfig(options).servo_ids = {2};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).servo_ids = {2};
   options.device("servo_bus").link = bus_port + "_sim";
   sim::RobotSim robot(options);
   robot.start();
   g_robot = &robot;
   serial_robot_driver::protocol::FramerConfig bus_framer;
-  bus_framer.accept(serial_robot_driver::protocol::servo::kRequestFrames);
+  bus_framer.accept(serial_robot_driver::devices::servo_bus::kRequestFrames);
   test_support::PtyTap tap(bus_port, *options.device("servo_bus").link, bus_framer);
   g_bus = &tap;
 

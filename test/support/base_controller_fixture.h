@@ -16,17 +16,16 @@
 #include "support/golden_frames.h"
 #include "support/manual_clock.h"
 
-namespace serial_robot_driver::device::base_controller_test {
+namespace serial_robot_driver::devices::base::base_controller_test {
 
 using Bytes = std::vector<uint8_t>;
 using std::chrono::milliseconds;
 
 /// A controller whose loop runs on `clock`, started and waiting for its first tick; the frames it
 /// writes go to `frames` when one is given (for tests with a configuration of their own).
-inline std::unique_ptr<BaseController> startOnManualClock(const BaseConfig& config,
-                                                          BaseEvents events,
-                                                          const std::shared_ptr<ManualClock>& clock,
-                                                          std::vector<Bytes>* frames = nullptr) {
+inline std::unique_ptr<BaseController> startOnManualClock(
+    const BaseConfig& config, BaseEvents events, const std::shared_ptr<core::ManualClock>& clock,
+    std::vector<Bytes>* frames = nullptr) {
   auto controller = std::make_unique<BaseController>(
       config,
       [frames](const Bytes& frame) {
@@ -44,7 +43,7 @@ inline std::unique_ptr<BaseController> startOnManualClock(const BaseConfig& conf
 class BaseControllerTest : public ::testing::Test {
  protected:
   BaseControllerTest()
-      : clock_(std::make_shared<ManualClock>(t0_)),
+      : clock_(std::make_shared<core::ManualClock>(t0_)),
         controller_(
             config(), [this](const Bytes& frame) { return write(frame); }, events(), clock_) {
     controller_.start();
@@ -77,9 +76,9 @@ class BaseControllerTest : public ::testing::Test {
   std::vector<WheelFrameSent> sent_;
   std::vector<OdometrySample> odometry_;
   bool port_up_ = true;
-  const Clock::time_point t0_ = Clock::now();
-  std::shared_ptr<ManualClock> clock_;
+  const core::Clock::time_point t0_ = core::Clock::now();
+  std::shared_ptr<core::ManualClock> clock_;
   BaseController controller_;
 };
 
-}  // namespace serial_robot_driver::device::base_controller_test
+}  // namespace serial_robot_driver::devices::base::base_controller_test

@@ -108,8 +108,9 @@ class FakeBase {
   std::vector<SeenFrame> frames() const {
     std::vector<SeenFrame> seen;
     for (const auto& frame : device_.frames()) {
-      const auto decoded = protocol::base::decodeFrame(frame.bytes.data(), frame.bytes.size());
-      if (frame.family != protocol::base::kFrames || !decoded) continue;
+      const auto decoded =
+          serial_robot_driver::devices::base::decodeFrame(frame.bytes.data(), frame.bytes.size());
+      if (frame.family != serial_robot_driver::devices::base::kFrames || !decoded) continue;
       seen.push_back(SeenFrame{frame.bytes, decoded->seq, decoded->msg_id, frame.arrival});
     }
     return seen;
@@ -136,7 +137,7 @@ class FakeBase {
  private:
   static protocol::FramerConfig baseFramer() {
     protocol::FramerConfig config;
-    config.accept(protocol::base::kFrames);
+    config.accept(serial_robot_driver::devices::base::kFrames);
     return config;
   }
 

@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace test_support {
 
-namespace device = serial_robot_driver::device;
+namespace core = serial_robot_driver::core;
 namespace params = serial_robot_driver::params;
 namespace protocol = serial_robot_driver::protocol;
 
@@ -21,20 +21,20 @@ namespace protocol = serial_robot_driver::protocol;
 /// `body_servos` servos in the body's telemetry.
 inline protocol::FramerConfig driverFramer(const std::vector<std::string>& names,
                                            std::size_t body_servos = 0) {
-  std::vector<const device::DeviceModule*> devices;
+  std::vector<const core::DeviceModule*> devices;
   for (const std::string& name : names) {
-    const device::DeviceModule* device = device::findDevice(name);
+    const core::DeviceModule* device = core::findDevice(name);
     if (device == nullptr) throw std::invalid_argument("no registered device " + name);
     devices.push_back(device);
   }
   params::DriverParams params;
-  params.section(params::kBodySection).servo_ids.assign(body_servos, 1);
-  return device::framerFor(devices, params);
+  params.section(serial_robot_driver::devices::body::kBodySection).servo_ids.assign(body_servos, 1);
+  return core::framerFor(devices, params);
 }
 
 /// What the simulator's framer accepts (every registered device's inbound frames).
 inline protocol::FramerConfig simulatorFramer() {
-  return device::simulatorFramerFor(device::registeredDevices());
+  return core::simulatorFramerFor(core::registeredDevices());
 }
 
 /// Every frame family of the registered devices, both directions, telemetry of `body_servos`.

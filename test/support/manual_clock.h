@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <mutex>
 
-#include "serial_robot_driver/device/loop_clock.h"
+#include "serial_robot_driver/core/loop_clock.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 
 /// A LoopClock the test moves: the controller's loop thread runs for real, but its time only
 /// passes when the test says so, and each step returns once the loop has done what fell due.
@@ -89,4 +89,4 @@ class ManualClock : public LoopClock {
   bool waiting_ = false;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::core

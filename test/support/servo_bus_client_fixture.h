@@ -15,7 +15,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "support/golden_frames.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 using Bytes = std::vector<uint8_t>;
 using protocol::FrameFamily;
@@ -57,7 +57,7 @@ class FakeBus {
     if (!connected) return false;
     std::lock_guard<std::mutex> lock(mutex_);  // two callers may write (the client serializes them)
     written.push_back(frame);
-    if (echo) deliver(protocol::servo::kRequestFrames, frame);
+    if (echo) deliver(kRequestFrames, frame);
     if (drop_link_on_write) client->onLinkDown();
     auto it = script_.find(frame);
     if (it == script_.end()) return true;
@@ -65,11 +65,11 @@ class FakeBus {
     if (++script.writes < script.first_answered_write) return true;
     if (from_other_thread) {
       answer_threads_.emplace_back([this, frames = script.frames] {
-        for (const Bytes& reply : frames) deliver(protocol::servo::kResponseFrames, reply);
+        for (const Bytes& reply : frames) deliver(kResponseFrames, reply);
       });
       return true;
     }
-    for (const Bytes& reply : script.frames) deliver(protocol::servo::kResponseFrames, reply);
+    for (const Bytes& reply : script.frames) deliver(kResponseFrames, reply);
     return true;
   }
 
@@ -80,7 +80,7 @@ class FakeBus {
     int writes;
   };
   void deliver(FrameFamily family, const Bytes& frame) {
-    client->onFrame(family, frame.data(), frame.size(), Clock::now());
+    client->onFrame(family, frame.data(), frame.size(), core::Clock::now());
   }
   std::map<Bytes, Script> script_;
   std::mutex mutex_;
@@ -111,4 +111,4 @@ class ServoBusClientArmedTest : public ServoBusClientTest {
   ServoBusClientArmedTest() : ServoBusClientTest(true) {}
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -38,7 +38,7 @@
 #include "serial_robot_driver/ServoWrite.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/sim/robot_sim.h"
@@ -79,7 +79,7 @@ using ServoBusPlayer = test_support::FakeDevice;
 /// request is written back first, as an adapter with a looped-back transmit line does.
 inline std::unique_ptr<ServoBusPlayer> servoBus(const std::string& path, bool echo) {
   protocol::FramerConfig config;
-  config.accept(protocol::servo::kRequestFrames);
+  config.accept(serial_robot_driver::devices::servo_bus::kRequestFrames);
   auto bus = std::make_unique<ServoBusPlayer>(path, config, echo);
   bus->plug();
   return bus;
@@ -173,13 +173,15 @@ inline std::string g_bus_sim_port;        // the simulator's side of it
 /// A tap between the node's bus port and the simulator's: the cable plugged (again).
 inline std::unique_ptr<PtyTap> plugBus() {
   protocol::FramerConfig framer;
-  framer.accept(protocol::servo::kRequestFrames);
+  framer.accept(serial_robot_driver::devices::servo_bus::kRequestFrames);
   return std::make_unique<PtyTap>(g_bus_port, g_bus_sim_port, framer);
 }
 
 /// The simulated servo at `id` now; none when no servo has that address.
-inline std::optional<sim::BusServoSnapshot> simServo(uint8_t id) {
-  for (const sim::BusServoSnapshot& servo : servoBusStats(g_robot->stats()).servos) {
+inline std::optional<serial_robot_driver::devices::servo_bus::sim::BusServoSnapshot> simServo(
+    uint8_t id) {
+  for (const serial_robot_driver::devices::servo_bus::sim::BusServoSnapshot& servo :
+       serial_robot_driver::devices::servo_bus::sim::servoBusStats(g_robot->stats()).servos) {
     if (servo.id == id) return servo;
   }
   return std::nullopt;
@@ -200,7 +202,7 @@ inline sim::SimOptions simBusOptions(const std::string& bus_port, std::vector<ui
   g_bus_sim_port = bus_port + "_sim";
   sim::SimOptions options;
   options.device("body").enabled = false;
-  servoBusConfig(options).servo_ids = std::move(ids);
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).servo_ids = std::move(ids);
   options.device("servo_bus").link = g_bus_sim_port;
   return options;
 }
@@ -210,7 +212,7 @@ inline sim::SimOptions simBusOptions(const std::string& bus_port, std::vector<ui
 inline sim::SimOptions firstStopLostOptions(const std::string& node) {
   sim::SimOptions options =
       simBusOptions(test_support::nodeParam(node, "servo_bus/port"), {0, 1, 2, 3});
-  servoBusConfig(options).lost_stops = 1;
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).lost_stops = 1;
   return options;
 }
 
@@ -227,7 +229,7 @@ inline int runAllTestsOnSimBus(sim::SimOptions options, const std::string& base_
   std::unique_ptr<PtyTap> base;
   if (base_hosted) {
     protocol::FramerConfig base_framer;
-    base_framer.accept(protocol::base::kFrames);
+    base_framer.accept(serial_robot_driver::devices::base::kFrames);
     base = std::make_unique<PtyTap>(base_port, *options.device("base").link, base_framer);
     if (base_tap != nullptr) *base_tap = base.get();
   }

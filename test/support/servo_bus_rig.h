@@ -22,7 +22,7 @@
 #include "support/golden_frames.h"
 #include "support/manual_clock.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 using Bytes = std::vector<uint8_t>;
 
@@ -112,7 +112,7 @@ class ServoBusTest : public ::testing::Test {
         reply = it->second;
       }
     }
-    bus_->onFrame(protocol::servo::kResponseFrames, reply.data(), reply.size(), Clock::now());
+    bus_->onFrame(kResponseFrames, reply.data(), reply.size(), core::Clock::now());
     return true;
   }
 
@@ -196,8 +196,8 @@ class ServoBusTest : public ::testing::Test {
     return count;
   }
 
-  const Clock::time_point t0_ = Clock::time_point() + std::chrono::hours(1);
-  std::shared_ptr<ManualClock> clock_ = std::make_shared<ManualClock>(t0_);
+  const core::Clock::time_point t0_ = core::Clock::time_point() + std::chrono::hours(1);
+  std::shared_ptr<core::ManualClock> clock_ = std::make_shared<core::ManualClock>(t0_);
   std::mutex mutex_;
   std::map<Bytes, Bytes> answers_ = {
       {golden::servo::kReadAngle0, golden::servo::kReadAngle0Reply902}};
@@ -211,9 +211,9 @@ class ServoBusTest : public ::testing::Test {
   bool port_down_ = false;                               // guarded by mutex_
   std::unique_ptr<ServoBus> bus_;
   std::condition_variable gate_opened_;
-  Bytes gated_frame_;  // guarded by mutex_
+  Bytes gated_frame_;   // guarded by mutex_
   std::thread holder_;  // the held PING of callWaitingBehindPing3() / moveQueuedBehindPing3()
   std::thread caller_;  // the call of callWaitingBehindPing3()
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

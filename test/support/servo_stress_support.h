@@ -26,9 +26,9 @@
 #include "serial_robot_driver/ServoReadAll.h"
 #include "serial_robot_driver/ServoReadAngle.h"
 #include "serial_robot_driver/ServoWrite.h"
-#include "serial_robot_driver/devices/base/base_sim.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -61,10 +61,11 @@ constexpr int64_t kOpeningInFlight = 20;
 constexpr std::size_t kTelemetryFrameBytes = 32;  // 24 + 4 * 2 servos, no foot block
 
 inline uint64_t telemetryIntact(const sim::SimStats& s) {
-  return s.sentOf(sim::kTelemetryOutput).intact;
+  return s.sentOf(serial_robot_driver::devices::body::sim::kTelemetryOutput).intact;
 }
 inline uint64_t speedFramesReceived(const sim::SimStats& s) {
-  return baseStats(s).speed_frames_applied + baseStats(s).speed_frames_ignored;
+  return serial_robot_driver::devices::base::sim::baseStats(s).speed_frames_applied +
+         serial_robot_driver::devices::base::sim::baseStats(s).speed_frames_ignored;
 }
 
 /// Publishes cmd_vel at 20 Hz and joint_commands at 10 Hz (absolute deadlines) until stopped.

@@ -21,11 +21,11 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/command_line.h"
 #include "serial_robot_driver/sim/robot_sim.h"
@@ -206,8 +206,8 @@ inline SimOptions onlyServoBus() {
   SimOptions options;
   options.device("base").enabled = false;
   options.device("body").enabled = false;
-  servoBusConfig(options).servo_ids = {0, 1, 2, 3, 7};
-  servoBusConfig(options).offline_ids = {7};
+  devices::servo_bus::sim::servoBusConfig(options).servo_ids = {0, 1, 2, 3, 7};
+  devices::servo_bus::sim::servoBusConfig(options).offline_ids = {7};
   return options;
 }
 

@@ -28,9 +28,9 @@
 #include "serial_robot_driver/ServoRotate.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/WheelCommand.h"
-#include "serial_robot_driver/devices/base/base_sim.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/framer_configs.h"
@@ -63,13 +63,13 @@ inline double soakSeconds() {
 }
 
 inline uint64_t telemetryIntact(const sim::SimStats& s) {
-  return s.sentOf(sim::kTelemetryOutput).intact;
+  return s.sentOf(serial_robot_driver::devices::body::sim::kTelemetryOutput).intact;
 }
 inline uint64_t hostFramesReceived(const sim::SimStats& s) {
   using protocol::FrameFamily;
-  return s.framer.framesOf(protocol::base::kFrames) +
-         s.framer.framesOf(protocol::servo::kRequestFrames) +
-         s.framer.framesOf(protocol::body::kSyncWriteFrames);
+  return s.framer.framesOf(serial_robot_driver::devices::base::kFrames) +
+         s.framer.framesOf(serial_robot_driver::devices::servo_bus::kRequestFrames) +
+         s.framer.framesOf(serial_robot_driver::devices::body::kSyncWriteFrames);
 }
 
 /// Both sides at rest while the pty is unplugged.

@@ -134,15 +134,15 @@ inline MixedStream mixedStream() {
   // Junk without any header byte, so the skip count is exact.
   const Bytes junk = {0x00, 0x01, 0xAA, 0x34, 0x4C, 0x1C, 0xFD, 0x7E};
   const std::vector<Frame> frames = {
-      {protocol::body::kTelemetryFrames, kTelemetry},
-      {protocol::base::kFrames, kBaseBatteryReply},
-      {protocol::servo::kResponseFrames, kServoPingReply},
-      {protocol::servo::kRequestFrames, kServoRotate},
-      {protocol::body::kSyncWriteFrames, kSyncWrite},
-      {protocol::body::kTelemetryFrames, kTelemetryFoot},
-      {protocol::base::kFrames, kBaseErrorStatus},
-      {protocol::servo::kRequestFrames, kServoReadAngle},
-      {protocol::servo::kResponseFrames, kServoReadAngleReply},
+      {devices::body::kTelemetryFrames, kTelemetry},
+      {devices::base::kFrames, kBaseBatteryReply},
+      {devices::servo_bus::kResponseFrames, kServoPingReply},
+      {devices::servo_bus::kRequestFrames, kServoRotate},
+      {devices::body::kSyncWriteFrames, kSyncWrite},
+      {devices::body::kTelemetryFrames, kTelemetryFoot},
+      {devices::base::kFrames, kBaseErrorStatus},
+      {devices::servo_bus::kRequestFrames, kServoReadAngle},
+      {devices::servo_bus::kResponseFrames, kServoReadAngleReply},
   };
   MixedStream stream;
   for (std::size_t i = 0; i < frames.size(); ++i) {

@@ -161,15 +161,15 @@ TEST_F(BagReplayTest, AChunkOfAPortTheConfigurationLacksIsNamed) {
   EXPECT_NE(error.find("port /dev/ttyACM7"), std::string::npos) << error;
   EXPECT_NE(error.find("configuration does not have"), std::string::npos) << error;
 
-  params.section(params::kServoBusSection).port = "/dev/ttyACM7";  // now it has it
+  params.section(devices::servo_bus::kServoBusSection).port = "/dev/ttyACM7";  // now it has it
   EXPECT_EQ(errorOf([&] { BagReplay replay(params); }), "no error");
 }
 
 TEST(ConfiguredPorts, AreTheEnabledDevicesPaths) {
   DriverParams params;
-  params.section(params::kBodySection).port = "/dev/ttyBODY";
-  params.section(params::kServoBusSection).enabled = false;
-  params.section(params::kServoBusSection).port = "/dev/ttySERVO";
+  params.section(devices::body::kBodySection).port = "/dev/ttyBODY";
+  params.section(devices::servo_bus::kServoBusSection).enabled = false;
+  params.section(devices::servo_bus::kServoBusSection).port = "/dev/ttySERVO";
   EXPECT_EQ(configuredPorts(params), (std::set<std::string>{"/dev/ttyUSB0", "/dev/ttyBODY"}));
 }
 

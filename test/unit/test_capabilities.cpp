@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/capabilities.h"
+#include "serial_robot_driver/core/capabilities.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 namespace {
 
 class StillQuery : public MotionQuery {
@@ -63,4 +63,4 @@ TEST(HeadingFeed, EveryListenerGetsEachHeadingWithItsArrival) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::core

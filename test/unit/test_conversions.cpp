@@ -13,9 +13,9 @@
 namespace serial_robot_driver::ros_layer {
 namespace {
 
-using protocol::body::Telemetry;
-using params::BodyParams;
-using params::ImuParams;
+using devices::body::BodyParams;
+using devices::body::ImuParams;
+using devices::body::Telemetry;
 
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 constexpr double kHalfSqrt2 = 0.70710678118654752;
@@ -33,7 +33,8 @@ Telemetry goldenTelemetry(bool with_foot = false) {
   return t;
 }
 
-std::vector<device::BodyJoint> joints(int direction_of_second = 1, double velocity_scale = 0.0) {
+std::vector<devices::body::BodyJoint> joints(int direction_of_second = 1,
+                                             double velocity_scale = 0.0) {
   BodyParams params;
   params.servo_ids = {2, 3};
   params.joint_names = {"hip", "knee"};
@@ -41,7 +42,7 @@ std::vector<device::BodyJoint> joints(int direction_of_second = 1, double veloci
   params.directions = {1, direction_of_second};
   params.calibration.ticks_per_revolution = 4096;
   params.calibration.velocity_scale = velocity_scale;
-  return makeBodyJoints(params);
+  return devices::body::ros::makeBodyJoints(params);
 }
 
 void expectQuaternion(const geometry_msgs::Quaternion& q, double x, double y, double z, double w) {
@@ -74,7 +75,8 @@ TEST(ConversionsTime, FutureArrivalIsNowAndOldArrivalSaturatesAtZero) {
 
 TEST(ConversionsJointState, PositionsInRadiansAndNoVelocityWithoutItsScale) {
   const ros::Time stamp(42, 5);
-  const sensor_msgs::JointState msg = toJointState(goldenTelemetry(), joints(), stamp);
+  const sensor_msgs::JointState msg =
+      devices::body::ros::toJointState(goldenTelemetry(), joints(), stamp);
   EXPECT_EQ(msg.header.stamp, stamp);
   ASSERT_EQ(msg.name, (std::vector<std::string>{"hip", "knee"}));
   ASSERT_EQ(msg.position.size(), 2u);
@@ -86,7 +88,7 @@ TEST(ConversionsJointState, PositionsInRadiansAndNoVelocityWithoutItsScale) {
 
 TEST(ConversionsJointState, ReversedJointAndVelocityScale) {
   const sensor_msgs::JointState msg =
-      toJointState(goldenTelemetry(), joints(-1, 0.02), ros::Time());
+      devices::body::ros::toJointState(goldenTelemetry(), joints(-1, 0.02), ros::Time());
   EXPECT_NEAR(msg.position[1], M_PI / 2, 1e-12);
   EXPECT_NEAR(msg.velocity[0], 0.2, 1e-12);  // 10 * 0.02
   EXPECT_NEAR(msg.velocity[1], 0.1, 1e-12);  // -1 * 0.02 * -5
@@ -104,7 +106,7 @@ TEST(ConversionsImu, ScaledValuesOrientationAndCovariances) {
   params.angular_velocity_variance = 0.2;
   params.linear_acceleration_variance = 0.3;
   const ros::Time stamp(7, 0);
-  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, stamp);
+  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, stamp);
 
   EXPECT_EQ(msg.header.stamp, stamp);
   EXPECT_EQ(msg.header.frame_id, "imu_test");
@@ -125,7 +127,8 @@ TEST(ConversionsImu, ScaledValuesOrientationAndCovariances) {
 }
 
 TEST(ConversionsImu, DefaultScalesAreTheDatasheetOnes) {
-  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), ImuParams(), ros::Time());
+  const sensor_msgs::Imu msg =
+      devices::body::ros::toImu(goldenTelemetry(), ImuParams(), ros::Time());
   // 16384 LSB = 8 g; 100 LSB = 100 * 2000/32768 deg/s; -16384 LSB = -90 deg.
   EXPECT_NEAR(msg.linear_acceleration.z, 8 * 9.80665, 0.01);
   EXPECT_NEAR(msg.angular_velocity.z, 100 * 2000.0 / 32768 * M_PI / 180, 1e-5);
@@ -140,9 +143,9 @@ TEST(ConversionsImu, AxisMapRemapsVectorsAndTurnsTheOrientation) {
   params.gyro_scale = 0.25;
   params.angle_scale = M_PI / 32768.0;
   params.axis_map = {"-y", "x", "z"};
-  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
-  EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 0.5);   // -(-1 * 0.5)
-  EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 0.5);   // 1 * 0.5
+  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time());
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 0.5);  // -(-1 * 0.5)
+  EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 0.5);  // 1 * 0.5
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, 8192.0);
   EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 25.0);
   // The sensor's yaw -90 deg, seen from a frame turned +90 deg about z: yaw -180 deg.
@@ -157,15 +160,16 @@ TEST(ConversionsImu, GyroBiasIsSubtractedInRawUnitsBeforeTheScaleAndTheAxisMap) 
   params.gyro_scale = 0.25;
   params.axis_map = {"-y", "x", "z"};
   const std::array<double, 3> bias{4, -2, 10};
-  sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time(), bias);
+  sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time(), bias);
   EXPECT_DOUBLE_EQ(msg.angular_velocity.x, -0.5);  // -(2 * 0.25)
   EXPECT_DOUBLE_EQ(msg.angular_velocity.y, -1.0);  // -4 * 0.25
   EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 22.5);  // 90 * 0.25
   params.gyro_scale = 0.5;
-  msg = toImu(goldenTelemetry(), params, ros::Time(), bias);
+  msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time(), bias);
   EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 45.0);
-  EXPECT_DOUBLE_EQ(msg.linear_acceleration.z,
-                   toImu(goldenTelemetry(), params, ros::Time()).linear_acceleration.z)
+  EXPECT_DOUBLE_EQ(
+      msg.linear_acceleration.z,
+      devices::body::ros::toImu(goldenTelemetry(), params, ros::Time()).linear_acceleration.z)
       << "the accelerometer is left alone";
 }
 
@@ -173,7 +177,7 @@ TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
   ImuParams params;
   params.accel_scale = 1.0;
   params.axis_map = {"x", "-y", "-z"};
-  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
+  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time());
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 1.0);
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 1.0);
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, -16384.0);
@@ -182,7 +186,7 @@ TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
 TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {
   ImuParams params;
   params.orientation_variance = -1;
-  const sensor_msgs::Imu msg = toImu(goldenTelemetry(), params, ros::Time());
+  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time());
   EXPECT_EQ(msg.orientation_covariance[0], -1.0);
   EXPECT_EQ(msg.orientation_covariance[4], 0.0);
 }
@@ -190,8 +194,9 @@ TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {
 // --- FootPressure and Telemetry ------------------------------------------------------------------
 
 TEST(ConversionsFootPressure, OnlyForFramesWithTheFootBlock) {
-  EXPECT_FALSE(toFootPressure(goldenTelemetry(false), ros::Time(1, 0)).has_value());
-  const auto msg = toFootPressure(goldenTelemetry(true), ros::Time(1, 0));
+  EXPECT_FALSE(
+      devices::body::ros::toFootPressure(goldenTelemetry(false), ros::Time(1, 0)).has_value());
+  const auto msg = devices::body::ros::toFootPressure(goldenTelemetry(true), ros::Time(1, 0));
   ASSERT_TRUE(msg.has_value());
   EXPECT_EQ(msg->header.stamp, ros::Time(1, 0));
   const boost::array<uint16_t, 8> expected = {0x0201, 0x0403, 5, 6, 7, 8, 9, 0xFFFF};
@@ -200,7 +205,8 @@ TEST(ConversionsFootPressure, OnlyForFramesWithTheFootBlock) {
 
 TEST(ConversionsTelemetry, RawFrameWithServoIds) {
   const ros::Time stamp(3, 4);
-  const serial_robot_driver::Telemetry msg = toTelemetryMsg(goldenTelemetry(), joints(), stamp);
+  const serial_robot_driver::Telemetry msg =
+      devices::body::ros::toTelemetryMsg(goldenTelemetry(), joints(), stamp);
   EXPECT_EQ(msg.header.stamp, stamp);
   EXPECT_EQ(msg.servo_ids, (std::vector<uint8_t>{2, 3}));
   EXPECT_EQ(msg.positions, (std::vector<uint16_t>{2048, 1024}));
@@ -213,7 +219,7 @@ TEST(ConversionsTelemetry, RawFrameWithServoIds) {
 
 TEST(ConversionsTelemetry, FootReadingsWhenPresent) {
   const serial_robot_driver::Telemetry msg =
-      toTelemetryMsg(goldenTelemetry(true), joints(), ros::Time());
+      devices::body::ros::toTelemetryMsg(goldenTelemetry(true), joints(), ros::Time());
   EXPECT_TRUE(msg.has_foot);
   EXPECT_EQ(msg.foot, (std::vector<uint16_t>{0x0201, 0x0403, 5, 6, 7, 8, 9, 0xFFFF}));
 }
@@ -233,7 +239,8 @@ TEST(ConversionsJointCommand, NamesAndPositionsOnly) {
 // --- the base's readings -------------------------------------------------------------------------
 
 TEST(ConversionsBattery, OnlyThePercentageIsKnown) {
-  const sensor_msgs::BatteryState msg = toBatteryState(device::batteryReading(57), ros::Time(2, 0));
+  const sensor_msgs::BatteryState msg =
+      devices::base::ros::toBatteryState(devices::base::batteryReading(57), ros::Time(2, 0));
   EXPECT_EQ(msg.header.stamp, ros::Time(2, 0));
   EXPECT_FLOAT_EQ(msg.percentage, 0.57f);
   EXPECT_TRUE(std::isnan(msg.voltage));
@@ -243,13 +250,14 @@ TEST(ConversionsBattery, OnlyThePercentageIsKnown) {
 }
 
 TEST(ConversionsOdometry, PoseTwistFramesAndCovariances) {
-  device::OdometrySample sample;
+  devices::base::OdometrySample sample;
   sample.pose = {1.0, -2.0, M_PI / 2};
   sample.linear = 0.3;
   sample.angular = -0.4;
   sample.position_variance = 0.5;
   sample.yaw_variance = 0.6;
-  const nav_msgs::Odometry odom = toOdometry(sample, {"odom", "base_link"}, ros::Time(5, 0));
+  const nav_msgs::Odometry odom =
+      devices::base::ros::toOdometry(sample, {"odom", "base_link"}, ros::Time(5, 0));
   EXPECT_EQ(odom.header.stamp, ros::Time(5, 0));
   EXPECT_EQ(odom.header.frame_id, "odom");
   EXPECT_EQ(odom.child_frame_id, "base_link");
@@ -269,10 +277,11 @@ TEST(ConversionsOdometry, PoseTwistFramesAndCovariances) {
 }
 
 TEST(ConversionsOdometry, WheelStatesAreTheSamplesAnglesAndRates) {
-  device::OdometrySample sample;
+  devices::base::OdometrySample sample;
   sample.wheel_angles = {1.5, -0.5};
   sample.wheel_rates = {0.25, -0.125};
-  const sensor_msgs::JointState msg = toWheelStates(sample, "base_link", "l", "r", ros::Time(1, 0));
+  const sensor_msgs::JointState msg =
+      devices::base::ros::toWheelStates(sample, "base_link", "l", "r", ros::Time(1, 0));
   EXPECT_EQ(msg.header.frame_id, "base_link");
   EXPECT_EQ(msg.name, (std::vector<std::string>{"l", "r"}));
   EXPECT_EQ(msg.position, (std::vector<double>{1.5, -0.5}));
@@ -284,8 +293,8 @@ TEST(WriteStatusReport, ReplacesTheUpdatersPlaceholderSummaryAndAppendsTheValues
   // What diagnostic_updater::Updater hands a task.
   status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "No message was set");
   status.hardware_id = "node";
-  device::StatusReport report;
-  report.summary(device::StatusLevel::kWarn, "battery 19 % (below 20 %)");
+  core::StatusReport report;
+  report.summary(core::StatusLevel::kWarn, "battery 19 % (below 20 %)");
   report.hardware_id = "/dev/ttyUSB0";
   report.add("connected", true);
   report.add("battery (%)", 19);
@@ -299,7 +308,7 @@ TEST(WriteStatusReport, ReplacesTheUpdatersPlaceholderSummaryAndAppendsTheValues
   EXPECT_EQ(status.values[1].key, "battery (%)");
   EXPECT_EQ(status.values[1].value, "19");
 
-  device::StatusReport no_id;
+  core::StatusReport no_id;
   writeStatusReport(no_id, status);
   EXPECT_EQ(status.hardware_id, "/dev/ttyUSB0") << "a report without one keeps the status's";
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK);
@@ -309,12 +318,12 @@ TEST(WriteStatusReport, MergesIntoAnotherChecksVerdict) {
   diagnostic_updater::DiagnosticStatusWrapper status;
   status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "Frequency too low.");
   status.add("Events in window", 3);
-  device::StatusReport fine;
+  core::StatusReport fine;
   writeStatusReport(fine, status, SummaryWrite::kMerge);
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_EQ(status.message, "Frequency too low.");
-  device::StatusReport stopped;
-  stopped.mergeSummary(device::StatusLevel::kError, "telemetry stopped");
+  core::StatusReport stopped;
+  stopped.mergeSummary(core::StatusLevel::kError, "telemetry stopped");
   stopped.add("frames decoded", 10);
   writeStatusReport(stopped, status, SummaryWrite::kMerge);
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);

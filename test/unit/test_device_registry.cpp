@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 namespace {
 
 using protocol::FrameFamily;
@@ -57,7 +57,7 @@ TEST(DeviceRegistry, FrameFamiliesHaveUniqueNames) {
 TEST(DeviceRegistry, FramerOfEachCombinationAcceptsItsDevicesFamilies) {
   const auto& all = registeredDevices();
   params::DriverParams params;
-  params.section(params::kBodySection).servo_ids = {1, 2, 3};
+  params.section(devices::body::kBodySection).servo_ids = {1, 2, 3};
   for (std::size_t mask = 1; mask < (std::size_t{1} << all.size()); ++mask) {
     std::vector<const DeviceModule*> devices;
     std::set<std::string> expected;
@@ -74,7 +74,7 @@ TEST(DeviceRegistry, FramerOfEachCombinationAcceptsItsDevicesFamilies) {
   EXPECT_EQ(familyNames(bus), (std::set<std::string>{"servo_response", "servo_request"}));
   // The body's telemetry is framed for its configured servo count.
   const FramerConfig body = framerFor({findDevice("body")}, params);
-  EXPECT_EQ(body.expectedOf(protocol::body::kTelemetryFrames), 3u);
+  EXPECT_EQ(body.expectedOf(devices::body::kTelemetryFrames), 3u);
 }
 
 TEST(DeviceRegistry, SimulatorFramerAcceptsWhatTheHostSends) {
@@ -118,4 +118,4 @@ TEST(DeviceRegistry, AnalyzersConfigurationGroupsEveryDevice) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::core

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/driver_core.h"
+#include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/params/driver_params.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 namespace {
 
 /// A device that writes what the core asks of it into a shared log.
@@ -142,4 +142,4 @@ TEST_F(DriverCoreTest, TheEStopStatusCountsTheDevicesRefusalsWithTheFrontEndsOwn
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::core

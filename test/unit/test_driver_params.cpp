@@ -8,7 +8,7 @@
 #include <map>
 #include <set>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
@@ -18,9 +18,9 @@
 namespace serial_robot_driver::ros_layer {
 namespace {
 
-using params::AxisMap;
-using params::kMinBaseLoopRate;
-using params::parseAxisMap;
+using devices::base::kMinBaseLoopRate;
+using devices::body::AxisMap;
+using devices::body::parseAxisMap;
 
 TEST(DriverParams, DefaultsAreValid) { EXPECT_NO_THROW(DriverParams().validate()); }
 
@@ -58,83 +58,83 @@ INSTANTIATE_TEST_SUITE_P(
                   p.replay_bag = "/tmp/field.bag";
                 }},
         BadCase{"base/wheel_diameter",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.geometry.wheel_diameter = -0.25; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.geometry.wheel_diameter = -0.25; }},
         BadCase{"base/wheel_diameter",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.geometry.wheel_diameter = std::nan(""); }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.geometry.wheel_diameter = std::nan(""); }},
         BadCase{"base/encoder_resolution",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.geometry.encoder_resolution = 0; }},
-        BadCase{"base/pid_rate", [](DriverParams& p) { p.section(params::kBaseSection).controller.geometry.pid_rate = 0; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.geometry.encoder_resolution = 0; }},
+        BadCase{"base/pid_rate", [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.geometry.pid_rate = 0; }},
         BadCase{"base/wheel_separation",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.geometry.wheel_separation = 0; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.geometry.wheel_separation = 0; }},
         BadCase{"base/max_wheel_speed",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.max_wheel_speed = -1; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.max_wheel_speed = -1; }},
         // 0 is no "no limit": the speed limit cannot be switched off.
         BadCase{"base/max_wheel_speed",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.max_wheel_speed = 0; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.max_wheel_speed = 0; }},
         BadCase{"base/max_wheel_speed",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.max_wheel_speed = std::nan(""); }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.max_wheel_speed = std::nan(""); }},
         BadCase{"base/max_wheel_accel",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.max_wheel_accel = -1; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.max_wheel_accel = -1; }},
         BadCase{"base/cmd_vel_timeout",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.cmd_vel_timeout = 0; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.cmd_vel_timeout = 0; }},
         // Bounded: the deadman that stops the base when cmd_vel stops cannot be tuned away.
         BadCase{"base/cmd_vel_timeout",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.cmd_vel_timeout = 5.01; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.cmd_vel_timeout = 5.01; }},
         BadCase{"base/battery_poll_rate",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.battery_poll_rate = -1; }},
-        BadCase{"base/baud", [](DriverParams& p) { p.section(params::kBaseSection).baud = 7; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.battery_poll_rate = -1; }},
+        BadCase{"base/baud", [](DriverParams& p) { p.section(devices::base::kBaseSection).baud = 7; }},
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 1.0; }},  // heartbeat at risk
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 4.9; }},
         BadCase{"base/battery_warn_percent",
-                [](DriverParams& p) { p.section(params::kBaseSection).battery_warn_percent = 101; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).battery_warn_percent = 101; }},
         BadCase{"base/battery_error_percent",
-                [](DriverParams& p) { p.section(params::kBaseSection).battery_error_percent = -1; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).battery_error_percent = -1; }},
         BadCase{"base/battery_error_percent",
                 [](DriverParams& p) {
-                  p.section(params::kBaseSection).battery_warn_percent = 10;
-                  p.section(params::kBaseSection).battery_error_percent = 20;
+                  p.section(devices::base::kBaseSection).battery_warn_percent = 10;
+                  p.section(devices::base::kBaseSection).battery_error_percent = 20;
                 }},
-        BadCase{"base/odom_frame", [](DriverParams& p) { p.section(params::kBaseSection).odom_frame.clear(); }},
-        BadCase{"base/base_frame", [](DriverParams& p) { p.section(params::kBaseSection).base_frame = "base link"; }},
-        BadCase{"base/base_frame", [](DriverParams& p) { p.section(params::kBaseSection).base_frame = "odom"; }},
+        BadCase{"base/odom_frame", [](DriverParams& p) { p.section(devices::base::kBaseSection).odom_frame.clear(); }},
+        BadCase{"base/base_frame", [](DriverParams& p) { p.section(devices::base::kBaseSection).base_frame = "base link"; }},
+        BadCase{"base/base_frame", [](DriverParams& p) { p.section(devices::base::kBaseSection).base_frame = "odom"; }},
         BadCase{"base/left_wheel_direction",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.left_wheel_direction = 0; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.left_wheel_direction = 0; }},
         BadCase{"base/right_wheel_direction",
-                [](DriverParams& p) { p.section(params::kBaseSection).controller.right_wheel_direction = 2; }},
-        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(params::kBodySection).servo_ids = {}; }},
-        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(params::kBodySection).servo_ids = {1, 1}; }},
-        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(params::kBodySection).servo_ids = {1, 300}; }},
-        BadCase{"body/joint_names", [](DriverParams& p) { p.section(params::kBodySection).joint_names = {"a"}; }},
-        BadCase{"body/joint_names", [](DriverParams& p) { p.section(params::kBodySection).joint_names = {"a", "a"}; }},
-        BadCase{"body/zero_ticks", [](DriverParams& p) { p.section(params::kBodySection).zero_ticks = {0}; }},
-        BadCase{"body/zero_ticks", [](DriverParams& p) { p.section(params::kBodySection).zero_ticks = {0, 70000}; }},
-        BadCase{"body/directions", [](DriverParams& p) { p.section(params::kBodySection).directions = {1, 2}; }},
+                [](DriverParams& p) { p.section(devices::base::kBaseSection).controller.right_wheel_direction = 2; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(devices::body::kBodySection).servo_ids = {}; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(devices::body::kBodySection).servo_ids = {1, 1}; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(devices::body::kBodySection).servo_ids = {1, 300}; }},
+        BadCase{"body/joint_names", [](DriverParams& p) { p.section(devices::body::kBodySection).joint_names = {"a"}; }},
+        BadCase{"body/joint_names", [](DriverParams& p) { p.section(devices::body::kBodySection).joint_names = {"a", "a"}; }},
+        BadCase{"body/zero_ticks", [](DriverParams& p) { p.section(devices::body::kBodySection).zero_ticks = {0}; }},
+        BadCase{"body/zero_ticks", [](DriverParams& p) { p.section(devices::body::kBodySection).zero_ticks = {0, 70000}; }},
+        BadCase{"body/directions", [](DriverParams& p) { p.section(devices::body::kBodySection).directions = {1, 2}; }},
         BadCase{"body/ticks_per_revolution",
-                [](DriverParams& p) { p.section(params::kBodySection).calibration.ticks_per_revolution = 0; }},
+                [](DriverParams& p) { p.section(devices::body::kBodySection).calibration.ticks_per_revolution = 0; }},
         BadCase{"body/velocity_scale",
-                [](DriverParams& p) { p.section(params::kBodySection).calibration.velocity_scale = -1; }},
-        BadCase{"imu/frame_id", [](DriverParams& p) { p.section(params::kImuSection).frame_id.clear(); }},
-        BadCase{"imu/accel_scale", [](DriverParams& p) { p.section(params::kImuSection).accel_scale = 0; }},
-        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(params::kImuSection).axis_map = {"x", "y"}; }},
-        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(params::kImuSection).axis_map = {"x", "x", "z"}; }},
-        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(params::kImuSection).axis_map = {"x", "y", "w"}; }},
-        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(params::kImuSection).axis_map = {"x", "y", "-z"}; }},
-        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(params::kImuSection).axis_map = {"y", "x", "z"}; }},
+                [](DriverParams& p) { p.section(devices::body::kBodySection).calibration.velocity_scale = -1; }},
+        BadCase{"imu/frame_id", [](DriverParams& p) { p.section(devices::body::kImuSection).frame_id.clear(); }},
+        BadCase{"imu/accel_scale", [](DriverParams& p) { p.section(devices::body::kImuSection).accel_scale = 0; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(devices::body::kImuSection).axis_map = {"x", "y"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(devices::body::kImuSection).axis_map = {"x", "x", "z"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(devices::body::kImuSection).axis_map = {"x", "y", "w"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(devices::body::kImuSection).axis_map = {"x", "y", "-z"}; }},
+        BadCase{"imu/axis_map", [](DriverParams& p) { p.section(devices::body::kImuSection).axis_map = {"y", "x", "z"}; }},
         BadCase{
             "servo_bus/timeout",
-            [](DriverParams& p) { p.section(params::kServoBusSection).bus.client.timeout = std::chrono::milliseconds(0); }},
+            [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).bus.client.timeout = std::chrono::milliseconds(0); }},
         BadCase{"servo_bus/timeout",
                 [](DriverParams& p) { params::specFor("servo_bus/timeout").set(p, -0.0004); }},
-        BadCase{"servo_bus/retries", [](DriverParams& p) { p.section(params::kServoBusSection).bus.client.retries = -1; }},
-        BadCase{"servo_bus/baud", [](DriverParams& p) { p.section(params::kServoBusSection).baud = 9600; }},
+        BadCase{"servo_bus/retries", [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).bus.client.retries = -1; }},
+        BadCase{"servo_bus/baud", [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).baud = 9600; }},
         // 253 puts FF FF FD (the sync-write header) inside a sync-write frame.
-        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(params::kBodySection).servo_ids = {1, 253}; }},
-        BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.section(params::kServoBusSection).state_ids = {1, 255}; }},
-        BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.section(params::kServoBusSection).state_ids = {4, 4}; }},
-        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.section(params::kServoBusSection).bus.poll_rate = 0; }},
-        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.section(params::kServoBusSection).bus.poll_rate = 1001; }},
+        BadCase{"body/servo_ids", [](DriverParams& p) { p.section(devices::body::kBodySection).servo_ids = {1, 253}; }},
+        BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).state_ids = {1, 255}; }},
+        BadCase{"servo_bus/state_ids", [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).state_ids = {4, 4}; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).bus.poll_rate = 0; }},
+        BadCase{"servo_bus/state_rate", [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).bus.poll_rate = 1001; }},
         BadCase{"servo_bus/command_interval_ms",
-                [](DriverParams& p) { p.section(params::kServoBusSection).command_interval_ms = 70000; }},
+                [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).command_interval_ms = 70000; }},
         BadCase{
             "servo_bus/on_shutdown",
             [](DriverParams&
@@ -142,14 +142,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"servo_bus/relax_power_mw",
                 [](DriverParams& p) { params::specFor("servo_bus/relax_power_mw").set(p, -1); }},
         BadCase{"servo_bus/health_rate",
-                [](DriverParams& p) { p.section(params::kServoBusSection).bus.health_rate = -1.0; }},
+                [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).bus.health_rate = -1.0; }},
         BadCase{"base/enabled", [](DriverParams& p) {
-                  p.section(params::kBaseSection).enabled = p.section(params::kBodySection).enabled = p.section(params::kServoBusSection).enabled = false;
+                  p.section(devices::base::kBaseSection).enabled = p.section(devices::body::kBodySection).enabled = p.section(devices::servo_bus::kServoBusSection).enabled = false;
                 }}));
 
 TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
   DriverParams params;
-  params.section(params::kBaseSection).controller.use_imu_heading = true;
+  params.section(devices::base::kBaseSection).controller.use_imu_heading = true;
   EXPECT_NO_THROW(params.validate());
   const auto expectRefused = [](const DriverParams& p, const std::string& reason) {
     try {
@@ -161,10 +161,10 @@ TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
     }
   };
   DriverParams no_body = params;
-  no_body.section(params::kBodySection).enabled = false;
+  no_body.section(devices::body::kBodySection).enabled = false;
   expectRefused(no_body, "body/enabled is false");
   DriverParams no_orientation = params;
-  no_orientation.section(params::kImuSection).orientation_variance = -1;
+  no_orientation.section(devices::body::kImuSection).orientation_variance = -1;
   expectRefused(no_orientation, "imu/orientation_variance is negative");
 }
 
@@ -178,8 +178,8 @@ TEST(DriverParams, EveryRateThePortOpensAtPasses) {
   }
   for (int rate : {9600, 19200, 38400, 57600, 115200, 250000, 500000, 1152000, 2500000, 3500000}) {
     DriverParams params;
-    params.section(params::kServoBusSection).port = "/dev/ttyUSB1";
-    params.section(params::kServoBusSection).baud = rate;
+    params.section(devices::servo_bus::kServoBusSection).port = "/dev/ttyUSB1";
+    params.section(devices::servo_bus::kServoBusSection).baud = rate;
     EXPECT_NO_THROW(params.validate()) << rate;
   }
   DriverParams params;
@@ -189,11 +189,11 @@ TEST(DriverParams, EveryRateThePortOpensAtPasses) {
 
 TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
   DriverParams params;
-  params.section(params::kServoBusSection).port = "/dev/ttyUSB1";
-  params.section(params::kServoBusSection).baud = 9600;
+  params.section(devices::servo_bus::kServoBusSection).port = "/dev/ttyUSB1";
+  params.section(devices::servo_bus::kServoBusSection).baud = 9600;
   EXPECT_NO_THROW(params.validate());
-  const device::DeviceModule& bus = *device::findDevice("servo_bus");
-  const device::DeviceModule& base = *device::findDevice("base");
+  const core::DeviceModule& bus = *core::findDevice("servo_bus");
+  const core::DeviceModule& base = *core::findDevice("base");
   EXPECT_EQ(params.portOf(bus), "/dev/ttyUSB1");
   EXPECT_EQ(params.baudOf(bus), 9600);
   EXPECT_EQ(params.portOf(base), "/dev/ttyUSB0");
@@ -202,8 +202,8 @@ TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
 
 TEST(DriverParams, DisabledDeviceIsNotValidated) {
   DriverParams params;
-  params.section(params::kBodySection).enabled = false;
-  params.section(params::kBodySection).joint_names = {};
+  params.section(devices::body::kBodySection).enabled = false;
+  params.section(devices::body::kBodySection).joint_names = {};
   EXPECT_NO_THROW(params.validate());
 }
 
@@ -216,9 +216,9 @@ TEST(DriverParams, SlowLoopRateIsRefusedWithTheReason) {
   } catch (const ParameterError& e) {
     EXPECT_NE(std::string(e.what()).find("heartbeat"), std::string::npos) << e.what();
   }
-  params.section(params::kBaseSection).enabled = false;  // only the base needs the heartbeat
+  params.section(devices::base::kBaseSection).enabled = false;  // only the base needs the heartbeat
   EXPECT_NO_THROW(params.validate());
-  params.section(params::kBaseSection).enabled = true;
+  params.section(devices::base::kBaseSection).enabled = true;
   params.loop_rate = kMinBaseLoopRate;
   EXPECT_NO_THROW(params.validate());
 }
@@ -270,8 +270,8 @@ TEST(AxisMap, RotationsParseAndMirrorsAreRefusedWithAReason) {
   ASSERT_TRUE(turned.has_value());
   EXPECT_EQ(turned->source, (std::array<int, 3>{1, 0, 2}));
   EXPECT_EQ(turned->sign, (std::array<int, 3>{-1, 1, 1}));
-  EXPECT_TRUE(parseAxisMap({"x", "-y", "-z"}, nullptr).has_value());   // upside down
-  EXPECT_TRUE(parseAxisMap({"+z", "x", "y"}, nullptr).has_value());    // cyclic: a rotation
+  EXPECT_TRUE(parseAxisMap({"x", "-y", "-z"}, nullptr).has_value());  // upside down
+  EXPECT_TRUE(parseAxisMap({"+z", "x", "y"}, nullptr).has_value());   // cyclic: a rotation
   std::string problem;
   EXPECT_FALSE(parseAxisMap({"y", "x", "z"}, &problem).has_value());
   EXPECT_NE(problem.find("left-handed"), std::string::npos) << problem;
@@ -293,8 +293,8 @@ TEST(ParameterTable, NothingGivenLoadsTheStructDefaults) {
   for (const auto& spec : parameterTable()) {
     EXPECT_TRUE(spec.get(loaded) == spec.get(defaults)) << spec.key;
   }
-  EXPECT_EQ(loaded.section(params::kBaseSection).controller.geometry.wheel_diameter, 0.25);
-  EXPECT_EQ(loaded.section(params::kServoBusSection).bus.client.retries, 1);
+  EXPECT_EQ(loaded.section(devices::base::kBaseSection).controller.geometry.wheel_diameter, 0.25);
+  EXPECT_EQ(loaded.section(devices::servo_bus::kServoBusSection).bus.client.retries, 1);
 }
 
 TEST(ParameterTable, EachKeyLoadsIntoItsOwnField) {
@@ -326,9 +326,10 @@ TEST(ParameterTable, KnownKeysByNameAndType) {
   source.values["base/wheel_diamter"] = 0.3;
   std::vector<std::string> unknown;
   const DriverParams loaded = loadParams(source, &unknown);
-  EXPECT_EQ(loaded.section(params::kBaseSection).controller.geometry.wheel_diameter, 0.3);
-  EXPECT_EQ(loaded.section(params::kBodySection).servo_ids, (std::vector<int>{4, 5, 6}));
-  EXPECT_TRUE(loaded.section(params::kServoBusSection).bus.client.allow_dangerous_writes);
+  EXPECT_EQ(loaded.section(devices::base::kBaseSection).controller.geometry.wheel_diameter, 0.3);
+  EXPECT_EQ(loaded.section(devices::body::kBodySection).servo_ids, (std::vector<int>{4, 5, 6}));
+  EXPECT_TRUE(
+      loaded.section(devices::servo_bus::kServoBusSection).bus.client.allow_dangerous_writes);
   EXPECT_EQ(loaded.port, "/dev/ttyACM0");
   EXPECT_EQ(unknown, std::vector<std::string>{"base/wheel_diamter"});
 }
@@ -374,11 +375,11 @@ TEST(ResolveFrame, PrefixSlashesAreTrimmedInnerOnesKept) {
 TEST(DriverParamsFrames, ResolveFramesPrefixesEveryFrameParameter) {
   DriverParams params;
   params.tf_prefix = "robot2";
-  params.section(params::kImuSection).frame_id = "/imu_shared";
+  params.section(devices::body::kImuSection).frame_id = "/imu_shared";
   params.resolveFrames();
-  EXPECT_EQ(params.section(params::kBaseSection).odom_frame, "robot2/odom");
-  EXPECT_EQ(params.section(params::kBaseSection).base_frame, "robot2/base_link");
-  EXPECT_EQ(params.section(params::kImuSection).frame_id, "imu_shared");
+  EXPECT_EQ(params.section(devices::base::kBaseSection).odom_frame, "robot2/odom");
+  EXPECT_EQ(params.section(devices::base::kBaseSection).base_frame, "robot2/base_link");
+  EXPECT_EQ(params.section(devices::body::kImuSection).frame_id, "imu_shared");
   EXPECT_NO_THROW(params.validate());
 }
 
@@ -392,7 +393,7 @@ TEST(DriverParamsFrames, BadPrefixOrFrameIsNamed) {
     EXPECT_EQ(e.name(), "tf_prefix");
   }
   DriverParams slash_only;
-  slash_only.section(params::kBaseSection).base_frame = "/";
+  slash_only.section(devices::base::kBaseSection).base_frame = "/";
   slash_only.tf_prefix = "robot1";
   slash_only.resolveFrames();
   try {
@@ -430,39 +431,43 @@ TEST(DriverParams, TrajectoryDefaultsMustNotBeNegative) {
 TEST(DriverParams, BusJointsAreCheckedAndNamed) {
   const auto withJoints = [] {
     DriverParams p;
-    p.section(params::kServoBusSection).joint_ids = {3, 4};
-    p.section(params::kServoBusSection).joint_names = {"pan", "tilt"};
+    p.section(devices::servo_bus::kServoBusSection).joint_ids = {3, 4};
+    p.section(devices::servo_bus::kServoBusSection).joint_names = {"pan", "tilt"};
     return p;
   };
   EXPECT_NO_THROW(withJoints().validate());
   const std::vector<std::pair<std::string, std::function<void(DriverParams&)>>> cases = {
       {"servo_bus/joint_ids",
        [](DriverParams& p) {
-         p.section(params::kServoBusSection).joint_ids = {3, 3};
+         p.section(devices::servo_bus::kServoBusSection).joint_ids = {3, 3};
        }},
       {"servo_bus/joint_ids",
        [](DriverParams& p) {
-         p.section(params::kServoBusSection).joint_ids = {3, 255};
-       }},
-      {"servo_bus/joint_names",
-       [](DriverParams& p) { p.section(params::kServoBusSection).joint_names = {"pan"}; }},
-      {"servo_bus/joint_names",
-       [](DriverParams& p) {
-         p.section(params::kServoBusSection).joint_names = {"pan", "pan"};
+         p.section(devices::servo_bus::kServoBusSection).joint_ids = {3, 255};
        }},
       {"servo_bus/joint_names",
        [](DriverParams& p) {
-         p.section(params::kServoBusSection).joint_names = {"pan", "joint_1"};
+         p.section(devices::servo_bus::kServoBusSection).joint_names = {"pan"};
+       }},
+      {"servo_bus/joint_names",
+       [](DriverParams& p) {
+         p.section(devices::servo_bus::kServoBusSection).joint_names = {"pan", "pan"};
+       }},
+      {"servo_bus/joint_names",
+       [](DriverParams& p) {
+         p.section(devices::servo_bus::kServoBusSection).joint_names = {"pan", "joint_1"};
        }},  // a body joint
       {"servo_bus/joint_zero_deg",
-       [](DriverParams& p) { p.section(params::kServoBusSection).joint_zero_deg = {0}; }},
+       [](DriverParams& p) {
+         p.section(devices::servo_bus::kServoBusSection).joint_zero_deg = {0};
+       }},
       {"servo_bus/joint_zero_deg",
        [](DriverParams& p) {
-         p.section(params::kServoBusSection).joint_zero_deg = {0, 200};
+         p.section(devices::servo_bus::kServoBusSection).joint_zero_deg = {0, 200};
        }},
       {"servo_bus/joint_directions",
        [](DriverParams& p) {
-         p.section(params::kServoBusSection).joint_directions = {1, 0};
+         p.section(devices::servo_bus::kServoBusSection).joint_directions = {1, 0};
        }},
   };
   for (const auto& [key, spoil] : cases) {

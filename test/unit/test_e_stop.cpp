@@ -5,14 +5,14 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/e_stop.h"
-#include "serial_robot_driver/device/motion_gate.h"
+#include "serial_robot_driver/core/e_stop.h"
+#include "serial_robot_driver/core/motion_gate.h"
 
 namespace {
 
-using serial_robot_driver::device::EStop;
-using serial_robot_driver::device::GateState;
-using serial_robot_driver::device::MotionGate;
+using serial_robot_driver::core::EStop;
+using serial_robot_driver::core::GateState;
+using serial_robot_driver::core::MotionGate;
 
 TEST(EStop, ListenersRunOncePerChangeInOrder) {
   EStop e_stop;
@@ -56,7 +56,8 @@ TEST(MotionGate, AnEStopVoidsWhatWasAcceptedBeforeIt) {
   EXPECT_EQ(gate.writeIfOpen(write, &written, before), GateState::kLocked);
   gate.setLocked(true);  // a repeated engage is the same e-stop
   gate.setLocked(false);
-  EXPECT_EQ(gate.writeIfOpen(write, &written, before), GateState::kVoided) << "released, still void";
+  EXPECT_EQ(gate.writeIfOpen(write, &written, before), GateState::kVoided)
+      << "released, still void";
   EXPECT_FALSE(written);
   EXPECT_EQ(gate.generation(), before + 1);
   EXPECT_EQ(gate.writeIfOpen(write, &written, gate.generation()), GateState::kOpen);

@@ -5,9 +5,9 @@
 #include <limits>
 #include <string>
 
-#include "serial_robot_driver/device/event_rate.h"
+#include "serial_robot_driver/core/event_rate.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 namespace {
 
 struct FakeClock {
@@ -83,4 +83,4 @@ TEST(EventRate, TheWindowReachesBackFiveCalls) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::core

@@ -17,7 +17,7 @@ namespace {
 class GuardedCallbacks : public ::testing::Test {
  protected:
   void SetUp() override { ros::Time::init(); }  // the throttled log reads the clock
-  device::InputRefusals refusals;
+  core::InputRefusals refusals;
 };
 
 TEST_F(GuardedCallbacks, AnExceptionIsCountedAndSwallowed) {

@@ -6,15 +6,15 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/device/input_refusals.h"
+#include "serial_robot_driver/core/input_refusals.h"
 
 namespace {
 
-using serial_robot_driver::device::addInputRefusals;
-using serial_robot_driver::device::InputRefusals;
-using serial_robot_driver::device::InputRefusalStats;
-using serial_robot_driver::device::StatusLevel;
-using serial_robot_driver::device::StatusReport;
+using serial_robot_driver::core::addInputRefusals;
+using serial_robot_driver::core::InputRefusals;
+using serial_robot_driver::core::InputRefusalStats;
+using serial_robot_driver::core::StatusLevel;
+using serial_robot_driver::core::StatusReport;
 
 TEST(InputRefusals, CountsEachSourceFromAnyThread) {
   InputRefusals refusals;
@@ -45,7 +45,7 @@ TEST(InputRefusals, PartsAddUpAndTheStatusNamesEverySourceAndTheTotals) {
 
   StatusReport status;
   status.summary(StatusLevel::kOk, "released");
-  addInputRefusals(all, status);
+  serial_robot_driver::core::addInputRefusals(all, status);
   EXPECT_EQ(*status.find("inputs refused: joint_commands"), "2");
   EXPECT_EQ(*status.find("inputs refused: joint_trajectory"), "1");
   EXPECT_EQ(*status.find("inputs refused"), "3");
@@ -54,7 +54,7 @@ TEST(InputRefusals, PartsAddUpAndTheStatusNamesEverySourceAndTheTotals) {
   EXPECT_EQ(status.level, StatusLevel::kOk) << "a refused input is the sender's mistake";
 
   StatusReport none;
-  addInputRefusals(InputRefusalStats{}, none);
+  serial_robot_driver::core::addInputRefusals(InputRefusalStats{}, none);
   EXPECT_EQ(*none.find("inputs refused"), "0");
   EXPECT_EQ(*none.find("callback errors"), "0");
 }

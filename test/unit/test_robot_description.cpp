@@ -17,7 +17,8 @@ namespace serial_robot_driver::ros_layer {
 namespace {
 
 const std::string kDefaultConfig = std::string(SRD_SOURCE_DIR) + "/config/robot.yaml";
-const std::string kOtherConfig = std::string(SRD_SOURCE_DIR) + "/test/config/description_other.yaml";
+const std::string kOtherConfig =
+    std::string(SRD_SOURCE_DIR) + "/test/config/description_other.yaml";
 
 struct CommandResult {
   int status;
@@ -37,7 +38,8 @@ CommandResult run(const std::string& command) {
 
 /// The executable's URDF for `config` written to a file, and check_urdf's verdict on it.
 std::string generatedUrdf(const std::string& config, const std::string& extra_args = "") {
-  const CommandResult generated = run(std::string(SRD_ROBOT_DESCRIPTION) + " '" + config + "' " + extra_args);
+  const CommandResult generated =
+      run(std::string(SRD_ROBOT_DESCRIPTION) + " '" + config + "' " + extra_args);
   EXPECT_EQ(generated.status, 0) << generated.output;
   return generated.output;
 }
@@ -59,13 +61,15 @@ urdf::Model parse(const std::string& urdf) {
 constexpr double kTick = 2 * M_PI / 4096;
 
 TEST(RobotDescription, DefaultConfigPassesCheckUrdfAndFollowsTheGeometry) {
-  const std::string urdf = generatedUrdf(kDefaultConfig, "--imu-xyz '0.1 0 0.2' --imu-rpy '0 0 1.5'");
+  const std::string urdf =
+      generatedUrdf(kDefaultConfig, "--imu-xyz '0.1 0 0.2' --imu-rpy '0 0 1.5'");
   expectCheckUrdfPasses(urdf, "/tmp/srd_description_default_" + std::to_string(getpid()) + ".urdf");
   const urdf::Model model = parse(urdf);
   ASSERT_TRUE(model.getRoot());
   EXPECT_EQ(model.getRoot()->name, "base_link");
 
-  for (const auto& [name, side] : {std::pair{"left_wheel_joint", 1.0}, {"right_wheel_joint", -1.0}}) {
+  for (const auto& [name, side] :
+       {std::pair{"left_wheel_joint", 1.0}, {"right_wheel_joint", -1.0}}) {
     const auto joint = model.getJoint(name);
     ASSERT_TRUE(joint) << name;
     EXPECT_EQ(joint->type, urdf::Joint::CONTINUOUS);
@@ -141,16 +145,20 @@ TEST(RobotDescription, BadFilesAreRefusedNamingTheParameter) {
     EXPECT_NE(result.status, 0) << yaml;
     return result.output;
   };
-  EXPECT_NE(refusal("base: {wheel_diameter: -0.1}\n").find("base/wheel_diameter"), std::string::npos);
-  EXPECT_NE(refusal("base: {wheel_diameter: wide}\n").find("base/wheel_diameter"), std::string::npos);
+  EXPECT_NE(refusal("base: {wheel_diameter: -0.1}\n").find("base/wheel_diameter"),
+            std::string::npos);
+  EXPECT_NE(refusal("base: {wheel_diameter: wide}\n").find("base/wheel_diameter"),
+            std::string::npos);
   EXPECT_NE(refusal("servo_bus: {joint_ids: [5], joint_names: [joint_1]}\n")
                 .find("servo_bus/joint_names"),
             std::string::npos)
       << "a bus joint named like a body joint";
-  EXPECT_NE(refusal("servo_bus: {joint_ids: [5, 6], joint_names: [a]}\n").find("servo_bus/joint_names"),
-            std::string::npos);
-  EXPECT_NE(refusal("base: {left_wheel_joint: w, right_wheel_joint: w}\n").find("base/right_wheel_joint"),
-            std::string::npos);
+  EXPECT_NE(
+      refusal("servo_bus: {joint_ids: [5, 6], joint_names: [a]}\n").find("servo_bus/joint_names"),
+      std::string::npos);
+  EXPECT_NE(
+      refusal("base: {left_wheel_joint: w, right_wheel_joint: w}\n").find("base/right_wheel_joint"),
+      std::string::npos);
   std::remove(file.c_str());
   EXPECT_NE(run(std::string(SRD_ROBOT_DESCRIPTION) + " /nonexistent.yaml").status, 0);
 }
@@ -159,17 +167,20 @@ TEST(YamlParamSource, ReadsTheDriversParametersWithTheirDefaults) {
   const YamlParamSource source(kOtherConfig);
   std::vector<std::string> unknown;
   const DriverParams params = loadParams(source, &unknown);
-  EXPECT_DOUBLE_EQ(params.section(params::kBaseSection).controller.geometry.wheel_diameter, 0.1);
-  EXPECT_EQ(params.section(params::kBaseSection).left_wheel_joint, "wheel_l");
-  EXPECT_EQ(params.section(params::kBodySection).servo_ids, (std::vector<int>{3, 4}));
-  EXPECT_EQ(params.section(params::kBodySection).directions, (std::vector<int>{1, -1}));
+  EXPECT_DOUBLE_EQ(params.section(devices::base::kBaseSection).controller.geometry.wheel_diameter,
+                   0.1);
+  EXPECT_EQ(params.section(devices::base::kBaseSection).left_wheel_joint, "wheel_l");
+  EXPECT_EQ(params.section(devices::body::kBodySection).servo_ids, (std::vector<int>{3, 4}));
+  EXPECT_EQ(params.section(devices::body::kBodySection).directions, (std::vector<int>{1, -1}));
   EXPECT_EQ(params.loop_rate, DriverParams().loop_rate) << "absent: the driver's default";
-  EXPECT_TRUE(params.section(params::kBaseSection).publish_tf);
-  EXPECT_EQ(params.section(params::kServoBusSection).joint_ids, (std::vector<int>{5}));
-  EXPECT_EQ(params.section(params::kServoBusSection).joint_names,
+  EXPECT_TRUE(params.section(devices::base::kBaseSection).publish_tf);
+  EXPECT_EQ(params.section(devices::servo_bus::kServoBusSection).joint_ids, (std::vector<int>{5}));
+  EXPECT_EQ(params.section(devices::servo_bus::kServoBusSection).joint_names,
             (std::vector<std::string>{"gripper"}));
-  EXPECT_EQ(params.section(params::kServoBusSection).joint_zero_deg, (std::vector<double>{90.0}));
-  EXPECT_EQ(params.section(params::kServoBusSection).joint_directions, (std::vector<int>{-1}));
+  EXPECT_EQ(params.section(devices::servo_bus::kServoBusSection).joint_zero_deg,
+            (std::vector<double>{90.0}));
+  EXPECT_EQ(params.section(devices::servo_bus::kServoBusSection).joint_directions,
+            (std::vector<int>{-1}));
 }
 
 TEST(RobotDescription, LinkNamesDropALeadingSlash) {

@@ -192,23 +192,27 @@ TEST(TuneParams, AValidChangeApplies) {
   const TuningResult result =
       tuneParams(in_force, {{"base/max_wheel_speed", 0.5}, {"base/wheel_separation", 0.5}});
   EXPECT_TRUE(result.refusals.empty());
-  EXPECT_DOUBLE_EQ(result.applied.section(params::kBaseSection).controller.max_wheel_speed, 0.5);
+  EXPECT_DOUBLE_EQ(result.applied.section(devices::base::kBaseSection).controller.max_wheel_speed,
+                   0.5);
   EXPECT_DOUBLE_EQ(
-      result.applied.section(params::kBaseSection).controller.geometry.wheel_separation, 0.5);
-  EXPECT_DOUBLE_EQ(result.applied.section(params::kBaseSection).controller.geometry.wheel_diameter,
-                   in_force.section(params::kBaseSection).controller.geometry.wheel_diameter);
+      result.applied.section(devices::base::kBaseSection).controller.geometry.wheel_separation,
+      0.5);
+  EXPECT_DOUBLE_EQ(
+      result.applied.section(devices::base::kBaseSection).controller.geometry.wheel_diameter,
+      in_force.section(devices::base::kBaseSection).controller.geometry.wheel_diameter);
 }
 
 // What changes is what RuntimeTuning logs and hands to the devices: nothing when the request
 // only repeats the values in force or is refused.
 TEST(TuneParams, ChangesListEachValueThatDiffersFromTheValueInForce) {
   DriverParams in_force;
-  in_force.section(params::kBaseSection).controller.max_wheel_speed = 0.8;
+  in_force.section(devices::base::kBaseSection).controller.max_wheel_speed = 0.8;
   const TuningResult result = tuneParams(
-      in_force, {{"base/max_wheel_speed", 0.5},
-                 {"base/wheel_separation",
-                  in_force.section(params::kBaseSection).controller.geometry.wheel_separation},
-                 {"base/cmd_vel_timeout", 0.0}});
+      in_force,
+      {{"base/max_wheel_speed", 0.5},
+       {"base/wheel_separation",
+        in_force.section(devices::base::kBaseSection).controller.geometry.wheel_separation},
+       {"base/cmd_vel_timeout", 0.0}});
   EXPECT_EQ(result.changes, std::vector<std::string>{"~base/max_wheel_speed = 0.5 (was 0.8)"});
   EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.8}}).changes.empty());
   EXPECT_TRUE(tuneParams(in_force, {{"base/max_wheel_speed", 0.0}}).changes.empty());
@@ -216,11 +220,13 @@ TEST(TuneParams, ChangesListEachValueThatDiffersFromTheValueInForce) {
 
 TEST(TuneParams, AValueTheStartUpCheckRefusesKeepsTheValueInForce) {
   DriverParams in_force;
-  in_force.section(params::kBaseSection).controller.cmd_vel_timeout = 0.8;
+  in_force.section(devices::base::kBaseSection).controller.cmd_vel_timeout = 0.8;
   const TuningResult result =
       tuneParams(in_force, {{"base/cmd_vel_timeout", 0.0}, {"base/max_wheel_speed", 0.3}});
-  EXPECT_DOUBLE_EQ(result.applied.section(params::kBaseSection).controller.cmd_vel_timeout, 0.8);
-  EXPECT_DOUBLE_EQ(result.applied.section(params::kBaseSection).controller.max_wheel_speed, 0.3)
+  EXPECT_DOUBLE_EQ(result.applied.section(devices::base::kBaseSection).controller.cmd_vel_timeout,
+                   0.8);
+  EXPECT_DOUBLE_EQ(result.applied.section(devices::base::kBaseSection).controller.max_wheel_speed,
+                   0.3)
       << "the valid part applies";
   ASSERT_EQ(result.refusals.size(), 1u);
   EXPECT_NE(result.refusals[0].find("~base/cmd_vel_timeout = 0 refused"), std::string::npos)
@@ -244,11 +250,12 @@ TEST(TuneParams, ASpeedLimitOfZeroOrLessIsRefusedAndTheLimitInForceStays) {
   EXPECT_FALSE(tableAccepts("base/max_wheel_speed", cfg_min));
 
   DriverParams in_force;
-  in_force.section(params::kBaseSection).controller.max_wheel_speed = 0.8;
+  in_force.section(devices::base::kBaseSection).controller.max_wheel_speed = 0.8;
   for (const double requested : {0.0, -1.0}) {
     SCOPED_TRACE(requested);
     const TuningResult result = tuneParams(in_force, {{"base/max_wheel_speed", requested}});
-    EXPECT_DOUBLE_EQ(result.applied.section(params::kBaseSection).controller.max_wheel_speed, 0.8);
+    EXPECT_DOUBLE_EQ(result.applied.section(devices::base::kBaseSection).controller.max_wheel_speed,
+                     0.8);
     ASSERT_EQ(result.refusals.size(), 1u);
     EXPECT_NE(result.refusals[0].find("~base/max_wheel_speed = "), std::string::npos)
         << result.refusals[0];
@@ -261,7 +268,7 @@ TEST(TuneParams, ARuleBetweenValuesRefusesTheWholeChange) {
   const DriverParams in_force;  // warn 20, error 10
   const TuningResult result =
       tuneParams(in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 10}});
-  EXPECT_EQ(result.applied.section(params::kBaseSection).battery_warn_percent, 20);
+  EXPECT_EQ(result.applied.section(devices::base::kBaseSection).battery_warn_percent, 20);
   ASSERT_EQ(result.refusals.size(), 1u);
   EXPECT_NE(result.refusals[0].find("battery_warn_percent = 5 refused"), std::string::npos);
   EXPECT_NE(result.refusals[0].find("must not exceed"), std::string::npos) << result.refusals[0];
@@ -269,20 +276,20 @@ TEST(TuneParams, ARuleBetweenValuesRefusesTheWholeChange) {
   const TuningResult both =
       tuneParams(in_force, {{"base/battery_warn_percent", 5}, {"base/battery_error_percent", 3}});
   EXPECT_TRUE(both.refusals.empty()) << "lowered together, both apply";
-  EXPECT_EQ(both.applied.section(params::kBaseSection).battery_warn_percent, 5);
-  EXPECT_EQ(both.applied.section(params::kBaseSection).battery_error_percent, 3);
+  EXPECT_EQ(both.applied.section(devices::base::kBaseSection).battery_warn_percent, 5);
+  EXPECT_EQ(both.applied.section(devices::base::kBaseSection).battery_error_percent, 3);
 }
 
 TEST(TuneParams, PollRateAboveTheLoopRateAndImuHeadingWithoutTheBodyAreRefused) {
   DriverParams in_force;
   in_force.loop_rate = 20;
   EXPECT_EQ(tuneParams(in_force, {{"base/battery_poll_rate", 25.0}})
-                .applied.section(params::kBaseSection)
+                .applied.section(devices::base::kBaseSection)
                 .controller.battery_poll_rate,
-            in_force.section(params::kBaseSection).controller.battery_poll_rate);
-  in_force.section(params::kBodySection).enabled = false;
+            in_force.section(devices::base::kBaseSection).controller.battery_poll_rate);
+  in_force.section(devices::body::kBodySection).enabled = false;
   const TuningResult result = tuneParams(in_force, {{"base/use_imu_heading", true}});
-  EXPECT_FALSE(result.applied.section(params::kBaseSection).controller.use_imu_heading);
+  EXPECT_FALSE(result.applied.section(devices::base::kBaseSection).controller.use_imu_heading);
   EXPECT_EQ(result.refusals.size(), 1u);
 }
 

@@ -8,7 +8,7 @@
 #include <mutex>
 #include <vector>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
@@ -17,7 +17,7 @@
 #include "support/golden_frames.h"
 #include "support/test_helpers.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 namespace {
 
 using std::chrono::milliseconds;
@@ -199,9 +199,9 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   stream.insert(stream.end(), kPingReply.begin(), kPingReply.end());
   pty.write(stream.data(), stream.size());
   ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 2; }, kWaitSeconds));
-  EXPECT_EQ(listener.frames[0].first, protocol::base::kFrames);
+  EXPECT_EQ(listener.frames[0].first, devices::base::kFrames);
   EXPECT_EQ(listener.frames[0].second, kBatteryReply);
-  EXPECT_EQ(listener.frames[1].first, protocol::servo::kResponseFrames);
+  EXPECT_EQ(listener.frames[1].first, devices::servo_bus::kResponseFrames);
   EXPECT_EQ(listener.frames[1].second, kPingReply);
 
   const Bytes& reset = golden::base::kResetSeq2;
@@ -354,4 +354,4 @@ TEST(SerialLink, WaitsForAPortThatDoesNotExistYet) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::core

@@ -22,16 +22,19 @@ TEST(RobotSimCommandLine, ParsesFlagsAndIgnoresRoslaunchArguments) {
              "--battery", "40", "--telemetry-rate", "0", "--offline-ids", "7"});
   ASSERT_TRUE(line.error.empty()) << line.error;
   EXPECT_FALSE(line.help);
-  EXPECT_EQ(bodyConfig(line.options).servo_ids, (std::vector<uint8_t>{3, 4, 5}));
-  EXPECT_EQ(bodyConfig(line.options).foot_mode, FootMode::kAlternate);
+  EXPECT_EQ(devices::body::sim::bodyConfig(line.options).servo_ids,
+            (std::vector<uint8_t>{3, 4, 5}));
+  EXPECT_EQ(devices::body::sim::bodyConfig(line.options).foot_mode,
+            devices::body::sim::FootMode::kAlternate);
   EXPECT_EQ(line.options.faults.seed, 9u);
   EXPECT_DOUBLE_EQ(line.options.faults.corrupt_rate, 0.5);
   EXPECT_EQ(line.options.device("base").link.value_or(""), "/tmp/b");
   EXPECT_FALSE(line.options.device("body").link.has_value());
   EXPECT_FALSE(line.options.hosts("servo_bus"));
-  EXPECT_EQ(baseConfig(line.options).battery_percent, 40);
-  EXPECT_DOUBLE_EQ(bodyConfig(line.options).telemetry_rate_hz, 0.0);
-  EXPECT_EQ(servoBusConfig(line.options).offline_ids, (std::vector<uint8_t>{7}));
+  EXPECT_EQ(devices::base::sim::baseConfig(line.options).battery_percent, 40);
+  EXPECT_DOUBLE_EQ(devices::body::sim::bodyConfig(line.options).telemetry_rate_hz, 0.0);
+  EXPECT_EQ(devices::servo_bus::sim::servoBusConfig(line.options).offline_ids,
+            (std::vector<uint8_t>{7}));
   EXPECT_EQ(line.options.pace_baud, 0u);  // off unless asked for
   EXPECT_EQ(parse({"--pace-baud", "115200"}).options.pace_baud, 115200u);
 }

@@ -13,7 +13,7 @@ using namespace sim_test;  // NOLINT: the shared fixture
 
 TEST(RobotSimBaseDevice, IntegratesOncePerPidPeriodAndTimesOut) {
   const TimePoint t0{};
-  BaseSim base(BaseSimConfig{}, t0);
+  devices::base::sim::BaseSim base(devices::base::sim::BaseSimConfig{}, t0);
   Outbox out;
   base.handleFrame(kBoth4Seq0.data(), kBoth4Seq0.size(), t0, &out);
   base.tick(t0 + milliseconds(105), &out);  // 5 periods of 20 ms
@@ -34,7 +34,7 @@ TEST(RobotSimBaseDevice, IntegratesOncePerPidPeriodAndTimesOut) {
 
 TEST(RobotSimBaseDevice, YawRateFollowsTheWheelDifference) {
   const TimePoint t0{};
-  BaseSim base(BaseSimConfig{}, t0);
+  devices::base::sim::BaseSim base(devices::base::sim::BaseSimConfig{}, t0);
   Outbox out;
   // left 0, right 4 ticks per period: 4 * 50 / 2037.18 m/s on the right wheel, 0.40 m apart.
   const Bytes right4 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x00,
@@ -46,9 +46,9 @@ TEST(RobotSimBaseDevice, YawRateFollowsTheWheelDifference) {
 
 TEST(RobotSimBaseDevice, TurnSlipTurnsTheChassisLessThanItsWheelsCommand) {
   const TimePoint t0{};
-  BaseSimConfig config;
+  devices::base::sim::BaseSimConfig config;
   config.turn_slip = 0.3;
-  BaseSim base(config, t0);
+  devices::base::sim::BaseSim base(config, t0);
   Outbox out;
   const Bytes right4 = {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x00,
                         0x00, 0x04, 0x00, 0x00, 0x00, 0x00, 0xF3};
@@ -63,63 +63,64 @@ TEST(RobotSimBaseDevice, TurnSlipTurnsTheChassisLessThanItsWheelsCommand) {
 
 TEST(RobotSimBodyDevice, ImuReportsTheChassisHeadingAndYawRate) {
   const TimePoint t0{};
-  BodySimConfig config;
+  devices::body::sim::BodySimConfig config;
   config.telemetry_rate_hz = 50;
-  BodySim body(config, t0);
+  devices::body::sim::BodySim body(config, t0);
   Outbox out;
   body.tick(t0 + milliseconds(20), ChassisMotion{1.0, 0.5}, &out);
   ASSERT_EQ(out.size(), 1u);
   const auto telemetry =
-      protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+      devices::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
   ASSERT_TRUE(telemetry.ok());
   // 1 rad at 180 deg / 32768 per LSB: 10430.4 LSB; 0.5 rad/s at 2000 deg/s / 32768: 469.4 LSB.
-  EXPECT_EQ(telemetry->imu[protocol::body::kYaw], 10430);
-  EXPECT_EQ(telemetry->imu[protocol::body::kGyroZ], 469);
+  EXPECT_EQ(telemetry->imu[devices::body::kYaw], 10430);
+  EXPECT_EQ(telemetry->imu[devices::body::kGyroZ], 469);
   // A heading beyond pi is reported wrapped, as an attitude module does: 4 rad = 4 - 2 pi.
   out.clear();
   body.tick(t0 + milliseconds(40), ChassisMotion{4.0, 0.0}, &out);
   ASSERT_EQ(out.size(), 1u);
-  const auto wrapped = protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+  const auto wrapped = devices::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
   ASSERT_TRUE(wrapped.ok());
-  EXPECT_EQ(wrapped->imu[protocol::body::kYaw], -23814);  // -2.2832 rad * 32768 / pi
+  EXPECT_EQ(wrapped->imu[devices::body::kYaw], -23814);  // -2.2832 rad * 32768 / pi
 }
 
 TEST(RobotSimBodyDevice, GyroBiasIsAddedToEachGyroAxis) {
   const TimePoint t0{};
-  BodySimConfig config;
+  devices::body::sim::BodySimConfig config;
   config.telemetry_rate_hz = 50;
   config.gyro_bias = {0.02, -0.015, 0.03};  // rad/s, as --gyro-bias 0.02,-0.015,0.03
-  BodySim body(config, t0);
+  devices::body::sim::BodySim body(config, t0);
   Outbox out;
   body.tick(t0 + milliseconds(20), ChassisMotion{0.0, 0.5}, &out);
   ASSERT_EQ(out.size(), 1u);
   const auto telemetry =
-      protocol::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
+      devices::body::decodeTelemetry(out[0].bytes.data(), out[0].bytes.size(), 2);
   ASSERT_TRUE(telemetry.ok());
   // 938.734 LSB per rad/s (2000 deg/s / 32768): 18.77, -14.08 and (0.5 + 0.03) * 938.734 = 497.5.
-  EXPECT_EQ(telemetry->imu[protocol::body::kGyroX], 19);
-  EXPECT_EQ(telemetry->imu[protocol::body::kGyroY], -14);
-  EXPECT_EQ(telemetry->imu[protocol::body::kGyroZ], 498);
-  EXPECT_EQ(telemetry->imu[protocol::body::kAccelX], 0) << "the accelerometer is left alone";
-  EXPECT_EQ(telemetry->imu[protocol::body::kRoll], 0) << "and so are the angles";
+  EXPECT_EQ(telemetry->imu[devices::body::kGyroX], 19);
+  EXPECT_EQ(telemetry->imu[devices::body::kGyroY], -14);
+  EXPECT_EQ(telemetry->imu[devices::body::kGyroZ], 498);
+  EXPECT_EQ(telemetry->imu[devices::body::kAccelX], 0) << "the accelerometer is left alone";
+  EXPECT_EQ(telemetry->imu[devices::body::kRoll], 0) << "and so are the angles";
 
   const char* args[] = {"robot_sim", "--gyro-bias", "0.02,-0.015,0.03"};
   CommandLine line = parseCommandLine(3, args);
   ASSERT_TRUE(line.error.empty()) << line.error;
-  EXPECT_EQ(bodyConfig(line.options).gyro_bias, (std::array<double, 3>{0.02, -0.015, 0.03}));
+  EXPECT_EQ(devices::body::sim::bodyConfig(line.options).gyro_bias,
+            (std::array<double, 3>{0.02, -0.015, 0.03}));
   for (const char* bad : {"0.02,0.01", "1,2,3,4", "a,b,c", "0.1,,0.2", "1,2,nan"}) {
-    EXPECT_FALSE(parseGyroBias(bad).has_value()) << bad;
+    EXPECT_FALSE(devices::body::sim::parseGyroBias(bad).has_value()) << bad;
   }
   EXPECT_NE(usage().find("--gyro-bias X,Y,Z"), std::string::npos);
 }
 
 TEST(RobotSimBodyDevice, ServoMovesAtTheBoundedSpeed) {
   const TimePoint t0{};
-  BodySimConfig config;
+  devices::body::sim::BodySimConfig config;
   config.servo_ids = {2, 3};
   config.servo_speed = 1000;
   config.telemetry_rate_hz = 0;
-  BodySim body(config, t0);
+  devices::body::sim::BodySim body(config, t0);
   body.handleSyncWrite(kSyncWrite2And3.data(), kSyncWrite2And3.size());
   Outbox out;
   body.tick(t0 + milliseconds(500), ChassisMotion{}, &out);
@@ -136,8 +137,8 @@ TEST(RobotSimBodyDevice, ServoMovesAtTheBoundedSpeed) {
 class ServoBusSimMotion : public ::testing::Test {
  protected:
   ServoBusSimMotion() : start_(TimePoint() + std::chrono::hours(1)), sim_(config(), start_) {}
-  static ServoBusSimConfig config() {
-    ServoBusSimConfig c;
+  static devices::servo_bus::sim::ServoBusSimConfig config() {
+    devices::servo_bus::sim::ServoBusSimConfig c;
     c.servo_ids = {0, 1};
     c.answer_latency_s = 0.001;
     return c;
@@ -148,7 +149,7 @@ class ServoBusSimMotion : public ::testing::Test {
   double angleAt(double at_s, uint8_t id = 1) {
     Outbox out;
     sim_.tick(start_ + fromSeconds(at_s), &out);
-    for (const BusServoSnapshot& servo : sim_.stats().servos) {
+    for (const devices::servo_bus::sim::BusServoSnapshot& servo : sim_.stats().servos) {
       if (servo.id == id) return servo.angle_deg;
     }
     ADD_FAILURE() << "no servo " << int(id);
@@ -162,7 +163,7 @@ class ServoBusSimMotion : public ::testing::Test {
     return frames;
   }
   TimePoint start_;
-  ServoBusSim sim_;
+  devices::servo_bus::sim::ServoBusSim sim_;
 };
 
 TEST_F(ServoBusSimMotion, MoveByIntervalRunsATrapezoidInTheInterval) {

@@ -13,7 +13,7 @@ using namespace sim_test;  // NOLINT: the shared fixture
 
 TEST(RobotSimBase, AnswersBatteryRequestsAndCountsResets) {
   SimOptions options = onlyBase();
-  baseConfig(options).battery_percent = 64;
+  devices::base::sim::baseConfig(options).battery_percent = 64;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), baseHostConfig());
@@ -21,12 +21,13 @@ TEST(RobotSimBase, AnswersBatteryRequestsAndCountsResets) {
   host.send(kBatteryRequestSeq1);
   host.send(kResetSeq2);
   EXPECT_TRUE(host.waitForFrame(kBattery64ReplySeq0));
-  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).resets == 1; }));
+  EXPECT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::base::sim::baseStats(s).resets == 1; }));
   const SimStats stats = sim.stats();
-  EXPECT_EQ(baseStats(stats).frames_received, 2u);
-  EXPECT_EQ(baseStats(stats).battery_requests, 1u);
-  EXPECT_EQ(baseStats(stats).seq_gaps, 0u);
-  EXPECT_EQ(stats.sentOf(kBaseReplyOutput).intact, 1u);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).frames_received, 2u);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).battery_requests, 1u);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).seq_gaps, 0u);
+  EXPECT_EQ(stats.sentOf(devices::base::sim::kBaseReplyOutput).intact, 1u);
 }
 
 TEST(RobotSimBase, SpeedFramesIntegrateAndClearEncodersZeroes) {
@@ -35,29 +36,33 @@ TEST(RobotSimBase, SpeedFramesIntegrateAndClearEncodersZeroes) {
   Host host(slaveOf(sim), baseHostConfig());
   ASSERT_TRUE(host.ok());
   host.send(kBoth4Seq0);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).left_ticks >= 40; }));
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::base::sim::baseStats(s).left_ticks >= 40; }));
   host.send(kBoth0Seq1);
-  ASSERT_TRUE(
-      waitForStats(sim, [](const SimStats& s) { return baseStats(s).speed_frames_applied == 2; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) {
+    return devices::base::sim::baseStats(s).speed_frames_applied == 2;
+  }));
   SimStats stats = sim.stats();
-  EXPECT_EQ(baseStats(stats).left_ticks, baseStats(stats).right_ticks);
-  EXPECT_EQ(baseStats(stats).left_ticks % 4, 0);
-  EXPECT_EQ(baseStats(stats).last_left_speed, 0);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).left_ticks,
+            devices::base::sim::baseStats(stats).right_ticks);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).left_ticks % 4, 0);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).last_left_speed, 0);
 
   host.send(kClearEncodersSeq3);  // SEQ 03 after 01: one gap
-  ASSERT_TRUE(
-      waitForStats(sim, [](const SimStats& s) { return baseStats(s).encoder_clears == 1; }));
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::base::sim::baseStats(s).encoder_clears == 1; }));
   stats = sim.stats();
-  EXPECT_EQ(baseStats(stats).left_ticks, 0);
-  EXPECT_EQ(baseStats(stats).right_ticks, 0);
-  EXPECT_EQ(baseStats(stats).seq_gaps, 1u);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).left_ticks, 0);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).right_ticks, 0);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).seq_gaps, 1u);
 
   host.send(kBothMinus6Seq0);  // SEQ 00 after 03: another gap
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).left_ticks <= -12; }));
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::base::sim::baseStats(s).left_ticks <= -12; }));
   stats = sim.stats();
-  EXPECT_EQ(baseStats(stats).last_left_speed, -6);
-  EXPECT_EQ(baseStats(stats).last_right_speed, -6);
-  EXPECT_EQ(baseStats(stats).seq_gaps, 2u);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).last_left_speed, -6);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).last_right_speed, -6);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).seq_gaps, 2u);
 }
 
 TEST(RobotSimBase, SilenceRaisesTheTimeoutErrorAndSpeedIsIgnoredUntilReset) {
@@ -68,19 +73,21 @@ TEST(RobotSimBase, SilenceRaisesTheTimeoutErrorAndSpeedIsIgnoredUntilReset) {
   // Nothing sent since power-on: after 1 s the base reports FF.
   ASSERT_TRUE(host.waitForFrame(kErrorStatusSeq0));
   host.send(kBoth4Seq0);
-  ASSERT_TRUE(
-      waitForStats(sim, [](const SimStats& s) { return baseStats(s).speed_frames_ignored == 1; }));
-  EXPECT_EQ(baseStats(sim.stats()).left_ticks, 0);
-  EXPECT_TRUE(baseStats(sim.stats()).in_error);
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) {
+    return devices::base::sim::baseStats(s).speed_frames_ignored == 1;
+  }));
+  EXPECT_EQ(devices::base::sim::baseStats(sim.stats()).left_ticks, 0);
+  EXPECT_TRUE(devices::base::sim::baseStats(sim.stats()).in_error);
 
   host.send(kResetSeq1);
   host.send(kBoth4Seq2);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).left_ticks > 0; }));
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::base::sim::baseStats(s).left_ticks > 0; }));
   const SimStats stats = sim.stats();
-  EXPECT_FALSE(baseStats(stats).in_error);
-  EXPECT_EQ(baseStats(stats).resets, 1u);
-  EXPECT_EQ(baseStats(stats).speed_frames_applied, 1u);
-  EXPECT_GE(baseStats(stats).errors_sent, 1u);
+  EXPECT_FALSE(devices::base::sim::baseStats(stats).in_error);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).resets, 1u);
+  EXPECT_EQ(devices::base::sim::baseStats(stats).speed_frames_applied, 1u);
+  EXPECT_GE(devices::base::sim::baseStats(stats).errors_sent, 1u);
 }
 
 // --- the body on a pty -----------------------------------------------------------------------
@@ -91,28 +98,28 @@ TEST(RobotSimBody, TelemetryDecodesWithGravityOnZ) {
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
   ASSERT_TRUE(
-      host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 5; }));
-  for (const Bytes& frame : host.framesOf(protocol::body::kTelemetryFrames)) {
+      host.waitUntil([&] { return host.framesOf(devices::body::kTelemetryFrames).size() >= 5; }));
+  for (const Bytes& frame : host.framesOf(devices::body::kTelemetryFrames)) {
     ASSERT_EQ(frame.size(), 32u);
     EXPECT_EQ(frame[2], 0x20);
     // Servo 0 at 2048 (08 00), standing still.
     EXPECT_EQ(frame[3], 0x08);
     EXPECT_EQ(frame[4], 0x00);
-    const auto telemetry = protocol::body::decodeTelemetry(frame.data(), frame.size(), 2);
+    const auto telemetry = devices::body::decodeTelemetry(frame.data(), frame.size(), 2);
     ASSERT_TRUE(telemetry.ok());
     EXPECT_EQ(telemetry->servos[0].position, 2048);
     EXPECT_EQ(telemetry->servos[1].position, 2048);
     EXPECT_EQ(telemetry->servos[0].speed, 0);
-    EXPECT_EQ(telemetry->imu[protocol::body::kAccelZ], 2048);  // 1 g at 16 g full scale
-    EXPECT_EQ(telemetry->imu[protocol::body::kGyroZ], 0);
+    EXPECT_EQ(telemetry->imu[devices::body::kAccelZ], 2048);  // 1 g at 16 g full scale
+    EXPECT_EQ(telemetry->imu[devices::body::kGyroZ], 0);
     EXPECT_FALSE(telemetry->has_foot);
   }
 }
 
 TEST(RobotSimBody, SyncWriteMovesTheServoTowardItsTarget) {
   SimOptions options = onlyBody();
-  bodyConfig(options).servo_ids = {2, 3};
-  bodyConfig(options).servo_speed = 4096;
+  devices::body::sim::bodyConfig(options).servo_ids = {2, 3};
+  devices::body::sim::bodyConfig(options).servo_speed = 4096;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
@@ -120,8 +127,8 @@ TEST(RobotSimBody, SyncWriteMovesTheServoTowardItsTarget) {
   host.send(kSyncWrite2And3);
   bool saw_full_speed = false;
   const auto reached = [&] {
-    for (const Bytes& frame : host.framesOf(protocol::body::kTelemetryFrames)) {
-      const auto telemetry = protocol::body::decodeTelemetry(frame.data(), frame.size(), 2);
+    for (const Bytes& frame : host.framesOf(devices::body::kTelemetryFrames)) {
+      const auto telemetry = devices::body::decodeTelemetry(frame.data(), frame.size(), 2);
       if (!telemetry) continue;
       EXPECT_EQ(telemetry->servos[0].position, 2048);
       if (telemetry->servos[1].speed == -4096) saw_full_speed = true;
@@ -131,12 +138,12 @@ TEST(RobotSimBody, SyncWriteMovesTheServoTowardItsTarget) {
   };
   EXPECT_TRUE(host.waitUntil(reached));
   EXPECT_TRUE(saw_full_speed);
-  EXPECT_EQ(bodyStats(sim.stats()).sync_writes_ok, 1u);
+  EXPECT_EQ(devices::body::sim::bodyStats(sim.stats()).sync_writes_ok, 1u);
 }
 
 TEST(RobotSimBody, BadCrcAndUnknownIdsAreCounted) {
   SimOptions options = onlyBody();
-  bodyConfig(options).servo_ids = {2};
+  devices::body::sim::bodyConfig(options).servo_ids = {2};
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(1));
@@ -145,28 +152,28 @@ TEST(RobotSimBody, BadCrcAndUnknownIdsAreCounted) {
   bad_crc.back() ^= 0xFF;
   host.send(bad_crc);
   host.send(kSyncWrite2And3);  // id 3 is not on this board
-  ASSERT_TRUE(
-      waitForStats(sim, [](const SimStats& s) { return bodyStats(s).sync_writes_ok == 1; }));
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::body::sim::bodyStats(s).sync_writes_ok == 1; }));
   const SimStats stats = sim.stats();
-  EXPECT_EQ(bodyStats(stats).sync_write_unknown_ids, 1u);
-  EXPECT_GE(bodyStats(stats).port_checksum_errors, 1u);
+  EXPECT_EQ(devices::body::sim::bodyStats(stats).sync_write_unknown_ids, 1u);
+  EXPECT_GE(devices::body::sim::bodyStats(stats).port_checksum_errors, 1u);
   EXPECT_NE(formatStats(stats).find("sync_writes_bad 1\n"), std::string::npos);
 }
 
 TEST(RobotSimBody, FootAlternateInterleavesFrameLengths) {
   SimOptions options = onlyBody();
-  bodyConfig(options).foot_mode = FootMode::kAlternate;
+  devices::body::sim::bodyConfig(options).foot_mode = devices::body::sim::FootMode::kAlternate;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
   ASSERT_TRUE(
-      host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 6; }));
-  const auto frames = host.framesOf(protocol::body::kTelemetryFrames);
+      host.waitUntil([&] { return host.framesOf(devices::body::kTelemetryFrames).size() >= 6; }));
+  const auto frames = host.framesOf(devices::body::kTelemetryFrames);
   for (std::size_t i = 1; i < frames.size(); ++i) EXPECT_NE(frames[i].size(), frames[i - 1].size());
   for (const Bytes& frame : frames) {
     ASSERT_TRUE(frame.size() == 32u || frame.size() == 48u);
-    const auto telemetry = protocol::body::decodeTelemetry(frame.data(), frame.size(), 2);
+    const auto telemetry = devices::body::decodeTelemetry(frame.data(), frame.size(), 2);
     ASSERT_TRUE(telemetry.ok());
     EXPECT_EQ(telemetry->has_foot, frame.size() == 48u);
     if (telemetry->has_foot) {
@@ -197,7 +204,7 @@ class RobotSimServoBus : public ::testing::Test {
     host_->frames().clear();
     host_->send(request);
     host_->waitUntil([] { return false; }, milliseconds(150));
-    EXPECT_TRUE(host_->framesOf(protocol::servo::kResponseFrames).empty());
+    EXPECT_TRUE(host_->framesOf(devices::servo_bus::kResponseFrames).empty());
   }
   std::unique_ptr<RobotSim> sim_;
   std::unique_ptr<Host> host_;
@@ -208,16 +215,16 @@ TEST_F(RobotSimServoBus, PingAnswersOnlineServosOnly) {
   expectSilence(kPing7);  // configured offline
   expectReply(kPing3, kPing3Reply);
   const SimStats stats = sim_->stats();
-  EXPECT_EQ(servoBusStats(stats).requests, 3u);
-  EXPECT_EQ(servoBusStats(stats).unaddressed, 1u);
-  EXPECT_EQ(servoBusStats(stats).answers, 2u);
+  EXPECT_EQ(devices::servo_bus::sim::servoBusStats(stats).requests, 3u);
+  EXPECT_EQ(devices::servo_bus::sim::servoBusStats(stats).unaddressed, 1u);
+  EXPECT_EQ(devices::servo_bus::sim::servoBusStats(stats).answers, 2u);
 }
 
 TEST_F(RobotSimServoBus, VoltageReadIsPlausible) {
   host_->send(kReadVoltage0);
-  ASSERT_TRUE(
-      host_->waitUntil([&] { return !host_->framesOf(protocol::servo::kResponseFrames).empty(); }));
-  const Bytes reply = host_->framesOf(protocol::servo::kResponseFrames).at(0);
+  ASSERT_TRUE(host_->waitUntil(
+      [&] { return !host_->framesOf(devices::servo_bus::kResponseFrames).empty(); }));
+  const Bytes reply = host_->framesOf(devices::servo_bus::kResponseFrames).at(0);
   ASSERT_EQ(reply.size(), 9u);  // 05 1C 03 04 id data_id V_L V_H SUM
   EXPECT_EQ(Bytes(reply.begin(), reply.begin() + 6), (Bytes{0x05, 0x1C, 0x03, 0x04, 0x00, 0x01}));
   const int millivolts = reply[6] | (reply[7] << 8);
@@ -230,7 +237,7 @@ TEST_F(RobotSimServoBus, WriteIsReadBackAndReadOnlyWritesFail) {
   expectReply(kReadLimitHigh1, kReadLimitHigh1Reply);
   expectReply(kWriteVoltage0, kWriteVoltage0Reply);
   expectSilence(kReadUnknown20);
-  EXPECT_EQ(servoBusStats(sim_->stats()).unknown_data_ids, 1u);
+  EXPECT_EQ(devices::servo_bus::sim::servoBusStats(sim_->stats()).unknown_data_ids, 1u);
 }
 
 TEST_F(RobotSimServoBus, RotateMovesTheAngleWithoutAnAnswerByDefault) {
@@ -246,7 +253,7 @@ TEST_F(RobotSimServoBus, RotateMovesTheAngleWithoutAnAnswerByDefault) {
   }
   EXPECT_TRUE(reached);
   // Only READ_ANGLE answers arrived: response_switch is 0, ROTATE is silent.
-  for (const Bytes& frame : host_->framesOf(protocol::servo::kResponseFrames))
+  for (const Bytes& frame : host_->framesOf(devices::servo_bus::kResponseFrames))
     EXPECT_EQ(frame[2], 0x0A);
 }
 
@@ -264,17 +271,19 @@ TEST_F(RobotSimServoBus, ServoIdWriteMovesTheServoAndResetSendsItToIdZero) {
   // Like the servo: the reset restores the factory id 0, and the answer comes from there.
   expectReply(kResetUserData9, kResetUserDataOkFromId0);
   expectSilence(kPing9);
-  const auto servos = servoBusStats(sim_->stats()).servos;
+  const auto servos = devices::servo_bus::sim::servoBusStats(sim_->stats()).servos;
   EXPECT_EQ(std::count_if(servos.begin(), servos.end(),
-                          [](const BusServoSnapshot& servo) { return servo.id == 0; }),
+                          [](const devices::servo_bus::sim::BusServoSnapshot& servo) {
+                            return servo.id == 0;
+                          }),
             2);
 }
 
 TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {
   host_->send(kReadBatch0);
-  ASSERT_TRUE(
-      host_->waitUntil([&] { return !host_->framesOf(protocol::servo::kResponseFrames).empty(); }));
-  Bytes reply = host_->framesOf(protocol::servo::kResponseFrames).at(0);
+  ASSERT_TRUE(host_->waitUntil(
+      [&] { return !host_->framesOf(devices::servo_bus::kResponseFrames).empty(); }));
+  Bytes reply = host_->framesOf(devices::servo_bus::kResponseFrames).at(0);
   ASSERT_EQ(reply.size(), 5u + 33u);
   EXPECT_EQ(reply[2], 0x05);
   EXPECT_EQ(reply[3], 33);
@@ -285,14 +294,14 @@ TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {
   EXPECT_EQ(block[18], 1);                        // accel_switch
   EXPECT_EQ(block[26] | (block[27] << 8), 1800);  // angle_limit_high, 180.0 deg
 
-  std::array<uint8_t, protocol::servo::kUserBlockSize> new_block{};
+  std::array<uint8_t, devices::servo_bus::kUserBlockSize> new_block{};
   std::copy(block, block + new_block.size(), new_block.begin());
   new_block[26] = 0x84;  // angle_limit_high := 900
   new_block[27] = 0x03;
   host_->frames().clear();
-  host_->send(protocol::servo::encodeWriteBatchData(0, new_block));
+  host_->send(devices::servo_bus::encodeWriteBatchData(0, new_block));
   EXPECT_TRUE(host_->waitForFrame({0x05, 0x1C, 0x06, 0x02, 0x00, 0x01, 0x2A}));
-  const auto servos = servoBusStats(sim_->stats()).servos;
+  const auto servos = devices::servo_bus::sim::servoBusStats(sim_->stats()).servos;
   ASSERT_FALSE(servos.empty());
   EXPECT_EQ(servos[0].params.at(51), 900);
 }
@@ -300,10 +309,13 @@ TEST_F(RobotSimServoBus, BatchReadAndWriteOfTheUserBlock) {
 TEST_F(RobotSimServoBus, BroadcastActsOnAllAndAnswersNone) {
   expectSilence(kRotateAllTo45);
   ASSERT_TRUE(waitForStats(*sim_, [](const SimStats& s) {
-    return std::all_of(servoBusStats(s).servos.begin(), servoBusStats(s).servos.end(),
-                       [](const BusServoSnapshot& servo) { return servo.angle_deg == 45.0; });
+    return std::all_of(devices::servo_bus::sim::servoBusStats(s).servos.begin(),
+                       devices::servo_bus::sim::servoBusStats(s).servos.end(),
+                       [](const devices::servo_bus::sim::BusServoSnapshot& servo) {
+                         return servo.angle_deg == 45.0;
+                       });
   }));
-  EXPECT_EQ(servoBusStats(sim_->stats()).broadcasts, 1u);
+  EXPECT_EQ(devices::servo_bus::sim::servoBusStats(sim_->stats()).broadcasts, 1u);
 }
 
 }  // namespace

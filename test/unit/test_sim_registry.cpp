@@ -57,7 +57,7 @@ TEST(SimRegistry, LeftOutDevicesKeepTheirStatsKeysAtZero) {
     EXPECT_NE(text.find(expected), std::string::npos) << expected << " missing from:\n" << text;
   }
   EXPECT_EQ(text.find("echo_"), std::string::npos) << "the tests' device has no keys unless hosted";
-  EXPECT_EQ(baseStats(sim.stats()).resets, 0u);
+  EXPECT_EQ(devices::base::sim::baseStats(sim.stats()).resets, 0u);
 }
 
 TEST(SimRegistry, UnknownDeviceNamesAreRejected) {
@@ -107,19 +107,19 @@ TEST(SimRegistry, EachDeviceListsItsFlagsInItsOwnHelpSection) {
 TEST(SimRegistry, TheBoardsImuReportsTheBasesTurnThroughTheWorld) {
   const TimePoint t0{};
   SimOptions options;
-  baseConfig(options).turn_slip = 0.3;
+  devices::base::sim::baseConfig(options).turn_slip = 0.3;
   const auto base = findSimDevice("base")->make(options.device("base"), 1, t0);
   const auto body = findSimDevice("body")->make(options.device("body"), 2, t0);
   SimWorld world;
   Outbox out;
-  base->handleFrame(protocol::base::kFrames, kRight4Seq0.data(), kRight4Seq0.size(), t0, &out);
+  base->handleFrame(devices::base::kFrames, kRight4Seq0.data(), kRight4Seq0.size(), t0, &out);
   for (int ms = 20; ms <= 200; ms += 20) {
     const TimePoint now = t0 + milliseconds(ms);
     base->tick(now, world, &out);
     body->tick(now, world, &out);
   }
-  const auto base_stats = base->stats({}).counters.as<BaseSimStats>();
-  const auto body_stats = body->stats({}).counters.as<BodySimStats>();
+  const auto base_stats = base->stats({}).counters.as<devices::base::sim::BaseSimStats>();
+  const auto body_stats = body->stats({}).counters.as<devices::body::sim::BodySimStats>();
   EXPECT_GT(base_stats.yaw_rad, 0.0);  // right wheel faster: counter-clockwise
   EXPECT_DOUBLE_EQ(world.chassis.yaw_rad, base_stats.yaw_rad);
   EXPECT_NEAR(body_stats.yaw_rad, base_stats.yaw_rad, 1e-9);

@@ -31,10 +31,10 @@ TEST(RobotSim, SharedPortCarriesAllThreeDevicesBehindTheLink) {
   host.send({0x12, 0x4C, 0x01, 0x01, 0x01, 0x61});  // PING id 1
   EXPECT_TRUE(host.waitForFrame(kPing1Reply));
   EXPECT_TRUE(host.waitUntil([&] {
-    return !host.framesOf(protocol::base::kFrames).empty() &&
-           host.framesOf(protocol::body::kTelemetryFrames).size() >= 3;
+    return !host.framesOf(devices::base::kFrames).empty() &&
+           host.framesOf(devices::body::kTelemetryFrames).size() >= 3;
   }));
-  EXPECT_EQ(host.framesOf(protocol::base::kFrames).at(0)[4], 0x02);  // the battery reply
+  EXPECT_EQ(host.framesOf(devices::base::kFrames).at(0)[4], 0x02);  // the battery reply
 }
 
 TEST(RobotSim, DevicesWithTheirOwnLinksGetTheirOwnPtys) {
@@ -54,15 +54,16 @@ TEST(RobotSim, DevicesWithTheirOwnLinksGetTheirOwnPtys) {
   ASSERT_TRUE(base_host.ok());
   base_host.send(kSyncWrite2And3);  // the board is not on this port
   base_host.send(kResetSeq2);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return baseStats(s).resets == 1; }));
+  ASSERT_TRUE(waitForStats(
+      sim, [](const SimStats& s) { return devices::base::sim::baseStats(s).resets == 1; }));
   const SimStats stats = sim.stats();
   EXPECT_EQ(stats.frames_for_absent_device, 1u);
-  EXPECT_EQ(bodyStats(stats).sync_writes_ok, 0u);
+  EXPECT_EQ(devices::body::sim::bodyStats(stats).sync_writes_ok, 0u);
 }
 
 TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
   SimOptions options = onlyBody();
-  bodyConfig(options).telemetry_rate_hz = 200;
+  devices::body::sim::bodyConfig(options).telemetry_rate_hz = 200;
   options.faults.seed = 7;
   options.faults.corrupt_rate = 0.2;
   options.faults.drop_rate = 0.2;
@@ -71,25 +72,26 @@ TEST(RobotSim, IntactFramesReceivedMatchTheSendCountersUnderFaults) {
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
   ASSERT_TRUE(host.ok());
-  host.waitUntil([&] { return host.framesOf(protocol::body::kTelemetryFrames).size() >= 100; });
+  host.waitUntil([&] { return host.framesOf(devices::body::kTelemetryFrames).size() >= 100; });
   sim.stop();  // the pty stays open: drain everything that was sent
   for (int i = 0; i < 10; ++i) host.pump(20);
   host.feedPadding();
   const SimStats stats = sim.stats();
-  const SendCounters& telemetry = stats.sentOf(kTelemetryOutput);
+  const SendCounters& telemetry = stats.sentOf(devices::body::sim::kTelemetryOutput);
   EXPECT_GT(telemetry.damaged, 0u);
   EXPECT_GT(stats.garbage_bursts, 0u);
-  EXPECT_EQ(host.framesOf(protocol::body::kTelemetryFrames).size(), telemetry.intact);
+  EXPECT_EQ(host.framesOf(devices::body::kTelemetryFrames).size(), telemetry.intact);
   EXPECT_EQ(telemetry.intact + telemetry.damaged + telemetry.discarded,
-            bodyStats(stats).telemetry_generated);
+            devices::body::sim::bodyStats(stats).telemetry_generated);
 }
 
 // --pace-baud bounds can only be checked from one side without timing assertions: a paced line is
 // never faster than its baud rate, however slow or busy the machine is.
 TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
   SimOptions options = onlyBody();
-  bodyConfig(options).telemetry_rate_hz = 200;  // several times what 9600 baud carries
-  options.pace_baud = 9600;              // 960 bytes/s
+  devices::body::sim::bodyConfig(options).telemetry_rate_hz =
+      200;                   // several times what 9600 baud carries
+  options.pace_baud = 9600;  // 960 bytes/s
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), bodyHostConfig(2));
@@ -107,14 +109,14 @@ TEST(RobotSim, PacedPortSendsNoFasterThanItsBaudRate) {
   EXPECT_LE(static_cast<double>(received - std::min(received, held_at_start)),
             960.0 * elapsed_s + 16.0);
   EXPECT_FALSE(
-      host.framesOf(protocol::body::kTelemetryFrames).empty());  // cut into slices, not damaged
+      host.framesOf(devices::body::kTelemetryFrames).empty());  // cut into slices, not damaged
   EXPECT_EQ(host.framerStats().checksum_errors, 0u);
 }
 
 TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
   SimOptions options = onlyBody();
-  bodyConfig(options).servo_ids = {2, 3};
-  bodyConfig(options).telemetry_rate_hz = 0;
+  devices::body::sim::bodyConfig(options).servo_ids = {2, 3};
+  devices::body::sim::bodyConfig(options).telemetry_rate_hz = 0;
   options.pace_baud = 9600;
   RobotSim sim(options);
   sim.start();
@@ -124,7 +126,8 @@ TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
   const auto start = Clock::now();
   for (int i = 0; i < kFrames; ++i) host.send(kSyncWrite2And3);
   ASSERT_TRUE(waitForStats(
-      sim, [](const SimStats& s) { return bodyStats(s).sync_writes_ok == kFrames; },
+      sim,
+      [](const SimStats& s) { return devices::body::sim::bodyStats(s).sync_writes_ok == kFrames; },
       milliseconds(10000)));
   const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
   // The last frame reached the board only once all its bits were through the line.
@@ -138,7 +141,7 @@ TEST(RobotSim, PacedPortTakesBytesInNoFasterThanItsBaudRate) {
 TEST(RobotSim, PacedServoAnswersAfterTheRequestTheLatencyAndTheAnswerOnTheLine) {
   SimOptions options = onlyServoBus();
   options.pace_baud = 9600;
-  servoBusConfig(options).answer_latency_s = 0.005;
+  devices::servo_bus::sim::servoBusConfig(options).answer_latency_s = 0.005;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), servoHostConfig());
@@ -156,16 +159,18 @@ TEST(RobotSim, PacedServoAnswersAfterTheRequestTheLatencyAndTheAnswerOnTheLine) 
 
 TEST(RobotSim, ServoFaultsGarbleOrSuppressAnswers) {
   SimOptions options = onlyServoBus();
-  servoBusConfig(options).answer_fault_rate = 1.0;
+  devices::servo_bus::sim::servoBusConfig(options).answer_fault_rate = 1.0;
   RobotSim sim(options);
   sim.start();
   Host host(slaveOf(sim), servoHostConfig());
   ASSERT_TRUE(host.ok());
   for (int i = 0; i < 20; ++i) host.send(kPing3);
-  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) { return servoBusStats(s).answers == 20; }));
+  ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) {
+    return devices::servo_bus::sim::servoBusStats(s).answers == 20;
+  }));
   for (int i = 0; i < 5; ++i) host.pump(20);
   host.feedPadding();
-  const SendCounters answers = sim.stats().sentOf(kServoAnswerOutput);
+  const SendCounters answers = sim.stats().sentOf(devices::servo_bus::sim::kServoAnswerOutput);
   EXPECT_EQ(answers.intact, 0u);
   EXPECT_GT(answers.suppressed, 0u);
   EXPECT_GT(answers.damaged, 0u);
@@ -215,7 +220,8 @@ TEST(RobotSim, StatsFileHasKeyValueLines) {
     ASSERT_TRUE(host.ok());
     host.send(kResetSeq2);
     ASSERT_TRUE(waitForStats(sim, [](const SimStats& s) {
-      return baseStats(s).resets == 1 && bodyStats(s).telemetry_generated > 2;
+      return devices::base::sim::baseStats(s).resets == 1 &&
+             devices::body::sim::bodyStats(s).telemetry_generated > 2;
     }));
   }
   sim.stop();

@@ -7,14 +7,14 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/e_stop_status.h"
-#include "serial_robot_driver/device/link_status.h"
-#include "serial_robot_driver/device/status_report.h"
-#include "serial_robot_driver/device/wire_capture_status.h"
+#include "serial_robot_driver/core/e_stop_status.h"
+#include "serial_robot_driver/core/link_status.h"
+#include "serial_robot_driver/core/status_report.h"
+#include "serial_robot_driver/core/wire_capture_status.h"
 
 namespace {
 
-using namespace serial_robot_driver::device;
+using namespace serial_robot_driver::core;
 using Values = std::vector<std::pair<std::string, std::string>>;
 
 TEST(StatusReport, MergeNamesEveryProblemAndKeepsTheWorstLevel) {

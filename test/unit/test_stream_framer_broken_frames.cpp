@@ -25,9 +25,9 @@ class StreamFramerBroken : public ::testing::TestWithParam<BrokenCase> {};
 
 TEST_P(StreamFramerBroken, CountedSkippedAndTheNextFrameStillComesThrough) {
   const BrokenCase& c = GetParam();
-  for (const Frame& good : {Frame{protocol::servo::kResponseFrames, kServoPingReply},
-                            Frame{protocol::base::kFrames, kBaseBatteryReply},
-                            Frame{protocol::body::kSyncWriteFrames, kSyncWrite}}) {
+  for (const Frame& good : {Frame{devices::servo_bus::kResponseFrames, kServoPingReply},
+                            Frame{devices::base::kFrames, kBaseBatteryReply},
+                            Frame{devices::body::kSyncWriteFrames, kSyncWrite}}) {
     SCOPED_TRACE(good.family.name);
     RecordingFramer framer(allFamilies());
     framer.feed(concat({c.broken, good.bytes}));
@@ -149,9 +149,9 @@ TEST_P(StreamFramerTruncated, FollowingFramesStillComeThrough) {
   RecordingFramer framer(allFamilies());
   framer.feedInRandomChunks(concat({truncated, followers, kTelemetry}), &rng, 16);
   ASSERT_EQ(framer.frames().size(), 7u);
-  EXPECT_EQ(framer.frames()[0], (Frame{protocol::servo::kResponseFrames, kServoPingReply}));
-  EXPECT_EQ(framer.frames()[5], (Frame{protocol::base::kFrames, kBaseBatteryReply}));
-  EXPECT_EQ(framer.frames()[6], (Frame{protocol::body::kTelemetryFrames, kTelemetry}));
+  EXPECT_EQ(framer.frames()[0], (Frame{devices::servo_bus::kResponseFrames, kServoPingReply}));
+  EXPECT_EQ(framer.frames()[5], (Frame{devices::base::kFrames, kBaseBatteryReply}));
+  EXPECT_EQ(framer.frames()[6], (Frame{devices::body::kTelemetryFrames, kTelemetry}));
   EXPECT_EQ(framer.stats().bytes_skipped, truncated.size());
   // The truncated candidate failed exactly once (which check fails depends on the bytes after it).
   EXPECT_EQ(errorCount(framer.stats()), 1u);

@@ -33,10 +33,10 @@ TEST(StreamFramerState, ResetDropsThePartialFrame) {
   EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size());
   framer.feed(kServoPing);
   ASSERT_EQ(framer.frames().size(), 1u);
-  EXPECT_EQ(framer.frames()[0], (Frame{protocol::servo::kRequestFrames, kServoPing}));
+  EXPECT_EQ(framer.frames()[0], (Frame{devices::servo_bus::kRequestFrames, kServoPing}));
   // Statistics survive a reset: they describe the port, not the buffer.
   EXPECT_EQ(framer.stats().bytes_in, kTelemetry.size() + kServoPing.size());
-  EXPECT_EQ(frameCount(framer.stats(), protocol::servo::kRequestFrames), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), devices::servo_bus::kRequestFrames), 1u);
   expectBytesAccountedFor(framer, 0);
 }
 
@@ -65,7 +65,7 @@ TEST(StreamFramerStale, AStrayHeaderWithALongLenStopsHoldingBackTheAnswerBehindI
   }
   ASSERT_EQ(framer.frames().size(), 1u);
   EXPECT_EQ(framer.frames()[0],
-            (Frame{protocol::servo::kResponseFrames, golden::servo::kPing3Reply}));
+            (Frame{devices::servo_bus::kResponseFrames, golden::servo::kPing3Reply}));
   EXPECT_EQ(framer.framer().buffered(), 0u);
   EXPECT_EQ(framer.stats().stale_candidates, 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, 4u);

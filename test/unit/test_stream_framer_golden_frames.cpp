@@ -13,42 +13,43 @@ using namespace stream_framer_test;  // NOLINT: the shared fixture
 // --- small pieces ------------------------------------------------------------------------------
 
 TEST(StreamFramerConfig, EveryFamilyHasItsName) {
-  EXPECT_STREQ(protocol::base::kFrames.name, "base");
-  EXPECT_STREQ(protocol::body::kTelemetryFrames.name, "telemetry");
-  EXPECT_STREQ(protocol::servo::kResponseFrames.name, "servo_response");
-  EXPECT_STREQ(protocol::servo::kRequestFrames.name, "servo_request");
-  EXPECT_STREQ(protocol::body::kSyncWriteFrames.name, "sync_write");
+  EXPECT_STREQ(devices::base::kFrames.name, "base");
+  EXPECT_STREQ(devices::body::kTelemetryFrames.name, "telemetry");
+  EXPECT_STREQ(devices::servo_bus::kResponseFrames.name, "servo_response");
+  EXPECT_STREQ(devices::servo_bus::kRequestFrames.name, "servo_request");
+  EXPECT_STREQ(devices::body::kSyncWriteFrames.name, "sync_write");
 }
 
 TEST(StreamFramerConfig, ForDriverEnablesWhatTheDevicesSend) {
   const FramerConfig all = test_support::driverFramer({"base", "body", "servo_bus"}, 7);
-  EXPECT_TRUE(all.accepts(base::kFrames));
-  EXPECT_TRUE(all.accepts(body::kTelemetryFrames));
-  EXPECT_TRUE(all.accepts(servo::kResponseFrames));
-  EXPECT_TRUE(all.accepts(servo::kRequestFrames));  // the half-duplex echo of our own requests
-  EXPECT_FALSE(all.accepts(body::kSyncWriteFrames));
-  EXPECT_EQ(all.expectedOf(body::kTelemetryFrames), 7u);
+  EXPECT_TRUE(all.accepts(devices::base::kFrames));
+  EXPECT_TRUE(all.accepts(devices::body::kTelemetryFrames));
+  EXPECT_TRUE(all.accepts(devices::servo_bus::kResponseFrames));
+  EXPECT_TRUE(
+      all.accepts(devices::servo_bus::kRequestFrames));  // the half-duplex echo of our own requests
+  EXPECT_FALSE(all.accepts(devices::body::kSyncWriteFrames));
+  EXPECT_EQ(all.expectedOf(devices::body::kTelemetryFrames), 7u);
 
   const FramerConfig body_only = test_support::driverFramer({"body"}, 2);
-  EXPECT_FALSE(body_only.accepts(base::kFrames));
-  EXPECT_TRUE(body_only.accepts(body::kTelemetryFrames));
-  EXPECT_FALSE(body_only.accepts(servo::kResponseFrames));
-  EXPECT_FALSE(body_only.accepts(servo::kRequestFrames));
+  EXPECT_FALSE(body_only.accepts(devices::base::kFrames));
+  EXPECT_TRUE(body_only.accepts(devices::body::kTelemetryFrames));
+  EXPECT_FALSE(body_only.accepts(devices::servo_bus::kResponseFrames));
+  EXPECT_FALSE(body_only.accepts(devices::servo_bus::kRequestFrames));
 
   const FramerConfig bus_only = test_support::driverFramer({"servo_bus"});
-  EXPECT_FALSE(bus_only.accepts(base::kFrames));
-  EXPECT_FALSE(bus_only.accepts(body::kTelemetryFrames));
-  EXPECT_TRUE(bus_only.accepts(servo::kResponseFrames));
-  EXPECT_TRUE(bus_only.accepts(servo::kRequestFrames));
+  EXPECT_FALSE(bus_only.accepts(devices::base::kFrames));
+  EXPECT_FALSE(bus_only.accepts(devices::body::kTelemetryFrames));
+  EXPECT_TRUE(bus_only.accepts(devices::servo_bus::kResponseFrames));
+  EXPECT_TRUE(bus_only.accepts(devices::servo_bus::kRequestFrames));
 }
 
 TEST(StreamFramerConfig, ForSimulatorEnablesWhatTheHostSends) {
   const FramerConfig config = test_support::simulatorFramer();
-  EXPECT_TRUE(config.accepts(base::kFrames));
-  EXPECT_FALSE(config.accepts(body::kTelemetryFrames));
-  EXPECT_FALSE(config.accepts(servo::kResponseFrames));
-  EXPECT_TRUE(config.accepts(servo::kRequestFrames));
-  EXPECT_TRUE(config.accepts(body::kSyncWriteFrames));
+  EXPECT_TRUE(config.accepts(devices::base::kFrames));
+  EXPECT_FALSE(config.accepts(devices::body::kTelemetryFrames));
+  EXPECT_FALSE(config.accepts(devices::servo_bus::kResponseFrames));
+  EXPECT_TRUE(config.accepts(devices::servo_bus::kRequestFrames));
+  EXPECT_TRUE(config.accepts(devices::body::kSyncWriteFrames));
 }
 
 // --- every golden frame, alone
@@ -110,31 +111,32 @@ TEST_P(StreamFramerGolden, IgnoredWhenItsFamilyIsDisabled) {
 INSTANTIATE_TEST_SUITE_P(
     StreamFramerVectors, StreamFramerGolden,
     ::testing::Values(
-        GoldenCase{"BaseReset", kBaseReset, protocol::base::kFrames},
-        GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, protocol::base::kFrames},
-        GoldenCase{"BaseClearEncoders", kBaseClearEncoders, protocol::base::kFrames},
-        GoldenCase{"BaseLeft4", kBaseLeft4, protocol::base::kFrames},
-        GoldenCase{"BaseRight4", kBaseRight4, protocol::base::kFrames},
-        GoldenCase{"BaseBoth4", kBaseBoth4, protocol::base::kFrames},
-        GoldenCase{"BaseBothMinus6", kBaseBothMinus6, protocol::base::kFrames},
-        GoldenCase{"BaseBatteryReply", kBaseBatteryReply, protocol::base::kFrames},
-        GoldenCase{"BaseErrorStatus", kBaseErrorStatus, protocol::base::kFrames},
-        GoldenCase{"BaseLen1", kBaseLen1, protocol::base::kFrames},
-        GoldenCase{"Telemetry", kTelemetry, protocol::body::kTelemetryFrames},
-        GoldenCase{"TelemetryFoot", kTelemetryFoot, protocol::body::kTelemetryFrames},
-        GoldenCase{"SyncWrite", kSyncWrite, protocol::body::kSyncWriteFrames},
-        GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, protocol::body::kSyncWriteFrames},
-        GoldenCase{"ServoPing", kServoPing, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoRotate", kServoRotate, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoReadAngle", kServoReadAngle, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoSpinCcw", kServoSpinCcw, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoSpinStop", kServoSpinStop, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoSpinTurns", kServoSpinTurns, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoSpinMs", kServoSpinMs, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoDamping", kServoDamping, protocol::servo::kRequestFrames},
-        GoldenCase{"ServoPingReply", kServoPingReply, protocol::servo::kResponseFrames},
-        GoldenCase{"ServoReadAngleReply", kServoReadAngleReply, protocol::servo::kResponseFrames},
-        GoldenCase{"ServoEmptyReply", kServoEmptyReply, protocol::servo::kResponseFrames}),
+        GoldenCase{"BaseReset", kBaseReset, devices::base::kFrames},
+        GoldenCase{"BaseBatteryRequest", kBaseBatteryRequest, devices::base::kFrames},
+        GoldenCase{"BaseClearEncoders", kBaseClearEncoders, devices::base::kFrames},
+        GoldenCase{"BaseLeft4", kBaseLeft4, devices::base::kFrames},
+        GoldenCase{"BaseRight4", kBaseRight4, devices::base::kFrames},
+        GoldenCase{"BaseBoth4", kBaseBoth4, devices::base::kFrames},
+        GoldenCase{"BaseBothMinus6", kBaseBothMinus6, devices::base::kFrames},
+        GoldenCase{"BaseBatteryReply", kBaseBatteryReply, devices::base::kFrames},
+        GoldenCase{"BaseErrorStatus", kBaseErrorStatus, devices::base::kFrames},
+        GoldenCase{"BaseLen1", kBaseLen1, devices::base::kFrames},
+        GoldenCase{"Telemetry", kTelemetry, devices::body::kTelemetryFrames},
+        GoldenCase{"TelemetryFoot", kTelemetryFoot, devices::body::kTelemetryFrames},
+        GoldenCase{"SyncWrite", kSyncWrite, devices::body::kSyncWriteFrames},
+        GoldenCase{"SyncWriteEmpty", kSyncWriteEmpty, devices::body::kSyncWriteFrames},
+        GoldenCase{"ServoPing", kServoPing, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoRotate", kServoRotate, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoReadAngle", kServoReadAngle, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoSpinCcw", kServoSpinCcw, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoSpinStop", kServoSpinStop, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoSpinTurns", kServoSpinTurns, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoSpinMs", kServoSpinMs, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoDamping", kServoDamping, devices::servo_bus::kRequestFrames},
+        GoldenCase{"ServoPingReply", kServoPingReply, devices::servo_bus::kResponseFrames},
+        GoldenCase{"ServoReadAngleReply", kServoReadAngleReply,
+                   devices::servo_bus::kResponseFrames},
+        GoldenCase{"ServoEmptyReply", kServoEmptyReply, devices::servo_bus::kResponseFrames}),
     [](const ::testing::TestParamInfo<GoldenCase>& info) { return info.param.name; });
 
 }  // namespace

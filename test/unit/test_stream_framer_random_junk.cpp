@@ -18,16 +18,16 @@ void expectDecoderAccepts(const Frame& frame) {
   const auto expectOk = [](const auto& decoded) {
     EXPECT_TRUE(decoded.ok()) << toString(decoded.error());
   };
-  if (frame.family == base::kFrames) {
-    expectOk(base::decodeFrame(data, size));
-  } else if (frame.family == body::kTelemetryFrames) {
-    expectOk(body::decodeTelemetry(data, size, kServoCount));
-  } else if (frame.family == servo::kResponseFrames) {
-    expectOk(servo::decodeResponse(data, size));
-  } else if (frame.family == servo::kRequestFrames) {
-    expectOk(servo::decodeRequest(data, size));
-  } else if (frame.family == body::kSyncWriteFrames) {
-    expectOk(body::decodeSyncWrite(data, size));
+  if (frame.family == devices::base::kFrames) {
+    expectOk(devices::base::decodeFrame(data, size));
+  } else if (frame.family == devices::body::kTelemetryFrames) {
+    expectOk(devices::body::decodeTelemetry(data, size, kServoCount));
+  } else if (frame.family == devices::servo_bus::kResponseFrames) {
+    expectOk(devices::servo_bus::decodeResponse(data, size));
+  } else if (frame.family == devices::servo_bus::kRequestFrames) {
+    expectOk(devices::servo_bus::decodeRequest(data, size));
+  } else if (frame.family == devices::body::kSyncWriteFrames) {
+    expectOk(devices::body::decodeSyncWrite(data, size));
   } else {
     ADD_FAILURE() << "a frame of family " << frame.family.name;
   }

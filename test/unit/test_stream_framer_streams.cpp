@@ -16,21 +16,21 @@ TEST(StreamFramerStream, BackToBackFramesAllComeOutInOrder) {
                                kTelemetry, kSyncWrite, kServoDamping, kBaseLen1});
   RecordingFramer framer(allFamilies());
   framer.feed(stream);
-  const std::vector<Frame> expected = {{protocol::base::kFrames, kBaseReset},
-                                       {protocol::base::kFrames, kBaseBoth4},
-                                       {protocol::servo::kRequestFrames, kServoPing},
-                                       {protocol::servo::kResponseFrames, kServoPingReply},
-                                       {protocol::body::kTelemetryFrames, kTelemetry},
-                                       {protocol::body::kTelemetryFrames, kTelemetry},
-                                       {protocol::body::kSyncWriteFrames, kSyncWrite},
-                                       {protocol::servo::kRequestFrames, kServoDamping},
-                                       {protocol::base::kFrames, kBaseLen1}};
+  const std::vector<Frame> expected = {{devices::base::kFrames, kBaseReset},
+                                       {devices::base::kFrames, kBaseBoth4},
+                                       {devices::servo_bus::kRequestFrames, kServoPing},
+                                       {devices::servo_bus::kResponseFrames, kServoPingReply},
+                                       {devices::body::kTelemetryFrames, kTelemetry},
+                                       {devices::body::kTelemetryFrames, kTelemetry},
+                                       {devices::body::kSyncWriteFrames, kSyncWrite},
+                                       {devices::servo_bus::kRequestFrames, kServoDamping},
+                                       {devices::base::kFrames, kBaseLen1}};
   EXPECT_EQ(framer.frames(), expected);
-  EXPECT_EQ(frameCount(framer.stats(), protocol::base::kFrames), 3u);
-  EXPECT_EQ(frameCount(framer.stats(), protocol::body::kTelemetryFrames), 2u);
-  EXPECT_EQ(frameCount(framer.stats(), protocol::servo::kRequestFrames), 2u);
-  EXPECT_EQ(frameCount(framer.stats(), protocol::servo::kResponseFrames), 1u);
-  EXPECT_EQ(frameCount(framer.stats(), protocol::body::kSyncWriteFrames), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), devices::base::kFrames), 3u);
+  EXPECT_EQ(frameCount(framer.stats(), devices::body::kTelemetryFrames), 2u);
+  EXPECT_EQ(frameCount(framer.stats(), devices::servo_bus::kRequestFrames), 2u);
+  EXPECT_EQ(frameCount(framer.stats(), devices::servo_bus::kResponseFrames), 1u);
+  EXPECT_EQ(frameCount(framer.stats(), devices::body::kSyncWriteFrames), 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, 0u);
   EXPECT_EQ(errorCount(framer.stats()), 0u);
 }
@@ -63,8 +63,8 @@ TEST(StreamFramerStream, RandomChunkSizesGiveTheSameFrames) {
     EXPECT_EQ(framer.frames(), expected);
     EXPECT_EQ(framer.stats().bytes_skipped, kRepeats * stream.junk);
     EXPECT_EQ(errorCount(framer.stats()), 0u);
-    EXPECT_EQ(frameCount(framer.stats(), protocol::body::kTelemetryFrames), 2u * kRepeats);
-    EXPECT_EQ(frameCount(framer.stats(), protocol::body::kSyncWriteFrames), 1u * kRepeats);
+    EXPECT_EQ(frameCount(framer.stats(), devices::body::kTelemetryFrames), 2u * kRepeats);
+    EXPECT_EQ(frameCount(framer.stats(), devices::body::kSyncWriteFrames), 1u * kRepeats);
     EXPECT_EQ(framer.framer().buffered(), 0u);
   }
 }
@@ -84,7 +84,7 @@ TEST(StreamFramerStream, ChunkLargerThanTheBuffer) {
   EXPECT_EQ(framer.framer().buffered(), 10u);
   framer.feed(Bytes(kTelemetry.begin() + 10, kTelemetry.end()));
   ASSERT_EQ(framer.frames().size(), frames + 1);
-  EXPECT_EQ(framer.frames().back(), (Frame{protocol::body::kTelemetryFrames, kTelemetry}));
+  EXPECT_EQ(framer.frames().back(), (Frame{devices::body::kTelemetryFrames, kTelemetry}));
   EXPECT_EQ(framer.stats().bytes_skipped, 0u);
   EXPECT_EQ(framer.framer().buffered(), 0u);
 }
@@ -94,8 +94,8 @@ TEST(StreamFramerStream, JunkWithLoneHeaderBytesIsSkipped) {
   const Bytes junk = {0x55, 0x55, 0x12, 0x12, 0x05, 0xFF, 0xFE, 0x12, 0x00, 0xFF, 0xFF, 0x00};
   RecordingFramer framer(allFamilies());
   framer.feed(concat({junk, kServoPingReply, junk, kBaseReset, junk}));
-  const std::vector<Frame> expected = {{protocol::servo::kResponseFrames, kServoPingReply},
-                                       {protocol::base::kFrames, kBaseReset}};
+  const std::vector<Frame> expected = {{devices::servo_bus::kResponseFrames, kServoPingReply},
+                                       {devices::base::kFrames, kBaseReset}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, 3 * junk.size());
   EXPECT_EQ(errorCount(framer.stats()), 0u);
@@ -106,7 +106,7 @@ TEST(StreamFramerStream, DynamixelFrameThatIsNotASyncWriteIsSkipped) {
   FramerConfig config = test_support::simulatorFramer();
   RecordingFramer framer(config);
   framer.feed(concat({kDynamixelPing, kSyncWrite}));
-  const std::vector<Frame> expected = {{protocol::body::kSyncWriteFrames, kSyncWrite}};
+  const std::vector<Frame> expected = {{devices::body::kSyncWriteFrames, kSyncWrite}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, kDynamixelPing.size());
   EXPECT_EQ(errorCount(framer.stats()), 0u);
@@ -114,19 +114,18 @@ TEST(StreamFramerStream, DynamixelFrameThatIsNotASyncWriteIsSkipped) {
 
 TEST(StreamFramerStream, TelemetryAndServoRequestShareTheirFirstByte) {
   FramerConfig requests_only;
-  requests_only.accept(servo::kRequestFrames);
+  requests_only.accept(devices::servo_bus::kRequestFrames);
   RecordingFramer framer(requests_only);
   framer.feed(concat({kTelemetry, kServoPing, kTelemetryFoot, kServoRotate}));
-  const std::vector<Frame> expected = {{protocol::servo::kRequestFrames, kServoPing},
-                                       {protocol::servo::kRequestFrames, kServoRotate}};
+  const std::vector<Frame> expected = {{devices::servo_bus::kRequestFrames, kServoPing},
+                                       {devices::servo_bus::kRequestFrames, kServoRotate}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().bytes_skipped, kTelemetry.size() + kTelemetryFoot.size());
 
   RecordingFramer telemetry_only(test_support::driverFramer({"body"}, kServoCount));
   telemetry_only.feed(concat({kServoPing, kTelemetry, kServoRotate, kTelemetryFoot}));
-  const std::vector<Frame> expected_telemetry = {
-      {protocol::body::kTelemetryFrames, kTelemetry},
-      {protocol::body::kTelemetryFrames, kTelemetryFoot}};
+  const std::vector<Frame> expected_telemetry = {{devices::body::kTelemetryFrames, kTelemetry},
+                                                 {devices::body::kTelemetryFrames, kTelemetryFoot}};
   EXPECT_EQ(telemetry_only.frames(), expected_telemetry);
   EXPECT_EQ(telemetry_only.stats().bytes_skipped, kServoPing.size() + kServoRotate.size());
 }
@@ -152,8 +151,8 @@ TEST(StreamFramerStream, RealFrameHiddenInsideABrokenOneIsFound) {
   const Bytes broken_header = {0x55, 0xAA, 0x09};
   RecordingFramer framer(allFamilies());
   framer.feed(concat({broken_header, kServoPingReply, kBaseReset}));
-  const std::vector<Frame> expected = {{protocol::servo::kResponseFrames, kServoPingReply},
-                                       {protocol::base::kFrames, kBaseReset}};
+  const std::vector<Frame> expected = {{devices::servo_bus::kResponseFrames, kServoPingReply},
+                                       {devices::base::kFrames, kBaseReset}};
   EXPECT_EQ(framer.frames(), expected);
   EXPECT_EQ(framer.stats().checksum_errors, 1u);
   EXPECT_EQ(framer.stats().bytes_skipped, broken_header.size());

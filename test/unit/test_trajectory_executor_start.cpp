@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/core/e_stop.h"
 #include "serial_robot_driver/trajectory/executor.h"
 #include "support/trajectory_executor_rig.h"
 
@@ -90,7 +90,7 @@ TEST_F(ExecutorRig, ALateStampBridgesInTheCommandsOwnTimeNeverInAJump) {
 }
 
 TEST_F(ExecutorRig, EStopAbortsHoldsAndRefuses) {
-  device::EStop e_stop;
+  core::EStop e_stop;
   executor.attachEStop(e_stop);
   measure({"arm_1"}, {0.0});
   GoalLog log;
@@ -128,7 +128,7 @@ TEST_F(ExecutorRig, EStopAbortsHoldsAndRefuses) {
 // its start, accepted before an e-stop that was engaged and released between two ticks never
 // moves a joint after the release; the goal is aborted, saying why.
 TEST_F(ExecutorRig, TrajectoriesAcceptedBeforeAnEStopNeverMoveAfterItsRelease) {
-  device::EStop e_stop;
+  core::EStop e_stop;
   executor.attachEStop(e_stop);
   // As the node's body: its gate starts a new generation after the trajectories stopped.
   e_stop.addListener([this](bool engaged) { body_generation += engaged ? 1 : 0; });

@@ -17,6 +17,10 @@
 namespace serial_robot_driver::trajectory {
 namespace {
 
+using devices::body::bodyTrajectoryJoints;
+using devices::servo_bus::busStateTimeout;
+using devices::servo_bus::busTrajectoryJoints;
+
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 
 TEST(TrajectoryStop, StreamedJointHoldsWhatTheServerLastWrote) {
@@ -36,12 +40,12 @@ TEST(TrajectoryStop, NeverCommandedHoldsAFreshMeasurementElseNothing) {
 }
 
 TEST(TrajectoryStop, BodyReportsItsLastCommandedPosition) {
-  device::JointCalibration reversed;
+  devices::body::JointCalibration reversed;
   reversed.zero_ticks = 1000;
   reversed.direction = -1;
-  std::vector<device::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, reversed}};
+  std::vector<devices::body::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, reversed}};
   int frames = 0;
-  device::BodyController controller(joints, [&](const std::vector<uint8_t>&) {
+  devices::body::BodyController controller(joints, [&](const std::vector<uint8_t>&) {
     ++frames;
     return true;
   });
@@ -62,8 +66,9 @@ TEST(TrajectoryStop, BodyReportsItsLastCommandedPosition) {
 }
 
 TEST(TrajectoryStop, BodyJointsOfferTheLastCommandToTheServer) {
-  std::vector<device::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, {}}};
-  device::BodyController controller(joints, [](const std::vector<uint8_t>&) { return true; });
+  std::vector<devices::body::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, {}}};
+  devices::body::BodyController controller(joints,
+                                           [](const std::vector<uint8_t>&) { return true; });
   const TrajectoryJoints group = bodyTrajectoryJoints(controller);
   ASSERT_TRUE(group.last_commanded);
   EXPECT_FALSE(group.stop);
@@ -77,9 +82,9 @@ TEST(TrajectoryStop, BodyJointsOfferTheLastCommandToTheServer) {
 
 // A body frame carries the e-stop generation its trajectory was accepted under, to the gate.
 TEST(TrajectoryStop, BodyJointsWriteThroughTheGateWithTheAcceptedGeneration) {
-  std::vector<device::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, {}}};
+  std::vector<devices::body::BodyJoint> joints = {{"joint_1", 1, {}}, {"joint_2", 2, {}}};
   int frames = 0;
-  device::BodyController controller(joints, [&frames](const std::vector<uint8_t>&) {
+  devices::body::BodyController controller(joints, [&frames](const std::vector<uint8_t>&) {
     ++frames;
     return true;
   });

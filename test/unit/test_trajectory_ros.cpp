@@ -8,13 +8,13 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
-#include "serial_robot_driver/ros/trajectory_server.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
+#include "serial_robot_driver/ros/trajectory_server.h"
 
 namespace serial_robot_driver::ros_layer {
 namespace {
 
-using params::ServoBusParams;
+using devices::servo_bus::ServoBusParams;
 
 TEST(TrajectoryRos, CommandFromMessageKeepsEveryField) {
   trajectory_msgs::JointTrajectory msg;
@@ -35,7 +35,7 @@ TEST(TrajectoryRos, BusJointsFromParametersWithDefaults) {
   ServoBusParams params;
   params.joint_ids = {5, 9};
   params.joint_names = {"pan", "tilt"};
-  std::vector<trajectory::BusJoint> joints = makeBusJoints(params);
+  std::vector<trajectory::BusJoint> joints = devices::servo_bus::makeBusJoints(params);
   ASSERT_EQ(joints.size(), 2u);
   EXPECT_EQ(joints[1].id, 9);
   EXPECT_EQ(joints[1].name, "tilt");
@@ -43,7 +43,7 @@ TEST(TrajectoryRos, BusJointsFromParametersWithDefaults) {
   EXPECT_EQ(joints[1].direction, 1);
   params.joint_zero_deg = {10.0, -20.0};
   params.joint_directions = {1, -1};
-  joints = makeBusJoints(params);
+  joints = devices::servo_bus::makeBusJoints(params);
   EXPECT_EQ(joints[1].zero_deg, -20.0);
   EXPECT_EQ(joints[1].direction, -1);
 }
@@ -51,12 +51,13 @@ TEST(TrajectoryRos, BusJointsFromParametersWithDefaults) {
 TEST(TrajectoryRos, PolledAngleBecomesTheJointsPosition) {
   const std::vector<trajectory::BusJoint> joints = {{9, "tilt", -20.0, -1}};
   // tilt = -(70 - (-20)) deg = -90 deg.
-  sensor_msgs::JointState state = busJointState(joints, 9, 70.0, ros::Time(3.0));
+  sensor_msgs::JointState state =
+      devices::servo_bus::ros::busJointState(joints, 9, 70.0, ros::Time(3.0));
   ASSERT_EQ(state.name.size(), 1u);
   EXPECT_EQ(state.name[0], "tilt");
   EXPECT_NEAR(state.position[0], -M_PI / 2, 1e-12);
   EXPECT_EQ(state.header.stamp, ros::Time(3.0));
-  state = busJointState(joints, 4, 90.0, ros::Time(3.0));
+  state = devices::servo_bus::ros::busJointState(joints, 4, 90.0, ros::Time(3.0));
   EXPECT_EQ(state.name[0], "servo_4");
   EXPECT_NEAR(state.position[0], M_PI / 2, 1e-12);
 }

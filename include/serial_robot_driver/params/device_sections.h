@@ -12,7 +12,7 @@
 #include <type_traits>
 #include <typeinfo>
 
-#include "serial_robot_driver/device/typed_value.h"
+#include "serial_robot_driver/core/typed_value.h"
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
@@ -24,20 +24,20 @@ class AnySectionKey {
  public:
   /// The section's parameter prefix ("base", "imu"): also its name in DeviceSections.
   const char* name() const { return name_; }
-  device::TypedValue makeDefaults() const { return make_defaults_(); }
+  core::TypedValue makeDefaults() const { return make_defaults_(); }
   /// The port parameters inside `section` (a value of this key's type) when its struct has
   /// them (a device's own section), else null.
-  DevicePortParams* portParams(device::TypedValue& section) const { return port_params_(section); }
+  DevicePortParams* portParams(core::TypedValue& section) const { return port_params_(section); }
 
  protected:
-  constexpr AnySectionKey(const char* name, device::TypedValue (*make_defaults)(),
-                          DevicePortParams* (*port_params)(device::TypedValue&))
+  constexpr AnySectionKey(const char* name, core::TypedValue (*make_defaults)(),
+                          DevicePortParams* (*port_params)(core::TypedValue&))
       : name_(name), make_defaults_(make_defaults), port_params_(port_params) {}
 
  private:
   const char* name_;
-  device::TypedValue (*make_defaults_)();
-  DevicePortParams* (*port_params_)(device::TypedValue&);
+  core::TypedValue (*make_defaults_)();
+  DevicePortParams* (*port_params_)(core::TypedValue&);
 };
 
 /// The typed key of a section of type `Section`, declared once by the device that owns it.
@@ -48,8 +48,8 @@ class SectionKey final : public AnySectionKey {
       : AnySectionKey(name, &makeSection, &portParamsOf) {}
 
  private:
-  static device::TypedValue makeSection() { return Section{}; }
-  static DevicePortParams* portParamsOf(device::TypedValue& section) {
+  static core::TypedValue makeSection() { return Section{}; }
+  static DevicePortParams* portParamsOf(core::TypedValue& section) {
     if constexpr (std::is_base_of_v<DevicePortParams, Section>) {
       return &section.as<Section>();
     } else {
@@ -81,7 +81,7 @@ class DeviceSections {
  private:
   struct Entry {
     const AnySectionKey* key;
-    device::TypedValue value;  ///< of the key's type
+    core::TypedValue value;  ///< of the key's type
   };
   /// The section called `name`; throws std::logic_error when there is none or it is no `type`.
   Entry& find(const std::string& name, const std::type_info& type);

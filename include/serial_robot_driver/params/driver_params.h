@@ -15,7 +15,7 @@
 #include "serial_robot_driver/trajectory/tolerances.h"
 #include "serial_robot_driver/transport/recorded_stream.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::core {
 struct DeviceModule;
 }
 
@@ -80,14 +80,14 @@ struct DriverParams {
   void validate() const;
 
   /// The port parameters (~<name>/enabled, port, baud) of a registered device.
-  const DevicePortParams& portParams(const device::DeviceModule& device) const;
-  DevicePortParams& portParams(const device::DeviceModule& device);
-  bool enabled(const device::DeviceModule& device) const { return portParams(device).enabled; }
+  const DevicePortParams& portParams(const core::DeviceModule& device) const;
+  DevicePortParams& portParams(const core::DeviceModule& device);
+  bool enabled(const core::DeviceModule& device) const { return portParams(device).enabled; }
   /// Whether the registered device called `name` is enabled (false for an unknown name).
   bool enabled(const std::string& device) const;
   /// The device's own port or baud, or the node-wide one it inherits.
-  std::string portOf(const device::DeviceModule& device) const;
-  int baudOf(const device::DeviceModule& device) const;
+  std::string portOf(const core::DeviceModule& device) const;
+  int baudOf(const core::DeviceModule& device) const;
   /// A topic's publisher queue: `live` frames (a slow subscriber drops old ones), but unbounded
   /// while replaying, where a full-speed replay must not lose what subscribers have not read yet.
   int publisherQueue(int live) const { return replay_bag.empty() ? live : 0; }

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/transport/recorded_stream.h"
 
@@ -49,7 +49,7 @@ class BagReplay {
   explicit BagReplay(const DriverParams& params);
 
   /// Streams for SerialLink: every (re)open of a port reads on where the last one stopped.
-  device::SerialLink::StreamFactory streamFactory() const;
+  core::SerialLink::StreamFactory streamFactory() const;
   /// The recorded pace counts from now (call just before the links start).
   void startClock() { pacing_->restart(); }
   /// The replay's timeline, for the stamps of what the replay publishes (DriverParams).

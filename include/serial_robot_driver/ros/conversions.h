@@ -11,11 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/core/status_report.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
-
 
 /// The ROS time at which a steady_clock event happened: `ros_now` minus how long ago it was
 /// (`steady_now` - `event`). Saturates at ros::Time(0) instead of going negative.
@@ -53,7 +52,7 @@ enum class SummaryWrite {
 };
 /// A core status report as the updater publishes it: its summary, its hardware_id when it has
 /// one, and its values appended in order.
-void writeStatusReport(const device::StatusReport& report,
+void writeStatusReport(const core::StatusReport& report,
                        diagnostic_updater::DiagnosticStatusWrapper& status,
                        SummaryWrite summary = SummaryWrite::kReplace);
 

@@ -3,12 +3,12 @@
 // DiagnosticStatus under the name it was registered under (device/device_module.h).
 #pragma once
 
-#include "serial_robot_driver/device/device.h"
+#include "serial_robot_driver/core/device.h"
 
 namespace serial_robot_driver::ros_layer {
 
 using trajectory::TrajectoryJoints;
 
-class DeviceInterface : public device::Device {};
+class DeviceInterface : public core::Device {};
 
 }  // namespace serial_robot_driver::ros_layer

@@ -38,9 +38,9 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/driver_core.h"
-#include "serial_robot_driver/device/input_refusals.h"
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/driver_core.h"
+#include "serial_robot_driver/core/input_refusals.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -55,7 +55,7 @@ class DriverNode {
   /// `stream_factory` builds each port's stream (default: a termios serial port); benchmarks pass
   /// their own, e.g. a stream that polls.
   DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
-             device::SerialLink::StreamFactory stream_factory = {});
+             core::SerialLink::StreamFactory stream_factory = {});
   ~DriverNode();
 
   /// Opens the ports (in the background: a missing port is waited for), then starts the devices
@@ -69,8 +69,8 @@ class DriverNode {
 
  private:
   /// The ROS side of `module`'s device on `link` (its RosDeviceModule).
-  std::unique_ptr<device::Device> makeDevice(const device::DeviceModule& module,
-                                             device::SerialLink& link);
+  std::unique_ptr<core::Device> makeDevice(const core::DeviceModule& module,
+                                           core::SerialLink& link);
   /// A monitor and a status per port, a status (and its extras) per device.
   void addPortsAndDevices();
   /// follow_joint_trajectory / joint_trajectory when a device offers joints.
@@ -81,7 +81,7 @@ class DriverNode {
 
   ros::NodeHandle nh_;
   DriverParams params_;
-  device::InputRefusals input_refusals_;  // the node's own topic's (e_stop)
+  core::InputRefusals input_refusals_;  // the node's own topic's (e_stop)
   ros::Subscriber e_stop_sub_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
@@ -89,7 +89,7 @@ class DriverNode {
   /// One per port; outlive the ports' reader threads.
   std::vector<std::unique_ptr<PortMonitor>> port_monitors_;
   /// The ports, the devices, their wiring and their order.
-  std::unique_ptr<device::DriverCore> core_;
+  std::unique_ptr<core::DriverCore> core_;
   /// follow_joint_trajectory / joint_trajectory for the core's trajectories; null without joints.
   std::unique_ptr<TrajectoryServer> trajectory_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up

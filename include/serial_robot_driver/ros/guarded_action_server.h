@@ -36,7 +36,7 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
   /// As actionlib::ActionServer(nh, name, goal_cb, cancel_cb, false): start() starts it. Inputs
   /// refused and callback errors are counted in `refusals` under `name`.
   GuardedActionServer(const ros::NodeHandle& nh, const std::string& name,
-                      device::InputRefusals& refusals, boost::function<void(GoalHandle)> goal_cb,
+                      core::InputRefusals& refusals, boost::function<void(GoalHandle)> goal_cb,
                       boost::function<void(GoalHandle)> cancel_cb)
       : Base(goal_cb, cancel_cb, false), node_(nh, name), name_(name), refusals_(refusals) {}
 
@@ -120,7 +120,7 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
 
   ros::NodeHandle node_;
   const std::string name_;
-  device::InputRefusals& refusals_;
+  core::InputRefusals& refusals_;
   ros::Publisher result_pub_, feedback_pub_, status_pub_;
   ros::Subscriber goal_sub_, cancel_sub_;
   ros::Timer status_timer_;

@@ -16,14 +16,14 @@
 #include <type_traits>
 #include <utility>
 
-#include "serial_robot_driver/device/input_refusals.h"
+#include "serial_robot_driver/core/input_refusals.h"
 
 namespace serial_robot_driver::ros_layer {
 
 /// Runs `callback` of `source` (a topic, service or action name). An exception it throws
 /// is logged (ROS_ERROR, at most once a second), counted (counters.failed(source)) and swallowed;
 /// `error` (may be null) gets its text. Returns whether `callback` returned normally.
-bool runGuarded(device::InputRefusals& counters, const std::string& source,
+bool runGuarded(core::InputRefusals& counters, const std::string& source,
                 const std::function<void()>& callback, std::string* error = nullptr);
 
 namespace detail {
@@ -56,7 +56,7 @@ using SubscriberCallback = boost::function<void(const boost::shared_ptr<const Me
 
 /// `callback`, run through runGuarded() as a callback of `source`.
 template <typename Message>
-SubscriberCallback<Message> guardedSubscriber(device::InputRefusals& counters,
+SubscriberCallback<Message> guardedSubscriber(core::InputRefusals& counters,
                                               const std::string& source,
                                               SubscriberCallback<Message> callback) {
   return [&counters, source, callback](const boost::shared_ptr<const Message>& msg) {
@@ -66,7 +66,7 @@ SubscriberCallback<Message> guardedSubscriber(device::InputRefusals& counters,
 
 /// nh.subscribe() of `owner`'s member `callback`, guarded (the topic names the source).
 template <typename Message, typename Owner>
-ros::Subscriber subscribeGuarded(ros::NodeHandle& nh, device::InputRefusals& counters,
+ros::Subscriber subscribeGuarded(ros::NodeHandle& nh, core::InputRefusals& counters,
                                  const std::string& topic, uint32_t queue_size,
                                  void (Owner::*callback)(const boost::shared_ptr<const Message>&),
                                  Owner* owner,
@@ -81,7 +81,7 @@ ros::Subscriber subscribeGuarded(ros::NodeHandle& nh, device::InputRefusals& cou
 /// returns true so the caller reads that message instead of a bare "service call failed".
 template <typename Request, typename Response>
 boost::function<bool(Request&, Response&)> guardedService(
-    device::InputRefusals& counters, const std::string& service,
+    core::InputRefusals& counters, const std::string& service,
     boost::function<bool(Request&, Response&)> serve) {
   return [&counters, service, serve](Request& req, Response& res) {
     bool answered = true;
@@ -97,7 +97,7 @@ boost::function<bool(Request&, Response&)> guardedService(
 
 /// nh.advertiseService() of `owner`'s member `serve`, guarded (the service names the source).
 template <typename Owner, typename Request, typename Response>
-ros::ServiceServer advertiseGuarded(ros::NodeHandle& nh, device::InputRefusals& counters,
+ros::ServiceServer advertiseGuarded(ros::NodeHandle& nh, core::InputRefusals& counters,
                                     const std::string& service,
                                     bool (Owner::*serve)(Request&, Response&), Owner* owner) {
   const boost::function<bool(Request&, Response&)> bound =

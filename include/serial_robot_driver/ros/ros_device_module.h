@@ -8,7 +8,7 @@
 #include <memory>
 #include <vector>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 
@@ -20,7 +20,7 @@ struct RosDeviceModule {
   const char* name = nullptr;
   /// Builds the device's interface on its port (before the ports start).
   std::unique_ptr<DeviceInterface> (*make)(ros::NodeHandle& nh, const DriverParams& params,
-                                           device::SerialLink& link) = nullptr;
+                                           core::SerialLink& link) = nullptr;
   /// Starts the device's runtime tuning servers (addGroupServer, ros/tuning_group_server.h) under
   /// `private_nh` into `servers`; RuntimeTuning calls it while the device is enabled. Null: the
   /// device has nothing to tune.
@@ -36,7 +36,7 @@ const RosDeviceModule* findInterface(const std::string& name);
 /// RosDeviceModule::make for an interface constructed from (nh, params, link).
 template <typename Interface>
 std::unique_ptr<DeviceInterface> makeInterface(ros::NodeHandle& nh, const DriverParams& params,
-                                               device::SerialLink& link) {
+                                               core::SerialLink& link) {
   return std::make_unique<Interface>(nh, params, link);
 }
 

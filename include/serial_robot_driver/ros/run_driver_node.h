@@ -6,7 +6,7 @@
 
 #include <functional>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -15,7 +15,7 @@ namespace serial_robot_driver::ros_layer {
 /// parameters are loaded (it may read, and must then delete, parameters of its own). An empty
 /// factory means termios serial ports; throwing ParameterError stops the node with that message.
 using StreamFactoryMaker =
-    std::function<device::SerialLink::StreamFactory(ros::NodeHandle& private_nh)>;
+    std::function<core::SerialLink::StreamFactory(ros::NodeHandle& private_nh)>;
 
 /// Loads the driver's parameters from `private_nh`, warns about unknown keys (typos) and
 /// validates them; throws ParameterError. Shared by driver_node and the nodelet.

@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/device.h"
+#include "serial_robot_driver/core/device.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -34,7 +34,7 @@ class RuntimeTuning {
   /// `params` are the parameters in force; `devices` and `trajectory` get every accepted change
   /// and must outlive this object.
   RuntimeTuning(const ros::NodeHandle& private_nh, const DriverParams& params,
-                std::vector<device::Device*> devices,
+                std::vector<core::Device*> devices,
                 trajectory::TrajectoryExecutor* trajectory = nullptr);
   ~RuntimeTuning();
   RuntimeTuning(const RuntimeTuning&) = delete;
@@ -63,7 +63,7 @@ class RuntimeTuning {
   mutable std::mutex mutex_;
   DriverParams in_force_;
   bool stopped_ = false;
-  const std::vector<device::Device*> devices_;
+  const std::vector<core::Device*> devices_;
   trajectory::TrajectoryExecutor* const trajectory_;
   Servers servers_;  // last: destroyed first
 };

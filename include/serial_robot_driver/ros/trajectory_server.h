@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "serial_robot_driver/FollowJointTrajectoryAction.h"
-#include "serial_robot_driver/device/input_refusals.h"
+#include "serial_robot_driver/core/input_refusals.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/guarded_action_server.h"
 #include "serial_robot_driver/trajectory/executor.h"
@@ -60,7 +60,7 @@ class TrajectoryServer {
   void shutdown();
 
   /// The goals and messages refused for what they ask, and its callbacks' errors, by source.
-  device::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
+  core::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
 
  private:
   /// onGoal() guarded: an error rejects the goal (or aborts it, once accepted).
@@ -70,7 +70,7 @@ class TrajectoryServer {
   /// The steady start of a message stamped `stamp`; nothing: at once.
   std::optional<double> startOf(const ros::Time& stamp) const;
 
-  device::InputRefusals input_refusals_;  // before the callbacks that count into it
+  core::InputRefusals input_refusals_;  // before the callbacks that count into it
   trajectory::TrajectoryExecutor& executor_;
   const double loop_period_;
   ros::NodeHandle nh_;

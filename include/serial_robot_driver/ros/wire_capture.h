@@ -32,14 +32,14 @@
 #include <thread>
 
 #include "serial_robot_driver/SerialChunk.h"
-#include "serial_robot_driver/device/serial_link.h"
-#include "serial_robot_driver/device/wire_capture_status.h"
+#include "serial_robot_driver/core/serial_link.h"
+#include "serial_robot_driver/core/wire_capture_status.h"
 #include "serial_robot_driver/ros/conversions.h"
 
 namespace serial_robot_driver::ros_layer {
 
 // Its counters and status are the core's (device/wire_capture_status.h).
-using device::WireCaptureStats;
+using core::WireCaptureStats;
 
 struct WireCaptureLimits {
   /// About 10 s of a busy 1 Mbaud port; a backlog beyond this means the subscribers cannot keep up.
@@ -48,7 +48,7 @@ struct WireCaptureLimits {
   std::size_t max_in_roscpp = 1000;
 };
 
-class WireCapture : public device::ChunkObserver {
+class WireCapture : public core::ChunkObserver {
  public:
   /// Advertises serial_raw and starts the publishing thread.
   WireCapture(ros::NodeHandle& nh, const DriverParams& params, WireCaptureLimits limits = {});
@@ -56,7 +56,7 @@ class WireCapture : public device::ChunkObserver {
   /// dropped: a stalled subscriber cannot hold the node's exit), then stops the thread.
   ~WireCapture() override;
 
-  void onChunk(const device::WireChunk& chunk) override;
+  void onChunk(const core::WireChunk& chunk) override;
   WireCaptureStats stats() const;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) const;
 

@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/typed_value.h"
+#include "serial_robot_driver/core/typed_value.h"
 #include "serial_robot_driver/protocol/frame_family.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/sim_types.h"
@@ -46,7 +46,7 @@ struct PortCounters {
 /// accessor, <name>Stats(stats) in its <name>_sim.h) and as its stats-file lines.
 struct DeviceSimStats {
   std::string name;
-  device::TypedValue counters;
+  core::TypedValue counters;
   std::vector<StatsLine> lines;
 };
 
@@ -74,7 +74,7 @@ struct HostedDeviceOptions {
   std::map<std::string, std::string> settings;
   /// Its typed settings (its <Name>SimConfig), made with their defaults on first use; reading
   /// them as another type throws std::logic_error.
-  device::TypedValue config;
+  core::TypedValue config;
 
   template <typename Config>
   Config& configAs() {

@@ -30,7 +30,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/core/e_stop.h"
 #include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/command.h"
 #include "serial_robot_driver/trajectory/goal.h"
@@ -90,7 +90,7 @@ class TrajectoryExecutor {
   void stopAll(const std::string& reason);
   /// The node's e-stop (before start()): engaging it calls stopAll(); while it holds, goals are
   /// rejected and joint_trajectory messages ignored, both counted.
-  void attachEStop(device::EStop& e_stop);
+  void attachEStop(core::EStop& e_stop);
 
   /// One loop tick: supervises the goals (ending them, else giving feedback), then writes or
   /// queues what the splines ask for.
@@ -175,7 +175,7 @@ class TrajectoryExecutor {
   std::vector<Track> tracks_;
   std::vector<ActiveGoal> goals_;
   bool running_ = false;
-  device::EStop* e_stop_ = nullptr;
+  core::EStop* e_stop_ = nullptr;
   std::array<std::optional<double>, kThrottledKinds> last_warned_;
 };
 

@@ -27,7 +27,7 @@ struct TrajectoryJoints {
   std::function<std::string(const std::vector<std::string>& names,
                             const std::vector<double>& positions, std::optional<uint64_t> accepted)>
       write;
-  /// The device's e-stop generation now (device::MotionGate::generation()): noted when a
+  /// The device's e-stop generation now (core::MotionGate::generation()): noted when a
   /// trajectory is accepted and handed to `write`, so that one accepted before an e-stop never
   /// moves a joint after it. May be empty (nothing is voided by generation).
   std::function<uint64_t()> generation;

@@ -5,11 +5,11 @@
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/protocol/wire_fields.h"
 
-namespace serial_robot_driver::protocol::base {
+namespace serial_robot_driver::devices::base {
 
 namespace {
 
-constexpr auto kBE = wire::ByteOrder::kBig;
+constexpr auto kBE = protocol::wire::ByteOrder::kBig;
 constexpr uint8_t kMaxBatteryPercent = 100;
 
 // Frame envelope: header (2), LEN, SEQ, MSGID, PARAM..., XOR.
@@ -19,23 +19,25 @@ constexpr std::size_t kMsgIdOffset = 4;
 constexpr std::size_t kParamsOffset = 5;
 
 // The PARAM of each frame kind, as one field list each.
-constexpr std::array<wire::Field<WheelSpeed>, 3> kWheelSpeedParams = {{
-    wire::field<&WheelSpeed::left_ticks>("left", wire::kI16, kBE, "ticks/period"),
-    wire::field<&WheelSpeed::right_ticks>("right", wire::kI16, kBE, "ticks/period"),
-    wire::reservedField<WheelSpeed>("reserved", 4),
+constexpr std::array<protocol::wire::Field<WheelSpeed>, 3> kWheelSpeedParams = {{
+    protocol::wire::field<&WheelSpeed::left_ticks>("left", protocol::wire::kI16, kBE,
+                                                   "ticks/period"),
+    protocol::wire::field<&WheelSpeed::right_ticks>("right", protocol::wire::kI16, kBE,
+                                                    "ticks/period"),
+    protocol::wire::reservedField<WheelSpeed>("reserved", 4),
 }};
 struct BatteryLevel {
   uint8_t percent = 0;
 };
-constexpr std::array<wire::Field<BatteryLevel>, 1> kBatteryReplyParams = {
-    {wire::field<&BatteryLevel::percent>("percent", wire::kU8, kBE, "%")}};
+constexpr std::array<protocol::wire::Field<BatteryLevel>, 1> kBatteryReplyParams = {
+    {protocol::wire::field<&BatteryLevel::percent>("percent", protocol::wire::kU8, kBE, "%")}};
 // The vendor's one-byte commands (battery request, Reset, clear encoders, the error status).
 struct NoParams {};
-constexpr std::array<wire::Field<NoParams>, 1> kSimpleCommandParams = {
-    {wire::reservedField<NoParams>("reserved", 1)}};
+constexpr std::array<protocol::wire::Field<NoParams>, 1> kSimpleCommandParams = {
+    {protocol::wire::reservedField<NoParams>("reserved", 1)}};
 
 template <typename Record>
-std::vector<uint8_t> buildFrame(uint8_t seq, MsgId msg_id, wire::FieldList<Record> params,
+std::vector<uint8_t> buildFrame(uint8_t seq, MsgId msg_id, protocol::wire::FieldList<Record> params,
                                 const Record& record) {
   const std::size_t len = 1 + params.size();  // MSGID + PARAM
   std::vector<uint8_t> frame(frameSize(static_cast<uint8_t>(len)));
@@ -44,13 +46,13 @@ std::vector<uint8_t> buildFrame(uint8_t seq, MsgId msg_id, wire::FieldList<Recor
   frame[kLenOffset] = static_cast<uint8_t>(len);
   frame[kSeqOffset] = seq;
   frame[kMsgIdOffset] = static_cast<uint8_t>(msg_id);
-  wire::encodeFields(params, record, &frame[kParamsOffset]);
+  protocol::wire::encodeFields(params, record, &frame[kParamsOffset]);
   frame.back() = xorChecksum(frame.data(), frame.size() - 1);
   return frame;
 }
 
 std::vector<uint8_t> buildSimpleCommand(uint8_t seq, MsgId msg_id) {
-  return buildFrame(seq, msg_id, wire::listOf(kSimpleCommandParams), NoParams{});
+  return buildFrame(seq, msg_id, protocol::wire::listOf(kSimpleCommandParams), NoParams{});
 }
 
 }  // namespace
@@ -62,7 +64,7 @@ uint8_t xorChecksum(const uint8_t* data, std::size_t size) {
 }
 
 std::vector<uint8_t> encodeWheelSpeed(uint8_t seq, int16_t left_ticks, int16_t right_ticks) {
-  return buildFrame(seq, MsgId::kWheelSpeed, wire::listOf(kWheelSpeedParams),
+  return buildFrame(seq, MsgId::kWheelSpeed, protocol::wire::listOf(kWheelSpeedParams),
                     WheelSpeed{left_ticks, right_ticks});
 }
 
@@ -81,33 +83,35 @@ std::vector<uint8_t> encodeErrorStatus(uint8_t seq) {
 }
 
 std::vector<uint8_t> encodeBatteryReply(uint8_t seq, uint8_t percent) {
-  return buildFrame(seq, MsgId::kBattery, wire::listOf(kBatteryReplyParams), BatteryLevel{percent});
+  return buildFrame(seq, MsgId::kBattery, protocol::wire::listOf(kBatteryReplyParams),
+                    BatteryLevel{percent});
 }
 
-Probe probeFrame(const uint8_t* data, std::size_t available) {
-  if (available < 1) return Probe::needMore();
-  if (data[0] != kHeader0) return Probe::invalid(DecodeError::kBadHeader);
-  if (available < 2) return Probe::needMore();
-  if (data[1] != kHeader1) return Probe::invalid(DecodeError::kBadHeader);
-  if (available <= kLenOffset) return Probe::needMore();
+protocol::Probe probeFrame(const uint8_t* data, std::size_t available) {
+  if (available < 1) return protocol::Probe::needMore();
+  if (data[0] != kHeader0) return protocol::Probe::invalid(protocol::DecodeError::kBadHeader);
+  if (available < 2) return protocol::Probe::needMore();
+  if (data[1] != kHeader1) return protocol::Probe::invalid(protocol::DecodeError::kBadHeader);
+  if (available <= kLenOffset) return protocol::Probe::needMore();
   const uint8_t len = data[kLenOffset];
-  if (len < kMinLen || len > kMaxLen) return Probe::invalid(DecodeError::kBadLength);
+  if (len < kMinLen || len > kMaxLen)
+    return protocol::Probe::invalid(protocol::DecodeError::kBadLength);
   const std::size_t size = frameSize(len);
-  if (available < size) return Probe::needMore();
+  if (available < size) return protocol::Probe::needMore();
   if (xorChecksum(data, size - 1) != data[size - 1]) {
-    return Probe::invalid(DecodeError::kBadChecksum);
+    return protocol::Probe::invalid(protocol::DecodeError::kBadChecksum);
   }
-  return Probe::frame(size);
+  return protocol::Probe::frame(size);
 }
 
-Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size) {
-  if (size <= kLenOffset) return DecodeError::kTooShort;
-  if (data[0] != kHeader0 || data[1] != kHeader1) return DecodeError::kBadHeader;
+protocol::Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size) {
+  if (size <= kLenOffset) return protocol::DecodeError::kTooShort;
+  if (data[0] != kHeader0 || data[1] != kHeader1) return protocol::DecodeError::kBadHeader;
   const uint8_t len = data[kLenOffset];
-  if (len < kMinLen || len > kMaxLen) return DecodeError::kBadLength;
-  if (size < frameSize(len)) return DecodeError::kTooShort;
-  if (size > frameSize(len)) return DecodeError::kBadLength;
-  if (xorChecksum(data, size - 1) != data[size - 1]) return DecodeError::kBadChecksum;
+  if (len < kMinLen || len > kMaxLen) return protocol::DecodeError::kBadLength;
+  if (size < frameSize(len)) return protocol::DecodeError::kTooShort;
+  if (size > frameSize(len)) return protocol::DecodeError::kBadLength;
+  if (xorChecksum(data, size - 1) != data[size - 1]) return protocol::DecodeError::kBadChecksum;
 
   Frame frame;
   frame.seq = data[kSeqOffset];
@@ -117,7 +121,7 @@ Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size) {
   return frame;
 }
 
-Decoded<Reply> interpretReply(const Frame& frame) {
+protocol::Decoded<Reply> interpretReply(const Frame& frame) {
   Reply reply;
   reply.frame = frame;
   switch (frame.msg_id) {
@@ -125,10 +129,10 @@ Decoded<Reply> interpretReply(const Frame& frame) {
       reply.kind = Reply::Kind::kTimeoutError;
       break;
     case static_cast<uint8_t>(MsgId::kBattery): {
-      const auto params = wire::listOf(kBatteryReplyParams);
-      if (frame.param_count < params.size()) return DecodeError::kUnexpectedContent;
+      const auto params = protocol::wire::listOf(kBatteryReplyParams);
+      if (frame.param_count < params.size()) return protocol::DecodeError::kUnexpectedContent;
       BatteryLevel level;
-      wire::decodeFields(params, frame.params.data(), &level);
+      protocol::wire::decodeFields(params, frame.params.data(), &level);
       reply.kind = Reply::Kind::kBattery;
       reply.battery_percent = std::min(level.percent, kMaxBatteryPercent);
       break;
@@ -141,20 +145,21 @@ Decoded<Reply> interpretReply(const Frame& frame) {
   return reply;
 }
 
-Decoded<WheelSpeed> interpretWheelSpeed(const Frame& frame) {
-  const auto params = wire::listOf(kWheelSpeedParams);
+protocol::Decoded<WheelSpeed> interpretWheelSpeed(const Frame& frame) {
+  const auto params = protocol::wire::listOf(kWheelSpeedParams);
   if (frame.msg_id != static_cast<uint8_t>(MsgId::kWheelSpeed) ||
       frame.param_count != params.size()) {
-    return DecodeError::kUnexpectedContent;
+    return protocol::DecodeError::kUnexpectedContent;
   }
   WheelSpeed speed;
-  wire::decodeFields(params, frame.params.data(), &speed);
+  protocol::wire::decodeFields(params, frame.params.data(), &speed);
   return speed;
 }
 
-static_assert(kMaxFrameSize <= StreamFramer::kLongestFrame, "base frame too long for the framer");
+static_assert(kMaxFrameSize <= protocol::StreamFramer::kLongestFrame,
+              "base frame too long for the framer");
 
-constexpr FrameFamily kFrames{
+constexpr protocol::FrameFamily kFrames{
     "base", kHeader0,
     [](const uint8_t* data, std::size_t available, std::size_t) {
       return probeFrame(data, available);
@@ -168,4 +173,4 @@ constexpr FrameFamily kFrames{
       return true;
     }};
 
-}  // namespace serial_robot_driver::protocol::base
+}  // namespace serial_robot_driver::devices::base

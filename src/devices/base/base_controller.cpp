@@ -5,23 +5,21 @@
 #include <cstdio>
 #include <limits>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
-namespace base = protocol::base;
 using kinematics::WheelSpeeds;
 
 namespace {
-double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+double seconds(core::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-Clock::duration fromSeconds(double s) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+core::Clock::duration fromSeconds(double s) {
+  return std::chrono::duration_cast<core::Clock::duration>(std::chrono::duration<double>(s));
 }
 
 /// A speed frame's airtime at `baud` (start + 8 data + stop bits per byte), stretched so that
 /// frames sent this closely take at most `line_share` of the line.
-Clock::duration immediateInterval(int baud, double line_share) {
-  const double frame_bits =
-      10.0 * static_cast<double>(protocol::base::encodeWheelSpeed(0, 0, 0).size());
+core::Clock::duration immediateInterval(int baud, double line_share) {
+  const double frame_bits = 10.0 * static_cast<double>(encodeWheelSpeed(0, 0, 0).size());
   const double airtime = frame_bits / std::max(baud, 1);
   return fromSeconds(airtime / std::clamp(line_share, 0.01, 1.0));
 }
@@ -35,12 +33,12 @@ int16_t withDirection(int16_t ticks, int direction) {
 
 }  // namespace
 
-BaseController::BaseController(BaseConfig config, FrameWriter writer, BaseEvents events,
-                               std::shared_ptr<LoopClock> clock)
+BaseController::BaseController(BaseConfig config, core::FrameWriter writer, BaseEvents events,
+                               std::shared_ptr<core::LoopClock> clock)
     : config_(config),
       writer_(std::move(writer)),
       events_(std::move(events)),
-      clock_(clock ? std::move(clock) : steadyLoopClock()),
+      clock_(clock ? std::move(clock) : core::steadyLoopClock()),
       period_(fromSeconds(1.0 / config.loop_rate)),
       min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
       limiter_(config.max_wheel_accel),
@@ -125,15 +123,15 @@ void BaseController::resetOdometry() {
   odometry_.reset(clock_->now());
 }
 
-void BaseController::onImuYaw(double yaw, Clock::time_point stamp) {
+void BaseController::onImuYaw(double yaw, core::Clock::time_point stamp) {
   // Not under mutex_: the odometry takes the sample under the heading fusion's own short lock.
   odometry_.addImuYaw(yaw, stamp);
 }
 
 bool BaseController::sendReset() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Clock::time_point now = clock_->now();
-  const bool ok = writeLocked(base::encodeReset(seq_.peek()), now);
+  const core::Clock::time_point now = clock_->now();
+  const bool ok = writeLocked(encodeReset(seq_.peek()), now);
   if (ok) {
     ++stats_.resets_sent;
     needs_reset_ = false;
@@ -144,7 +142,7 @@ bool BaseController::sendReset() {
 
 bool BaseController::sendClearEncoders() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool ok = writeLocked(base::encodeClearEncoders(seq_.peek()), clock_->now());
+  const bool ok = writeLocked(encodeClearEncoders(seq_.peek()), clock_->now());
   if (ok) ++stats_.clear_encoders_sent;
   return ok;
 }
@@ -170,7 +168,7 @@ void BaseController::stop() {
     std::lock_guard<std::mutex> lock(mutex_);
     sent.seq = seq_.peek();
     sent.time = clock_->now();
-    written = writeLocked(base::encodeWheelSpeed(sent.seq, 0, 0), sent.time);
+    written = writeLocked(encodeWheelSpeed(sent.seq, 0, 0), sent.time);
     if (written) {
       ++stats_.speed_frames;
       if (!needs_reset_) odometry_.speedAccepted(kinematics::WheelTicks{}, sent.time);
@@ -181,7 +179,7 @@ void BaseController::stop() {
 
 void BaseController::retune(const BaseTuning& next) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Clock::time_point now = clock_->now();
+  const core::Clock::time_point now = clock_->now();
   // The motion so far with the geometry it ran under, from now on with the new one.
   odometry_.retune(next.geometry, next.use_imu_heading, now);
   limiter_.setMaxAccel(next.max_wheel_accel);
@@ -190,7 +188,7 @@ void BaseController::retune(const BaseTuning& next) {
   static_cast<BaseTuning&>(config_) = next;
 }
 
-void BaseController::rescheduleBatteryPollLocked(double next_rate, Clock::time_point now) {
+void BaseController::rescheduleBatteryPollLocked(double next_rate, core::Clock::time_point now) {
   if (next_rate == config_.battery_poll_rate) return;
   if (next_rate > 0) {
     // A faster rate starts now, not after the slower period still pending.
@@ -208,7 +206,7 @@ BaseConfig BaseController::config() const {
 
 BaseStats BaseController::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Clock::time_point now = clock_->now();
+  const core::Clock::time_point now = clock_->now();
   BaseStats snapshot = stats_;
   odometry_.addHeadingStats(snapshot, now);
   snapshot.min_immediate_interval_ms = seconds(min_immediate_interval_) * 1e3;
@@ -241,15 +239,15 @@ void BaseController::onLinkDown() {
 }
 
 void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                             Clock::time_point arrival) {
-  if (family != protocol::base::kFrames) return;
-  const auto frame = base::decodeFrame(data, size);
+                             core::Clock::time_point arrival) {
+  if (family != kFrames) return;
+  const auto frame = decodeFrame(data, size);
   if (!frame) {
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.bad_replies;
     return;
   }
-  const auto reply = base::interpretReply(*frame);
+  const auto reply = interpretReply(*frame);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!reply) {
@@ -260,10 +258,10 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
     silent_reported_ = false;
   }
   switch (reply->kind) {
-    case base::Reply::Kind::kTimeoutError: {
+    case Reply::Kind::kTimeoutError: {
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        const Clock::time_point now = clock_->now();
+        const core::Clock::time_point now = clock_->now();
         ++stats_.timeout_errors_received;
         // One FF may still be in flight from before our Reset (e.g. at power-on): not "running".
         const bool running = !needs_reset_ && last_reset_sent_ &&
@@ -281,7 +279,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
       if (events_.on_timeout_error) events_.on_timeout_error();
       break;
     }
-    case base::Reply::Kind::kBattery: {
+    case Reply::Kind::kBattery: {
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ++stats_.battery_replies;
@@ -290,7 +288,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
       if (events_.on_battery) events_.on_battery(reply->battery_percent, arrival);
       break;
     }
-    case base::Reply::Kind::kUnknown: {
+    case Reply::Kind::kUnknown: {
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ++stats_.unknown_replies;
@@ -301,7 +299,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
   }
 }
 
-bool BaseController::writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now) {
+bool BaseController::writeLocked(const std::vector<uint8_t>& frame, core::Clock::time_point now) {
   if (!writer_(frame)) {
     ++stats_.write_failures;
     needs_reset_ = true;  // whatever the base saw, start the next exchange with a Reset
@@ -312,7 +310,7 @@ bool BaseController::writeLocked(const std::vector<uint8_t>& frame, Clock::time_
   return true;
 }
 
-WheelSpeeds BaseController::targetSpeedsLocked(Clock::time_point now, bool* timed_out_now) {
+WheelSpeeds BaseController::targetSpeedsLocked(core::Clock::time_point now, bool* timed_out_now) {
   if (e_stop_) return WheelSpeeds::Zero();
   const bool timed_out = !last_command_ || seconds(now - *last_command_) > config_.cmd_vel_timeout;
   if (timed_out && !command_timed_out_ && last_command_) {
@@ -334,7 +332,7 @@ kinematics::WheelTicks BaseController::onWire(const kinematics::WheelTicks& tick
                                 withDirection(ticks.right, config_.right_wheel_direction)};
 }
 
-void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
+void BaseController::sendSpeed(core::Clock::time_point now, bool immediate) {
   WheelFrameSent sent;
   bool written = false;
   bool timed_out_now = false;
@@ -352,7 +350,7 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
     // assume it did, even if its FF frame was lost.
     if (last_write_ && seconds(now - *last_write_) >= config_.heartbeat_gap) needs_reset_ = true;
     if (needs_reset_) {
-      if (!writeLocked(base::encodeReset(seq_.peek()), now)) return;
+      if (!writeLocked(encodeReset(seq_.peek()), now)) return;
       ++stats_.resets_sent;
       needs_reset_ = false;
       last_reset_sent_ = now;
@@ -363,7 +361,7 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
     sent.seq = seq_.peek();
     sent.speeds = speeds;
     sent.time = now;
-    written = writeLocked(base::encodeWheelSpeed(sent.seq, sent.ticks.left, sent.ticks.right), now);
+    written = writeLocked(encodeWheelSpeed(sent.seq, sent.ticks.left, sent.ticks.right), now);
     if (written) {
       ++stats_.speed_frames;
       if (immediate) {
@@ -378,7 +376,7 @@ void BaseController::sendSpeed(Clock::time_point now, bool immediate) {
   if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
 }
 
-void BaseController::tick(Clock::time_point now) {
+void BaseController::tick(core::Clock::time_point now) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (last_tick_) {
@@ -389,10 +387,10 @@ void BaseController::tick(Clock::time_point now) {
     last_tick_ = now;
     if (config_.battery_poll_rate > 0 && now >= next_battery_poll_) {
       next_battery_poll_ =
-          now + std::chrono::duration_cast<Clock::duration>(
+          now + std::chrono::duration_cast<core::Clock::duration>(
                     std::chrono::duration<double>(1.0 / config_.battery_poll_rate));
       // A Reset pending goes out with the speed frame below; the battery request can wait for it.
-      if (!needs_reset_ && writeLocked(base::encodeBatteryRequest(seq_.peek()), now)) {
+      if (!needs_reset_ && writeLocked(encodeBatteryRequest(seq_.peek()), now)) {
         ++stats_.battery_requests;
         if (!unanswered_since_) unanswered_since_ = now;
       }
@@ -422,7 +420,7 @@ void BaseController::tick(Clock::time_point now) {
 }
 
 void BaseController::run() {
-  Clock::time_point deadline = clock_->now() + period_;
+  core::Clock::time_point deadline = clock_->now() + period_;
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stopping_) {
     // Wake at the next tick, or earlier for a new command that may be rushed out.
@@ -430,7 +428,7 @@ void BaseController::run() {
       clock_->waitUntil(lock, wake_, deadline);
     }
     if (stopping_) break;
-    const Clock::time_point now = clock_->now();
+    const core::Clock::time_point now = clock_->now();
     if (now < deadline) {
       // Woken early by a command: send it at once unless the last rushed frame is so recent that
       // a flood would take more than its share of the line; then it goes when the line allows (or
@@ -439,7 +437,7 @@ void BaseController::run() {
       const bool may_rush =
           !last_immediate_frame_ || now - *last_immediate_frame_ >= min_immediate_interval_;
       if (!may_rush) {
-        const Clock::time_point until =
+        const core::Clock::time_point until =
             std::min(deadline, *last_immediate_frame_ + min_immediate_interval_);
         while (!stopping_ && clock_->now() < until) clock_->waitUntil(lock, wake_, until);
         continue;  // re-evaluate with command_pending_ still set
@@ -463,4 +461,4 @@ void BaseController::run() {
   }
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

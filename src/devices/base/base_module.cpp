@@ -2,29 +2,28 @@
 #include <cmath>
 #include <sstream>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
-namespace serial_robot_driver::params {
-extern const SectionKey<BaseParams> kBaseSection{"base"};
+namespace serial_robot_driver::devices::base {
+extern const params::SectionKey<BaseParams> kBaseSection{"base"};
 
-device::BaseConfig makeBaseConfig(const DriverParams& params) {
-  device::BaseConfig config = params.section(kBaseSection).controller;
+BaseConfig makeBaseConfig(const params::DriverParams& params) {
+  BaseConfig config = params.section(kBaseSection).controller;
   config.loop_rate = params.loop_rate;
-  config.baud = params.baudOf(*device::findDevice("base"));
-  config.imu_yaw_variance = params.section(kImuSection).orientation_variance;
+  config.baud = params.baudOf(*core::findDevice("base"));
+  config.imu_yaw_variance = params.section(body::kImuSection).orientation_variance;
   return config;
 }
-}
+}  // namespace serial_robot_driver::devices::base
 
 namespace serial_robot_driver::devices::base {
 
 namespace {
 
-using params::BaseParams;
 using params::DriverParams;
 using params::require;
 
@@ -32,17 +31,16 @@ void addParameters(std::vector<params::ParamSpec>& table) {
   // Three kinds of rows, in the documented order: the wheel geometry and the controller's other
   // settings (bound into BaseParams::controller), and the ROS layer's own values.
   using Own = BaseParams;
-  using Controller = device::BaseConfig;
+  using Controller = BaseConfig;
   using Geometry = kinematics::DiffDriveGeometry;
   params::SectionRows<Geometry> geometry(table, "base", "base", [](DriverParams& p) -> Geometry& {
-    return p.section(params::kBaseSection).controller.geometry;
+    return p.section(kBaseSection).controller.geometry;
   });
   params::SectionRows<Controller> controller(
       table, "base", "base",
-      [](DriverParams& p) -> Controller& { return p.section(params::kBaseSection).controller; });
-  params::SectionRows<Own> own(table, "base", "base", [](DriverParams& p) -> Own& {
-    return p.section(params::kBaseSection);
-  });
+      [](DriverParams& p) -> Controller& { return p.section(kBaseSection).controller; });
+  params::SectionRows<Own> own(table, "base", "base",
+                               [](DriverParams& p) -> Own& { return p.section(kBaseSection); });
   geometry
       .add("wheel_diameter", &Geometry::wheel_diameter, params::positiveNumber)
       // A whole number of ticks, which the geometry's arithmetic keeps as a double.
@@ -79,15 +77,15 @@ void addParameters(std::vector<params::ParamSpec>& table) {
 }
 
 void validate(const DriverParams& p) {
-  const BaseParams& base = p.section(params::kBaseSection);
+  const BaseParams& base = p.section(kBaseSection);
   // Every tick's wheel frame is the base's heartbeat; it stops with a timeout error after 1 s
   // without one. 5 Hz leaves five frames in that second, so one lost frame is harmless.
   std::ostringstream rate;
-  rate << "must be at least " << params::kMinBaseLoopRate
+  rate << "must be at least " << kMinBaseLoopRate
        << " Hz while the base is enabled: each loop tick sends the wheel frame that keeps the "
           "base's 1 s heartbeat alive (got "
        << p.loop_rate << ")";
-  require(p.loop_rate >= params::kMinBaseLoopRate, "loop_rate", rate.str());
+  require(p.loop_rate >= kMinBaseLoopRate, "loop_rate", rate.str());
   require(base.controller.battery_poll_rate <= p.loop_rate, "base/battery_poll_rate",
           "must not exceed loop_rate (requests go out from the loop)");
   require(base.battery_error_percent <= base.battery_warn_percent, "base/battery_error_percent",
@@ -101,25 +99,25 @@ void validate(const DriverParams& p) {
     require(p.enabled("body"), "base/use_imu_heading",
             "needs the servo controller board's IMU, but body/enabled is false");
     require(
-        p.section(params::kImuSection).orientation_variance >= 0, "base/use_imu_heading",
+        p.section(body::kImuSection).orientation_variance >= 0, "base/use_imu_heading",
         "needs the IMU's orientation, but imu/orientation_variance is negative (no orientation)");
   }
 }
 
 void resolveFrames(DriverParams& p) {
-  BaseParams& base = p.section(params::kBaseSection);
+  BaseParams& base = p.section(kBaseSection);
   base.odom_frame = params::resolveFrame(p.tf_prefix, base.odom_frame);
   base.base_frame = params::resolveFrame(p.tf_prefix, base.base_frame);
 }
 
 }  // namespace
 
-extern const device::DeviceModule kModule{
+extern const core::DeviceModule kModule{
     .name = "base",
     .title = "Base",
-    .driver_frames = {protocol::base::kFrames},
-    .simulator_frames = {protocol::base::kFrames},
-    .sections = {&params::kBaseSection},
+    .driver_frames = {kFrames},
+    .simulator_frames = {kFrames},
+    .sections = {&kBaseSection},
     .add_parameters = addParameters,
     .validate = validate,
     .resolve_frames = resolveFrames,

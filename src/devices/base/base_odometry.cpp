@@ -5,15 +5,15 @@
 
 #include "serial_robot_driver/devices/base/base_controller.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 using kinematics::WheelSpeeds;
 
 namespace {
-double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+double seconds(core::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-Clock::duration fromSeconds(double s) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+core::Clock::duration fromSeconds(double s) {
+  return std::chrono::duration_cast<core::Clock::duration>(std::chrono::duration<double>(s));
 }
 }  // namespace
 
@@ -25,11 +25,11 @@ BaseOdometry::BaseOdometry(const BaseConfig& config)
       odometry_(config.geometry.wheel_separation, config.odometry_covariance),
       heading_(config.imu_stale_after) {}
 
-void BaseOdometry::advance(Clock::time_point now) {
+void BaseOdometry::advance(core::Clock::time_point now) {
   double dt = 0;
   if (accepted_at_) {
     // The base runs the last accepted speeds until its heartbeat timeout stops it.
-    const Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(heartbeat_gap_));
+    const core::Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(heartbeat_gap_));
     if (end > integrated_until_) {
       dt = seconds(end - integrated_until_);
       wheel_travel_ += held_speeds_ * dt;
@@ -46,7 +46,7 @@ void BaseOdometry::advance(Clock::time_point now) {
   }
 }
 
-void BaseOdometry::speedAccepted(const kinematics::WheelTicks& ticks, Clock::time_point now) {
+void BaseOdometry::speedAccepted(const kinematics::WheelTicks& ticks, core::Clock::time_point now) {
   advance(now);
   const double per_tick = 1.0 / geometry_.ticksPerPeriodPerMps();
   held_speeds_ = WheelSpeeds(ticks.left * per_tick, ticks.right * per_tick);
@@ -54,12 +54,12 @@ void BaseOdometry::speedAccepted(const kinematics::WheelTicks& ticks, Clock::tim
   integrated_until_ = now;
 }
 
-void BaseOdometry::baseStopped(Clock::time_point now) {
+void BaseOdometry::baseStopped(core::Clock::time_point now) {
   advance(now);
   held_speeds_.setZero();
 }
 
-void BaseOdometry::reset(Clock::time_point now) {
+void BaseOdometry::reset(core::Clock::time_point now) {
   advance(now);
   odometry_.reset();
   if (use_imu_heading_) {
@@ -69,7 +69,7 @@ void BaseOdometry::reset(Clock::time_point now) {
 }
 
 void BaseOdometry::retune(const kinematics::DiffDriveGeometry& geometry, bool use_imu_heading,
-                          Clock::time_point now) {
+                          core::Clock::time_point now) {
   // The motion so far, and the wheel angles so far, with the geometry they ran under.
   advance(now);
   wheel_angles_at_retune_ += (wheel_travel_ - travel_at_retune_) / (geometry_.wheel_diameter / 2.0);
@@ -87,7 +87,7 @@ void BaseOdometry::retune(const kinematics::DiffDriveGeometry& geometry, bool us
   }
 }
 
-OdometrySample BaseOdometry::sample(Clock::time_point now) const {
+OdometrySample BaseOdometry::sample(core::Clock::time_point now) const {
   OdometrySample sample;
   sample.time = now;
   sample.pose = odometry_.pose();
@@ -108,14 +108,14 @@ OdometrySample BaseOdometry::sample(Clock::time_point now) const {
   return sample;
 }
 
-void BaseOdometry::addImuYaw(double yaw, Clock::time_point stamp) {
+void BaseOdometry::addImuYaw(double yaw, core::Clock::time_point stamp) {
   // Stored even while use_imu_heading is off (addSample only copies two values under its own
   // lock): use_imu_heading_ belongs to the controller's lock, and a retune may switch the fusion
   // on at any time.
   heading_.addSample(yaw, stamp);
 }
 
-void BaseOdometry::addHeadingStats(BaseStats& stats, Clock::time_point now) const {
+void BaseOdometry::addHeadingStats(BaseStats& stats, core::Clock::time_point now) const {
   if (!use_imu_heading_) return;
   stats.heading_source = heading_.source();
   stats.imu_heading_fallbacks = heading_.fallbacks();
@@ -128,4 +128,4 @@ std::optional<kinematics::HeadingSource> BaseOdometry::headingSourceChange() {
   return reported_heading_source_;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -2,45 +2,45 @@
 
 #include <string>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 namespace {
 
 /// The port down, the base silent, a recent FF timeout error.
-void summarizeLink(const BaseStats& s, const PortState& port, StatusReport* status) {
+void summarizeLink(const BaseStats& s, const core::PortState& port, core::StatusReport* status) {
   if (!port.connected) {
-    status->mergeSummary(StatusLevel::kError, "port " + port.path + " not connected");
+    status->mergeSummary(core::StatusLevel::kError, "port " + port.path + " not connected");
     return;
   }
   if (s.base_silent && s.seconds_without_reply) {
-    status->mergeSummaryf(StatusLevel::kError, "no reply from the base for %.0f s",
+    status->mergeSummaryf(core::StatusLevel::kError, "no reply from the base for %.0f s",
                           *s.seconds_without_reply);
   }
   if (s.seconds_since_running_timeout_error &&
       *s.seconds_since_running_timeout_error < kRecentTimeoutErrorS) {
-    status->mergeSummaryf(StatusLevel::kWarn,
+    status->mergeSummaryf(core::StatusLevel::kWarn,
                           "base reported a timeout error (FF) %.0f s ago: frames were lost",
                           *s.seconds_since_running_timeout_error);
   }
 }
 
-void summarizeBattery(const BaseStats& s, BatteryLimits limits, StatusReport* status) {
+void summarizeBattery(const BaseStats& s, BatteryLimits limits, core::StatusReport* status) {
   if (!s.battery_percent) return;
   const int percent = *s.battery_percent;
   if (percent < limits.error_percent) {
-    status->mergeSummaryf(StatusLevel::kError, "battery %d %% (below %d %%)", percent,
+    status->mergeSummaryf(core::StatusLevel::kError, "battery %d %% (below %d %%)", percent,
                           limits.error_percent);
   } else if (percent < limits.warn_percent) {
-    status->mergeSummaryf(StatusLevel::kWarn, "battery %d %% (below %d %%)", percent,
+    status->mergeSummaryf(core::StatusLevel::kWarn, "battery %d %% (below %d %%)", percent,
                           limits.warn_percent);
   }
 }
 
-void addHeadingSource(const BaseStats& s, StatusReport* status) {
+void addHeadingSource(const BaseStats& s, core::StatusReport* status) {
   if (!s.heading_source) return;
   // ~base/use_imu_heading: odom without the IMU is worth a warning, the driving goes on.
   if (*s.heading_source != kinematics::HeadingSource::kImu) {
-    status->mergeSummaryf(StatusLevel::kWarn, "odom heading: %s",
+    status->mergeSummaryf(core::StatusLevel::kWarn, "odom heading: %s",
                           kinematics::toString(*s.heading_source));
   }
   status->add("odom heading source", kinematics::toString(*s.heading_source));
@@ -50,7 +50,7 @@ void addHeadingSource(const BaseStats& s, StatusReport* status) {
 }
 
 /// The link's frames and replies, in and out.
-void addLinkCounters(const BaseStats& s, const PortState& port, StatusReport* status) {
+void addLinkCounters(const BaseStats& s, const core::PortState& port, core::StatusReport* status) {
   status->add("port", port.path);
   status->add("connected", port.connected);
   status->add("speed frames out", s.speed_frames);
@@ -73,7 +73,7 @@ void addLinkCounters(const BaseStats& s, const PortState& port, StatusReport* st
 }
 
 /// What cmd_vel and the control loop did.
-void addLoopCounters(const BaseStats& s, StatusReport* status) {
+void addLoopCounters(const BaseStats& s, core::StatusReport* status) {
   status->add("cmd_vel timeouts", s.cmd_vel_timeouts);
   status->add("rejected cmd_vel (NaN/Inf)", s.rejected_commands);
   status->add("loop overruns", s.loop_overruns);
@@ -83,12 +83,13 @@ void addLoopCounters(const BaseStats& s, StatusReport* status) {
 
 }  // namespace
 
-StatusReport baseStatus(const BaseStats& s, const PortState& port, BatteryLimits limits) {
-  StatusReport status;
-  status.summary(StatusLevel::kOk, "driving");
+core::StatusReport baseStatus(const BaseStats& s, const core::PortState& port,
+                              BatteryLimits limits) {
+  core::StatusReport status;
+  status.summary(core::StatusLevel::kOk, "driving");
   summarizeLink(s, port, &status);
   summarizeBattery(s, limits, &status);
-  if (s.e_stop) status.mergeSummary(StatusLevel::kWarn, "e-stop engaged: holding zero speed");
+  if (s.e_stop) status.mergeSummary(core::StatusLevel::kWarn, "e-stop engaged: holding zero speed");
   addHeadingSource(s, &status);
   status.hardware_id = port.path;
   addLinkCounters(s, port, &status);
@@ -97,4 +98,4 @@ StatusReport baseStatus(const BaseStats& s, const PortState& port, BatteryLimits
   return status;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

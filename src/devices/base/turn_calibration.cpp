@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <tuple>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 namespace {
 
@@ -158,4 +158,4 @@ Checked<DiameterCalibration> calibrateDiameter(const MotionRecord& straight,
   return {result, ""};
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <sstream>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 const char* const kCalibrateBaseUsage =
     R"(usage: rosrun serial_robot_driver calibrate_base [options]
@@ -84,4 +84,4 @@ ParsedCalibrationOptions parseCalibrationOptions(const std::vector<std::string>&
   return parsed;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <limits>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 namespace {
 
@@ -420,4 +420,4 @@ void TurnCalibrationRun::printSetting(const std::string& key, double value, doub
   say("  keep it:     in your config file, under base:   " + key + ": " + fixed(value));
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -6,7 +6,7 @@
 #include <limits>
 #include <utility>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 namespace {
 
@@ -81,22 +81,23 @@ std::string JointCommandResult::message() const {
     case JointCommandStatus::kMotionRefused:
       return "joint command not written: e_stop engaged or shutting down";
     case JointCommandStatus::kMotionVoided:
-      return std::string("joint command not written: ") + toString(GateState::kVoided);
+      return std::string("joint command not written: ") + core::toString(core::GateState::kVoided);
   }
   return "unknown joint command status";
 }
 
-BodyController::BodyController(std::vector<BodyJoint> joints, FrameWriter writer, BodyEvents events)
+BodyController::BodyController(std::vector<BodyJoint> joints, core::FrameWriter writer,
+                               BodyEvents events)
     : joints_(std::move(joints)),
       writer_(std::move(writer)),
       events_(std::move(events)),
       last_commanded_ticks_(joints_.size()) {}
 
 void BodyController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                             Clock::time_point arrival) {
+                             core::Clock::time_point arrival) {
   // A shared port hands every listener every frame: only telemetry is ours.
-  if (family != protocol::body::kTelemetryFrames) return;
-  const auto telemetry = protocol::body::decodeTelemetry(data, size, joints_.size());
+  if (family != kTelemetryFrames) return;
+  const auto telemetry = decodeTelemetry(data, size, joints_.size());
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!telemetry) {
@@ -172,9 +173,9 @@ JointCommandResult resolveTargets(const std::vector<BodyJoint>& joints,
 
 JointCommandResult BodyController::sendJointCommand(
     const std::vector<std::string>& names, const std::vector<double>& positions,
-    std::optional<MotionGate::Generation> accepted) {
+    std::optional<core::MotionGate::Generation> accepted) {
   // Noted before waiting for the lock: an e-stop while this command waits voids it.
-  const MotionGate::Generation generation = accepted.value_or(gate_.generation());
+  const core::MotionGate::Generation generation = accepted.value_or(gate_.generation());
   std::vector<std::optional<uint16_t>> requested(joints_.size());
   JointCommandResult result = resolveTargets(joints_, names, positions, &requested);
 
@@ -185,7 +186,7 @@ JointCommandResult BodyController::sendJointCommand(
     return result;
   }
   // A joint not in this command keeps the target last sent for it.
-  std::vector<protocol::body::ServoTarget> targets;
+  std::vector<ServoTarget> targets;
   targets.reserve(joints_.size());
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     const std::optional<uint16_t> ticks = requested[i] ? requested[i] : last_commanded_ticks_[i];
@@ -196,22 +197,21 @@ JointCommandResult BodyController::sendJointCommand(
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     if (requested[i]) last_commanded_ticks_[i] = requested[i];
   }
-  last_written_ = Clock::now();
+  last_written_ = core::Clock::now();
   ++stats_.commands_sent;
   return result;
 }
 
-JointCommandStatus BodyController::writeTargetsLocked(
-    const std::vector<protocol::body::ServoTarget>& targets, MotionGate::Generation generation) {
+JointCommandStatus BodyController::writeTargetsLocked(const std::vector<ServoTarget>& targets,
+                                                      core::MotionGate::Generation generation) {
   // Writing under the lock keeps frames in the order their positions were stored; through the
   // gate, so a command that waited for this lock is refused if the e-stop came meanwhile.
   bool written = false;
-  const GateState gate = gate_.writeIfOpen(
-      [&] { return writer_ && writer_(protocol::body::encodeSyncWrite(targets)); }, &written,
-      generation);
-  if (gate != GateState::kOpen) {
+  const core::GateState gate = gate_.writeIfOpen(
+      [&] { return writer_ && writer_(encodeSyncWrite(targets)); }, &written, generation);
+  if (gate != core::GateState::kOpen) {
     ++stats_.motion_refused;
-    const bool voided = gate == GateState::kVoided;
+    const bool voided = gate == core::GateState::kVoided;
     if (voided) ++stats_.motion_voided;
     return voided ? JointCommandStatus::kMotionVoided : JointCommandStatus::kMotionRefused;
   }
@@ -222,7 +222,7 @@ JointCommandStatus BodyController::writeTargetsLocked(
   return JointCommandStatus::kSent;
 }
 
-std::string BodyController::motionInForce(Clock::time_point now) const {
+std::string BodyController::motionInForce(core::Clock::time_point now) const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!last_written_ || now - *last_written_ >= kJointCommandMotion) return {};
   char text[96];
@@ -244,4 +244,4 @@ BodyStats BodyController::stats() const {
   return stats_;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

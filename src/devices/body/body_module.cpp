@@ -3,31 +3,28 @@
 #include <array>
 #include <set>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/body/gyro_bias.h"
 #include "serial_robot_driver/params/driver_params.h"
 
-namespace serial_robot_driver::params {
-extern const SectionKey<BodyParams> kBodySection{"body"};
-extern const SectionKey<ImuParams> kImuSection{"imu"};
-}  // namespace serial_robot_driver::params
+namespace serial_robot_driver::devices::body {
+extern const params::SectionKey<BodyParams> kBodySection{"body"};
+extern const params::SectionKey<ImuParams> kImuSection{"imu"};
+}  // namespace serial_robot_driver::devices::body
 
 namespace serial_robot_driver::devices::body {
 
 namespace {
 
-using params::BodyParams;
 using params::DriverParams;
-using params::ImuParams;
 using params::require;
 
 void servoIds(const std::vector<int>& ids, const std::string& key) {
   require(!ids.empty(), key, "must list at least one servo id");
-  require(ids.size() <= protocol::body::kMaxTelemetryServos, key,
-          "at most " + std::to_string(protocol::body::kMaxTelemetryServos) +
-              " servos fit in a telemetry frame");
+  require(ids.size() <= kMaxTelemetryServos, key,
+          "at most " + std::to_string(kMaxTelemetryServos) + " servos fit in a telemetry frame");
   std::set<int> seen;
   for (int id : ids) {
     // 253 = FD would put FF FF FD, the sync-write header, inside a sync-write frame.
@@ -42,13 +39,12 @@ void addParameters(std::vector<params::ParamSpec>& table) {
   // The board's own values and the calibration every joint shares (BodyParams::calibration), in
   // the documented order.
   using Own = BodyParams;
-  using Calibration = device::JointCalibration;
-  params::SectionRows<Own> own(table, "body", "body", [](DriverParams& p) -> Own& {
-    return p.section(params::kBodySection);
-  });
+  using Calibration = JointCalibration;
+  params::SectionRows<Own> own(table, "body", "body",
+                               [](DriverParams& p) -> Own& { return p.section(kBodySection); });
   params::SectionRows<Calibration> joints(
       table, "body", "body",
-      [](DriverParams& p) -> Calibration& { return p.section(params::kBodySection).calibration; });
+      [](DriverParams& p) -> Calibration& { return p.section(kBodySection).calibration; });
   own.add("servo_ids", &Own::servo_ids, servoIds)
       .add("joint_names", &Own::joint_names, params::uniqueNames);
   joints.add("ticks_per_revolution", &Calibration::ticks_per_revolution,
@@ -62,8 +58,7 @@ void addParameters(std::vector<params::ParamSpec>& table) {
   joints.add("velocity_scale", &Calibration::velocity_scale, params::nonNegativeNumber);
   // The IMU is the board's: its keys are checked while the body is enabled.
   params::SectionRows<ImuParams>(
-      table, "body", "imu",
-      [](DriverParams& p) -> ImuParams& { return p.section(params::kImuSection); })
+      table, "body", "imu", [](DriverParams& p) -> ImuParams& { return p.section(kImuSection); })
       .add("frame_id", &ImuParams::frame_id,
            [](const std::string& v, const std::string& key) {
              require(!v.empty(), key, "must not be empty");
@@ -71,7 +66,7 @@ void addParameters(std::vector<params::ParamSpec>& table) {
       .add("axis_map", &ImuParams::axis_map,
            [](const std::vector<std::string>& entries, const std::string& key) {
              std::string problem;
-             require(params::parseAxisMap(entries, &problem).has_value(), key, problem);
+             require(parseAxisMap(entries, &problem).has_value(), key, problem);
            })
       .add("accel_scale", &ImuParams::accel_scale, params::positiveNumber)
       .add("gyro_scale", &ImuParams::gyro_scale, params::positiveNumber)
@@ -86,7 +81,7 @@ void addParameters(std::vector<params::ParamSpec>& table) {
 }
 
 void validate(const DriverParams& p) {
-  const BodyParams& body = p.section(params::kBodySection);
+  const BodyParams& body = p.section(kBodySection);
   const std::size_t n = body.servo_ids.size();
   const auto requireOnePerServo = [n](std::size_t size, const std::string& name) {
     require(size == n, name,
@@ -98,31 +93,31 @@ void validate(const DriverParams& p) {
 }
 
 void resolveFrames(DriverParams& p) {
-  ImuParams& imu = p.section(params::kImuSection);
+  ImuParams& imu = p.section(kImuSection);
   imu.frame_id = params::resolveFrame(p.tf_prefix, imu.frame_id);
 }
 
 }  // namespace
 
-extern const device::DeviceModule kModule{
+extern const core::DeviceModule kModule{
     .name = "body",
     .title = "Body",
-    .driver_frames = {protocol::body::kTelemetryFrames},
-    .simulator_frames = {protocol::body::kSyncWriteFrames},
-    .sections = {&params::kBodySection, &params::kImuSection},
+    .driver_frames = {kTelemetryFrames},
+    .simulator_frames = {kSyncWriteFrames},
+    .sections = {&kBodySection, &kImuSection},
     .add_parameters = addParameters,
     .validate = validate,
     .resolve_frames = resolveFrames,
     // A telemetry frame's LEN depends on how many servos it carries.
     .probe_argument =
-        [](const DriverParams& p) { return p.section(params::kBodySection).servo_ids.size(); },
+        [](const DriverParams& p) { return p.section(kBodySection).servo_ids.size(); },
 };
 
 }  // namespace serial_robot_driver::devices::body
 
-namespace serial_robot_driver::params {
+namespace serial_robot_driver::devices::body {
 
-device::GyroUnits gyroUnits(const ImuParams& imu) {
+GyroUnits gyroUnits(const ImuParams& imu) {
   return {imu.gyro_scale, parseAxisMap(imu.axis_map, nullptr).value_or(AxisMap{})};
 }
 
@@ -163,4 +158,4 @@ std::optional<AxisMap> parseAxisMap(const std::vector<std::string>& entries, std
   return map;
 }
 
-}  // namespace serial_robot_driver::params
+}  // namespace serial_robot_driver::devices::body

@@ -5,11 +5,9 @@
 #include <cmath>
 #include <optional>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
-namespace body = protocol::body;
-
-std::vector<BodyJoint> makeBodyJoints(const params::BodyParams& params) {
+std::vector<BodyJoint> makeBodyJoints(const BodyParams& params) {
   std::vector<BodyJoint> joints(params.servo_ids.size());
   for (std::size_t i = 0; i < joints.size(); ++i) {
     BodyJoint& joint = joints[i];
@@ -22,8 +20,7 @@ std::vector<BodyJoint> makeBodyJoints(const params::BodyParams& params) {
   return joints;
 }
 
-JointReadings jointReadings(const body::Telemetry& telemetry,
-                            const std::vector<BodyJoint>& joints) {
+JointReadings jointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints) {
   JointReadings readings;
   const std::size_t count = std::min(joints.size(), telemetry.servo_count);
   readings.names.reserve(count);
@@ -52,7 +49,7 @@ Quaternion quaternionFromRollPitchYaw(double roll, double pitch, double yaw) {
 
 Eigen::Matrix3d axisMapMatrix(const std::vector<std::string>& axis_map) {
   Eigen::Matrix3d matrix = Eigen::Matrix3d::Zero();
-  const std::optional<params::AxisMap> map = params::parseAxisMap(axis_map, nullptr);
+  const std::optional<AxisMap> map = parseAxisMap(axis_map, nullptr);
   if (!map) return Eigen::Matrix3d::Identity();  // validate() refuses such a map at start-up
   for (int i = 0; i < 3; ++i) matrix(i, map->source[i]) = map->sign[i];
   return matrix;
@@ -60,18 +57,17 @@ Eigen::Matrix3d axisMapMatrix(const std::vector<std::string>& axis_map) {
 
 namespace {
 /// R_world_imu from the board's attitude angles and the axis map M (v_imu = M v_sensor).
-Eigen::Quaterniond imuOrientation(const body::Telemetry& telemetry, double angle_scale,
+Eigen::Quaterniond imuOrientation(const Telemetry& telemetry, double angle_scale,
                                   const Eigen::Matrix3d& map) {
   const auto& raw = telemetry.imu;
-  const Quaternion sensor =
-      quaternionFromRollPitchYaw(raw[body::kRoll] * angle_scale, raw[body::kPitch] * angle_scale,
-                                 raw[body::kYaw] * angle_scale);
+  const Quaternion sensor = quaternionFromRollPitchYaw(
+      raw[kRoll] * angle_scale, raw[kPitch] * angle_scale, raw[kYaw] * angle_scale);
   return Eigen::Quaterniond(sensor.w, sensor.x, sensor.y, sensor.z) *
          Eigen::Quaterniond(map.transpose());
 }
 }  // namespace
 
-double imuYaw(const body::Telemetry& telemetry, const params::ImuParams& params) {
+double imuYaw(const Telemetry& telemetry, const ImuParams& params) {
   const Eigen::Quaterniond q =
       imuOrientation(telemetry, params.angle_scale, axisMapMatrix(params.axis_map));
   // The Z (yaw) angle of a Z-Y-X decomposition.
@@ -79,7 +75,7 @@ double imuYaw(const body::Telemetry& telemetry, const params::ImuParams& params)
                     1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
 }
 
-ImuReading imuReading(const body::Telemetry& telemetry, const params::ImuParams& params,
+ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
                       const std::array<double, 3>& gyro_bias) {
   const auto& raw = telemetry.imu;
   // The axis map M turns sensor-frame vectors into imu-frame ones (v_imu = M v_sensor); the
@@ -87,16 +83,14 @@ ImuReading imuReading(const body::Telemetry& telemetry, const params::ImuParams&
   const Eigen::Matrix3d map = axisMapMatrix(params.axis_map);
   ImuReading reading;
   reading.linear_acceleration =
-      map * Eigen::Vector3d(raw[body::kAccelX], raw[body::kAccelY], raw[body::kAccelZ]) *
-      params.accel_scale;
-  reading.angular_velocity =
-      map *
-      (Eigen::Vector3d(raw[body::kGyroX], raw[body::kGyroY], raw[body::kGyroZ]) -
-       Eigen::Vector3d(gyro_bias[0], gyro_bias[1], gyro_bias[2])) *
-      params.gyro_scale;
+      map * Eigen::Vector3d(raw[kAccelX], raw[kAccelY], raw[kAccelZ]) * params.accel_scale;
+  reading.angular_velocity = map *
+                             (Eigen::Vector3d(raw[kGyroX], raw[kGyroY], raw[kGyroZ]) -
+                              Eigen::Vector3d(gyro_bias[0], gyro_bias[1], gyro_bias[2])) *
+                             params.gyro_scale;
   const Eigen::Quaterniond world_imu = imuOrientation(telemetry, params.angle_scale, map);
   reading.orientation = {world_imu.x(), world_imu.y(), world_imu.z(), world_imu.w()};
   return reading;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

@@ -2,20 +2,20 @@
 
 #include "serial_robot_driver/protocol/decode_result.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 BodyStatus::Update BodyStatus::update(const BodyStats& stats, const protocol::FramerStats& framer,
-                                      const PortState& port) {
+                                      const core::PortState& port) {
   Update update;
-  StatusReport& status = update.report;
+  core::StatusReport& status = update.report;
   if (!port.connected) {
-    status.mergeSummary(StatusLevel::kError, "port " + port.path + " not connected");
+    status.mergeSummary(core::StatusLevel::kError, "port " + port.path + " not connected");
   } else if (stats.frames_decoded == 0) {
     // ERROR, as the frequency check's "No events recorded." already is: a board streaming
     // nothing is a fault a robot monitor must show red, not a warning.
-    status.mergeSummary(StatusLevel::kError, "no telemetry received yet");
+    status.mergeSummary(core::StatusLevel::kError, "no telemetry received yet");
   } else if (stats.frames_decoded == frames_at_last_period_) {
-    status.mergeSummary(StatusLevel::kError, "telemetry stopped");
+    status.mergeSummary(core::StatusLevel::kError, "telemetry stopped");
   }
 
   const bool stalled =
@@ -48,4 +48,4 @@ BodyStatus::Update BodyStatus::update(const BodyStats& stats, const protocol::Fr
   return update;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

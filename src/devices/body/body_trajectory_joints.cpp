@@ -1,17 +1,18 @@
 #include "serial_robot_driver/devices/body/body_trajectory_joints.h"
 
-namespace serial_robot_driver::trajectory {
+namespace serial_robot_driver::devices::body {
 
-TrajectoryJoints bodyTrajectoryJoints(device::BodyController& controller) {
+TrajectoryJoints bodyTrajectoryJoints(devices::body::BodyController& controller) {
   TrajectoryJoints result;
-  for (const device::BodyJoint& joint : controller.joints()) {
+  for (const devices::body::BodyJoint& joint : controller.joints()) {
     const auto [low, high] = joint.calibration.reachableRadians();
     result.joints.push_back({joint.name, low, high});
   }
   result.write = [&controller](const std::vector<std::string>& names,
                                const std::vector<double>& positions,
                                std::optional<uint64_t> accepted) {
-    const device::JointCommandResult sent = controller.sendJointCommand(names, positions, accepted);
+    const devices::body::JointCommandResult sent =
+        controller.sendJointCommand(names, positions, accepted);
     return sent.ok() && sent.out_of_range.empty() ? std::string() : sent.message();
   };
   result.generation = [&controller] { return controller.gate().generation(); };
@@ -22,4 +23,4 @@ TrajectoryJoints bodyTrajectoryJoints(device::BodyController& controller) {
   return result;
 }
 
-}  // namespace serial_robot_driver::trajectory
+}  // namespace serial_robot_driver::devices::body

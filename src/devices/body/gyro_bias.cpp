@@ -5,7 +5,7 @@
 #include <ctime>
 #include <utility>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 namespace {
 
@@ -33,8 +33,8 @@ std::string utc(std::chrono::system_clock::time_point when) {
   return text;
 }
 
-Clock::duration fromSeconds(double seconds) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+core::Clock::duration fromSeconds(double seconds) {
+  return std::chrono::duration_cast<core::Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
 }  // namespace
@@ -105,7 +105,7 @@ std::string describeGyroBias(const GyroVector& raw, const GyroUnits& units) {
 GyroBiasCalibrator::GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimits limits)
     : still_(std::move(still)), limits_(limits) {}
 
-GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, Clock::time_point arrival,
+GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, core::Clock::time_point arrival,
                                         const GyroUnits& units, double seconds) {
   bool after_gap = false;
   {
@@ -171,7 +171,7 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
     last_motion_ = not_still;
     return refuseLocked(how, "the robot is not held still (" + not_still + ")", units, true);
   }
-  const Clock::time_point now = Clock::now();
+  const core::Clock::time_point now = core::Clock::now();
   if (!last_arrival_ || now - *last_arrival_ > limits_.max_telemetry_age) {
     const std::string since =
         last_arrival_
@@ -185,8 +185,9 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
   session_ = Session{how, now, now + fromSeconds(seconds), seconds, {}, {}, false};
   // Between frames too the robot may start moving (or telemetry stop while it moves): look every
   // 50 ms, not only when a frame arrives.
-  while (!cancelled_ && session_->not_still.empty() && Clock::now() < session_->end) {
-    wake_.wait_until(lock, std::min(session_->end, Clock::now() + std::chrono::milliseconds(50)));
+  while (!cancelled_ && session_->not_still.empty() && core::Clock::now() < session_->end) {
+    wake_.wait_until(lock,
+                     std::min(session_->end, core::Clock::now() + std::chrono::milliseconds(50)));
     if (cancelled_ || !session_->not_still.empty()) break;
     lock.unlock();
     const std::string moving = still_();
@@ -231,7 +232,7 @@ GyroVector GyroBiasCalibrator::bias() const {
   return in_force_ ? in_force_->bias : GyroVector{};
 }
 
-void GyroBiasCalibrator::report(StatusReport& status, const GyroUnits& units) const {
+void GyroBiasCalibrator::report(core::StatusReport& status, const GyroUnits& units) const {
   std::lock_guard<std::mutex> lock(mutex_);
   status.add("gyro bias", in_force_ ? describeGyroBias(in_force_->bias, units) : "not calibrated");
   status.add("gyro bias calibrated",
@@ -246,7 +247,7 @@ void GyroBiasCalibrator::report(StatusReport& status, const GyroUnits& units) co
   }
   if (!last_refusal_.empty()) {
     status.add("gyro calibration refused", last_refusal_);
-    status.mergeSummary(StatusLevel::kWarn, last_refusal_);
+    status.mergeSummary(core::StatusLevel::kWarn, last_refusal_);
   }
 }
 
@@ -266,11 +267,11 @@ GyroCalibrationOutcome GyroBiasCalibrator::finishLocked(const Session& session,
           false};
 }
 
-bool GyroBiasCalibrator::settledLocked(Clock::time_point now) const {
+bool GyroBiasCalibrator::settledLocked(core::Clock::time_point now) const {
   return still_since_ && now - *still_since_ >= limits_.settle;
 }
 
-std::string GyroBiasCalibrator::unsettledLocked(Clock::time_point now) const {
+std::string GyroBiasCalibrator::unsettledLocked(core::Clock::time_point now) const {
   const std::string settle =
       format("%g", std::chrono::duration<double>(limits_.settle).count()) + " s";
   // Unset: no frame has found it still since the motion the last one saw.
@@ -300,4 +301,4 @@ GyroCalibrationOutcome GyroBiasCalibrator::refuseLocked(const std::string& how,
           not_still};
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

@@ -1,6 +1,6 @@
 #include "serial_robot_driver/devices/echo/echo_codec.h"
 
-namespace serial_robot_driver::protocol::echo {
+namespace serial_robot_driver::devices::echo {
 
 namespace {
 
@@ -24,45 +24,50 @@ std::vector<uint8_t> encode(uint8_t type, const std::vector<uint8_t>& payload) {
   return frame;
 }
 
-Probe probe(uint8_t type, const uint8_t* data, std::size_t available) {
-  if (available > 0 && data[0] != kHeader) return Probe::invalid(DecodeError::kBadHeader);
+protocol::Probe probe(uint8_t type, const uint8_t* data, std::size_t available) {
+  if (available > 0 && data[0] != kHeader)
+    return protocol::Probe::invalid(protocol::DecodeError::kBadHeader);
   // The other direction's frames share the header: not ours, and not an error.
   if (available > kTypeOffset && data[kTypeOffset] != type) {
-    return Probe::invalid(DecodeError::kBadHeader);
+    return protocol::Probe::invalid(protocol::DecodeError::kBadHeader);
   }
-  if (available <= kLenOffset) return Probe::needMore();
+  if (available <= kLenOffset) return protocol::Probe::needMore();
   const std::size_t len = data[kLenOffset];
-  if (len > kMaxPayload) return Probe::invalid(DecodeError::kBadLength);
+  if (len > kMaxPayload) return protocol::Probe::invalid(protocol::DecodeError::kBadLength);
   const std::size_t size = kOverhead + len;
-  if (available < size) return Probe::needMore();
-  if (xorOf(data, size - 1) != data[size - 1]) return Probe::invalid(DecodeError::kBadChecksum);
-  return Probe::frame(size);
+  if (available < size) return protocol::Probe::needMore();
+  if (xorOf(data, size - 1) != data[size - 1])
+    return protocol::Probe::invalid(protocol::DecodeError::kBadChecksum);
+  return protocol::Probe::frame(size);
 }
 
-Decoded<std::vector<uint8_t>> decode(uint8_t type, const uint8_t* data, std::size_t size) {
-  const Probe found = probe(type, data, size);
-  if (found.status == Probe::Status::kNeedMore) return DecodeError::kTooShort;
-  if (found.status == Probe::Status::kInvalid) return found.reason;
-  if (found.size != size) return DecodeError::kBadLength;
+protocol::Decoded<std::vector<uint8_t>> decode(uint8_t type, const uint8_t* data,
+                                               std::size_t size) {
+  const protocol::Probe found = probe(type, data, size);
+  if (found.status == protocol::Probe::Status::kNeedMore) return protocol::DecodeError::kTooShort;
+  if (found.status == protocol::Probe::Status::kInvalid) return found.reason;
+  if (found.size != size) return protocol::DecodeError::kBadLength;
   return std::vector<uint8_t>(data + kPayloadOffset, data + size - 1);
 }
 
 // Requests first: the two families share the header, the type byte tells them apart.
-constexpr FrameFamily kRequestFrames{"echo_request", kHeader,
-                                     [](const uint8_t* data, std::size_t available, std::size_t) {
-                                       return probe(kRequestType, data, available);
-                                     },
-                                     0,
-                                     [](const uint8_t* frame, std::size_t size, std::size_t) {
-                                       return decode(kRequestType, frame, size).ok();
-                                     }};
-constexpr FrameFamily kAnswerFrames{"echo_answer", kHeader,
-                                    [](const uint8_t* data, std::size_t available, std::size_t) {
-                                      return probe(kAnswerType, data, available);
-                                    },
-                                    1,
-                                    [](const uint8_t* frame, std::size_t size, std::size_t) {
-                                      return decode(kAnswerType, frame, size).ok();
-                                    }};
+constexpr protocol::FrameFamily kRequestFrames{
+    "echo_request", kHeader,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probe(kRequestType, data, available);
+    },
+    0,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      return decode(kRequestType, frame, size).ok();
+    }};
+constexpr protocol::FrameFamily kAnswerFrames{
+    "echo_answer", kHeader,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probe(kAnswerType, data, available);
+    },
+    1,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      return decode(kAnswerType, frame, size).ok();
+    }};
 
-}  // namespace serial_robot_driver::protocol::echo
+}  // namespace serial_robot_driver::devices::echo

@@ -2,11 +2,9 @@
 
 #include "serial_robot_driver/devices/echo/echo_codec.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::echo {
 
-namespace echo = protocol::echo;
-
-EchoController::EchoController(FrameWriter writer, std::chrono::milliseconds timeout)
+EchoController::EchoController(core::FrameWriter writer, std::chrono::milliseconds timeout)
     : writer_(std::move(writer)), timeout_(timeout) {}
 
 PingResult EchoController::ping() {
@@ -28,8 +26,8 @@ PingResult EchoController::ping() {
     answer_arrival_.reset();
     ++stats_.pings;
   }
-  const Clock::time_point sent = Clock::now();
-  if (!writer_(echo::encodeRequest(payload))) {
+  const core::Clock::time_point sent = core::Clock::now();
+  if (!writer_(encodeRequest(payload))) {
     std::lock_guard<std::mutex> lock(mutex_);
     expected_.reset();
     ++stats_.write_failures;
@@ -45,15 +43,15 @@ PingResult EchoController::ping() {
     ++stats_.timeouts;
     return PingResult{false, {}, "no answer within " + std::to_string(timeout_.count()) + " ms"};
   }
-  const auto round_trip = std::max(Clock::duration::zero(), *answer_arrival_ - sent);
+  const auto round_trip = std::max(core::Clock::duration::zero(), *answer_arrival_ - sent);
   stats_.last_round_trip = round_trip;
   return PingResult{true, round_trip, ""};
 }
 
 void EchoController::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                             Clock::time_point arrival) {
-  if (family != echo::kAnswerFrames) return;
-  const auto payload = echo::decode(echo::kAnswerType, data, size);
+                             core::Clock::time_point arrival) {
+  if (family != kAnswerFrames) return;
+  const auto payload = decode(kAnswerType, data, size);
   std::lock_guard<std::mutex> lock(mutex_);
   if (!payload || !expected_ || *payload != *expected_ || answer_arrival_) {
     ++stats_.mismatches;
@@ -69,4 +67,4 @@ EchoStats EchoController::stats() const {
   return stats_;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::echo

@@ -2,19 +2,19 @@
 
 #include <chrono>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::echo {
 
-StatusReport echoStatus(const EchoStats& stats, const PortState& port) {
-  StatusReport report;
+core::StatusReport echoStatus(const EchoStats& stats, const core::PortState& port) {
+  core::StatusReport report;
   report.hardware_id = port.path;
   if (!port.connected) {
-    report.summary(StatusLevel::kError, "port " + port.path + " is not open");
+    report.summary(core::StatusLevel::kError, "port " + port.path + " is not open");
   } else if (stats.last_ping_failed) {
-    report.summary(StatusLevel::kWarn, "the last ping had no answer");
+    report.summary(core::StatusLevel::kWarn, "the last ping had no answer");
   } else if (stats.round_trips == 0) {
-    report.summary(StatusLevel::kOk, "no ping yet");
+    report.summary(core::StatusLevel::kOk, "no ping yet");
   } else {
-    report.summary(StatusLevel::kOk, "answering");
+    report.summary(core::StatusLevel::kOk, "answering");
   }
   report.add("port", port.path);
   report.add("pings", stats.pings);
@@ -29,4 +29,4 @@ StatusReport echoStatus(const EchoStats& stats, const PortState& port) {
   return report;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::echo

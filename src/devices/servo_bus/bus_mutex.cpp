@@ -3,7 +3,7 @@
 #include <chrono>
 #include <utility>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -23,7 +23,7 @@ void BusMutex::waitTurn(std::unique_lock<std::mutex>& lock, Predicate free) {
     // The reader thread: whoever holds the bus may be waiting for an answer only it can read.
     reader_waiting_ = true;
     lock.unlock();
-    const bool port_up = pump_->pump(Clock::now() + kReaderWaitSlice);
+    const bool port_up = pump_->pump(core::Clock::now() + kReaderWaitSlice);
     lock.lock();
     // A port that is down has nothing to read: the holder's write fails at once, so this wait
     // is short, but it must not spin.
@@ -120,4 +120,4 @@ void BusMutex::wakeWaiters(std::unique_lock<std::mutex>& lock) {
   lock.lock();
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
-namespace serial_robot_driver::trajectory {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 constexpr double kMaxRotateIntervalMs = 65535.0;  // ROTATE's interval is a u16
 }  // namespace
 
-std::vector<BusJoint> makeBusJoints(const params::ServoBusParams& params) {
+std::vector<BusJoint> makeBusJoints(const devices::servo_bus::ServoBusParams& params) {
   std::vector<BusJoint> joints;
   for (std::size_t i = 0; i < params.joint_ids.size(); ++i) {
     BusJoint joint;
@@ -57,4 +57,4 @@ TrajectoryJoints busTrajectoryJoints(const std::vector<BusJoint>& joints, QueueS
   return result;
 }
 
-}  // namespace serial_robot_driver::trajectory
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -11,26 +11,24 @@
 
 #include "servo_bus_text.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
-constexpr uint8_t kBroadcastId = 255;
-constexpr uint8_t kServoIdParam = protocol::servo::dataId(protocol::servo::ServoDataId::kServoId);
+constexpr uint8_t kServoIdParam = dataId(ServoDataId::kServoId);
 constexpr uint8_t kIdAfterReset = 0;  // RESET_USER_DATA sets the servo's id to 0
 
 std::string servoLabel(uint8_t id) { return "servo " + std::to_string(id); }
 
 /// The parameters that change where or how a servo moves, or where its stop goes.
 bool affectsMotion(uint8_t data_id) {
-  using protocol::servo::ServoDataId;
   constexpr std::array<ServoDataId, 10> kMotionParams = {
       ServoDataId::kServoId,          ServoDataId::kBaudrate,        ServoDataId::kResponseSwitch,
       ServoDataId::kStallProtectMode, ServoDataId::kStallPowerLimit, ServoDataId::kAccelSwitch,
       ServoDataId::kAngleLimitSwitch, ServoDataId::kAngleLimitHigh,  ServoDataId::kAngleLimitLow,
       ServoDataId::kAngleMidOffset};
   return std::any_of(kMotionParams.begin(), kMotionParams.end(),
-                     [&](ServoDataId id) { return protocol::servo::dataId(id) == data_id; });
+                     [&](ServoDataId id) { return dataId(id) == data_id; });
 }
 
 ServoStatus eStopRefusal(uint8_t id) {
@@ -60,9 +58,9 @@ const char* toString(ShutdownAction action) {
 }
 
 MotionSafety::MotionSafety(const std::vector<uint8_t>& polled_ids, const ServoBusConfig& settings,
-                           ServoBusClient& client, const ServoBusEvents& events, LoopClock& clock,
-                           std::mutex& mutex, StopKeeper& stops, const ServoPoller& poller,
-                           Hooks hooks)
+                           ServoBusClient& client, const ServoBusEvents& events,
+                           core::LoopClock& clock, std::mutex& mutex, StopKeeper& stops,
+                           const ServoPoller& poller, Hooks hooks)
     : polled_ids_(polled_ids),
       settings_(settings),
       client_(client),
@@ -95,7 +93,7 @@ ServoStatus MotionSafety::refusal(uint8_t id) const {
   return refusalLocked(id);
 }
 
-ServoStatus MotionSafety::accept(uint8_t id, MotionGate::Generation* generation) const {
+ServoStatus MotionSafety::accept(uint8_t id, core::MotionGate::Generation* generation) const {
   if (id == kBroadcastId) {
     return {ServoError::kInvalidArgument,
             "motions to id 255 (broadcast) are refused: nothing answers them, so the driver could "
@@ -105,7 +103,7 @@ ServoStatus MotionSafety::accept(uint8_t id, MotionGate::Generation* generation)
   // The generation first: an e-stop engaged after this line voids the command at the write, one
   // engaged before it is still engaged below (or was released: the command came after it).
   *generation = gate_.generation();
-  if (gate_.state() == GateState::kLocked) return eStopRefusal(id);
+  if (gate_.state() == core::GateState::kLocked) return eStopRefusal(id);
   return refusal(id);
 }
 
@@ -125,7 +123,7 @@ ServoStatus MotionSafety::refusalLocked(uint8_t id) const {
 }
 
 ServoStatus MotionSafety::move(const MoveRequest& request) {
-  MotionGate::Generation generation = 0;
+  core::MotionGate::Generation generation = 0;
   ServoStatus status = accept(request.id, &generation);
   if (!status.ok()) return status;
   status = client_.move(request, BusPriority::kCaller, generation);
@@ -134,7 +132,7 @@ ServoStatus MotionSafety::move(const MoveRequest& request) {
 }
 
 ServoStatus MotionSafety::rotate(const RotateRequest& request) {
-  MotionGate::Generation generation = 0;
+  core::MotionGate::Generation generation = 0;
   ServoStatus status = accept(request.id, &generation);
   if (!status.ok()) return status;
   status = client_.rotate(request, generation);
@@ -145,7 +143,7 @@ ServoStatus MotionSafety::rotate(const RotateRequest& request) {
 ServoStatus MotionSafety::spin(const SpinRequest& request) {
   // A SPIN stop is always let through: it is what the e-stop itself sends.
   const bool stop = request.mode == 0;
-  MotionGate::Generation generation = 0;
+  core::MotionGate::Generation generation = 0;
   ServoStatus status = stop ? ServoStatus{} : accept(request.id, &generation);
   if (!status.ok()) return status;
   status = client_.spin(request, stop ? std::nullopt : std::optional(generation));
@@ -192,9 +190,9 @@ ServoStatus MotionSafety::hold(const std::vector<uint8_t>& ids) {
             "no servo given and none configured (state_ids, joint_ids)"};
   }
   std::string held;
-  std::optional<MotionGate::Generation> accepted;  // the call's: noted at its first check
+  std::optional<core::MotionGate::Generation> accepted;  // the call's: noted at its first check
   for (uint8_t id : targets) {
-    MotionGate::Generation generation = 0;
+    core::MotionGate::Generation generation = 0;
     ServoStatus status = accept(id, &generation);
     if (!status.ok()) return status;
     if (!accepted) accepted = generation;
@@ -234,7 +232,7 @@ ServoStatus MotionSafety::settingRefusal(uint8_t id, const std::string& what) co
 }
 
 ServoStatus MotionSafety::writeParam(uint8_t id, std::string_view param, int64_t value) {
-  const protocol::servo::ParamInfo* info = protocol::servo::findParam(param);
+  const ParamInfo* info = findParam(param);
   if (info != nullptr && affectsMotion(info->data_id)) {
     const ServoStatus refused = settingRefusal(id, "a write of '" + std::string(info->name) + "'");
     if (!refused.ok()) return refused;
@@ -294,14 +292,14 @@ void MotionSafety::setMotionLocked(bool locked) {
       return;
     }
     hooks_.drop_queued_moves_locked();
-    const Clock::time_point now = clock_.now();
+    const core::Clock::time_point now = clock_.now();
     for (uint8_t id : commanded_) stops_.armLocked(id, now, /*repeat=*/true);
     if (stops_.emptyLocked()) return;
   }
   hooks_.deliver_stops();
 }
 
-bool MotionSafety::rearmStopsLocked(Clock::time_point now) {
+bool MotionSafety::rearmStopsLocked(core::Clock::time_point now) {
   if (motion_locked_) {
     for (uint8_t id : commanded_) stops_.armLocked(id, now, /*repeat=*/true);
   }
@@ -324,7 +322,7 @@ void MotionSafety::finalWords() {
   std::unique_lock<std::mutex> lock(mutex_);
   switch (in_force.on_shutdown) {
     case ShutdownAction::kStop: {
-      const Clock::time_point now = clock_.now();
+      const core::Clock::time_point now = clock_.now();
       stops_.endRepeatsLocked();  // each ends once seen at rest: the budget is short
       for (uint8_t id : commanded_) stops_.armLocked(id, now);
       // Back to back on this thread (the worker has stopped), until each is seen at rest.
@@ -367,4 +365,4 @@ void MotionSafety::finalWords() {
   }
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

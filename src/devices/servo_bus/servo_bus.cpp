@@ -5,14 +5,14 @@
 
 #include "serial_robot_driver/devices/servo_bus/servo_joint_commands.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-ServoBus::ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events,
-                   std::shared_ptr<LoopClock> clock)
+ServoBus::ServoBus(ServoBusConfig config, core::FrameWriter writer, ServoBusEvents events,
+                   std::shared_ptr<core::LoopClock> clock)
     : config_(std::move(config)),
       settings_(config_),
       events_(std::move(events)),
-      clock_(clock ? std::move(clock) : steadyLoopClock()),
+      clock_(clock ? std::move(clock) : core::steadyLoopClock()),
       client_(config_.client, std::move(writer)),
       poller_(config_.polled_ids, settings_, client_, events_, *clock_, mutex_,
               {[this](uint8_t id) { dropQueuedMovesLocked(id); },
@@ -29,7 +29,7 @@ ServoBus::~ServoBus() { shutdown(); }
 void ServoBus::onLinkDown() { client_.onLinkDown(); }
 
 void ServoBus::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                       Clock::time_point arrival) {
+                       core::Clock::time_point arrival) {
   client_.onFrame(family, data, size, arrival);
 }
 
@@ -39,7 +39,7 @@ void ServoBus::queueMoves(const std::vector<MoveRequest>& moves) {
     // The e-stop holds: the caller refused (and counted) it already.
     if (safety_.motionLockedLocked()) return;
     // Under mutex_: an e-stop engaged after this note drops the queue (or voids the write).
-    const MotionGate::Generation accepted = safety_.gate().generation();
+    const core::MotionGate::Generation accepted = safety_.gate().generation();
     for (const MoveRequest& move : moves) {
       auto queued = std::find_if(queued_moves_.begin(), queued_moves_.end(),
                                  [&move](const QueuedMove& q) { return q.move.id == move.id; });
@@ -117,12 +117,12 @@ ServoBusWorkerStats ServoBus::stats() const {
   return stats;
 }
 
-void ServoBus::runOn(SerialLink& link) {
+void ServoBus::runOn(core::SerialLink& link) {
   link_ = &link;
   link.addListener(this);
   link.setWorker(this);
   client_.setReaderPump({[&link] { return link.onReaderThread(); },
-                         [&link](Clock::time_point until) { return link.pump(until); },
+                         [&link](core::Clock::time_point until) { return link.pump(until); },
                          [&link] { link.wake(); }});
 }
 
@@ -131,13 +131,13 @@ void ServoBus::wakeWorker() {
   if (link_ != nullptr) link_->wake();
 }
 
-Clock::time_point ServoBus::nextWorkLocked() const {
-  if (!started_ || stop_) return Clock::time_point::max();
-  if (!queued_moves_.empty()) return Clock::time_point::min();
+core::Clock::time_point ServoBus::nextWorkLocked() const {
+  if (!started_ || stop_) return core::Clock::time_point::max();
+  if (!queued_moves_.empty()) return core::Clock::time_point::min();
   return std::min(stops_.nextWorkLocked(), poller_.nextPollLocked());
 }
 
-Clock::time_point ServoBus::nextWork() {
+core::Clock::time_point ServoBus::nextWork() {
   std::lock_guard<std::mutex> lock(mutex_);
   return nextWorkLocked();
 }
@@ -155,9 +155,9 @@ void ServoBus::work() {
 void ServoBus::workerLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
-    Clock::time_point due = nextWorkLocked();
+    core::Clock::time_point due = nextWorkLocked();
     // Nothing scheduled: wait to be woken (bounded, so the clock's arithmetic cannot overflow).
-    if (due == Clock::time_point::max()) due = clock_->now() + std::chrono::hours(1);
+    if (due == core::Clock::time_point::max()) due = clock_->now() + std::chrono::hours(1);
     if (clock_->now() < due) {
       clock_->waitUntil(lock, wake_, due);
     } else {
@@ -278,4 +278,4 @@ std::vector<PendingStopReport> ServoBus::pendingStops() const { return stops_.re
 std::vector<ServoHealthReport> ServoBus::health() const { return poller_.health(); }
 std::vector<ServoIdentityReport> ServoBus::identities() const { return poller_.identities(); }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -10,11 +10,8 @@
 
 #include "servo_bus_text.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-namespace servo = protocol::servo;
-using servo::Command;
-using servo::ParamInfo;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
 
 namespace {
@@ -22,28 +19,28 @@ namespace {
 constexpr uint8_t kMaxSpinMode = 3;
 constexpr double kDegreesPerTurn = 360.0;
 
-constexpr uint8_t kServoIdParam = servo::dataId(servo::ServoDataId::kServoId);
-constexpr uint8_t kBaudrateParam = servo::dataId(servo::ServoDataId::kBaudrate);
+constexpr uint8_t kServoIdParam = dataId(ServoDataId::kServoId);
+constexpr uint8_t kBaudrateParam = dataId(ServoDataId::kBaudrate);
 constexpr std::size_t kReadDataHeader = 2;  // id, data_id, then the value
 constexpr uint8_t kDefaultServoId = 0;      // what RESET_USER_DATA sets the id to
 
-ServoStatus fromWriteCheck(servo::WriteCheck check, const ParamInfo& param, int64_t value) {
+ServoStatus fromWriteCheck(WriteCheck check, const ParamInfo& param, int64_t value) {
   ServoError error = ServoError::kInvalidArgument;
   switch (check) {
-    case servo::WriteCheck::kOk:
+    case WriteCheck::kOk:
       return ok("");
-    case servo::WriteCheck::kReadOnly:
+    case WriteCheck::kReadOnly:
       error = ServoError::kReadOnly;
       break;
-    case servo::WriteCheck::kOutOfRange:
+    case WriteCheck::kOutOfRange:
       error = ServoError::kOutOfRange;
       break;
-    case servo::WriteCheck::kDangerous:
+    case WriteCheck::kDangerous:
       error = ServoError::kDangerous;
       break;
   }
   // The switch that arms dangerous writes is named by the caller's layer (a ROS parameter there).
-  return fail(error, servo::describe(check, param, value));
+  return fail(error, describe(check, param, value));
 }
 
 ServoParamValue toParamValue(const ParamInfo& param, int64_t raw) {
@@ -64,15 +61,15 @@ std::string valueText(const ServoParamValue& value) {
 
 }  // namespace
 
-ServoBusClient::ServoBusClient(ServoBusOptions options, FrameWriter writer)
+ServoBusClient::ServoBusClient(ServoBusOptions options, core::FrameWriter writer)
     : transactions_(std::move(options), std::move(writer)) {}
 
 // Queries: PING, scan, READ_ANGLE and the multi-turn angle.
 
 ServoStatus ServoBusClient::pingLocked(uint8_t id) {
-  servo::Packet answer;
+  Packet answer;
   const ServoStatus status =
-      transactions_.exchangeLocked(servo::encodePing(id), Expectation(Command::kPing, id), &answer);
+      transactions_.exchangeLocked(encodePing(id), Expectation(Command::kPing, id), &answer);
   if (!status.ok()) return status;
   return ok(servoName(id) + " is online (" + status.message + ")");
 }
@@ -83,13 +80,13 @@ ServoStatus ServoBusClient::ping(uint8_t id) {
   return pingLocked(id);
 }
 
-ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival,
-                                      BusPriority priority) {
+ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg,
+                                      core::Clock::time_point* arrival, BusPriority priority) {
   if (auto rejection = rejectBroadcast(id, Command::kReadAngle)) return *rejection;
-  servo::Packet answer;
-  Clock::time_point answered_at;
+  Packet answer;
+  core::Clock::time_point answered_at;
   ServoStatus status;
-  const std::vector<uint8_t> request = servo::encodeReadAngle(id);
+  const std::vector<uint8_t> request = encodeReadAngle(id);
   const Expectation expect(Command::kReadAngle, id);
   if (!transactions_.takeBus(priority)) {
     return fail(ServoError::kPreempted, servoName(id) + "'s READ_ANGLE gave way to a stop");
@@ -104,7 +101,7 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
                                     &answered_at);
   }
   if (!status.ok()) return status;
-  const protocol::Decoded<servo::AngleAnswer> decoded = servo::decodeAngleAnswer(answer);
+  const protocol::Decoded<AngleAnswer> decoded = decodeAngleAnswer(answer);
   if (!decoded) return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable angle");
   if (arrival != nullptr) *arrival = answered_at;
   *angle_deg = decoded->angle_decidegrees / kDecidegreesPerDegree;
@@ -117,11 +114,11 @@ ServoStatus ServoBusClient::readAngle(uint8_t id, double* angle_deg, Clock::time
 
 ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* reading) {
   if (auto rejection = rejectBroadcast(id, Command::kReadMultiTurnAngle)) return *rejection;
-  servo::Packet answer;
+  Packet answer;
   const ServoStatus status = transactions_.exchange(
-      servo::encodeReadMultiTurnAngle(id), Expectation(Command::kReadMultiTurnAngle, id), &answer);
+      encodeReadMultiTurnAngle(id), Expectation(Command::kReadMultiTurnAngle, id), &answer);
   if (!status.ok()) return status;
-  const protocol::Decoded<servo::MultiTurnAngle> decoded = servo::decodeMultiTurnAngle(answer);
+  const protocol::Decoded<MultiTurnAngle> decoded = decodeMultiTurnAngle(answer);
   if (!decoded) {
     return fail(ServoError::kBadAnswer, servoName(id) + " sent an unreadable multi-turn angle");
   }
@@ -133,8 +130,8 @@ ServoStatus ServoBusClient::readMultiTurnAngle(uint8_t id, MultiTurnReading* rea
 }
 
 ServoStatus ServoBusClient::pingOnceLocked(uint8_t id) {
-  servo::Packet answer;
-  return transactions_.transact(servo::encodePing(id), Expectation(Command::kPing, id),
+  Packet answer;
+  return transactions_.transact(encodePing(id), Expectation(Command::kPing, id),
                                 transactions_.options().timeout, 1, &answer);
 }
 
@@ -143,7 +140,7 @@ ServoStatus ServoBusClient::scan(uint8_t first_id, uint8_t last_id, std::vector<
     return fail(ServoError::kInvalidArgument, "first_id " + std::to_string(first_id) +
                                                   " is above last_id " + std::to_string(last_id));
   }
-  if (last_id == servo::kBroadcastId) {
+  if (last_id == kBroadcastId) {
     return fail(ServoError::kInvalidArgument,
                 "id 255 is the broadcast address and cannot be scanned (ids 0..254)");
   }
@@ -170,13 +167,13 @@ ServoStatus ServoBusClient::scan(uint8_t first_id, uint8_t last_id, std::vector<
 ServoStatus ServoBusClient::readParamLocked(uint8_t id, const ParamInfo& param,
                                             ServoParamValue* value) {
   // The answer's size follows from the parameter's type, not from the command alone.
-  Expectation expect(Command::kReadData, id, kReadDataHeader + servo::typeSize(param.type));
+  Expectation expect(Command::kReadData, id, kReadDataHeader + typeSize(param.type));
   expect.data_id = param.data_id;
-  servo::Packet answer;
+  Packet answer;
   const ServoStatus status =
-      transactions_.exchangeLocked(servo::encodeReadData(id, param.data_id), expect, &answer);
+      transactions_.exchangeLocked(encodeReadData(id, param.data_id), expect, &answer);
   if (!status.ok()) return status;
-  const protocol::Decoded<int64_t> raw = servo::decodeReadDataAnswer(answer, param);
+  const protocol::Decoded<int64_t> raw = decodeReadDataAnswer(answer, param);
   if (!raw) {
     return fail(ServoError::kBadAnswer,
                 servoName(id) + " sent an unreadable value for " + quoted(param.name));
@@ -187,7 +184,7 @@ ServoStatus ServoBusClient::readParamLocked(uint8_t id, const ParamInfo& param,
 
 ServoStatus ServoBusClient::readParam(uint8_t id, std::string_view param_name,
                                       ServoParamValue* value, BusPriority priority) {
-  const ParamInfo* param = servo::findParam(param_name);
+  const ParamInfo* param = findParam(param_name);
   if (param == nullptr) {
     return fail(ServoError::kUnknownParam,
                 "unknown servo parameter " + quoted(param_name) +
@@ -218,16 +215,16 @@ ServoStatus ServoBusClient::checkIdFreeLocked(uint8_t id, uint8_t new_id) {
 }
 
 ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, int64_t value) {
-  const ParamInfo* param = servo::findParam(param_name);
+  const ParamInfo* param = findParam(param_name);
   if (param == nullptr) {
     return fail(ServoError::kUnknownParam,
                 "unknown servo parameter " + quoted(param_name) +
                     " (use a name such as 'soft_start_time' or a data_id such as '50')");
   }
   if (auto rejection = rejectBroadcast(id, Command::kWriteData)) return *rejection;
-  const servo::WriteCheck check =
-      servo::checkWrite(*param, value, transactions_.options().allow_dangerous_writes);
-  if (check != servo::WriteCheck::kOk) return fromWriteCheck(check, *param, value);
+  const WriteCheck check =
+      checkWrite(*param, value, transactions_.options().allow_dangerous_writes);
+  if (check != WriteCheck::kOk) return fromWriteCheck(check, *param, value);
 
   // One lock for the probe, the write and the read-back: no other call comes between them, but
   // each transaction hands the bus to a stop first (transact), so a stop waits for one attempt.
@@ -242,9 +239,9 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
   Expectation expect(Command::kWriteData, id);
   if (id_change) expect.alt_id = new_id;  // the answer may already come from the new address
   expect.data_id = param->data_id;
-  servo::Packet answer;
+  Packet answer;
   const ServoStatus status =
-      transactions_.exchangeLocked(servo::encodeWriteData(id, *param, value), expect, &answer);
+      transactions_.exchangeLocked(encodeWriteData(id, *param, value), expect, &answer);
   if (!status.ok()) return status;
   const std::string assignment = quoted(param->name) + " = " + std::to_string(value);
   if (refused(answer)) {
@@ -277,18 +274,18 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
 
 ServoStatus ServoBusClient::readAll(uint8_t id, std::vector<ServoParamValue>* values) {
   if (auto rejection = rejectBroadcast(id, Command::kReadBatchData)) return *rejection;
-  servo::Packet answer;
+  Packet answer;
   const ServoStatus status = transactions_.exchange(
-      servo::encodeReadBatchData(id), Expectation(Command::kReadBatchData, id), &answer);
+      encodeReadBatchData(id), Expectation(Command::kReadBatchData, id), &answer);
   if (!status.ok()) return status;
 
   // The exchange checked the answer's size against the command table, so the block is whole.
-  const auto block = servo::decodeUserBlock(answer);
+  const auto block = decodeUserBlock(answer);
   if (!block) {
     return fail(ServoError::kBadAnswer, servoName(id) + " sent a user block of the wrong size");
   }
   std::vector<ServoParamValue> result;
-  for (const auto& [param, raw] : servo::unpackUserBlock(*block)) {
+  for (const auto& [param, raw] : unpackUserBlock(*block)) {
     result.push_back(toParamValue(*param, raw));
   }
   const std::size_t count = result.size();
@@ -310,10 +307,9 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
   ServoStatus last;
   const ServoBusOptions options = transactions_.options();  // the same for every attempt
   for (int attempt = 1; attempt <= options.retries + 1; ++attempt) {
-    servo::Packet answer;
+    Packet answer;
     // One attempt at a time: a re-sent reset would go to an id the servo may have left already.
-    last =
-        transactions_.transact(servo::encodeResetUserData(id), expect, options.timeout, 1, &answer);
+    last = transactions_.transact(encodeResetUserData(id), expect, options.timeout, 1, &answer);
     if (last.ok()) {
       if (refused(answer)) {
         return fail(ServoError::kRefused, servoName(id) + " refused RESET_USER_DATA (result 0)");
@@ -341,18 +337,18 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
 // Motions: servo/move (CMD 8, 11..15), ROTATE, SPIN and DAMPING.
 
 ServoStatus ServoBusClient::move(const MoveRequest& request, BusPriority priority,
-                                 std::optional<MotionGate::Generation> accepted) {
-  servo::MoveCommand command;
+                                 std::optional<core::MotionGate::Generation> accepted) {
+  MoveCommand command;
   const ServoStatus checked = toMoveCommand(request, &command);
   if (!checked.ok()) return checked;
-  const std::vector<uint8_t> frame = servo::encodeMove(command);
+  const std::vector<uint8_t> frame = encodeMove(command);
   if (!transactions_.takeBus(priority)) return gaveWayToAStop(command.cmd, request.id);
   std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
   return transactions_.sendCommand(frame, command.cmd, request.id, FrameGate::kMotion, accepted);
 }
 
 ServoStatus ServoBusClient::rotate(const RotateRequest& request,
-                                   std::optional<MotionGate::Generation> accepted) {
+                                   std::optional<core::MotionGate::Generation> accepted) {
   if (!std::isfinite(request.angle_deg)) {
     return fail(ServoError::kInvalidArgument, "angle is not a finite number");
   }
@@ -367,28 +363,28 @@ ServoStatus ServoBusClient::rotate(const RotateRequest& request,
   if (request.wait) {
     if (auto rejection = rejectBroadcast(request.id, Command::kRotate)) return *rejection;
   }
-  const std::vector<uint8_t> frame = servo::encodeRotate(
-      request.id, static_cast<int16_t>(decidegrees), request.interval_ms, request.power_mw);
+  const std::vector<uint8_t> frame = encodeRotate(request.id, static_cast<int16_t>(decidegrees),
+                                                  request.interval_ms, request.power_mw);
   return sendMotion(frame, Command::kRotate, request.id, request.wait,
                     std::chrono::milliseconds(request.interval_ms), FrameGate::kMotion,
                     request.priority, accepted);
 }
 
 ServoStatus ServoBusClient::spin(const SpinRequest& request,
-                                 std::optional<MotionGate::Generation> accepted) {
+                                 std::optional<core::MotionGate::Generation> accepted) {
   if (request.mode > kMaxSpinMode) {
     return fail(ServoError::kInvalidArgument,
                 "spin mode " + std::to_string(request.mode) +
                     " is out of range 0..3 (0 stop, 1 continuous, 2 turns, 3 milliseconds)");
   }
-  const auto mode = static_cast<servo::SpinMode>(request.mode);
+  const auto mode = static_cast<SpinMode>(request.mode);
   std::chrono::milliseconds motion_time{0};
   if (request.wait) {
     if (auto rejection = rejectBroadcast(request.id, Command::kSpin)) return *rejection;
     double expected_ms = 0.0;
-    if (mode == servo::SpinMode::kDurationMs) {
+    if (mode == SpinMode::kDurationMs) {
       expected_ms = request.value;
-    } else if (mode == servo::SpinMode::kTurns && request.speed_dps > 0) {
+    } else if (mode == SpinMode::kTurns && request.speed_dps > 0) {
       expected_ms = request.value * kDegreesPerTurn * 1000.0 / request.speed_dps;
     }
     // A service must not hang: long spins are started without waiting and polled instead.
@@ -403,9 +399,9 @@ ServoStatus ServoBusClient::spin(const SpinRequest& request,
     motion_time = std::chrono::milliseconds(std::llround(expected_ms));
   }
   const std::vector<uint8_t> frame =
-      servo::encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
+      encodeSpin(request.id, request.clockwise, mode, request.speed_dps, request.value);
   // A SPIN stop is what the e-stop itself sends: never held back, and urgent work.
-  const bool stop = mode == servo::SpinMode::kStop;
+  const bool stop = mode == SpinMode::kStop;
   return sendMotion(frame, Command::kSpin, request.id, request.wait, motion_time,
                     stop ? FrameGate::kSafetyAction : FrameGate::kMotion,
                     stop ? BusPriority::kStop : request.priority, accepted);
@@ -415,7 +411,7 @@ ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, Fr
   if (wait) {
     if (auto rejection = rejectBroadcast(id, Command::kDamping)) return *rejection;
   }
-  const std::vector<uint8_t> frame = servo::encodeDamping(id, power_mw);
+  const std::vector<uint8_t> frame = encodeDamping(id, power_mw);
   // Torque off moves nothing: it goes out as a stop does.
   return sendMotion(frame, Command::kDamping, id, wait, std::chrono::milliseconds(0), gate,
                     BusPriority::kStop, std::nullopt);
@@ -424,11 +420,11 @@ ServoStatus ServoBusClient::damping(uint8_t id, uint16_t power_mw, bool wait, Fr
 ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
                                        bool wait, std::chrono::milliseconds motion_time,
                                        FrameGate gate, BusPriority priority,
-                                       std::optional<MotionGate::Generation> accepted) {
+                                       std::optional<core::MotionGate::Generation> accepted) {
   if (!transactions_.takeBus(priority)) return gaveWayToAStop(cmd, id);
   std::lock_guard<BusMutex> bus(transactions_.busMutex(), std::adopt_lock);
   if (!wait) return transactions_.sendCommand(request, cmd, id, gate, accepted);
-  servo::Packet answer;
+  Packet answer;
   // A motion is never re-sent: with response_switch = 1 commands are queued, so a second copy
   // would run the motion twice.
   ServoStatus status = transactions_.transact(request, Expectation(cmd, id),
@@ -448,4 +444,4 @@ ServoStatus ServoBusClient::sendMotion(const std::vector<uint8_t>& request, Comm
             status.message);
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -5,7 +5,7 @@
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "servo_layouts.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -38,7 +38,7 @@ std::vector<uint8_t> buildRequest(Command cmd, layout::FieldList<Record> fields,
                                   std::size_t tail_size = 0) {
   std::array<uint8_t, kMaxContent> content{};
   const std::size_t size = fields.size();
-  wire::encodeFields(fields, record, content.data());
+  protocol::wire::encodeFields(fields, record, content.data());
   std::copy(tail, tail + tail_size, content.begin() + size);
   return buildRequest(cmd, content.data(), size + tail_size);
 }
@@ -52,7 +52,7 @@ template <typename Record>
 std::vector<uint8_t> contentOf(layout::FieldList<Record> fields, const Record& record,
                                const uint8_t* tail = nullptr, std::size_t tail_size = 0) {
   std::vector<uint8_t> content(fields.size() + tail_size);
-  wire::encodeFields(fields, record, content.data());
+  protocol::wire::encodeFields(fields, record, content.data());
   std::copy(tail, tail + tail_size, content.begin() + fields.size());
   return content;
 }
@@ -60,24 +60,24 @@ std::vector<uint8_t> contentOf(layout::FieldList<Record> fields, const Record& r
 // `record` with the members `fields` describe read from `content`, which must be exactly their
 // size.
 template <typename Record>
-Decoded<Record> decodeExactly(layout::FieldList<Record> fields, const uint8_t* content,
-                              std::size_t content_size, Record record = {}) {
-  if (content_size != fields.size()) return DecodeError::kBadLength;
-  wire::decodeFields(fields, content, &record);
+protocol::Decoded<Record> decodeExactly(layout::FieldList<Record> fields, const uint8_t* content,
+                                        std::size_t content_size, Record record = {}) {
+  if (content_size != fields.size()) return protocol::DecodeError::kBadLength;
+  protocol::wire::decodeFields(fields, content, &record);
   return record;
 }
 
-Decoded<Packet> decodePacket(uint8_t header0, uint8_t header1, const uint8_t* data,
-                             std::size_t size) {
-  if (size < kContentOffset) return DecodeError::kTooShort;
-  if (data[0] != header0 || data[1] != header1) return DecodeError::kBadHeader;
+protocol::Decoded<Packet> decodePacket(uint8_t header0, uint8_t header1, const uint8_t* data,
+                                       std::size_t size) {
+  if (size < kContentOffset) return protocol::DecodeError::kTooShort;
+  if (data[0] != header0 || data[1] != header1) return protocol::DecodeError::kBadHeader;
   const uint8_t content_size = data[kSizeOffset];
-  if (content_size > kMaxContent) return DecodeError::kBadLength;
-  if (size < content_size + kOverhead) return DecodeError::kTooShort;
-  if (size > content_size + kOverhead) return DecodeError::kBadLength;
+  if (content_size > kMaxContent) return protocol::DecodeError::kBadLength;
+  if (size < content_size + kOverhead) return protocol::DecodeError::kTooShort;
+  if (size > content_size + kOverhead) return protocol::DecodeError::kBadLength;
   const uint8_t cmd = data[kCmdOffset];
-  if (!isKnownCommand(cmd)) return DecodeError::kUnknownCommand;
-  if (byteSum(data, size - 1) != data[size - 1]) return DecodeError::kBadChecksum;
+  if (!isKnownCommand(cmd)) return protocol::DecodeError::kUnknownCommand;
+  if (byteSum(data, size - 1) != data[size - 1]) return protocol::DecodeError::kBadChecksum;
 
   Packet packet;
   packet.cmd = cmd;
@@ -86,7 +86,8 @@ Decoded<Packet> decodePacket(uint8_t header0, uint8_t header1, const uint8_t* da
   return packet;
 }
 
-Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data, std::size_t available);
+protocol::Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data,
+                            std::size_t available);
 
 }  // namespace
 
@@ -139,8 +140,9 @@ std::vector<uint8_t> encodeDamping(uint8_t id, uint16_t power_mw) {
                       layout::PowerContent{id, power_mw});
 }
 
-Decoded<uint16_t> decodeDamping(const Packet& request) {
-  if (request.cmd != static_cast<uint8_t>(Command::kDamping)) return DecodeError::kUnknownCommand;
+protocol::Decoded<uint16_t> decodeDamping(const Packet& request) {
+  if (request.cmd != static_cast<uint8_t>(Command::kDamping))
+    return protocol::DecodeError::kUnknownCommand;
   const auto damping =
       decodeExactly(layout::listOf(layout::kDamping), request.content.data(), request.content_size);
   if (!damping) return damping.error();
@@ -180,21 +182,22 @@ std::vector<uint8_t> encodeSpin(const SpinCommand& spin) {
 bool isMove(Command cmd) { return layout::moveFields(cmd).count > 0; }
 bool isMultiTurn(Command cmd) {
   const auto* angle = layout::moveFields(cmd).find("angle");
-  return angle != nullptr && angle->type.width == wire::kI32.width;
+  return angle != nullptr && angle->type.width == protocol::wire::kI32.width;
 }
 bool isByVelocity(Command cmd) { return layout::moveFields(cmd).has("velocity"); }
 bool hasRamps(Command cmd) { return layout::moveFields(cmd).has("accel"); }
 
-Decoded<MoveCommand> decodeMove(const Packet& request) {
+protocol::Decoded<MoveCommand> decodeMove(const Packet& request) {
   const auto cmd = static_cast<Command>(request.cmd);
-  if (!isMove(cmd)) return DecodeError::kUnknownCommand;
+  if (!isMove(cmd)) return protocol::DecodeError::kUnknownCommand;
   MoveCommand move;
   move.cmd = cmd;
   return decodeExactly(layout::moveFields(cmd), request.content.data(), request.content_size, move);
 }
 
-Decoded<SpinCommand> decodeSpin(const Packet& request) {
-  if (request.cmd != static_cast<uint8_t>(Command::kSpin)) return DecodeError::kUnknownCommand;
+protocol::Decoded<SpinCommand> decodeSpin(const Packet& request) {
+  if (request.cmd != static_cast<uint8_t>(Command::kSpin))
+    return protocol::DecodeError::kUnknownCommand;
   return decodeExactly(layout::listOf(layout::kSpin), request.content.data(), request.content_size);
 }
 
@@ -216,12 +219,12 @@ std::vector<uint8_t> angleAnswerContent(const AngleAnswer& answer) {
   return contentOf(layout::listOf(layout::kAngleAnswer), answer);
 }
 
-Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer) {
+protocol::Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer) {
   return decodeExactly(layout::listOf(layout::kAngleAnswer), answer.content.data(),
                        answer.content_size);
 }
 
-Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer) {
+protocol::Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer) {
   return decodeMultiTurnAngle(answer.content.data(), answer.content_size);
 }
 
@@ -232,25 +235,25 @@ std::vector<uint8_t> readDataAnswerContent(uint8_t id, const ParamInfo& param, i
                    value_bytes.data(), value_size);
 }
 
-Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param) {
+protocol::Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param) {
   const std::size_t value_offset = layout::listOf(layout::kDataId).size();
-  if (answer.content_size < value_offset) return DecodeError::kBadLength;
+  if (answer.content_size < value_offset) return protocol::DecodeError::kBadLength;
   const std::optional<int64_t> value =
       readValue(param, answer.content.data() + value_offset, answer.content_size - value_offset);
-  if (!value) return DecodeError::kBadLength;
+  if (!value) return protocol::DecodeError::kBadLength;
   return *value;
 }
 
-Decoded<DataContent> decodeDataContent(const Packet& packet) {
+protocol::Decoded<DataContent> decodeDataContent(const Packet& packet) {
   const auto fields = layout::listOf(layout::kDataId);
-  if (packet.content_size < fields.size()) return DecodeError::kBadLength;
+  if (packet.content_size < fields.size()) return protocol::DecodeError::kBadLength;
   layout::DataIdContent head;
-  wire::decodeFields(fields, packet.content.data(), &head);
+  protocol::wire::decodeFields(fields, packet.content.data(), &head);
   DataContent data;
   data.id = head.id;
   data.data_id = head.data_id;
   data.value_size = packet.content_size - fields.size();
-  if (data.value_size > data.value.size()) return DecodeError::kBadLength;
+  if (data.value_size > data.value.size()) return protocol::DecodeError::kBadLength;
   std::copy_n(packet.content.begin() + fields.size(), data.value_size, data.value.begin());
   return data;
 }
@@ -260,9 +263,10 @@ std::vector<uint8_t> userBlockAnswerContent(uint8_t id,
   return contentOf(layout::listOf(layout::kId), layout::IdContent{id}, block.data(), block.size());
 }
 
-Decoded<std::array<uint8_t, kUserBlockSize>> decodeUserBlock(const Packet& packet) {
+protocol::Decoded<std::array<uint8_t, kUserBlockSize>> decodeUserBlock(const Packet& packet) {
   const std::size_t block_offset = layout::listOf(layout::kId).size();
-  if (packet.content_size != block_offset + kUserBlockSize) return DecodeError::kBadLength;
+  if (packet.content_size != block_offset + kUserBlockSize)
+    return protocol::DecodeError::kBadLength;
   std::array<uint8_t, kUserBlockSize> block{};
   std::copy_n(packet.content.begin() + block_offset, kUserBlockSize, block.begin());
   return block;
@@ -311,7 +315,7 @@ std::vector<uint8_t> encodeReadMultiTurnAngle(uint8_t id) {
   return buildIdOnlyRequest(Command::kReadMultiTurnAngle, id);
 }
 
-Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size) {
+protocol::Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size) {
   return decodeExactly(layout::listOf(layout::kMultiTurnAngle), content, size);
 }
 
@@ -320,38 +324,41 @@ std::vector<uint8_t> multiTurnAngleContent(const MultiTurnAngle& angle) {
 }
 
 namespace {
-Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data, std::size_t available) {
-  if (available < 1) return Probe::needMore();
-  if (data[0] != header0) return Probe::invalid(DecodeError::kBadHeader);
-  if (available < 2) return Probe::needMore();
-  if (data[1] != header1) return Probe::invalid(DecodeError::kBadHeader);
-  if (available <= kSizeOffset) return Probe::needMore();
+protocol::Probe probePacket(uint8_t header0, uint8_t header1, const uint8_t* data,
+                            std::size_t available) {
+  if (available < 1) return protocol::Probe::needMore();
+  if (data[0] != header0) return protocol::Probe::invalid(protocol::DecodeError::kBadHeader);
+  if (available < 2) return protocol::Probe::needMore();
+  if (data[1] != header1) return protocol::Probe::invalid(protocol::DecodeError::kBadHeader);
+  if (available <= kSizeOffset) return protocol::Probe::needMore();
   const uint8_t cmd = data[kCmdOffset];
   const uint8_t content_size = data[kSizeOffset];
   // Both mean a corrupted or misaligned header, but they are counted apart: an unknown CMD may
   // also be a newer firmware's command.
-  if (!isKnownCommand(cmd)) return Probe::invalid(DecodeError::kUnknownCommand);
-  if (content_size > kMaxContent) return Probe::invalid(DecodeError::kBadLength);
+  if (!isKnownCommand(cmd)) return protocol::Probe::invalid(protocol::DecodeError::kUnknownCommand);
+  if (content_size > kMaxContent)
+    return protocol::Probe::invalid(protocol::DecodeError::kBadLength);
   const std::size_t size = content_size + kOverhead;
-  if (available < size) return Probe::needMore();
-  if (byteSum(data, size - 1) != data[size - 1]) return Probe::invalid(DecodeError::kBadChecksum);
-  return Probe::frame(size);
+  if (available < size) return protocol::Probe::needMore();
+  if (byteSum(data, size - 1) != data[size - 1])
+    return protocol::Probe::invalid(protocol::DecodeError::kBadChecksum);
+  return protocol::Probe::frame(size);
 }
 }  // namespace
 
-Probe probeResponse(const uint8_t* data, std::size_t available) {
+protocol::Probe probeResponse(const uint8_t* data, std::size_t available) {
   return probePacket(kResponseHeader0, kResponseHeader1, data, available);
 }
 
-Probe probeRequest(const uint8_t* data, std::size_t available) {
+protocol::Probe probeRequest(const uint8_t* data, std::size_t available) {
   return probePacket(kRequestHeader0, kRequestHeader1, data, available);
 }
 
-Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size) {
+protocol::Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size) {
   return decodePacket(kResponseHeader0, kResponseHeader1, data, size);
 }
 
-Decoded<Packet> decodeRequest(const uint8_t* data, std::size_t size) {
+protocol::Decoded<Packet> decodeRequest(const uint8_t* data, std::size_t size) {
   return decodePacket(kRequestHeader0, kRequestHeader1, data, size);
 }
 
@@ -361,29 +368,30 @@ std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& con
   return buildPacket(kResponseHeader0, kResponseHeader1, cmd, content.data(), content.size());
 }
 
-static_assert(kMaxFrameSize <= StreamFramer::kLongestFrame, "servo frame too long for the framer");
+static_assert(kMaxFrameSize <= protocol::StreamFramer::kLongestFrame,
+              "servo frame too long for the framer");
 
-constexpr FrameFamily kResponseFrames{"servo_response", kResponseHeader0,
-                                      [](const uint8_t* data, std::size_t available, std::size_t) {
-                                        return probeResponse(data, available);
-                                      },
-                                      0,
-                                      [](const uint8_t* frame, std::size_t size, std::size_t) {
-                                        const auto decoded = decodeResponse(frame, size);
-                                        return decoded.ok() &&
-                                               decoded->content_size + kOverhead == size;
-                                      }};
+constexpr protocol::FrameFamily kResponseFrames{
+    "servo_response", kResponseHeader0,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probeResponse(data, available);
+    },
+    0,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      const auto decoded = decodeResponse(frame, size);
+      return decoded.ok() && decoded->content_size + kOverhead == size;
+    }};
 
 // Rank 1: after the body's telemetry, which shares the first byte 0x12.
-constexpr FrameFamily kRequestFrames{"servo_request", kRequestHeader0,
-                                     [](const uint8_t* data, std::size_t available, std::size_t) {
-                                       return probeRequest(data, available);
-                                     },
-                                     1,
-                                     [](const uint8_t* frame, std::size_t size, std::size_t) {
-                                       const auto decoded = decodeRequest(frame, size);
-                                       return decoded.ok() &&
-                                              decoded->content_size + kOverhead == size;
-                                     }};
+constexpr protocol::FrameFamily kRequestFrames{
+    "servo_request", kRequestHeader0,
+    [](const uint8_t* data, std::size_t available, std::size_t) {
+      return probeRequest(data, available);
+    },
+    1,
+    [](const uint8_t* frame, std::size_t size, std::size_t) {
+      const auto decoded = decodeRequest(frame, size);
+      return decoded.ok() && decoded->content_size + kOverhead == size;
+    }};
 
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -3,9 +3,9 @@
 #include <chrono>
 #include <vector>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-StatusReport ServoBusDiagnostics::servoStatus(uint8_t id) const {
+core::StatusReport ServoBusDiagnostics::servoStatus(uint8_t id) const {
   const double health_rate = bus_.settings().health_rate;
   const std::vector<ServoHealthReport> health =
       health_rate > 0.0 ? bus_.health() : std::vector<ServoHealthReport>{};
@@ -13,7 +13,7 @@ StatusReport ServoBusDiagnostics::servoStatus(uint8_t id) const {
   for (const ServoHealthReport& report : health) {
     if (report.id == id) found = &report;
   }
-  StatusReport report = servoHealthStatus(id, health_rate, found);
+  core::StatusReport report = servoHealthStatus(id, health_rate, found);
   const std::vector<ServoIdentityReport> identities = bus_.identities();
   const ServoIdentityReport* identity = nullptr;
   for (const ServoIdentityReport& candidate : identities) {
@@ -24,7 +24,7 @@ StatusReport ServoBusDiagnostics::servoStatus(uint8_t id) const {
   return report;
 }
 
-StatusReport ServoBusDiagnostics::busStatus(uint64_t commands_rejected) {
+core::StatusReport ServoBusDiagnostics::busStatus(uint64_t commands_rejected) {
   ServoBusSnapshot bus;
   bus.port = {link_.options().path, link_.connected()};
   bus.stats = bus_.client().stats();
@@ -39,4 +39,4 @@ StatusReport ServoBusDiagnostics::busStatus(uint64_t commands_rejected) {
   return status_.update(bus, std::chrono::steady_clock::now());
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

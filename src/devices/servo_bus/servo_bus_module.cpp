@@ -4,14 +4,14 @@
 #include <cmath>
 #include <set>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
-namespace serial_robot_driver::params {
-extern const SectionKey<ServoBusParams> kServoBusSection{"servo_bus"};
+namespace serial_robot_driver::devices::servo_bus {
+extern const params::SectionKey<ServoBusParams> kServoBusSection{"servo_bus"};
 }
 
 namespace serial_robot_driver::devices::servo_bus {
@@ -20,7 +20,6 @@ namespace {
 
 using params::DriverParams;
 using params::require;
-using params::ServoBusParams;
 
 /// A list of bus servo ids: each addressable (255 is the broadcast address), none twice.
 void busServoIds(const std::vector<int>& ids, const std::string& key) {
@@ -41,12 +40,12 @@ std::chrono::milliseconds wholeMilliseconds(double seconds) {
 
 // The section's three parts, each with its own rows: the bus's configuration, its client's
 // options and the ROS layer's own values.
-using Bus = device::ServoBusConfig;
-using Client = device::ServoBusOptions;
+using Bus = ServoBusConfig;
+using Client = ServoBusOptions;
 using BusRows = params::SectionRows<Bus>;
 using OwnRows = params::SectionRows<ServoBusParams>;
 
-ServoBusParams& section(DriverParams& p) { return p.section(params::kServoBusSection); }
+ServoBusParams& section(DriverParams& p) { return p.section(kServoBusSection); }
 
 /// A whole-number row of a uint16_t field of the bus's configuration.
 void addUint16(BusRows& rows, const char* name, uint16_t& (*field)(Bus&), params::Rule<int> rule) {
@@ -97,14 +96,14 @@ void addSafetyRows(BusRows& bus) {
       bus, "relax_power_mw", [](Bus& c) -> uint16_t& { return c.relax_power_mw; },
       params::integerWithin(0, 65535, "mW"));
   bus.addConverted<std::string>(
-      "on_shutdown", [](Bus& c) -> device::ShutdownAction& { return c.on_shutdown; },
+      "on_shutdown", [](Bus& c) -> ShutdownAction& { return c.on_shutdown; },
       // Checked before: only a disabled bus's value can be unknown, and it is never used.
       [](const std::string& v) {
-        return device::shutdownActionFromString(v).value_or(device::ShutdownAction::kStop);
+        return shutdownActionFromString(v).value_or(ShutdownAction::kStop);
       },
-      [](device::ShutdownAction action) { return std::string(device::toString(action)); },
+      [](ShutdownAction action) { return std::string(toString(action)); },
       [](const std::string& v, const std::string& key) {
-        require(device::shutdownActionFromString(v).has_value(), key,
+        require(shutdownActionFromString(v).has_value(), key,
                 "must be stop, relax or none, got '" + v + "'");
       });
   bus.add("health_rate", &Bus::health_rate, params::numberWithin(0.0, 10.0, "Hz (0: off)"))
@@ -137,7 +136,7 @@ void addParameters(std::vector<params::ParamSpec>& table) {
 }
 
 void validate(const DriverParams& p) {
-  const ServoBusParams& bus = p.section(params::kServoBusSection);
+  const ServoBusParams& bus = p.section(kServoBusSection);
   const std::size_t n = bus.joint_ids.size();
   const auto requireOnePerJoint = [n](std::size_t size, const std::string& name,
                                       bool may_be_empty) {
@@ -149,7 +148,7 @@ void validate(const DriverParams& p) {
   requireOnePerJoint(bus.joint_zero_deg.size(), "servo_bus/joint_zero_deg", true);
   requireOnePerJoint(bus.joint_directions.size(), "servo_bus/joint_directions", true);
   if (!p.enabled("body")) return;
-  const std::vector<std::string>& body_joints = p.section(params::kBodySection).joint_names;
+  const std::vector<std::string>& body_joints = p.section(body::kBodySection).joint_names;
   for (const std::string& name : bus.joint_names) {
     require(std::find(body_joints.begin(), body_joints.end(), name) == body_joints.end(),
             "servo_bus/joint_names",
@@ -159,20 +158,20 @@ void validate(const DriverParams& p) {
 
 }  // namespace
 
-extern const device::DeviceModule kModule{
+extern const core::DeviceModule kModule{
     .name = "servo_bus",
     .title = "Servo bus",
     // The bus is half duplex: the driver's own requests come back as an echo.
-    .driver_frames = {protocol::servo::kResponseFrames, protocol::servo::kRequestFrames},
-    .simulator_frames = {protocol::servo::kRequestFrames},
-    .sections = {&params::kServoBusSection},
+    .driver_frames = {kResponseFrames, kRequestFrames},
+    .simulator_frames = {kRequestFrames},
+    .sections = {&kServoBusSection},
     .add_parameters = addParameters,
     .validate = validate,
     // A servo answer must not wait behind a stray header longer than an answer may take.
     .stale_frame_timeout =
         [](const DriverParams& p) {
           return std::max(std::chrono::milliseconds(1),
-                          p.section(params::kServoBusSection).bus.client.timeout);
+                          p.section(kServoBusSection).bus.client.timeout);
         },
 };
 

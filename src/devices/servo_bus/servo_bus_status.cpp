@@ -2,23 +2,24 @@
 
 #include <cstdio>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-StatusReport servoHealthStatus(uint8_t id, double health_rate, const ServoHealthReport* found) {
-  StatusReport status;
+core::StatusReport servoHealthStatus(uint8_t id, double health_rate,
+                                     const ServoHealthReport* found) {
+  core::StatusReport status;
   const std::string name = "servo " + std::to_string(id);
   if (health_rate <= 0.0) {
-    status.summary(StatusLevel::kOk, name + ": health poll off (~servo_bus/health_rate 0)");
+    status.summary(core::StatusLevel::kOk, name + ": health poll off (~servo_bus/health_rate 0)");
     return status;
   }
   if (!found || !found->polled) {
-    status.summary(StatusLevel::kOk, name + ": no health poll yet");
+    status.summary(core::StatusLevel::kOk, name + ": no health poll yet");
     return status;
   }
   const ServoHealthReport& report = *found;
   status.add("online", report.online);
   if (!report.online) {
-    status.summary(StatusLevel::kError, name + " does not answer: " + report.last_error);
+    status.summary(core::StatusLevel::kError, name + " does not answer: " + report.last_error);
     return status;
   }
   const ServoReadings& r = report.readings;
@@ -39,22 +40,22 @@ StatusReport servoHealthStatus(uint8_t id, double health_rate, const ServoHealth
   status.add("relaxed for its temperature (protect)", report.overheated);
   switch (report.assessment.level) {
     case HealthLevel::kOk:
-      status.summary(StatusLevel::kOk, name + " ok");
+      status.summary(core::StatusLevel::kOk, name + " ok");
       break;
     case HealthLevel::kWarn:
-      status.summary(StatusLevel::kWarn, report.assessment.message);
+      status.summary(core::StatusLevel::kWarn, report.assessment.message);
       break;
     case HealthLevel::kError:
-      status.summary(StatusLevel::kError, report.assessment.message);
+      status.summary(core::StatusLevel::kError, report.assessment.message);
       break;
   }
   if (report.overheated) {
-    status.mergeSummary(StatusLevel::kError, "relaxed, moves refused until it has cooled");
+    status.mergeSummary(core::StatusLevel::kError, "relaxed, moves refused until it has cooled");
   }
   return status;
 }
 
-void addServoIdentity(const ServoIdentityReport* found, StatusReport* status) {
+void addServoIdentity(const ServoIdentityReport* found, core::StatusReport* status) {
   if (!found || !found->known) {
     status->add("identity", "not read yet (read once the servo answers)");
     return;
@@ -66,20 +67,20 @@ void addServoIdentity(const ServoIdentityReport* found, StatusReport* status) {
   status->add("response_switch", static_cast<int>(identity.response_switch));
   status->add("angle limits", describeAngleLimits(identity));
   for (const std::string& warning : found->warnings) {
-    status->mergeSummary(StatusLevel::kWarn, warning);
+    status->mergeSummary(core::StatusLevel::kWarn, warning);
   }
 }
 
 namespace {
 
 /// The summary by the port, its transaction counters and the options in force on it.
-void addLink(const ServoBusSnapshot& bus, StatusReport* status) {
+void addLink(const ServoBusSnapshot& bus, core::StatusReport* status) {
   const ServoBusStats& stats = bus.stats;
   if (bus.port.connected) {
-    status->summary(StatusLevel::kOk, std::to_string(stats.transactions) + " transactions, " +
-                                          std::to_string(stats.timeouts) + " timeouts");
+    status->summary(core::StatusLevel::kOk, std::to_string(stats.transactions) + " transactions, " +
+                                                std::to_string(stats.timeouts) + " timeouts");
   } else {
-    status->summary(StatusLevel::kWarn, "servo bus port is not connected");
+    status->summary(core::StatusLevel::kWarn, "servo bus port is not connected");
   }
   status->hardware_id = bus.port.path;
   status->add("port", bus.port.path);
@@ -99,7 +100,7 @@ void addLink(const ServoBusSnapshot& bus, StatusReport* status) {
 }
 
 /// The polls, the moves, the e-stop's stops not yet confirmed and the settings in force.
-void addWorker(const ServoBusSnapshot& bus, StatusReport* status) {
+void addWorker(const ServoBusSnapshot& bus, core::StatusReport* status) {
   const ServoBusWorkerStats& worker = bus.worker;
   const std::string offline = servoIdList(worker.offline_ids);
   status->add("servo_states published", worker.angles_polled);
@@ -117,21 +118,22 @@ void addWorker(const ServoBusSnapshot& bus, StatusReport* status) {
   }
   status->add("stops not yet confirmed", unconfirmed.empty() ? std::string("none") : unconfirmed);
   if (!unconfirmed.empty()) {
-    status->mergeSummary(StatusLevel::kError, "stop not yet known to have reached " + unconfirmed);
+    status->mergeSummary(core::StatusLevel::kError,
+                         "stop not yet known to have reached " + unconfirmed);
   }
   status->add("on shutdown", toString(bus.in_force.on_shutdown));
   status->add("health polls per second", bus.in_force.health_rate);
   status->add("protect", bus.in_force.protect);
   if (!offline.empty() && bus.port.connected) {
-    status->mergeSummary(StatusLevel::kWarn, "polled servos not answering: " + offline);
+    status->mergeSummary(core::StatusLevel::kWarn, "polled servos not answering: " + offline);
   }
 }
 
 }  // namespace
 
-StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
-                                    std::chrono::steady_clock::time_point now) {
-  StatusReport status;
+core::StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
+                                          std::chrono::steady_clock::time_point now) {
+  core::StatusReport status;
   addLink(bus, &status);
   addWorker(bus, &status);
   addPollRate(bus, now, &status);
@@ -139,7 +141,8 @@ StatusReport ServoBusStatus::update(const ServoBusSnapshot& bus,
 }
 
 void ServoBusStatus::addPollRate(const ServoBusSnapshot& bus,
-                                 std::chrono::steady_clock::time_point now, StatusReport* status) {
+                                 std::chrono::steady_clock::time_point now,
+                                 core::StatusReport* status) {
   // Asked vs achieved: the state_rate in force for every answering polled servo, against the
   // angles read over the window. A line too slow for what was asked (or service calls taking
   // the bus) shows here rather than as a silently lower rate.
@@ -159,7 +162,7 @@ void ServoBusStatus::addPollRate(const ServoBusSnapshot& bus,
   if (achieved_rate_ < 0) return;  // the first window is not over yet
   status->addf("servo_states achieved (per s)", "%.1f", achieved_rate_);
   if (bus.port.connected && asked > 0 && achieved_rate_ < kRateSlack * asked) {
-    status->mergeSummaryf(StatusLevel::kWarn,
+    status->mergeSummaryf(core::StatusLevel::kWarn,
                           "servo_states: %.0f reads/s asked, the bus delivers %.0f/s (the line or "
                           "service calls are the limit: lower ~servo_bus/state_rate or raise the "
                           "baud)",
@@ -167,4 +170,4 @@ void ServoBusStatus::addPollRate(const ServoBusSnapshot& bus,
   }
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -2,9 +2,7 @@
 
 #include <cstdio>
 
-namespace serial_robot_driver::device::servo_text {
-
-namespace servo = protocol::servo;
+namespace serial_robot_driver::devices::servo_bus::servo_text {
 
 std::string formatNumber(double value) {
   char text[32];
@@ -13,7 +11,7 @@ std::string formatNumber(double value) {
 }
 
 std::string servoName(uint8_t id) {
-  if (id == servo::kBroadcastId) return "all servos (broadcast id 255)";
+  if (id == kBroadcastId) return "all servos (broadcast id 255)";
   return "servo " + std::to_string(id);
 }
 
@@ -39,17 +37,17 @@ ServoStatus notConnected() {
   return fail(ServoError::kNotConnected, "servo bus port is not connected");
 }
 
-std::optional<ServoStatus> rejectBroadcast(uint8_t id, servo::Command cmd) {
-  if (id != servo::kBroadcastId) return std::nullopt;
+std::optional<ServoStatus> rejectBroadcast(uint8_t id, Command cmd) {
+  if (id != kBroadcastId) return std::nullopt;
   return fail(ServoError::kInvalidArgument, std::string("id 255 is the broadcast address; ") +
                                                 commandName(cmd) +
                                                 " needs the answer of one servo (ids 0..254)");
 }
 
-bool refused(const servo::Packet& answer) {
-  const int index = servo::commandInfo(static_cast<servo::Command>(answer.cmd)).result_index;
-  return index != servo::kNoResult && index < answer.content_size &&
+bool refused(const Packet& answer) {
+  const int index = commandInfo(static_cast<Command>(answer.cmd)).result_index;
+  return index != kNoResult && index < answer.content_size &&
          answer.content[index] == kResultFailed;
 }
 
-}  // namespace serial_robot_driver::device::servo_text
+}  // namespace serial_robot_driver::devices::servo_bus::servo_text

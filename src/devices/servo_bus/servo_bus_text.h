@@ -10,7 +10,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
-namespace serial_robot_driver::device::servo_text {
+namespace serial_robot_driver::devices::servo_bus::servo_text {
 
 constexpr double kDecidegreesPerDegree = 10.0;
 constexpr uint8_t kResultFailed = 0;
@@ -22,9 +22,7 @@ std::string attemptsText(int attempts);
 std::string servoName(uint8_t id);
 /// Quotes a name for a message; a caller's absurdly long string is cut, not echoed in full.
 std::string quoted(std::string_view name);
-inline const char* commandName(protocol::servo::Command cmd) {
-  return protocol::servo::commandInfo(cmd).name;
-}
+inline const char* commandName(Command cmd) { return commandInfo(cmd).name; }
 
 inline ServoStatus ok(std::string message) { return {ServoError::kOk, std::move(message)}; }
 inline ServoStatus fail(ServoError error, std::string message) {
@@ -33,8 +31,8 @@ inline ServoStatus fail(ServoError error, std::string message) {
 ServoStatus notConnected();
 /// Commands that need one servo's answer cannot go to the broadcast id: every servo would answer
 /// at once and the answers would collide on the bus.
-std::optional<ServoStatus> rejectBroadcast(uint8_t id, protocol::servo::Command cmd);
+std::optional<ServoStatus> rejectBroadcast(uint8_t id, Command cmd);
 /// Whether an answer that passed the client's checks reports failure (result 0).
-bool refused(const protocol::servo::Packet& answer);
+bool refused(const Packet& answer);
 
-}  // namespace serial_robot_driver::device::servo_text
+}  // namespace serial_robot_driver::devices::servo_bus::servo_text

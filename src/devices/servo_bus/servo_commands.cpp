@@ -2,7 +2,7 @@
 
 #include "servo_layouts.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -71,4 +71,4 @@ const std::array<CommandInfo, kMaxCommand>& commandTable() { return kTable; }
 
 const CommandInfo& commandInfo(Command cmd) { return kTable[commandRow(cmd)]; }
 
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

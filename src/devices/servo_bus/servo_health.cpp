@@ -2,7 +2,7 @@
 
 #include <vector>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -90,4 +90,4 @@ bool OverheatGuard::update(int64_t temperature_c, int64_t over_temperature_c) {
   return tripped_;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

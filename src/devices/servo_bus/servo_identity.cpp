@@ -5,7 +5,7 @@
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -132,4 +132,4 @@ ServoStatus readServoInfo(ServoBusClient& client, uint8_t id, const ServoIdentit
   return {ServoError::kOk, message};
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

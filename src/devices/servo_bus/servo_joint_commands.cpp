@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 constexpr double kDegreesPerRadian = 180.0 / M_PI;
@@ -75,4 +75,4 @@ ServoCommandBatch toServoMoves(const std::vector<std::string>& names,
   return batch;
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -12,14 +12,14 @@
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
 #include "serial_robot_driver/protocol/wire_fields.h"
 
-namespace serial_robot_driver::protocol::servo::layout {
+namespace serial_robot_driver::devices::servo_bus::layout {
 
-using wire::field;
-using wire::Field;
-using wire::FieldList;
-using wire::listOf;
-using wire::nestedField;
-constexpr auto kLE = wire::ByteOrder::kLittle;
+using protocol::wire::field;
+using protocol::wire::Field;
+using protocol::wire::FieldList;
+using protocol::wire::listOf;
+using protocol::wire::nestedField;
+constexpr auto kLE = protocol::wire::ByteOrder::kLittle;
 
 /// The answer field that says 1 (ok) or 0 (failed); the command table points at it.
 constexpr std::string_view kResultField = "result";
@@ -46,23 +46,24 @@ struct PowerContent {
   uint16_t power_mw = 0;
 };
 
-constexpr std::array<Field<IdContent>, 1> kId = {{field<&IdContent::id>("id", wire::kU8, kLE)}};
+constexpr std::array<Field<IdContent>, 1> kId = {
+    {field<&IdContent::id>("id", protocol::wire::kU8, kLE)}};
 constexpr std::array<Field<DataIdContent>, 2> kDataId = {{
-    field<&DataIdContent::id>("id", wire::kU8, kLE),
-    field<&DataIdContent::data_id>("data_id", wire::kU8, kLE),
+    field<&DataIdContent::id>("id", protocol::wire::kU8, kLE),
+    field<&DataIdContent::data_id>("data_id", protocol::wire::kU8, kLE),
 }};
 constexpr std::array<Field<ResultContent>, 2> kIdResult = {{
-    field<&ResultContent::id>("id", wire::kU8, kLE),
-    field<&ResultContent::result>(kResultField, wire::kU8, kLE),
+    field<&ResultContent::id>("id", protocol::wire::kU8, kLE),
+    field<&ResultContent::result>(kResultField, protocol::wire::kU8, kLE),
 }};
 constexpr std::array<Field<DataIdResult>, 3> kDataIdResult = {{
-    field<&DataIdResult::id>("id", wire::kU8, kLE),
-    field<&DataIdResult::data_id>("data_id", wire::kU8, kLE),
-    field<&DataIdResult::result>(kResultField, wire::kU8, kLE),
+    field<&DataIdResult::id>("id", protocol::wire::kU8, kLE),
+    field<&DataIdResult::data_id>("data_id", protocol::wire::kU8, kLE),
+    field<&DataIdResult::result>(kResultField, protocol::wire::kU8, kLE),
 }};
 constexpr std::array<Field<PowerContent>, 2> kDamping = {{
-    field<&PowerContent::id>("id", wire::kU8, kLE),
-    field<&PowerContent::power_mw>("power", wire::kU16, kLE, "mW"),
+    field<&PowerContent::id>("id", protocol::wire::kU8, kLE),
+    field<&PowerContent::power_mw>("power", protocol::wire::kU16, kLE, "mW"),
 }};
 
 // SPIN method byte: bit 7 direction, bits 1..0 mode; the other bits are not part of SPIN.
@@ -76,29 +77,31 @@ inline void setSpinMethod(SpinCommand& spin, int64_t method) {
   spin.mode = static_cast<SpinMode>(method & kSpinModeMask);
 }
 constexpr std::array<Field<SpinCommand>, 4> kSpin = {{
-    field<&SpinCommand::id>("id", wire::kU8, kLE),
-    {"method", wire::kU8, kLE, "", &spinMethodOf, &setSpinMethod},
-    field<&SpinCommand::speed_dps>("speed", wire::kU16, kLE, "deg/s"),
-    field<&SpinCommand::value>("value", wire::kU16, kLE, "turns or ms"),
+    field<&SpinCommand::id>("id", protocol::wire::kU8, kLE),
+    {"method", protocol::wire::kU8, kLE, "", &spinMethodOf, &setSpinMethod},
+    field<&SpinCommand::speed_dps>("speed", protocol::wire::kU16, kLE, "deg/s"),
+    field<&SpinCommand::value>("value", protocol::wire::kU16, kLE, "turns or ms"),
 }};
 
 // The moves: ROTATE and CMD 11..15 differ in the angle's and interval's widths and in which of
 // velocity, interval and ramps they carry.
-constexpr auto kMoveId = field<&MoveCommand::id>("id", wire::kU8, kLE);
+constexpr auto kMoveId = field<&MoveCommand::id>("id", protocol::wire::kU8, kLE);
 constexpr auto kAngle16 =
-    field<&MoveCommand::angle_decidegrees>("angle", wire::kI16, kLE, "0.1deg");
+    field<&MoveCommand::angle_decidegrees>("angle", protocol::wire::kI16, kLE, "0.1deg");
 constexpr auto kAngle32 =
-    field<&MoveCommand::angle_decidegrees>("angle", wire::kI32, kLE, "0.1deg");
-constexpr auto kInterval16 = field<&MoveCommand::interval_ms>("interval", wire::kU16, kLE, "ms");
-constexpr auto kInterval32 = field<&MoveCommand::interval_ms>("interval", wire::kU32, kLE, "ms");
-constexpr auto kVelocity =
-    field<&MoveCommand::velocity_decidegrees_per_s>("velocity", wire::kU16, kLE, "0.1deg/s");
-constexpr auto kAccel =
-    nestedField<&MoveCommand::ramps, &MoveRamps::accel_ms>("accel", wire::kU16, kLE, "ms");
-constexpr auto kDecel =
-    nestedField<&MoveCommand::ramps, &MoveRamps::decel_ms>("decel", wire::kU16, kLE, "ms");
-constexpr auto kPower =
-    nestedField<&MoveCommand::ramps, &MoveRamps::power_mw>("power", wire::kU16, kLE, "mW");
+    field<&MoveCommand::angle_decidegrees>("angle", protocol::wire::kI32, kLE, "0.1deg");
+constexpr auto kInterval16 =
+    field<&MoveCommand::interval_ms>("interval", protocol::wire::kU16, kLE, "ms");
+constexpr auto kInterval32 =
+    field<&MoveCommand::interval_ms>("interval", protocol::wire::kU32, kLE, "ms");
+constexpr auto kVelocity = field<&MoveCommand::velocity_decidegrees_per_s>(
+    "velocity", protocol::wire::kU16, kLE, "0.1deg/s");
+constexpr auto kAccel = nestedField<&MoveCommand::ramps, &MoveRamps::accel_ms>(
+    "accel", protocol::wire::kU16, kLE, "ms");
+constexpr auto kDecel = nestedField<&MoveCommand::ramps, &MoveRamps::decel_ms>(
+    "decel", protocol::wire::kU16, kLE, "ms");
+constexpr auto kPower = nestedField<&MoveCommand::ramps, &MoveRamps::power_mw>(
+    "power", protocol::wire::kU16, kLE, "mW");
 
 constexpr std::array<Field<MoveCommand>, 4> kRotate = {{kMoveId, kAngle16, kInterval16, kPower}};
 constexpr std::array<Field<MoveCommand>, 6> kMoveByInterval = {
@@ -133,13 +136,13 @@ constexpr FieldList<MoveCommand> moveFields(Command cmd) {
 }
 
 constexpr std::array<Field<AngleAnswer>, 2> kAngleAnswer = {{
-    field<&AngleAnswer::id>("id", wire::kU8, kLE),
-    field<&AngleAnswer::angle_decidegrees>("angle", wire::kI16, kLE, "0.1deg"),
+    field<&AngleAnswer::id>("id", protocol::wire::kU8, kLE),
+    field<&AngleAnswer::angle_decidegrees>("angle", protocol::wire::kI16, kLE, "0.1deg"),
 }};
 constexpr std::array<Field<MultiTurnAngle>, 3> kMultiTurnAngle = {{
-    field<&MultiTurnAngle::id>("id", wire::kU8, kLE),
-    field<&MultiTurnAngle::angle_decidegrees>("angle", wire::kI32, kLE, "0.1deg"),
-    field<&MultiTurnAngle::turns>("turns", wire::kI16, kLE),
+    field<&MultiTurnAngle::id>("id", protocol::wire::kU8, kLE),
+    field<&MultiTurnAngle::angle_decidegrees>("angle", protocol::wire::kI32, kLE, "0.1deg"),
+    field<&MultiTurnAngle::turns>("turns", protocol::wire::kI16, kLE),
 }};
 
 // --- what the command table needs of a layout --------------------------------------------------
@@ -171,4 +174,4 @@ constexpr ContentLayout content(const std::array<Field<Record>, N>& fields,
           result ? static_cast<int>(*result) : kNoResult};
 }
 
-}  // namespace serial_robot_driver::protocol::servo::layout
+}  // namespace serial_robot_driver::devices::servo_bus::layout

@@ -2,7 +2,7 @@
 
 #include "serial_robot_driver/devices/servo_bus/bus_trajectory_joints.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 ServoStatus ServoMotionClaims::refuseWhileEStopped(const std::string& source) {
   if (!e_stop_ || !e_stop_->refuse(source)) return {};
@@ -58,7 +58,7 @@ void ServoMotionClaims::yieldJoints(const std::vector<uint8_t>& ids, const char*
 }
 
 void ServoMotionClaims::yieldJoint(uint8_t id, const char* source) {
-  const trajectory::BusJoint* joint = trajectory::findBusJoint(joints_, id);
+  const trajectory::BusJoint* joint = findBusJoint(joints_, id);
   if (!trajectories_ || !joint) return;
   trajectories_->takeOver({joint->name}, source, [&] {
     // A trajectory move still queued must not follow the service's command.
@@ -70,7 +70,7 @@ void ServoMotionClaims::yieldJoint(uint8_t id, const char* source) {
 void ServoMotionClaims::queueCommand(const std::vector<MoveRequest>& moves, const char* source) {
   std::vector<std::string> joints;
   for (const MoveRequest& move : moves) {
-    if (const trajectory::BusJoint* joint = trajectory::findBusJoint(joints_, move.id)) {
+    if (const trajectory::BusJoint* joint = findBusJoint(joints_, move.id)) {
       joints.push_back(joint->name);
     }
   }
@@ -89,7 +89,7 @@ void ServoMotionClaims::followPollRate(double poll_rate) {
   if (!trajectories_ || joints_.empty()) return;
   std::vector<std::string> names;
   for (const trajectory::BusJoint& joint : joints_) names.push_back(joint.name);
-  trajectories_->setStateTimeout(names, trajectory::busStateTimeout(poll_rate));
+  trajectories_->setStateTimeout(names, busStateTimeout(poll_rate));
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

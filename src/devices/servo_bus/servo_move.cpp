@@ -8,10 +8,8 @@
 
 #include "servo_bus_text.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-namespace servo = protocol::servo;
-using servo::Command;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
 
 namespace {
@@ -59,7 +57,7 @@ std::string velocityProblem(const MoveRequest& request) {
 /// Given ramps the servo runs, and (by interval) an interval that fits the move and its ramps as
 /// they will be sent; "" if fine.
 std::string timingProblem(const MoveRequest& request, bool by_velocity, bool with_ramps,
-                          const servo::MoveRamps& ramps) {
+                          const MoveRamps& ramps) {
   for (const auto& [name, ramp] :
        {std::pair<const char*, uint16_t>{"accel_ms", request.accel_ms},
         std::pair<const char*, uint16_t>{"decel_ms", request.decel_ms}}) {
@@ -92,10 +90,10 @@ Command moveCommandFor(bool multi_turn, bool by_velocity, bool with_ramps) {
 
 }  // namespace
 
-ServoStatus toMoveCommand(const MoveRequest& request, servo::MoveCommand* out) {
+ServoStatus toMoveCommand(const MoveRequest& request, MoveCommand* out) {
   const bool by_velocity = request.velocity_dps > 0;
   const bool with_ramps = by_velocity || request.accel_ms > 0 || request.decel_ms > 0;
-  servo::MoveRamps ramps;
+  MoveRamps ramps;
   ramps.accel_ms = std::max(request.accel_ms, kMinRampMs);
   ramps.decel_ms = std::max(request.decel_ms, kMinRampMs);
   ramps.power_mw = request.power_mw;
@@ -105,7 +103,7 @@ ServoStatus toMoveCommand(const MoveRequest& request, servo::MoveCommand* out) {
   if (!problem.empty()) return fail(ServoError::kInvalidArgument, problem);
 
   // On the wire as the vendor SDK puts them: int(value * 10), truncated toward zero.
-  servo::MoveCommand& command = *out;
+  MoveCommand& command = *out;
   command.id = request.id;
   command.angle_decidegrees =
       static_cast<int32_t>(std::trunc(request.angle_deg * kDecidegreesPerDegree));
@@ -117,4 +115,4 @@ ServoStatus toMoveCommand(const MoveRequest& request, servo::MoveCommand* out) {
   return ok({});
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

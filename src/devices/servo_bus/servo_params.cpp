@@ -2,7 +2,7 @@
 
 #include <limits>
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -172,12 +172,14 @@ std::string describe(WriteCheck check, const ParamInfo& param, int64_t value) {
 
 std::optional<int64_t> readValue(const ParamInfo& param, const uint8_t* data, std::size_t size) {
   if (size != typeSize(param.type)) return std::nullopt;
-  return wire::readInteger(data, wireType(param.type), wire::ByteOrder::kLittle);
+  return protocol::wire::readInteger(data, wireType(param.type),
+                                     protocol::wire::ByteOrder::kLittle);
 }
 
 std::size_t writeValue(const ParamInfo& param, int64_t value, uint8_t* out) {
   // Two's complement: the low bytes of a negative i16 are its wire form.
-  wire::writeInteger(out, value, wireType(param.type), wire::ByteOrder::kLittle);
+  protocol::wire::writeInteger(out, value, wireType(param.type),
+                               protocol::wire::ByteOrder::kLittle);
   return typeSize(param.type);
 }
 
@@ -216,4 +218,4 @@ std::vector<std::pair<const ParamInfo*, int64_t>> unpackUserBlock(
   return values;
 }
 
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -4,7 +4,7 @@
 #include <string>
 #include <utility>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -17,15 +17,16 @@ const std::vector<const char*> kReadingNames = {"voltage", "current", "power", "
 const std::vector<const char*> kLimitNames = {"over_volt_low", "over_volt_high", "over_temperature",
                                               "over_power", "over_current"};
 
-Clock::duration periodOf(double rate_hz) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));
+core::Clock::duration periodOf(double rate_hz) {
+  return std::chrono::duration_cast<core::Clock::duration>(
+      std::chrono::duration<double>(1.0 / rate_hz));
 }
 
 }  // namespace
 
 ServoPoller::ServoPoller(const std::vector<uint8_t>& ids, const ServoBusConfig& settings,
-                         ServoBusClient& client, const ServoBusEvents& events, LoopClock& clock,
-                         std::mutex& mutex, Hooks hooks)
+                         ServoBusClient& client, const ServoBusEvents& events,
+                         core::LoopClock& clock, std::mutex& mutex, Hooks hooks)
     : settings_(settings),
       client_(client),
       events_(events),
@@ -34,7 +35,7 @@ ServoPoller::ServoPoller(const std::vector<uint8_t>& ids, const ServoBusConfig& 
       hooks_(std::move(hooks)),
       poll_period_(periodOf(settings.poll_rate)),
       read_identity_(settings.read_identity) {
-  const Clock::time_point now = clock_.now();
+  const core::Clock::time_point now = clock_.now();
   for (uint8_t id : ids) {
     PolledServo servo;
     servo.id = id;
@@ -52,8 +53,8 @@ ServoPoller::ServoPoller(const std::vector<uint8_t>& ids, const ServoBusConfig& 
   }
 }
 
-Clock::time_point ServoPoller::nextPollLocked() const {
-  Clock::time_point next = nextHealthPollLocked();
+core::Clock::time_point ServoPoller::nextPollLocked() const {
+  core::Clock::time_point next = nextHealthPollLocked();
   for (const PolledServo& servo : polled_) {
     next = std::min({next, servo.next_poll, servo.identity_due});
   }
@@ -61,7 +62,7 @@ Clock::time_point ServoPoller::nextPollLocked() const {
 }
 
 void ServoPoller::pollDue(std::unique_lock<std::mutex>& lock) {
-  const Clock::time_point now = clock_.now();
+  const core::Clock::time_point now = clock_.now();
   // A servo's identity first: read once, before its readings are judged.
   if (auto identity_due = identityDueLocked(now); identity_due != polled_.end()) {
     PolledServo& servo = *identity_due;
@@ -94,14 +95,14 @@ void ServoPoller::pollDue(std::unique_lock<std::mutex>& lock) {
 
 void ServoPoller::retuneLocked(double poll_rate, double health_rate) {
   poll_period_ = periodOf(poll_rate);
-  const Clock::time_point now = clock_.now();
-  const Clock::time_point soonest = now + poll_period_;
+  const core::Clock::time_point now = clock_.now();
+  const core::Clock::time_point soonest = now + poll_period_;
   for (PolledServo& servo : polled_) {
     // A servo in back-off keeps its back-off; the others are due within the new period.
     if (servo.backoff.count() == 0) servo.next_poll = std::min(servo.next_poll, soonest);
   }
   const bool health_was_off = health_period_.count() == 0;
-  health_period_ = health_rate > 0.0 ? periodOf(health_rate) : Clock::duration(0);
+  health_period_ = health_rate > 0.0 ? periodOf(health_rate) : core::Clock::duration(0);
   for (HealthServo& servo : health_) {
     servo.next_poll = health_was_off ? now : std::min(servo.next_poll, now + health_period_);
   }
@@ -130,14 +131,14 @@ void ServoPoller::pollAngleOnce(PolledServo& servo) {
   const ServoStatus status =
       client_.readAngle(servo.id, &sample.angle_deg, &sample.arrival, BusPriority::kBackground);
   if (status.error == ServoError::kPreempted) return;  // a stop went first: due again at once
-  const Clock::time_point now = clock_.now();
+  const core::Clock::time_point now = clock_.now();
   bool went_silent = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (status.error == ServoError::kNotConnected || status.error == ServoError::kShutdown) {
       // The port is down, not the servo: ask again at the poll rate, but no more often than
       // kPortDownRetry, so a down port at a high state_rate does not keep the worker busy.
-      servo.next_poll = now + std::max<Clock::duration>(poll_period_, kPortDownRetry);
+      servo.next_poll = now + std::max<core::Clock::duration>(poll_period_, kPortDownRetry);
       return;
     }
     if (!status.ok()) {
@@ -147,7 +148,8 @@ void ServoPoller::pollAngleOnce(PolledServo& servo) {
     } else {
       servo.backoff = std::chrono::milliseconds(0);
       // It answers: its identity is read once, as soon as the bus has time for it.
-      if (read_identity_ && !servo.identity.known && servo.identity_due == Clock::time_point::max())
+      if (read_identity_ && !servo.identity.known &&
+          servo.identity_due == core::Clock::time_point::max())
         servo.identity_due = now;
       // Keep the rate without drifting; after a stall, start again from now.
       servo.next_poll = std::max(servo.next_poll + poll_period_, now);
@@ -164,7 +166,7 @@ void ServoPoller::pollAngleOnce(PolledServo& servo) {
 }
 
 std::vector<ServoPoller::PolledServo>::iterator ServoPoller::identityDueLocked(
-    Clock::time_point now) {
+    core::Clock::time_point now) {
   auto due = std::min_element(
       polled_.begin(), polled_.end(),
       [](const PolledServo& a, const PolledServo& b) { return a.identity_due < b.identity_due; });
@@ -182,7 +184,7 @@ void ServoPoller::readIdentityOnce(PolledServo& servo) {
   ServoIdentityReport report;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    const Clock::time_point now = clock_.now();
+    const core::Clock::time_point now = clock_.now();
     if (status.error == ServoError::kNotConnected) {
       servo.identity_due = now + kPortDownRetry;  // the port, not the servo
       return;
@@ -198,7 +200,7 @@ void ServoPoller::readIdentityOnce(PolledServo& servo) {
     servo.identity.known = true;
     servo.identity.identity = identity;
     servo.identity.warnings = identityWarnings(servo.id, identity, settings_.identity);
-    servo.identity_due = Clock::time_point::max();  // read once
+    servo.identity_due = core::Clock::time_point::max();  // read once
     report = servo.identity;
   }
   if (events_.on_identity) events_.on_identity(report);
@@ -212,8 +214,8 @@ std::vector<ServoIdentityReport> ServoPoller::identities() const {
   return reports;
 }
 
-Clock::time_point ServoPoller::nextHealthPollLocked() const {
-  Clock::time_point next = Clock::time_point::max();
+core::Clock::time_point ServoPoller::nextHealthPollLocked() const {
+  core::Clock::time_point next = core::Clock::time_point::max();
   if (health_period_.count() == 0) return next;  // health_rate 0: off
   for (const HealthServo& servo : health_) next = std::min(next, servo.next_poll);
   return next;
@@ -314,4 +316,4 @@ void ServoPoller::relaxOverheated(uint8_t id) {
   hooks_.relaxed(id);
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

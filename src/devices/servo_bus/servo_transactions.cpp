@@ -6,15 +6,13 @@
 
 #include "servo_bus_text.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-namespace servo = protocol::servo;
-using servo::Command;
 using namespace servo_text;  // NOLINT: the shared sentences of every servo operation
 
 namespace {
 
-double toMs(Clock::duration duration) {
+double toMs(core::Clock::duration duration) {
   return std::chrono::duration<double, std::milli>(duration).count();
 }
 
@@ -63,9 +61,9 @@ const char* toString(ServoError error) {
 }
 
 ServoTransactions::Expectation::Expectation(Command answer_cmd, uint8_t answer_id)
-    : Expectation(answer_cmd, answer_id, servo::commandInfo(answer_cmd).answer.min) {}
+    : Expectation(answer_cmd, answer_id, commandInfo(answer_cmd).answer.min) {}
 
-ServoTransactions::ServoTransactions(ServoBusOptions options, FrameWriter writer)
+ServoTransactions::ServoTransactions(ServoBusOptions options, core::FrameWriter writer)
     : options_(std::move(options)), writer_(std::move(writer)) {}
 
 ServoBusStats ServoTransactions::stats() const {
@@ -87,7 +85,7 @@ void ServoTransactions::onLinkDown() {
   }
 }
 
-bool ServoTransactions::matches(const servo::Packet& packet) const {
+bool ServoTransactions::matches(const Packet& packet) const {
   const Expectation& expect = pending_.expect;
   if (packet.cmd != static_cast<uint8_t>(expect.cmd) || packet.content_size == 0) return false;
   const uint8_t id = packet.id();
@@ -100,8 +98,8 @@ bool ServoTransactions::matches(const servo::Packet& packet) const {
 }
 
 void ServoTransactions::onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-                                Clock::time_point arrival) {
-  if (family == protocol::servo::kRequestFrames) {
+                                core::Clock::time_point arrival) {
+  if (family == kRequestFrames) {
     // On a half-duplex adapter our own request comes back: recognise it, skip it.
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (!last_request_.empty() && size == last_request_.size() &&
@@ -112,9 +110,9 @@ void ServoTransactions::onFrame(protocol::FrameFamily family, const uint8_t* dat
     }
     return;
   }
-  if (family != protocol::servo::kResponseFrames) return;  // another device on this port
+  if (family != kResponseFrames) return;  // another device on this port
 
-  const protocol::Decoded<servo::Packet> packet = servo::decodeResponse(data, size);
+  const protocol::Decoded<Packet> packet = decodeResponse(data, size);
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (!packet.ok()) {
@@ -146,7 +144,7 @@ void ServoTransactions::setReaderPump(ReaderPump pump) {
 }
 
 void ServoTransactions::waitForAnswer(std::unique_lock<std::mutex>& lock,
-                                      Clock::time_point deadline) {
+                                      core::Clock::time_point deadline) {
   const auto settled = [this] {
     return pending_.answered || pending_.garbled || link_lost_ || stopping_ ||
            motionWaitCutLocked();
@@ -156,7 +154,7 @@ void ServoTransactions::waitForAnswer(std::unique_lock<std::mutex>& lock,
     return;
   }
   // The reader thread reads the answer itself: onFrame() runs inside pump(), on this thread.
-  while (!settled() && Clock::now() < deadline) {
+  while (!settled() && core::Clock::now() < deadline) {
     lock.unlock();
     const bool port_up = pump_.pump(deadline);
     lock.lock();
@@ -166,17 +164,17 @@ void ServoTransactions::waitForAnswer(std::unique_lock<std::mutex>& lock,
 
 std::optional<ServoStatus> ServoTransactions::writeRequest(
     const std::vector<uint8_t>& request, Command cmd, uint8_t id, FrameGate gate,
-    std::optional<MotionGate::Generation> accepted) {
+    std::optional<core::MotionGate::Generation> accepted) {
   bool written = false;
   if (gate == FrameGate::kMotion && gate_ != nullptr) {
-    const GateState state = gate_->writeIfOpen(
+    const core::GateState state = gate_->writeIfOpen(
         [&] {
           const bool out = writer_(request);
           if (out && on_motion_written_) on_motion_written_(id);
           return out;
         },
         &written, accepted);
-    if (state != GateState::kOpen) {
+    if (state != core::GateState::kOpen) {
       return fail(ServoError::kMotionRefused,
                   std::string(toString(state)) + ": " + commandName(cmd) + " to " + servoName(id) +
                       " was not written (refused when its turn on the bus came)");
@@ -191,9 +189,9 @@ std::optional<ServoStatus> ServoTransactions::writeRequest(
 ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
                                         const Expectation& expect,
                                         std::chrono::milliseconds timeout, int attempts,
-                                        servo::Packet* answer, FrameGate gate, bool give_way,
-                                        Clock::time_point* arrival,
-                                        std::optional<MotionGate::Generation> accepted) {
+                                        Packet* answer, FrameGate gate, bool give_way,
+                                        core::Clock::time_point* arrival,
+                                        std::optional<core::MotionGate::Generation> accepted) {
   bool any_garbled = false;
   std::size_t garbled_size = 0;
   for (int attempt = 1; attempt <= attempts; ++attempt) {
@@ -207,7 +205,7 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
     if (!beginAttempt(request, expect, gate)) {
       return fail(ServoError::kShutdown, "servo bus client is shutting down");
     }
-    const Clock::time_point sent_at = Clock::now();
+    const core::Clock::time_point sent_at = core::Clock::now();
     if (auto refusal = writeRequest(request, expect.cmd, expect.id, gate, accepted)) {
       std::lock_guard<std::mutex> lock(state_mutex_);
       pending_.active = false;
@@ -249,7 +247,7 @@ ServoStatus ServoTransactions::transact(const std::vector<uint8_t>& request,
   return timedOut(expect, timeout, attempts);
 }
 
-ServoStatus ServoTransactions::answeredLocked(Clock::time_point sent_at, servo::Packet* answer) {
+ServoStatus ServoTransactions::answeredLocked(core::Clock::time_point sent_at, Packet* answer) {
   const double latency_ms = toMs(pending_.arrival - sent_at);
   stats_.last_latency_ms = latency_ms;
   stats_.max_latency_ms = std::max(stats_.max_latency_ms, latency_ms);
@@ -299,7 +297,7 @@ void ServoTransactions::retune(const ServoClientTuning& next) {
 }
 
 ServoStatus ServoTransactions::exchangeLocked(const std::vector<uint8_t>& request,
-                                              const Expectation& expect, servo::Packet* answer) {
+                                              const Expectation& expect, Packet* answer) {
   const ServoBusOptions options = this->options();  // one transaction, one set of options
   return transact(request, expect, options.timeout, options.retries + 1, answer);
 }
@@ -343,14 +341,14 @@ bool ServoTransactions::takeBus(BusPriority priority) {
 }
 
 ServoStatus ServoTransactions::exchange(const std::vector<uint8_t>& request,
-                                        const Expectation& expect, servo::Packet* answer) {
+                                        const Expectation& expect, Packet* answer) {
   std::lock_guard<BusMutex> bus(bus_mutex_);
   return exchangeLocked(request, expect, answer);
 }
 
 ServoStatus ServoTransactions::sendCommand(const std::vector<uint8_t>& request, Command cmd,
                                            uint8_t id, FrameGate gate,
-                                           std::optional<MotionGate::Generation> accepted) {
+                                           std::optional<core::MotionGate::Generation> accepted) {
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (stopping_) return fail(ServoError::kShutdown, "servo bus client is shutting down");
@@ -370,8 +368,7 @@ void ServoTransactions::writeStops(const std::vector<uint8_t>& ids, std::vector<
   lockUrgent();
   std::lock_guard<BusMutex> bus(bus_mutex_, std::adopt_lock);
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    const std::vector<uint8_t> frame =
-        servo::encodeSpin(ids[i], false, servo::SpinMode::kStop, 0, 0);
+    const std::vector<uint8_t> frame = encodeSpin(ids[i], false, SpinMode::kStop, 0, 0);
     (*written)[i] = sendCommand(frame, Command::kSpin, ids[i], FrameGate::kSafetyAction).ok();
   }
 }
@@ -393,4 +390,4 @@ void ServoTransactions::endUrgent() {
   bus_mutex_.endUrgent();
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

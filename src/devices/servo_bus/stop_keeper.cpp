@@ -6,7 +6,7 @@
 #include <thread>
 #include <utility>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
@@ -20,7 +20,7 @@ std::chrono::milliseconds stopBackoff(int written) {
 
 }  // namespace
 
-StopKeeper::StopKeeper(ServoBusClient& client, const ServoBusEvents& events, LoopClock& clock,
+StopKeeper::StopKeeper(ServoBusClient& client, const ServoBusEvents& events, core::LoopClock& clock,
                        std::mutex& mutex, std::function<void(uint8_t id)> on_written_locked)
     : client_(client),
       events_(events),
@@ -28,7 +28,7 @@ StopKeeper::StopKeeper(ServoBusClient& client, const ServoBusEvents& events, Loo
       mutex_(mutex),
       on_written_locked_(std::move(on_written_locked)) {}
 
-void StopKeeper::armLocked(uint8_t id, Clock::time_point now, bool repeat) {
+void StopKeeper::armLocked(uint8_t id, core::Clock::time_point now, bool repeat) {
   PendingStop& stop = stops_[id];
   stop.phase = PendingStop::Phase::kWrite;
   stop.due = now;
@@ -36,7 +36,7 @@ void StopKeeper::armLocked(uint8_t id, Clock::time_point now, bool repeat) {
   stop.at_rest = false;  // seen at rest again before it is no longer pending
 }
 
-void StopKeeper::rearmAllLocked(Clock::time_point now) {
+void StopKeeper::rearmAllLocked(core::Clock::time_point now) {
   for (auto& [id, stop] : stops_) armLocked(id, now, stop.repeat);
 }
 
@@ -85,11 +85,11 @@ void StopKeeper::endUrgentLocked() {
   client_.endUrgent();  // takes only the client's own locks
 }
 
-Clock::time_point StopKeeper::nextWorkLocked() const {
+core::Clock::time_point StopKeeper::nextWorkLocked() const {
   // The bus is reserved for stops (askUrgent): the worker must see to it now, even when the stop
   // it was asked for is gone meanwhile (released, superseded), or every caller would wait.
-  if (urgent_asked_) return Clock::time_point::min();
-  Clock::time_point next = Clock::time_point::max();
+  if (urgent_asked_) return core::Clock::time_point::min();
+  core::Clock::time_point next = core::Clock::time_point::max();
   for (const auto& [id, stop] : stops_) next = std::min(next, stop.due);
   return next;
 }
@@ -104,7 +104,7 @@ std::vector<PendingStopReport> StopKeeper::reports() const {
 }
 
 bool StopKeeper::workOnce(std::unique_lock<std::mutex>& lock, StopPace pace) {
-  const Clock::time_point now = clock_.now();
+  const core::Clock::time_point now = clock_.now();
   const auto due = [&](const PendingStop& stop) {
     return pace == StopPace::kNow || stop.due <= now;
   };
@@ -127,7 +127,7 @@ bool StopKeeper::workOnce(std::unique_lock<std::mutex>& lock, StopPace pace) {
 
 void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
   std::vector<uint8_t> ids;
-  const Clock::time_point now = clock_.now();
+  const core::Clock::time_point now = clock_.now();
   for (const auto& [id, stop] : stops_) {
     if (stop.phase == PendingStop::Phase::kWrite && (pace == StopPace::kNow || stop.due <= now)) {
       ids.push_back(id);
@@ -137,7 +137,7 @@ void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
   lock.unlock();
   client_.writeStops(ids, &written);
   lock.lock();
-  const Clock::time_point after = clock_.now();
+  const core::Clock::time_point after = clock_.now();
   std::vector<std::pair<uint8_t, ServoStatus>> failures;
   for (std::size_t i = 0; i < ids.size(); ++i) {
     auto it = stops_.find(ids[i]);
@@ -153,7 +153,7 @@ void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
     }
     ++stop.written;
     on_written_locked_(ids[i]);
-    if (ids[i] == protocol::servo::kBroadcastId) {
+    if (ids[i] == kBroadcastId) {
       stops_.erase(it);  // nothing answers a broadcast: written is all that can be known
       continue;
     }
@@ -178,7 +178,7 @@ void StopKeeper::writeDue(std::unique_lock<std::mutex>& lock, StopPace pace) {
 }
 
 ServoStatus StopKeeper::seenAtRestLocked(std::map<uint8_t, PendingStop>::iterator it,
-                                         double angle_deg, Clock::time_point now) {
+                                         double angle_deg, core::Clock::time_point now) {
   PendingStop& stop = it->second;
   char text[96];
   std::snprintf(text, sizeof(text), "at rest at %.1f deg after %d stop(s)", angle_deg,
@@ -214,7 +214,7 @@ void StopKeeper::lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t 
   auto it = stops_.find(id);
   if (it == stops_.end() || it->second.phase != phase) return;  // released or re-armed meanwhile
   PendingStop& stop = it->second;
-  const Clock::time_point now = clock_.now();
+  const core::Clock::time_point now = clock_.now();
   ServoStatus outcome;
   if (!read.ok()) {
     stop.phase = PendingStop::Phase::kWrite;
@@ -245,4 +245,4 @@ void StopKeeper::lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t 
   lock.lock();
 }
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

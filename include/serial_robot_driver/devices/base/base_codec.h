@@ -14,7 +14,7 @@
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/protocol/frame_family.h"
 
-namespace serial_robot_driver::protocol::base {
+namespace serial_robot_driver::devices::base {
 
 constexpr uint8_t kHeader0 = 0x55;
 constexpr uint8_t kHeader1 = 0xAA;
@@ -68,12 +68,12 @@ struct Frame {
 
 /// Probes the `available` bytes at a stream position for a complete, verified frame: header,
 /// LEN range and XOR (kBadHeader / kBadLength / kBadChecksum).
-Probe probeFrame(const uint8_t* data, std::size_t available);
+protocol::Probe probeFrame(const uint8_t* data, std::size_t available);
 /// The base's frames (both directions share the layout): "base", 55 AA, XOR.
-extern const FrameFamily kFrames;
+extern const protocol::FrameFamily kFrames;
 
 /// Decodes one complete frame (exactly frameSize(LEN) bytes).
-Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size);
+protocol::Decoded<Frame> decodeFrame(const uint8_t* data, std::size_t size);
 
 /// What a frame from the base means to the driver.
 struct Reply {
@@ -84,17 +84,17 @@ struct Reply {
 };
 
 /// Interprets a decoded base frame. A battery reply without a PARAM byte is kUnexpectedContent.
-Decoded<Reply> interpretReply(const Frame& frame);
+protocol::Decoded<Reply> interpretReply(const Frame& frame);
 
 /// Host-side wheel speed content of a kWheelSpeed frame (used by the simulator and tests).
 struct WheelSpeed {
   int16_t left_ticks = 0;
   int16_t right_ticks = 0;
 };
-Decoded<WheelSpeed> interpretWheelSpeed(const Frame& frame);
+protocol::Decoded<WheelSpeed> interpretWheelSpeed(const Frame& frame);
 
 /// Base->host replies, for the simulator.
 std::vector<uint8_t> encodeErrorStatus(uint8_t seq);
 std::vector<uint8_t> encodeBatteryReply(uint8_t seq, uint8_t percent);
 
-}  // namespace serial_robot_driver::protocol::base
+}  // namespace serial_robot_driver::devices::base

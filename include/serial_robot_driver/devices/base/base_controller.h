@@ -35,15 +35,15 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/device/loop_clock.h"
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/loop_clock.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/base/base_odometry.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/kinematics/heading_fusion.h"
 #include "serial_robot_driver/kinematics/odometry.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 /// The part of the configuration that can change while the loop runs (retune() takes it over
 /// whole). Each tunable parameter's row binds straight to its field here.
@@ -51,9 +51,9 @@ struct BaseTuning {
   /// Only wheel_diameter and wheel_separation are offered for runtime tuning (encoder_resolution
   /// and pid_rate are the base's firmware), but the controller follows any geometry it is given.
   kinematics::DiffDriveGeometry geometry;
-  double max_wheel_speed = 1.0;    ///< m/s; must be > 0 (no "no limit" value)
-  double max_wheel_accel = 0.0;    ///< m/s^2; 0: no limit
-  double cmd_vel_timeout = 0.5;    ///< s without a command: zero speed; > 0, <= the maximum
+  double max_wheel_speed = 1.0;  ///< m/s; must be > 0 (no "no limit" value)
+  double max_wheel_accel = 0.0;  ///< m/s^2; 0: no limit
+  double cmd_vel_timeout = 0.5;  ///< s without a command: zero speed; > 0, <= the maximum
   /// The longest cmd_vel_timeout (s): the deadman that stops the base when its client dies
   /// (calibrate_base killed hard included) cannot be tuned away.
   static constexpr double kMaxCmdVelTimeout = 5.0;
@@ -76,12 +76,12 @@ struct BaseConfig : BaseTuning {
   double silent_after_polls = 3.0;
   kinematics::PoseCovarianceModel odometry_covariance;
   double imu_yaw_variance = 0.0003;  ///< rad^2, odom's yaw variance while the IMU heading is used
-  Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
+  core::Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
 };
 
 /// Where the odometry stood after a scheduled tick.
 struct OdometrySample {
-  Clock::time_point time;
+  core::Clock::time_point time;
   kinematics::Pose2D pose;
   double linear = 0;             ///< m/s the base runs at now (0 once its timeout stopped it)
   double angular = 0;            ///< rad/s
@@ -108,7 +108,7 @@ struct WheelFrameSent {
   uint8_t seq = 0;
   bool reset_before = false;
   kinematics::WheelSpeeds speeds = kinematics::WheelSpeeds::Zero();  ///< m/s the ticks stand for
-  Clock::time_point time;
+  core::Clock::time_point time;
 };
 
 struct BaseStats {
@@ -123,8 +123,8 @@ struct BaseStats {
   uint64_t unknown_replies = 0;
   uint64_t bad_replies = 0;
   uint64_t cmd_vel_timeouts = 0;
-  uint64_t rejected_commands = 0;             ///< NaN/Inf cmd_vel
-  uint64_t ignored_commands_e_stop = 0;       ///< cmd_vel received while the e-stop was engaged
+  uint64_t rejected_commands = 0;        ///< NaN/Inf cmd_vel
+  uint64_t ignored_commands_e_stop = 0;  ///< cmd_vel received while the e-stop was engaged
   /// cmd_vel accepted before an e-stop that engaged before it was stored (even one released since)
   uint64_t voided_commands = 0;
   uint64_t timeout_errors_while_running = 0;  ///< FF after the base had accepted our Reset
@@ -149,8 +149,8 @@ struct BaseStats {
 struct BaseEvents {
   std::function<void(const WheelFrameSent&)> on_wheel_frame;
   /// `arrival`: when the reply's last byte was read (its stamp).
-  std::function<void(uint8_t percent, Clock::time_point arrival)> on_battery;
-  std::function<void(const protocol::base::Frame&)> on_unknown_reply;
+  std::function<void(uint8_t percent, core::Clock::time_point arrival)> on_battery;
+  std::function<void(const Frame&)> on_unknown_reply;
   std::function<void()> on_timeout_error;
   std::function<void(const OdometrySample&)> on_odometry;  ///< after every scheduled tick
   std::function<void()> on_cmd_vel_timeout;                ///< once per timeout, when it starts
@@ -167,14 +167,14 @@ enum class CommandOutcome {
   kVoided,        ///< ignored: an e-stop engaged after it was accepted (even if released since)
 };
 
-class BaseController : public LinkListener {
+class BaseController : public core::LinkListener {
  public:
   /// Counts the e-stop's engagements: a cmd_vel accepted under one never drives under a later one.
   using Generation = uint64_t;
 
   /// `clock` empty: the steady clock.
-  BaseController(BaseConfig config, FrameWriter writer, BaseEvents events = {},
-                 std::shared_ptr<LoopClock> clock = {});
+  BaseController(BaseConfig config, core::FrameWriter writer, BaseEvents events = {},
+                 std::shared_ptr<core::LoopClock> clock = {});
   ~BaseController() override;
 
   /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded. Ignored (and
@@ -197,10 +197,10 @@ class BaseController : public LinkListener {
   void resetOdometry();
   /// Any thread (the body port's reader): the yaw (rad) of the IMU on the base, measured at
   /// `stamp`. Used only with use_imu_heading.
-  void onImuYaw(double yaw, Clock::time_point stamp);
+  void onImuYaw(double yaw, core::Clock::time_point stamp);
   /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
   /// the port's baud (10 bits per byte) divided by immediate_line_share.
-  Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
+  core::Clock::duration minImmediateInterval() const { return min_immediate_interval_; }
   /// Why the wheels may be moving now, or "" when they are commanded still: a non-zero cmd_vel in
   /// force (not timed out, no e-stop) or wheels still ramping toward zero. Any thread.
   std::string motionInForce() const;
@@ -229,56 +229,58 @@ class BaseController : public LinkListener {
   void onLinkUp() override;
   void onLinkDown() override;
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) override;
+               core::Clock::time_point arrival) override;
 
  private:
   void run();
   /// A scheduled tick: battery poll when due, then the wheel frame.
-  void tick(Clock::time_point now);
+  void tick(core::Clock::time_point now);
   /// Sends the wheel frame for the current command (Reset first when needed).
-  void sendSpeed(Clock::time_point now, bool immediate);
+  void sendSpeed(core::Clock::time_point now, bool immediate);
   /// Requires mutex_. Writes one frame with the next SEQ; false on failure.
-  bool writeLocked(const std::vector<uint8_t>& frame, Clock::time_point now);
+  bool writeLocked(const std::vector<uint8_t>& frame, core::Clock::time_point now);
   /// `timed_out_now`: set when the cmd_vel timeout started with this call.
-  kinematics::WheelSpeeds targetSpeedsLocked(Clock::time_point now, bool* timed_out_now);
+  kinematics::WheelSpeeds targetSpeedsLocked(core::Clock::time_point now, bool* timed_out_now);
   kinematics::WheelTicks onWire(const kinematics::WheelTicks& ticks) const;
   /// Requires mutex_, before the rate in force changes: the next poll for `next_rate`.
-  void rescheduleBatteryPollLocked(double next_rate, Clock::time_point now);
+  void rescheduleBatteryPollLocked(double next_rate, core::Clock::time_point now);
 
   BaseConfig config_;  ///< its BaseTuning part changes under mutex_ (retune)
-  const FrameWriter writer_;
+  const core::FrameWriter writer_;
   const BaseEvents events_;
-  const std::shared_ptr<LoopClock> clock_;
-  const Clock::duration period_;
-  const Clock::duration min_immediate_interval_;
+  const std::shared_ptr<core::LoopClock> clock_;
+  const core::Clock::duration period_;
+  const core::Clock::duration min_immediate_interval_;
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;
   bool stopped_ = false;
   bool command_pending_ = false;  ///< a new cmd_vel or an FF error wants an early frame
-  protocol::base::SequenceCounter seq_;
+  SequenceCounter seq_;
   kinematics::AccelerationLimiter limiter_;
   kinematics::TickQuantizer quantizer_;
   double linear_x_ = 0;
   double angular_z_ = 0;
-  std::optional<Clock::time_point> last_command_;
+  std::optional<core::Clock::time_point> last_command_;
   bool command_timed_out_ = true;
   bool needs_reset_ = true;
-  std::optional<Clock::time_point> last_write_;  ///< any base frame
-  std::optional<Clock::time_point> last_speed_frame_;
-  std::optional<Clock::time_point> last_immediate_frame_;  ///< the last one a command rushed out
-  std::optional<Clock::time_point> last_tick_;
-  Clock::time_point next_battery_poll_{};
+  std::optional<core::Clock::time_point> last_write_;  ///< any base frame
+  std::optional<core::Clock::time_point> last_speed_frame_;
+  std::optional<core::Clock::time_point>
+      last_immediate_frame_;  ///< the last one a command rushed out
+  std::optional<core::Clock::time_point> last_tick_;
+  core::Clock::time_point next_battery_poll_{};
   bool e_stop_ = false;
   Generation generation_ = 0;  ///< e-stop engagements so far
-  BaseOdometry odometry_;  ///< not thread-safe: used under mutex_ (onImuYaw excepted)
-  std::optional<Clock::time_point> last_reset_sent_;
-  std::optional<Clock::time_point> unanswered_since_;  ///< first battery request with no reply yet
+  BaseOdometry odometry_;      ///< not thread-safe: used under mutex_ (onImuYaw excepted)
+  std::optional<core::Clock::time_point> last_reset_sent_;
+  std::optional<core::Clock::time_point>
+      unanswered_since_;  ///< first battery request with no reply yet
   bool silent_reported_ = false;
-  std::optional<Clock::time_point> last_running_timeout_error_;
+  std::optional<core::Clock::time_point> last_running_timeout_error_;
   BaseStats stats_;
   std::thread loop_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -11,12 +11,12 @@
 
 #include <optional>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/kinematics/heading_fusion.h"
 #include "serial_robot_driver/kinematics/odometry.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 // Defined in base_controller.h, the controller's public interface.
 struct BaseConfig;
@@ -30,26 +30,26 @@ class BaseOdometry {
 
   /// Integrates the speeds the base runs on up to `now` (capped at its heartbeat timeout). A fused
   /// heading follows the IMU even while the wheels stand still.
-  void advance(Clock::time_point now);
+  void advance(core::Clock::time_point now);
   /// A speed frame with these (robot-side, before wheel directions) ticks was accepted at `now`.
-  void speedAccepted(const kinematics::WheelTicks& ticks, Clock::time_point now);
+  void speedAccepted(const kinematics::WheelTicks& ticks, core::Clock::time_point now);
   /// The base reported its timeout error at `now`: it has stopped its wheels.
-  void baseStopped(Clock::time_point now);
+  void baseStopped(core::Clock::time_point now);
   /// Puts the pose (and its covariance) back to zero at `now`; a fused heading restarts at zero.
-  void reset(Clock::time_point now);
+  void reset(core::Clock::time_point now);
   /// From `now` on: `geometry` (the speeds the base holds are re-read through it), and
   /// use_imu_heading. The motion and the wheel angles up to `now` keep the geometry they ran
   /// under; the pose does not jump.
   void retune(const kinematics::DiffDriveGeometry& geometry, bool use_imu_heading,
-              Clock::time_point now);
+              core::Clock::time_point now);
 
   /// Where the odometry stands at `now` (call advance() first).
-  OdometrySample sample(Clock::time_point now) const;
+  OdometrySample sample(core::Clock::time_point now) const;
 
   /// Any thread: the yaw (rad) of the IMU on the base, measured at `stamp`.
-  void addImuYaw(double yaw, Clock::time_point stamp);
+  void addImuYaw(double yaw, core::Clock::time_point stamp);
   /// With use_imu_heading: fills the heading fields of `stats` (source, fallbacks, IMU yaw age).
-  void addHeadingStats(BaseStats& stats, Clock::time_point now) const;
+  void addHeadingStats(BaseStats& stats, core::Clock::time_point now) const;
   /// With use_imu_heading: the heading's source, when it changed since the last call.
   std::optional<kinematics::HeadingSource> headingSourceChange();
 
@@ -66,8 +66,8 @@ class BaseOdometry {
   /// Wheel angles and travel when the diameter last changed (see OdometrySample::wheel_angles).
   kinematics::WheelSpeeds wheel_angles_at_retune_ = kinematics::WheelSpeeds::Zero();
   kinematics::WheelSpeeds travel_at_retune_ = kinematics::WheelSpeeds::Zero();
-  std::optional<Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
-  Clock::time_point integrated_until_{};
+  std::optional<core::Clock::time_point> accepted_at_;  ///< last speed frame the base accepted
+  core::Clock::time_point integrated_until_{};
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -8,13 +8,17 @@
 #include "serial_robot_driver/params/port_params.h"
 
 namespace serial_robot_driver::params {
+struct DriverParams;
+}  // namespace serial_robot_driver::params
+
+namespace serial_robot_driver::devices::base {
 
 /// The base's parameters. Those that configure the controller are bound straight into
 /// `controller` (their defaults are its own); the rest are the ROS layer's and the checks'.
-struct BaseParams : DevicePortParams {
+struct BaseParams : params::DevicePortParams {
   /// The controller's configuration as the parameters set it. Not parameters of this section:
   /// loop_rate, baud and imu_yaw_variance, which makeBaseConfig fills in from the node-wide values.
-  device::BaseConfig controller;
+  BaseConfig controller;
   int battery_warn_percent = 20;   ///< below: diagnostics WARN
   int battery_error_percent = 10;  ///< below: diagnostics ERROR
   std::string odom_frame = "odom";
@@ -25,14 +29,13 @@ struct BaseParams : DevicePortParams {
 };
 
 /// The key of the base's section (DeviceModule::sections): params.section(kBaseSection).
-extern const SectionKey<BaseParams> kBaseSection;
+extern const params::SectionKey<BaseParams> kBaseSection;
 
-struct DriverParams;
 /// The controller's configuration in force: the base's own parameters (bound into `controller`
 /// already, base_module.cpp) plus those that come from node-wide or other devices' parameters.
-device::BaseConfig makeBaseConfig(const DriverParams& params);
+BaseConfig makeBaseConfig(const params::DriverParams& params);
 
 /// Below this loop rate the base's 1 s heartbeat is at risk (the base's checks say so).
 constexpr double kMinBaseLoopRate = 5.0;
 
-}  // namespace serial_robot_driver::params
+}  // namespace serial_robot_driver::devices::base

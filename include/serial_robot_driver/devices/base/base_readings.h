@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 /// The battery as the base reports it: only its charge; voltage, current and the rest are unknown.
 struct BatteryReading {
@@ -28,4 +28,4 @@ constexpr double kTwistAngularVariance = 0.01;   ///< (rad/s)^2: std 0.1 rad/s
 /// The variance of what the odometry does not estimate at all (z, roll, pitch).
 constexpr double kNotEstimatedVariance = 1e6;
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -2,10 +2,10 @@
 // ~base/battery_{warn,error}_percent, the e-stop, the odom heading source and the counters.
 #pragma once
 
-#include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/core/status_report.h"
 #include "serial_robot_driver/devices/base/base_controller.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 /// A timeout error (FF) from a running base stays a WARN this long (s).
 constexpr double kRecentTimeoutErrorS = 10.0;
@@ -18,6 +18,7 @@ struct BatteryLimits {
 
 /// OK "driving", else every problem: port down or base silent (ERROR), a recent FF, the e-stop or
 /// odom without the IMU's heading (WARN), the battery against `limits`.
-StatusReport baseStatus(const BaseStats& stats, const PortState& port, BatteryLimits limits);
+core::StatusReport baseStatus(const BaseStats& stats, const core::PortState& port,
+                              BatteryLimits limits);
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -15,7 +15,7 @@
 
 #include "serial_robot_driver/kinematics/diff_drive.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 /// One turn (or straight run) as recorded: both integrals over the same window, which starts and
 /// ends with the base at rest, so the IMU's lag behind the wheel frames does not matter.
@@ -110,4 +110,4 @@ Checked<DiameterCalibration> calibrateDiameter(const MotionRecord& straight,
                                                double measured_distance, double configured_diameter,
                                                const CalibrationLimits& limits = {});
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 /// calibrate_base's exit statuses besides 0 (a result) and 128 + signal (stopped by a signal).
 constexpr int kCalibrationExitRefused = 1;  ///< refused or aborted
@@ -38,4 +38,4 @@ std::string stopSignalMessage(int signal_number);
 /// Parses the arguments after the program's name, once ros::init removed the ROS remappings.
 ParsedCalibrationOptions parseCalibrationOptions(const std::vector<std::string>& args);
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -17,7 +17,7 @@
 #include "serial_robot_driver/devices/base/turn_calibration.h"
 #include "serial_robot_driver/devices/base/turn_calibration_options.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 
 /// What the tool knows at a step besides the messages that arrived.
 struct CalibrationTick {
@@ -173,4 +173,4 @@ class TurnCalibrationRun {
   std::vector<MotionRecord> records_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

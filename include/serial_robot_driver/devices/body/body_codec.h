@@ -16,7 +16,7 @@
 #include "serial_robot_driver/protocol/frame_family.h"
 #include "serial_robot_driver/protocol/wire_fields.h"
 
-namespace serial_robot_driver::protocol::body {
+namespace serial_robot_driver::devices::body {
 
 // --- sync write --------------------------------------------------------------------------------
 constexpr std::array<uint8_t, 4> kSyncWriteHeader = {0xFF, 0xFF, 0xFD, 0x00};
@@ -39,35 +39,40 @@ struct SyncWriteCommand {
   uint16_t address = kGoalPositionAddress;
   uint16_t data_size = kGoalPositionSize;
 };
-constexpr std::array<wire::Field<SyncWriteCommand>, 3> kSyncWriteCommandFields = {{
-    wire::field<&SyncWriteCommand::instruction>("instruction", wire::kU8, wire::ByteOrder::kLittle),
-    wire::field<&SyncWriteCommand::address>("address", wire::kU16, wire::ByteOrder::kLittle),
-    wire::field<&SyncWriteCommand::data_size>("data_size", wire::kU16, wire::ByteOrder::kLittle),
+constexpr std::array<protocol::wire::Field<SyncWriteCommand>, 3> kSyncWriteCommandFields = {{
+    protocol::wire::field<&SyncWriteCommand::instruction>("instruction", protocol::wire::kU8,
+                                                          protocol::wire::ByteOrder::kLittle),
+    protocol::wire::field<&SyncWriteCommand::address>("address", protocol::wire::kU16,
+                                                      protocol::wire::ByteOrder::kLittle),
+    protocol::wire::field<&SyncWriteCommand::data_size>("data_size", protocol::wire::kU16,
+                                                        protocol::wire::ByteOrder::kLittle),
 }};
 
 struct ServoTarget {
   uint8_t id = 0;
   uint16_t position = 0;  ///< raw ticks
 };
-constexpr std::array<wire::Field<ServoTarget>, 2> kServoTargetFields = {{
-    wire::field<&ServoTarget::id>("id", wire::kU8, wire::ByteOrder::kLittle),
-    wire::field<&ServoTarget::position>("position", wire::kU16, wire::ByteOrder::kLittle, "ticks"),
+constexpr std::array<protocol::wire::Field<ServoTarget>, 2> kServoTargetFields = {{
+    protocol::wire::field<&ServoTarget::id>("id", protocol::wire::kU8,
+                                            protocol::wire::ByteOrder::kLittle),
+    protocol::wire::field<&ServoTarget::position>("position", protocol::wire::kU16,
+                                                  protocol::wire::ByteOrder::kLittle, "ticks"),
 }};
 
 /// LEN: the command fields, one record per servo, the CRC.
 constexpr std::size_t syncWriteLen(std::size_t servo_count) {
-  return wire::listOf(kSyncWriteCommandFields).size() +
-         wire::listOf(kServoTargetFields).size() * servo_count + kCrcSize;
+  return protocol::wire::listOf(kSyncWriteCommandFields).size() +
+         protocol::wire::listOf(kServoTargetFields).size() * servo_count + kCrcSize;
 }
 
 std::vector<uint8_t> encodeSyncWrite(const std::vector<ServoTarget>& targets);
 /// Probes for a complete sync write: header and broadcast id, LEN (syncWriteLen, N <= 64),
 /// instruction, CRC (kBadHeader / kBadLength / kBadChecksum).
-Probe probeSyncWrite(const uint8_t* data, std::size_t available);
+protocol::Probe probeSyncWrite(const uint8_t* data, std::size_t available);
 /// Sync writes (host -> board; what the simulated board reads): "sync_write".
-extern const FrameFamily kSyncWriteFrames;
+extern const protocol::FrameFamily kSyncWriteFrames;
 /// For the simulator: a complete sync-write frame back into targets (CRC and layout checked).
-Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size_t size);
+protocol::Decoded<std::vector<ServoTarget>> decodeSyncWrite(const uint8_t* data, std::size_t size);
 
 // --- telemetry ---------------------------------------------------------------------------------
 constexpr uint8_t kTelemetryHeader0 = 0x12;
@@ -97,17 +102,21 @@ struct ServoSample {
 
 // The blocks of a telemetry frame, one field list each: a servo record (N of them), an IMU value
 // (kImuValueCount) and a foot sensor (kFootSensorCount, the only little-endian block).
-constexpr std::array<wire::Field<ServoSample>, 2> kServoSampleFields = {{
-    wire::field<&ServoSample::position>("position", wire::kU16, wire::ByteOrder::kBig, "ticks"),
-    wire::field<&ServoSample::speed>("speed", wire::kI16, wire::ByteOrder::kBig),
+constexpr std::array<protocol::wire::Field<ServoSample>, 2> kServoSampleFields = {{
+    protocol::wire::field<&ServoSample::position>("position", protocol::wire::kU16,
+                                                  protocol::wire::ByteOrder::kBig, "ticks"),
+    protocol::wire::field<&ServoSample::speed>("speed", protocol::wire::kI16,
+                                               protocol::wire::ByteOrder::kBig),
 }};
 struct TelemetryValue {
   int64_t value = 0;
 };
-constexpr wire::Field<TelemetryValue> kImuValueField =
-    wire::field<&TelemetryValue::value>("imu", wire::kI16, wire::ByteOrder::kBig);
-constexpr wire::Field<TelemetryValue> kFootValueField =
-    wire::field<&TelemetryValue::value>("foot", wire::kU16, wire::ByteOrder::kLittle);
+constexpr protocol::wire::Field<TelemetryValue> kImuValueField =
+    protocol::wire::field<&TelemetryValue::value>("imu", protocol::wire::kI16,
+                                                  protocol::wire::ByteOrder::kBig);
+constexpr protocol::wire::Field<TelemetryValue> kFootValueField =
+    protocol::wire::field<&TelemetryValue::value>("foot", protocol::wire::kU16,
+                                                  protocol::wire::ByteOrder::kLittle);
 /// Bytes around the blocks: header (2) + LEN before them, SUM + tail (2) after them.
 constexpr std::size_t kTelemetryPrefix = 3;
 constexpr std::size_t kTelemetryTrailer = 3;
@@ -116,8 +125,8 @@ constexpr std::size_t kFootBlockSize = kFootValueField.type.width * kFootSensorC
 
 /// LEN is the whole frame; one byte, so at most kMaxTelemetryServos servos.
 constexpr std::size_t telemetryLen(std::size_t servo_count, bool with_foot) {
-  return kTelemetryPrefix + wire::listOf(kServoSampleFields).size() * servo_count + kImuBlockSize +
-         (with_foot ? kFootBlockSize : 0) + kTelemetryTrailer;
+  return kTelemetryPrefix + protocol::wire::listOf(kServoSampleFields).size() * servo_count +
+         kImuBlockSize + (with_foot ? kFootBlockSize : 0) + kTelemetryTrailer;
 }
 constexpr std::size_t kMaxTelemetryServos = 57;
 static_assert(telemetryLen(kMaxTelemetryServos, false) <= 255 &&
@@ -138,15 +147,16 @@ uint8_t telemetrySum(const uint8_t* frame, std::size_t len);
 
 /// Probes for a complete telemetry frame of `servo_count` servos: header, LEN (telemetryLen),
 /// then tail before SUM (kBadHeader / kBadLength / kBadTail / kBadChecksum).
-Probe probeTelemetry(const uint8_t* data, std::size_t available, std::size_t servo_count);
+protocol::Probe probeTelemetry(const uint8_t* data, std::size_t available, std::size_t servo_count);
 /// Telemetry (board -> host): "telemetry"; the framer's argument is the servo count.
-extern const FrameFamily kTelemetryFrames;
+extern const protocol::FrameFamily kTelemetryFrames;
 
 /// Decodes one complete telemetry frame for `servo_count` configured servos. LEN must be
 /// telemetryLen(servo_count, false|true) and match `size`.
-Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size, std::size_t servo_count);
+protocol::Decoded<Telemetry> decodeTelemetry(const uint8_t* data, std::size_t size,
+                                             std::size_t servo_count);
 
 /// For the simulator and benchmarks.
 std::vector<uint8_t> encodeTelemetry(const Telemetry& telemetry);
 
-}  // namespace serial_robot_driver::protocol::body
+}  // namespace serial_robot_driver::devices::body

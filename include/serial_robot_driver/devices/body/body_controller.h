@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/motion_gate.h"
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/motion_gate.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/protocol/decode_result.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 /// Maps one servo's raw ticks to a joint angle and back:
 ///   position [rad] = direction * (ticks - zero_ticks) * 2 pi / ticks_per_revolution
@@ -55,9 +55,9 @@ struct BodyStats {
   uint64_t decode_errors = 0;  ///< verified telemetry frames that still did not decode (e.g. LEN)
   std::optional<protocol::DecodeError> last_decode_error;
   uint64_t commands_sent = 0;
-  uint64_t commands_rejected = 0;    ///< invalid commands: nothing was written
-  uint64_t write_failures = 0;       ///< valid commands the link refused (port down)
-  uint64_t motion_refused = 0;       ///< valid commands the motion gate refused (e-stop, shutdown)
+  uint64_t commands_rejected = 0;  ///< invalid commands: nothing was written
+  uint64_t write_failures = 0;     ///< valid commands the link refused (port down)
+  uint64_t motion_refused = 0;     ///< valid commands the motion gate refused (e-stop, shutdown)
   /// Of motion_refused: accepted before an e-stop that engaged before their write (even one
   /// released since): an e-stop voids everything accepted before it.
   uint64_t motion_voided = 0;
@@ -96,17 +96,17 @@ struct JointCommandResult {
 struct BodyEvents {
   /// Called on the reader thread for every decoded telemetry frame with its arrival time.
   using TelemetryCallback =
-      std::function<void(const protocol::body::Telemetry& telemetry, Clock::time_point arrival)>;
+      std::function<void(const Telemetry& telemetry, core::Clock::time_point arrival)>;
   TelemetryCallback on_telemetry;
 };
 
-class BodyController : public LinkListener {
+class BodyController : public core::LinkListener {
  public:
   /// `joints` in frame order (the order of ~body/servo_ids).
-  BodyController(std::vector<BodyJoint> joints, FrameWriter writer, BodyEvents events = {});
+  BodyController(std::vector<BodyJoint> joints, core::FrameWriter writer, BodyEvents events = {});
 
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) override;
+               core::Clock::time_point arrival) override;
 
   /// Validates a command (positions in rad) and writes one sync-write frame in servo_ids order.
   ///
@@ -121,11 +121,11 @@ class BodyController : public LinkListener {
   /// an e-stop engaged since voids it (kMotionVoided), released or not. Unset: accepted now.
   JointCommandResult sendJointCommand(const std::vector<std::string>& names,
                                       const std::vector<double>& positions,
-                                      std::optional<MotionGate::Generation> accepted = {});
+                                      std::optional<core::MotionGate::Generation> accepted = {});
 
   /// The gate every sync-write passes when it is written (see motion_gate.h): the e-stop locks
   /// it, the shutdown closes it.
-  MotionGate& gate() { return gate_; }
+  core::MotionGate& gate() { return gate_; }
   /// The position (rad) joint `joint_index` (frame order) was last commanded, i.e. what the
   /// board was last sent for it; nothing when it never was (or for an index beyond the joints).
   std::optional<double> lastCommandedPosition(std::size_t joint_index) const;
@@ -135,7 +135,7 @@ class BodyController : public LinkListener {
   static constexpr std::chrono::milliseconds kJointCommandMotion{500};
   /// Why the joints may be moving at `now`: a joint command written less than kJointCommandMotion
   /// before it; "" when none was. Any thread.
-  std::string motionInForce(Clock::time_point now) const;
+  std::string motionInForce(core::Clock::time_point now) const;
 
   const std::vector<BodyJoint>& joints() const { return joints_; }
   std::size_t servoCount() const { return joints_.size(); }
@@ -143,19 +143,19 @@ class BodyController : public LinkListener {
 
  private:
   /// Sync-writes `targets` through the motion gate (mutex_ held): kSent, or why not (counted).
-  JointCommandStatus writeTargetsLocked(const std::vector<protocol::body::ServoTarget>& targets,
-                                        MotionGate::Generation generation);
+  JointCommandStatus writeTargetsLocked(const std::vector<ServoTarget>& targets,
+                                        core::MotionGate::Generation generation);
 
   const std::vector<BodyJoint> joints_;
-  const FrameWriter writer_;
+  const core::FrameWriter writer_;
   const BodyEvents events_;
 
-  MotionGate gate_;
+  core::MotionGate gate_;
 
   mutable std::mutex mutex_;  // guards the fields below
   std::vector<std::optional<uint16_t>> last_commanded_ticks_;
-  std::optional<Clock::time_point> last_written_;  ///< the last sync-write that went out
+  std::optional<core::Clock::time_point> last_written_;  ///< the last sync-write that went out
   BodyStats stats_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

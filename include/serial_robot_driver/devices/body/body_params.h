@@ -11,19 +11,19 @@
 #include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 struct GyroUnits;
 }
 
-namespace serial_robot_driver::params {
+namespace serial_robot_driver::devices::body {
 
-struct BodyParams : DevicePortParams {
+struct BodyParams : params::DevicePortParams {
   std::vector<int> servo_ids{1, 2};
   std::vector<std::string> joint_names{"joint_1", "joint_2"};
   /// What every joint shares: ticks_per_revolution and velocity_scale (0: unknown, and
   /// joint_states carries no velocity) are bound here; each joint's zero and direction come from
-  /// the lists below (device::makeBodyJoints).
-  device::JointCalibration calibration;
+  /// the lists below (makeBodyJoints).
+  JointCalibration calibration;
   std::vector<int> zero_ticks{2048, 2048};
   std::vector<int> directions{1, 1};
 };
@@ -56,11 +56,11 @@ struct ImuParams {
 };
 
 /// The keys of the body's sections (DeviceModule::sections): its own and its IMU's.
-extern const SectionKey<BodyParams> kBodySection;
-extern const SectionKey<ImuParams> kImuSection;
+extern const params::SectionKey<BodyParams> kBodySection;
+extern const params::SectionKey<ImuParams> kImuSection;
 
 /// The gyro's units for the calibration: the scale and the axis map (validate() refused an axis
 /// map that does not parse at start-up; one that does not parse here is the identity).
-device::GyroUnits gyroUnits(const ImuParams& imu);
+GyroUnits gyroUnits(const ImuParams& imu);
 
-}  // namespace serial_robot_driver::params
+}  // namespace serial_robot_driver::devices::body

@@ -12,11 +12,11 @@
 #include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 /// The joints configured from ~body (servo_ids, joint_names, zero_ticks, directions,
 /// ticks_per_revolution, velocity_scale), in frame order. Assumes validated parameters.
-std::vector<BodyJoint> makeBodyJoints(const params::BodyParams& params);
+std::vector<BodyJoint> makeBodyJoints(const BodyParams& params);
 
 /// Joint positions (rad) and velocities (rad/s) of every configured joint, in frame order.
 struct JointReadings {
@@ -27,8 +27,7 @@ struct JointReadings {
 };
 /// Joints beyond the frame's servo_count are left out (cannot happen when the frame was decoded
 /// for these joints).
-JointReadings jointReadings(const protocol::body::Telemetry& telemetry,
-                            const std::vector<BodyJoint>& joints);
+JointReadings jointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints);
 
 /// A rotation as a unit quaternion.
 struct Quaternion {
@@ -50,11 +49,11 @@ struct ImuReading {
 };
 /// Accel and gyro scaled from raw LSB, orientation from the attitude angles. `gyro_bias` (raw
 /// LSB, the sensor's axes) is subtracted from the gyro before it is scaled and mapped.
-ImuReading imuReading(const protocol::body::Telemetry& telemetry, const params::ImuParams& params,
+ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
                       const std::array<double, 3>& gyro_bias = {});
 
 /// The yaw (rad, [-pi, pi]) of imuReading()'s orientation: the board's attitude through
 /// ~imu/axis_map, i.e. the heading of the imu frame (~base/use_imu_heading feeds it to odometry).
-double imuYaw(const protocol::body::Telemetry& telemetry, const params::ImuParams& params);
+double imuYaw(const Telemetry& telemetry, const ImuParams& params);
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

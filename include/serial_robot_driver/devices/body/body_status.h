@@ -5,11 +5,11 @@
 
 #include <cstdint>
 
-#include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/core/status_report.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 /// Called once per diagnostics period (one thread): a frame count that stood still for a whole
 /// period while the port is up means the board stopped talking.
@@ -19,15 +19,16 @@ class BodyStatus {
   enum class FlowChange { kNone, kStopped, kResumed };
   struct Update {
     /// OK with no message when nothing is wrong (the telemetry rate's verdict stands), else ERROR.
-    StatusReport report;
+    core::StatusReport report;
     FlowChange flow = FlowChange::kNone;
   };
 
-  Update update(const BodyStats& stats, const protocol::FramerStats& framer, const PortState& port);
+  Update update(const BodyStats& stats, const protocol::FramerStats& framer,
+                const core::PortState& port);
 
  private:
   uint64_t frames_at_last_period_ = 0;
   bool stop_reported_ = false;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

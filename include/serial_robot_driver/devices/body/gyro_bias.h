@@ -20,11 +20,11 @@
 #include <optional>
 #include <string>
 
-#include "serial_robot_driver/device/serial_link.h"
-#include "serial_robot_driver/device/status_report.h"
+#include "serial_robot_driver/core/serial_link.h"
+#include "serial_robot_driver/core/status_report.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 
 /// One value per sensor axis (x, y, z).
 using GyroVector = std::array<double, 3>;
@@ -32,7 +32,7 @@ using GyroVector = std::array<double, 3>;
 /// How raw gyro values read in rad/s on imu/data's axes (~imu/gyro_scale and ~imu/axis_map).
 struct GyroUnits {
   double gyro_scale = 0.0010653;  ///< rad/s per LSB
-  params::AxisMap axes;
+  AxisMap axes;
   /// `raw` (LSB, sensor axes) in rad/s on the imu frame's axes.
   GyroVector toImuRadPerSecond(const GyroVector& raw) const;
 };
@@ -105,8 +105,8 @@ class GyroBiasCalibrator {
   /// Reader thread: one frame's raw gyro (LSB, sensor axes) arrived at `arrival`. `units` and
   /// `seconds` (~imu/calibration_time) are the ones in force for this frame. Returns the bias to
   /// subtract from it.
-  GyroVector onSample(const GyroVector& raw, Clock::time_point arrival, const GyroUnits& units,
-                      double seconds);
+  GyroVector onSample(const GyroVector& raw, core::Clock::time_point arrival,
+                      const GyroUnits& units, double seconds);
   /// Blocks the caller for `seconds` while the samples arrive, then keeps the bias found or
   /// nothing (a refusal changes nothing in force). Refused unless the robot has been seen still
   /// for the settle time (limits). `how` names the request ("imu/calibrate").
@@ -122,7 +122,7 @@ class GyroBiasCalibrator {
   GyroVector bias() const;
   /// The bias in force and the last calibration's verdict, added to the body's status: a refusal
   /// since the last good calibration is a WARN.
-  void report(StatusReport& status, const GyroUnits& units) const;
+  void report(core::StatusReport& status, const GyroUnits& units) const;
 
  private:
   struct InForce {
@@ -134,8 +134,8 @@ class GyroBiasCalibrator {
   };
   struct Session {
     std::string how;
-    Clock::time_point begin;
-    Clock::time_point end;
+    core::Clock::time_point begin;
+    core::Clock::time_point end;
     double seconds = 0;
     GyroSampleStats stats;
     std::string not_still;  ///< set when the robot moved during the averaging
@@ -146,9 +146,9 @@ class GyroBiasCalibrator {
   GyroCalibrationOutcome finishLocked(const Session& session, const GyroUnits& units);
   std::string inForceLocked(const GyroUnits& units) const;
   /// Whether the robot has been seen still for the settle time at `now`.
-  bool settledLocked(Clock::time_point now) const;
+  bool settledLocked(core::Clock::time_point now) const;
   /// Why it has not (settledLocked() false).
-  std::string unsettledLocked(Clock::time_point now) const;
+  std::string unsettledLocked(core::Clock::time_point now) const;
   GyroCalibrationOutcome refuseLocked(const std::string& how, const std::string& why,
                                       const GyroUnits& units, bool not_still);
 
@@ -158,14 +158,14 @@ class GyroBiasCalibrator {
   std::condition_variable wake_;
   std::optional<InForce> in_force_;
   std::optional<Session> session_;
-  std::optional<Clock::time_point> last_arrival_;
+  std::optional<core::Clock::time_point> last_arrival_;
   /// Since when every frame found the robot still (the end of the last motion, or the first frame
   /// after a telemetry gap: what happened in the gap is unknown); unset while it moves.
-  std::optional<Clock::time_point> still_since_;
+  std::optional<core::Clock::time_point> still_since_;
   std::string last_motion_;   ///< what moved last, when still_since_ is the end of a motion
   std::string last_refusal_;  ///< since the last good calibration
   StartReport start_report_;  ///< set while calibrate_on_start waits for its result
   bool cancelled_ = false;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

@@ -15,7 +15,7 @@
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/protocol/frame_family.h"
 
-namespace serial_robot_driver::protocol::echo {
+namespace serial_robot_driver::devices::echo {
 
 constexpr uint8_t kHeader = 0xE5;
 constexpr uint8_t kRequestType = 0x01;
@@ -35,13 +35,13 @@ inline std::vector<uint8_t> encodeAnswer(const std::vector<uint8_t>& payload) {
 
 /// Probes for a complete frame of `type`: kBadHeader (another header or type: not ours),
 /// kBadLength (LEN > kMaxPayload), kBadChecksum.
-Probe probe(uint8_t type, const uint8_t* data, std::size_t available);
+protocol::Probe probe(uint8_t type, const uint8_t* data, std::size_t available);
 /// A complete frame of `type` back into its payload (header, LEN and XOR checked).
-Decoded<std::vector<uint8_t>> decode(uint8_t type, const uint8_t* data, std::size_t size);
+protocol::Decoded<std::vector<uint8_t>> decode(uint8_t type, const uint8_t* data, std::size_t size);
 
 /// Requests (what the simulated device reads): "echo_request".
-extern const FrameFamily kRequestFrames;
+extern const protocol::FrameFamily kRequestFrames;
 /// Answers (what the driver reads): "echo_answer".
-extern const FrameFamily kAnswerFrames;
+extern const protocol::FrameFamily kAnswerFrames;
 
-}  // namespace serial_robot_driver::protocol::echo
+}  // namespace serial_robot_driver::devices::echo

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::echo {
 
 struct EchoStats {
   uint64_t pings = 0;        ///< requests written
@@ -31,29 +31,29 @@ struct PingResult {
   std::string error;  ///< why not, when !ok
 };
 
-class EchoController : public LinkListener {
+class EchoController : public core::LinkListener {
  public:
-  EchoController(FrameWriter writer, std::chrono::milliseconds timeout);
+  EchoController(core::FrameWriter writer, std::chrono::milliseconds timeout);
 
   /// Writes one request and waits up to the timeout for its answer. Call from any thread but the
   /// link's reader (which delivers the answer); one ping at a time, others wait their turn.
   PingResult ping();
 
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) override;
+               core::Clock::time_point arrival) override;
 
   EchoStats stats() const;
 
  private:
-  FrameWriter writer_;
+  core::FrameWriter writer_;
   const std::chrono::milliseconds timeout_;
   std::mutex ping_mutex_;     ///< one ping in flight
   mutable std::mutex mutex_;  ///< guards what follows
   std::condition_variable answered_;
   std::optional<std::vector<uint8_t>> expected_;  ///< the payload in flight
-  std::optional<Clock::time_point> answer_arrival_;
+  std::optional<core::Clock::time_point> answer_arrival_;
   uint32_t sequence_ = 0;
   EchoStats stats_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::echo

@@ -5,9 +5,9 @@
 #include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
-namespace serial_robot_driver::params {
+namespace serial_robot_driver::devices::echo {
 
-struct EchoParams : DevicePortParams {
+struct EchoParams : params::DevicePortParams {
   /// Off unless asked for: the echo device is the tests' and changes nothing for the robot.
   EchoParams() { enabled = false; }
   /// ms an answer may take before a ping counts as timed out.
@@ -15,6 +15,6 @@ struct EchoParams : DevicePortParams {
 };
 
 /// The key of the echo device's section (DeviceModule::sections).
-extern const SectionKey<EchoParams> kEchoSection;
+extern const params::SectionKey<EchoParams> kEchoSection;
 
-}  // namespace serial_robot_driver::params
+}  // namespace serial_robot_driver::devices::echo

@@ -15,9 +15,9 @@
 #include <functional>
 #include <mutex>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// Who waits for the bus: a caller (a service) goes before background work (the poll). kWorker
 /// is the bus's own worker, which writes the stops: it waits like a caller, but gives way to the
@@ -32,7 +32,7 @@ enum class BusPriority { kCaller, kWorker, kBackground, kStop };
 struct ReaderPump {
   std::function<bool()> on_reader_thread;
   /// Reads once, up to `until`; false when the port is down or stopping.
-  std::function<bool(Clock::time_point until)> pump;
+  std::function<bool(core::Clock::time_point until)> pump;
   std::function<void()> wake;
 };
 
@@ -87,4 +87,4 @@ class BusMutex {
   const ReaderPump* pump_ = nullptr;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -12,10 +12,13 @@
 #include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/joint_groups.h"
 
-namespace serial_robot_driver::trajectory {
+namespace serial_robot_driver::devices::servo_bus {
+
+using trajectory::BusJoint;
+using trajectory::TrajectoryJoints;
 
 /// The bus servos named as joints, from validated parameters (empty zero / direction lists: 0 / 1).
-std::vector<BusJoint> makeBusJoints(const params::ServoBusParams& params);
+std::vector<BusJoint> makeBusJoints(const ServoBusParams& params);
 
 /// The joint of bus servo `id`, if it is one.
 const BusJoint* findBusJoint(const std::vector<BusJoint>& joints, uint8_t id);
@@ -49,4 +52,4 @@ double busStateTimeout(double state_rate);
 TrajectoryJoints busTrajectoryJoints(const std::vector<BusJoint>& joints, QueueServoMove queue_move,
                                      double state_rate, StopServo stop_servo = {});
 
-}  // namespace serial_robot_driver::trajectory
+}  // namespace serial_robot_driver::devices::servo_bus

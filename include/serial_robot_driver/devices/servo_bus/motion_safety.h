@@ -37,15 +37,15 @@
 #include <string_view>
 #include <vector>
 
-#include "serial_robot_driver/device/loop_clock.h"
-#include "serial_robot_driver/device/motion_gate.h"
+#include "serial_robot_driver/core/loop_clock.h"
+#include "serial_robot_driver/core/motion_gate.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_config.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_events.h"
 #include "serial_robot_driver/devices/servo_bus/servo_poller.h"
 #include "serial_robot_driver/devices/servo_bus/stop_keeper.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 class MotionSafety {
  public:
@@ -62,7 +62,7 @@ class MotionSafety {
   /// `settings`: the bus's settings in force, guarded by `mutex`. `polled_ids`: the servos
   /// relax() and hold() mean when given none.
   MotionSafety(const std::vector<uint8_t>& polled_ids, const ServoBusConfig& settings,
-               ServoBusClient& client, const ServoBusEvents& events, LoopClock& clock,
+               ServoBusClient& client, const ServoBusEvents& events, core::LoopClock& clock,
                std::mutex& mutex, StopKeeper& stops, const ServoPoller& poller, Hooks hooks);
 
   // The client's motion operations, refused (kMotionRefused) while the e-stop holds or protect
@@ -81,7 +81,7 @@ class MotionSafety {
   /// Whether servo `id` may be set moving now (refusal(), and no broadcast), and the generation
   /// the command is accepted under: noted before the e-stop is looked at, so an e-stop engaged
   /// in between either refuses the command here or voids it at the write.
-  ServoStatus accept(uint8_t id, MotionGate::Generation* generation) const;
+  ServoStatus accept(uint8_t id, core::MotionGate::Generation* generation) const;
   /// A motion frame of servo `id` went out (told by the client under the gate's lock, so an
   /// e-stop engaged right after it finds the servo among those to stop). A pending stop of the
   /// servo (a hold's) is superseded.
@@ -97,11 +97,11 @@ class MotionSafety {
   bool motionLockedLocked() const { return motion_locked_; }
   /// A reconnect: the e-stop's stops and every kept one are written again first. Whether any
   /// stop is kept.
-  bool rearmStopsLocked(Clock::time_point now);
+  bool rearmStopsLocked(core::Clock::time_point now);
   std::vector<uint8_t> movingIds() const;
   std::vector<uint8_t> commandedIds() const;
 
-  MotionGate& gate() { return gate_; }
+  core::MotionGate& gate() { return gate_; }
   uint64_t refusedAtWrite() const { return gate_.refusedAtWrite(); }
   /// From now on no motion frame passes, for good (the last words are being decided).
   void closeGate() { gate_.close(); }
@@ -121,16 +121,16 @@ class MotionSafety {
   const ServoBusConfig& settings_;
   ServoBusClient& client_;
   const ServoBusEvents& events_;
-  LoopClock& clock_;
+  core::LoopClock& clock_;
   std::mutex& mutex_;  // the bus's: guards everything below but the gate
   StopKeeper& stops_;
   const ServoPoller& poller_;
   const Hooks hooks_;
-  MotionGate gate_;              // every motion frame passes it when written; its own lock
+  core::MotionGate gate_;        // every motion frame passes it when written; its own lock
   std::set<uint8_t> commanded_;  // set moving or positioned since start-up
   std::set<uint8_t> moving_;     // servos set moving and not stopped since
   bool motion_locked_ = false;
   bool final_words_said_ = false;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

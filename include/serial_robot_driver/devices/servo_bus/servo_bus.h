@@ -3,7 +3,7 @@
 // (servo_poller.h: servo_states, health, protect), the motion policy (motion_safety.h: what may be
 // written, the servos set moving, the last words) with the stops it keeps until confirmed
 // (stop_keeper.h). The bus itself keeps the queue of moves from a stream of targets
-// (servo_commands). ROS-free: the ROS layer (ros/servo_bus_interface.h) converts messages to
+// (servo_commands). ROS-free: the ROS layer (ros/servo_bus_ros.h) converts messages to
 // calls and events to messages.
 //
 // Threading model:
@@ -55,8 +55,8 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/device/loop_clock.h"
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/loop_clock.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/motion_safety.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_config.h"
@@ -64,9 +64,9 @@
 #include "serial_robot_driver/devices/servo_bus/servo_poller.h"
 #include "serial_robot_driver/devices/servo_bus/stop_keeper.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
-class ServoBus : public LinkListener, public LinkWorker {
+class ServoBus : public core::LinkListener, public core::LinkWorker {
  public:
   // The parts' constants, by the bus's name (see servo_poller.h, stop_keeper.h, motion_safety.h).
   static constexpr std::chrono::milliseconds kFirstBackoff{ServoPoller::kFirstBackoff};
@@ -76,8 +76,8 @@ class ServoBus : public LinkListener, public LinkWorker {
   static constexpr std::chrono::milliseconds kShutdownStopBudget{MotionSafety::kShutdownStopBudget};
 
   /// `clock` empty: the steady clock.
-  ServoBus(ServoBusConfig config, FrameWriter writer, ServoBusEvents events = {},
-           std::shared_ptr<LoopClock> clock = {});
+  ServoBus(ServoBusConfig config, core::FrameWriter writer, ServoBusEvents events = {},
+           std::shared_ptr<core::LoopClock> clock = {});
   ~ServoBus() override;
   ServoBus(const ServoBus&) = delete;
   ServoBus& operator=(const ServoBus&) = delete;
@@ -145,7 +145,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// Before start(): the worker runs on `link`'s reader thread (see the threading model), which
   /// the bus listens to. `link` must use the steady clock's time (no LoopClock of a test) and be
   /// stopped before the bus is destroyed.
-  void runOn(SerialLink& link);
+  void runOn(core::SerialLink& link);
   /// Starts the worker (its thread, or the work on the link's reader thread). Idempotent.
   void start();
   /// Stops and joins the worker, gives the servos set moving what config().on_shutdown says
@@ -169,16 +169,16 @@ class ServoBus : public LinkListener, public LinkWorker {
   void onLinkUp() override;
   void onLinkDown() override;
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) override;
+               core::Clock::time_point arrival) override;
   // LinkWorker (reader thread, after runOn()).
-  Clock::time_point nextWork() override;
+  core::Clock::time_point nextWork() override;
   void work() override;
 
  private:
   void workerLoop();
   /// When the worker has something to do next (mutex_ held): min() for a queued move, max()
   /// before start(), after shutdown() or with nothing scheduled.
-  Clock::time_point nextWorkLocked() const;
+  core::Clock::time_point nextWorkLocked() const;
   /// One piece of the work due, if any (mutex_ held by `lock`; released around the bus).
   void workOnce(std::unique_lock<std::mutex>& lock);
   /// A change the worker must see: its own thread, or the link's reader thread.
@@ -189,7 +189,7 @@ class ServoBus : public LinkListener, public LinkWorker {
   /// A queued move with the gate's generation it was accepted under.
   struct QueuedMove {
     MoveRequest move;
-    MotionGate::Generation accepted = 0;
+    core::MotionGate::Generation accepted = 0;
   };
 
   void dropQueuedMovesLocked(uint8_t id);  // mutex_ held
@@ -198,15 +198,15 @@ class ServoBus : public LinkListener, public LinkWorker {
   const ServoBusConfig config_;
   ServoBusConfig settings_;  // guarded by mutex_: config_ as retune() left it
   const ServoBusEvents events_;
-  const std::shared_ptr<LoopClock> clock_;
+  const std::shared_ptr<core::LoopClock> clock_;
   ServoBusClient client_;
 
   mutable std::mutex mutex_;  // guards everything below, the parts' state included
   std::condition_variable wake_;
   bool stop_ = false;
   bool started_ = false;
-  bool working_ = false;        // work() in progress on the link's reader thread
-  SerialLink* link_ = nullptr;  // runOn(): the worker is the link's reader thread
+  bool working_ = false;              // work() in progress on the link's reader thread
+  core::SerialLink* link_ = nullptr;  // runOn(): the worker is the link's reader thread
   std::deque<QueuedMove> queued_moves_;
   ServoPoller poller_;   // the angle and health polls
   StopKeeper stops_;     // stops not yet known to have reached their servo
@@ -215,4 +215,4 @@ class ServoBus : public LinkListener, public LinkWorker {
   std::thread worker_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -3,7 +3,7 @@
 // READ_BATCH_DATA, RESET_USER_DATA) and motions (servo/move, ROTATE, SPIN, DAMPING), each checked
 // before anything is written, over the transaction client (servo_transactions.h, which has the
 // threading model). ROS-free; device::ServoBus (servo_bus.h) owns one, with the queue and the
-// poll, and the ROS services (ros/servo_bus_interface.h) call its operations.
+// poll, and the ROS services (ros/servo_bus_ros.h) call its operations.
 //
 // Threading: any thread; the transaction client serializes the calls on the bus.
 #pragma once
@@ -18,15 +18,15 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/motion_gate.h"
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/motion_gate.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/bus_mutex.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_move.h"
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// A parameter value in the unit of the parameter table (mV, mA, mW, degC, ms, 0.1deg or raw "").
 struct ServoParamValue {
@@ -67,12 +67,12 @@ struct MultiTurnReading {
   int16_t turns = 0;
 };
 
-class ServoBusClient : public LinkListener {
+class ServoBusClient : public core::LinkListener {
  public:
   /// The longest motion a caller may wait for (the longest ROTATE interval).
   static constexpr std::chrono::milliseconds kMaxMotionWait{65535};
 
-  ServoBusClient(ServoBusOptions options, FrameWriter writer);
+  ServoBusClient(ServoBusOptions options, core::FrameWriter writer);
 
   /// PING: ok when the servo answered.
   ServoStatus ping(uint8_t id);
@@ -87,14 +87,14 @@ class ServoBusClient : public LinkListener {
   /// READ_ANGLE in degrees. `arrival` (optional): when the answer's last byte was read.
   /// kBackground (the servo_states poll): one attempt, and the bus is taken only while no other
   /// caller waits for it.
-  ServoStatus readAngle(uint8_t id, double* angle_deg, Clock::time_point* arrival = nullptr,
+  ServoStatus readAngle(uint8_t id, double* angle_deg, core::Clock::time_point* arrival = nullptr,
                         BusPriority priority = BusPriority::kCaller);
   /// CMD 16: the multi-turn angle and the turn count.
   ServoStatus readMultiTurnAngle(uint8_t id, MultiTurnReading* reading);
   /// CMD 8 or 11..15, chosen by the request (see MoveRequest); returns once the frame is written.
   /// `accepted` (every motion): the motion gate's generation the command was accepted under.
   ServoStatus move(const MoveRequest& request, BusPriority priority = BusPriority::kCaller,
-                   std::optional<MotionGate::Generation> accepted = std::nullopt);
+                   std::optional<core::MotionGate::Generation> accepted = std::nullopt);
   /// PINGs first_id..last_id, one attempt each (a silent id costs one timeout), and lists the ids
   /// that answered. The bus is taken per id, so other callers are served in between.
   ServoStatus scan(uint8_t first_id, uint8_t last_id, std::vector<uint8_t>* ids);
@@ -107,9 +107,9 @@ class ServoBusClient : public LinkListener {
   /// A SPIN stop and every DAMPING (torque off) take the bus at BusPriority::kStop: after the one
   /// attempt in flight, before every waiting call and poll.
   ServoStatus rotate(const RotateRequest& request,
-                     std::optional<MotionGate::Generation> accepted = std::nullopt);
+                     std::optional<core::MotionGate::Generation> accepted = std::nullopt);
   ServoStatus spin(const SpinRequest& request,
-                   std::optional<MotionGate::Generation> accepted = std::nullopt);
+                   std::optional<core::MotionGate::Generation> accepted = std::nullopt);
   ServoStatus damping(uint8_t id, uint16_t power_mw, bool wait,
                       FrameGate gate = FrameGate::kMotion);
   /// READ_BATCH_DATA: the 22 user-block parameters (data_id 32..53) in table order.
@@ -150,14 +150,15 @@ class ServoBusClient : public LinkListener {
   void setReaderPump(ReaderPump pump) { transactions_.setReaderPump(std::move(pump)); }
   /// Before any call: the gate every motion frame passes when it is written (nullptr: none), and
   /// what is told, under the gate's lock, of each motion frame that went out (the servo's id).
-  void setMotionGate(MotionGate* gate, std::function<void(uint8_t id)> on_motion_written = {}) {
+  void setMotionGate(core::MotionGate* gate,
+                     std::function<void(uint8_t id)> on_motion_written = {}) {
     transactions_.setMotionGate(gate, std::move(on_motion_written));
   }
 
   // LinkListener (reader thread): the answers are the transaction client's.
   void onLinkDown() override { transactions_.onLinkDown(); }
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) override {
+               core::Clock::time_point arrival) override {
     transactions_.onFrame(family, data, size, arrival);
   }
 
@@ -166,14 +167,13 @@ class ServoBusClient : public LinkListener {
 
   /// The shared tail of ROTATE/SPIN/DAMPING: takes the bus at `priority` (kCaller or kStop),
   /// then sends, or transacts and checks the result byte.
-  ServoStatus sendMotion(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
-                         uint8_t id, bool wait, std::chrono::milliseconds motion_time,
-                         FrameGate gate, BusPriority priority,
-                         std::optional<MotionGate::Generation> accepted);
+  ServoStatus sendMotion(const std::vector<uint8_t>& request, Command cmd, uint8_t id, bool wait,
+                         std::chrono::milliseconds motion_time, FrameGate gate,
+                         BusPriority priority,
+                         std::optional<core::MotionGate::Generation> accepted);
 
   // The helpers below expect the bus to be held by the caller.
-  ServoStatus readParamLocked(uint8_t id, const protocol::servo::ParamInfo& param,
-                              ServoParamValue* value);
+  ServoStatus readParamLocked(uint8_t id, const ParamInfo& param, ServoParamValue* value);
   ServoStatus pingLocked(uint8_t id);
   /// Before servo `id` moves to `new_id`: ok when nothing answers at `new_id`.
   ServoStatus checkIdFreeLocked(uint8_t id, uint8_t new_id);
@@ -183,4 +183,4 @@ class ServoBusClient : public LinkListener {
   ServoTransactions transactions_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

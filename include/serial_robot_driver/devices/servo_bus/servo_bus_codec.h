@@ -15,7 +15,7 @@
 #include "serial_robot_driver/protocol/decode_result.h"
 #include "serial_robot_driver/protocol/frame_family.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 
 constexpr uint8_t kRequestHeader0 = 0x12;
 constexpr uint8_t kRequestHeader1 = 0x4C;
@@ -100,7 +100,7 @@ struct MultiTurnAngle {
   int16_t turns = 0;
 };
 /// Decodes the CONTENT of a CMD 16 answer (kBadLength unless exactly its layout's size).
-Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size);
+protocol::Decoded<MultiTurnAngle> decodeMultiTurnAngle(const uint8_t* content, std::size_t size);
 /// The CONTENT of a CMD 16 answer (simulator side).
 std::vector<uint8_t> multiTurnAngleContent(const MultiTurnAngle& angle);
 
@@ -114,18 +114,18 @@ struct Packet {
 
 /// Probe for a complete response (05 1C) or request (12 4C): header, CMD (kUnknownCommand),
 /// N (kBadLength), sum (kBadChecksum).
-Probe probeResponse(const uint8_t* data, std::size_t available);
-Probe probeRequest(const uint8_t* data, std::size_t available);
+protocol::Probe probeResponse(const uint8_t* data, std::size_t available);
+protocol::Probe probeRequest(const uint8_t* data, std::size_t available);
 /// Responses (servo -> host): "servo_response".
-extern const FrameFamily kResponseFrames;
+extern const protocol::FrameFamily kResponseFrames;
 /// Requests (host -> servo: the half-duplex echo, or what the simulated bus reads):
 /// "servo_request".
-extern const FrameFamily kRequestFrames;
+extern const protocol::FrameFamily kRequestFrames;
 
 /// Decodes one complete response (05 1C ...) or request (12 4C ..., for the simulator and for
 /// recognising the half-duplex echo of our own request).
-Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size);
-Decoded<Packet> decodeRequest(const uint8_t* data, std::size_t size);
+protocol::Decoded<Packet> decodeResponse(const uint8_t* data, std::size_t size);
+protocol::Decoded<Packet> decodeRequest(const uint8_t* data, std::size_t size);
 
 /// Builds a response packet (simulator side).
 std::vector<uint8_t> encodeResponse(Command cmd, const std::vector<uint8_t>& content);
@@ -145,12 +145,12 @@ struct AngleAnswer {
   int16_t angle_decidegrees = 0;
 };
 std::vector<uint8_t> angleAnswerContent(const AngleAnswer& answer);
-Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer);
+protocol::Decoded<AngleAnswer> decodeAngleAnswer(const Packet& answer);
 /// A CMD 16 answer packet.
-Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer);
+protocol::Decoded<MultiTurnAngle> decodeMultiTurnAngle(const Packet& answer);
 /// A READ_DATA answer: its fields, then the value as `param`'s type lays it out.
 std::vector<uint8_t> readDataAnswerContent(uint8_t id, const ParamInfo& param, int64_t value);
-Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param);
+protocol::Decoded<int64_t> decodeReadDataAnswer(const Packet& answer, const ParamInfo& param);
 
 /// A READ_DATA / WRITE_DATA request or READ_DATA answer: the parameter's data_id and the value
 /// bytes that follow it (none in a READ_DATA request), still in the parameter's type.
@@ -161,13 +161,13 @@ struct DataContent {
   std::size_t value_size = 0;
 };
 /// kBadLength when the content is shorter than its fields or the value longer than any type.
-Decoded<DataContent> decodeDataContent(const Packet& packet);
+protocol::Decoded<DataContent> decodeDataContent(const Packet& packet);
 
 /// A READ_BATCH_DATA answer (simulator side) and the user block of it or of a WRITE_BATCH_DATA
 /// request (kBadLength unless the packet is that long).
 std::vector<uint8_t> userBlockAnswerContent(uint8_t id,
                                             const std::array<uint8_t, kUserBlockSize>& block);
-Decoded<std::array<uint8_t, kUserBlockSize>> decodeUserBlock(const Packet& packet);
+protocol::Decoded<std::array<uint8_t, kUserBlockSize>> decodeUserBlock(const Packet& packet);
 
 /// Any of the motions CMD 8 (ROTATE) and 11..15, as its request carries it.
 struct MoveCommand {
@@ -185,7 +185,7 @@ bool isByVelocity(Command cmd);
 bool hasRamps(Command cmd);
 /// The request of `move.cmd` (fields the command does not carry are ignored).
 std::vector<uint8_t> encodeMove(const MoveCommand& move);
-Decoded<MoveCommand> decodeMove(const Packet& request);
+protocol::Decoded<MoveCommand> decodeMove(const Packet& request);
 
 /// A SPIN request.
 struct SpinCommand {
@@ -196,9 +196,9 @@ struct SpinCommand {
   uint16_t value = 0;
 };
 std::vector<uint8_t> encodeSpin(const SpinCommand& spin);
-Decoded<SpinCommand> decodeSpin(const Packet& request);
+protocol::Decoded<SpinCommand> decodeSpin(const Packet& request);
 
 /// The power of a DAMPING request.
-Decoded<uint16_t> decodeDamping(const Packet& request);
+protocol::Decoded<uint16_t> decodeDamping(const Packet& request);
 
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -10,7 +10,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_identity.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// What servos set moving get when the bus shuts down (before its port closes).
 enum class ShutdownAction { kStop, kRelax, kNone };
@@ -43,4 +43,4 @@ struct ServoBusConfig : ServoBusTuning {
   std::vector<uint8_t> polled_ids;  ///< servos whose angle is polled (servo_states)
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

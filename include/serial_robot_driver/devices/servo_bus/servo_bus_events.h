@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/servo_health.h"
 #include "serial_robot_driver/devices/servo_bus/servo_identity.h"
 #include "serial_robot_driver/devices/servo_bus/servo_move.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// The health of one polled servo (health_rate > 0).
 struct ServoHealthReport {
@@ -33,7 +33,7 @@ struct ServoHealthReport {
 struct ServoAngleSample {
   uint8_t id = 0;
   double angle_deg = 0.0;
-  Clock::time_point arrival;  ///< when the answer's last byte was read
+  core::Clock::time_point arrival;  ///< when the answer's last byte was read
 };
 
 /// What the bus reports; every hook may be empty.
@@ -71,4 +71,4 @@ struct ServoBusWorkerStats {
   double asked_poll_rate = 0.0;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

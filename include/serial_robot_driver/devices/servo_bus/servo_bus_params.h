@@ -9,15 +9,15 @@
 #include "serial_robot_driver/params/device_sections.h"
 #include "serial_robot_driver/params/port_params.h"
 
-namespace serial_robot_driver::params {
+namespace serial_robot_driver::devices::servo_bus {
 
-/// The bus's parameters. Those that configure device::ServoBus are bound straight into `bus`
+/// The bus's parameters. Those that configure ServoBus are bound straight into `bus`
 /// (their defaults are its own; timeout, relax_power_mw and on_shutdown through converted rows,
 /// whose checks see the value as written); the rest are the ROS layer's and the checks'.
-struct ServoBusParams : DevicePortParams {
+struct ServoBusParams : params::DevicePortParams {
   /// The bus's configuration as the parameters set it; polled_ids is not a parameter:
-  /// ros_layer::makeServoBusConfig fills it in from state_ids and joint_ids.
-  device::ServoBusConfig bus;
+  /// ros::makeServoBusConfig fills it in from state_ids and joint_ids.
+  ServoBusConfig bus;
   std::vector<int> state_ids;   ///< bus servos polled for servo_states (empty: no poll)
   int command_interval_ms = 0;  ///< ROTATE interval for servo_commands without a velocity
   // Bus servos used as named joints (trajectories, servo_states); one entry per joint_ids.
@@ -28,6 +28,6 @@ struct ServoBusParams : DevicePortParams {
 };
 
 /// The key of the bus's section (DeviceModule::sections): params.section(kServoBusSection).
-extern const SectionKey<ServoBusParams> kServoBusSection;
+extern const params::SectionKey<ServoBusParams> kServoBusSection;
 
-}  // namespace serial_robot_driver::params
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -11,7 +11,7 @@
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// When a servo answers a command. Nobody answers the broadcast id.
 enum class Answers : uint8_t {
@@ -49,4 +49,4 @@ constexpr std::size_t commandRow(Command cmd) {
 /// The row of a known command.
 const CommandInfo& commandInfo(Command cmd);
 
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

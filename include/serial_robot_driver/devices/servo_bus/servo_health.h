@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// The servo's protection limits, in the parameter table's units (mV, degC, mW, mA).
 /// A limit of 0 is not set on the servo and is not checked.
@@ -57,4 +57,4 @@ class OverheatGuard {
   bool tripped_ = false;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -12,7 +12,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_health.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 class ServoBusClient;
 
@@ -78,4 +78,4 @@ struct ServoIdentityReport {
   std::vector<std::string> warnings;  ///< identityWarnings() when it was read
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

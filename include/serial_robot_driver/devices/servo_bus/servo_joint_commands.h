@@ -8,7 +8,7 @@
 
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// The servo_states / servo_commands joint name of bus servo `id`: "servo_<id>".
 std::string servoJointName(uint8_t id);
@@ -29,4 +29,4 @@ ServoCommandBatch toServoMoves(const std::vector<std::string>& names,
                                const std::vector<double>& positions,
                                const std::vector<double>& velocities, uint16_t interval_ms);
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/core/e_stop.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/trajectory/bus_joint.h"
 #include "serial_robot_driver/trajectory/executor.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 class ServoMotionClaims {
  public:
@@ -23,7 +23,7 @@ class ServoMotionClaims {
   ServoMotionClaims(ServoBus& bus, const std::vector<trajectory::BusJoint>& joints)
       : bus_(bus), joints_(joints) {}
 
-  void attachEStop(EStop& e_stop) { e_stop_ = &e_stop; }
+  void attachEStop(core::EStop& e_stop) { e_stop_ = &e_stop; }
   void attachTrajectories(trajectory::TrajectoryExecutor& executor) { trajectories_ = &executor; }
   /// The node's executor, or null when the bus has no joints under trajectories.
   trajectory::TrajectoryExecutor* trajectories() const { return trajectories_; }
@@ -60,8 +60,8 @@ class ServoMotionClaims {
  private:
   ServoBus& bus_;
   const std::vector<trajectory::BusJoint>& joints_;
-  EStop* e_stop_ = nullptr;                                 // the node's, set before start
+  core::EStop* e_stop_ = nullptr;                           // the node's, set before start
   trajectory::TrajectoryExecutor* trajectories_ = nullptr;  // the node's, set before start
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

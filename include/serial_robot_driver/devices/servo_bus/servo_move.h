@@ -7,7 +7,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "serial_robot_driver/devices/servo_bus/servo_transactions.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// One request for the whole motion set of CMD 8 and 11..15 (servo/move). The command follows from
 /// the fields: velocity_dps > 0 -> by velocity (12, multi-turn 15); else accel_ms or decel_ms > 0
@@ -25,6 +25,6 @@ struct MoveRequest {
 
 /// The command `request` asks for (see MoveRequest), with the wire's units; kInvalidArgument, and
 /// `command` untouched, when a field is out of range.
-ServoStatus toMoveCommand(const MoveRequest& request, protocol::servo::MoveCommand* command);
+ServoStatus toMoveCommand(const MoveRequest& request, MoveCommand* command);
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

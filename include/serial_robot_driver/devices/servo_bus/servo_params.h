@@ -15,7 +15,7 @@
 
 #include "serial_robot_driver/protocol/wire_fields.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// Every data_id of the parameter table; the one place where these numbers are spelled.
 enum class ServoDataId : uint8_t {
@@ -57,18 +57,18 @@ constexpr std::array<ParamType, 4> kParamTypes = {ParamType::kU8, ParamType::kU1
                                                   ParamType::kI16};
 
 /// How a value of `type` goes on the wire (little-endian, as all of the servo bus).
-constexpr wire::WireType wireType(ParamType type) {
+constexpr protocol::wire::WireType wireType(ParamType type) {
   switch (type) {
     case ParamType::kU8:
-      return wire::kU8;
+      return protocol::wire::kU8;
     case ParamType::kU16:
-      return wire::kU16;
+      return protocol::wire::kU16;
     case ParamType::kU32:
-      return wire::kU32;
+      return protocol::wire::kU32;
     case ParamType::kI16:
-      return wire::kI16;
+      return protocol::wire::kI16;
   }
-  return wire::reserved(0);
+  return protocol::wire::reserved(0);
 }
 constexpr std::size_t typeSize(ParamType type) { return wireType(type).width; }
 /// The narrowest and widest parameter value on the wire.
@@ -131,4 +131,4 @@ std::array<uint8_t, kUserBlockSize> packUserBlock(
 std::vector<std::pair<const ParamInfo*, int64_t>> unpackUserBlock(
     const std::array<uint8_t, kUserBlockSize>& block);
 
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -18,13 +18,13 @@
 #include <mutex>
 #include <vector>
 
-#include "serial_robot_driver/device/loop_clock.h"
+#include "serial_robot_driver/core/loop_clock.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_config.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_events.h"
 #include "serial_robot_driver/devices/servo_bus/servo_health.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 class ServoPoller {
  public:
@@ -44,11 +44,11 @@ class ServoPoller {
   /// `settings`: the bus's settings in force, guarded by `mutex` (poll_rate, health_rate,
   /// protect, relax_power_mw are read there).
   ServoPoller(const std::vector<uint8_t>& ids, const ServoBusConfig& settings,
-              ServoBusClient& client, const ServoBusEvents& events, LoopClock& clock,
+              ServoBusClient& client, const ServoBusEvents& events, core::LoopClock& clock,
               std::mutex& mutex, Hooks hooks);
 
   /// When the poll due first falls due (max() when none).
-  Clock::time_point nextPollLocked() const;
+  core::Clock::time_point nextPollLocked() const;
   /// Runs the poll due first, if it is due (mutex held by `lock`, released around the bus):
   /// the health poll before the angle poll.
   void pollDue(std::unique_lock<std::mutex>& lock);
@@ -69,23 +69,23 @@ class ServoPoller {
   /// One polled servo and its schedule.
   struct PolledServo {
     uint8_t id = 0;
-    Clock::time_point next_poll;
+    core::Clock::time_point next_poll;
     std::chrono::milliseconds backoff{0};  ///< 0: online
     /// Its identity: due once it answered the angle poll (max: not due), read once; after a
     /// failed read due again after a back-off of its own, doubling like the angle poll's.
     ServoIdentityReport identity;
-    Clock::time_point identity_due = Clock::time_point::max();
+    core::Clock::time_point identity_due = core::Clock::time_point::max();
     std::chrono::milliseconds identity_backoff{0};
   };
   /// Its health: one entry per polled servo, changed by the worker only (read under the mutex).
   struct HealthServo {
     ServoHealthReport report;
-    Clock::time_point next_poll;
+    core::Clock::time_point next_poll;
     OverheatGuard guard;
   };
 
   /// The health poll's schedule: the servo due first, and when (max when none).
-  Clock::time_point nextHealthPollLocked() const;
+  core::Clock::time_point nextHealthPollLocked() const;
   void pollAngleOnce(PolledServo& servo);
   void pollHealthOnce(std::size_t index);
   /// The angle poll has the servo in back-off: no bus time for a silent servo.
@@ -96,7 +96,7 @@ class ServoPoller {
   /// Relaxes a servo that overheated, as a safety action.
   void relaxOverheated(uint8_t id);
   /// The polled servo whose identity read is due first, or polled_.end().
-  std::vector<PolledServo>::iterator identityDueLocked(Clock::time_point now);
+  std::vector<PolledServo>::iterator identityDueLocked(core::Clock::time_point now);
   void readIdentityOnce(PolledServo& servo);
   /// Reads `names` in order into `values`; the first failure.
   ServoStatus readHealthParams(uint8_t id, const std::vector<const char*>& names,
@@ -105,15 +105,15 @@ class ServoPoller {
   const ServoBusConfig& settings_;
   ServoBusClient& client_;
   const ServoBusEvents& events_;
-  LoopClock& clock_;
+  core::LoopClock& clock_;
   std::mutex& mutex_;  // the bus's: guards everything below
   const Hooks hooks_;
-  Clock::duration poll_period_;
+  core::Clock::duration poll_period_;
   std::vector<PolledServo> polled_;  // schedule changed by the worker (and by retune)
   std::vector<HealthServo> health_;  // one per polled servo; polled while health_period_ > 0
-  Clock::duration health_period_{0};
+  core::Clock::duration health_period_{0};
   uint64_t angles_polled_ = 0;
   const bool read_identity_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -39,12 +39,12 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/motion_gate.h"
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/motion_gate.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/bus_mutex.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// Why a servo operation failed. Every error before kTimeout is a rejection: nothing was written.
 enum class ServoError {
@@ -102,24 +102,24 @@ struct ServoBusStats {
 /// (a stop, a relax at shutdown or for temperature) that is always let through.
 enum class FrameGate { kMotion, kSafetyAction };
 
-class ServoTransactions : public LinkListener {
+class ServoTransactions : public core::LinkListener {
  public:
   /// What an answer must look like to complete the pending transaction.
   struct Expectation {
     Expectation() = default;
     /// The answer of `answer_cmd` as the command table sizes it (commands of a fixed answer).
-    Expectation(protocol::servo::Command answer_cmd, uint8_t answer_id);
-    Expectation(protocol::servo::Command answer_cmd, uint8_t answer_id, std::size_t size)
+    Expectation(Command answer_cmd, uint8_t answer_id);
+    Expectation(Command answer_cmd, uint8_t answer_id, std::size_t size)
         : cmd(answer_cmd), id(answer_id), content_size(size) {}
 
-    protocol::servo::Command cmd = protocol::servo::Command::kPing;
+    Command cmd = Command::kPing;
     uint8_t id = 0;
     std::optional<uint8_t> alt_id;   ///< also accepted (a servo_id change may answer at the new id)
     std::optional<uint8_t> data_id;  ///< READ_DATA / WRITE_DATA: content[1]
     std::size_t content_size = 0;
   };
 
-  ServoTransactions(ServoBusOptions options, FrameWriter writer);
+  ServoTransactions(ServoBusOptions options, core::FrameWriter writer);
 
   // Taking the bus: every helper below expects it held by the caller (std::lock_guard on
   // busMutex(), or takeBus() adopted).
@@ -136,20 +136,20 @@ class ServoTransactions : public LinkListener {
   /// `arrival` (optional): when the answer's last byte was read.
   /// `accepted` (a motion): the gate's generation it was accepted under (MotionGate::writeIfOpen).
   ServoStatus transact(const std::vector<uint8_t>& request, const Expectation& expect,
-                       std::chrono::milliseconds timeout, int attempts,
-                       protocol::servo::Packet* answer, FrameGate gate = FrameGate::kSafetyAction,
-                       bool give_way = false, Clock::time_point* arrival = nullptr,
-                       std::optional<MotionGate::Generation> accepted = std::nullopt);
+                       std::chrono::milliseconds timeout, int attempts, Packet* answer,
+                       FrameGate gate = FrameGate::kSafetyAction, bool give_way = false,
+                       core::Clock::time_point* arrival = nullptr,
+                       std::optional<core::MotionGate::Generation> accepted = std::nullopt);
   /// transact() with the configured timeout and retries: the usual request/answer exchange.
   ServoStatus exchangeLocked(const std::vector<uint8_t>& request, const Expectation& expect,
-                             protocol::servo::Packet* answer);
+                             Packet* answer);
   /// exchangeLocked() of a single request, taking the bus itself.
   ServoStatus exchange(const std::vector<uint8_t>& request, const Expectation& expect,
-                       protocol::servo::Packet* answer);
+                       Packet* answer);
   /// Fire and forget: a motion command without wait.
-  ServoStatus sendCommand(const std::vector<uint8_t>& request, protocol::servo::Command cmd,
-                          uint8_t id, FrameGate gate,
-                          std::optional<MotionGate::Generation> accepted = std::nullopt);
+  ServoStatus sendCommand(const std::vector<uint8_t>& request, Command cmd, uint8_t id,
+                          FrameGate gate,
+                          std::optional<core::MotionGate::Generation> accepted = std::nullopt);
 
   /// SPIN stops to `ids` as urgent work (BusMutex::lockUrgent): written after the one transaction
   /// attempt in flight, before every waiting caller. `written[i]`: whether the stop of ids[i]
@@ -177,7 +177,7 @@ class ServoTransactions : public LinkListener {
   void setReaderPump(ReaderPump pump);
   /// Before any transaction: the gate every motion frame passes when it is written (nullptr:
   /// none), and what is told, under the gate's lock, of each motion frame that went out.
-  void setMotionGate(MotionGate* gate, std::function<void(uint8_t id)> on_motion_written) {
+  void setMotionGate(core::MotionGate* gate, std::function<void(uint8_t id)> on_motion_written) {
     gate_ = gate;
     on_motion_written_ = std::move(on_motion_written);
   }
@@ -185,7 +185,7 @@ class ServoTransactions : public LinkListener {
   // LinkListener (reader thread).
   void onLinkDown() override;
   void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
-               Clock::time_point arrival) override;
+               core::Clock::time_point arrival) override;
 
  private:
   struct Pending {
@@ -193,21 +193,21 @@ class ServoTransactions : public LinkListener {
     Expectation expect;
     bool answered = false;
     bool garbled = false;
-    protocol::servo::Packet answer;
-    Clock::time_point arrival;
+    Packet answer;
+    core::Clock::time_point arrival;
   };
 
   /// Writes one request, through the motion gate when `gate` is kMotion (voided when an e-stop
   /// engaged since generation `accepted`). nullopt when written; else why not (the gate's
   /// refusal, or the port is down).
-  std::optional<ServoStatus> writeRequest(const std::vector<uint8_t>& request,
-                                          protocol::servo::Command cmd, uint8_t id, FrameGate gate,
-                                          std::optional<MotionGate::Generation> accepted);
-  bool matches(const protocol::servo::Packet& packet) const;  // state_mutex_ held
+  std::optional<ServoStatus> writeRequest(const std::vector<uint8_t>& request, Command cmd,
+                                          uint8_t id, FrameGate gate,
+                                          std::optional<core::MotionGate::Generation> accepted);
+  bool matches(const Packet& packet) const;  // state_mutex_ held
   /// Sets up the pending transaction of one attempt; false when shutting down.
   bool beginAttempt(const std::vector<uint8_t>& request, const Expectation& expect, FrameGate gate);
   /// The pending transaction's answer, its latency counted (state_mutex_ held).
-  ServoStatus answeredLocked(Clock::time_point sent_at, protocol::servo::Packet* answer);
+  ServoStatus answeredLocked(core::Clock::time_point sent_at, Packet* answer);
   /// kBadAnswer: only malformed answers (the last one `garbled_size` content bytes).
   static ServoStatus malformed(const Expectation& expect, std::size_t garbled_size);
   /// kTimeout after `attempts` unanswered attempts, counted.
@@ -218,13 +218,13 @@ class ServoTransactions : public LinkListener {
   void lockUrgent();
   /// Waits (state_mutex_ held by `lock`) until the pending transaction is answered, garbled,
   /// lost or shut down, or `deadline` passes.
-  void waitForAnswer(std::unique_lock<std::mutex>& lock, Clock::time_point deadline);
+  void waitForAnswer(std::unique_lock<std::mutex>& lock, core::Clock::time_point deadline);
 
   ServoBusOptions
       options_;  // timeout and retries guarded by state_mutex_ (retune), read via options()
-  const FrameWriter writer_;
-  ReaderPump pump_;             // set before any call; empty: every wait is on a condition variable
-  MotionGate* gate_ = nullptr;  // set before any call
+  const core::FrameWriter writer_;
+  ReaderPump pump_;  // set before any call; empty: every wait is on a condition variable
+  core::MotionGate* gate_ = nullptr;  // set before any call
   std::function<void(uint8_t id)> on_motion_written_;
   std::function<bool()> stop_calls_queued_;  // set before any call; empty: none
 
@@ -242,4 +242,4 @@ class ServoTransactions : public LinkListener {
   ServoBusStats stats_;
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -29,11 +29,11 @@
 #include <utility>
 #include <vector>
 
-#include "serial_robot_driver/device/loop_clock.h"
+#include "serial_robot_driver/core/loop_clock.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_client.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_events.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 
 /// How stop work is paced: by the bus's clock (the worker), or back to back with real sleeps for
 /// the settle (on the caller's thread, whatever clock the bus has).
@@ -51,14 +51,14 @@ class StopKeeper {
   static constexpr std::chrono::milliseconds kStopRepeat{500};
 
   /// `on_written_locked`: the stop of `id` went out (mutex held): it is no longer set moving.
-  StopKeeper(ServoBusClient& client, const ServoBusEvents& events, LoopClock& clock,
+  StopKeeper(ServoBusClient& client, const ServoBusEvents& events, core::LoopClock& clock,
              std::mutex& mutex, std::function<void(uint8_t id)> on_written_locked);
 
   /// Adds a stop of `id` to be written now, or has a kept one written again now (and seen at
   /// rest again). `repeat`: the e-stop's, written again every kStopRepeat even once at rest.
-  void armLocked(uint8_t id, Clock::time_point now, bool repeat = false);
+  void armLocked(uint8_t id, core::Clock::time_point now, bool repeat = false);
   /// Every kept stop is written again now (a reconnect).
-  void rearmAllLocked(Clock::time_point now);
+  void rearmAllLocked(core::Clock::time_point now);
   /// The servo needs no stop any more (a later motion superseded it, or it was relaxed).
   void eraseLocked(uint8_t id) { stops_.erase(id); }
   /// The e-stop released: the stops that went out are done and none is repeated any more; one
@@ -82,7 +82,7 @@ class StopKeeper {
   void askUrgent();
   void endUrgentLocked();
   /// When the stop work falls due next; min() while the bus is reserved, max() when none.
-  Clock::time_point nextWorkLocked() const;
+  core::Clock::time_point nextWorkLocked() const;
   /// One piece of stop work that is due (mutex held by `lock`, released around the bus): every
   /// stop to be written, or one look at a stopped servo. False when nothing was due.
   bool workOnce(std::unique_lock<std::mutex>& lock, StopPace pace);
@@ -93,7 +93,7 @@ class StopKeeper {
   /// A stop until the servo is seen at rest.
   struct PendingStop {
     enum class Phase { kWrite, kFirstLook, kSecondLook } phase = Phase::kWrite;
-    Clock::time_point due;
+    core::Clock::time_point due;
     double first_angle = 0.0;
     int written = 0;
     bool repeat = false;     ///< the e-stop's: written again every kStopRepeat while it holds
@@ -105,15 +105,15 @@ class StopKeeper {
   void lookAtStoppedServo(std::unique_lock<std::mutex>& lock, uint8_t id, StopPace pace);
   /// The second look found the servo at rest: the stop is done, or repeated (the e-stop's).
   ServoStatus seenAtRestLocked(std::map<uint8_t, PendingStop>::iterator it, double angle_deg,
-                               Clock::time_point now);
+                               core::Clock::time_point now);
 
   ServoBusClient& client_;
   const ServoBusEvents& events_;
-  LoopClock& clock_;
+  core::LoopClock& clock_;
   std::mutex& mutex_;  // the bus's: guards everything below
   const std::function<void(uint8_t id)> on_written_locked_;
   std::map<uint8_t, PendingStop> stops_;  // not yet known to have reached their servo
   bool urgent_asked_ = false;             // askUrgent() .. endUrgentLocked()
 };
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -32,7 +32,7 @@ void drawWheel(UrdfWriter& urdf, const std::string& base_link, const std::string
 Chassis drawChassis(const ros_layer::DriverParams& params, UrdfWriter& urdf) {
   // Simple shapes sized from the wheel geometry: base_link on the ground between the wheels
   // (REP-105), the axle at the wheel radius, a box chassis and a rear caster ball.
-  const params::BaseParams& section = params.section(params::kBaseSection);
+  const BaseParams& section = params.section(kBaseSection);
   const kinematics::DiffDriveGeometry& wheels = section.controller.geometry;
   const double radius = wheels.wheel_diameter / 2.0;
   const double wheel_width = std::min(0.25 * wheels.wheel_diameter, 0.3 * wheels.wheel_separation);

@@ -2,10 +2,9 @@
 
 #include <limits>
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::base::ros {
 
-sensor_msgs::BatteryState toBatteryState(const device::BatteryReading& battery,
-                                         const ros::Time& stamp) {
+sensor_msgs::BatteryState toBatteryState(const BatteryReading& battery, const ::ros::Time& stamp) {
   sensor_msgs::BatteryState msg;
   msg.header.stamp = stamp;
   // The base reports only a percentage; everything else is unknown (NaN per the message docs).
@@ -20,9 +19,9 @@ sensor_msgs::BatteryState toBatteryState(const device::BatteryReading& battery,
   return msg;
 }
 
-nav_msgs::Odometry toOdometry(const device::OdometrySample& sample, const OdomFrames& frames,
-                              const ros::Time& stamp) {
-  const device::YawRotation rotation = device::yawRotation(sample.pose.yaw);
+nav_msgs::Odometry toOdometry(const OdometrySample& sample, const OdomFrames& frames,
+                              const ::ros::Time& stamp) {
+  const YawRotation rotation = yawRotation(sample.pose.yaw);
   nav_msgs::Odometry odom;
   odom.header.stamp = stamp;
   odom.header.frame_id = frames.odom;
@@ -36,20 +35,20 @@ nav_msgs::Odometry toOdometry(const device::OdometrySample& sample, const OdomFr
   // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
   // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
   // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
-  constexpr double kNotEstimated = device::kNotEstimatedVariance;
+  constexpr double kNotEstimated = kNotEstimatedVariance;
   odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
   odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
   odom.pose.covariance[35] = sample.yaw_variance;
-  odom.twist.covariance[0] = device::kTwistLinearVariance;
-  odom.twist.covariance[7] = device::kTwistLateralVariance;
+  odom.twist.covariance[0] = kTwistLinearVariance;
+  odom.twist.covariance[7] = kTwistLateralVariance;
   odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
-  odom.twist.covariance[35] = device::kTwistAngularVariance;
+  odom.twist.covariance[35] = kTwistAngularVariance;
   return odom;
 }
 
-sensor_msgs::JointState toWheelStates(const device::OdometrySample& sample,
-                                      const std::string& frame, const std::string& left,
-                                      const std::string& right, const ros::Time& stamp) {
+sensor_msgs::JointState toWheelStates(const OdometrySample& sample, const std::string& frame,
+                                      const std::string& left, const std::string& right,
+                                      const ::ros::Time& stamp) {
   sensor_msgs::JointState wheels;
   wheels.header.stamp = stamp;
   wheels.header.frame_id = frame;
@@ -60,4 +59,4 @@ sensor_msgs::JointState toWheelStates(const device::OdometrySample& sample,
   return wheels;
 }
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::base::ros

@@ -1,5 +1,5 @@
 #include "serial_robot_driver/BaseTuningConfig.h"
-#include "serial_robot_driver/devices/base/base_interface.h"
+#include "serial_robot_driver/devices/base/ros/base_ros.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/tuning_group_server.h"
 
@@ -8,7 +8,7 @@ namespace serial_robot_driver::devices::base {
 namespace {
 
 // The ~base group: the wheel, speed, battery and odometry tunables (BaseTuning.cfg).
-void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_nh,
+void addTuning(ros_layer::RuntimeTuning& tuning, const ::ros::NodeHandle& private_nh,
                ros_layer::RuntimeTuning::Servers& servers) {
   ros_layer::addGroupServer<BaseTuningConfig>(tuning, private_nh, "base", servers);
 }
@@ -17,7 +17,7 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_
 
 extern const ros_layer::RosDeviceModule kRosModule{
     .name = "base",
-    .make = ros_layer::makeInterface<ros_layer::BaseInterface>,
+    .make = ros_layer::makeInterface<ros::BaseRos>,
     .add_tuning = addTuning,
 };
 

@@ -1,41 +1,41 @@
-#include "serial_robot_driver/devices/base/base_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace serial_robot_driver::sim {
+namespace serial_robot_driver::devices::base::sim {
 
-namespace base = protocol::base;
+const serial_robot_driver::sim::OutputKind kBaseReplyOutput{"base_replies", 1};
 
-const OutputKind kBaseReplyOutput{"base_replies", 1};
-
-BaseSim::BaseSim(const BaseSimConfig& config, TimePoint now)
+BaseSim::BaseSim(const BaseSimConfig& config, serial_robot_driver::sim::TimePoint now)
     : config_(config),
-      pid_period_(fromSeconds(1.0 / std::max(config.pid_rate_hz, 1e-3))),
+      pid_period_(serial_robot_driver::sim::fromSeconds(1.0 / std::max(config.pid_rate_hz, 1e-3))),
       next_pid_(now + pid_period_),
       last_host_frame_(now),  // the heartbeat runs from power-on, like the real base
       next_error_frame_(now) {}
 
-void BaseSim::emit(Outbox* out, std::vector<uint8_t> frame) {
-  out->push_back(Outgoing{&kBaseReplyOutput, std::move(frame)});
+void BaseSim::emit(serial_robot_driver::sim::Outbox* out, std::vector<uint8_t> frame) {
+  out->push_back(serial_robot_driver::sim::Outgoing{&kBaseReplyOutput, std::move(frame)});
 }
 
-void BaseSim::handleFrame(const uint8_t* data, std::size_t size, TimePoint now, Outbox* out) {
-  const auto decoded = base::decodeFrame(data, size);
+void BaseSim::handleFrame(const uint8_t* data, std::size_t size,
+                          serial_robot_driver::sim::TimePoint now,
+                          serial_robot_driver::sim::Outbox* out) {
+  const auto decoded = decodeFrame(data, size);
   if (!decoded) {
     ++stats_.unknown_frames;
     return;
   }
-  const base::Frame& frame = *decoded;
+  const Frame& frame = *decoded;
   ++stats_.frames_received;
   last_host_frame_ = now;
   if (have_seq_ && frame.seq != expected_seq_) ++stats_.seq_gaps;
   have_seq_ = true;
   expected_seq_ = static_cast<uint8_t>(frame.seq + 1);
 
-  switch (static_cast<base::MsgId>(frame.msg_id)) {
-    case base::MsgId::kWheelSpeed: {
-      const auto speed = base::interpretWheelSpeed(frame);
+  switch (static_cast<MsgId>(frame.msg_id)) {
+    case MsgId::kWheelSpeed: {
+      const auto speed = interpretWheelSpeed(frame);
       if (!speed) {
         ++stats_.unknown_frames;
         break;
@@ -50,15 +50,15 @@ void BaseSim::handleFrame(const uint8_t* data, std::size_t size, TimePoint now, 
       ++stats_.speed_frames_applied;
       break;
     }
-    case base::MsgId::kBattery:
+    case MsgId::kBattery:
       ++stats_.battery_requests;
-      emit(out, base::encodeBatteryReply(reply_seq_.next(), config_.battery_percent));
+      emit(out, encodeBatteryReply(reply_seq_.next(), config_.battery_percent));
       break;
-    case base::MsgId::kReset:
+    case MsgId::kReset:
       ++stats_.resets;
       stats_.in_error = false;
       break;
-    case base::MsgId::kClearEncoders:
+    case MsgId::kClearEncoders:
       ++stats_.encoder_clears;
       stats_.left_ticks = 0;
       stats_.right_ticks = 0;
@@ -69,18 +69,19 @@ void BaseSim::handleFrame(const uint8_t* data, std::size_t size, TimePoint now, 
   }
 }
 
-void BaseSim::enterError(TimePoint now, Outbox* out) {
+void BaseSim::enterError(serial_robot_driver::sim::TimePoint now,
+                         serial_robot_driver::sim::Outbox* out) {
   stats_.in_error = true;
   ++stats_.timeouts;
   // A base that lost its host stops rather than running on the last command.
   stats_.last_left_speed = 0;
   stats_.last_right_speed = 0;
-  emit(out, base::encodeErrorStatus(reply_seq_.next()));
+  emit(out, encodeErrorStatus(reply_seq_.next()));
   ++stats_.errors_sent;
-  next_error_frame_ = now + fromSeconds(config_.error_repeat_s);
+  next_error_frame_ = now + serial_robot_driver::sim::fromSeconds(config_.error_repeat_s);
 }
 
-void BaseSim::tick(TimePoint now, Outbox* out) {
+void BaseSim::tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver::sim::Outbox* out) {
   // After a long stall (debugger, suspended process) skip the missed periods instead of looping.
   if (now - next_pid_ > std::chrono::seconds(1)) next_pid_ = now;
   while (next_pid_ <= now) {
@@ -91,22 +92,25 @@ void BaseSim::tick(TimePoint now, Outbox* out) {
   }
 
   if (!stats_.in_error) {
-    if (now - last_host_frame_ > fromSeconds(config_.heartbeat_timeout_s)) enterError(now, out);
+    if (now - last_host_frame_ > serial_robot_driver::sim::fromSeconds(config_.heartbeat_timeout_s))
+      enterError(now, out);
   } else if (now >= next_error_frame_) {
-    emit(out, base::encodeErrorStatus(reply_seq_.next()));
+    emit(out, encodeErrorStatus(reply_seq_.next()));
     ++stats_.errors_sent;
-    next_error_frame_ += fromSeconds(config_.error_repeat_s);
-    if (next_error_frame_ <= now) next_error_frame_ = now + fromSeconds(config_.error_repeat_s);
+    next_error_frame_ += serial_robot_driver::sim::fromSeconds(config_.error_repeat_s);
+    if (next_error_frame_ <= now)
+      next_error_frame_ = now + serial_robot_driver::sim::fromSeconds(config_.error_repeat_s);
   }
 }
 
-TimePoint BaseSim::nextEvent() const {
-  TimePoint next = next_pid_;
+serial_robot_driver::sim::TimePoint BaseSim::nextEvent() const {
+  serial_robot_driver::sim::TimePoint next = next_pid_;
   if (stats_.in_error) {
     next = std::min(next, next_error_frame_);
   } else {
     // One tick just past the deadline: the timeout is "more than" heartbeat_timeout_s.
-    next = std::min(next, last_host_frame_ + fromSeconds(config_.heartbeat_timeout_s) +
+    next = std::min(next, last_host_frame_ +
+                              serial_robot_driver::sim::fromSeconds(config_.heartbeat_timeout_s) +
                               std::chrono::milliseconds(1));
   }
   return next;
@@ -132,4 +136,4 @@ double BaseSim::yawRate() const {
   return (right - left) / config_.wheel_separation_m * (1.0 - config_.turn_slip);
 }
 
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::devices::base::sim

@@ -15,11 +15,11 @@
 
 namespace calibration_test {
 
-using serial_robot_driver::device::BaseConfig;
-using serial_robot_driver::device::BaseTwist;
-using serial_robot_driver::device::CalibrationLine;
-using serial_robot_driver::device::CalibrationTick;
-using serial_robot_driver::device::TurnCalibrationRun;
+using serial_robot_driver::devices::base::BaseConfig;
+using serial_robot_driver::devices::base::BaseTwist;
+using serial_robot_driver::devices::base::CalibrationLine;
+using serial_robot_driver::devices::base::CalibrationTick;
+using serial_robot_driver::devices::base::TurnCalibrationRun;
 
 // The node's default geometry, written out: 0.25 m wheels of 1600 ticks a turn, 0.40 m apart, a
 // PID period of 1/50 s. Ticks per period for 1 m/s = 1600 / (pi * 0.25) / 50.
@@ -27,16 +27,16 @@ constexpr double kTicksPerPeriodPerMps = 1600.0 / (M_PI * 0.25) / 50.0;
 constexpr double kSeparation = 0.40;
 
 struct FakeRobot {
-  double slip = 0.15;         ///< the chassis turns by (1 - slip) of the commanded turn
-  double gyro_bias = 0.01;    ///< rad/s in every IMU sample
-  bool e_stop = false;        ///< the driver writes zero frames; reported on "diagnostics"
+  double slip = 0.15;       ///< the chassis turns by (1 - slip) of the commanded turn
+  double gyro_bias = 0.01;  ///< rad/s in every IMU sample
+  bool e_stop = false;      ///< the driver writes zero frames; reported on "diagnostics"
   /// The tool sees the e-stop's state (false: it always looks released; an engagement only the
   /// driver's count shows).
   bool e_stop_visible = true;
-  uint64_t engagements = 0;   ///< the driver's count of engagements (its e_stop status)
-  bool telemetry = true;      ///< IMU samples arrive
-  bool frames = true;         ///< the driver writes wheel frames
-  bool ignores_zero = false;  ///< a wedged driver: keeps writing the last moving frame
+  uint64_t engagements = 0;              ///< the driver's count of engagements (its e_stop status)
+  bool telemetry = true;                 ///< IMU samples arrive
+  bool frames = true;                    ///< the driver writes wheel frames
+  bool ignores_zero = false;             ///< a wedged driver: keeps writing the last moving frame
   std::optional<double> typed_distance;  ///< what the user types at the prompt
   bool prompted = false;                 ///< the run asked for the distance
 

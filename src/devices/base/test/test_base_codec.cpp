@@ -10,7 +10,7 @@
 #include "support/golden_frames.h"
 #include "support/probe_expectations.h"
 
-namespace serial_robot_driver::protocol::base {
+namespace serial_robot_driver::devices::base {
 namespace {
 
 using Bytes = std::vector<uint8_t>;
@@ -60,8 +60,8 @@ TEST_P(BaseCodecHostFrame, EncoderReproducesGoldenBytes) {
 
 TEST_P(BaseCodecHostFrame, DecoderReadsGoldenBytes) {
   const HostFrameCase& c = GetParam();
-  const Decoded<Frame> frame = decodeFrame(c.expected.data(), c.expected.size());
-  ASSERT_TRUE(frame.ok()) << toString(frame.error());
+  const protocol::Decoded<Frame> frame = decodeFrame(c.expected.data(), c.expected.size());
+  ASSERT_TRUE(frame.ok()) << protocol::toString(frame.error());
   EXPECT_EQ(frame->seq, c.seq);
   EXPECT_EQ(frame->msg_id, c.msg_id);
   ASSERT_EQ(frame->param_count, c.params.size());
@@ -100,9 +100,9 @@ class BaseCodecWheelSpeed : public ::testing::TestWithParam<WheelSpeedCase> {};
 
 TEST_P(BaseCodecWheelSpeed, BigEndianSignedTicks) {
   const WheelSpeedCase& c = GetParam();
-  const Decoded<Frame> frame = decodeFrame(c.frame.data(), c.frame.size());
+  const protocol::Decoded<Frame> frame = decodeFrame(c.frame.data(), c.frame.size());
   ASSERT_TRUE(frame.ok());
-  const Decoded<WheelSpeed> speed = interpretWheelSpeed(*frame);
+  const protocol::Decoded<WheelSpeed> speed = interpretWheelSpeed(*frame);
   ASSERT_TRUE(speed.ok());
   EXPECT_EQ(speed->left_ticks, c.left);
   EXPECT_EQ(speed->right_ticks, c.right);
@@ -113,11 +113,11 @@ INSTANTIATE_TEST_SUITE_P(BaseCodecGolden, BaseCodecWheelSpeed, ::testing::Values
 
 TEST(BaseCodec, WheelSpeedOfOtherMessageIsUnexpected) {
   const Bytes& reset = golden::base::kResetSeq2;
-  const Decoded<Frame> frame = decodeFrame(reset.data(), reset.size());
+  const protocol::Decoded<Frame> frame = decodeFrame(reset.data(), reset.size());
   ASSERT_TRUE(frame.ok());
-  const Decoded<WheelSpeed> speed = interpretWheelSpeed(*frame);
+  const protocol::Decoded<WheelSpeed> speed = interpretWheelSpeed(*frame);
   ASSERT_FALSE(speed.ok());
-  EXPECT_EQ(speed.error(), DecodeError::kUnexpectedContent);
+  EXPECT_EQ(speed.error(), protocol::DecodeError::kUnexpectedContent);
 }
 
 // --- base -> host replies ----------------------------------------------------------------------
@@ -154,9 +154,9 @@ class BaseCodecReply : public ::testing::TestWithParam<ReplyCase> {};
 
 TEST_P(BaseCodecReply, Interpreted) {
   const ReplyCase& c = GetParam();
-  const Decoded<Frame> frame = decodeFrame(c.frame.data(), c.frame.size());
-  ASSERT_TRUE(frame.ok()) << toString(frame.error());
-  const Decoded<Reply> reply = interpretReply(*frame);
+  const protocol::Decoded<Frame> frame = decodeFrame(c.frame.data(), c.frame.size());
+  ASSERT_TRUE(frame.ok()) << protocol::toString(frame.error());
+  const protocol::Decoded<Reply> reply = interpretReply(*frame);
   ASSERT_TRUE(reply.ok());
   EXPECT_EQ(reply->kind, c.kind);
   if (c.kind == Reply::Kind::kBattery) {
@@ -170,9 +170,9 @@ INSTANTIATE_TEST_SUITE_P(BaseCodecGolden, BaseCodecReply, ::testing::ValuesIn(kR
 
 TEST(BaseCodec, UnknownReplyKeepsRawFrame) {
   const Bytes bytes = {0x55, 0xAA, 0x03, 0x05, 0x33, 0x01, 0x02, 0xC9};
-  const Decoded<Frame> frame = decodeFrame(bytes.data(), bytes.size());
+  const protocol::Decoded<Frame> frame = decodeFrame(bytes.data(), bytes.size());
   ASSERT_TRUE(frame.ok());
-  const Decoded<Reply> reply = interpretReply(*frame);
+  const protocol::Decoded<Reply> reply = interpretReply(*frame);
   ASSERT_TRUE(reply.ok());
   EXPECT_EQ(reply->frame.seq, 0x05);
   ASSERT_EQ(reply->frame.param_count, 2);
@@ -183,11 +183,11 @@ TEST(BaseCodec, UnknownReplyKeepsRawFrame) {
 TEST(BaseCodec, BatteryReplyWithoutParamIsUnexpected) {
   // LEN 1: MSGID only. XOR: 55^AA^01^00^02 = FC
   const Bytes bytes = {0x55, 0xAA, 0x01, 0x00, 0x02, 0xFC};
-  const Decoded<Frame> frame = decodeFrame(bytes.data(), bytes.size());
+  const protocol::Decoded<Frame> frame = decodeFrame(bytes.data(), bytes.size());
   ASSERT_TRUE(frame.ok());
-  const Decoded<Reply> reply = interpretReply(*frame);
+  const protocol::Decoded<Reply> reply = interpretReply(*frame);
   ASSERT_FALSE(reply.ok());
-  EXPECT_EQ(reply.error(), DecodeError::kUnexpectedContent);
+  EXPECT_EQ(reply.error(), protocol::DecodeError::kUnexpectedContent);
 }
 
 // --- malformed frames ----------------------------------------------------------------------------
@@ -195,23 +195,23 @@ TEST(BaseCodec, BatteryReplyWithoutParamIsUnexpected) {
 struct MalformedCase {
   std::string name;
   Bytes frame;
-  DecodeError error;
+  protocol::DecodeError error;
 };
 
 // clang-format off
 const MalformedCase kMalformed[] = {
-    {"BadChecksum", {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFB}, DecodeError::kBadChecksum},
-    {"BadHeader", {0x55, 0xAB, 0x02, 0x02, 0x05, 0x00, 0xFA}, DecodeError::kBadHeader},
-    {"SwappedHeader", {0xAA, 0x55, 0x02, 0x02, 0x05, 0x00, 0xFA}, DecodeError::kBadHeader},
-    {"Truncated", {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x04, 0x00}, DecodeError::kTooShort},
-    {"OnlyHeader", {0x55, 0xAA}, DecodeError::kTooShort},
-    {"Empty", {}, DecodeError::kTooShort},
-    {"LenZero", {0x55, 0xAA, 0x00, 0x02, 0x05, 0x00, 0xFA}, DecodeError::kBadLength},
-    {"Len255", {0x55, 0xAA, 0xFF, 0x02, 0x05, 0x00, 0xFA}, DecodeError::kBadLength},
-    {"LenAboveMax", {0x55, 0xAA, 0x21, 0x02, 0x05, 0x00, 0xFA}, DecodeError::kBadLength},
+    {"BadChecksum", {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0xFB}, protocol::DecodeError::kBadChecksum},
+    {"BadHeader", {0x55, 0xAB, 0x02, 0x02, 0x05, 0x00, 0xFA}, protocol::DecodeError::kBadHeader},
+    {"SwappedHeader", {0xAA, 0x55, 0x02, 0x02, 0x05, 0x00, 0xFA}, protocol::DecodeError::kBadHeader},
+    {"Truncated", {0x55, 0xAA, 0x09, 0x00, 0x01, 0x00, 0x04, 0x00}, protocol::DecodeError::kTooShort},
+    {"OnlyHeader", {0x55, 0xAA}, protocol::DecodeError::kTooShort},
+    {"Empty", {}, protocol::DecodeError::kTooShort},
+    {"LenZero", {0x55, 0xAA, 0x00, 0x02, 0x05, 0x00, 0xFA}, protocol::DecodeError::kBadLength},
+    {"Len255", {0x55, 0xAA, 0xFF, 0x02, 0x05, 0x00, 0xFA}, protocol::DecodeError::kBadLength},
+    {"LenAboveMax", {0x55, 0xAA, 0x21, 0x02, 0x05, 0x00, 0xFA}, protocol::DecodeError::kBadLength},
     // LEN 2 says 7 bytes, 8 were given.
     {"LenTooSmallForSize", {0x55, 0xAA, 0x02, 0x02, 0x05, 0x00, 0x00, 0xFA},
-     DecodeError::kBadLength},
+     protocol::DecodeError::kBadLength},
 };
 // clang-format on
 
@@ -219,9 +219,9 @@ class BaseCodecMalformed : public ::testing::TestWithParam<MalformedCase> {};
 
 TEST_P(BaseCodecMalformed, Rejected) {
   const MalformedCase& c = GetParam();
-  const Decoded<Frame> frame = decodeFrame(c.frame.data(), c.frame.size());
+  const protocol::Decoded<Frame> frame = decodeFrame(c.frame.data(), c.frame.size());
   ASSERT_FALSE(frame.ok());
-  EXPECT_EQ(frame.error(), c.error) << toString(frame.error());
+  EXPECT_EQ(frame.error(), c.error) << protocol::toString(frame.error());
 }
 
 INSTANTIATE_TEST_SUITE_P(BaseCodecErrors, BaseCodecMalformed, ::testing::ValuesIn(kMalformed),
@@ -230,7 +230,7 @@ INSTANTIATE_TEST_SUITE_P(BaseCodecErrors, BaseCodecMalformed, ::testing::ValuesI
 TEST(BaseCodec, LenOneIsSmallestFrame) {
   // LEN 1, MSGID 05. XOR: 55^AA^01^00^05 = FB
   const Bytes bytes = {0x55, 0xAA, 0x01, 0x00, 0x05, 0xFB};
-  const Decoded<Frame> frame = decodeFrame(bytes.data(), bytes.size());
+  const protocol::Decoded<Frame> frame = decodeFrame(bytes.data(), bytes.size());
   ASSERT_TRUE(frame.ok());
   EXPECT_EQ(frame->msg_id, 0x05);
   EXPECT_EQ(frame->param_count, 0);
@@ -275,12 +275,15 @@ TEST(BaseCodecProbe, FindsGoldenFrameAndNeedsMoreAtEveryTruncation) {
 }
 
 TEST(BaseCodecProbe, SaysWhyACandidateIsInvalid) {
-  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x01, 0x00, 0x05, 0xFA}, DecodeError::kBadChecksum);
-  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x00, 0x00, 0x05, 0xFA}, DecodeError::kBadLength);
-  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x21}, DecodeError::kBadLength);  // LEN 33 > 32
-  expectProbeRejects(probeFrame, {0x55, 0xAB}, DecodeError::kBadHeader);
-  expectProbeRejects(probeFrame, {0xAA}, DecodeError::kBadHeader);
+  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x01, 0x00, 0x05, 0xFA},
+                     protocol::DecodeError::kBadChecksum);
+  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x00, 0x00, 0x05, 0xFA},
+                     protocol::DecodeError::kBadLength);
+  expectProbeRejects(probeFrame, {0x55, 0xAA, 0x21},
+                     protocol::DecodeError::kBadLength);  // LEN 33 > 32
+  expectProbeRejects(probeFrame, {0x55, 0xAB}, protocol::DecodeError::kBadHeader);
+  expectProbeRejects(probeFrame, {0xAA}, protocol::DecodeError::kBadHeader);
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::protocol::base
+}  // namespace serial_robot_driver::devices::base

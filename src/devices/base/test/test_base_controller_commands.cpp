@@ -4,7 +4,7 @@
 
 #include "support/base_controller_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 namespace {
 
 using namespace base_controller_test;  // NOLINT: the shared fixture
@@ -85,9 +85,7 @@ TEST_F(BaseControllerTest, TimeoutErrorFrameMakesNextFrameReset) {
   frames_.clear();
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
   const Bytes& error = golden::base::kErrorStatusSeq7;
-  clock_->step([&] {
-    controller_.onFrame(protocol::base::kFrames, error.data(), error.size(), clock_->now());
-  });
+  clock_->step([&] { controller_.onFrame(kFrames, error.data(), error.size(), clock_->now()); });
   clock_->tick(1);
   // The error wakes the loop: Reset, then the speed frame (rushed), then the tick's speed frame.
   ASSERT_EQ(frames_.size(), 3u);
@@ -152,7 +150,8 @@ constexpr auto kExpectedImmediateInterval = std::chrono::nanoseconds(2430556);
 
 /// Moves the manual clock to `target`, stopping at every 20 ms tick on the way so each tick runs
 /// at its own deadline (as on the real clock).
-void advanceTo(ManualClock& clock, Clock::time_point t0, Clock::time_point target) {
+void advanceTo(core::ManualClock& clock, core::Clock::time_point t0,
+               core::Clock::time_point target) {
   while (clock.now() < target) {
     const auto since_start = clock.now() - t0;
     const auto next_tick = t0 + (since_start / milliseconds(20) + 1) * milliseconds(20);
@@ -171,7 +170,7 @@ TEST_F(BaseControllerTest, CmdVelAt300HzGoesOutAtOnceEveryTime) {
   // right after a tick (the pattern repeats every 20 ms: six commands per tick).
   const auto spacing = std::chrono::microseconds(3333);
   for (int k = 0; k < 60; ++k) {  // 0.2 s
-    const Clock::time_point at = t0_ + std::chrono::microseconds(2900) + k * spacing;
+    const core::Clock::time_point at = t0_ + std::chrono::microseconds(2900) + k * spacing;
     advanceTo(*clock_, t0_, at);
     const double speed = 0.05 + 0.005 * (k % 20);
     clock_->step([&] { controller_.setCommand(speed, 0.0); });
@@ -195,11 +194,11 @@ TEST_F(BaseControllerTest, CmdVelFloodIsLimitedToTheLineShareAndTicksKeepTheirSc
   EXPECT_GE(immediate, 40u);
   // Any two speed frames the commands caused are at least the interval apart, and the scheduled
   // frames stayed on their 20 ms grid.
-  std::optional<Clock::time_point> last_immediate;
+  std::optional<core::Clock::time_point> last_immediate;
   int scheduled = 0;
   for (const WheelFrameSent& sent : sent_) {
     const auto offset = sent.time - t0_;
-    if (offset % milliseconds(20) == Clock::duration::zero()) {
+    if (offset % milliseconds(20) == core::Clock::duration::zero()) {
       ++scheduled;
       continue;
     }
@@ -279,7 +278,7 @@ TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
   std::vector<WheelFrameSent> sent;
   BaseEvents events;
   events.on_wheel_frame = [&sent](const WheelFrameSent& s) { sent.push_back(s); };
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, events, clock);
   BaseController& controller = *started;
   clock->step([&] { controller.setCommand(0.5, 0.0); });
@@ -297,7 +296,7 @@ TEST(BaseControllerMotion, MotionInForceNamesTheCommandThenTheRampUntilTheWheels
   BaseConfig config;
   config.battery_poll_rate = 0;
   config.max_wheel_accel = 1.0;  // 0.5 m/s takes 0.5 s to ramp down
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   auto controller = startOnManualClock(config, {}, clock);
   EXPECT_EQ(controller->motionInForce(), "") << "never commanded";
   clock->step([&] { controller->setCommand(0.5, 0.0); });
@@ -317,4 +316,4 @@ TEST(BaseControllerMotion, MotionInForceNamesTheCommandThenTheRampUntilTheWheels
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -4,7 +4,7 @@
 
 #include "support/base_controller_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 namespace {
 
 using namespace base_controller_test;  // NOLINT: the shared fixture
@@ -96,7 +96,7 @@ TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
   std::vector<OdometrySample> samples;
   BaseEvents events;
   events.on_odometry = [&samples](const OdometrySample& s) { samples.push_back(s); };
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, events, clock, &frames);
   BaseController& controller = *started;
   clock->step([&] { controller.setCommand(0.1, 0.0); });
@@ -123,8 +123,8 @@ TEST(BaseControllerImuHeading, FollowsTheImuFallsBackWithoutAJumpAndResumesWitho
   config.cmd_vel_timeout = 100;  // one command turns for the whole test
   config.use_imu_heading = true;
   config.imu_yaw_variance = 0.0003;
-  const Clock::time_point t0 = Clock::now();
-  auto clock = std::make_shared<ManualClock>(t0);
+  const core::Clock::time_point t0 = core::Clock::now();
+  auto clock = std::make_shared<core::ManualClock>(t0);
   auto controller = startOnManualClock(config, events, clock);
 
   // The IMU starts at an arbitrary yaw (2.0 rad): odom's heading is relative to it.
@@ -187,4 +187,4 @@ TEST(BaseControllerImuHeading, FollowsTheImuFallsBackWithoutAJumpAndResumesWitho
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

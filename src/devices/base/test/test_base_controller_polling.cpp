@@ -4,7 +4,7 @@
 
 #include "support/base_controller_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 namespace {
 
 using namespace base_controller_test;  // NOLINT: the shared fixture
@@ -17,7 +17,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   int silent_events = 0;
   BaseEvents events;
   events.on_silent = [&silent_events](double) { ++silent_events; };
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, events, clock);
   BaseController& controller = *started;
   clock->tick(150);  // 3 s: the first request went out at 1.02 s (the first tick sent the Reset)
@@ -30,7 +30,7 @@ TEST(BaseControllerSilence, UnansweredPollsMakeTheBaseSilentOnceUntilItAnswers) 
   EXPECT_EQ(silent_events, 1) << "reported once, not every tick";
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
   const Bytes& reply = golden::base::kBattery87ReplySeq0;
-  controller.onFrame(protocol::base::kFrames, reply.data(), reply.size(), clock->now());
+  controller.onFrame(kFrames, reply.data(), reply.size(), clock->now());
   EXPECT_FALSE(controller.stats().base_silent);
   controller.stop();
 }
@@ -39,14 +39,10 @@ TEST_F(BaseControllerTest, TimeoutErrorWhileRunningIsCountedButNotTheOneAtStart)
   // FF error status from the base, SEQ 07: 55^AA^02^07^FF^00 = 05
   const Bytes& error = golden::base::kErrorStatusSeq7;
   clock_->tick(1);  // Reset + first frame
-  clock_->step([&] {
-    controller_.onFrame(protocol::base::kFrames, error.data(), error.size(), clock_->now());
-  });
+  clock_->step([&] { controller_.onFrame(kFrames, error.data(), error.size(), clock_->now()); });
   EXPECT_EQ(controller_.stats().timeout_errors_while_running, 0u) << "in flight before our Reset";
   clock_->tick(100);  // 2 s of running
-  clock_->step([&] {
-    controller_.onFrame(protocol::base::kFrames, error.data(), error.size(), clock_->now());
-  });
+  clock_->step([&] { controller_.onFrame(kFrames, error.data(), error.size(), clock_->now()); });
   EXPECT_EQ(controller_.stats().timeout_errors_while_running, 1u);
   ASSERT_TRUE(controller_.stats().seconds_since_running_timeout_error.has_value());
   EXPECT_EQ(controller_.stats().timeout_errors_received, 2u);
@@ -58,8 +54,8 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   std::vector<Bytes> frames;
   std::vector<int> percents;
   BaseEvents events;
-  events.on_battery = [&percents](uint8_t p, Clock::time_point) { percents.push_back(p); };
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  events.on_battery = [&percents](uint8_t p, core::Clock::time_point) { percents.push_back(p); };
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, events, clock, &frames);
   BaseController& controller = *started;
   clock->tick(101);  // 2.02 s: the first tick sends the Reset instead, then one request per second
@@ -69,7 +65,7 @@ TEST(BaseControllerBattery, PollsAtTheConfiguredRateAndReportsReplies) {
   EXPECT_EQ(controller.stats().battery_requests, 2u);
   // battery reply, 87 %, SEQ 00: 55^AA^02^00^02^57 = A8
   const Bytes& reply = golden::base::kBattery87ReplySeq0;
-  controller.onFrame(protocol::base::kFrames, reply.data(), reply.size(), Clock::now());
+  controller.onFrame(kFrames, reply.data(), reply.size(), core::Clock::now());
   ASSERT_EQ(percents.size(), 1u);
   EXPECT_EQ(percents[0], 87);
   controller.stop();
@@ -121,8 +117,8 @@ TEST(BaseControllerLoop, NewCommandGoesOutBeforeTheNextTick) {
   std::this_thread::sleep_for(milliseconds(50));
   EXPECT_TRUE(writer.frames().empty());
   controller.setCommand(0.2, 0.0);
-  const auto deadline = Clock::now() + milliseconds(1500);
-  while (writer.frames().size() < 2 && Clock::now() < deadline) {
+  const auto deadline = core::Clock::now() + milliseconds(1500);
+  while (writer.frames().size() < 2 && core::Clock::now() < deadline) {
     std::this_thread::sleep_for(milliseconds(2));
   }
   const std::vector<Bytes> frames = writer.frames();
@@ -135,4 +131,4 @@ TEST(BaseControllerLoop, NewCommandGoesOutBeforeTheNextTick) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -4,7 +4,7 @@
 
 #include "support/base_controller_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 namespace {
 
 using namespace base_controller_test;  // NOLINT: the shared fixture
@@ -129,7 +129,7 @@ TEST(BaseControllerRetune, FasterBatteryPollStartsWithoutWaitingForTheSlowPeriod
   BaseConfig config;
   config.battery_poll_rate = 0.2;  // every 5 s
   std::vector<Bytes> frames;
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, {}, clock, &frames);
   BaseController& controller = *started;
   clock->tick(2);  // the first tick's Reset took the request's turn: the next is 5 s away
@@ -156,7 +156,7 @@ TEST(BaseControllerRetune, ImuHeadingSwitchedOnAndOffWithoutAJump) {
   BaseConfig config;
   config.battery_poll_rate = 0;
   config.cmd_vel_timeout = 100;  // one command turns for the whole test
-  auto clock = std::make_shared<ManualClock>(Clock::now());
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   auto controller = startOnManualClock(config, events, clock);
   double imu_yaw = 2.0;  // far from odom's heading: fusion must anchor, not jump to it
   const auto feed = [&] { controller->onImuYaw(imu_yaw, clock->now()); };
@@ -192,4 +192,4 @@ TEST(BaseControllerRetune, ImuHeadingSwitchedOnAndOffWithoutAJump) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

@@ -6,7 +6,7 @@
 
 #include "serial_robot_driver/devices/base/base_readings.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::base {
 namespace {
 
 TEST(BaseReadings, BatteryPercentIsAFractionOfOne) {
@@ -28,4 +28,4 @@ TEST(BaseReadings, YawIsARotationAboutZ) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::base

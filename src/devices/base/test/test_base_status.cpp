@@ -9,7 +9,8 @@
 
 namespace {
 
-using namespace serial_robot_driver::device;
+using namespace serial_robot_driver::devices::base;
+using namespace serial_robot_driver::core;
 using serial_robot_driver::kinematics::HeadingSource;
 
 const PortState kUp{"/dev/ttyUSB0", true};

@@ -9,7 +9,7 @@
 
 namespace {
 
-using namespace serial_robot_driver::device;
+using namespace serial_robot_driver::devices::base;
 using serial_robot_driver::kinematics::DiffDriveGeometry;
 
 // The node's defaults: 0.25 m wheels, 1600 ticks a turn, PID at 50 Hz, 0.40 m apart.

@@ -13,8 +13,8 @@
 namespace {
 
 using namespace calibration_test;
-using serial_robot_driver::device::CalibrationOptions;
-using serial_robot_driver::device::parseCalibrationOptions;
+using serial_robot_driver::devices::base::CalibrationOptions;
+using serial_robot_driver::devices::base::parseCalibrationOptions;
 
 constexpr double kEffectiveSeparation = 0.40 / 0.85;  // slip 0.15
 
@@ -331,15 +331,15 @@ TEST(TurnCalibrationRun, RefusedWithoutTelemetryBeforeMoving) {
 }
 
 TEST(CalibrationOptions, DefaultsAndValues) {
-  auto parsed = parseCalibrationOptions({});
+  auto parsed = serial_robot_driver::devices::base::parseCalibrationOptions({});
   ASSERT_TRUE(parsed.options);
   EXPECT_DOUBLE_EQ(parsed.options->rate, 1.0);
   EXPECT_NEAR(parsed.options->angle, 6.2832, 1e-4);
   EXPECT_EQ(parsed.options->distance, 0.0);
   EXPECT_FALSE(parsed.options->measured);
-  parsed = parseCalibrationOptions({"--rate", "0.5", "--angle", "12.57", "--distance", "1",
-                                    "--measured", "0.98", "--node", "/robot1/driver_node",
-                                    "--settle", "1", "--speed", "0.3"});
+  parsed = serial_robot_driver::devices::base::parseCalibrationOptions(
+      {"--rate", "0.5", "--angle", "12.57", "--distance", "1", "--measured", "0.98", "--node",
+       "/robot1/driver_node", "--settle", "1", "--speed", "0.3"});
   ASSERT_TRUE(parsed.options) << parsed.error;
   EXPECT_DOUBLE_EQ(parsed.options->rate, 0.5);
   EXPECT_DOUBLE_EQ(parsed.options->angle, 12.57);
@@ -348,8 +348,9 @@ TEST(CalibrationOptions, DefaultsAndValues) {
   EXPECT_EQ(parsed.options->node, "/robot1/driver_node");
   EXPECT_DOUBLE_EQ(parsed.options->settle, 1.0);
   EXPECT_DOUBLE_EQ(parsed.options->speed, 0.3);
-  EXPECT_TRUE(parseCalibrationOptions({"--rate", "2", "--help"}).help);
-  EXPECT_TRUE(parseCalibrationOptions({"-h"}).help);
+  EXPECT_TRUE(
+      serial_robot_driver::devices::base::parseCalibrationOptions({"--rate", "2", "--help"}).help);
+  EXPECT_TRUE(serial_robot_driver::devices::base::parseCalibrationOptions({"-h"}).help);
 }
 
 TEST(CalibrationOptions, BadOptionsAreRefusedWithTheReason) {
@@ -363,7 +364,7 @@ TEST(CalibrationOptions, BadOptionsAreRefusedWithTheReason) {
       {{"--turbo"}, "unknown option --turbo (--help lists them)"},
   };
   for (const auto& [args, error] : cases) {
-    const auto parsed = parseCalibrationOptions(args);
+    const auto parsed = serial_robot_driver::devices::base::parseCalibrationOptions(args);
     EXPECT_FALSE(parsed.options) << args[0];
     EXPECT_FALSE(parsed.help);
     EXPECT_EQ(parsed.error, error);

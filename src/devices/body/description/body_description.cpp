@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "serial_robot_driver/description/robot_description.h"
-#include "serial_robot_driver/devices/body/body_readings.h"
 #include "serial_robot_driver/devices/body/body_params.h"
+#include "serial_robot_driver/devices/body/body_readings.h"
 #include "serial_robot_driver/params/driver_params.h"
 
 namespace serial_robot_driver::devices::body {
@@ -15,7 +15,7 @@ using description::numbers;
 
 void drawImu(const ros_layer::DriverParams& params, const description::Chassis& chassis,
              const description::Mounts& mounts, description::UrdfWriter& urdf) {
-  const std::string imu_link = description::linkName(params.section(params::kImuSection).frame_id);
+  const std::string imu_link = description::linkName(params.section(kImuSection).frame_id);
   const description::Mount mount = description::mountOf(mounts, "imu");
   urdf.link(imu_link, "imu/frame_id",
             description::visual(description::box(0.03, 0.03, 0.01), "imu"));
@@ -26,8 +26,8 @@ void drawImu(const ros_layer::DriverParams& params, const description::Chassis& 
 
 std::vector<description::ServoJoint> servoJoints(const ros_layer::DriverParams& params) {
   std::vector<description::ServoJoint> servos;
-  if (!params.section(params::kBodySection).enabled) return servos;
-  for (const device::BodyJoint& joint : device::makeBodyJoints(params.section(params::kBodySection))) {
+  if (!params.section(kBodySection).enabled) return servos;
+  for (const BodyJoint& joint : makeBodyJoints(params.section(kBodySection))) {
     const auto [lower, upper] = joint.calibration.reachableRadians();
     // The board's speed unit is not known (body/velocity_scale); one turn per second.
     servos.push_back({joint.name, "body/joint_names", lower, upper, 2.0 * M_PI});

@@ -1,8 +1,6 @@
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 
-namespace serial_robot_driver::ros_layer {
-
-namespace body = protocol::body;
+namespace serial_robot_driver::devices::body::ros {
 
 namespace {
 geometry_msgs::Vector3 toVector3(const Eigen::Vector3d& v) {
@@ -13,7 +11,7 @@ geometry_msgs::Vector3 toVector3(const Eigen::Vector3d& v) {
   return msg;
 }
 
-geometry_msgs::Quaternion toQuaternion(const device::Quaternion& q) {
+geometry_msgs::Quaternion toQuaternion(const Quaternion& q) {
   geometry_msgs::Quaternion msg;
   msg.x = q.x;
   msg.y = q.y;
@@ -23,10 +21,10 @@ geometry_msgs::Quaternion toQuaternion(const device::Quaternion& q) {
 }
 }  // namespace
 
-sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
-                                     const std::vector<device::BodyJoint>& joints,
-                                     const ros::Time& stamp) {
-  device::JointReadings readings = device::jointReadings(telemetry, joints);
+sensor_msgs::JointState toJointState(const Telemetry& telemetry,
+                                     const std::vector<BodyJoint>& joints,
+                                     const ::ros::Time& stamp) {
+  JointReadings readings = jointReadings(telemetry, joints);
   sensor_msgs::JointState msg;
   msg.header.stamp = stamp;
   msg.name = std::move(readings.names);
@@ -35,9 +33,9 @@ sensor_msgs::JointState toJointState(const body::Telemetry& telemetry,
   return msg;
 }
 
-sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const params::ImuParams& params,
-                       const ros::Time& stamp, const std::array<double, 3>& gyro_bias) {
-  const device::ImuReading reading = device::imuReading(telemetry, params, gyro_bias);
+sensor_msgs::Imu toImu(const Telemetry& telemetry, const ImuParams& params,
+                       const ::ros::Time& stamp, const std::array<double, 3>& gyro_bias) {
+  const ImuReading reading = imuReading(telemetry, params, gyro_bias);
   sensor_msgs::Imu msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = params.frame_id;
@@ -58,20 +56,20 @@ sensor_msgs::Imu toImu(const body::Telemetry& telemetry, const params::ImuParams
   return msg;
 }
 
-std::optional<serial_robot_driver::FootPressure> toFootPressure(const body::Telemetry& telemetry,
-                                                                const ros::Time& stamp,
+std::optional<serial_robot_driver::FootPressure> toFootPressure(const Telemetry& telemetry,
+                                                                const ::ros::Time& stamp,
                                                                 const std::string& frame_id) {
   if (!telemetry.has_foot) return std::nullopt;
   serial_robot_driver::FootPressure msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = frame_id;
-  for (std::size_t j = 0; j < body::kFootSensorCount; ++j) msg.pressure[j] = telemetry.foot[j];
+  for (std::size_t j = 0; j < kFootSensorCount; ++j) msg.pressure[j] = telemetry.foot[j];
   return msg;
 }
 
-serial_robot_driver::Telemetry toTelemetryMsg(const body::Telemetry& telemetry,
-                                              const std::vector<device::BodyJoint>& joints,
-                                              const ros::Time& stamp) {
+serial_robot_driver::Telemetry toTelemetryMsg(const Telemetry& telemetry,
+                                              const std::vector<BodyJoint>& joints,
+                                              const ::ros::Time& stamp) {
   serial_robot_driver::Telemetry msg;
   msg.header.stamp = stamp;
   const std::size_t count = telemetry.servo_count;
@@ -84,10 +82,10 @@ serial_robot_driver::Telemetry toTelemetryMsg(const body::Telemetry& telemetry,
     msg.positions[i] = telemetry.servos[i].position;
     msg.speeds[i] = telemetry.servos[i].speed;
   }
-  for (std::size_t k = 0; k < body::kImuValueCount; ++k) msg.imu[k] = telemetry.imu[k];
+  for (std::size_t k = 0; k < kImuValueCount; ++k) msg.imu[k] = telemetry.imu[k];
   msg.has_foot = telemetry.has_foot;
   if (telemetry.has_foot) msg.foot.assign(telemetry.foot.begin(), telemetry.foot.end());
   return msg;
 }
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::body::ros

@@ -1,5 +1,5 @@
 #include "serial_robot_driver/ImuTuningConfig.h"
-#include "serial_robot_driver/devices/body/body_interface.h"
+#include "serial_robot_driver/devices/body/ros/body_ros.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/tuning_group_server.h"
 
@@ -8,7 +8,7 @@ namespace serial_robot_driver::devices::body {
 namespace {
 
 // The board's IMU scales are the ~imu group (ImuTuning.cfg), named like their parameters.
-void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_nh,
+void addTuning(ros_layer::RuntimeTuning& tuning, const ::ros::NodeHandle& private_nh,
                ros_layer::RuntimeTuning::Servers& servers) {
   ros_layer::addGroupServer<ImuTuningConfig>(tuning, private_nh, "imu", servers);
 }
@@ -17,7 +17,7 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ros::NodeHandle& private_
 
 extern const ros_layer::RosDeviceModule kRosModule{
     .name = "body",
-    .make = ros_layer::makeInterface<ros_layer::BodyInterface>,
+    .make = ros_layer::makeInterface<ros::BodyRos>,
     .add_tuning = addTuning,
 };
 

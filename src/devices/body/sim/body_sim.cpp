@@ -1,16 +1,14 @@
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-namespace serial_robot_driver::sim {
-
-namespace body = protocol::body;
+namespace serial_robot_driver::devices::body::sim {
 
 // The SUM byte precedes the 1F 2F tail.
-const OutputKind kTelemetryOutput{"telemetry", 3};
+const serial_robot_driver::sim::OutputKind kTelemetryOutput{"telemetry", 3};
 
 namespace {
 
@@ -28,8 +26,8 @@ double wrapAngle(double radians) {
 }
 
 // Plausible standing readings for the 8 foot sensors (raw, no unit given by the vendor).
-constexpr std::array<uint16_t, body::kFootSensorCount> kFootBaseline = {812, 790, 655, 701,
-                                                                        820, 775, 640, 690};
+constexpr std::array<uint16_t, kFootSensorCount> kFootBaseline = {812, 790, 655, 701,
+                                                                  820, 775, 640, 690};
 
 }  // namespace
 
@@ -51,29 +49,29 @@ std::optional<std::array<double, 3>> parseGyroBias(const std::string& text) {
   return bias;
 }
 
-BodySim::BodySim(const BodySimConfig& config, TimePoint now)
+BodySim::BodySim(const BodySimConfig& config, serial_robot_driver::sim::TimePoint now)
     : config_(config), last_step_(now), next_telemetry_(now), rng_(config.seed) {
-  if (config_.servo_ids.size() > body::kMaxTelemetryServos) {
-    config_.servo_ids.resize(body::kMaxTelemetryServos);
+  if (config_.servo_ids.size() > kMaxTelemetryServos) {
+    config_.servo_ids.resize(kMaxTelemetryServos);
   }
   const uint16_t start = std::min(config_.initial_position, config_.max_position);
   for (uint8_t id : config_.servo_ids) {
     stats_.servos.push_back(BodySimServoState{id, static_cast<double>(start), start, 0});
   }
   if (config_.telemetry_rate_hz > 0) {
-    telemetry_period_ = fromSeconds(1.0 / config_.telemetry_rate_hz);
+    telemetry_period_ = serial_robot_driver::sim::fromSeconds(1.0 / config_.telemetry_rate_hz);
     next_telemetry_ = now + telemetry_period_;
   }
 }
 
 void BodySim::handleSyncWrite(const uint8_t* data, std::size_t size) {
-  const auto targets = body::decodeSyncWrite(data, size);
+  const auto targets = decodeSyncWrite(data, size);
   if (!targets) {
     ++stats_.sync_writes_malformed;
     return;
   }
   ++stats_.sync_writes_ok;
-  for (const body::ServoTarget& target : *targets) {
+  for (const ServoTarget& target : *targets) {
     auto servo = std::find_if(stats_.servos.begin(), stats_.servos.end(),
                               [&](const BodySimServoState& s) { return s.id == target.id; });
     if (servo == stats_.servos.end()) {
@@ -84,8 +82,8 @@ void BodySim::handleSyncWrite(const uint8_t* data, std::size_t size) {
   }
 }
 
-void BodySim::advance(TimePoint now) {
-  const double dt = toSeconds(now - last_step_);
+void BodySim::advance(serial_robot_driver::sim::TimePoint now) {
+  const double dt = serial_robot_driver::sim::toSeconds(now - last_step_);
   if (dt <= 0) return;
   last_step_ = now;
   const double max_step = config_.servo_speed * dt;
@@ -102,26 +100,27 @@ int16_t BodySim::noise() {
   return static_cast<int16_t>(std::uniform_int_distribution<int>(-2, 2)(rng_));
 }
 
-std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
+std::vector<uint8_t> BodySim::buildTelemetry(
+    const serial_robot_driver::sim::ChassisMotion& chassis) {
   stats_.yaw_rad = wrapAngle(chassis.yaw_rad);
-  body::Telemetry telemetry;
+  Telemetry telemetry;
   telemetry.servo_count = stats_.servos.size();
   for (std::size_t i = 0; i < stats_.servos.size(); ++i) {
     telemetry.servos[i].position = static_cast<uint16_t>(std::lround(stats_.servos[i].position));
     telemetry.servos[i].speed = stats_.servos[i].speed;
   }
   constexpr double kRadToDeg = 180.0 / M_PI;
-  telemetry.imu[body::kAccelX] = noise();
-  telemetry.imu[body::kAccelY] = noise();
-  telemetry.imu[body::kAccelZ] = clipToInt16(config_.accel_lsb_per_g + noise());
+  telemetry.imu[kAccelX] = noise();
+  telemetry.imu[kAccelY] = noise();
+  telemetry.imu[kAccelZ] = clipToInt16(config_.accel_lsb_per_g + noise());
   const double lsb_per_rad_s = kRadToDeg * config_.gyro_lsb_per_dps;
   const auto& bias = config_.gyro_bias;
-  telemetry.imu[body::kGyroX] = clipToInt16(bias[0] * lsb_per_rad_s + noise());
-  telemetry.imu[body::kGyroY] = clipToInt16(bias[1] * lsb_per_rad_s + noise());
-  telemetry.imu[body::kGyroZ] = clipToInt16((chassis.yaw_rate + bias[2]) * lsb_per_rad_s + noise());
-  telemetry.imu[body::kRoll] = noise();
-  telemetry.imu[body::kPitch] = noise();
-  telemetry.imu[body::kYaw] = clipToInt16(stats_.yaw_rad * kRadToDeg * config_.angle_lsb_per_deg);
+  telemetry.imu[kGyroX] = clipToInt16(bias[0] * lsb_per_rad_s + noise());
+  telemetry.imu[kGyroY] = clipToInt16(bias[1] * lsb_per_rad_s + noise());
+  telemetry.imu[kGyroZ] = clipToInt16((chassis.yaw_rate + bias[2]) * lsb_per_rad_s + noise());
+  telemetry.imu[kRoll] = noise();
+  telemetry.imu[kPitch] = noise();
+  telemetry.imu[kYaw] = clipToInt16(stats_.yaw_rad * kRadToDeg * config_.angle_lsb_per_deg);
 
   switch (config_.foot_mode) {
     case FootMode::kNever:
@@ -135,7 +134,7 @@ std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
       break;
   }
   if (telemetry.has_foot) {
-    for (std::size_t j = 0; j < body::kFootSensorCount; ++j) {
+    for (std::size_t j = 0; j < kFootSensorCount; ++j) {
       // A slow sway so consecutive readings differ a little.
       const double sway = 15.0 * std::sin(0.05 * static_cast<double>(stats_.telemetry_generated) +
                                           static_cast<double>(j));
@@ -144,10 +143,12 @@ std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
     ++stats_.telemetry_with_foot;
   }
   ++stats_.telemetry_generated;
-  return body::encodeTelemetry(telemetry);
+  return encodeTelemetry(telemetry);
 }
 
-void BodySim::tick(TimePoint now, const ChassisMotion& chassis, Outbox* out) {
+void BodySim::tick(serial_robot_driver::sim::TimePoint now,
+                   const serial_robot_driver::sim::ChassisMotion& chassis,
+                   serial_robot_driver::sim::Outbox* out) {
   if (config_.telemetry_rate_hz <= 0) {
     advance(now);
     return;
@@ -155,15 +156,15 @@ void BodySim::tick(TimePoint now, const ChassisMotion& chassis, Outbox* out) {
   if (now - next_telemetry_ > std::chrono::seconds(1)) next_telemetry_ = now;  // after a stall
   while (next_telemetry_ <= now) {
     advance(next_telemetry_);
-    out->push_back(Outgoing{&kTelemetryOutput, buildTelemetry(chassis)});
+    out->push_back(serial_robot_driver::sim::Outgoing{&kTelemetryOutput, buildTelemetry(chassis)});
     next_telemetry_ += telemetry_period_;
   }
   advance(now);
 }
 
-TimePoint BodySim::nextEvent() const {
+serial_robot_driver::sim::TimePoint BodySim::nextEvent() const {
   if (config_.telemetry_rate_hz <= 0) return last_step_ + std::chrono::milliseconds(100);
   return next_telemetry_;
 }
 
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::devices::body::sim

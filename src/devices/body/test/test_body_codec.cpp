@@ -10,7 +10,7 @@
 #include "support/probe_expectations.h"
 #include "support/test_helpers.h"
 
-namespace serial_robot_driver::protocol::body {
+namespace serial_robot_driver::devices::body {
 namespace {
 
 using test_support::Bytes;
@@ -51,7 +51,7 @@ TEST_P(BodyCodecSyncWrite, EncoderReproducesGoldenBytes) {
 TEST_P(BodyCodecSyncWrite, DecoderReadsGoldenBytes) {
   const SyncWriteCase& c = GetParam();
   const auto targets = decodeSyncWrite(c.expected.data(), c.expected.size());
-  ASSERT_TRUE(targets.ok()) << toString(targets.error());
+  ASSERT_TRUE(targets.ok()) << protocol::toString(targets.error());
   ASSERT_EQ(targets->size(), c.targets.size());
   for (std::size_t i = 0; i < c.targets.size(); ++i) {
     EXPECT_EQ((*targets)[i].id, c.targets[i].id);
@@ -87,7 +87,7 @@ TEST(BodyCodec, SyncWriteWithTooManyServosIsNotBuilt) {
 struct MalformedCase {
   std::string name;
   Bytes frame;
-  DecodeError error;
+  protocol::DecodeError error;
 };
 
 // clang-format off
@@ -96,41 +96,41 @@ const MalformedCase kMalformedSyncWrites[] = {
     {"VendorErratumBytes",
      {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x02, 0x00, 0x08, 0x03, 0x00, 0x40, 0x79, 0x68},
-     DecodeError::kBadChecksum},
+     protocol::DecodeError::kBadChecksum},
     {"CrcBytesSwapped",
      {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x68, 0x79},
-     DecodeError::kBadChecksum},
+     protocol::DecodeError::kBadChecksum},
     {"BadHeader",
      {0xFF, 0xFF, 0xFD, 0x01, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
-     DecodeError::kBadHeader},
+     protocol::DecodeError::kBadHeader},
     {"Truncated",
      {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00, 0x02, 0x00},
-     DecodeError::kTooShort},
-    {"OnlyHeader", {0xFF, 0xFF, 0xFD, 0x00}, DecodeError::kTooShort},
+     protocol::DecodeError::kTooShort},
+    {"OnlyHeader", {0xFF, 0xFF, 0xFD, 0x00}, protocol::DecodeError::kTooShort},
     // LEN 14 is not 7 + 3N.
     {"LenNotSevenPlusThreeN",
      {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0E, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
-     DecodeError::kBadLength},
+     protocol::DecodeError::kBadLength},
     // LEN 10 (N = 1) but the bytes of N = 2.
     {"LenInconsistentWithSize",
      {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
-     DecodeError::kBadLength},
+     protocol::DecodeError::kBadLength},
     {"LenFFFF",
      {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0xFF, 0xFF, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x02, 0x00, 0x08, 0x03, 0x00, 0x04, 0x79, 0x68},
-     DecodeError::kBadLength},
+     protocol::DecodeError::kBadLength},
     // A valid Dynamixel PING is not a sync write: LEN 3 is below 7.
     {"DynamixelPing", {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x03, 0x00, 0x01, 0x19, 0x4E},
-     DecodeError::kBadLength},
+     protocol::DecodeError::kBadLength},
     // Same layout addressed to ID 1 instead of broadcast, with its own valid CRC (0x42D2).
     {"NotBroadcast",
      {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x0A, 0x00, 0x83, 0x74, 0x00, 0x02, 0x00,
       0x01, 0x00, 0x02, 0xD2, 0x42},
-     DecodeError::kUnexpectedContent},
+     protocol::DecodeError::kUnexpectedContent},
 };
 // clang-format on
 
@@ -140,7 +140,7 @@ TEST_P(BodyCodecMalformedSyncWrite, Rejected) {
   const MalformedCase& c = GetParam();
   const auto targets = decodeSyncWrite(c.frame.data(), c.frame.size());
   ASSERT_FALSE(targets.ok());
-  EXPECT_EQ(targets.error(), c.error) << toString(targets.error());
+  EXPECT_EQ(targets.error(), c.error) << protocol::toString(targets.error());
 }
 
 INSTANTIATE_TEST_SUITE_P(BodyCodecErrors, BodyCodecMalformedSyncWrite,
@@ -210,7 +210,7 @@ class BodyCodecTelemetry : public ::testing::TestWithParam<TelemetryCase> {};
 TEST_P(BodyCodecTelemetry, DecoderReadsHandWrittenFrame) {
   const TelemetryCase& c = GetParam();
   const auto decoded = decodeTelemetry(c.frame.data(), c.frame.size(), c.telemetry.servo_count);
-  ASSERT_TRUE(decoded.ok()) << toString(decoded.error());
+  ASSERT_TRUE(decoded.ok()) << protocol::toString(decoded.error());
   expectSameTelemetry(*decoded, c.telemetry);
 }
 
@@ -257,27 +257,29 @@ struct MalformedTelemetryCase {
   std::string name;
   Bytes frame;
   std::size_t servo_count;
-  DecodeError error;
+  protocol::DecodeError error;
 };
 
 const MalformedTelemetryCase kMalformedTelemetry[] = {
-    {"BadSum", withByte(kGoldenTelemetry, 29, 0x94), 2, DecodeError::kBadChecksum},
-    {"CorruptedContent", withByte(kGoldenTelemetry, 10, 0xFA), 2, DecodeError::kBadChecksum},
-    {"BadTail", withByte(kGoldenTelemetry, 31, 0x2E), 2, DecodeError::kBadTail},
-    {"BadHeader", withByte(kGoldenTelemetry, 1, 0x35), 2, DecodeError::kBadHeader},
+    {"BadSum", withByte(kGoldenTelemetry, 29, 0x94), 2, protocol::DecodeError::kBadChecksum},
+    {"CorruptedContent", withByte(kGoldenTelemetry, 10, 0xFA), 2,
+     protocol::DecodeError::kBadChecksum},
+    {"BadTail", withByte(kGoldenTelemetry, 31, 0x2E), 2, protocol::DecodeError::kBadTail},
+    {"BadHeader", withByte(kGoldenTelemetry, 1, 0x35), 2, protocol::DecodeError::kBadHeader},
     {"Truncated", Bytes(kGoldenTelemetry.begin(), kGoldenTelemetry.begin() + 20), 2,
-     DecodeError::kTooShort},
-    {"OnlyHeader", {0x12, 0x34}, 2, DecodeError::kTooShort},
-    {"Empty", {}, 2, DecodeError::kTooShort},
-    {"LenZero", withByte(kGoldenTelemetry, 2, 0x00), 2, DecodeError::kBadLength},
-    {"LenOne", withByte(kGoldenTelemetry, 2, 0x01), 2, DecodeError::kBadLength},
-    {"Len255", withByte(kGoldenTelemetry, 2, 0xFF), 2, DecodeError::kBadLength},
+     protocol::DecodeError::kTooShort},
+    {"OnlyHeader", {0x12, 0x34}, 2, protocol::DecodeError::kTooShort},
+    {"Empty", {}, 2, protocol::DecodeError::kTooShort},
+    {"LenZero", withByte(kGoldenTelemetry, 2, 0x00), 2, protocol::DecodeError::kBadLength},
+    {"LenOne", withByte(kGoldenTelemetry, 2, 0x01), 2, protocol::DecodeError::kBadLength},
+    {"Len255", withByte(kGoldenTelemetry, 2, 0xFF), 2, protocol::DecodeError::kBadLength},
     // LEN 32 is right for N = 2 but not for N = 3 (36 or 52) or N = 1 (28 or 44).
-    {"LenInconsistentWithThreeServos", kGoldenTelemetry, 3, DecodeError::kBadLength},
-    {"LenInconsistentWithOneServo", kGoldenTelemetry, 1, DecodeError::kBadLength},
+    {"LenInconsistentWithThreeServos", kGoldenTelemetry, 3, protocol::DecodeError::kBadLength},
+    {"LenInconsistentWithOneServo", kGoldenTelemetry, 1, protocol::DecodeError::kBadLength},
     // LEN 36 would be valid for N = 3, but only 32 bytes are there.
-    {"LenBeyondSize", withByte(kGoldenTelemetry, 2, 0x24), 3, DecodeError::kTooShort},
-    {"ServoCountAboveMax", kGoldenTelemetry, kMaxTelemetryServos + 1, DecodeError::kBadLength},
+    {"LenBeyondSize", withByte(kGoldenTelemetry, 2, 0x24), 3, protocol::DecodeError::kTooShort},
+    {"ServoCountAboveMax", kGoldenTelemetry, kMaxTelemetryServos + 1,
+     protocol::DecodeError::kBadLength},
 };
 
 class BodyCodecMalformedTelemetry : public ::testing::TestWithParam<MalformedTelemetryCase> {};
@@ -286,7 +288,7 @@ TEST_P(BodyCodecMalformedTelemetry, Rejected) {
   const MalformedTelemetryCase& c = GetParam();
   const auto decoded = decodeTelemetry(c.frame.data(), c.frame.size(), c.servo_count);
   ASSERT_FALSE(decoded.ok());
-  EXPECT_EQ(decoded.error(), c.error) << toString(decoded.error());
+  EXPECT_EQ(decoded.error(), c.error) << protocol::toString(decoded.error());
 }
 
 INSTANTIATE_TEST_SUITE_P(BodyCodecErrors, BodyCodecMalformedTelemetry,
@@ -298,7 +300,7 @@ TEST(BodyCodec, TrailingByteAfterFrameIsBadLength) {
   frame.push_back(0x12);
   const auto decoded = decodeTelemetry(frame.data(), frame.size(), 2);
   ASSERT_FALSE(decoded.ok());
-  EXPECT_EQ(decoded.error(), DecodeError::kBadLength);
+  EXPECT_EQ(decoded.error(), protocol::DecodeError::kBadLength);
 }
 
 // --- probe (what the stream framer asks) -------------------------------------------------------
@@ -318,7 +320,7 @@ const Bytes kProbeSyncWrite = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0A, 0x00, 0x83, 0
                                0x02, 0x00, 0x01, 0x00, 0x02, 0x3A, 0x8E};
 // clang-format on
 
-Probe probeTelemetryOfNoServos(const uint8_t* data, std::size_t available) {
+protocol::Probe probeTelemetryOfNoServos(const uint8_t* data, std::size_t available) {
   return probeTelemetry(data, available, 0);
 }
 
@@ -328,22 +330,23 @@ TEST(BodyCodecProbe, TelemetryFrameFoundAndNeedsMoreAtEveryTruncation) {
 
 TEST(BodyCodecProbe, TelemetryInvalidReasons) {
   expectProbeRejects(probeTelemetryOfNoServos, withByte(kProbeTelemetryNoServos, 21, 0x19),
-                     DecodeError::kBadChecksum);
+                     protocol::DecodeError::kBadChecksum);
   expectProbeRejects(probeTelemetryOfNoServos, withByte(kProbeTelemetryNoServos, 23, 0x2E),
-                     DecodeError::kBadTail);
+                     protocol::DecodeError::kBadTail);
   // LEN 28 is a frame of one servo: wrong for the configured zero.
   expectProbeRejects(probeTelemetryOfNoServos, withByte(kProbeTelemetryNoServos, 2, 0x1C),
-                     DecodeError::kBadLength);
-  expectProbeRejects(probeTelemetryOfNoServos, {0x12, 0x4C}, DecodeError::kBadHeader);
+                     protocol::DecodeError::kBadLength);
+  expectProbeRejects(probeTelemetryOfNoServos, {0x12, 0x4C}, protocol::DecodeError::kBadHeader);
 }
 
 TEST(BodyCodecProbe, TelemetryLenFollowsTheConfiguredServoCount) {
   // The same bytes with LEN 0x1C (24 + 4) are one servo's length, 0x2C (40 + 4) one with foot.
   const Bytes one_servo_len = {0x12, 0x34, 0x1C};
-  EXPECT_EQ(probeTelemetry(one_servo_len.data(), 3, 1).status, Probe::Status::kNeedMore);
+  EXPECT_EQ(probeTelemetry(one_servo_len.data(), 3, 1).status, protocol::Probe::Status::kNeedMore);
   const Bytes one_servo_foot_len = {0x12, 0x34, 0x2C};
-  EXPECT_EQ(probeTelemetry(one_servo_foot_len.data(), 3, 1).status, Probe::Status::kNeedMore);
-  EXPECT_EQ(probeTelemetry(one_servo_len.data(), 3, 2).status, Probe::Status::kInvalid);
+  EXPECT_EQ(probeTelemetry(one_servo_foot_len.data(), 3, 1).status,
+            protocol::Probe::Status::kNeedMore);
+  EXPECT_EQ(probeTelemetry(one_servo_len.data(), 3, 2).status, protocol::Probe::Status::kInvalid);
 }
 
 TEST(BodyCodecProbe, SyncWriteFrameFoundAndNeedsMoreAtEveryTruncation) {
@@ -352,14 +355,18 @@ TEST(BodyCodecProbe, SyncWriteFrameFoundAndNeedsMoreAtEveryTruncation) {
 
 TEST(BodyCodecProbe, SyncWriteInvalidReasons) {
   expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 16, 0x8F),
-                     DecodeError::kBadChecksum);
+                     protocol::DecodeError::kBadChecksum);
   // LEN 0x0B is not 7 + 3N.
-  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0x0B), DecodeError::kBadLength);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0x0B),
+                     protocol::DecodeError::kBadLength);
   // 7 + 3 * 65 = 202 = 0xCA: one servo more than the 64 accepted.
-  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0xCA), DecodeError::kBadLength);
-  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 4, 0x01), DecodeError::kBadHeader);
-  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 7, 0x82), DecodeError::kBadHeader);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 5, 0xCA),
+                     protocol::DecodeError::kBadLength);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 4, 0x01),
+                     protocol::DecodeError::kBadHeader);
+  expectProbeRejects(probeSyncWrite, withByte(kProbeSyncWrite, 7, 0x82),
+                     protocol::DecodeError::kBadHeader);
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::protocol::body
+}  // namespace serial_robot_driver::devices::body

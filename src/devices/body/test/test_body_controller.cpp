@@ -14,11 +14,10 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
 #include "support/golden_frames.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 namespace {
 
 using protocol::FrameFamily;
-using protocol::body::Telemetry;
 using Bytes = std::vector<uint8_t>;
 
 constexpr double kTwoPi = 2.0 * M_PI;
@@ -127,11 +126,11 @@ std::vector<BodyJoint> twoJoints() {
 
 struct Received {
   std::vector<Telemetry> frames;
-  std::vector<Clock::time_point> arrivals;
+  std::vector<core::Clock::time_point> arrivals;
 };
 
 BodyEvents recorder(Received* received) {
-  return {[received](const Telemetry& telemetry, Clock::time_point arrival) {
+  return {[received](const Telemetry& telemetry, core::Clock::time_point arrival) {
     received->frames.push_back(telemetry);
     received->arrivals.push_back(arrival);
   }};
@@ -140,9 +139,8 @@ BodyEvents recorder(Received* received) {
 TEST(BodyControllerTelemetry, GoldenFrameReachesTheCallbackWithItsArrivalTime) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
-  const Clock::time_point arrival = Clock::time_point(std::chrono::milliseconds(1234));
-  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(),
-                     kGoldenTelemetry.size(), arrival);
+  const core::Clock::time_point arrival = core::Clock::time_point(std::chrono::milliseconds(1234));
+  controller.onFrame(kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(), arrival);
 
   ASSERT_EQ(received.frames.size(), 1u);
   EXPECT_EQ(received.arrivals[0], arrival);
@@ -163,8 +161,8 @@ TEST(BodyControllerTelemetry, FootBlockIsLittleEndian) {
   Received received;
   BodyController controller({BodyJoint{"ankle", 7, calibration(2048, 1)}}, nullptr,
                             recorder(&received));
-  controller.onFrame(protocol::body::kTelemetryFrames, kFootTelemetry.data(), kFootTelemetry.size(),
-                     Clock::now());
+  controller.onFrame(kTelemetryFrames, kFootTelemetry.data(), kFootTelemetry.size(),
+                     core::Clock::now());
   ASSERT_EQ(received.frames.size(), 1u);
   const Telemetry& t = received.frames[0];
   EXPECT_EQ(t.servos[0].position, 256);
@@ -179,8 +177,8 @@ TEST(BodyControllerTelemetry, FrameOfAnotherServoCountIsADecodeError) {
   std::vector<BodyJoint> joints = twoJoints();
   joints.push_back(BodyJoint{"ankle", 4, calibration(2048, 1)});
   BodyController controller(joints, nullptr, recorder(&received));
-  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(),
-                     kGoldenTelemetry.size(), Clock::now());
+  controller.onFrame(kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+                     core::Clock::now());
   EXPECT_TRUE(received.frames.empty());
   const BodyStats stats = controller.stats();
   EXPECT_EQ(stats.frames_decoded, 0u);
@@ -193,10 +191,10 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
   const Bytes& base_reset = golden::base::kResetSeq2;
-  controller.onFrame(protocol::base::kFrames, base_reset.data(), base_reset.size(), Clock::now());
+  controller.onFrame(base::kFrames, base_reset.data(), base_reset.size(), core::Clock::now());
   // Even telemetry bytes under another family tag are not ours to decode.
-  controller.onFrame(protocol::servo::kResponseFrames, kGoldenTelemetry.data(),
-                     kGoldenTelemetry.size(), Clock::now());
+  controller.onFrame(servo_bus::kResponseFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+                     core::Clock::now());
   EXPECT_TRUE(received.frames.empty());
   EXPECT_EQ(controller.stats().frames_decoded, 0u);
   EXPECT_EQ(controller.stats().decode_errors, 0u);
@@ -204,8 +202,8 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
 
 TEST(BodyControllerTelemetry, WorksWithoutACallback) {
   BodyController controller(twoJoints(), nullptr);
-  controller.onFrame(protocol::body::kTelemetryFrames, kGoldenTelemetry.data(),
-                     kGoldenTelemetry.size(), Clock::now());
+  controller.onFrame(kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+                     core::Clock::now());
   EXPECT_EQ(controller.stats().frames_decoded, 1u);
 }
 
@@ -213,7 +211,7 @@ TEST(BodyControllerTelemetry, WorksWithoutACallback) {
 
 class BodyControllerCommand : public testing::Test {
  protected:
-  FrameWriter sink() {
+  core::FrameWriter sink() {
     return [this](const Bytes& frame) {
       written_.push_back(frame);
       return port_up_;
@@ -380,7 +378,7 @@ TEST_F(BodyControllerCommand, RefusedWriteIsReportedAndCounted) {
 // An e-stop voids everything accepted before it: a command accepted before an e-stop and written
 // after its release is dropped, said and counted; one accepted after the release goes out.
 TEST_F(BodyControllerCommand, ACommandAcceptedBeforeAnEStopIsVoidedEvenAfterTheRelease) {
-  const MotionGate::Generation accepted = controller_.gate().generation();
+  const core::MotionGate::Generation accepted = controller_.gate().generation();
   controller_.gate().setLocked(true);
   controller_.gate().setLocked(false);
   const JointCommandResult result = controller_.sendJointCommand({"hip"}, {0.0}, accepted);
@@ -393,16 +391,16 @@ TEST_F(BodyControllerCommand, ACommandAcceptedBeforeAnEStopIsVoidedEvenAfterTheR
   EXPECT_EQ(controller_.gate().refusedAtWrite(), 1u);
   EXPECT_FALSE(controller_.lastCommandedPosition(0)) << "nothing stored for a voided command";
 
-  const MotionGate::Generation fresh = controller_.gate().generation();
+  const core::MotionGate::Generation fresh = controller_.gate().generation();
   EXPECT_TRUE(controller_.sendJointCommand({"hip"}, {0.0}, fresh).ok());
   EXPECT_TRUE(controller_.sendJointCommand({"hip"}, {0.1}).ok()) << "unset: accepted now";
   EXPECT_EQ(written_.size(), 2u);
 }
 
 TEST_F(BodyControllerCommand, AWrittenCommandCountsAsMotionForAWhile) {
-  EXPECT_EQ(controller_.motionInForce(Clock::now()), "") << "never commanded";
+  EXPECT_EQ(controller_.motionInForce(core::Clock::now()), "") << "never commanded";
   ASSERT_TRUE(controller_.sendJointCommand({"hip"}, {0.0}).ok());
-  const Clock::time_point now = Clock::now();
+  const core::Clock::time_point now = core::Clock::now();
   EXPECT_EQ(controller_.motionInForce(now).rfind("joint command written 0.", 0), 0u)
       << controller_.motionInForce(now);
   EXPECT_EQ(controller_.motionInForce(now + BodyController::kJointCommandMotion), "");
@@ -418,4 +416,4 @@ TEST(BodyControllerCommandNoSink, MissingWriterIsAWriteFailure) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

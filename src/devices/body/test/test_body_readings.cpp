@@ -8,12 +8,8 @@
 
 #include "serial_robot_driver/devices/body/body_readings.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 namespace {
-
-using params::BodyParams;
-using params::ImuParams;
-using protocol::body::Telemetry;
 
 constexpr double kHalfSqrt2 = 0.70710678118654752;
 
@@ -201,4 +197,4 @@ TEST(BodyReadingsImu, ImuYawIsTheHeadingOfThePublishedOrientation) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

@@ -9,7 +9,8 @@
 
 namespace {
 
-using namespace serial_robot_driver::device;
+using namespace serial_robot_driver::devices::body;
+using namespace serial_robot_driver::core;
 using Flow = BodyStatus::FlowChange;
 
 const PortState kUp{"/dev/ttyACM0", true};

@@ -12,7 +12,7 @@
 
 #include "serial_robot_driver/devices/body/gyro_bias.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::body {
 namespace {
 
 using std::chrono::milliseconds;
@@ -114,7 +114,7 @@ class GyroCalibratorTest : public ::testing::Test {
           std::lock_guard<std::mutex> lock(mutex_);
           raw = raw_;
         }
-        in_force_seen_ = calibrator_.onSample(raw, Clock::now(), kUnits, 0.3)[2];
+        in_force_seen_ = calibrator_.onSample(raw, core::Clock::now(), kUnits, 0.3)[2];
         ++frames_fed_;
         std::this_thread::sleep_for(milliseconds(5));
       }
@@ -239,12 +239,12 @@ TEST_F(GyroCalibratorTest, CancelEndsAWaitingCalibrationAtOnce) {
     std::this_thread::sleep_for(milliseconds(100));
     calibrator_.cancel();
   });
-  const auto start = Clock::now();
+  const auto start = core::Clock::now();
   const GyroCalibrationOutcome outcome = calibrator_.calibrate(30.0, kUnits, "imu/calibrate");
   canceller.join();
   EXPECT_FALSE(outcome.success);
   EXPECT_TRUE(contains(outcome.message, "shutting down")) << outcome.message;
-  EXPECT_LT(Clock::now() - start, std::chrono::seconds(20)) << "not the whole 30 s";
+  EXPECT_LT(core::Clock::now() - start, std::chrono::seconds(20)) << "not the whole 30 s";
 }
 
 /// The same, with a settle time of 0.3 s.
@@ -276,8 +276,8 @@ TEST_F(GyroSettleTest, RefusedRightAfterAMotionEndsUntilTheSettleTimeHasPassed) 
       << outcome.message;
   EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
   // Once settled it goes through (waited for, bounded).
-  const auto give_up = Clock::now() + std::chrono::seconds(10);
-  while (!outcome.success && outcome.not_still && Clock::now() < give_up) {
+  const auto give_up = core::Clock::now() + std::chrono::seconds(10);
+  while (!outcome.success && outcome.not_still && core::Clock::now() < give_up) {
     outcome = calibrator_.calibrate(0.1, kUnits, "imu/calibrate");
   }
   EXPECT_TRUE(outcome.success) << outcome.message;
@@ -290,7 +290,7 @@ TEST(GyroCalibrateOnStart, StartsOnlyOnceTheRobotHasBeenStillForTheSettleTime) {
   GyroBiasCalibrator calibrator([&] { return not_still; }, limits);
   int reports = 0;
   calibrator.calibrateOnStart([&](const GyroCalibrationOutcome&) { ++reports; });
-  const Clock::time_point t0{};
+  const core::Clock::time_point t0{};
   int frame = 0;
   const auto feed = [&](int count, GyroVector raw) {
     for (int i = 0; i < count; ++i, ++frame) {
@@ -318,7 +318,7 @@ TEST(GyroCalibrateOnStart, WaitsForStillnessRestartsOnMotionAndReportsOnce) {
     ++reports;
     reported = outcome;
   });
-  const Clock::time_point t0{};
+  const core::Clock::time_point t0{};
   int frame = 0;
   // 100 Hz frames with their own arrival times: the automatic averaging runs on them alone.
   const auto feed = [&](int count, GyroVector raw) {
@@ -352,7 +352,7 @@ TEST(GyroCalibrateOnStart, ARefusalOtherThanMotionIsReportedOnceAndNotRetried) {
     message = outcome.message;
   });
   for (int i = 0; i < 200; ++i) {
-    calibrator.onSample({0, 0, 200}, Clock::time_point{} + milliseconds(10 * i), kUnits, 0.5);
+    calibrator.onSample({0, 0, 200}, core::Clock::time_point{} + milliseconds(10 * i), kUnits, 0.5);
   }
   EXPECT_EQ(reports, 1);
   EXPECT_TRUE(contains(message, "calibrate_on_start refused: the mean z rate 0.2 rad/s"))
@@ -362,27 +362,28 @@ TEST(GyroCalibrateOnStart, ARefusalOtherThanMotionIsReportedOnceAndNotRetried) {
 
 TEST(GyroBiasStatus, ShowsTheBiasInForceAndWarnsAboutARefusalUntilAGoodCalibration) {
   GyroBiasCalibrator calibrator([] { return std::string(); }, noSettle());
-  StatusReport before;
+  core::StatusReport before;
   calibrator.report(before, kUnits);
-  EXPECT_EQ(before.level, StatusLevel::kOk);
+  EXPECT_EQ(before.level, core::StatusLevel::kOk);
   EXPECT_EQ(*before.find("gyro bias"), "not calibrated");
   EXPECT_EQ(*before.find("gyro bias calibrated"), "never");
 
-  StatusReport refused;
+  core::StatusReport refused;
   calibrator.calibrate(0.1, kUnits, "imu/calibrate");  // no telemetry
   calibrator.report(refused, kUnits);
-  EXPECT_EQ(refused.level, StatusLevel::kWarn);
+  EXPECT_EQ(refused.level, core::StatusLevel::kWarn);
   EXPECT_TRUE(contains(refused.message, "imu/calibrate refused: no IMU telemetry"))
       << refused.message;
   ASSERT_NE(refused.find("gyro calibration refused"), nullptr);
 
   calibrator.calibrateOnStart([](const GyroCalibrationOutcome&) {});
   for (int i = 0; i < 60; ++i) {
-    calibrator.onSample({20, -15, 30}, Clock::time_point{} + milliseconds(10 * i), kUnits, 0.5);
+    calibrator.onSample({20, -15, 30}, core::Clock::time_point{} + milliseconds(10 * i), kUnits,
+                        0.5);
   }
-  StatusReport calibrated;
+  core::StatusReport calibrated;
   calibrator.report(calibrated, kUnits);
-  EXPECT_EQ(calibrated.level, StatusLevel::kOk) << calibrated.message;
+  EXPECT_EQ(calibrated.level, core::StatusLevel::kOk) << calibrated.message;
   EXPECT_EQ(*calibrated.find("gyro bias"),
             "(0.02, -0.015, 0.03) rad/s = (1.146, -0.8594, 1.719) deg/s");
   EXPECT_TRUE(contains(*calibrated.find("gyro bias calibrated"), "by calibrate_on_start at "));
@@ -390,4 +391,4 @@ TEST(GyroBiasStatus, ShowsTheBiasInForceAndWarnsAboutARefusalUntilAGoodCalibrati
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::body

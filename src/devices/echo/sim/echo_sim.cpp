@@ -1,4 +1,4 @@
-#include "serial_robot_driver/devices/echo/echo_sim.h"
+#include "serial_robot_driver/devices/echo/sim/echo_sim.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -6,53 +6,58 @@
 
 #include "serial_robot_driver/devices/echo/echo_codec.h"
 
-namespace serial_robot_driver::sim {
+namespace serial_robot_driver::devices::echo::sim {
 
-namespace echo = protocol::echo;
-
-const OutputKind kEchoAnswerOutput{"echo_replies", 1};
+const serial_robot_driver::sim::OutputKind kEchoAnswerOutput{"echo_replies", 1};
 
 void EchoSim::handleFrame(const protocol::FrameFamily& family, const uint8_t* data,
-                          std::size_t size, TimePoint at, Outbox* out) {
-  if (family != echo::kRequestFrames) return;
-  const auto payload = echo::decode(echo::kRequestType, data, size);
+                          std::size_t size, serial_robot_driver::sim::TimePoint at,
+                          serial_robot_driver::sim::Outbox* out) {
+  if (family != kRequestFrames) return;
+  const auto payload = decode(kRequestType, data, size);
   if (!payload) return;  // the framer verified it; nothing else can fail
   ++stats_.requests;
-  if (latency_ == Clock::duration::zero()) {
+  if (latency_ == serial_robot_driver::sim::Clock::duration::zero()) {
     ++stats_.answers;
-    out->push_back(Outgoing{&kEchoAnswerOutput, echo::encodeAnswer(*payload)});
+    out->push_back(serial_robot_driver::sim::Outgoing{&kEchoAnswerOutput, encodeAnswer(*payload)});
     return;
   }
-  pending_.emplace_back(at + latency_, echo::encodeAnswer(*payload));
+  pending_.emplace_back(at + latency_, encodeAnswer(*payload));
 }
 
-void EchoSim::tick(TimePoint now, SimWorld& /*world*/, Outbox* out) {
+void EchoSim::tick(serial_robot_driver::sim::TimePoint now,
+                   serial_robot_driver::sim::SimWorld& /*world*/,
+                   serial_robot_driver::sim::Outbox* out) {
   while (!pending_.empty() && pending_.front().first <= now) {
     ++stats_.answers;
-    out->push_back(Outgoing{&kEchoAnswerOutput, std::move(pending_.front().second)});
+    out->push_back(
+        serial_robot_driver::sim::Outgoing{&kEchoAnswerOutput, std::move(pending_.front().second)});
     pending_.pop_front();
   }
 }
 
-TimePoint EchoSim::nextEvent() const {
-  return pending_.empty() ? TimePoint::max() : pending_.front().first;
+serial_robot_driver::sim::TimePoint EchoSim::nextEvent() const {
+  return pending_.empty() ? serial_robot_driver::sim::TimePoint::max() : pending_.front().first;
 }
 
-DeviceSimStats EchoSim::stats(const PortCounters& /*ports*/) const {
-  return DeviceSimStats{
+serial_robot_driver::sim::DeviceSimStats EchoSim::stats(
+    const serial_robot_driver::sim::PortCounters& /*ports*/) const {
+  return serial_robot_driver::sim::DeviceSimStats{
       "echo",
       stats_,
-      {statsLine("echo_requests", stats_.requests), statsLine("echo_answers", stats_.answers)}};
+      {serial_robot_driver::sim::statsLine("echo_requests", stats_.requests),
+       serial_robot_driver::sim::statsLine("echo_answers", stats_.answers)}};
 }
 
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::devices::echo::sim
 
 namespace serial_robot_driver::devices::echo {
 
 namespace {
 
-std::unique_ptr<sim::SimDevice> makeEchoSim(const sim::HostedDeviceOptions& options, uint32_t,
-                                            sim::TimePoint) {
+std::unique_ptr<serial_robot_driver::sim::SimDevice> makeEchoSim(
+    const serial_robot_driver::sim::HostedDeviceOptions& options, uint32_t,
+    serial_robot_driver::sim::TimePoint) {
   double latency_ms = 0.0;
   const auto setting = options.settings.find("latency-ms");
   if (setting != options.settings.end()) {
@@ -62,14 +67,14 @@ std::unique_ptr<sim::SimDevice> makeEchoSim(const sim::HostedDeviceOptions& opti
       throw std::invalid_argument("bad value for --echo-latency-ms: '" + setting->second + "'");
     }
   }
-  return std::make_unique<sim::EchoSim>(sim::fromSeconds(latency_ms / 1000.0));
+  return std::make_unique<sim::EchoSim>(serial_robot_driver::sim::fromSeconds(latency_ms / 1000.0));
 }
 
 }  // namespace
 
 // Not one of the robot's own: hosted only when asked for, and no stats unless hosted (no
 // left_out_stats).
-extern const sim::SimDeviceModule kSimModule{
+extern const serial_robot_driver::sim::SimDeviceModule kSimModule{
     .name = "echo",
     .description = "echo device",
     .toggle_help = "simulate the echo device (on the shared pty)",

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/device/device_module.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/echo/echo_codec.h"
 #include "serial_robot_driver/devices/echo/echo_params.h"
 #include "serial_robot_driver/params/driver_params.h"
@@ -14,7 +14,7 @@
 #include "support/golden_frames.h"
 #include "support/test_helpers.h"
 
-namespace serial_robot_driver::protocol::echo {
+namespace serial_robot_driver::devices::echo {
 namespace {
 
 using Bytes = std::vector<uint8_t>;
@@ -28,19 +28,19 @@ const Bytes kEmptyAnswer = {0xE5, 0x02, 0x00, 0xE7};
 /// Every frame a framer configured with `config` hands out, in order, with its family's name.
 struct Collected {
   std::vector<std::pair<std::string, Bytes>> frames;
-  FramerStats stats;
+  protocol::FramerStats stats;
 };
-Collected frame(const FramerConfig& config, const std::vector<Bytes>& chunks) {
+Collected frame(const protocol::FramerConfig& config, const std::vector<Bytes>& chunks) {
   Collected out;
-  StreamFramer framer(config,
-                      [&out](const FrameFamily& family, const uint8_t* data, std::size_t size) {
-                        out.frames.emplace_back(family.name, Bytes(data, data + size));
-                      });
+  protocol::StreamFramer framer(
+      config, [&out](const protocol::FrameFamily& family, const uint8_t* data, std::size_t size) {
+        out.frames.emplace_back(family.name, Bytes(data, data + size));
+      });
   for (const Bytes& chunk : chunks) framer.feed(chunk.data(), chunk.size());
   out.stats = framer.stats();
   return out;
 }
-FramerConfig driverSide() { return test_support::driverFramer({"echo"}); }
+protocol::FramerConfig driverSide() { return test_support::driverFramer({"echo"}); }
 
 TEST(EchoCodec, EncodesTheGoldenFrames) {
   EXPECT_EQ(encodeRequest({1, 2, 3}), kRequest123);
@@ -56,10 +56,11 @@ TEST(EchoCodec, DecodesOnlyItsOwnDirection) {
   ASSERT_TRUE(payload.ok());
   EXPECT_EQ(*payload, (Bytes{1, 2, 3}));
   EXPECT_EQ(decode(kRequestType, kAnswer123.data(), kAnswer123.size()).error(),
-            DecodeError::kBadHeader);
+            protocol::DecodeError::kBadHeader);
   const Bytes bad = test_support::withByte(kAnswer123, 6, 0xE5);
-  EXPECT_EQ(decode(kAnswerType, bad.data(), bad.size()).error(), DecodeError::kBadChecksum);
-  EXPECT_EQ(decode(kAnswerType, kAnswer123.data(), 5).error(), DecodeError::kTooShort);
+  EXPECT_EQ(decode(kAnswerType, bad.data(), bad.size()).error(),
+            protocol::DecodeError::kBadChecksum);
+  EXPECT_EQ(decode(kAnswerType, kAnswer123.data(), 5).error(), protocol::DecodeError::kTooShort);
 }
 
 TEST(EchoFramer, FindsAnswersWholeSplitAndBehindJunk) {
@@ -114,7 +115,8 @@ TEST(EchoFramer, SharesAPortWithEveryOtherDevice) {
   // A servo bus ping and its answer (docs/protocols.md section 3, as in support/sim_host.h).
   const Bytes servo_ping1 = {0x12, 0x4C, 0x01, 0x01, 0x01, 0x61};
   const Bytes servo_ping1_reply = {0x05, 0x1C, 0x01, 0x01, 0x01, 0x24};
-  const FramerConfig shared = test_support::driverFramer({"base", "body", "servo_bus", "echo"}, 2);
+  const protocol::FramerConfig shared =
+      test_support::driverFramer({"base", "body", "servo_bus", "echo"}, 2);
   const Collected mixed = frame(
       shared, {::golden::base::kBattery64ReplySeq0, kAnswer123, servo_ping1_reply, kEmptyAnswer});
   std::vector<std::string> names;
@@ -146,7 +148,7 @@ TEST(EchoParameters, TheTableHasItsRowsAndItIsOffByDefault) {
   params::specFor("echo/enabled").set(on, true);
   params::specFor("echo/timeout").set(on, 50);
   EXPECT_TRUE(on.enabled("echo"));
-  EXPECT_EQ(on.section(params::kEchoSection).timeout_ms, 50);
+  EXPECT_EQ(on.section(kEchoSection).timeout_ms, 50);
   EXPECT_NO_THROW(on.validate());
   // 1 ms cannot carry a whole answer at 9600 baud.
   params::specFor("echo/baud").set(on, 9600);
@@ -157,4 +159,4 @@ TEST(EchoParameters, TheTableHasItsRowsAndItIsOffByDefault) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::protocol::echo
+}  // namespace serial_robot_driver::devices::echo

@@ -4,15 +4,14 @@
 
 #include "serial_robot_driver/devices/echo/echo_codec.h"
 #include "serial_robot_driver/devices/echo/echo_controller.h"
-#include "serial_robot_driver/devices/echo/echo_sim.h"
+#include "serial_robot_driver/devices/echo/sim/echo_sim.h"
 #include "support/sim_host.h"
 #include "support/test_helpers.h"
 
-namespace serial_robot_driver::sim {
+namespace serial_robot_driver::devices::echo::sim {
 namespace {
 
-using namespace sim_test;  // NOLINT: the shared fixture
-namespace echo = protocol::echo;
+using namespace serial_robot_driver::sim::sim_test;  // NOLINT: the shared fixture
 
 const Bytes kRequest123 = {0xE5, 0x01, 0x03, 0x01, 0x02, 0x03, 0xE7};
 const Bytes kAnswer123 = {0xE5, 0x02, 0x03, 0x01, 0x02, 0x03, 0xE4};
@@ -25,29 +24,30 @@ std::string statsLine(const std::string& text, const std::string& key) {
 }
 
 TEST(EchoSim, AnswersEachRequestWithItsPayload) {
-  EchoSim sim(Clock::duration::zero());
-  Outbox out;
-  sim.handleFrame(echo::kRequestFrames, kRequest123.data(), kRequest123.size(), Clock::now(), &out);
+  EchoSim sim(serial_robot_driver::sim::Clock::duration::zero());
+  serial_robot_driver::sim::Outbox out;
+  sim.handleFrame(kRequestFrames, kRequest123.data(), kRequest123.size(),
+                  serial_robot_driver::sim::Clock::now(), &out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].bytes, kAnswer123);
 
   EchoSim slow(std::chrono::milliseconds(5));
   out.clear();
-  const TimePoint at = Clock::now();
-  slow.handleFrame(echo::kRequestFrames, kRequest123.data(), kRequest123.size(), at, &out);
+  const serial_robot_driver::sim::TimePoint at = serial_robot_driver::sim::Clock::now();
+  slow.handleFrame(kRequestFrames, kRequest123.data(), kRequest123.size(), at, &out);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(slow.nextEvent(), at + std::chrono::milliseconds(5));
-  SimWorld world;
+  serial_robot_driver::sim::SimWorld world;
   slow.tick(at + std::chrono::milliseconds(5), world, &out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(slow.stats().answers, 1u);
 }
 
 TEST(EchoSim, RobotSimHostsItOnTheSharedPortNextToTheBase) {
-  SimOptions options = onlyBase();
-  baseConfig(options).battery_percent = 64;
+  serial_robot_driver::sim::SimOptions options = onlyBase();
+  base::sim::baseConfig(options).battery_percent = 64;
   options.device("echo").enabled = true;
-  RobotSim sim(options);
+  serial_robot_driver::sim::RobotSim sim(options);
   sim.start();
   ASSERT_EQ(sim.ports().size(), 1u);
   EXPECT_EQ(sim.ports()[0].devices, (std::vector<std::string>{"base", "echo"}));
@@ -57,22 +57,26 @@ TEST(EchoSim, RobotSimHostsItOnTheSharedPortNextToTheBase) {
   host.send(kRequest123);
   EXPECT_TRUE(host.waitForFrame(kAnswer123));
   EXPECT_TRUE(host.waitForFrame(kBattery64ReplySeq0));
-  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.findDevice("echo") != nullptr; }));
-  const std::string text = formatStats(sim.stats());
+  EXPECT_TRUE(waitForStats(sim, [](const serial_robot_driver::sim::SimStats& s) {
+    return s.findDevice("echo") != nullptr;
+  }));
+  const std::string text = serial_robot_driver::sim::formatStats(sim.stats());
   EXPECT_EQ(statsLine(text, "echo_requests"), "echo_requests 1");
   EXPECT_EQ(statsLine(text, "echo_answers"), "echo_answers 1");
   EXPECT_EQ(statsLine(text, "frames_for_absent_device"), "frames_for_absent_device 0");
 }
 
 TEST(EchoSim, NotHostedUnlessAskedForAndItsRequestsAreThenForNobody) {
-  RobotSim sim(onlyBase());
+  serial_robot_driver::sim::RobotSim sim(onlyBase());
   sim.start();
   EXPECT_EQ(sim.ports()[0].devices, (std::vector<std::string>{"base"}));
   Host host(slaveOf(sim), echoHost());
   ASSERT_TRUE(host.ok());
   host.send(kRequest123);
-  EXPECT_TRUE(waitForStats(sim, [](const SimStats& s) { return s.frames_for_absent_device == 1; }));
-  EXPECT_EQ(formatStats(sim.stats()).find("echo_"), std::string::npos);
+  EXPECT_TRUE(waitForStats(sim, [](const serial_robot_driver::sim::SimStats& s) {
+    return s.frames_for_absent_device == 1;
+  }));
+  EXPECT_EQ(serial_robot_driver::sim::formatStats(sim.stats()).find("echo_"), std::string::npos);
 }
 
 TEST(EchoSim, CommandLineHostsItAloneOnItsOwnLink) {
@@ -81,36 +85,41 @@ TEST(EchoSim, CommandLineHostsItAloneOnItsOwnLink) {
   const std::string latency = "--echo-latency-ms=2";
   const char* argv[] = {"robot_sim",   "--no-base",  "--no-body",    "--no-servo-bus",
                         "--echo-link", link.c_str(), latency.c_str()};
-  const CommandLine parsed = parseCommandLine(7, argv);
+  const serial_robot_driver::sim::CommandLine parsed =
+      serial_robot_driver::sim::parseCommandLine(7, argv);
   ASSERT_EQ(parsed.error, "");
   ASSERT_TRUE(parsed.options.hosts("echo"));
   EXPECT_EQ(parsed.options.findDevice("echo")->settings.at("latency-ms"), "2");
-  EXPECT_NE(usage().find("--echo-link PATH"), std::string::npos);
-  EXPECT_FALSE(parseCommandLine(1, argv).options.hosts("echo")) << "off by default";
+  EXPECT_NE(serial_robot_driver::sim::usage().find("--echo-link PATH"), std::string::npos);
+  EXPECT_FALSE(serial_robot_driver::sim::parseCommandLine(1, argv).options.hosts("echo"))
+      << "off by default";
   const char* bad[] = {"robot_sim", "--echo-latency-ms", "soon"};
-  EXPECT_THROW(RobotSim(parseCommandLine(3, bad).options).start(), std::invalid_argument);
+  EXPECT_THROW(
+      serial_robot_driver::sim::RobotSim(serial_robot_driver::sim::parseCommandLine(3, bad).options)
+          .start(),
+      std::invalid_argument);
 
-  RobotSim sim(parsed.options);
+  serial_robot_driver::sim::RobotSim sim(parsed.options);
   sim.start();
   ASSERT_EQ(sim.ports().size(), 1u);
   EXPECT_EQ(sim.ports()[0].link, link);
 
   // The driver's controller on a link to it: round trips, counted.
-  device::SerialLinkOptions link_options;
+  core::SerialLinkOptions link_options;
   link_options.path = link;
   link_options.framer = test_support::driverFramer({"echo"});
-  device::SerialLink serial(link_options);
-  device::EchoController controller(serial.writer(), std::chrono::milliseconds(500));
+  core::SerialLink serial(link_options);
+  EchoController controller(serial.writer(), std::chrono::milliseconds(500));
   serial.addListener(&controller);
   serial.start();
   ASSERT_TRUE(test_support::waitFor([&] { return serial.connected(); }, 3.0));
   for (int i = 0; i < 3; ++i) {
-    const device::PingResult result = controller.ping();
+    const PingResult result = controller.ping();
     EXPECT_TRUE(result.ok) << result.error;
     EXPECT_GE(result.round_trip, std::chrono::milliseconds(2));
   }
   serial.stop();
-  const device::EchoStats stats = controller.stats();
+  const EchoStats stats = controller.stats();
   EXPECT_EQ(stats.pings, 3u);
   EXPECT_EQ(stats.round_trips, 3u);
   EXPECT_EQ(stats.mismatches + stats.timeouts, 0u);
@@ -121,21 +130,22 @@ TEST(EchoSim, CommandLineHostsItAloneOnItsOwnLink) {
 
 TEST(EchoController, CountsTimeoutsAndMismatchedAnswers) {
   std::vector<Bytes> written;
-  device::EchoController controller(
+  EchoController controller(
       [&written](const Bytes& frame) {
         written.push_back(frame);
         return true;
       },
       std::chrono::milliseconds(20));
-  const device::PingResult silent = controller.ping();
+  const PingResult silent = controller.ping();
   EXPECT_FALSE(silent.ok);
   ASSERT_EQ(written.size(), 1u);
-  const auto payload = echo::decode(echo::kRequestType, written[0].data(), written[0].size());
+  const auto payload = decode(kRequestType, written[0].data(), written[0].size());
   ASSERT_TRUE(payload.ok());
   // Its answer comes too late: nothing is waiting for it any more.
-  const Bytes late = echo::encodeAnswer(*payload);
-  controller.onFrame(echo::kAnswerFrames, late.data(), late.size(), Clock::now());
-  const device::EchoStats stats = controller.stats();
+  const Bytes late = encodeAnswer(*payload);
+  controller.onFrame(kAnswerFrames, late.data(), late.size(),
+                     serial_robot_driver::sim::Clock::now());
+  const EchoStats stats = controller.stats();
   EXPECT_EQ(stats.timeouts, 1u);
   EXPECT_EQ(stats.mismatches, 1u);
   EXPECT_EQ(stats.round_trips, 0u);
@@ -143,4 +153,4 @@ TEST(EchoController, CountsTimeoutsAndMismatchedAnswers) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::devices::echo::sim

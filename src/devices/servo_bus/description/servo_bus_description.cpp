@@ -13,9 +13,10 @@ namespace {
 
 std::vector<description::ServoJoint> servoJoints(const ros_layer::DriverParams& params) {
   std::vector<description::ServoJoint> servos;
-  if (!params.section(params::kServoBusSection).enabled) return servos;
+  if (!params.section(kServoBusSection).enabled) return servos;
   constexpr double kMaxBusServoSpeedDps = 750.0;  // servo/move's velocity limit
-  for (const trajectory::BusJoint& joint : trajectory::makeBusJoints(params.section(params::kServoBusSection))) {
+  for (const trajectory::BusJoint& joint :
+       makeBusJoints(params.section(kServoBusSection))) {
     const trajectory::JointRange range = joint.range();
     servos.push_back({joint.name, "servo_bus/joint_names", range.min_position, range.max_position,
                       kMaxBusServoSpeedDps * M_PI / 180.0});

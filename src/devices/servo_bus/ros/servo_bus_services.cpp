@@ -1,24 +1,24 @@
-#include "serial_robot_driver/devices/servo_bus/servo_bus_services.h"
+#include "serial_robot_driver/devices/servo_bus/ros/servo_bus_services.h"
 
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/servo_bus/servo_bus_interface.h"
+#include "serial_robot_driver/devices/servo_bus/ros/servo_bus_ros.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::servo_bus::ros {
 
 namespace {
 
 constexpr int kSpinnerThreads = 2;
 constexpr int kStopSpinnerThreads = 1;
 
-void logOutcome(const std::string& service, const device::ServoStatus& status) {
+void logOutcome(const std::string& service, const ServoStatus& status) {
   if (status.ok()) {
     ROS_DEBUG("%s: %s", service.c_str(), status.message.c_str());
   } else {
-    ROS_DEBUG("%s failed (%s): %s", service.c_str(), device::toString(status.error),
+    ROS_DEBUG("%s failed (%s): %s", service.c_str(), toString(status.error),
               status.message.c_str());
   }
 }
@@ -45,28 +45,28 @@ enum class Announce { kDebug, kInfo };
 /// and returns the status; the outcome fields are filled by advertiseServo().
 template <typename Service>
 using ServoCall =
-    std::function<device::ServoStatus(typename Service::Request&, typename Service::Response&)>;
+    std::function<ServoStatus(typename Service::Request&, typename Service::Response&)>;
 
 /// The node handle the servo/* services are advertised on, and where their refusals are counted.
 struct ServoServiceSite {
-  ros::NodeHandle& nh;
-  device::InputRefusals& refusals;
+  ::ros::NodeHandle& nh;
+  core::InputRefusals& refusals;
 };
 
 /// Advertises one servo/* service from its call. The service logs the outcome, never throws
 /// through to its caller (guardedService) and always returns true, so the caller gets the message
 /// instead of a bare "service call failed".
 template <typename Service>
-ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name,
-                                  ServoCall<Service> call, Announce announce = Announce::kDebug) {
+::ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name,
+                                    ServoCall<Service> call, Announce announce = Announce::kDebug) {
   using Request = typename Service::Request;
   using Response = typename Service::Response;
-  device::InputRefusals& refusals = site.refusals;
+  core::InputRefusals& refusals = site.refusals;
   const boost::function<bool(Request&, Response&)> serve = [name, call, announce, &refusals](
                                                                Request& req, Response& res) {
-    const device::ServoStatus status = call(req, res);
+    const ServoStatus status = call(req, res);
     logOutcome(name, status);
-    if (device::refusesRequest(status.error)) refusals.refused(name);
+    if (refusesRequest(status.error)) refusals.refused(name);
     if (status.ok() && announce == Announce::kInfo) {
       ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
     }
@@ -74,16 +74,16 @@ ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name
     return true;
   };
   return site.nh.advertiseService<Request, Response>(
-      name, guardedService<Request, Response>(refusals, name, serve));
+      name, ros_layer::guardedService<Request, Response>(refusals, name, serve));
 }
 
-device::ServoStatus readAngle(device::ServoBusClient& client, const ServoReadAngle::Request& req,
-                              ServoReadAngle::Response& res) {
+ServoStatus readAngle(ServoBusClient& client, const ServoReadAngle::Request& req,
+                      ServoReadAngle::Response& res) {
   res.angle_deg = 0.0;
   res.turns = 0;
   if (req.multi_turn) {
-    device::MultiTurnReading reading;
-    const device::ServoStatus status = client.readMultiTurnAngle(req.id, &reading);
+    MultiTurnReading reading;
+    const ServoStatus status = client.readMultiTurnAngle(req.id, &reading);
     if (status.ok()) {
       res.angle_deg = reading.angle_deg;
       res.turns = reading.turns;
@@ -91,29 +91,28 @@ device::ServoStatus readAngle(device::ServoBusClient& client, const ServoReadAng
     return status;
   }
   double angle_deg = 0.0;
-  const device::ServoStatus status = client.readAngle(req.id, &angle_deg);
+  const ServoStatus status = client.readAngle(req.id, &angle_deg);
   if (status.ok()) res.angle_deg = angle_deg;
   return status;
 }
 
-device::ServoStatus readAll(device::ServoBusClient& client, const ServoReadAll::Request& req,
-                            ServoReadAll::Response& res) {
-  std::vector<device::ServoParamValue> values;
-  const device::ServoStatus status = client.readAll(req.id, &values);
+ServoStatus readAll(ServoBusClient& client, const ServoReadAll::Request& req,
+                    ServoReadAll::Response& res) {
+  std::vector<ServoParamValue> values;
+  const ServoStatus status = client.readAll(req.id, &values);
   res.names.clear();
   res.values.clear();
-  for (const device::ServoParamValue& value : values) {
+  for (const ServoParamValue& value : values) {
     res.names.push_back(value.name);
     res.values.push_back(value.value);
   }
   return status;
 }
 
-device::ServoStatus readInfo(device::ServoBusClient& client,
-                             const device::ServoIdentityChecks& expected,
-                             const ServoInfo::Request& req, ServoInfo::Response& res) {
-  device::ServoIdentity identity;
-  const device::ServoStatus status = device::readServoInfo(client, req.id, expected, &identity);
+ServoStatus readInfo(ServoBusClient& client, const ServoIdentityChecks& expected,
+                     const ServoInfo::Request& req, ServoInfo::Response& res) {
+  ServoIdentity identity;
+  const ServoStatus status = readServoInfo(client, req.id, expected, &identity);
   res.servo_type = identity.servo_type;
   res.firmware_version = identity.firmware_version;
   res.serial_number = identity.serial_number;
@@ -121,8 +120,8 @@ device::ServoStatus readInfo(device::ServoBusClient& client,
   return status;
 }
 
-device::MoveRequest toMoveRequest(const ServoMove::Request& req) {
-  device::MoveRequest request;
+MoveRequest toMoveRequest(const ServoMove::Request& req) {
+  MoveRequest request;
   request.id = req.id;
   request.angle_deg = req.angle_deg;
   request.multi_turn = req.multi_turn;
@@ -134,8 +133,8 @@ device::MoveRequest toMoveRequest(const ServoMove::Request& req) {
   return request;
 }
 
-device::SpinRequest toSpinRequest(const ServoSpin::Request& req) {
-  device::SpinRequest request;
+SpinRequest toSpinRequest(const ServoSpin::Request& req) {
+  SpinRequest request;
   request.id = req.id;
   request.clockwise = req.clockwise;
   request.mode = req.mode;
@@ -147,9 +146,8 @@ device::SpinRequest toSpinRequest(const ServoSpin::Request& req) {
 
 }  // namespace
 
-ServoBusServices::ServoBusServices(ros::NodeHandle& nh, device::ServoBus& bus,
-                                   device::ServoMotionClaims& claims,
-                                   device::InputRefusals& refusals)
+ServoBusServices::ServoBusServices(::ros::NodeHandle& nh, ServoBus& bus, ServoMotionClaims& claims,
+                                   core::InputRefusals& refusals)
     : bus_(bus),
       client_(bus.client()),
       claims_(claims),
@@ -159,7 +157,7 @@ ServoBusServices::ServoBusServices(ros::NodeHandle& nh, device::ServoBus& bus,
       stop_nh_(nh) {
   // Own queues: a servo call waits on the bus (up to timeout * (retries + 1), or a whole motion
   // with wait = true) and must never hold up cmd_vel or joint_commands on the global queue; a stop
-  // must never wait behind such a call (see the threading model in servo_bus_interface.h).
+  // must never wait behind such a call (see the threading model in servo_bus_ros.h).
   nh_.setCallbackQueue(&queue_);
   stop_nh_.setCallbackQueue(&stop_queue_);
   client_.setStopCallsQueued([this] { return stop_queue_.waiting(); });
@@ -174,18 +172,18 @@ ServoBusServices::~ServoBusServices() { shutdown(); }
 void ServoBusServices::start() {
   if (spinner_ || shut_down_) return;
   // The stop services' thread first: from the first call on, a stop never waits behind another.
-  stop_spinner_ = std::make_unique<QueueSpinner>(&stop_queue_, kStopSpinnerThreads);
+  stop_spinner_ = std::make_unique<ros_layer::QueueSpinner>(&stop_queue_, kStopSpinnerThreads);
   stop_spinner_->start();
   // Two threads: one call waits on the bus while another is accepted and queued behind the bus
   // mutex, so ROS never sees the service as unresponsive. Idle, they sleep (no 10 Hz polling).
-  spinner_ = std::make_unique<QueueSpinner>(&queue_, kSpinnerThreads);
+  spinner_ = std::make_unique<ros_layer::QueueSpinner>(&queue_, kSpinnerThreads);
   spinner_->start();
 }
 
 void ServoBusServices::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
-  for (ros::ServiceServer& service : services_) service.shutdown();
+  for (::ros::ServiceServer& service : services_) service.shutdown();
   if (spinner_) spinner_->stop();
   if (stop_spinner_) stop_spinner_->stop();
 }
@@ -197,8 +195,8 @@ void ServoBusServices::advertiseReads() {
       [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }));
   services_.push_back(advertiseServo<ServoRead>(
       site, "servo/read", [this](ServoRead::Request& req, ServoRead::Response& res) {
-        device::ServoParamValue value;
-        const device::ServoStatus status = client_.readParam(req.id, req.param, &value);
+        ServoParamValue value;
+        const ServoStatus status = client_.readParam(req.id, req.param, &value);
         if (status.ok()) {
           res.value = value.value;
           res.unit = value.unit;
@@ -248,7 +246,7 @@ void ServoBusServices::advertiseMoves() {
       }));
   services_.push_back(advertiseServo<ServoRotate>(
       site, "servo/rotate", [this](ServoRotate::Request& req, ServoRotate::Response&) {
-        device::RotateRequest request;
+        RotateRequest request;
         request.id = req.id;
         request.angle_deg = req.angle_deg;
         request.interval_ms = req.interval_ms;
@@ -278,4 +276,4 @@ void ServoBusServices::advertiseStops() {
       }));
 }
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::servo_bus::ros

@@ -1,16 +1,16 @@
-#include "serial_robot_driver/devices/servo_bus/stop_call_queue.h"
+#include "serial_robot_driver/devices/servo_bus/ros/stop_call_queue.h"
 
 #include <boost/make_shared.hpp>
 #include <utility>
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::servo_bus::ros {
 
 namespace {
 
 /// A queued call, counted as waiting from its queuing until it starts (or is dropped unstarted).
-class CountedCall : public ros::CallbackInterface {
+class CountedCall : public ::ros::CallbackInterface {
  public:
-  CountedCall(ros::CallbackInterfacePtr call, std::shared_ptr<std::atomic<int>> waiting)
+  CountedCall(::ros::CallbackInterfacePtr call, std::shared_ptr<std::atomic<int>> waiting)
       : call_(std::move(call)), waiting_(std::move(waiting)) {
     waiting_->fetch_add(1);
   }
@@ -36,7 +36,7 @@ class CountedCall : public ros::CallbackInterface {
     counted_ = false;
   }
 
-  const ros::CallbackInterfacePtr call_;
+  const ::ros::CallbackInterfacePtr call_;
   const std::shared_ptr<std::atomic<int>> waiting_;
   bool counted_ = true;  // one thread at a time calls or destroys a queued call
 };
@@ -45,9 +45,10 @@ class CountedCall : public ros::CallbackInterface {
 
 StopCallQueue::StopCallQueue(std::function<void()> on_queued) : on_queued_(std::move(on_queued)) {}
 
-void StopCallQueue::addCallback(const ros::CallbackInterfacePtr& callback, uint64_t removal_id) {
-  ros::CallbackQueue::addCallback(boost::make_shared<CountedCall>(callback, waiting_), removal_id);
+void StopCallQueue::addCallback(const ::ros::CallbackInterfacePtr& callback, uint64_t removal_id) {
+  ::ros::CallbackQueue::addCallback(boost::make_shared<CountedCall>(callback, waiting_),
+                                    removal_id);
   if (on_queued_) on_queued_();
 }
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::servo_bus::ros

@@ -1,10 +1,10 @@
 #include "serial_robot_driver/devices/servo_bus/ros/trajectory_bus_joints.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::servo_bus::ros {
 
 sensor_msgs::JointState busJointState(const std::vector<trajectory::BusJoint>& joints, uint8_t id,
-                                      double angle_deg, const ros::Time& stamp) {
-  const trajectory::JointPosition measured = trajectory::busJointPosition(joints, id, angle_deg);
+                                      double angle_deg, const ::ros::Time& stamp) {
+  const JointPosition measured = busJointPosition(joints, id, angle_deg);
   sensor_msgs::JointState msg;
   msg.header.stamp = stamp;
   msg.name.push_back(measured.name);
@@ -12,4 +12,4 @@ sensor_msgs::JointState busJointState(const std::vector<trajectory::BusJoint>& j
   return msg;
 }
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::servo_bus::ros

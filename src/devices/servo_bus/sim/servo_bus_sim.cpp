@@ -1,4 +1,4 @@
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,29 +7,27 @@
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
 
-namespace serial_robot_driver::sim {
+namespace serial_robot_driver::devices::servo_bus::sim {
 
-namespace servo = protocol::servo;
-
-const OutputKind kServoAnswerOutput{"servo_answers", 1};
-using servo::Command;
+const serial_robot_driver::sim::OutputKind kServoAnswerOutput{"servo_answers", 1};
+using servo_bus::Command;
 
 namespace {
 
 // data_ids of docs/protocols.md, section 3 the simulator gives a behaviour to.
-constexpr uint8_t kVoltage = servo::dataId(servo::ServoDataId::kVoltage);
-constexpr uint8_t kCurrent = servo::dataId(servo::ServoDataId::kCurrent);
-constexpr uint8_t kPower = servo::dataId(servo::ServoDataId::kPower);
-constexpr uint8_t kTemperature = servo::dataId(servo::ServoDataId::kTemperature);
-constexpr uint8_t kServoStatus = servo::dataId(servo::ServoDataId::kServoStatus);
-constexpr uint8_t kServoType = servo::dataId(servo::ServoDataId::kServoType);
-constexpr uint8_t kFirmwareVersion = servo::dataId(servo::ServoDataId::kFirmwareVersion);
-constexpr uint8_t kSerialNumber = servo::dataId(servo::ServoDataId::kSerialNumber);
-constexpr uint8_t kResponseSwitch = servo::dataId(servo::ServoDataId::kResponseSwitch);
-constexpr uint8_t kServoId = servo::dataId(servo::ServoDataId::kServoId);
-constexpr uint8_t kAngleLimitSwitch = servo::dataId(servo::ServoDataId::kAngleLimitSwitch);
-constexpr uint8_t kAngleLimitHigh = servo::dataId(servo::ServoDataId::kAngleLimitHigh);
-constexpr uint8_t kAngleLimitLow = servo::dataId(servo::ServoDataId::kAngleLimitLow);
+constexpr uint8_t kVoltage = dataId(ServoDataId::kVoltage);
+constexpr uint8_t kCurrent = dataId(ServoDataId::kCurrent);
+constexpr uint8_t kPower = dataId(ServoDataId::kPower);
+constexpr uint8_t kTemperature = dataId(ServoDataId::kTemperature);
+constexpr uint8_t kServoStatus = dataId(ServoDataId::kServoStatus);
+constexpr uint8_t kServoType = dataId(ServoDataId::kServoType);
+constexpr uint8_t kFirmwareVersion = dataId(ServoDataId::kFirmwareVersion);
+constexpr uint8_t kSerialNumber = dataId(ServoDataId::kSerialNumber);
+constexpr uint8_t kResponseSwitch = dataId(ServoDataId::kResponseSwitch);
+constexpr uint8_t kServoId = dataId(ServoDataId::kServoId);
+constexpr uint8_t kAngleLimitSwitch = dataId(ServoDataId::kAngleLimitSwitch);
+constexpr uint8_t kAngleLimitHigh = dataId(ServoDataId::kAngleLimitHigh);
+constexpr uint8_t kAngleLimitLow = dataId(ServoDataId::kAngleLimitLow);
 
 constexpr int64_t kNominalVoltage = 7400;  // mV, a 2S LiPo
 constexpr int64_t kNominalTemperature = 35;
@@ -41,7 +39,6 @@ constexpr auto kDriftPeriod = std::chrono::milliseconds(100);
 // Factory values of the user block (assumption: datasheet-like numbers). The id goes back to the
 // factory default 0 like on the real servo, so a reset on a chain may collide with servo 0.
 const std::map<uint8_t, int64_t>& userDefaults() {
-  using servo::ServoDataId;
   static const std::map<uint8_t, int64_t> defaults = {
       {dataId(ServoDataId::kReserved32), 0},        {dataId(ServoDataId::kResponseSwitch), 0},
       {dataId(ServoDataId::kReserved35), 0},        {dataId(ServoDataId::kBaudrate), 5},
@@ -82,12 +79,12 @@ constexpr double kMsPerSecond = 1000.0;
 
 }  // namespace
 
-ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
+ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, serial_robot_driver::sim::TimePoint now)
     : config_(config), rng_(config.seed), last_drift_(now) {
   for (uint8_t id : config_.servo_ids) {
     const bool offline = std::find(config_.offline_ids.begin(), config_.offline_ids.end(), id) !=
                          config_.offline_ids.end();
-    if (offline || id == servo::kBroadcastId) continue;
+    if (offline || id == kBroadcastId) continue;
     Servo s;
     s.last_step = now;
     s.params[kVoltage] = kNominalVoltage;
@@ -163,7 +160,8 @@ double ServoBusSim::moveAngle(const Motion& m, double elapsed) {
   return m.start_angle + direction * travelled;
 }
 
-void ServoBusSim::requestMove(Servo* s, Motion motion, uint8_t id, bool broadcast, TimePoint now) {
+void ServoBusSim::requestMove(Servo* s, Motion motion, uint8_t id, bool broadcast,
+                              serial_robot_driver::sim::TimePoint now) {
   if (!motion.multi_turn && param(*s, kAngleLimitSwitch) == 1) {
     motion.target_angle = std::clamp(motion.target_angle, param(*s, kAngleLimitLow) / 10.0,
                                      param(*s, kAngleLimitHigh) / 10.0);
@@ -179,30 +177,32 @@ int64_t ServoBusSim::param(const Servo& s, uint8_t data_id) {
   return it == s.params.end() ? 0 : it->second;
 }
 
-void ServoBusSim::answer(TimePoint due, Command cmd, const std::vector<uint8_t>& content) {
-  PendingAnswer pending{due, servo::encodeResponse(cmd, content)};
-  const auto position =
-      std::upper_bound(pending_.begin(), pending_.end(), due,
-                       [](TimePoint t, const PendingAnswer& other) { return t < other.due; });
+void ServoBusSim::answer(serial_robot_driver::sim::TimePoint due, Command cmd,
+                         const std::vector<uint8_t>& content) {
+  PendingAnswer pending{due, encodeResponse(cmd, content)};
+  const auto position = std::upper_bound(pending_.begin(), pending_.end(), due,
+                                         [](serial_robot_driver::sim::TimePoint t,
+                                            const PendingAnswer& other) { return t < other.due; });
   pending_.insert(position, std::move(pending));
 }
 
-void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint now) {
-  const auto decoded = servo::decodeRequest(data, size);
+void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size,
+                                serial_robot_driver::sim::TimePoint now) {
+  const auto decoded = decodeRequest(data, size);
   if (!decoded || decoded->content_size == 0) {
     ++stats_.malformed;
     return;
   }
-  const servo::Packet& packet = *decoded;
+  const Packet& packet = *decoded;
   ++stats_.requests;
   const uint8_t id = packet.id();
-  const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(packet);
-  if (spin && spin->mode == servo::SpinMode::kStop && config_.lost_stops > 0) {
+  const protocol::Decoded<SpinCommand> spin = decodeSpin(packet);
+  if (spin && spin->mode == SpinMode::kStop && config_.lost_stops > 0) {
     --config_.lost_stops;
     ++stats_.stops_lost;
     return;
   }
-  if (id == servo::kBroadcastId) {
+  if (id == kBroadcastId) {
     ++stats_.broadcasts;
     for (Servo& s : servos_) execute(&s, packet, true, now);
     return;
@@ -217,8 +217,8 @@ void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint
   ++stats_.unaddressed;
 }
 
-const std::array<ServoBusSim::HandlerRow, servo::kMaxCommand>& ServoBusSim::handlers() {
-  static constexpr std::array<HandlerRow, servo::kMaxCommand> kRows = {{
+const std::array<ServoBusSim::HandlerRow, kMaxCommand>& ServoBusSim::handlers() {
+  static constexpr std::array<HandlerRow, kMaxCommand> kRows = {{
       {Command::kPing, &ServoBusSim::onPing},
       {Command::kResetUserData, &ServoBusSim::onResetUserData},
       {Command::kReadData, &ServoBusSim::onReadData},
@@ -239,7 +239,7 @@ const std::array<ServoBusSim::HandlerRow, servo::kMaxCommand>& ServoBusSim::hand
   static_assert(
       [] {
         for (std::size_t i = 0; i < kRows.size(); ++i) {
-          if (servo::commandRow(kRows[i].cmd) != i) return false;
+          if (commandRow(kRows[i].cmd) != i) return false;
         }
         return true;
       }(),
@@ -247,20 +247,24 @@ const std::array<ServoBusSim::HandlerRow, servo::kMaxCommand>& ServoBusSim::hand
   return kRows;
 }
 
-void ServoBusSim::execute(Servo* s, const servo::Packet& packet, bool broadcast, TimePoint now) {
+void ServoBusSim::execute(Servo* s, const Packet& packet, bool broadcast,
+                          serial_robot_driver::sim::TimePoint now) {
   runMotions(s, now);  // the angle and the queue as of this request
   const auto cmd = static_cast<Command>(packet.cmd);
-  const servo::CommandInfo& info = servo::commandInfo(cmd);
+  const CommandInfo& info = commandInfo(cmd);
   if (!info.request.fits(packet.content_size)) {
     ++stats_.malformed;
     return;
   }
   // Nobody answers the broadcast id; a motion answers (on completion) only with response_switch 1.
   const bool answers =
-      !broadcast && (info.answers == servo::Answers::kAlways || param(*s, kResponseSwitch) == 1);
-  const Request request{s,         packet,  cmd, packet.id(),
-                        broadcast, answers, now, now + fromSeconds(config_.answer_latency_s)};
-  (this->*handlers()[servo::commandRow(cmd)].handle)(request);
+      !broadcast && (info.answers == Answers::kAlways || param(*s, kResponseSwitch) == 1);
+  const Request request{
+      s,         packet,
+      cmd,       packet.id(),
+      broadcast, answers,
+      now,       now + serial_robot_driver::sim::fromSeconds(config_.answer_latency_s)};
+  (this->*handlers()[commandRow(cmd)].handle)(request);
 }
 
 void ServoBusSim::reply(const Request& request, const std::vector<uint8_t>& content) {
@@ -269,16 +273,16 @@ void ServoBusSim::reply(const Request& request, const std::vector<uint8_t>& cont
 
 void ServoBusSim::onMove(const Request& request) {
   const Command cmd = request.cmd;
-  const protocol::Decoded<servo::MoveCommand> move = servo::decodeMove(request.packet);
+  const protocol::Decoded<MoveCommand> move = decodeMove(request.packet);
   if (!move) {
     ++stats_.malformed;
     return;
   }
   Motion motion;
   motion.cmd = cmd;
-  motion.multi_turn = servo::isMultiTurn(cmd);
+  motion.multi_turn = isMultiTurn(cmd);
   motion.target_angle = move->angle_decidegrees / 10.0;
-  if (servo::isByVelocity(cmd)) {
+  if (isByVelocity(cmd)) {
     motion.velocity_dps = move->velocity_decidegrees_per_s / 10.0;
     if (motion.velocity_dps <= 0) {
       ++stats_.malformed;
@@ -287,31 +291,28 @@ void ServoBusSim::onMove(const Request& request) {
   } else {
     motion.duration_s = move->interval_ms / kMsPerSecond;
   }
-  if (servo::hasRamps(cmd)) {
+  if (hasRamps(cmd)) {
     motion.accel_s = move->ramps.accel_ms / kMsPerSecond;
     motion.decel_s = move->ramps.decel_ms / kMsPerSecond;
   }
   requestMove(request.servo, motion, request.id, request.broadcast, request.now);
 }
 
-void ServoBusSim::onPing(const Request& request) {
-  reply(request, servo::pingAnswerContent(request.id));
-}
+void ServoBusSim::onPing(const Request& request) { reply(request, pingAnswerContent(request.id)); }
 
 void ServoBusSim::onResetUserData(const Request& request) {
   resetUserData(request.servo);
   // The servo now has its factory id and answers from there.
-  reply(request, servo::resultAnswerContent(kFactoryId, true));
+  reply(request, resultAnswerContent(kFactoryId, true));
 }
 
-const servo::ParamInfo* ServoBusSim::dataRequest(const Request& request,
-                                                 servo::DataContent* content) {
-  const protocol::Decoded<servo::DataContent> decoded = servo::decodeDataContent(request.packet);
+const ParamInfo* ServoBusSim::dataRequest(const Request& request, DataContent* content) {
+  const protocol::Decoded<DataContent> decoded = decodeDataContent(request.packet);
   if (!decoded) {
     ++stats_.malformed;
     return nullptr;
   }
-  const servo::ParamInfo* param_info = servo::findParamById(decoded->data_id);
+  const ParamInfo* param_info = findParamById(decoded->data_id);
   if (param_info == nullptr) {
     ++stats_.unknown_data_ids;
     return nullptr;
@@ -321,49 +322,47 @@ const servo::ParamInfo* ServoBusSim::dataRequest(const Request& request,
 }
 
 void ServoBusSim::onReadData(const Request& request) {
-  servo::DataContent content;
-  const servo::ParamInfo* param_info = dataRequest(request, &content);
+  DataContent content;
+  const ParamInfo* param_info = dataRequest(request, &content);
   if (param_info == nullptr) return;
-  reply(request, servo::readDataAnswerContent(request.id, *param_info,
-                                              param(*request.servo, param_info->data_id)));
+  reply(request,
+        readDataAnswerContent(request.id, *param_info, param(*request.servo, param_info->data_id)));
 }
 
 void ServoBusSim::onWriteData(const Request& request) {
-  servo::DataContent content;
-  const servo::ParamInfo* param_info = dataRequest(request, &content);
+  DataContent content;
+  const ParamInfo* param_info = dataRequest(request, &content);
   if (param_info == nullptr) return;
-  const auto value = servo::readValue(*param_info, content.value.data(), content.value_size);
+  const auto value = readValue(*param_info, content.value.data(), content.value_size);
   if (!value) {
     ++stats_.malformed;
     return;
   }
   // The servo enforces ranges and read-only cells, not the host's notion of "dangerous".
-  const bool ok = servo::checkWrite(*param_info, *value, true) == servo::WriteCheck::kOk;
+  const bool ok = checkWrite(*param_info, *value, true) == WriteCheck::kOk;
   if (ok) {
     request.servo->params[param_info->data_id] = *value;
   } else {
     ++stats_.writes_rejected;
   }
-  reply(request, servo::writeDataAnswerContent(request.id, param_info->data_id, ok));
+  reply(request, writeDataAnswerContent(request.id, param_info->data_id, ok));
 }
 
 void ServoBusSim::onReadBatchData(const Request& request) {
-  const auto value_of = [&](const servo::ParamInfo& info) {
-    return param(*request.servo, info.data_id);
-  };
-  reply(request, servo::userBlockAnswerContent(request.id, servo::packUserBlock(value_of)));
+  const auto value_of = [&](const ParamInfo& info) { return param(*request.servo, info.data_id); };
+  reply(request, userBlockAnswerContent(request.id, packUserBlock(value_of)));
 }
 
 void ServoBusSim::onWriteBatchData(const Request& request) {
-  const auto block = servo::decodeUserBlock(request.packet);
+  const auto block = decodeUserBlock(request.packet);
   if (!block) {
     ++stats_.malformed;
     return;
   }
-  const auto values = servo::unpackUserBlock(*block);
+  const auto values = unpackUserBlock(*block);
   // All or nothing: one bad cell rejects the block.
   const bool ok = std::all_of(values.begin(), values.end(), [](const auto& cell) {
-    return servo::checkWrite(*cell.first, cell.second, true) == servo::WriteCheck::kOk;
+    return checkWrite(*cell.first, cell.second, true) == WriteCheck::kOk;
   });
   if (ok) {
     for (const auto& [param_info, value] : values)
@@ -371,11 +370,11 @@ void ServoBusSim::onWriteBatchData(const Request& request) {
   } else {
     ++stats_.writes_rejected;
   }
-  reply(request, servo::resultAnswerContent(request.id, ok));
+  reply(request, resultAnswerContent(request.id, ok));
 }
 
 void ServoBusSim::onSpin(const Request& request) {
-  const protocol::Decoded<servo::SpinCommand> spin = servo::decodeSpin(request.packet);
+  const protocol::Decoded<SpinCommand> spin = decodeSpin(request.packet);
   if (!spin) {
     ++stats_.malformed;
     return;
@@ -390,20 +389,20 @@ void ServoBusSim::onSpin(const Request& request) {
   motion.answer_id = request.id;
   motion.rate_dps = rate;
   switch (spin->mode) {
-    case servo::SpinMode::kStop:
+    case SpinMode::kStop:
       stopAll(s);
-      reply(request, servo::resultAnswerContent(request.id, true));
+      reply(request, resultAnswerContent(request.id, true));
       return;
-    case servo::SpinMode::kContinuous:
+    case SpinMode::kContinuous:
       stopAll(s);
       s->relaxed = false;
       s->spin_rate_dps = rate;
-      reply(request, servo::resultAnswerContent(request.id, true));
+      reply(request, resultAnswerContent(request.id, true));
       return;
-    case servo::SpinMode::kTurns:
+    case SpinMode::kTurns:
       motion.duration_s = speed > 0 ? spin->value * 360.0 / speed : 0.0;
       break;
-    case servo::SpinMode::kDurationMs:
+    case SpinMode::kDurationMs:
       motion.duration_s = spin->value / 1000.0;
       break;
   }
@@ -412,24 +411,24 @@ void ServoBusSim::onSpin(const Request& request) {
 
 void ServoBusSim::onReadMultiTurnAngle(const Request& request) {
   const double angle_deg = request.servo->angle_deg;
-  servo::MultiTurnAngle reading;
+  MultiTurnAngle reading;
   reading.id = request.id;
   const double decidegrees =
       std::clamp(std::round(angle_deg * 10.0), double(std::numeric_limits<int32_t>::min()),
                  double(std::numeric_limits<int32_t>::max()));
   reading.angle_decidegrees = static_cast<int32_t>(decidegrees);
   reading.turns = static_cast<int16_t>(std::trunc(angle_deg / kDegreesPerTurn));
-  reply(request, servo::multiTurnAngleContent(reading));
+  reply(request, multiTurnAngleContent(reading));
 }
 
 void ServoBusSim::onDamping(const Request& request) {
   stopAll(request.servo);  // damping releases the holding torque: nothing keeps moving
   request.servo->relaxed = true;
-  reply(request, servo::resultAnswerContent(request.id, true));
+  reply(request, resultAnswerContent(request.id, true));
 }
 
 void ServoBusSim::onReadAngle(const Request& request) {
-  reply(request, servo::angleAnswerContent(servo::AngleAnswer{
+  reply(request, angleAnswerContent(AngleAnswer{
                      request.id, toDecidegrees(foldDegrees(request.servo->angle_deg))}));
 }
 
@@ -438,7 +437,7 @@ void ServoBusSim::stopAll(Servo* s) {
   s->spin_rate_dps = 0.0;
 }
 
-void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
+void ServoBusSim::startMotion(Servo* s, Motion motion, serial_robot_driver::sim::TimePoint now) {
   if (!motion.answer) stopAll(s);  // response_switch 0: the new command interrupts
   s->spin_rate_dps = 0.0;
   s->relaxed = false;
@@ -446,12 +445,13 @@ void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
   runMotions(s, now);
 }
 
-void ServoBusSim::runMotions(Servo* s, TimePoint now) {
+void ServoBusSim::runMotions(Servo* s, serial_robot_driver::sim::TimePoint now) {
   if (s->spin_rate_dps != 0.0) {
-    s->angle_deg += s->spin_rate_dps * toSeconds(now - s->last_step);  // turns accumulate
+    s->angle_deg += s->spin_rate_dps *
+                    serial_robot_driver::sim::toSeconds(now - s->last_step);  // turns accumulate
   }
   s->last_step = now;
-  TimePoint cursor = now;
+  serial_robot_driver::sim::TimePoint cursor = now;
   while (!s->motions.empty()) {
     Motion& motion = s->motions.front();
     if (!motion.started) {
@@ -463,7 +463,7 @@ void ServoBusSim::runMotions(Servo* s, TimePoint now) {
       motion.start_angle = s->angle_deg;
       if (motion.kind == Motion::Kind::kRotate) beginMove(&motion, motion.start_angle);
     }
-    const double elapsed = toSeconds(now - motion.start);
+    const double elapsed = serial_robot_driver::sim::toSeconds(now - motion.start);
     const bool done = elapsed >= motion.duration_s;
     const double progress = done ? motion.duration_s : elapsed;
     if (motion.kind == Motion::Kind::kRotate) {
@@ -472,10 +472,12 @@ void ServoBusSim::runMotions(Servo* s, TimePoint now) {
       s->angle_deg = motion.start_angle + motion.rate_dps * progress;
     }
     if (!done) break;
-    const TimePoint finished = motion.start + fromSeconds(motion.duration_s);
+    const serial_robot_driver::sim::TimePoint finished =
+        motion.start + serial_robot_driver::sim::fromSeconds(motion.duration_s);
     if (motion.answer) {
-      answer(std::max(finished, now) + fromSeconds(config_.answer_latency_s), motion.cmd,
-             servo::resultAnswerContent(motion.answer_id, true));
+      answer(
+          std::max(finished, now) + serial_robot_driver::sim::fromSeconds(config_.answer_latency_s),
+          motion.cmd, resultAnswerContent(motion.answer_id, true));
     }
     cursor = finished;  // the next queued motion starts where this one ended
     s->motions.pop_front();
@@ -504,7 +506,8 @@ void ServoBusSim::driftReadOnly(Servo* s) {
   s->params[kPower] = voltage * current / 1000;
 }
 
-void ServoBusSim::tick(TimePoint now, Outbox* out) {
+void ServoBusSim::tick(serial_robot_driver::sim::TimePoint now,
+                       serial_robot_driver::sim::Outbox* out) {
   const bool drift = now - last_drift_ >= kDriftPeriod;
   if (drift) last_drift_ = now;
   for (Servo& s : servos_) {
@@ -512,20 +515,22 @@ void ServoBusSim::tick(TimePoint now, Outbox* out) {
     if (drift) driftReadOnly(&s);
   }
   while (!pending_.empty() && pending_.front().due <= now) {
-    out->push_back(
-        Outgoing{&kServoAnswerOutput, std::move(pending_.front().bytes), pending_.front().due});
+    out->push_back(serial_robot_driver::sim::Outgoing{
+        &kServoAnswerOutput, std::move(pending_.front().bytes), pending_.front().due});
     pending_.pop_front();
     ++stats_.answers;
   }
 }
 
-TimePoint ServoBusSim::nextEvent() const {
-  TimePoint next = last_drift_ + kDriftPeriod;
+serial_robot_driver::sim::TimePoint ServoBusSim::nextEvent() const {
+  serial_robot_driver::sim::TimePoint next = last_drift_ + kDriftPeriod;
   if (!pending_.empty()) next = std::min(next, pending_.front().due);
   for (const Servo& s : servos_) {
     if (s.motions.empty()) continue;
     const Motion& motion = s.motions.front();
-    if (motion.started) next = std::min(next, motion.start + fromSeconds(motion.duration_s));
+    if (motion.started)
+      next =
+          std::min(next, motion.start + serial_robot_driver::sim::fromSeconds(motion.duration_s));
   }
   return next;
 }
@@ -545,4 +550,4 @@ ServoBusSimStats ServoBusSim::stats() const {
   return copy;
 }
 
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::devices::servo_bus::sim

@@ -2,59 +2,64 @@
 // its stats lines and its share of the line faults (--servo-fault-rate on its answers).
 #include <memory>
 
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/sim_option_builders.h"
 
-namespace serial_robot_driver::sim {
+namespace serial_robot_driver::devices::servo_bus::sim {
 
 namespace {
 
 constexpr const char* kName = "servo_bus";
 
-DeviceSimStats statsOf(ServoBusSimStats bus, const PortCounters& ports) {
-  std::vector<StatsLine> lines{
-      statsLine("servo_requests", bus.requests),
-      statsLine("servo_answers", bus.answers),
-      statsLine("servo_broadcasts", bus.broadcasts),
-      statsLine("servo_unaddressed", bus.unaddressed),
-      statsLine("servo_unknown_data_ids", bus.unknown_data_ids),
-      statsLine("servo_malformed", bus.malformed),
-      statsLine("servo_writes_rejected", bus.writes_rejected),
-      statsLine("servo_stops_lost", bus.stops_lost),
+serial_robot_driver::sim::DeviceSimStats statsOf(
+    ServoBusSimStats bus, const serial_robot_driver::sim::PortCounters& ports) {
+  std::vector<serial_robot_driver::sim::StatsLine> lines{
+      serial_robot_driver::sim::statsLine("servo_requests", bus.requests),
+      serial_robot_driver::sim::statsLine("servo_answers", bus.answers),
+      serial_robot_driver::sim::statsLine("servo_broadcasts", bus.broadcasts),
+      serial_robot_driver::sim::statsLine("servo_unaddressed", bus.unaddressed),
+      serial_robot_driver::sim::statsLine("servo_unknown_data_ids", bus.unknown_data_ids),
+      serial_robot_driver::sim::statsLine("servo_malformed", bus.malformed),
+      serial_robot_driver::sim::statsLine("servo_writes_rejected", bus.writes_rejected),
+      serial_robot_driver::sim::statsLine("servo_stops_lost", bus.stops_lost),
   };
   for (const BusServoSnapshot& servo : bus.servos) {
-    lines.push_back(
-        statsLine("bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
+    lines.push_back(serial_robot_driver::sim::statsLine(
+        "bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
   }
-  lines.push_back(statsLine("rx_frames_servo_request",
-                            ports.all_ports.framesOf(protocol::servo::kRequestFrames)));
-  return DeviceSimStats{kName, std::move(bus), std::move(lines)};
+  lines.push_back(serial_robot_driver::sim::statsLine("rx_frames_servo_request",
+                                                      ports.all_ports.framesOf(kRequestFrames)));
+  return serial_robot_driver::sim::DeviceSimStats{kName, std::move(bus), std::move(lines)};
 }
 
-DeviceSimStats leftOutStats(const PortCounters& ports) {
+serial_robot_driver::sim::DeviceSimStats leftOutStats(
+    const serial_robot_driver::sim::PortCounters& ports) {
   return statsOf(ServoBusSimStats{}, ports);
 }
 
-class ServoBusSimDevice : public SimDevice {
+class ServoBusSimDevice : public serial_robot_driver::sim::SimDevice {
  public:
-  ServoBusSimDevice(const ServoBusSimConfig& config, TimePoint now)
+  ServoBusSimDevice(const ServoBusSimConfig& config, serial_robot_driver::sim::TimePoint now)
       : bus_(config, now), answer_fault_rate_(config.answer_fault_rate) {}
 
   void handleFrame(const protocol::FrameFamily& family, const uint8_t* data, std::size_t size,
-                   TimePoint at, Outbox* /*out*/) override {
+                   serial_robot_driver::sim::TimePoint at,
+                   serial_robot_driver::sim::Outbox* /*out*/) override {
     // Answers leave from tick(), once their latency is over.
-    if (family == protocol::servo::kRequestFrames) bus_.handleRequest(data, size, at);
+    if (family == kRequestFrames) bus_.handleRequest(data, size, at);
   }
-  void tick(TimePoint now, SimWorld& /*world*/, Outbox* out) override {
+  void tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver::sim::SimWorld& /*world*/,
+            serial_robot_driver::sim::Outbox* out) override {
     const std::size_t first = out->size();
     bus_.tick(now, out);
     for (std::size_t i = first; i < out->size(); ++i) {
       (*out)[i].garble_or_suppress_rate = answer_fault_rate_;
     }
   }
-  TimePoint nextEvent() const override { return bus_.nextEvent(); }
+  serial_robot_driver::sim::TimePoint nextEvent() const override { return bus_.nextEvent(); }
 
-  DeviceSimStats stats(const PortCounters& ports) const override {
+  serial_robot_driver::sim::DeviceSimStats stats(
+      const serial_robot_driver::sim::PortCounters& ports) const override {
     return statsOf(bus_.stats(), ports);
   }
 
@@ -63,47 +68,52 @@ class ServoBusSimDevice : public SimDevice {
   double answer_fault_rate_;
 };
 
-std::unique_ptr<SimDevice> makeServoBusSim(const HostedDeviceOptions& options, uint32_t seed,
-                                           TimePoint now) {
+std::unique_ptr<serial_robot_driver::sim::SimDevice> makeServoBusSim(
+    const serial_robot_driver::sim::HostedDeviceOptions& options, uint32_t seed,
+    serial_robot_driver::sim::TimePoint now) {
   ServoBusSimConfig config = options.configAs<ServoBusSimConfig>();
   config.seed = seed;
   return std::make_unique<ServoBusSimDevice>(config, now);
 }
 
 /// --servo-latency-ms: given in ms, kept in seconds.
-SimDeviceOption latencyOption() {
-  SimDeviceOption option{"--servo-latency-ms", "MS", "servo bus answer latency", nullptr, nullptr};
-  option.apply = [](const std::string& value, HostedDeviceOptions& device) {
+serial_robot_driver::sim::SimDeviceOption latencyOption() {
+  serial_robot_driver::sim::SimDeviceOption option{"--servo-latency-ms", "MS",
+                                                   "servo bus answer latency", nullptr, nullptr};
+  option.apply = [](const std::string& value,
+                    serial_robot_driver::sim::HostedDeviceOptions& device) {
     double ms = 0;
-    if (!parseDouble(value, &ms) || ms < 0) return badValue("--servo-latency-ms", value);
+    if (!serial_robot_driver::sim::parseDouble(value, &ms) || ms < 0)
+      return serial_robot_driver::sim::badValue("--servo-latency-ms", value);
     device.configAs<ServoBusSimConfig>().answer_latency_s = ms / 1000.0;
     return std::string();
   };
-  option.shown_default = [](const HostedDeviceOptions& defaults) {
-    return showDefault(defaults.configAs<ServoBusSimConfig>().answer_latency_s * 1000.0);
+  option.shown_default = [](const serial_robot_driver::sim::HostedDeviceOptions& defaults) {
+    return serial_robot_driver::sim::showDefault(
+        defaults.configAs<ServoBusSimConfig>().answer_latency_s * 1000.0);
   };
   return option;
 }
 
 }  // namespace
 
-ServoBusSimConfig& servoBusConfig(SimOptions& options) {
+ServoBusSimConfig& servoBusConfig(serial_robot_driver::sim::SimOptions& options) {
   return options.device(kName).configAs<ServoBusSimConfig>();
 }
 
-const ServoBusSimStats& servoBusStats(const SimStats& stats) {
+const ServoBusSimStats& servoBusStats(const serial_robot_driver::sim::SimStats& stats) {
   return stats.countersOf<ServoBusSimStats>(kName);
 }
 
-ServoBusSimStats servoBusStats(SimStats&& stats) {
+ServoBusSimStats servoBusStats(serial_robot_driver::sim::SimStats&& stats) {
   return stats.countersOf<ServoBusSimStats>(kName);
 }
 
-}  // namespace serial_robot_driver::sim
+}  // namespace serial_robot_driver::devices::servo_bus::sim
 
 namespace serial_robot_driver::devices::servo_bus {
 
-extern const sim::SimDeviceModule kSimModule{
+extern const serial_robot_driver::sim::SimDeviceModule kSimModule{
     .name = sim::kName,
     .description = "UART bus servos",
     .hosted_by_default = true,
@@ -115,33 +125,38 @@ extern const sim::SimDeviceModule kSimModule{
     .make = sim::makeServoBusSim,
     .left_out_stats = sim::leftOutStats,
     .options = {
-        sim::idListOption("--bus-servo-ids", "0,1,2", "ids on the servo bus", SIZE_MAX, "",
-                          &sim::ServoBusSimConfig::servo_ids, true),
-        sim::idListOption("--offline-ids", "7", "ids that never answer", SIZE_MAX, "",
-                          &sim::ServoBusSimConfig::offline_ids, false),
-        sim::heldValueOption("--servo-temperature", "ID:DEGC",
-                             "hold a bus servo's temperature at DEGC (repeatable)",
-                             &sim::ServoBusSimConfig::temperature_c),
-        sim::heldValueOption("--servo-voltage", "ID:MV",
-                             "hold a bus servo's voltage at MV (repeatable)",
-                             &sim::ServoBusSimConfig::voltage_mv),
-        sim::heldValueOption("--servo-type", "ID:TYPE",
-                             "a bus servo's servo_type (repeatable; otherwise 257)",
-                             &sim::ServoBusSimConfig::servo_type),
-        sim::heldValueOption("--servo-firmware", "ID:VERSION",
-                             "a bus servo's firmware_version (repeatable; otherwise 258)",
-                             &sim::ServoBusSimConfig::firmware_version),
-        sim::heldValueOption("--servo-response-switch", "ID:0|1",
-                             "a bus servo's response_switch (repeatable; otherwise 0)",
-                             &sim::ServoBusSimConfig::response_switch),
+        serial_robot_driver::sim::idListOption("--bus-servo-ids", "0,1,2", "ids on the servo bus",
+                                               SIZE_MAX, "", &sim::ServoBusSimConfig::servo_ids,
+                                               true),
+        serial_robot_driver::sim::idListOption("--offline-ids", "7", "ids that never answer",
+                                               SIZE_MAX, "", &sim::ServoBusSimConfig::offline_ids,
+                                               false),
+        serial_robot_driver::sim::heldValueOption(
+            "--servo-temperature", "ID:DEGC", "hold a bus servo's temperature at DEGC (repeatable)",
+            &sim::ServoBusSimConfig::temperature_c),
+        serial_robot_driver::sim::heldValueOption("--servo-voltage", "ID:MV",
+                                                  "hold a bus servo's voltage at MV (repeatable)",
+                                                  &sim::ServoBusSimConfig::voltage_mv),
+        serial_robot_driver::sim::heldValueOption(
+            "--servo-type", "ID:TYPE", "a bus servo's servo_type (repeatable; otherwise 257)",
+            &sim::ServoBusSimConfig::servo_type),
+        serial_robot_driver::sim::heldValueOption(
+            "--servo-firmware", "ID:VERSION",
+            "a bus servo's firmware_version (repeatable; otherwise 258)",
+            &sim::ServoBusSimConfig::firmware_version),
+        serial_robot_driver::sim::heldValueOption(
+            "--servo-response-switch", "ID:0|1",
+            "a bus servo's response_switch (repeatable; otherwise 0)",
+            &sim::ServoBusSimConfig::response_switch),
         sim::latencyOption(),
-        sim::numberOption("--servo-fault-rate", "P",
-                          "probability a servo answer is garbled or missing", 0.0, 1.0,
-                          &sim::ServoBusSimConfig::answer_fault_rate, false),
-        sim::wholeOption("--lose-servo-stops", "N",
-                         "the next N SPIN stops to a bus servo are lost on the line: the servo "
-                         "keeps moving",
-                         1000000, &sim::ServoBusSimConfig::lost_stops, true),
+        serial_robot_driver::sim::numberOption(
+            "--servo-fault-rate", "P", "probability a servo answer is garbled or missing", 0.0, 1.0,
+            &sim::ServoBusSimConfig::answer_fault_rate, false),
+        serial_robot_driver::sim::wholeOption(
+            "--lose-servo-stops", "N",
+            "the next N SPIN stops to a bus servo are lost on the line: the servo "
+            "keeps moving",
+            1000000, &sim::ServoBusSimConfig::lost_stops, true),
     }};
 
 }  // namespace serial_robot_driver::devices::servo_bus

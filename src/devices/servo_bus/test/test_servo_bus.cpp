@@ -16,7 +16,7 @@
 #include "support/golden_frames.h"
 #include "support/servo_bus_rig.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using std::chrono::milliseconds;
@@ -271,4 +271,4 @@ TEST_F(ServoBusTest, RetunedSafetySettingsApplyFromTheirNextUse) {
 
 }  // namespace
 
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -10,7 +10,7 @@
 
 #include "support/servo_bus_client_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using protocol::FrameFamily;
@@ -82,8 +82,7 @@ TEST_F(ServoBusClientTest, AnswerOfTheWrongShapeIsReportedAsMalformed) {
 }
 
 TEST_F(ServoBusClientTest, AnswersArrivingWithoutARequestAreMismatched) {
-  client_.onFrame(protocol::servo::kResponseFrames, kPing3Reply.data(), kPing3Reply.size(),
-                  Clock::now());
+  client_.onFrame(kResponseFrames, kPing3Reply.data(), kPing3Reply.size(), core::Clock::now());
   EXPECT_EQ(client_.stats().mismatched, 1u);
 }
 
@@ -158,4 +157,4 @@ TEST(BusMutexTest, AWaitingForegroundCallerGoesBeforeBackgroundWork) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

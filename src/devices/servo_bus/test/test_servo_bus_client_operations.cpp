@@ -8,7 +8,7 @@
 
 #include "support/servo_bus_client_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using protocol::FrameFamily;
@@ -309,4 +309,4 @@ TEST_F(ServoBusClientTest, ScanListsTheIdsThatAnswerWithOneAttemptEach) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -8,7 +8,7 @@
 
 #include "support/servo_bus_client_fixture.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using protocol::FrameFamily;
@@ -213,4 +213,4 @@ INSTANTIATE_TEST_SUITE_P(ServoBusClient, ServoBusClientRejectionTest,
                          });
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

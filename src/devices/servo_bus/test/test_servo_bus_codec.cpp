@@ -12,7 +12,7 @@
 #include "support/golden_frames.h"
 #include "support/probe_expectations.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using Bytes = std::vector<uint8_t>;
@@ -123,8 +123,8 @@ TEST_P(ServoBusCodecRequest, EncoderReproducesGoldenBytes) {
 
 TEST_P(ServoBusCodecRequest, DecoderReadsGoldenBytes) {
   const RequestCase& c = GetParam();
-  const Decoded<Packet> packet = decodeRequest(c.expected.data(), c.expected.size());
-  ASSERT_TRUE(packet.ok()) << toString(packet.error());
+  const protocol::Decoded<Packet> packet = decodeRequest(c.expected.data(), c.expected.size());
+  ASSERT_TRUE(packet.ok()) << protocol::toString(packet.error());
   EXPECT_EQ(packet->cmd, c.cmd);
   ASSERT_EQ(packet->content_size, c.expected[3]);
   EXPECT_EQ(Bytes(packet->content.begin(), packet->content.begin() + packet->content_size),
@@ -134,9 +134,9 @@ TEST_P(ServoBusCodecRequest, DecoderReadsGoldenBytes) {
 
 TEST_P(ServoBusCodecRequest, RequestIsNotAResponse) {
   const Bytes& bytes = GetParam().expected;
-  const Decoded<Packet> packet = decodeResponse(bytes.data(), bytes.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(bytes.data(), bytes.size());
   ASSERT_FALSE(packet.ok());
-  EXPECT_EQ(packet.error(), DecodeError::kBadHeader);
+  EXPECT_EQ(packet.error(), protocol::DecodeError::kBadHeader);
 }
 
 INSTANTIATE_TEST_SUITE_P(ServoBusCodecGolden, ServoBusCodecRequest, ::testing::ValuesIn(kRequests),
@@ -169,8 +169,8 @@ TEST_P(ServoBusCodecResponse, EncoderReproducesGoldenBytes) {
 
 TEST_P(ServoBusCodecResponse, DecoderReadsGoldenBytes) {
   const ResponseCase& c = GetParam();
-  const Decoded<Packet> packet = decodeResponse(c.expected.data(), c.expected.size());
-  ASSERT_TRUE(packet.ok()) << toString(packet.error());
+  const protocol::Decoded<Packet> packet = decodeResponse(c.expected.data(), c.expected.size());
+  ASSERT_TRUE(packet.ok()) << protocol::toString(packet.error());
   EXPECT_EQ(packet->cmd, static_cast<uint8_t>(c.cmd));
   EXPECT_EQ(Bytes(packet->content.begin(), packet->content.begin() + packet->content_size),
             c.content);
@@ -182,24 +182,24 @@ INSTANTIATE_TEST_SUITE_P(ServoBusCodecGolden, ServoBusCodecResponse,
 
 TEST(ServoBusCodec, PingReplyVendorChecksumErratumIsRejected) {
   const Bytes vendor_text = {0x05, 0x1C, 0x01, 0x01, 0x03, 0x38};
-  const Decoded<Packet> packet = decodeResponse(vendor_text.data(), vendor_text.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(vendor_text.data(), vendor_text.size());
   ASSERT_FALSE(packet.ok());
-  EXPECT_EQ(packet.error(), DecodeError::kBadChecksum);
+  EXPECT_EQ(packet.error(), protocol::DecodeError::kBadChecksum);
 }
 
 TEST(ServoBusCodec, ReadAngleReplyIs90Point2Degrees) {
   const Bytes reply = {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86, 0x03, 0xB7};
-  const Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
   ASSERT_TRUE(packet.ok());
   EXPECT_EQ(packet->id(), 0);
-  EXPECT_EQ(readLE16Signed(&packet->content[1]), 902);
+  EXPECT_EQ(protocol::readLE16Signed(&packet->content[1]), 902);
 }
 
 TEST(ServoBusCodec, MultiTurnAngleAnswerIsDecoded) {
   const Bytes& reply = golden::servo::kReadMultiTurn1Reply720;
-  const Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
   ASSERT_TRUE(packet.ok());
-  const Decoded<MultiTurnAngle> angle =
+  const protocol::Decoded<MultiTurnAngle> angle =
       decodeMultiTurnAngle(packet->content.data(), packet->content_size);
   ASSERT_TRUE(angle.ok());
   EXPECT_EQ(angle->id, 1);
@@ -209,9 +209,9 @@ TEST(ServoBusCodec, MultiTurnAngleAnswerIsDecoded) {
 
 TEST(ServoBusCodec, NegativeMultiTurnAngleAndTurnsAreSigned) {
   const Bytes& reply = golden::servo::kReadMultiTurn1ReplyMinus1234p5;
-  const Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(reply.data(), reply.size());
   ASSERT_TRUE(packet.ok());
-  const Decoded<MultiTurnAngle> angle =
+  const protocol::Decoded<MultiTurnAngle> angle =
       decodeMultiTurnAngle(packet->content.data(), packet->content_size);
   ASSERT_TRUE(angle.ok());
   EXPECT_EQ(angle->angle_decidegrees, -12345);
@@ -223,9 +223,9 @@ TEST(ServoBusCodec, MultiTurnAngleAnswerOfWrongSizeIsRejected) {
   const Bytes& reply = golden::servo::kReadMultiTurn1Reply720;
   const uint8_t* content = reply.data() + 4;
   for (std::size_t size : {std::size_t{0}, std::size_t{3}, std::size_t{6}, std::size_t{8}}) {
-    const Decoded<MultiTurnAngle> angle = decodeMultiTurnAngle(content, size);
+    const protocol::Decoded<MultiTurnAngle> angle = decodeMultiTurnAngle(content, size);
     ASSERT_FALSE(angle.ok()) << size;
-    EXPECT_EQ(angle.error(), DecodeError::kBadLength);
+    EXPECT_EQ(angle.error(), protocol::DecodeError::kBadLength);
   }
 }
 
@@ -244,27 +244,27 @@ TEST(ServoBusCodec, ResponseLongerThanMaxContentIsNotBuilt) {
 struct MalformedCase {
   std::string name;
   Bytes packet;
-  DecodeError error;
+  protocol::DecodeError error;
 };
 
 // clang-format off
 const MalformedCase kMalformedResponses[] = {
-    {"BadChecksum", {0x05, 0x1C, 0x01, 0x01, 0x03, 0x27}, DecodeError::kBadChecksum},
-    {"BadHeader", {0x05, 0x1D, 0x01, 0x01, 0x03, 0x26}, DecodeError::kBadHeader},
-    {"Truncated", {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86}, DecodeError::kTooShort},
-    {"OnlyHeader", {0x05, 0x1C}, DecodeError::kTooShort},
-    {"Empty", {}, DecodeError::kTooShort},
+    {"BadChecksum", {0x05, 0x1C, 0x01, 0x01, 0x03, 0x27}, protocol::DecodeError::kBadChecksum},
+    {"BadHeader", {0x05, 0x1D, 0x01, 0x01, 0x03, 0x26}, protocol::DecodeError::kBadHeader},
+    {"Truncated", {0x05, 0x1C, 0x0A, 0x03, 0x00, 0x86}, protocol::DecodeError::kTooShort},
+    {"OnlyHeader", {0x05, 0x1C}, protocol::DecodeError::kTooShort},
+    {"Empty", {}, protocol::DecodeError::kTooShort},
     // N = 0 says 5 bytes, 6 were given.
-    {"LenZeroInconsistent", {0x05, 0x1C, 0x01, 0x00, 0x03, 0x26}, DecodeError::kBadLength},
+    {"LenZeroInconsistent", {0x05, 0x1C, 0x01, 0x00, 0x03, 0x26}, protocol::DecodeError::kBadLength},
     // N = 1 says 6 bytes, 7 were given.
     {"LenOneInconsistent", {0x05, 0x1C, 0x0A, 0x01, 0x00, 0x86, 0x03, 0xB7},
-     DecodeError::kBadLength},
+     protocol::DecodeError::kBadLength},
     // N = 34 is above the longest content (id + 32-byte block).
-    {"LenAboveMax", {0x05, 0x1C, 0x05, 0x22, 0x00, 0x00}, DecodeError::kBadLength},
-    {"Len255", {0x05, 0x1C, 0x05, 0xFF, 0x00, 0x00}, DecodeError::kBadLength},
+    {"LenAboveMax", {0x05, 0x1C, 0x05, 0x22, 0x00, 0x00}, protocol::DecodeError::kBadLength},
+    {"Len255", {0x05, 0x1C, 0x05, 0xFF, 0x00, 0x00}, protocol::DecodeError::kBadLength},
     // CMD 0 and 17 with correct sums (05+1C+00+01+03 = 25, 05+1C+11+01+03 = 36).
-    {"CmdZero", {0x05, 0x1C, 0x00, 0x01, 0x03, 0x25}, DecodeError::kUnknownCommand},
-    {"CmdSeventeen", {0x05, 0x1C, 0x11, 0x01, 0x03, 0x36}, DecodeError::kUnknownCommand},
+    {"CmdZero", {0x05, 0x1C, 0x00, 0x01, 0x03, 0x25}, protocol::DecodeError::kUnknownCommand},
+    {"CmdSeventeen", {0x05, 0x1C, 0x11, 0x01, 0x03, 0x36}, protocol::DecodeError::kUnknownCommand},
 };
 // clang-format on
 
@@ -272,9 +272,9 @@ class ServoBusCodecMalformed : public ::testing::TestWithParam<MalformedCase> {}
 
 TEST_P(ServoBusCodecMalformed, Rejected) {
   const MalformedCase& c = GetParam();
-  const Decoded<Packet> packet = decodeResponse(c.packet.data(), c.packet.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(c.packet.data(), c.packet.size());
   ASSERT_FALSE(packet.ok());
-  EXPECT_EQ(packet.error(), c.error) << toString(packet.error());
+  EXPECT_EQ(packet.error(), c.error) << protocol::toString(packet.error());
 }
 
 INSTANTIATE_TEST_SUITE_P(ServoBusCodecErrors, ServoBusCodecMalformed,
@@ -283,9 +283,9 @@ INSTANTIATE_TEST_SUITE_P(ServoBusCodecErrors, ServoBusCodecMalformed,
 
 TEST(ServoBusCodec, RequestDecoderChecksSum) {
   const Bytes ping = {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64};
-  const Decoded<Packet> packet = decodeRequest(ping.data(), ping.size());
+  const protocol::Decoded<Packet> packet = decodeRequest(ping.data(), ping.size());
   ASSERT_FALSE(packet.ok());
-  EXPECT_EQ(packet.error(), DecodeError::kBadChecksum);
+  EXPECT_EQ(packet.error(), protocol::DecodeError::kBadChecksum);
 }
 
 // --- probe (what the stream framer asks) -------------------------------------------------------
@@ -304,17 +304,20 @@ TEST(ServoBusCodecProbe, FindsGoldenFramesAndNeedsMoreAtEveryTruncation) {
 
 TEST(ServoBusCodecProbe, SaysWhyACandidateIsInvalid) {
   expectProbeRejects(probeResponse, {0x05, 0x1C, 0x01, 0x01, 0x03, 0x27},
-                     DecodeError::kBadChecksum);
-  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64}, DecodeError::kBadChecksum);
+                     protocol::DecodeError::kBadChecksum);
+  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x01, 0x01, 0x03, 0x64},
+                     protocol::DecodeError::kBadChecksum);
   // N = 34 exceeds the longest content (id + 32 bytes).
-  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x05, 0x22}, DecodeError::kBadLength);
+  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x05, 0x22}, protocol::DecodeError::kBadLength);
   // CMD 17 does not exist; it has its own reason, not a bad length.
-  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x11, 0x01}, DecodeError::kUnknownCommand);
-  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x00, 0x01}, DecodeError::kUnknownCommand);
+  expectProbeRejects(probeRequest, {0x12, 0x4C, 0x11, 0x01},
+                     protocol::DecodeError::kUnknownCommand);
+  expectProbeRejects(probeResponse, {0x05, 0x1C, 0x00, 0x01},
+                     protocol::DecodeError::kUnknownCommand);
   // The request header is not a response's, and the reverse.
-  expectProbeRejects(probeResponse, kProbePingRequest, DecodeError::kBadHeader);
-  expectProbeRejects(probeRequest, kProbePingResponse, DecodeError::kBadHeader);
+  expectProbeRejects(probeResponse, kProbePingRequest, protocol::DecodeError::kBadHeader);
+  expectProbeRejects(probeRequest, kProbePingResponse, protocol::DecodeError::kBadHeader);
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

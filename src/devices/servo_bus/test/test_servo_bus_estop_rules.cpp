@@ -17,7 +17,7 @@
 #include "support/golden_frames.h"
 #include "support/servo_bus_rig.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using namespace golden::servo;  // NOLINT: the shared golden frames
@@ -197,4 +197,4 @@ TEST_F(ServoBusTest, RelaxIsAllowedUnderTheEStopAndSatisfiesTheStop) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

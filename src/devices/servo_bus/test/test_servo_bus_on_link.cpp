@@ -1,9 +1,9 @@
-// device::ServoBus as the driver runs it: its worker on the port's reader thread (runOn), against
-// the simulated servos over a real pseudo-terminal. The schedules themselves are tested on a
-// manual clock in test_servo_bus.cpp; these tests are about the threads: the poll reads its own
-// answers on the reader thread, callers on other threads are still answered (the reader reads
-// for them, also while it waits for the bus), a move from another thread wakes the idle reader,
-// and an unplugged port ends a poll at once.
+// serial_robot_driver::devices::servo_bus::ServoBus as the driver runs it: its worker on the port's
+// reader thread (runOn), against the simulated servos over a real pseudo-terminal. The schedules
+// themselves are tested on a manual clock in test_servo_bus.cpp; these tests are about the threads:
+// the poll reads its own answers on the reader thread, callers on other threads are still answered
+// (the reader reads for them, also while it waits for the bus), a move from another thread wakes
+// the idle reader, and an unplugged port ends a poll at once.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,14 +13,14 @@
 #include <thread>
 #include <vector>
 
-#include "serial_robot_driver/device/serial_link.h"
+#include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/framer_configs.h"
 #include "support/test_helpers.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using std::chrono::milliseconds;
@@ -32,21 +32,21 @@ constexpr double kWaitSeconds = 5.0;  // generous: the machine may be busy
 struct BusOnLink {
   explicit BusOnLink(const std::string& name, ServoBusConfig config,
                      std::vector<uint8_t> sim_ids = {1, 2, 3}) {
-    sim::SimOptions options;
+    serial_robot_driver::sim::SimOptions options;
     options.device("base").enabled = false;
     options.device("body").enabled = false;
-    servoBusConfig(options).servo_ids = std::move(sim_ids);
-    servoBusConfig(options).answer_latency_s = 0.0;
+    sim::servoBusConfig(options).servo_ids = std::move(sim_ids);
+    sim::servoBusConfig(options).answer_latency_s = 0.0;
     options.link = "/tmp/srd_bus_on_link_" + name + "_" + std::to_string(::getpid());
-    sim = std::make_unique<sim::RobotSim>(options);
+    sim = std::make_unique<serial_robot_driver::sim::RobotSim>(options);
     sim->start();
 
-    SerialLinkOptions link_options;
+    core::SerialLinkOptions link_options;
     link_options.path = options.link;
     link_options.reconnect_interval = 0.05;
     link_options.framer = test_support::driverFramer({"servo_bus"});
     link_options.stale_frame_timeout = config.client.timeout;
-    link = std::make_unique<SerialLink>(link_options);
+    link = std::make_unique<core::SerialLink>(link_options);
 
     ServoBusEvents events;
     events.on_angle = [this](const ServoAngleSample&) {
@@ -63,8 +63,8 @@ struct BusOnLink {
     link->stop();  // before the bus it calls goes away
   }
 
-  std::unique_ptr<sim::RobotSim> sim;
-  std::unique_ptr<SerialLink> link;
+  std::unique_ptr<serial_robot_driver::sim::RobotSim> sim;
+  std::unique_ptr<core::SerialLink> link;
   std::unique_ptr<ServoBus> bus;
   std::atomic<int> angles{0};
   std::atomic<int> angles_off_reader{0};
@@ -120,7 +120,8 @@ TEST(ServoBusOnLink, AMoveFromAnotherThreadWakesTheIdleReader) {
   move.angle_deg = 30.0;
   rig.bus->queueMoves({move});
   ASSERT_TRUE(waitFor([&] { return rig.bus->stats().moves_sent == 1; }, kWaitSeconds));
-  ASSERT_TRUE(waitFor([&] { return servoBusStats(rig.sim->stats()).requests >= 1; }, kWaitSeconds));
+  ASSERT_TRUE(
+      waitFor([&] { return sim::servoBusStats(rig.sim->stats()).requests >= 1; }, kWaitSeconds));
   EXPECT_EQ(rig.bus->stats().moves_failed, 0u);
 }
 
@@ -135,11 +136,12 @@ TEST(ServoBusOnLink, ShutdownSaysItsLastWordsThroughTheRunningReader) {
   spin.speed_dps = 90;
   ASSERT_TRUE(rig.bus->spin(spin).ok());
   EXPECT_EQ(rig.bus->movingIds(), std::vector<uint8_t>{1});
-  const uint64_t requests_before = servoBusStats(rig.sim->stats()).requests;
+  const uint64_t requests_before = sim::servoBusStats(rig.sim->stats()).requests;
   rig.bus->shutdown();
   EXPECT_TRUE(rig.bus->movingIds().empty()) << "the SPIN stop went out";
-  ASSERT_TRUE(waitFor([&] { return servoBusStats(rig.sim->stats()).requests > requests_before; },
-                      kWaitSeconds));
+  ASSERT_TRUE(
+      waitFor([&] { return sim::servoBusStats(rig.sim->stats()).requests > requests_before; },
+              kWaitSeconds));
   EXPECT_EQ(rig.bus->client().ping(1).error, ServoError::kShutdown);
 }
 
@@ -158,4 +160,4 @@ TEST(ServoBusOnLink, ASilentServoIsBackedOffWithoutHoldingUpTheOthers) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

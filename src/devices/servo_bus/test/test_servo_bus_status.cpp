@@ -10,7 +10,8 @@
 
 namespace {
 
-using namespace serial_robot_driver::device;
+using namespace serial_robot_driver::devices::servo_bus;
+using namespace serial_robot_driver::core;
 using std::chrono::milliseconds;
 using SteadyClock = std::chrono::steady_clock;
 

@@ -14,7 +14,7 @@
 #include "support/golden_frames.h"
 #include "support/servo_bus_rig.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using std::chrono::milliseconds;
@@ -193,4 +193,4 @@ TEST_F(ServoBusTest, ShutdownRefusesACallThatWaitedForTheBus) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

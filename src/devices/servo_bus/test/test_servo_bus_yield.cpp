@@ -20,7 +20,7 @@
 #include "support/golden_frames.h"
 #include "support/servo_bus_rig.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using namespace golden::servo;  // NOLINT: the shared golden frames
@@ -192,4 +192,4 @@ TEST(BusMutexYieldTest, BackgroundWorkWaitsBehindAWaitingStopInsteadOfGivingUp) 
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

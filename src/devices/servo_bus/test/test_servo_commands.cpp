@@ -13,20 +13,20 @@
 #include "serial_robot_driver/devices/servo_bus/servo_commands.h"
 #include "support/golden_frames.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using Bytes = std::vector<uint8_t>;
 using namespace golden::servo;  // NOLINT: the shared golden frames
 
 Packet request(const Bytes& frame) {
-  const Decoded<Packet> packet = decodeRequest(frame.data(), frame.size());
+  const protocol::Decoded<Packet> packet = decodeRequest(frame.data(), frame.size());
   EXPECT_TRUE(packet.ok());
   return packet.ok() ? *packet : Packet{};
 }
 
 Packet response(const Bytes& frame) {
-  const Decoded<Packet> packet = decodeResponse(frame.data(), frame.size());
+  const protocol::Decoded<Packet> packet = decodeResponse(frame.data(), frame.size());
   EXPECT_TRUE(packet.ok());
   return packet.ok() ? *packet : Packet{};
 }
@@ -119,7 +119,7 @@ TEST(ServoCommandTable, EveryGoldenAnswerFitsItsRowAndItsResultByteSaysOk) {
 }
 
 TEST(ServoTypedAnswers, ReadAngleAnswerIs90Point2DegreesAndReencodes) {
-  const Decoded<AngleAnswer> angle = decodeAngleAnswer(response(kReadAngle0Reply902));
+  const protocol::Decoded<AngleAnswer> angle = decodeAngleAnswer(response(kReadAngle0Reply902));
   ASSERT_TRUE(angle.ok());
   EXPECT_EQ(angle->id, 0);
   EXPECT_EQ(angle->angle_decidegrees, 902);
@@ -132,18 +132,20 @@ TEST(ServoTypedAnswers, ReadDataAnswerFollowsTheParameterType) {
   const ParamInfo* limit_low = findParam("angle_limit_low");
   ASSERT_NE(voltage, nullptr);
   ASSERT_NE(limit_low, nullptr);
-  const Decoded<int64_t> mv = decodeReadDataAnswer(response(kReadVoltage3Reply), *voltage);
+  const protocol::Decoded<int64_t> mv =
+      decodeReadDataAnswer(response(kReadVoltage3Reply), *voltage);
   ASSERT_TRUE(mv.ok());
   EXPECT_EQ(*mv, 7400);
   EXPECT_EQ(readDataAnswerContent(3, *voltage, 7400), contentOf(kReadVoltage3Reply));
-  const Decoded<int64_t> low = decodeReadDataAnswer(response(kReadLimitLow3Reply), *limit_low);
+  const protocol::Decoded<int64_t> low =
+      decodeReadDataAnswer(response(kReadLimitLow3Reply), *limit_low);
   ASSERT_TRUE(low.ok());
   EXPECT_EQ(*low, -900);
   EXPECT_EQ(readDataAnswerContent(3, *limit_low, -900), contentOf(kReadLimitLow3Reply));
 }
 
 TEST(ServoTypedRequests, MovesDecodeToWhatTheirGoldenBytesSay) {
-  const Decoded<MoveCommand> rotate = decodeMove(request(kRotate2To90In500));
+  const protocol::Decoded<MoveCommand> rotate = decodeMove(request(kRotate2To90In500));
   ASSERT_TRUE(rotate.ok());
   EXPECT_EQ(rotate->cmd, Command::kRotate);
   EXPECT_EQ(rotate->id, 2);
@@ -151,14 +153,15 @@ TEST(ServoTypedRequests, MovesDecodeToWhatTheirGoldenBytesSay) {
   EXPECT_EQ(rotate->interval_ms, 500u);
   EXPECT_EQ(rotate->ramps.power_mw, 0);
 
-  const Decoded<MoveCommand> by_velocity = decodeMove(request(kMoveByVelocity1ToMinus90));
+  const protocol::Decoded<MoveCommand> by_velocity = decodeMove(request(kMoveByVelocity1ToMinus90));
   ASSERT_TRUE(by_velocity.ok());
   EXPECT_EQ(by_velocity->angle_decidegrees, -900);
   EXPECT_EQ(by_velocity->velocity_decidegrees_per_s, 3600);
   EXPECT_EQ(by_velocity->ramps.accel_ms, 100);
   EXPECT_EQ(by_velocity->ramps.decel_ms, 100);
 
-  const Decoded<MoveCommand> multi = decodeMove(request(kMultiTurnMoveByInterval1ToMinus360));
+  const protocol::Decoded<MoveCommand> multi =
+      decodeMove(request(kMultiTurnMoveByInterval1ToMinus360));
   ASSERT_TRUE(multi.ok());
   EXPECT_EQ(multi->angle_decidegrees, -3600);
   EXPECT_EQ(multi->interval_ms, 1000u);
@@ -166,38 +169,38 @@ TEST(ServoTypedRequests, MovesDecodeToWhatTheirGoldenBytesSay) {
   EXPECT_TRUE(isMultiTurn(multi->cmd));
   EXPECT_FALSE(isByVelocity(multi->cmd));
 
-  const Decoded<MoveCommand> plain = decodeMove(request(kMultiTurnMove1To720));
+  const protocol::Decoded<MoveCommand> plain = decodeMove(request(kMultiTurnMove1To720));
   ASSERT_TRUE(plain.ok());
   EXPECT_EQ(plain->angle_decidegrees, 7200);
   EXPECT_EQ(plain->interval_ms, 2000u);
   EXPECT_FALSE(hasRamps(plain->cmd));
 
-  const Decoded<MoveCommand> turns = decodeMove(request(kMultiTurnMoveByVelocity1To3600));
+  const protocol::Decoded<MoveCommand> turns = decodeMove(request(kMultiTurnMoveByVelocity1To3600));
   ASSERT_TRUE(turns.ok());
   EXPECT_EQ(turns->angle_decidegrees, 36000);
   EXPECT_EQ(turns->velocity_decidegrees_per_s, 3600);
 }
 
 TEST(ServoTypedRequests, NotAMoveOrWrongSizeIsRefused) {
-  EXPECT_EQ(decodeMove(request(kPing3)).error(), DecodeError::kUnknownCommand);
+  EXPECT_EQ(decodeMove(request(kPing3)).error(), protocol::DecodeError::kUnknownCommand);
   Packet short_rotate = request(kRotate2To90In500);
   short_rotate.content_size = 6;
-  EXPECT_EQ(decodeMove(short_rotate).error(), DecodeError::kBadLength);
+  EXPECT_EQ(decodeMove(short_rotate).error(), protocol::DecodeError::kBadLength);
 }
 
 TEST(ServoTypedRequests, SpinDecodesDirectionModeSpeedAndValue) {
-  const Decoded<SpinCommand> spin = decodeSpin(request(kSpin0Cw5Turns));
+  const protocol::Decoded<SpinCommand> spin = decodeSpin(request(kSpin0Cw5Turns));
   ASSERT_TRUE(spin.ok());
   EXPECT_EQ(spin->id, 0);
   EXPECT_TRUE(spin->clockwise);
   EXPECT_EQ(spin->mode, SpinMode::kTurns);
   EXPECT_EQ(spin->speed_dps, 100);
   EXPECT_EQ(spin->value, 5);
-  const Decoded<SpinCommand> ccw = decodeSpin(request(kSpin0CcwContinuous));
+  const protocol::Decoded<SpinCommand> ccw = decodeSpin(request(kSpin0CcwContinuous));
   ASSERT_TRUE(ccw.ok());
   EXPECT_FALSE(ccw->clockwise);
   EXPECT_EQ(ccw->mode, SpinMode::kContinuous);
-  EXPECT_EQ(decodeSpin(request(kRotate2To90In500)).error(), DecodeError::kUnknownCommand);
+  EXPECT_EQ(decodeSpin(request(kRotate2To90In500)).error(), protocol::DecodeError::kUnknownCommand);
 }
 
 // --- encode -> decode for every command of the table ---------------------------------------------
@@ -224,7 +227,7 @@ MoveRamps rampsOf(uint16_t accel, uint16_t decel, uint16_t power) {
 // A move request re-decodes to the values it was built from, and re-encodes to the same bytes.
 void expectMove(const Bytes& frame, Command cmd, int32_t angle, uint32_t interval,
                 uint16_t velocity, const MoveRamps& ramps) {
-  const Decoded<MoveCommand> move = decodeMove(request(frame));
+  const protocol::Decoded<MoveCommand> move = decodeMove(request(frame));
   ASSERT_TRUE(move.ok()) << commandInfo(cmd).name;
   EXPECT_EQ(move->cmd, cmd);
   EXPECT_EQ(move->id, 7);
@@ -259,13 +262,13 @@ Bytes requestRoundTrip(Command cmd) {
       break;
     case Command::kReadData: {
       frame = encodeReadData(7, 53);
-      const Decoded<DataContent> data = decodeDataContent(request(frame));
+      const protocol::Decoded<DataContent> data = decodeDataContent(request(frame));
       EXPECT_TRUE(data.ok() && data->id == 7 && data->data_id == 53 && data->value_size == 0);
       break;
     }
     case Command::kWriteData: {
       frame = encodeWriteData(7, limit_low, kI16Min);
-      const Decoded<DataContent> data = decodeDataContent(request(frame));
+      const protocol::Decoded<DataContent> data = decodeDataContent(request(frame));
       EXPECT_TRUE(data.ok() && data->id == 7 && data->data_id == limit_low.data_id);
       EXPECT_EQ(readValue(limit_low, data->value.data(), data->value_size), kI16Min);
       break;
@@ -278,7 +281,7 @@ Bytes requestRoundTrip(Command cmd) {
     }
     case Command::kSpin: {
       frame = encodeSpin(7, true, SpinMode::kDurationMs, kU16Max, 1);
-      const Decoded<SpinCommand> spin = decodeSpin(request(frame));
+      const protocol::Decoded<SpinCommand> spin = decodeSpin(request(frame));
       EXPECT_TRUE(spin.ok());
       if (!spin.ok()) break;
       EXPECT_EQ(spin->id, 7);
@@ -291,7 +294,7 @@ Bytes requestRoundTrip(Command cmd) {
     }
     case Command::kDamping: {
       frame = encodeDamping(7, kU16Max);
-      const Decoded<uint16_t> power = decodeDamping(request(frame));
+      const protocol::Decoded<uint16_t> power = decodeDamping(request(frame));
       EXPECT_TRUE(power.ok() && *power == kU16Max);
       break;
     }
@@ -348,7 +351,7 @@ Bytes answerRoundTrip(Command cmd, bool ok) {
       packet.cmd = static_cast<uint8_t>(cmd);
       packet.content_size = static_cast<uint8_t>(content.size());
       std::copy(content.begin(), content.end(), packet.content.begin());
-      const Decoded<int64_t> value = decodeReadDataAnswer(packet, serial);
+      const protocol::Decoded<int64_t> value = decodeReadDataAnswer(packet, serial);
       EXPECT_TRUE(value.ok() && *value == 0xFFFFFFFFll);
       break;
     }
@@ -383,7 +386,7 @@ TEST(ServoCommandRoundTrip, EveryAnswerDecodesToWhatWasEncodedAndFitsItsRow) {
         EXPECT_EQ(packet.content[info.result_index], ok ? 1 : 0);
       }
       if (info.cmd == Command::kWriteData) {
-        const Decoded<DataContent> data = decodeDataContent(packet);
+        const protocol::Decoded<DataContent> data = decodeDataContent(packet);
         EXPECT_TRUE(data.ok() && data->data_id == findParam("serial_number")->data_id);
       }
       if (info.cmd == Command::kReadBatchData) {
@@ -391,11 +394,11 @@ TEST(ServoCommandRoundTrip, EveryAnswerDecodesToWhatWasEncodedAndFitsItsRow) {
         EXPECT_TRUE(block.ok() && *block == countingBlock());
       }
       if (info.cmd == Command::kReadAngle) {
-        const Decoded<AngleAnswer> angle = decodeAngleAnswer(packet);
+        const protocol::Decoded<AngleAnswer> angle = decodeAngleAnswer(packet);
         EXPECT_TRUE(angle.ok() && angle->angle_decidegrees == kI16Min);
       }
       if (info.cmd == Command::kReadMultiTurnAngle) {
-        const Decoded<MultiTurnAngle> angle = decodeMultiTurnAngle(packet);
+        const protocol::Decoded<MultiTurnAngle> angle = decodeMultiTurnAngle(packet);
         ASSERT_TRUE(angle.ok());
         EXPECT_EQ(angle->angle_decidegrees, kI32Min);
         EXPECT_EQ(angle->turns, -2);
@@ -405,4 +408,4 @@ TEST(ServoCommandRoundTrip, EveryAnswerDecodesToWhatWasEncodedAndFitsItsRow) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

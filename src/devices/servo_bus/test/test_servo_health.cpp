@@ -6,11 +6,11 @@
 
 namespace {
 
-using serial_robot_driver::device::assessHealth;
-using serial_robot_driver::device::HealthLevel;
-using serial_robot_driver::device::OverheatGuard;
-using serial_robot_driver::device::ServoLimits;
-using serial_robot_driver::device::ServoReadings;
+using serial_robot_driver::devices::servo_bus::assessHealth;
+using serial_robot_driver::devices::servo_bus::HealthLevel;
+using serial_robot_driver::devices::servo_bus::OverheatGuard;
+using serial_robot_driver::devices::servo_bus::ServoLimits;
+using serial_robot_driver::devices::servo_bus::ServoReadings;
 
 // The simulator's factory limits: 4500..14000 mV, 65 degC, 12000 mW, 3000 mA.
 ServoLimits limits() {
@@ -33,7 +33,8 @@ ServoReadings nominal() {
 }
 
 TEST(ServoHealth, NominalValuesAreOk) {
-  const auto assessment = assessHealth(3, nominal(), limits());
+  const auto assessment =
+      serial_robot_driver::devices::servo_bus::assessHealth(3, nominal(), limits());
   EXPECT_EQ(assessment.level, HealthLevel::kOk);
   EXPECT_EQ(assessment.message, "");
 }
@@ -41,14 +42,15 @@ TEST(ServoHealth, NominalValuesAreOk) {
 TEST(ServoHealth, TemperatureWithinTenPercentWarnsAndAtTheLimitIsAnError) {
   ServoReadings r = nominal();
   r.temperature_c = 58;  // 65 - 6.5 = 58.5: not yet within
-  EXPECT_EQ(assessHealth(3, r, limits()).level, HealthLevel::kOk);
+  EXPECT_EQ(serial_robot_driver::devices::servo_bus::assessHealth(3, r, limits()).level,
+            HealthLevel::kOk);
   r.temperature_c = 59;
-  auto assessment = assessHealth(3, r, limits());
+  auto assessment = serial_robot_driver::devices::servo_bus::assessHealth(3, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kWarn);
   EXPECT_EQ(assessment.message,
             "servo 3: temperature 59 degC within 10 % of over_temperature 65 degC");
   r.temperature_c = 65;
-  assessment = assessHealth(3, r, limits());
+  assessment = serial_robot_driver::devices::servo_bus::assessHealth(3, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kError);
   EXPECT_EQ(assessment.message,
             "servo 3: temperature 65 degC at or beyond over_temperature 65 degC");
@@ -57,13 +59,14 @@ TEST(ServoHealth, TemperatureWithinTenPercentWarnsAndAtTheLimitIsAnError) {
 TEST(ServoHealth, LowVoltageIsCheckedAgainstTheLowerLimit) {
   ServoReadings r = nominal();
   r.voltage_mv = 4950;  // 4500 + 450
-  auto assessment = assessHealth(1, r, limits());
+  auto assessment = serial_robot_driver::devices::servo_bus::assessHealth(1, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kWarn);
   EXPECT_NE(assessment.message.find("over_volt_low 4500 mV"), std::string::npos);
   r.voltage_mv = 4951;
-  EXPECT_EQ(assessHealth(1, r, limits()).level, HealthLevel::kOk);
+  EXPECT_EQ(serial_robot_driver::devices::servo_bus::assessHealth(1, r, limits()).level,
+            HealthLevel::kOk);
   r.voltage_mv = 4000;
-  assessment = assessHealth(1, r, limits());
+  assessment = serial_robot_driver::devices::servo_bus::assessHealth(1, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kError);
   EXPECT_EQ(assessment.message, "servo 1: voltage 4000 mV at or below over_volt_low 4500 mV");
 }
@@ -71,16 +74,17 @@ TEST(ServoHealth, LowVoltageIsCheckedAgainstTheLowerLimit) {
 TEST(ServoHealth, HighVoltageCurrentAndPowerEachHaveTheirLimit) {
   ServoReadings r = nominal();
   r.voltage_mv = 14500;
-  EXPECT_NE(assessHealth(1, r, limits()).message.find("over_volt_high 14000 mV"),
+  EXPECT_NE(serial_robot_driver::devices::servo_bus::assessHealth(1, r, limits())
+                .message.find("over_volt_high 14000 mV"),
             std::string::npos);
   r = nominal();
   r.current_ma = 2800;
-  auto assessment = assessHealth(1, r, limits());
+  auto assessment = serial_robot_driver::devices::servo_bus::assessHealth(1, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kWarn);
   EXPECT_NE(assessment.message.find("over_current 3000 mA"), std::string::npos);
   r = nominal();
   r.power_mw = 12001;
-  assessment = assessHealth(1, r, limits());
+  assessment = serial_robot_driver::devices::servo_bus::assessHealth(1, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kError);
   EXPECT_NE(assessment.message.find("over_power 12000 mW"), std::string::npos);
 }
@@ -89,7 +93,7 @@ TEST(ServoHealth, ErrorsComeBeforeWarningsAndTheWorstLevelWins) {
   ServoReadings r = nominal();
   r.current_ma = 2900;   // warn
   r.temperature_c = 70;  // error
-  const auto assessment = assessHealth(2, r, limits());
+  const auto assessment = serial_robot_driver::devices::servo_bus::assessHealth(2, r, limits());
   EXPECT_EQ(assessment.level, HealthLevel::kError);
   EXPECT_EQ(assessment.message,
             "servo 2: temperature 70 degC at or beyond over_temperature 65 degC; current 2900 mA "
@@ -101,7 +105,7 @@ TEST(ServoHealth, AnUnsetLimitIsNotChecked) {
   r.temperature_c = 200;
   ServoLimits l = limits();
   l.over_temperature_c = 0;
-  EXPECT_EQ(assessHealth(1, r, l).level, HealthLevel::kOk);
+  EXPECT_EQ(serial_robot_driver::devices::servo_bus::assessHealth(1, r, l).level, HealthLevel::kOk);
 }
 
 TEST(OverheatGuard, TripsAtTheLimitAndClearsFiveDegreesBelow) {

@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_status.h"
 #include "serial_robot_driver/devices/servo_bus/servo_identity.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "support/servo_bus_rig.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using std::chrono::milliseconds;
@@ -225,10 +225,10 @@ TEST(ServoIdentityStatus, ShowsTheIdentityAndWarnsWithEachMismatch) {
   report.known = true;
   report.identity = plainServo();
   report.identity.serial_number = 77;
-  StatusReport status;
-  status.summary(StatusLevel::kOk, "servo 3 ok");
+  core::StatusReport status;
+  status.summary(core::StatusLevel::kOk, "servo 3 ok");
   addServoIdentity(&report, &status);
-  EXPECT_EQ(status.level, StatusLevel::kOk);
+  EXPECT_EQ(status.level, core::StatusLevel::kOk);
   EXPECT_EQ(*status.find("servo_type"), "257");
   EXPECT_EQ(*status.find("firmware_version"), "258");
   EXPECT_EQ(*status.find("serial_number"), "77");
@@ -236,13 +236,13 @@ TEST(ServoIdentityStatus, ShowsTheIdentityAndWarnsWithEachMismatch) {
   EXPECT_EQ(*status.find("angle limits"), "off");
 
   report.warnings = {"servo 3: response_switch is 1: ..."};
-  StatusReport warned;
-  warned.summary(StatusLevel::kOk, "servo 3 ok");
+  core::StatusReport warned;
+  warned.summary(core::StatusLevel::kOk, "servo 3 ok");
   addServoIdentity(&report, &warned);
-  EXPECT_EQ(warned.level, StatusLevel::kWarn);
+  EXPECT_EQ(warned.level, core::StatusLevel::kWarn);
   EXPECT_EQ(warned.message, "servo 3: response_switch is 1: ...");
 
-  StatusReport unknown;
+  core::StatusReport unknown;
   addServoIdentity(nullptr, &unknown);
   EXPECT_EQ(*unknown.find("identity"), "not read yet (read once the servo answers)");
 }
@@ -250,7 +250,8 @@ TEST(ServoIdentityStatus, ShowsTheIdentityAndWarnsWithEachMismatch) {
 // --- the simulated servo ---------------------------------------------------------------------
 
 TEST(ServoBusSimIdentity, AnswersWithItsConfiguredIdentityAndResponseSwitch) {
-  const sim::TimePoint start = sim::TimePoint() + std::chrono::hours(1);
+  const serial_robot_driver::sim::TimePoint start =
+      serial_robot_driver::sim::TimePoint() + std::chrono::hours(1);
   sim::ServoBusSimConfig config;
   config.servo_ids = {3};
   config.servo_type = {{3, 0x0A05}};
@@ -259,10 +260,10 @@ TEST(ServoBusSimIdentity, AnswersWithItsConfiguredIdentityAndResponseSwitch) {
   sim::ServoBusSim bus(config, start);
   const auto ask = [&](const Bytes& request, int at_ms) {
     bus.handleRequest(request.data(), request.size(), start + milliseconds(at_ms));
-    sim::Outbox out;
+    serial_robot_driver::sim::Outbox out;
     bus.tick(start + milliseconds(at_ms + 50), &out);
     std::vector<Bytes> frames;
-    for (const sim::Outgoing& frame : out) frames.push_back(frame.bytes);
+    for (const serial_robot_driver::sim::Outgoing& frame : out) frames.push_back(frame.bytes);
     return frames;
   };
   EXPECT_EQ(ask(kReadType3, 0), std::vector<Bytes>{kType3Is0A05});
@@ -272,4 +273,4 @@ TEST(ServoBusSimIdentity, AnswersWithItsConfiguredIdentityAndResponseSwitch) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

@@ -11,7 +11,8 @@
 
 namespace {
 
-using namespace serial_robot_driver::device;
+using namespace serial_robot_driver::devices::servo_bus;
+using namespace serial_robot_driver::core;
 
 TEST(ServoJointNames, RoundTripOnlyForCanonicalNamesOfBusIds) {
   EXPECT_EQ(servoJointName(12), "servo_12");

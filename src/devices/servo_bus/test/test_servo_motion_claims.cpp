@@ -4,11 +4,11 @@
 
 #include <vector>
 
-#include "serial_robot_driver/device/e_stop.h"
+#include "serial_robot_driver/core/e_stop.h"
 #include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
 #include "support/servo_bus_rig.h"
 
-namespace serial_robot_driver::device {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 class ServoMotionClaimsTest : public ServoBusTest {
@@ -20,7 +20,7 @@ class ServoMotionClaimsTest : public ServoBusTest {
 TEST_F(ServoMotionClaimsTest, NothingIsRefusedWithoutAnEngagedEStop) {
   ServoMotionClaims claims(*bus_, joints_);
   EXPECT_TRUE(claims.refuseWhileEStopped("servo/move").ok()) << "no e-stop attached";
-  EStop e_stop;
+  core::EStop e_stop;
   claims.attachEStop(e_stop);
   EXPECT_TRUE(claims.refuseWhileEStopped("servo/move").ok());
   EXPECT_TRUE(claims.claimServos({1}, "servo/rotate").ok());
@@ -29,7 +29,7 @@ TEST_F(ServoMotionClaimsTest, NothingIsRefusedWithoutAnEngagedEStop) {
 
 TEST_F(ServoMotionClaimsTest, AnEngagedEStopRefusesAndCountsEachSource) {
   ServoMotionClaims claims(*bus_, joints_);
-  EStop e_stop;
+  core::EStop e_stop;
   claims.attachEStop(e_stop);
   e_stop.set(true);
   const ServoStatus move = claims.refuseWhileEStopped("servo_commands");
@@ -37,7 +37,7 @@ TEST_F(ServoMotionClaimsTest, AnEngagedEStopRefusesAndCountsEachSource) {
   EXPECT_NE(move.message.find("e_stop is engaged"), std::string::npos) << move.message;
   EXPECT_EQ(claims.claimServos({}, "servo/hold").error, ServoError::kMotionRefused);
   EXPECT_EQ(claims.claimServos({2}, "servo/hold").error, ServoError::kMotionRefused);
-  const EStopStats stats = e_stop.stats();
+  const core::EStopStats stats = e_stop.stats();
   EXPECT_EQ(stats.refused.at("servo_commands"), 1u);
   EXPECT_EQ(stats.refused.at("servo/hold"), 2u);
 
@@ -47,7 +47,7 @@ TEST_F(ServoMotionClaimsTest, AnEngagedEStopRefusesAndCountsEachSource) {
 
 TEST_F(ServoMotionClaimsTest, UnderAnEngagedEStopTheMotionServicesWriteNothing) {
   ServoMotionClaims claims(*bus_, joints_);
-  EStop e_stop;
+  core::EStop e_stop;
   claims.attachEStop(e_stop);
   e_stop.set(true);
   MoveRequest move;
@@ -62,7 +62,7 @@ TEST_F(ServoMotionClaimsTest, UnderAnEngagedEStopTheMotionServicesWriteNothing) 
   EXPECT_EQ(claims.hold({1}, "servo/hold").error, ServoError::kMotionRefused);
   EXPECT_EQ(claims.spin(spin, "servo/spin").error, ServoError::kMotionRefused);
   EXPECT_TRUE(written().empty());
-  const EStopStats stats = e_stop.stats();
+  const core::EStopStats stats = e_stop.stats();
   for (const char* source : {"servo/move", "servo/rotate", "servo/hold", "servo/spin"}) {
     EXPECT_EQ(stats.refused.count(source), 1u) << source;
   }
@@ -70,7 +70,7 @@ TEST_F(ServoMotionClaimsTest, UnderAnEngagedEStopTheMotionServicesWriteNothing) 
 
 TEST_F(ServoMotionClaimsTest, UnderAnEngagedEStopTheStopsStillReachTheBus) {
   ServoMotionClaims claims(*bus_, joints_);
-  EStop e_stop;
+  core::EStop e_stop;
   claims.attachEStop(e_stop);
   e_stop.set(true);
   SpinRequest spin_stop;
@@ -95,4 +95,4 @@ TEST(ServoErrors, OnlyWhatARequestAsksForRefusesIt) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::device
+}  // namespace serial_robot_driver::devices::servo_bus

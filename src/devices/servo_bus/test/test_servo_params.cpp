@@ -10,7 +10,7 @@
 
 #include "serial_robot_driver/devices/servo_bus/servo_params.h"
 
-namespace serial_robot_driver::protocol::servo {
+namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 constexpr int64_t kU8 = 255;
@@ -334,4 +334,4 @@ TEST(ServoParams, UserBlockPacksEveryReadWriteParamAndUnpacksToTheSameValues) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::protocol::servo
+}  // namespace serial_robot_driver::devices::servo_bus

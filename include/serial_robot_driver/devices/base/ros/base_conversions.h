@@ -13,12 +13,11 @@
 #include "serial_robot_driver/devices/base/base_controller.h"
 #include "serial_robot_driver/devices/base/base_readings.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::base::ros {
 
 /// The charge as `percentage`; what the base does not report is NaN or UNKNOWN (the message's
 /// convention), and the battery is present.
-sensor_msgs::BatteryState toBatteryState(const device::BatteryReading& battery,
-                                         const ros::Time& stamp);
+sensor_msgs::BatteryState toBatteryState(const BatteryReading& battery, const ::ros::Time& stamp);
 
 /// The odom frames: `odom` the header's, `base` the child's.
 struct OdomFrames {
@@ -26,12 +25,12 @@ struct OdomFrames {
   std::string base;
 };
 /// Pose, twist and their covariances (row-major 6x6: x, y, z, roll, pitch, yaw).
-nav_msgs::Odometry toOdometry(const device::OdometrySample& sample, const OdomFrames& frames,
-                              const ros::Time& stamp);
+nav_msgs::Odometry toOdometry(const OdometrySample& sample, const OdomFrames& frames,
+                              const ::ros::Time& stamp);
 
 /// The wheels' angles (rad) and rates (rad/s) under joints `left` and `right`, in `frame`.
-sensor_msgs::JointState toWheelStates(const device::OdometrySample& sample,
-                                      const std::string& frame, const std::string& left,
-                                      const std::string& right, const ros::Time& stamp);
+sensor_msgs::JointState toWheelStates(const OdometrySample& sample, const std::string& frame,
+                                      const std::string& left, const std::string& right,
+                                      const ::ros::Time& stamp);
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::base::ros

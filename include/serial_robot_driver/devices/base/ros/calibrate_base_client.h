@@ -10,7 +10,7 @@
 
 #include "serial_robot_driver/devices/base/turn_calibration_run.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::base::ros {
 
 /// The driver's resolved name: `named` when given, else the one node publishing wheel_command,
 /// waited for up to 5 s (a signal in `stop_signal` or ROS shutting down ends the wait). Unset with
@@ -24,14 +24,14 @@ std::optional<std::string> findCalibrationDriver(const std::string& named,
 /// cmd_vel out. Messages arrive in ros::spinOnce().
 class CalibrationTopics {
  public:
-  explicit CalibrationTopics(device::TurnCalibrationRun& run);
-  void command(const device::BaseTwist& twist);
+  explicit CalibrationTopics(TurnCalibrationRun& run);
+  void command(const BaseTwist& twist);
   bool commandSubscribed() const { return cmd_vel_.getNumSubscribers() > 0; }
 
  private:
-  ros::NodeHandle nh_;
-  ros::Publisher cmd_vel_;
-  ros::Subscriber imu_, frames_, diagnostics_, e_stop_;
+  ::ros::NodeHandle nh_;
+  ::ros::Publisher cmd_vel_;
+  ::ros::Subscriber imu_, frames_, diagnostics_, e_stop_;
 };
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::base::ros

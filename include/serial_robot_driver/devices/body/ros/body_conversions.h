@@ -16,30 +16,30 @@
 
 #include "serial_robot_driver/devices/body/body_readings.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::body::ros {
 
-using device::imuYaw;
-using device::makeBodyJoints;
+using body::imuYaw;
+using body::makeBodyJoints;
 
-/// device::jointReadings() stamped: positions (rad) and velocities (rad/s, empty when unknown).
-sensor_msgs::JointState toJointState(const protocol::body::Telemetry& telemetry,
-                                     const std::vector<device::BodyJoint>& joints,
-                                     const ros::Time& stamp);
+/// jointReadings() stamped: positions (rad) and velocities (rad/s, empty when unknown).
+sensor_msgs::JointState toJointState(const Telemetry& telemetry,
+                                     const std::vector<BodyJoint>& joints,
+                                     const ::ros::Time& stamp);
 
-/// REP-145 IMU message: device::imuReading() (the bias subtracted), with diagonal covariances
+/// REP-145 IMU message: imuReading() (the bias subtracted), with diagonal covariances
 /// from `params`. A negative orientation_variance marks the orientation as unknown
 /// (orientation_covariance[0] = -1).
-sensor_msgs::Imu toImu(const protocol::body::Telemetry& telemetry, const params::ImuParams& params,
-                       const ros::Time& stamp, const std::array<double, 3>& gyro_bias = {});
+sensor_msgs::Imu toImu(const Telemetry& telemetry, const ImuParams& params,
+                       const ::ros::Time& stamp, const std::array<double, 3>& gyro_bias = {});
 
 /// The 8 raw foot readings, or nothing when the frame did not carry the foot block.
-std::optional<serial_robot_driver::FootPressure> toFootPressure(
-    const protocol::body::Telemetry& telemetry, const ros::Time& stamp,
-    const std::string& frame_id = "");
+std::optional<serial_robot_driver::FootPressure> toFootPressure(const Telemetry& telemetry,
+                                                                const ::ros::Time& stamp,
+                                                                const std::string& frame_id = "");
 
 /// The whole frame in raw units (for rosbag). `joints` give the servo ids in frame order.
-serial_robot_driver::Telemetry toTelemetryMsg(const protocol::body::Telemetry& telemetry,
-                                              const std::vector<device::BodyJoint>& joints,
-                                              const ros::Time& stamp);
+serial_robot_driver::Telemetry toTelemetryMsg(const Telemetry& telemetry,
+                                              const std::vector<BodyJoint>& joints,
+                                              const ::ros::Time& stamp);
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::body::ros

@@ -11,17 +11,10 @@
 #include "serial_robot_driver/devices/servo_bus/bus_trajectory_joints.h"
 #include "serial_robot_driver/ros/trajectory_server.h"  // the server the bus joints report to
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::servo_bus::ros {
 
-using trajectory::busStateTimeout;
-using trajectory::busTrajectoryJoints;
-using trajectory::findBusJoint;
-using trajectory::makeBusJoints;
-using trajectory::QueueServoMove;
-using trajectory::StopServo;
-
-/// trajectory::busJointPosition() stamped as a JointState.
+/// busJointPosition() stamped as a JointState.
 sensor_msgs::JointState busJointState(const std::vector<trajectory::BusJoint>& joints, uint8_t id,
-                                      double angle_deg, const ros::Time& stamp);
+                                      double angle_deg, const ::ros::Time& stamp);
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::servo_bus::ros

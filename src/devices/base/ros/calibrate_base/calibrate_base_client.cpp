@@ -9,19 +9,19 @@
 
 #include "serial_robot_driver/WheelCommand.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::devices::base::ros {
 
 std::optional<std::string> findCalibrationDriver(const std::string& named,
                                                  const std::atomic<int>& stop_signal,
                                                  std::string* why) {
-  if (!named.empty()) return ros::names::resolve(named);
-  const std::string topic = ros::names::resolve("wheel_command");
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
-  for (; ros::WallTime::now() < deadline && stop_signal == 0 && ros::ok();
-       ros::WallDuration(0.01).sleep()) {
+  if (!named.empty()) return ::ros::names::resolve(named);
+  const std::string topic = ::ros::names::resolve("wheel_command");
+  const ::ros::WallTime deadline = ::ros::WallTime::now() + ::ros::WallDuration(5.0);
+  for (; ::ros::WallTime::now() < deadline && stop_signal == 0 && ::ros::ok();
+       ::ros::WallDuration(0.01).sleep()) {
     XmlRpc::XmlRpcValue args, result, payload;
-    args[0] = ros::this_node::getName();
-    if (!ros::master::execute("getSystemState", args, result, payload, false)) continue;
+    args[0] = ::ros::this_node::getName();
+    if (!::ros::master::execute("getSystemState", args, result, payload, false)) continue;
     for (int i = 0; i < payload[0].size(); ++i) {  // payload[0]: [topic, [publishers]]
       if (std::string(payload[0][i][0]) != topic) continue;
       if (payload[0][i][1].size() > 1) {
@@ -31,15 +31,15 @@ std::optional<std::string> findCalibrationDriver(const std::string& named,
       if (payload[0][i][1].size() == 1) return std::string(payload[0][i][1][0]);
     }
   }
-  *why = stop_signal != 0 ? device::stopSignalMessage(stop_signal)
-         : !ros::ok()     ? "ROS shut down"
+  *why = stop_signal != 0 ? stopSignalMessage(stop_signal)
+         : !::ros::ok()   ? "ROS shut down"
                           : "no driver publishes " + topic +
-                            ": start it first (roslaunch serial_robot_driver sim.launch), or run "
-                            "the tool in its namespace (ROS_NAMESPACE=...)";
+                              ": start it first (roslaunch serial_robot_driver sim.launch), or run "
+                              "the tool in its namespace (ROS_NAMESPACE=...)";
   return std::nullopt;
 }
 
-CalibrationTopics::CalibrationTopics(device::TurnCalibrationRun& run) {
+CalibrationTopics::CalibrationTopics(TurnCalibrationRun& run) {
   cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
   imu_ = nh_.subscribe<sensor_msgs::Imu>(
       "imu/data", 100, [&run](const sensor_msgs::Imu::ConstPtr& msg) {
@@ -66,14 +66,14 @@ CalibrationTopics::CalibrationTopics(device::TurnCalibrationRun& run) {
   // status above would miss one shorter than its period; its count catches what this missed).
   e_stop_ = nh_.subscribe<std_msgs::Bool>(
       "e_stop", 10, [&run](const std_msgs::Bool::ConstPtr& msg) { run.setEStopEngaged(msg->data); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+      ::ros::VoidConstPtr(), ::ros::TransportHints().tcpNoDelay());
 }
 
-void CalibrationTopics::command(const device::BaseTwist& twist) {
+void CalibrationTopics::command(const BaseTwist& twist) {
   geometry_msgs::Twist msg;
   msg.linear.x = twist.linear;
   msg.angular.z = twist.angular;
   cmd_vel_.publish(msg);
 }
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::devices::base::ros

@@ -13,14 +13,15 @@
 #include <string>
 
 #include "serial_robot_driver/devices/base/base_params.h"
-#include "serial_robot_driver/devices/base/turn_calibration_run.h"
 #include "serial_robot_driver/devices/base/ros/calibrate_base_client.h"
+#include "serial_robot_driver/devices/base/turn_calibration_run.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace {
 
-using namespace serial_robot_driver::device;
-using serial_robot_driver::ros_layer::CalibrationTopics;
+using namespace serial_robot_driver::devices::base;
+using namespace serial_robot_driver::core;
+using serial_robot_driver::devices::base::ros::CalibrationTopics;
 
 std::atomic<int> g_signal{0};
 void onSignal(int signal_number) { g_signal = signal_number; }
@@ -45,10 +46,10 @@ int spinRun(TurnCalibrationRun& run) {
     }
   };
   while (true) {
-    guarded([] { ros::spinOnce(); });
+    guarded([] { ::ros::spinOnce(); });
     const CalibrationStep step =
-        run.step({ros::WallTime::now().toSec(), ros::Time::now().toSec(), g_signal.exchange(0),
-                  ros::ok(), topics.commandSubscribed()});
+        run.step({::ros::WallTime::now().toSec(), ::ros::Time::now().toSec(), g_signal.exchange(0),
+                  ::ros::ok(), topics.commandSubscribed()});
     print(step.lines);
     if (step.command) guarded([&] { topics.command(*step.command); });
     if (step.finished) return step.exit_status;
@@ -59,7 +60,7 @@ int spinRun(TurnCalibrationRun& run) {
       run.setMeasuredDistance(typed ? std::optional<double>(measured) : std::nullopt);
       continue;
     }
-    ros::WallDuration(step.next_step_in).sleep();
+    ::ros::WallDuration(step.next_step_in).sleep();
   }
 }
 
@@ -67,8 +68,8 @@ int spinRun(TurnCalibrationRun& run) {
 
 int main(int argc, char** argv) {
   // Our own SIGINT/SIGTERM: the base is stopped before the tool exits, not after roscpp's.
-  ros::init(argc, argv, "calibrate_base",
-            ros::init_options::NoSigintHandler | ros::init_options::AnonymousName);
+  ::ros::init(argc, argv, "calibrate_base",
+              ::ros::init_options::NoSigintHandler | ::ros::init_options::AnonymousName);
   const ParsedCalibrationOptions parsed =
       parseCalibrationOptions(std::vector<std::string>(argv + 1, argv + argc));
   if (parsed.help) {
@@ -85,27 +86,27 @@ int main(int argc, char** argv) {
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
-  ros::start();
+  ::ros::start();
 
   std::string why;
-  const auto node =
-      serial_robot_driver::ros_layer::findCalibrationDriver(parsed.options->node, g_signal, &why);
+  const auto node = serial_robot_driver::devices::base::ros::findCalibrationDriver(
+      parsed.options->node, g_signal, &why);
   if (!node) {
     std::cerr << "calibrate_base: " << why << std::endl;
     return g_signal != 0 ? 128 + g_signal : kCalibrationExitRefused;
   }
   BaseConfig base;
   try {  // the node's parameters read as the node reads them (its defaults for keys left out)
-    base = serial_robot_driver::ros_layer::loadParams(ros::NodeHandle(*node), nullptr)
-               .section(serial_robot_driver::params::kBaseSection)
+    base = serial_robot_driver::ros_layer::loadParams(::ros::NodeHandle(*node), nullptr)
+               .section(serial_robot_driver::devices::base::kBaseSection)
                .controller;
   } catch (const std::exception& error) {
     std::cerr << "calibrate_base: cannot read the parameters of " << *node << ": " << error.what()
               << std::endl;
     return kCalibrationExitRefused;
   }
-  TurnCalibrationRun run(*parsed.options, *node, ros::names::resolve("imu/data"), base);
+  TurnCalibrationRun run(*parsed.options, *node, ::ros::names::resolve("imu/data"), base);
   const int status = spinRun(run);
-  ros::shutdown();
+  ::ros::shutdown();
   return status;
 }

@@ -18,9 +18,9 @@
 #include <string>
 #include <thread>
 
-#include "serial_robot_driver/devices/base/base_sim.h"
 #include "serial_robot_driver/ServoSpin.h"
-#include "serial_robot_driver/devices/body/body_sim.h"
+#include "serial_robot_driver/devices/base/sim/base_sim.h"
+#include "serial_robot_driver/devices/body/sim/body_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 #include "support/test_helpers.h"
@@ -46,8 +46,8 @@ struct Robot {
     sim::SimOptions options;
     options.link = test_support::nodeParam("/" + ns + "/driver_node", "port");
     options.device("servo_bus").enabled = servo_bus;
-    bodyConfig(options).telemetry_rate_hz = telemetry_rate;
-    bodyConfig(options).gyro_bias = kBias;
+    serial_robot_driver::devices::body::sim::bodyConfig(options).telemetry_rate_hz = telemetry_rate;
+    serial_robot_driver::devices::body::sim::bodyConfig(options).gyro_bias = kBias;
     robot = std::make_unique<sim::RobotSim>(options);
     robot->start();
     cmd_vel = nh.advertise<geometry_msgs::Twist>("/" + ns + "/cmd_vel", 10);
@@ -90,7 +90,12 @@ struct Robot {
   }
   /// Waits until the simulated wheels turn (the node obeys the cmd_vel being published).
   bool waitMoving() {
-    return waitFor([&] { return baseStats(robot->stats()).last_left_speed != 0; }, 10);
+    return waitFor(
+        [&] {
+          return serial_robot_driver::devices::base::sim::baseStats(robot->stats())
+                     .last_left_speed != 0;
+        },
+        10);
   }
   /// servo/spin of servo 1: mode 1 spins, mode 0 stops.
   bool spin(uint8_t mode) {
@@ -116,7 +121,7 @@ struct Robot {
   bool waitStill() {
     const bool still = waitFor(
         [&] {
-          const auto base = baseStats(robot->stats());
+          const auto base = serial_robot_driver::devices::base::sim::baseStats(robot->stats());
           return base.last_left_speed == 0 && base.last_right_speed == 0;
         },
         10);
@@ -282,8 +287,7 @@ TEST_F(GyroCalibrationTest, RefusedDuringABodyTrajectoryAndABusSpinAndRightAfter
   ASSERT_TRUE(robot.spin(0));
   response = robot.calibrate();
   EXPECT_FALSE(response.success);
-  EXPECT_TRUE(contains(response.message, "(servo_bus: servo(s) 1 set moving"))
-      << response.message;
+  EXPECT_TRUE(contains(response.message, "(servo_bus: servo(s) 1 set moving")) << response.message;
   EXPECT_TRUE(contains(response.message, "it must be still for 1 s after the last motion"))
       << response.message;
   EXPECT_TRUE(contains(response.message, "unchanged: not calibrated")) << response.message;

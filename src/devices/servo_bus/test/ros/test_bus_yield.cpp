@@ -191,6 +191,6 @@ int main(int argc, char** argv) {
   test_support::RosTestNode node(argc, argv, "test_bus_yield");
   sim::SimOptions options = simBusOptions(test_support::nodeParam(kNode, "port"), {1, 2});
   options.device("base").enabled = false;
-  servoBusConfig(options).response_switch = {{2, 1}};
+  srd::devices::servo_bus::sim::servoBusConfig(options).response_switch = {{2, 1}};
   return runAllTestsOnSimBus(options);
 }

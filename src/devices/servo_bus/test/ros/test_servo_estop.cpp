@@ -68,7 +68,7 @@ TEST_F(ServoEStop, ASlowRotateWhoseFirstStopIsLostIsStillStoppedUnderTheEStop) {
   ASSERT_TRUE(waitMoving(1, true));
   setEStop(true);
   ASSERT_TRUE(waitMoving(1, false)) << "the slow servo still turns under the e-stop";
-  EXPECT_EQ(servoBusStats(g_robot->stats()).stops_lost, 1u);
+  EXPECT_EQ(srd::devices::servo_bus::sim::servoBusStats(g_robot->stats()).stops_lost, 1u);
   EXPECT_GE(count(g_bus->frames(), kSpin1StopSpeed0), 2u);
 }
 

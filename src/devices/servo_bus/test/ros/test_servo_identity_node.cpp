@@ -11,7 +11,7 @@
 #include <string>
 
 #include "serial_robot_driver/ServoInfo.h"
-#include "serial_robot_driver/devices/servo_bus/servo_bus_sim.h"
+#include "serial_robot_driver/devices/servo_bus/sim/servo_bus_sim.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 #include "support/ros_test_support.h"
 
@@ -127,10 +127,11 @@ int main(int argc, char** argv) {
   sim::SimOptions options;
   options.device("base").enabled = false;
   options.device("body").enabled = false;
-  servoBusConfig(options).servo_ids = {1, 2, 3, 4};
-  servoBusConfig(options).servo_type = {{2, 300}};
-  servoBusConfig(options).response_switch = {{3, 1}};
-  servoBusConfig(options).firmware_version = {{4, 300}};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).servo_ids = {1, 2, 3, 4};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).servo_type = {{2, 300}};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).response_switch = {{3, 1}};
+  serial_robot_driver::devices::servo_bus::sim::servoBusConfig(options).firmware_version = {
+      {4, 300}};
   options.device("servo_bus").link = port;
   return test_support::runAllTestsWithSim(options, &g_robot);
 }

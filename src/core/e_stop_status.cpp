@@ -1,0 +1,23 @@
+#include "serial_robot_driver/core/e_stop_status.h"
+
+namespace serial_robot_driver::core {
+
+StatusReport eStopStatus(const EStopStats& stats) {
+  StatusReport status;
+  if (stats.engaged) {
+    status.summary(StatusLevel::kWarn, "engaged: every actuator stopped, motion commands refused");
+  } else {
+    status.summary(StatusLevel::kOk, "released");
+  }
+  status.add("engaged", stats.engaged);
+  status.add("engagements", stats.engagements);
+  uint64_t refused = 0;
+  for (const auto& [source, count] : stats.refused) {
+    status.add("refused: " + source, count);
+    refused += count;
+  }
+  status.add("commands refused", refused);
+  return status;
+}
+
+}  // namespace serial_robot_driver::core

@@ -1,0 +1,274 @@
+#include "serial_robot_driver/core/serial_link.h"
+
+#include <algorithm>
+
+#include "serial_robot_driver/transport/serial_port.h"
+
+namespace serial_robot_driver::core {
+
+namespace {
+/// How long one read waits before the reader thread checks for stop/lost flags. Data wakes it at
+/// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on, for
+/// streams that cannot be woken. A wakeable stream is woken for those, so its reader sleeps until
+/// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here).
+constexpr int kReadTimeoutMs = 100;
+constexpr int kWakeableReadTimeoutMs = 5000;
+/// The longest a reader with nothing to do waits for its port to be reopened in one go.
+constexpr int kLongestIdleWaitS = 3600;
+
+std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& options) {
+  return std::make_unique<transport::SerialPort>(
+      transport::SerialPortOptions{options.path, options.baud});
+}
+}  // namespace
+
+SerialLink::SerialLink(SerialLinkOptions options, StreamFactory factory)
+    : options_(std::move(options)),
+      factory_(factory ? std::move(factory) : StreamFactory(openSerialPort)),
+      framer_(options_.framer,
+              [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size) {
+                for (LinkListener* listener : listeners_) {
+                  listener->onFrame(family, data, size, chunk_arrival_);
+                }
+              }) {}
+
+SerialLink::~SerialLink() { stop(); }
+
+void SerialLink::addListener(LinkListener* listener) { listeners_.push_back(listener); }
+
+void SerialLink::start() {
+  if (reader_.joinable()) return;
+  stopping_ = false;
+  reader_ = std::thread([this] { readerLoop(); });
+}
+
+void SerialLink::stop() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    stopping_ = true;
+  }
+  state_cv_.notify_all();
+  wakeReader();
+  // The reader closes the port on its way out, so onLinkDown stays on the reader thread.
+  if (reader_.joinable()) reader_.join();
+}
+
+bool SerialLink::write(const std::vector<uint8_t>& frame) {
+  return write(frame.data(), frame.size());
+}
+
+FrameWriter SerialLink::writer() {
+  return [this](const std::vector<uint8_t>& frame) { return write(frame); };
+}
+
+bool SerialLink::write(const uint8_t* data, std::size_t size) {
+  std::string error;
+  {
+    std::lock_guard<std::mutex> lock(write_mutex_);
+    if (!connected_ || lost_ || !stream_) {
+      error = "port is not connected";
+    } else {
+      try {
+        stream_->write(data, size);
+        if (observer_) observer_->onChunk({options_.path, true, data, size, Clock::now()});
+      } catch (const transport::TransportError& e) {
+        error = e.what();
+        lost_ = true;  // the reader thread closes and reopens the port
+        stream_->wakeRead();
+      }
+    }
+  }
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (!error.empty()) {
+    ++stats_.write_failures;
+    if (lost_) stats_.last_error = error;
+    return false;
+  }
+  ++stats_.frames_out;
+  stats_.bytes_out += size;
+  return true;
+}
+
+LinkStats SerialLink::stats() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  LinkStats copy = stats_;
+  copy.connected = connected_;
+  return copy;
+}
+
+bool SerialLink::waitConnected(std::chrono::milliseconds timeout) const {
+  std::unique_lock<std::mutex> lock(state_mutex_);
+  return state_cv_.wait_for(lock, timeout, [this] {
+    return connected_.load() || stopping_.load();
+  }) && connected_;
+}
+
+bool SerialLink::tryOpen() {
+  std::unique_ptr<transport::ByteStream> stream;
+  std::string error;
+  try {
+    stream = factory_(options_);
+    stream->open();
+  } catch (const transport::TransportError& e) {
+    error = e.what();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (!error.empty()) {
+    {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      stats_.last_error = error;
+    }
+    for (LinkListener* listener : listeners_) listener->onOpenFailed(error);
+    return false;
+  }
+  framer_.reset();  // a partial frame from before the loss means nothing now
+  const transport::StreamInfo info = stream->info();
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    ++stats_.connects;
+    stats_.low_latency = info.low_latency;
+    stats_.latency_timer_ms = info.latency_timer_ms;
+  }
+  if (observer_) observer_->onChunk({options_.path, false, nullptr, 0, Clock::now()});
+  // Listeners hear "up" before any write can succeed: the base must have queued its Reset first.
+  for (LinkListener* listener : listeners_) listener->onLinkUp();
+  {
+    std::lock_guard<std::mutex> lock(write_mutex_);
+    stream_ = std::move(stream);
+    lost_ = false;
+    connected_ = true;
+  }
+  { std::lock_guard<std::mutex> lock(state_mutex_); }  // no lost wake-up for waitConnected()
+  state_cv_.notify_all();
+  return true;
+}
+
+void SerialLink::closeStream(const std::string& reason) {
+  bool was_connected = false;
+  {
+    std::lock_guard<std::mutex> lock(write_mutex_);
+    was_connected = connected_;
+    connected_ = false;
+    if (stream_) stream_->close();
+    stream_.reset();
+  }
+  if (!was_connected) return;
+  next_open_attempt_ = Clock::now() + reconnectInterval();  // a lost port is reopened after a pause
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    ++stats_.disconnects;
+    stats_.last_error = reason;
+  }
+  for (LinkListener* listener : listeners_) listener->onLinkDown();
+}
+
+void SerialLink::wakeReader() {
+  std::lock_guard<std::mutex> lock(write_mutex_);  // stream_ is swapped under it
+  if (stream_) stream_->wakeRead();
+}
+
+void SerialLink::wake() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    wake_pending_ = true;
+  }
+  state_cv_.notify_all();  // a reader waiting to reopen the port
+  wakeReader();            // a reader in read()
+}
+
+bool SerialLink::onReaderThread() const { return std::this_thread::get_id() == reader_.get_id(); }
+
+void SerialLink::waitForRetry(Clock::time_point until) {
+  // Bounded: a far deadline (nothing to do) must not overflow the condition variable's clock.
+  until = std::min(until, Clock::now() + std::chrono::seconds(kLongestIdleWaitS));
+  std::unique_lock<std::mutex> lock(state_mutex_);
+  state_cv_.wait_until(lock, until, [this] { return stopping_.load() || wake_pending_; });
+  wake_pending_ = false;
+}
+
+void SerialLink::readerLoop() {
+  while (!stopping_) {
+    const Clock::time_point work_due =
+        worker_ != nullptr ? worker_->nextWork() : Clock::time_point::max();
+    if (work_due <= Clock::now()) {
+      worker_->work();
+      continue;
+    }
+    if (!connected_) {
+      if (Clock::now() >= next_open_attempt_ && !tryOpen()) {
+        next_open_attempt_ = Clock::now() + reconnectInterval();
+      }
+      if (!connected_) waitForRetry(std::min(next_open_attempt_, work_due));
+      continue;
+    }
+    if (lost_) {
+      std::string reason;
+      {
+        std::lock_guard<std::mutex> lock(state_mutex_);
+        reason = stats_.last_error;
+      }
+      closeStream(reason);
+      continue;
+    }
+    readOnce(work_due);
+  }
+  if (stream_) closeStream("stopped");
+}
+
+bool SerialLink::pump(Clock::time_point until) {
+  if (stopping_ || !connected_ || lost_) return false;
+  readOnce(until);
+  return connected_ && !lost_ && !stopping_;
+}
+
+Clock::duration SerialLink::reconnectInterval() const {
+  return std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(options_.reconnect_interval));
+}
+
+void SerialLink::readOnce(Clock::time_point until) {
+  // A wakeable stream sleeps until data, stop(), wake() or a failed write wakes it; the others
+  // poll.
+  const int longest_read_ms = stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs;
+  auto read_timeout = std::chrono::milliseconds(longest_read_ms);
+  if (until != Clock::time_point::max()) {
+    // Whole milliseconds, rounded up: poll() cannot wait less, and rounding down would spin.
+    read_timeout = std::min(
+        read_timeout, std::max(std::chrono::milliseconds(0),
+                               std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now())));
+  }
+  if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
+    // The stream's clock: a replay measures the recorded silence on its own timeline.
+    const auto quiet = stream_->now() - chunk_arrival_;
+    if (quiet >= options_.stale_frame_timeout) {
+      // No byte for a whole timeout: what is buffered will not complete. Frames found behind
+      // the stale candidate keep the arrival time of their bytes.
+      while (framer_.dropStaleCandidate()) {
+      }
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      stats_.framer = framer_.stats();
+      return;
+    }
+    const auto left =
+        std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet);
+    // Limited as a duration first: the int conversion never sees more than longest_read_ms.
+    read_timeout = std::min(read_timeout, std::max(left, std::chrono::milliseconds(1)));
+  }
+  std::size_t n = 0;
+  try {
+    n = stream_->read(chunk_.data(), chunk_.size(), static_cast<int>(read_timeout.count()));
+  } catch (const transport::TransportError& e) {
+    closeStream(e.what());
+    return;
+  }
+  if (n == 0) return;
+  // A replayed recording knows when its bytes arrived; a live port's bytes arrived now.
+  chunk_arrival_ = stream_->arrivalTime().value_or(Clock::now());
+  if (observer_) observer_->onChunk({options_.path, false, chunk_.data(), n, chunk_arrival_});
+  framer_.feed(chunk_.data(), n);
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  stats_.framer = framer_.stats();
+}
+
+}  // namespace serial_robot_driver::core
