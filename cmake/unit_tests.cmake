@@ -45,7 +45,7 @@ catkin_add_gtest(ros_layer_tests
   test/unit/test_driver_params.cpp
   test/unit/test_bag_replay.cpp
   test/unit/test_guarded_callbacks.cpp)
-target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS})
+target_include_directories(ros_layer_tests PRIVATE ${catkin_INCLUDE_DIRS} ${PROJECT_SOURCE_DIR}/test)
 target_link_libraries(ros_layer_tests srd_ros gtest_main)
 
 # The robot description: robot_description's URDF through check_urdf and urdf::Model.

@@ -9,6 +9,7 @@
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "support/body_telemetry_fixture.h"
 
 namespace serial_robot_driver::ros_layer {
 namespace {
@@ -17,42 +18,12 @@ using devices::body::BodyParams;
 using devices::body::ImuParams;
 using devices::body::Telemetry;
 
+using test_support::expectQuaternion;
+using test_support::goldenBodyTelemetry;
+using test_support::hipAndKnee;
+
 constexpr double kRadPerTick = 2.0 * M_PI / 4096.0;
 constexpr double kHalfSqrt2 = 0.70710678118654752;
-
-// The values of docs/protocols.md, section 2b's golden frame (positions 2048, 1024, speeds 10, -5,
-// IMU 1, -1, 16384, 0, 0, 100, 0, 0, -16384), optionally with a foot block.
-Telemetry goldenTelemetry(bool with_foot = false) {
-  Telemetry t;
-  t.servo_count = 2;
-  t.servos[0] = {2048, 10};
-  t.servos[1] = {1024, -5};
-  t.imu = {1, -1, 16384, 0, 0, 100, 0, 0, -16384};
-  t.has_foot = with_foot;
-  if (with_foot) t.foot = {0x0201, 0x0403, 5, 6, 7, 8, 9, 0xFFFF};
-  return t;
-}
-
-std::vector<devices::body::BodyJoint> joints(int direction_of_second = 1,
-                                             double velocity_scale = 0.0) {
-  BodyParams params;
-  params.servo_ids = {2, 3};
-  params.joint_names = {"hip", "knee"};
-  params.zero_ticks = {2048, 2048};
-  params.directions = {1, direction_of_second};
-  params.calibration.ticks_per_revolution = 4096;
-  params.calibration.velocity_scale = velocity_scale;
-  return devices::body::ros::makeBodyJoints(params);
-}
-
-void expectQuaternion(const geometry_msgs::Quaternion& q, double x, double y, double z, double w) {
-  // q and -q are the same rotation: compare up to sign.
-  const double sign = (q.w * w + q.x * x + q.y * y + q.z * z) < 0 ? -1.0 : 1.0;
-  EXPECT_NEAR(sign * q.x, x, 1e-9);
-  EXPECT_NEAR(sign * q.y, y, 1e-9);
-  EXPECT_NEAR(sign * q.z, z, 1e-9);
-  EXPECT_NEAR(sign * q.w, w, 1e-9);
-}
 
 // --- time ----------------------------------------------------------------------------------------
 
@@ -76,7 +47,7 @@ TEST(ConversionsTime, FutureArrivalIsNowAndOldArrivalSaturatesAtZero) {
 TEST(ConversionsJointState, PositionsInRadiansAndNoVelocityWithoutItsScale) {
   const ros::Time stamp(42, 5);
   const sensor_msgs::JointState msg =
-      devices::body::ros::toJointState(goldenTelemetry(), joints(), stamp);
+      devices::body::ros::toJointState(goldenBodyTelemetry(), hipAndKnee(), stamp);
   EXPECT_EQ(msg.header.stamp, stamp);
   ASSERT_EQ(msg.name, (std::vector<std::string>{"hip", "knee"}));
   ASSERT_EQ(msg.position.size(), 2u);
@@ -88,7 +59,7 @@ TEST(ConversionsJointState, PositionsInRadiansAndNoVelocityWithoutItsScale) {
 
 TEST(ConversionsJointState, ReversedJointAndVelocityScale) {
   const sensor_msgs::JointState msg =
-      devices::body::ros::toJointState(goldenTelemetry(), joints(-1, 0.02), ros::Time());
+      devices::body::ros::toJointState(goldenBodyTelemetry(), hipAndKnee(-1, 0.02), ros::Time());
   EXPECT_NEAR(msg.position[1], M_PI / 2, 1e-12);
   EXPECT_NEAR(msg.velocity[0], 0.2, 1e-12);  // 10 * 0.02
   EXPECT_NEAR(msg.velocity[1], 0.1, 1e-12);  // -1 * 0.02 * -5
@@ -106,7 +77,7 @@ TEST(ConversionsImu, ScaledValuesOrientationAndCovariances) {
   params.angular_velocity_variance = 0.2;
   params.linear_acceleration_variance = 0.3;
   const ros::Time stamp(7, 0);
-  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, stamp);
+  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenBodyTelemetry(), params, stamp);
 
   EXPECT_EQ(msg.header.stamp, stamp);
   EXPECT_EQ(msg.header.frame_id, "imu_test");
@@ -128,7 +99,7 @@ TEST(ConversionsImu, ScaledValuesOrientationAndCovariances) {
 
 TEST(ConversionsImu, DefaultScalesAreTheDatasheetOnes) {
   const sensor_msgs::Imu msg =
-      devices::body::ros::toImu(goldenTelemetry(), ImuParams(), ros::Time());
+      devices::body::ros::toImu(goldenBodyTelemetry(), ImuParams(), ros::Time());
   // 16384 LSB = 8 g; 100 LSB = 100 * 2000/32768 deg/s; -16384 LSB = -90 deg.
   EXPECT_NEAR(msg.linear_acceleration.z, 8 * 9.80665, 0.01);
   EXPECT_NEAR(msg.angular_velocity.z, 100 * 2000.0 / 32768 * M_PI / 180, 1e-5);
@@ -143,7 +114,8 @@ TEST(ConversionsImu, AxisMapRemapsVectorsAndTurnsTheOrientation) {
   params.gyro_scale = 0.25;
   params.angle_scale = M_PI / 32768.0;
   params.axis_map = {"-y", "x", "z"};
-  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time());
+  const sensor_msgs::Imu msg =
+      devices::body::ros::toImu(goldenBodyTelemetry(), params, ros::Time());
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 0.5);  // -(-1 * 0.5)
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 0.5);  // 1 * 0.5
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, 8192.0);
@@ -160,16 +132,17 @@ TEST(ConversionsImu, GyroBiasIsSubtractedInRawUnitsBeforeTheScaleAndTheAxisMap) 
   params.gyro_scale = 0.25;
   params.axis_map = {"-y", "x", "z"};
   const std::array<double, 3> bias{4, -2, 10};
-  sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time(), bias);
+  sensor_msgs::Imu msg =
+      devices::body::ros::toImu(goldenBodyTelemetry(), params, ros::Time(), bias);
   EXPECT_DOUBLE_EQ(msg.angular_velocity.x, -0.5);  // -(2 * 0.25)
   EXPECT_DOUBLE_EQ(msg.angular_velocity.y, -1.0);  // -4 * 0.25
   EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 22.5);  // 90 * 0.25
   params.gyro_scale = 0.5;
-  msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time(), bias);
+  msg = devices::body::ros::toImu(goldenBodyTelemetry(), params, ros::Time(), bias);
   EXPECT_DOUBLE_EQ(msg.angular_velocity.z, 45.0);
   EXPECT_DOUBLE_EQ(
       msg.linear_acceleration.z,
-      devices::body::ros::toImu(goldenTelemetry(), params, ros::Time()).linear_acceleration.z)
+      devices::body::ros::toImu(goldenBodyTelemetry(), params, ros::Time()).linear_acceleration.z)
       << "the accelerometer is left alone";
 }
 
@@ -177,7 +150,8 @@ TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
   ImuParams params;
   params.accel_scale = 1.0;
   params.axis_map = {"x", "-y", "-z"};
-  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time());
+  const sensor_msgs::Imu msg =
+      devices::body::ros::toImu(goldenBodyTelemetry(), params, ros::Time());
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.x, 1.0);
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.y, 1.0);
   EXPECT_DOUBLE_EQ(msg.linear_acceleration.z, -16384.0);
@@ -186,7 +160,8 @@ TEST(ConversionsImu, UpsideDownMountFlipsYAndZ) {
 TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {
   ImuParams params;
   params.orientation_variance = -1;
-  const sensor_msgs::Imu msg = devices::body::ros::toImu(goldenTelemetry(), params, ros::Time());
+  const sensor_msgs::Imu msg =
+      devices::body::ros::toImu(goldenBodyTelemetry(), params, ros::Time());
   EXPECT_EQ(msg.orientation_covariance[0], -1.0);
   EXPECT_EQ(msg.orientation_covariance[4], 0.0);
 }
@@ -195,8 +170,8 @@ TEST(ConversionsImu, NegativeOrientationVarianceMeansNoOrientation) {
 
 TEST(ConversionsFootPressure, OnlyForFramesWithTheFootBlock) {
   EXPECT_FALSE(
-      devices::body::ros::toFootPressure(goldenTelemetry(false), ros::Time(1, 0)).has_value());
-  const auto msg = devices::body::ros::toFootPressure(goldenTelemetry(true), ros::Time(1, 0));
+      devices::body::ros::toFootPressure(goldenBodyTelemetry(false), ros::Time(1, 0)).has_value());
+  const auto msg = devices::body::ros::toFootPressure(goldenBodyTelemetry(true), ros::Time(1, 0));
   ASSERT_TRUE(msg.has_value());
   EXPECT_EQ(msg->header.stamp, ros::Time(1, 0));
   const boost::array<uint16_t, 8> expected = {0x0201, 0x0403, 5, 6, 7, 8, 9, 0xFFFF};
@@ -206,7 +181,7 @@ TEST(ConversionsFootPressure, OnlyForFramesWithTheFootBlock) {
 TEST(ConversionsTelemetry, RawFrameWithServoIds) {
   const ros::Time stamp(3, 4);
   const serial_robot_driver::Telemetry msg =
-      devices::body::ros::toTelemetryMsg(goldenTelemetry(), joints(), stamp);
+      devices::body::ros::toTelemetryMsg(goldenBodyTelemetry(), hipAndKnee(), stamp);
   EXPECT_EQ(msg.header.stamp, stamp);
   EXPECT_EQ(msg.servo_ids, (std::vector<uint8_t>{2, 3}));
   EXPECT_EQ(msg.positions, (std::vector<uint16_t>{2048, 1024}));
@@ -219,7 +194,7 @@ TEST(ConversionsTelemetry, RawFrameWithServoIds) {
 
 TEST(ConversionsTelemetry, FootReadingsWhenPresent) {
   const serial_robot_driver::Telemetry msg =
-      devices::body::ros::toTelemetryMsg(goldenTelemetry(true), joints(), ros::Time());
+      devices::body::ros::toTelemetryMsg(goldenBodyTelemetry(true), hipAndKnee(), ros::Time());
   EXPECT_TRUE(msg.has_foot);
   EXPECT_EQ(msg.foot, (std::vector<uint16_t>{0x0201, 0x0403, 5, 6, 7, 8, 9, 0xFFFF}));
 }

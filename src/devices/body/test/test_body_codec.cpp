@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "support/body_telemetry_fixture.h"
 #include "support/golden_frames.h"
 #include "support/probe_expectations.h"
 #include "support/test_helpers.h"
@@ -149,17 +150,10 @@ INSTANTIATE_TEST_SUITE_P(BodyCodecErrors, BodyCodecMalformedSyncWrite,
 
 // --- telemetry -----------------------------------------------------------------------------------
 
+using test_support::goldenBodyTelemetry;
+
 // Section 2b golden frame, N = 2, no foot data, LEN 32 (test/support/golden_frames.h).
 const Bytes& kGoldenTelemetry = golden::body::kTelemetryTwoServos;
-
-Telemetry goldenTelemetry() {
-  Telemetry t;
-  t.servo_count = 2;
-  t.servos[0] = {2048, 10};
-  t.servos[1] = {1024, -5};
-  t.imu = {1, -1, 16384, 0, 0, 100, 0, 0, -16384};
-  return t;
-}
 
 // Hand-made frame WITH the foot block, N = 1, LEN = 40 + 4 = 44 = 0x2C.
 // SUM = LEN 44 + servo (01+2C+FF+FE = 1+44+255+254) + imu (01+02+FF+FF = 513)
@@ -225,7 +219,7 @@ TEST_P(BodyCodecTelemetry, SumCoversLenAndContent) {
 
 INSTANTIATE_TEST_SUITE_P(
     BodyCodecGolden, BodyCodecTelemetry,
-    ::testing::Values(TelemetryCase{"TwoServosNoFoot", kGoldenTelemetry, goldenTelemetry()},
+    ::testing::Values(TelemetryCase{"TwoServosNoFoot", kGoldenTelemetry, goldenBodyTelemetry()},
                       TelemetryCase{"OneServoWithFoot", kFootTelemetry, footTelemetry()}),
     [](const auto& info) { return info.param.name; });
 

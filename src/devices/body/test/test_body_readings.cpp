@@ -7,42 +7,16 @@
 #include <cmath>
 
 #include "serial_robot_driver/devices/body/body_readings.h"
+#include "support/body_telemetry_fixture.h"
 
 namespace serial_robot_driver::devices::body {
 namespace {
 
+using test_support::expectQuaternion;
+using test_support::goldenBodyTelemetry;
+using test_support::hipAndKnee;
+
 constexpr double kHalfSqrt2 = 0.70710678118654752;
-
-// The values of docs/protocols.md, section 2b's golden frame (positions 2048, 1024, speeds 10, -5,
-// IMU 1, -1, 16384, 0, 0, 100, 0, 0, -16384).
-Telemetry goldenTelemetry() {
-  Telemetry t;
-  t.servo_count = 2;
-  t.servos[0] = {2048, 10};
-  t.servos[1] = {1024, -5};
-  t.imu = {1, -1, 16384, 0, 0, 100, 0, 0, -16384};
-  return t;
-}
-
-std::vector<BodyJoint> joints(int direction_of_second = 1, double velocity_scale = 0.0) {
-  BodyParams params;
-  params.servo_ids = {2, 3};
-  params.joint_names = {"hip", "knee"};
-  params.zero_ticks = {2048, 2048};
-  params.directions = {1, direction_of_second};
-  params.calibration.ticks_per_revolution = 4096;
-  params.calibration.velocity_scale = velocity_scale;
-  return makeBodyJoints(params);
-}
-
-void expectQuaternion(const Quaternion& q, double x, double y, double z, double w) {
-  // q and -q are the same rotation: compare up to sign.
-  const double sign = (q.w * w + q.x * x + q.y * y + q.z * z) < 0 ? -1.0 : 1.0;
-  EXPECT_NEAR(sign * q.x, x, 1e-9);
-  EXPECT_NEAR(sign * q.y, y, 1e-9);
-  EXPECT_NEAR(sign * q.z, z, 1e-9);
-  EXPECT_NEAR(sign * q.w, w, 1e-9);
-}
 
 // --- parameters ----------------------------------------------------------------------------------
 
@@ -71,7 +45,7 @@ TEST(BodyReadingsJoints, BodyParamsBecomeJointsInServoIdOrder) {
 // --- joint radians -------------------------------------------------------------------------------
 
 TEST(BodyReadingsJoints, PositionsInRadiansAndNoVelocityWithoutItsScale) {
-  const JointReadings readings = jointReadings(goldenTelemetry(), joints());
+  const JointReadings readings = jointReadings(goldenBodyTelemetry(), hipAndKnee());
   ASSERT_EQ(readings.names, (std::vector<std::string>{"hip", "knee"}));
   ASSERT_EQ(readings.positions.size(), 2u);
   EXPECT_NEAR(readings.positions[0], 0.0, 1e-12);
@@ -80,16 +54,16 @@ TEST(BodyReadingsJoints, PositionsInRadiansAndNoVelocityWithoutItsScale) {
 }
 
 TEST(BodyReadingsJoints, ReversedJointAndVelocityScale) {
-  const JointReadings readings = jointReadings(goldenTelemetry(), joints(-1, 0.02));
+  const JointReadings readings = jointReadings(goldenBodyTelemetry(), hipAndKnee(-1, 0.02));
   EXPECT_NEAR(readings.positions[1], M_PI / 2, 1e-12);
   EXPECT_NEAR(readings.velocities[0], 0.2, 1e-12);  // 10 * 0.02
   EXPECT_NEAR(readings.velocities[1], 0.1, 1e-12);  // -1 * 0.02 * -5
 }
 
 TEST(BodyReadingsJoints, JointsBeyondTheFramesServoCountAreLeftOut) {
-  Telemetry telemetry = goldenTelemetry();
+  Telemetry telemetry = goldenBodyTelemetry();
   telemetry.servo_count = 1;
-  EXPECT_EQ(jointReadings(telemetry, joints()).names, (std::vector<std::string>{"hip"}));
+  EXPECT_EQ(jointReadings(telemetry, hipAndKnee()).names, (std::vector<std::string>{"hip"}));
 }
 
 // --- quaternion ----------------------------------------------------------------------------------
@@ -136,7 +110,7 @@ TEST(BodyReadingsImu, ScaledValuesAndOrientation) {
   params.accel_scale = 0.5;
   params.gyro_scale = 0.25;
   params.angle_scale = M_PI / 32768.0;  // 180 deg full scale: -16384 is -90 deg
-  const ImuReading reading = imuReading(goldenTelemetry(), params);
+  const ImuReading reading = imuReading(goldenBodyTelemetry(), params);
   EXPECT_DOUBLE_EQ(reading.linear_acceleration.x(), 0.5);
   EXPECT_DOUBLE_EQ(reading.linear_acceleration.y(), -0.5);
   EXPECT_DOUBLE_EQ(reading.linear_acceleration.z(), 8192.0);
@@ -153,7 +127,7 @@ TEST(BodyReadingsImu, AxisMapRemapsVectorsAndTurnsTheOrientation) {
   params.gyro_scale = 0.25;
   params.angle_scale = M_PI / 32768.0;
   params.axis_map = {"-y", "x", "z"};
-  const ImuReading reading = imuReading(goldenTelemetry(), params);
+  const ImuReading reading = imuReading(goldenBodyTelemetry(), params);
   EXPECT_DOUBLE_EQ(reading.linear_acceleration.x(), 0.5);  // -(-1 * 0.5)
   EXPECT_DOUBLE_EQ(reading.linear_acceleration.y(), 0.5);  // 1 * 0.5
   EXPECT_DOUBLE_EQ(reading.angular_velocity.z(), 25.0);
@@ -167,7 +141,7 @@ TEST(BodyReadingsImu, GyroBiasIsSubtractedInRawUnitsBeforeTheScaleAndTheAxisMap)
   ImuParams params;
   params.gyro_scale = 0.25;
   params.axis_map = {"-y", "x", "z"};
-  const ImuReading reading = imuReading(goldenTelemetry(), params, {4, -2, 10});
+  const ImuReading reading = imuReading(goldenBodyTelemetry(), params, {4, -2, 10});
   EXPECT_DOUBLE_EQ(reading.angular_velocity.x(), -0.5);  // -(2 * 0.25)
   EXPECT_DOUBLE_EQ(reading.angular_velocity.y(), -1.0);  // -4 * 0.25
   EXPECT_DOUBLE_EQ(reading.angular_velocity.z(), 22.5);  // 90 * 0.25
@@ -184,15 +158,15 @@ TEST(BodyReadingsImu, AxisMapMatrixIsTheSignedPermutation) {
 TEST(BodyReadingsImu, ImuYawIsTheHeadingOfThePublishedOrientation) {
   ImuParams params;
   params.angle_scale = M_PI / 32768.0;
-  EXPECT_NEAR(imuYaw(goldenTelemetry(), params), -M_PI / 2, 1e-9);  // raw yaw -16384: -90 deg
+  EXPECT_NEAR(imuYaw(goldenBodyTelemetry(), params), -M_PI / 2, 1e-9);  // raw yaw -16384: -90 deg
   // Board turned +90 deg about z ([-y, x, z]): the imu frame's heading is -180 deg.
   params.axis_map = {"-y", "x", "z"};
-  EXPECT_NEAR(std::abs(imuYaw(goldenTelemetry(), params)), M_PI, 1e-9);
+  EXPECT_NEAR(std::abs(imuYaw(goldenBodyTelemetry(), params)), M_PI, 1e-9);
   // Upside down ([x, -y, -z]) is a roll of 180 deg: the heading stays -90 deg.
   params.axis_map = {"x", "-y", "-z"};
-  EXPECT_NEAR(imuYaw(goldenTelemetry(), params), -M_PI / 2, 1e-9);
-  const Quaternion& q = imuReading(goldenTelemetry(), params).orientation;
-  EXPECT_NEAR(imuYaw(goldenTelemetry(), params),
+  EXPECT_NEAR(imuYaw(goldenBodyTelemetry(), params), -M_PI / 2, 1e-9);
+  const Quaternion& q = imuReading(goldenBodyTelemetry(), params).orientation;
+  EXPECT_NEAR(imuYaw(goldenBodyTelemetry(), params),
               std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z)), 1e-9);
 }
 
