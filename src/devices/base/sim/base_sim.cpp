@@ -5,22 +5,26 @@
 
 namespace serial_robot_driver::devices::base::sim {
 
-const serial_robot_driver::sim::OutputKind kBaseReplyOutput{"base_replies", 1};
+using serial_robot_driver::sim::fromSeconds;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::Outgoing;
+using serial_robot_driver::sim::OutputKind;
+using serial_robot_driver::sim::TimePoint;
 
-BaseSim::BaseSim(const BaseSimConfig& config, serial_robot_driver::sim::TimePoint now)
+const OutputKind kBaseReplyOutput{"base_replies", 1};
+
+BaseSim::BaseSim(const BaseSimConfig& config, TimePoint now)
     : config_(config),
-      pid_period_(serial_robot_driver::sim::fromSeconds(1.0 / std::max(config.pid_rate_hz, 1e-3))),
+      pid_period_(fromSeconds(1.0 / std::max(config.pid_rate_hz, 1e-3))),
       next_pid_(now + pid_period_),
       last_host_frame_(now),  // the heartbeat runs from power-on, like the real base
       next_error_frame_(now) {}
 
-void BaseSim::emit(serial_robot_driver::sim::Outbox* out, std::vector<uint8_t> frame) {
-  out->push_back(serial_robot_driver::sim::Outgoing{&kBaseReplyOutput, std::move(frame)});
+void BaseSim::emit(Outbox* out, std::vector<uint8_t> frame) {
+  out->push_back(Outgoing{&kBaseReplyOutput, std::move(frame)});
 }
 
-void BaseSim::handleFrame(const uint8_t* data, std::size_t size,
-                          serial_robot_driver::sim::TimePoint now,
-                          serial_robot_driver::sim::Outbox* out) {
+void BaseSim::handleFrame(const uint8_t* data, std::size_t size, TimePoint now, Outbox* out) {
   const auto decoded = decodeFrame(data, size);
   if (!decoded) {
     ++stats_.unknown_frames;
@@ -69,8 +73,7 @@ void BaseSim::handleFrame(const uint8_t* data, std::size_t size,
   }
 }
 
-void BaseSim::enterError(serial_robot_driver::sim::TimePoint now,
-                         serial_robot_driver::sim::Outbox* out) {
+void BaseSim::enterError(TimePoint now, Outbox* out) {
   stats_.in_error = true;
   ++stats_.timeouts;
   // A base that lost its host stops rather than running on the last command.
@@ -78,10 +81,10 @@ void BaseSim::enterError(serial_robot_driver::sim::TimePoint now,
   stats_.last_right_speed = 0;
   emit(out, encodeErrorStatus(reply_seq_.next()));
   ++stats_.errors_sent;
-  next_error_frame_ = now + serial_robot_driver::sim::fromSeconds(config_.error_repeat_s);
+  next_error_frame_ = now + fromSeconds(config_.error_repeat_s);
 }
 
-void BaseSim::tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver::sim::Outbox* out) {
+void BaseSim::tick(TimePoint now, Outbox* out) {
   // After a long stall (debugger, suspended process) skip the missed periods instead of looping.
   if (now - next_pid_ > std::chrono::seconds(1)) next_pid_ = now;
   while (next_pid_ <= now) {
@@ -92,25 +95,22 @@ void BaseSim::tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver:
   }
 
   if (!stats_.in_error) {
-    if (now - last_host_frame_ > serial_robot_driver::sim::fromSeconds(config_.heartbeat_timeout_s))
-      enterError(now, out);
+    if (now - last_host_frame_ > fromSeconds(config_.heartbeat_timeout_s)) enterError(now, out);
   } else if (now >= next_error_frame_) {
     emit(out, encodeErrorStatus(reply_seq_.next()));
     ++stats_.errors_sent;
-    next_error_frame_ += serial_robot_driver::sim::fromSeconds(config_.error_repeat_s);
-    if (next_error_frame_ <= now)
-      next_error_frame_ = now + serial_robot_driver::sim::fromSeconds(config_.error_repeat_s);
+    next_error_frame_ += fromSeconds(config_.error_repeat_s);
+    if (next_error_frame_ <= now) next_error_frame_ = now + fromSeconds(config_.error_repeat_s);
   }
 }
 
-serial_robot_driver::sim::TimePoint BaseSim::nextEvent() const {
-  serial_robot_driver::sim::TimePoint next = next_pid_;
+TimePoint BaseSim::nextEvent() const {
+  TimePoint next = next_pid_;
   if (stats_.in_error) {
     next = std::min(next, next_error_frame_);
   } else {
     // One tick just past the deadline: the timeout is "more than" heartbeat_timeout_s.
-    next = std::min(next, last_host_frame_ +
-                              serial_robot_driver::sim::fromSeconds(config_.heartbeat_timeout_s) +
+    next = std::min(next, last_host_frame_ + fromSeconds(config_.heartbeat_timeout_s) +
                               std::chrono::milliseconds(1));
   }
   return next;

@@ -7,65 +7,66 @@
 
 namespace serial_robot_driver::devices::base::sim {
 
+using serial_robot_driver::sim::ChassisMotion;
+using serial_robot_driver::sim::DeviceSimStats;
+using serial_robot_driver::sim::HostedDeviceOptions;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::PortCounters;
+using serial_robot_driver::sim::SimDevice;
+using serial_robot_driver::sim::SimOptions;
+using serial_robot_driver::sim::SimStats;
+using serial_robot_driver::sim::SimWorld;
+using serial_robot_driver::sim::statsLine;
+using serial_robot_driver::sim::TimePoint;
+
 namespace {
 
 constexpr const char* kName = "base";
 
-serial_robot_driver::sim::DeviceSimStats statsOf(
-    const BaseSimStats& base, const serial_robot_driver::sim::PortCounters& ports) {
-  return serial_robot_driver::sim::DeviceSimStats{
-      kName,
-      base,
-      {
-          serial_robot_driver::sim::statsLine("base_frames_received", base.frames_received),
-          serial_robot_driver::sim::statsLine("base_seq_gaps", base.seq_gaps),
-          serial_robot_driver::sim::statsLine("base_resets", base.resets),
-          serial_robot_driver::sim::statsLine("base_speed_frames_applied",
-                                              base.speed_frames_applied),
-          serial_robot_driver::sim::statsLine("base_speed_frames_ignored",
-                                              base.speed_frames_ignored),
-          serial_robot_driver::sim::statsLine("base_errors_sent", base.errors_sent),
-          serial_robot_driver::sim::statsLine("base_timeouts", base.timeouts),
-          serial_robot_driver::sim::statsLine("base_battery_requests", base.battery_requests),
-          serial_robot_driver::sim::statsLine("base_encoder_clears", base.encoder_clears),
-          serial_robot_driver::sim::statsLine("base_unknown_frames", base.unknown_frames),
-          serial_robot_driver::sim::statsLine("base_in_error", base.in_error ? 1 : 0),
-          serial_robot_driver::sim::statsLine("left_ticks", base.left_ticks),
-          serial_robot_driver::sim::statsLine("right_ticks", base.right_ticks),
-          serial_robot_driver::sim::statsLine("base_x_m", base.x_m),
-          serial_robot_driver::sim::statsLine("base_y_m", base.y_m),
-          serial_robot_driver::sim::statsLine("base_yaw_rad", base.yaw_rad),
-          serial_robot_driver::sim::statsLine("last_left_speed", base.last_left_speed),
-          serial_robot_driver::sim::statsLine("last_right_speed", base.last_right_speed),
-          serial_robot_driver::sim::statsLine("rx_frames_base", ports.all_ports.framesOf(kFrames)),
-      }};
+DeviceSimStats statsOf(const BaseSimStats& base, const PortCounters& ports) {
+  return DeviceSimStats{kName,
+                        base,
+                        {
+                            statsLine("base_frames_received", base.frames_received),
+                            statsLine("base_seq_gaps", base.seq_gaps),
+                            statsLine("base_resets", base.resets),
+                            statsLine("base_speed_frames_applied", base.speed_frames_applied),
+                            statsLine("base_speed_frames_ignored", base.speed_frames_ignored),
+                            statsLine("base_errors_sent", base.errors_sent),
+                            statsLine("base_timeouts", base.timeouts),
+                            statsLine("base_battery_requests", base.battery_requests),
+                            statsLine("base_encoder_clears", base.encoder_clears),
+                            statsLine("base_unknown_frames", base.unknown_frames),
+                            statsLine("base_in_error", base.in_error ? 1 : 0),
+                            statsLine("left_ticks", base.left_ticks),
+                            statsLine("right_ticks", base.right_ticks),
+                            statsLine("base_x_m", base.x_m),
+                            statsLine("base_y_m", base.y_m),
+                            statsLine("base_yaw_rad", base.yaw_rad),
+                            statsLine("last_left_speed", base.last_left_speed),
+                            statsLine("last_right_speed", base.last_right_speed),
+                            statsLine("rx_frames_base", ports.all_ports.framesOf(kFrames)),
+                        }};
 }
 
-serial_robot_driver::sim::DeviceSimStats leftOutStats(
-    const serial_robot_driver::sim::PortCounters& ports) {
-  return statsOf(BaseSimStats{}, ports);
-}
+DeviceSimStats leftOutStats(const PortCounters& ports) { return statsOf(BaseSimStats{}, ports); }
 
-class BaseSimDevice : public serial_robot_driver::sim::SimDevice {
+class BaseSimDevice : public SimDevice {
  public:
-  BaseSimDevice(const BaseSimConfig& config, serial_robot_driver::sim::TimePoint now)
-      : base_(config, now) {}
+  BaseSimDevice(const BaseSimConfig& config, TimePoint now) : base_(config, now) {}
 
   void handleFrame(const protocol::FrameFamily& family, const uint8_t* data, std::size_t size,
-                   serial_robot_driver::sim::TimePoint at,
-                   serial_robot_driver::sim::Outbox* out) override {
+                   TimePoint at, Outbox* out) override {
     if (family == kFrames) base_.handleFrame(data, size, at, out);
   }
-  void tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver::sim::SimWorld& world,
-            serial_robot_driver::sim::Outbox* out) override {
+  void tick(TimePoint now, SimWorld& world, Outbox* out) override {
     base_.tick(now, out);
     // Whatever rides on the base (the board's IMU) sees its true heading, slip included.
-    world.chassis = serial_robot_driver::sim::ChassisMotion{base_.stats().yaw_rad, base_.yawRate()};
+    world.chassis = ChassisMotion{base_.stats().yaw_rad, base_.yawRate()};
   }
-  serial_robot_driver::sim::TimePoint nextEvent() const override { return base_.nextEvent(); }
+  TimePoint nextEvent() const override { return base_.nextEvent(); }
 
-  serial_robot_driver::sim::DeviceSimStats stats(
-      const serial_robot_driver::sim::PortCounters& ports) const override {
+  DeviceSimStats stats(const PortCounters& ports) const override {
     return statsOf(base_.stats(), ports);
   }
 
@@ -73,25 +74,22 @@ class BaseSimDevice : public serial_robot_driver::sim::SimDevice {
   BaseSim base_;
 };
 
-std::unique_ptr<serial_robot_driver::sim::SimDevice> makeBaseSim(
-    const serial_robot_driver::sim::HostedDeviceOptions& options, uint32_t /*seed*/,
-    serial_robot_driver::sim::TimePoint now) {
+std::unique_ptr<SimDevice> makeBaseSim(const HostedDeviceOptions& options, uint32_t /*seed*/,
+                                       TimePoint now) {
   return std::make_unique<BaseSimDevice>(options.configAs<BaseSimConfig>(), now);
 }
 
 }  // namespace
 
-BaseSimConfig& baseConfig(serial_robot_driver::sim::SimOptions& options) {
+BaseSimConfig& baseConfig(SimOptions& options) {
   return options.device(kName).configAs<BaseSimConfig>();
 }
 
-const BaseSimStats& baseStats(const serial_robot_driver::sim::SimStats& stats) {
+const BaseSimStats& baseStats(const SimStats& stats) {
   return stats.countersOf<BaseSimStats>(kName);
 }
 
-BaseSimStats baseStats(serial_robot_driver::sim::SimStats&& stats) {
-  return stats.countersOf<BaseSimStats>(kName);
-}
+BaseSimStats baseStats(SimStats&& stats) { return stats.countersOf<BaseSimStats>(kName); }
 
 }  // namespace serial_robot_driver::devices::base::sim
 

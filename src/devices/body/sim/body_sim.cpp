@@ -7,8 +7,16 @@
 
 namespace serial_robot_driver::devices::body::sim {
 
+using serial_robot_driver::sim::ChassisMotion;
+using serial_robot_driver::sim::fromSeconds;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::Outgoing;
+using serial_robot_driver::sim::OutputKind;
+using serial_robot_driver::sim::TimePoint;
+using serial_robot_driver::sim::toSeconds;
+
 // The SUM byte precedes the 1F 2F tail.
-const serial_robot_driver::sim::OutputKind kTelemetryOutput{"telemetry", 3};
+const OutputKind kTelemetryOutput{"telemetry", 3};
 
 namespace {
 
@@ -49,7 +57,7 @@ std::optional<std::array<double, 3>> parseGyroBias(const std::string& text) {
   return bias;
 }
 
-BodySim::BodySim(const BodySimConfig& config, serial_robot_driver::sim::TimePoint now)
+BodySim::BodySim(const BodySimConfig& config, TimePoint now)
     : config_(config), last_step_(now), next_telemetry_(now), rng_(config.seed) {
   if (config_.servo_ids.size() > kMaxTelemetryServos) {
     config_.servo_ids.resize(kMaxTelemetryServos);
@@ -59,7 +67,7 @@ BodySim::BodySim(const BodySimConfig& config, serial_robot_driver::sim::TimePoin
     stats_.servos.push_back(BodySimServoState{id, static_cast<double>(start), start, 0});
   }
   if (config_.telemetry_rate_hz > 0) {
-    telemetry_period_ = serial_robot_driver::sim::fromSeconds(1.0 / config_.telemetry_rate_hz);
+    telemetry_period_ = fromSeconds(1.0 / config_.telemetry_rate_hz);
     next_telemetry_ = now + telemetry_period_;
   }
 }
@@ -82,8 +90,8 @@ void BodySim::handleSyncWrite(const uint8_t* data, std::size_t size) {
   }
 }
 
-void BodySim::advance(serial_robot_driver::sim::TimePoint now) {
-  const double dt = serial_robot_driver::sim::toSeconds(now - last_step_);
+void BodySim::advance(TimePoint now) {
+  const double dt = toSeconds(now - last_step_);
   if (dt <= 0) return;
   last_step_ = now;
   const double max_step = config_.servo_speed * dt;
@@ -100,8 +108,7 @@ int16_t BodySim::noise() {
   return static_cast<int16_t>(std::uniform_int_distribution<int>(-2, 2)(rng_));
 }
 
-std::vector<uint8_t> BodySim::buildTelemetry(
-    const serial_robot_driver::sim::ChassisMotion& chassis) {
+std::vector<uint8_t> BodySim::buildTelemetry(const ChassisMotion& chassis) {
   stats_.yaw_rad = wrapAngle(chassis.yaw_rad);
   Telemetry telemetry;
   telemetry.servo_count = stats_.servos.size();
@@ -146,9 +153,7 @@ std::vector<uint8_t> BodySim::buildTelemetry(
   return encodeTelemetry(telemetry);
 }
 
-void BodySim::tick(serial_robot_driver::sim::TimePoint now,
-                   const serial_robot_driver::sim::ChassisMotion& chassis,
-                   serial_robot_driver::sim::Outbox* out) {
+void BodySim::tick(TimePoint now, const ChassisMotion& chassis, Outbox* out) {
   if (config_.telemetry_rate_hz <= 0) {
     advance(now);
     return;
@@ -156,13 +161,13 @@ void BodySim::tick(serial_robot_driver::sim::TimePoint now,
   if (now - next_telemetry_ > std::chrono::seconds(1)) next_telemetry_ = now;  // after a stall
   while (next_telemetry_ <= now) {
     advance(next_telemetry_);
-    out->push_back(serial_robot_driver::sim::Outgoing{&kTelemetryOutput, buildTelemetry(chassis)});
+    out->push_back(Outgoing{&kTelemetryOutput, buildTelemetry(chassis)});
     next_telemetry_ += telemetry_period_;
   }
   advance(now);
 }
 
-serial_robot_driver::sim::TimePoint BodySim::nextEvent() const {
+TimePoint BodySim::nextEvent() const {
   if (config_.telemetry_rate_hz <= 0) return last_step_ + std::chrono::milliseconds(100);
   return next_telemetry_;
 }

@@ -8,58 +8,62 @@
 
 namespace serial_robot_driver::devices::body::sim {
 
+using serial_robot_driver::sim::badValue;
+using serial_robot_driver::sim::DeviceSimStats;
+using serial_robot_driver::sim::HostedDeviceOptions;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::PortCounters;
+using serial_robot_driver::sim::showDefault;
+using serial_robot_driver::sim::SimDevice;
+using serial_robot_driver::sim::SimDeviceOption;
+using serial_robot_driver::sim::SimOptions;
+using serial_robot_driver::sim::SimStats;
+using serial_robot_driver::sim::SimWorld;
+using serial_robot_driver::sim::StatsLine;
+using serial_robot_driver::sim::statsLine;
+using serial_robot_driver::sim::TimePoint;
+
 namespace {
 
 constexpr const char* kName = "body";
 
 /// `body` with what its port's framer saw, and its stats-file lines.
-serial_robot_driver::sim::DeviceSimStats statsOf(
-    BodySimStats body, const serial_robot_driver::sim::PortCounters& ports) {
+DeviceSimStats statsOf(BodySimStats body, const PortCounters& ports) {
   body.port_checksum_errors = ports.own_port.checksum_errors;
-  std::vector<serial_robot_driver::sim::StatsLine> lines{
-      serial_robot_driver::sim::statsLine("telemetry_generated", body.telemetry_generated),
-      serial_robot_driver::sim::statsLine("telemetry_with_foot", body.telemetry_with_foot),
-      serial_robot_driver::sim::statsLine("sync_writes_ok", body.sync_writes_ok),
-      serial_robot_driver::sim::statsLine("sync_writes_bad",
-                                          body.sync_writes_malformed + body.port_checksum_errors),
-      serial_robot_driver::sim::statsLine("sync_write_unknown_ids", body.sync_write_unknown_ids),
-      serial_robot_driver::sim::statsLine("yaw_rad", body.yaw_rad),
+  std::vector<StatsLine> lines{
+      statsLine("telemetry_generated", body.telemetry_generated),
+      statsLine("telemetry_with_foot", body.telemetry_with_foot),
+      statsLine("sync_writes_ok", body.sync_writes_ok),
+      statsLine("sync_writes_bad", body.sync_writes_malformed + body.port_checksum_errors),
+      statsLine("sync_write_unknown_ids", body.sync_write_unknown_ids),
+      statsLine("yaw_rad", body.yaw_rad),
   };
   for (const BodySimServoState& servo : body.servos) {
     const std::string prefix = "servo_" + std::to_string(servo.id);
-    lines.push_back(
-        serial_robot_driver::sim::statsLine(prefix + "_position", std::lround(servo.position)));
-    lines.push_back(serial_robot_driver::sim::statsLine(prefix + "_target", servo.target));
-    lines.push_back(serial_robot_driver::sim::statsLine(prefix + "_speed", servo.speed));
+    lines.push_back(statsLine(prefix + "_position", std::lround(servo.position)));
+    lines.push_back(statsLine(prefix + "_target", servo.target));
+    lines.push_back(statsLine(prefix + "_speed", servo.speed));
   }
-  lines.push_back(serial_robot_driver::sim::statsLine("rx_frames_sync_write",
-                                                      ports.all_ports.framesOf(kSyncWriteFrames)));
-  return serial_robot_driver::sim::DeviceSimStats{kName, std::move(body), std::move(lines)};
+  lines.push_back(statsLine("rx_frames_sync_write", ports.all_ports.framesOf(kSyncWriteFrames)));
+  return DeviceSimStats{kName, std::move(body), std::move(lines)};
 }
 
-serial_robot_driver::sim::DeviceSimStats leftOutStats(
-    const serial_robot_driver::sim::PortCounters& ports) {
-  return statsOf(BodySimStats{}, ports);
-}
+DeviceSimStats leftOutStats(const PortCounters& ports) { return statsOf(BodySimStats{}, ports); }
 
-class BodySimDevice : public serial_robot_driver::sim::SimDevice {
+class BodySimDevice : public SimDevice {
  public:
-  BodySimDevice(const BodySimConfig& config, serial_robot_driver::sim::TimePoint now)
-      : body_(config, now) {}
+  BodySimDevice(const BodySimConfig& config, TimePoint now) : body_(config, now) {}
 
   void handleFrame(const protocol::FrameFamily& family, const uint8_t* data, std::size_t size,
-                   serial_robot_driver::sim::TimePoint /*at*/,
-                   serial_robot_driver::sim::Outbox* /*out*/) override {
+                   TimePoint /*at*/, Outbox* /*out*/) override {
     if (family == kSyncWriteFrames) body_.handleSyncWrite(data, size);
   }
-  void tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver::sim::SimWorld& world,
-            serial_robot_driver::sim::Outbox* out) override {
+  void tick(TimePoint now, SimWorld& world, Outbox* out) override {
     body_.tick(now, world.chassis, out);
   }
-  serial_robot_driver::sim::TimePoint nextEvent() const override { return body_.nextEvent(); }
+  TimePoint nextEvent() const override { return body_.nextEvent(); }
 
-  serial_robot_driver::sim::DeviceSimStats stats(
-      const serial_robot_driver::sim::PortCounters& ports) const override {
+  DeviceSimStats stats(const PortCounters& ports) const override {
     return statsOf(body_.stats(), ports);
   }
 
@@ -67,48 +71,41 @@ class BodySimDevice : public serial_robot_driver::sim::SimDevice {
   BodySim body_;
 };
 
-std::unique_ptr<serial_robot_driver::sim::SimDevice> makeBodySim(
-    const serial_robot_driver::sim::HostedDeviceOptions& options, uint32_t seed,
-    serial_robot_driver::sim::TimePoint now) {
+std::unique_ptr<SimDevice> makeBodySim(const HostedDeviceOptions& options, uint32_t seed,
+                                       TimePoint now) {
   BodySimConfig config = options.configAs<BodySimConfig>();
   config.seed = seed;
   return std::make_unique<BodySimDevice>(config, now);
 }
 
 /// --gyro-bias X,Y,Z: rad/s on the sensor's axes.
-serial_robot_driver::sim::SimDeviceOption gyroBiasOption() {
-  serial_robot_driver::sim::SimDeviceOption option{
-      "--gyro-bias", "X,Y,Z", "rad/s added to the gyro's sensor axes", nullptr, nullptr};
-  option.apply = [](const std::string& value,
-                    serial_robot_driver::sim::HostedDeviceOptions& device) {
+SimDeviceOption gyroBiasOption() {
+  SimDeviceOption option{"--gyro-bias", "X,Y,Z", "rad/s added to the gyro's sensor axes", nullptr,
+                         nullptr};
+  option.apply = [](const std::string& value, HostedDeviceOptions& device) {
     const auto bias = parseGyroBias(value);
-    if (!bias)
-      return serial_robot_driver::sim::badValue("--gyro-bias", value) + " (X,Y,Z in rad/s)";
+    if (!bias) return badValue("--gyro-bias", value) + " (X,Y,Z in rad/s)";
     device.configAs<BodySimConfig>().gyro_bias = *bias;
     return std::string();
   };
-  option.shown_default = [](const serial_robot_driver::sim::HostedDeviceOptions& defaults) {
+  option.shown_default = [](const HostedDeviceOptions& defaults) {
     const auto& bias = defaults.configAs<BodySimConfig>().gyro_bias;
-    return serial_robot_driver::sim::showDefault(bias[0]) + "," +
-           serial_robot_driver::sim::showDefault(bias[1]) + "," +
-           serial_robot_driver::sim::showDefault(bias[2]);
+    return showDefault(bias[0]) + "," + showDefault(bias[1]) + "," + showDefault(bias[2]);
   };
   return option;
 }
 
 }  // namespace
 
-BodySimConfig& bodyConfig(serial_robot_driver::sim::SimOptions& options) {
+BodySimConfig& bodyConfig(SimOptions& options) {
   return options.device(kName).configAs<BodySimConfig>();
 }
 
-const BodySimStats& bodyStats(const serial_robot_driver::sim::SimStats& stats) {
+const BodySimStats& bodyStats(const SimStats& stats) {
   return stats.countersOf<BodySimStats>(kName);
 }
 
-BodySimStats bodyStats(serial_robot_driver::sim::SimStats&& stats) {
-  return stats.countersOf<BodySimStats>(kName);
-}
+BodySimStats bodyStats(SimStats&& stats) { return stats.countersOf<BodySimStats>(kName); }
 
 }  // namespace serial_robot_driver::devices::body::sim
 

@@ -8,45 +8,49 @@
 
 namespace serial_robot_driver::devices::echo::sim {
 
-const serial_robot_driver::sim::OutputKind kEchoAnswerOutput{"echo_replies", 1};
+using serial_robot_driver::sim::Clock;
+using serial_robot_driver::sim::DeviceSimStats;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::Outgoing;
+using serial_robot_driver::sim::OutputKind;
+using serial_robot_driver::sim::PortCounters;
+using serial_robot_driver::sim::SimWorld;
+using serial_robot_driver::sim::statsLine;
+using serial_robot_driver::sim::TimePoint;
+
+const OutputKind kEchoAnswerOutput{"echo_replies", 1};
 
 void EchoSim::handleFrame(const protocol::FrameFamily& family, const uint8_t* data,
-                          std::size_t size, serial_robot_driver::sim::TimePoint at,
-                          serial_robot_driver::sim::Outbox* out) {
+                          std::size_t size, TimePoint at, Outbox* out) {
   if (family != kRequestFrames) return;
   const auto payload = decode(kRequestType, data, size);
   if (!payload) return;  // the framer verified it; nothing else can fail
   ++stats_.requests;
-  if (latency_ == serial_robot_driver::sim::Clock::duration::zero()) {
+  if (latency_ == Clock::duration::zero()) {
     ++stats_.answers;
-    out->push_back(serial_robot_driver::sim::Outgoing{&kEchoAnswerOutput, encodeAnswer(*payload)});
+    out->push_back(Outgoing{&kEchoAnswerOutput, encodeAnswer(*payload)});
     return;
   }
   pending_.emplace_back(at + latency_, encodeAnswer(*payload));
 }
 
-void EchoSim::tick(serial_robot_driver::sim::TimePoint now,
-                   serial_robot_driver::sim::SimWorld& /*world*/,
-                   serial_robot_driver::sim::Outbox* out) {
+void EchoSim::tick(TimePoint now, SimWorld& /*world*/, Outbox* out) {
   while (!pending_.empty() && pending_.front().first <= now) {
     ++stats_.answers;
-    out->push_back(
-        serial_robot_driver::sim::Outgoing{&kEchoAnswerOutput, std::move(pending_.front().second)});
+    out->push_back(Outgoing{&kEchoAnswerOutput, std::move(pending_.front().second)});
     pending_.pop_front();
   }
 }
 
-serial_robot_driver::sim::TimePoint EchoSim::nextEvent() const {
-  return pending_.empty() ? serial_robot_driver::sim::TimePoint::max() : pending_.front().first;
+TimePoint EchoSim::nextEvent() const {
+  return pending_.empty() ? TimePoint::max() : pending_.front().first;
 }
 
-serial_robot_driver::sim::DeviceSimStats EchoSim::stats(
-    const serial_robot_driver::sim::PortCounters& /*ports*/) const {
-  return serial_robot_driver::sim::DeviceSimStats{
+DeviceSimStats EchoSim::stats(const PortCounters& /*ports*/) const {
+  return DeviceSimStats{
       "echo",
       stats_,
-      {serial_robot_driver::sim::statsLine("echo_requests", stats_.requests),
-       serial_robot_driver::sim::statsLine("echo_answers", stats_.answers)}};
+      {statsLine("echo_requests", stats_.requests), statsLine("echo_answers", stats_.answers)}};
 }
 
 }  // namespace serial_robot_driver::devices::echo::sim

@@ -9,7 +9,14 @@
 
 namespace serial_robot_driver::devices::servo_bus::sim {
 
-const serial_robot_driver::sim::OutputKind kServoAnswerOutput{"servo_answers", 1};
+using serial_robot_driver::sim::fromSeconds;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::Outgoing;
+using serial_robot_driver::sim::OutputKind;
+using serial_robot_driver::sim::TimePoint;
+using serial_robot_driver::sim::toSeconds;
+
+const OutputKind kServoAnswerOutput{"servo_answers", 1};
 using servo_bus::Command;
 
 namespace {
@@ -79,7 +86,7 @@ constexpr double kMsPerSecond = 1000.0;
 
 }  // namespace
 
-ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, serial_robot_driver::sim::TimePoint now)
+ServoBusSim::ServoBusSim(const ServoBusSimConfig& config, TimePoint now)
     : config_(config), rng_(config.seed), last_drift_(now) {
   for (uint8_t id : config_.servo_ids) {
     const bool offline = std::find(config_.offline_ids.begin(), config_.offline_ids.end(), id) !=
@@ -160,8 +167,7 @@ double ServoBusSim::moveAngle(const Motion& m, double elapsed) {
   return m.start_angle + direction * travelled;
 }
 
-void ServoBusSim::requestMove(Servo* s, Motion motion, uint8_t id, bool broadcast,
-                              serial_robot_driver::sim::TimePoint now) {
+void ServoBusSim::requestMove(Servo* s, Motion motion, uint8_t id, bool broadcast, TimePoint now) {
   if (!motion.multi_turn && param(*s, kAngleLimitSwitch) == 1) {
     motion.target_angle = std::clamp(motion.target_angle, param(*s, kAngleLimitLow) / 10.0,
                                      param(*s, kAngleLimitHigh) / 10.0);
@@ -177,17 +183,15 @@ int64_t ServoBusSim::param(const Servo& s, uint8_t data_id) {
   return it == s.params.end() ? 0 : it->second;
 }
 
-void ServoBusSim::answer(serial_robot_driver::sim::TimePoint due, Command cmd,
-                         const std::vector<uint8_t>& content) {
+void ServoBusSim::answer(TimePoint due, Command cmd, const std::vector<uint8_t>& content) {
   PendingAnswer pending{due, encodeResponse(cmd, content)};
-  const auto position = std::upper_bound(pending_.begin(), pending_.end(), due,
-                                         [](serial_robot_driver::sim::TimePoint t,
-                                            const PendingAnswer& other) { return t < other.due; });
+  const auto position =
+      std::upper_bound(pending_.begin(), pending_.end(), due,
+                       [](TimePoint t, const PendingAnswer& other) { return t < other.due; });
   pending_.insert(position, std::move(pending));
 }
 
-void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size,
-                                serial_robot_driver::sim::TimePoint now) {
+void ServoBusSim::handleRequest(const uint8_t* data, std::size_t size, TimePoint now) {
   const auto decoded = decodeRequest(data, size);
   if (!decoded || decoded->content_size == 0) {
     ++stats_.malformed;
@@ -247,8 +251,7 @@ const std::array<ServoBusSim::HandlerRow, kMaxCommand>& ServoBusSim::handlers() 
   return kRows;
 }
 
-void ServoBusSim::execute(Servo* s, const Packet& packet, bool broadcast,
-                          serial_robot_driver::sim::TimePoint now) {
+void ServoBusSim::execute(Servo* s, const Packet& packet, bool broadcast, TimePoint now) {
   runMotions(s, now);  // the angle and the queue as of this request
   const auto cmd = static_cast<Command>(packet.cmd);
   const CommandInfo& info = commandInfo(cmd);
@@ -259,11 +262,8 @@ void ServoBusSim::execute(Servo* s, const Packet& packet, bool broadcast,
   // Nobody answers the broadcast id; a motion answers (on completion) only with response_switch 1.
   const bool answers =
       !broadcast && (info.answers == Answers::kAlways || param(*s, kResponseSwitch) == 1);
-  const Request request{
-      s,         packet,
-      cmd,       packet.id(),
-      broadcast, answers,
-      now,       now + serial_robot_driver::sim::fromSeconds(config_.answer_latency_s)};
+  const Request request{s,         packet,  cmd, packet.id(),
+                        broadcast, answers, now, now + fromSeconds(config_.answer_latency_s)};
   (this->*handlers()[commandRow(cmd)].handle)(request);
 }
 
@@ -437,7 +437,7 @@ void ServoBusSim::stopAll(Servo* s) {
   s->spin_rate_dps = 0.0;
 }
 
-void ServoBusSim::startMotion(Servo* s, Motion motion, serial_robot_driver::sim::TimePoint now) {
+void ServoBusSim::startMotion(Servo* s, Motion motion, TimePoint now) {
   if (!motion.answer) stopAll(s);  // response_switch 0: the new command interrupts
   s->spin_rate_dps = 0.0;
   s->relaxed = false;
@@ -445,13 +445,12 @@ void ServoBusSim::startMotion(Servo* s, Motion motion, serial_robot_driver::sim:
   runMotions(s, now);
 }
 
-void ServoBusSim::runMotions(Servo* s, serial_robot_driver::sim::TimePoint now) {
+void ServoBusSim::runMotions(Servo* s, TimePoint now) {
   if (s->spin_rate_dps != 0.0) {
-    s->angle_deg += s->spin_rate_dps *
-                    serial_robot_driver::sim::toSeconds(now - s->last_step);  // turns accumulate
+    s->angle_deg += s->spin_rate_dps * toSeconds(now - s->last_step);  // turns accumulate
   }
   s->last_step = now;
-  serial_robot_driver::sim::TimePoint cursor = now;
+  TimePoint cursor = now;
   while (!s->motions.empty()) {
     Motion& motion = s->motions.front();
     if (!motion.started) {
@@ -463,7 +462,7 @@ void ServoBusSim::runMotions(Servo* s, serial_robot_driver::sim::TimePoint now) 
       motion.start_angle = s->angle_deg;
       if (motion.kind == Motion::Kind::kRotate) beginMove(&motion, motion.start_angle);
     }
-    const double elapsed = serial_robot_driver::sim::toSeconds(now - motion.start);
+    const double elapsed = toSeconds(now - motion.start);
     const bool done = elapsed >= motion.duration_s;
     const double progress = done ? motion.duration_s : elapsed;
     if (motion.kind == Motion::Kind::kRotate) {
@@ -472,12 +471,10 @@ void ServoBusSim::runMotions(Servo* s, serial_robot_driver::sim::TimePoint now) 
       s->angle_deg = motion.start_angle + motion.rate_dps * progress;
     }
     if (!done) break;
-    const serial_robot_driver::sim::TimePoint finished =
-        motion.start + serial_robot_driver::sim::fromSeconds(motion.duration_s);
+    const TimePoint finished = motion.start + fromSeconds(motion.duration_s);
     if (motion.answer) {
-      answer(
-          std::max(finished, now) + serial_robot_driver::sim::fromSeconds(config_.answer_latency_s),
-          motion.cmd, resultAnswerContent(motion.answer_id, true));
+      answer(std::max(finished, now) + fromSeconds(config_.answer_latency_s), motion.cmd,
+             resultAnswerContent(motion.answer_id, true));
     }
     cursor = finished;  // the next queued motion starts where this one ended
     s->motions.pop_front();
@@ -506,8 +503,7 @@ void ServoBusSim::driftReadOnly(Servo* s) {
   s->params[kPower] = voltage * current / 1000;
 }
 
-void ServoBusSim::tick(serial_robot_driver::sim::TimePoint now,
-                       serial_robot_driver::sim::Outbox* out) {
+void ServoBusSim::tick(TimePoint now, Outbox* out) {
   const bool drift = now - last_drift_ >= kDriftPeriod;
   if (drift) last_drift_ = now;
   for (Servo& s : servos_) {
@@ -515,22 +511,20 @@ void ServoBusSim::tick(serial_robot_driver::sim::TimePoint now,
     if (drift) driftReadOnly(&s);
   }
   while (!pending_.empty() && pending_.front().due <= now) {
-    out->push_back(serial_robot_driver::sim::Outgoing{
-        &kServoAnswerOutput, std::move(pending_.front().bytes), pending_.front().due});
+    out->push_back(
+        Outgoing{&kServoAnswerOutput, std::move(pending_.front().bytes), pending_.front().due});
     pending_.pop_front();
     ++stats_.answers;
   }
 }
 
-serial_robot_driver::sim::TimePoint ServoBusSim::nextEvent() const {
-  serial_robot_driver::sim::TimePoint next = last_drift_ + kDriftPeriod;
+TimePoint ServoBusSim::nextEvent() const {
+  TimePoint next = last_drift_ + kDriftPeriod;
   if (!pending_.empty()) next = std::min(next, pending_.front().due);
   for (const Servo& s : servos_) {
     if (s.motions.empty()) continue;
     const Motion& motion = s.motions.front();
-    if (motion.started)
-      next =
-          std::min(next, motion.start + serial_robot_driver::sim::fromSeconds(motion.duration_s));
+    if (motion.started) next = std::min(next, motion.start + fromSeconds(motion.duration_s));
   }
   return next;
 }

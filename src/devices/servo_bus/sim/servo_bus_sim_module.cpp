@@ -7,59 +7,69 @@
 
 namespace serial_robot_driver::devices::servo_bus::sim {
 
+using serial_robot_driver::sim::badValue;
+using serial_robot_driver::sim::DeviceSimStats;
+using serial_robot_driver::sim::HostedDeviceOptions;
+using serial_robot_driver::sim::Outbox;
+using serial_robot_driver::sim::parseDouble;
+using serial_robot_driver::sim::PortCounters;
+using serial_robot_driver::sim::showDefault;
+using serial_robot_driver::sim::SimDevice;
+using serial_robot_driver::sim::SimDeviceOption;
+using serial_robot_driver::sim::SimOptions;
+using serial_robot_driver::sim::SimStats;
+using serial_robot_driver::sim::SimWorld;
+using serial_robot_driver::sim::StatsLine;
+using serial_robot_driver::sim::statsLine;
+using serial_robot_driver::sim::TimePoint;
+
 namespace {
 
 constexpr const char* kName = "servo_bus";
 
-serial_robot_driver::sim::DeviceSimStats statsOf(
-    ServoBusSimStats bus, const serial_robot_driver::sim::PortCounters& ports) {
-  std::vector<serial_robot_driver::sim::StatsLine> lines{
-      serial_robot_driver::sim::statsLine("servo_requests", bus.requests),
-      serial_robot_driver::sim::statsLine("servo_answers", bus.answers),
-      serial_robot_driver::sim::statsLine("servo_broadcasts", bus.broadcasts),
-      serial_robot_driver::sim::statsLine("servo_unaddressed", bus.unaddressed),
-      serial_robot_driver::sim::statsLine("servo_unknown_data_ids", bus.unknown_data_ids),
-      serial_robot_driver::sim::statsLine("servo_malformed", bus.malformed),
-      serial_robot_driver::sim::statsLine("servo_writes_rejected", bus.writes_rejected),
-      serial_robot_driver::sim::statsLine("servo_stops_lost", bus.stops_lost),
+DeviceSimStats statsOf(ServoBusSimStats bus, const PortCounters& ports) {
+  std::vector<StatsLine> lines{
+      statsLine("servo_requests", bus.requests),
+      statsLine("servo_answers", bus.answers),
+      statsLine("servo_broadcasts", bus.broadcasts),
+      statsLine("servo_unaddressed", bus.unaddressed),
+      statsLine("servo_unknown_data_ids", bus.unknown_data_ids),
+      statsLine("servo_malformed", bus.malformed),
+      statsLine("servo_writes_rejected", bus.writes_rejected),
+      statsLine("servo_stops_lost", bus.stops_lost),
   };
   for (const BusServoSnapshot& servo : bus.servos) {
-    lines.push_back(serial_robot_driver::sim::statsLine(
-        "bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
+    lines.push_back(
+        statsLine("bus_servo_" + std::to_string(servo.id) + "_angle_deg", servo.angle_deg));
   }
-  lines.push_back(serial_robot_driver::sim::statsLine("rx_frames_servo_request",
-                                                      ports.all_ports.framesOf(kRequestFrames)));
-  return serial_robot_driver::sim::DeviceSimStats{kName, std::move(bus), std::move(lines)};
+  lines.push_back(statsLine("rx_frames_servo_request", ports.all_ports.framesOf(kRequestFrames)));
+  return DeviceSimStats{kName, std::move(bus), std::move(lines)};
 }
 
-serial_robot_driver::sim::DeviceSimStats leftOutStats(
-    const serial_robot_driver::sim::PortCounters& ports) {
+DeviceSimStats leftOutStats(const PortCounters& ports) {
   return statsOf(ServoBusSimStats{}, ports);
 }
 
-class ServoBusSimDevice : public serial_robot_driver::sim::SimDevice {
+class ServoBusSimDevice : public SimDevice {
  public:
-  ServoBusSimDevice(const ServoBusSimConfig& config, serial_robot_driver::sim::TimePoint now)
+  ServoBusSimDevice(const ServoBusSimConfig& config, TimePoint now)
       : bus_(config, now), answer_fault_rate_(config.answer_fault_rate) {}
 
   void handleFrame(const protocol::FrameFamily& family, const uint8_t* data, std::size_t size,
-                   serial_robot_driver::sim::TimePoint at,
-                   serial_robot_driver::sim::Outbox* /*out*/) override {
+                   TimePoint at, Outbox* /*out*/) override {
     // Answers leave from tick(), once their latency is over.
     if (family == kRequestFrames) bus_.handleRequest(data, size, at);
   }
-  void tick(serial_robot_driver::sim::TimePoint now, serial_robot_driver::sim::SimWorld& /*world*/,
-            serial_robot_driver::sim::Outbox* out) override {
+  void tick(TimePoint now, SimWorld& /*world*/, Outbox* out) override {
     const std::size_t first = out->size();
     bus_.tick(now, out);
     for (std::size_t i = first; i < out->size(); ++i) {
       (*out)[i].garble_or_suppress_rate = answer_fault_rate_;
     }
   }
-  serial_robot_driver::sim::TimePoint nextEvent() const override { return bus_.nextEvent(); }
+  TimePoint nextEvent() const override { return bus_.nextEvent(); }
 
-  serial_robot_driver::sim::DeviceSimStats stats(
-      const serial_robot_driver::sim::PortCounters& ports) const override {
+  DeviceSimStats stats(const PortCounters& ports) const override {
     return statsOf(bus_.stats(), ports);
   }
 
@@ -68,44 +78,39 @@ class ServoBusSimDevice : public serial_robot_driver::sim::SimDevice {
   double answer_fault_rate_;
 };
 
-std::unique_ptr<serial_robot_driver::sim::SimDevice> makeServoBusSim(
-    const serial_robot_driver::sim::HostedDeviceOptions& options, uint32_t seed,
-    serial_robot_driver::sim::TimePoint now) {
+std::unique_ptr<SimDevice> makeServoBusSim(const HostedDeviceOptions& options, uint32_t seed,
+                                           TimePoint now) {
   ServoBusSimConfig config = options.configAs<ServoBusSimConfig>();
   config.seed = seed;
   return std::make_unique<ServoBusSimDevice>(config, now);
 }
 
 /// --servo-latency-ms: given in ms, kept in seconds.
-serial_robot_driver::sim::SimDeviceOption latencyOption() {
-  serial_robot_driver::sim::SimDeviceOption option{"--servo-latency-ms", "MS",
-                                                   "servo bus answer latency", nullptr, nullptr};
-  option.apply = [](const std::string& value,
-                    serial_robot_driver::sim::HostedDeviceOptions& device) {
+SimDeviceOption latencyOption() {
+  SimDeviceOption option{"--servo-latency-ms", "MS", "servo bus answer latency", nullptr, nullptr};
+  option.apply = [](const std::string& value, HostedDeviceOptions& device) {
     double ms = 0;
-    if (!serial_robot_driver::sim::parseDouble(value, &ms) || ms < 0)
-      return serial_robot_driver::sim::badValue("--servo-latency-ms", value);
+    if (!parseDouble(value, &ms) || ms < 0) return badValue("--servo-latency-ms", value);
     device.configAs<ServoBusSimConfig>().answer_latency_s = ms / 1000.0;
     return std::string();
   };
-  option.shown_default = [](const serial_robot_driver::sim::HostedDeviceOptions& defaults) {
-    return serial_robot_driver::sim::showDefault(
-        defaults.configAs<ServoBusSimConfig>().answer_latency_s * 1000.0);
+  option.shown_default = [](const HostedDeviceOptions& defaults) {
+    return showDefault(defaults.configAs<ServoBusSimConfig>().answer_latency_s * 1000.0);
   };
   return option;
 }
 
 }  // namespace
 
-ServoBusSimConfig& servoBusConfig(serial_robot_driver::sim::SimOptions& options) {
+ServoBusSimConfig& servoBusConfig(SimOptions& options) {
   return options.device(kName).configAs<ServoBusSimConfig>();
 }
 
-const ServoBusSimStats& servoBusStats(const serial_robot_driver::sim::SimStats& stats) {
+const ServoBusSimStats& servoBusStats(const SimStats& stats) {
   return stats.countersOf<ServoBusSimStats>(kName);
 }
 
-ServoBusSimStats servoBusStats(serial_robot_driver::sim::SimStats&& stats) {
+ServoBusSimStats servoBusStats(SimStats&& stats) {
   return stats.countersOf<ServoBusSimStats>(kName);
 }
 
