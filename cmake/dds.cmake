@@ -59,7 +59,8 @@ endforeach()
 add_library(srd_dds STATIC
   ${SRD_DDS_GENERATED_SOURCES}
   src/dds/type_descriptions.cpp
-  src/dds/type_hash.cpp)
+  src/dds/type_hash.cpp
+  src/dds/cdr.cpp)
 target_include_directories(srd_dds PUBLIC ${SRD_DDS_GENERATED_DIR})
 target_link_libraries(srd_dds PUBLIC CycloneDDS::ddsc Threads::Threads PRIVATE OpenSSL::Crypto)
 set_target_properties(srd_dds PROPERTIES POSITION_INDEPENDENT_CODE ON)
@@ -67,6 +68,8 @@ set_target_properties(srd_dds PROPERTIES POSITION_INDEPENDENT_CODE ON)
 if(CATKIN_ENABLE_TESTING)
   # Type hashes, golden CDR bytes, the conventions' pure functions (no network).
   catkin_add_gtest(dds_tests
-    test/dds/test_type_hash.cpp)
+    test/dds/test_type_hash.cpp
+    test/dds/test_cdr_golden.cpp
+    test/dds/test_cdr_golden_navigation.cpp)
   target_link_libraries(dds_tests srd_dds gtest_main)
 endif()
