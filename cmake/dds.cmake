@@ -60,7 +60,13 @@ add_library(srd_dds STATIC
   ${SRD_DDS_GENERATED_SOURCES}
   src/dds/type_descriptions.cpp
   src/dds/type_hash.cpp
-  src/dds/cdr.cpp)
+  src/dds/cdr.cpp
+  src/dds/ros_conventions.cpp
+  src/dds/domain_lease.cpp
+  src/dds/dispatch_thread.cpp
+  src/dds/discovery_info.cpp
+  src/dds/participant.cpp
+  src/dds/endpoint.cpp)
 target_include_directories(srd_dds PUBLIC ${SRD_DDS_GENERATED_DIR})
 target_link_libraries(srd_dds PUBLIC CycloneDDS::ddsc Threads::Threads PRIVATE OpenSSL::Crypto)
 set_target_properties(srd_dds PROPERTIES POSITION_INDEPENDENT_CODE ON)
@@ -70,6 +76,8 @@ if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(dds_tests
     test/dds/test_type_hash.cpp
     test/dds/test_cdr_golden.cpp
-    test/dds/test_cdr_golden_navigation.cpp)
+    test/dds/test_cdr_golden_navigation.cpp
+    test/dds/test_ros_conventions.cpp
+    test/dds/test_loopback.cpp)
   target_link_libraries(dds_tests srd_dds gtest_main)
 endif()
