@@ -3,16 +3,15 @@
 # the SHA-256 of the REP-2011 type hashes), the ROS-free library srd_dds is built: the ROS 2 message
 # types compiled by idlc from dds/idl/, the type hashes, ROS 2's naming/QoS/discovery conventions
 # and the typed participant, publisher and subscription. Without them everything else builds as
-# before. SRD_WITH_DDS (CMake variable and compile definition, 1 or 0) tells code that needs to know.
+# before. The CMake variable SRD_WITH_DDS says which; C++ code that links srd_dds sees the compile
+# definition SRD_WITH_DDS (`#ifdef SRD_WITH_DDS`). Nothing else's compile flags change (ccache).
 find_package(CycloneDDS QUIET)
 find_package(OpenSSL QUIET COMPONENTS Crypto)
 find_program(SRD_IDLC idlc)
 if(CycloneDDS_FOUND AND OPENSSL_FOUND AND SRD_IDLC)
   set(SRD_WITH_DDS ON)
-  add_compile_definitions(SRD_WITH_DDS=1)
 else()
   set(SRD_WITH_DDS OFF)
-  add_compile_definitions(SRD_WITH_DDS=0)
   message(STATUS "serial_robot_driver: building WITHOUT the ROS 2 (DDS) front end: it needs Cyclone "
     "DDS and its idlc (apt install cyclonedds-dev cyclonedds-tools) and libcrypto (libssl-dev); "
     "scripts/install_deps.sh installs them")
@@ -68,6 +67,7 @@ add_library(srd_dds STATIC
   src/dds/participant.cpp
   src/dds/endpoint.cpp)
 target_include_directories(srd_dds PUBLIC ${SRD_DDS_GENERATED_DIR})
+target_compile_definitions(srd_dds PUBLIC SRD_WITH_DDS=1)
 target_link_libraries(srd_dds PUBLIC CycloneDDS::ddsc Threads::Threads PRIVATE OpenSSL::Crypto)
 set_target_properties(srd_dds PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
@@ -80,4 +80,13 @@ if(CATKIN_ENABLE_TESTING)
     test/dds/test_ros_conventions.cpp
     test/dds/test_loopback.cpp)
   target_link_libraries(dds_tests srd_dds gtest_main)
+  # A second participant (plain Cyclone, this process) discovers a node that dds_test_peer (another
+  # process) makes with the wrappers.
+  add_executable(dds_test_peer test/dds/dds_test_peer_main.cpp)
+  target_link_libraries(dds_test_peer srd_dds)
+  catkin_add_gtest(dds_discovery_tests test/dds/test_second_participant.cpp)
+  target_link_libraries(dds_discovery_tests srd_dds gtest_main)
+  target_compile_definitions(dds_discovery_tests PRIVATE
+    SRD_DDS_TEST_PEER="$<TARGET_FILE:dds_test_peer>")
+  add_dependencies(dds_discovery_tests dds_test_peer)
 endif()
