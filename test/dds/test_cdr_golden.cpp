@@ -29,6 +29,20 @@ TEST(CdrGolden, BoolBothWays) {
   EXPECT_TRUE(decoded.sample.data);
 }
 
+// A null string (a field left unset) goes out as the empty string: length 1, one NUL.
+TEST(CdrGolden, UnsetStringIsTheEmptyString) {
+  std_msgs_msg_dds__Header_ header{};
+  header.stamp = {-1, 999999999};
+  const Bytes expected =
+      cat({kHeader, {0xff, 0xff, 0xff, 0xff, 0xff, 0xc9, 0x9a, 0x3b}, {0x01, 0, 0, 0, 0x00}});
+  EXPECT_EQ(serialized(header), expected);
+  Decoded<std_msgs_msg_dds__Header_> decoded(expected);
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_EQ(decoded.sample.stamp.sec, -1);
+  EXPECT_EQ(decoded.sample.stamp.nanosec, 999999999u);
+  EXPECT_EQ(dds::text(decoded.sample.frame_id), "");
+}
+
 // --- geometry_msgs/Twist ----------------------------------------------------------------------
 const Bytes kTwist = cat({kHeader, kOne, kTwo, kThree, kZero, kZero, kHalf});
 

@@ -75,6 +75,43 @@ TEST(DdsLoopback, NoSubscriberNoMatch) {
   EXPECT_FALSE(publisher.hasSubscribers());
 }
 
+struct EndpointQos {
+  dds_history_kind_t history = DDS_HISTORY_KEEP_ALL;
+  int32_t depth = 0;
+  dds_reliability_kind_t reliability = DDS_RELIABILITY_BEST_EFFORT;
+  dds_durability_kind_t durability = DDS_DURABILITY_TRANSIENT_LOCAL;
+};
+
+EndpointQos qosOf(dds_entity_t endpoint) {
+  EndpointQos found;
+  dds_qos_t* qos = dds_create_qos();
+  dds_get_qos(endpoint, qos);
+  dds_qget_history(qos, &found.history, &found.depth);
+  dds_qget_reliability(qos, &found.reliability, nullptr);
+  dds_qget_durability(qos, &found.durability);
+  dds_delete_qos(qos);
+  return found;
+}
+
+// rclcpp's default QoS; tf keeps 100 (the history depth is not in DDS discovery data, so it is
+// checked on the entities themselves).
+TEST(DdsLoopback, EndpointsHaveRos2DefaultQos) {
+  dds::Participant participant(loopbackNode("qos_node"));
+  dds::Publisher<tf2_msgs_msg_dds__TFMessage_> tf(participant, "/tf");
+  dds::Publisher<sensor_msgs_msg_dds__JointState_> joint_states(participant, "joint_states");
+  dds::Subscription<geometry_msgs_msg_dds__Twist_> cmd_vel(
+      participant, "cmd_vel", [](const geometry_msgs_msg_dds__Twist_&) {});
+  EXPECT_EQ(tf.topicName(), "rt/tf");
+  EXPECT_EQ(qosOf(tf.handle()).depth, 100);
+  for (dds_entity_t endpoint : {joint_states.handle(), cmd_vel.handle()}) {
+    const EndpointQos qos = qosOf(endpoint);
+    EXPECT_EQ(qos.history, DDS_HISTORY_KEEP_LAST);
+    EXPECT_EQ(qos.depth, 10);
+    EXPECT_EQ(qos.reliability, DDS_RELIABILITY_RELIABLE);
+    EXPECT_EQ(qos.durability, DDS_DURABILITY_VOLATILE);
+  }
+}
+
 // What Cyclone puts on the wire for a JointState written with the wrappers: read back as CDR by a
 // plain reader of the same participant.
 TEST(DdsLoopback, WireBytesAreTheGoldenCdr) {
