@@ -89,4 +89,15 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_definitions(dds_discovery_tests PRIVATE
     SRD_DDS_TEST_PEER="$<TARGET_FILE:dds_test_peer>")
   add_dependencies(dds_discovery_tests dds_test_peer)
+  # The same node seen by another DDS implementation, Debian's Fast DDS, when it is installed.
+  find_package(fastrtps QUIET)
+  if(fastrtps_FOUND)
+    catkin_add_gtest(dds_fast_dds_tests test/dds/test_fast_dds_peer.cpp)
+    target_link_libraries(dds_fast_dds_tests fastrtps gtest_main)
+    target_compile_definitions(dds_fast_dds_tests PRIVATE
+      SRD_DDS_TEST_PEER="$<TARGET_FILE:dds_test_peer>")
+    add_dependencies(dds_fast_dds_tests dds_test_peer)
+  else()
+    message(STATUS "serial_robot_driver: Fast DDS not found (libfastrtps-dev): dds_fast_dds_tests left out")
+  endif()
 endif()
