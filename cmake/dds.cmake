@@ -12,8 +12,8 @@ if(CycloneDDS_FOUND AND OPENSSL_FOUND AND SRD_IDLC)
   set(SRD_WITH_DDS ON)
 else()
   set(SRD_WITH_DDS OFF)
-  message(STATUS "serial_robot_driver: building WITHOUT the ROS 2 (DDS) front end: it needs Cyclone "
-    "DDS and its idlc (apt install cyclonedds-dev cyclonedds-tools) and libcrypto (libssl-dev); "
+  message(STATUS "serial_robot_driver: building WITHOUT the ROS 2 (DDS) front end: it needs "
+    "Cyclone DDS and its idlc (apt install cyclonedds-dev cyclonedds-tools) and libcrypto (libssl-dev); "
     "scripts/install_deps.sh installs them")
   return()
 endif()
@@ -34,7 +34,8 @@ set(SRD_DDS_TYPES
   rmw_dds_common/msg/Gid rmw_dds_common/msg/NodeEntitiesInfo
   rmw_dds_common/msg/ParticipantEntitiesInfo)
 
-# idlc at build time: dds/idl/<pkg>/msg/<Type>.idl -> <build>/srd_dds_generated/<pkg>/msg/<Type>.{c,h}
+# idlc at build time: dds/idl/<pkg>/msg/<Type>.idl ->
+# <build>/srd_dds_generated/<pkg>/msg/<Type>.{c,h}
 # (final extensibility and no XTypes type information, as rmw_cyclonedds' own types: peers match
 # on the type name alone).
 set(SRD_DDS_IDL_DIR ${PROJECT_SOURCE_DIR}/dds/idl)
@@ -98,6 +99,7 @@ if(CATKIN_ENABLE_TESTING)
       SRD_DDS_TEST_PEER="$<TARGET_FILE:dds_test_peer>")
     add_dependencies(dds_fast_dds_tests dds_test_peer)
   else()
-    message(STATUS "serial_robot_driver: Fast DDS not found (libfastrtps-dev): dds_fast_dds_tests left out")
+    message(STATUS
+      "serial_robot_driver: Fast DDS not found (libfastrtps-dev): dds_fast_dds_tests left out")
   endif()
 endif()

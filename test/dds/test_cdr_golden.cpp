@@ -69,6 +69,8 @@ TEST(CdrGolden, BigEndianTwistDecodes) {
 
 // --- sensor_msgs/JointState -------------------------------------------------------------------
 // header {stamp {1, 2}, frame_id "base"}, name ["a", "bc"], position [1.5], velocity [], effort [].
+// One row per field, as on the wire.
+// clang-format off
 const Bytes kJointState = cat({kHeader,
                                {0x01, 0, 0, 0, 0x02, 0, 0, 0},              // 0: sec, nanosec
                                {0x05, 0, 0, 0, 'b', 'a', 's', 'e', 0x00},   // 8: "base"
@@ -79,6 +81,7 @@ const Bytes kJointState = cat({kHeader,
                                {0x01, 0, 0, 0, 0, 0, 0, 0},                 // 40: one position, pad
                                kOneAndHalf,                                 // 48: 1.5
                                {0, 0, 0, 0, 0, 0, 0, 0}});                  // 56: no vel., effort
+// clang-format on
 
 TEST(CdrGolden, JointStateSerializes) {
   const std::string frame = "base";

@@ -106,6 +106,8 @@ class DiscoveryRecorder : public fdds::DomainParticipantListener {
 
 // dds_test_peer's joint_states, by the CDR rules (test_cdr_golden.cpp): stamp 7 s 8 ns, frame
 // "base_link", names "left" "right", positions 0.25 -1.5, no velocity, no effort.
+// One row per field, as on the wire.
+// clang-format off
 const Bytes kPeerJointState = {
     0x00, 0x01, 0x00, 0x00,                                                     // CDR little-endian
     0x07, 0,    0,    0,    0x08, 0,   0,    0,                                 // 0: stamp
@@ -118,6 +120,7 @@ const Bytes kPeerJointState = {
     0,    0,    0,    0,    0,    0,   0xd0, 0x3f,                              // 56: 0.25
     0,    0,    0,    0,    0,    0,   0xf8, 0xbf,                              // 64: -1.5
     0,    0,    0,    0,    0,    0,   0,    0};  // 72: no velocity, effort
+// clang-format on
 
 class FastDdsPeer : public ::testing::Test {
  protected:

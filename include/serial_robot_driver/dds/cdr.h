@@ -16,8 +16,8 @@ namespace dds {
 std::vector<uint8_t> serializeCdr(const dds_topic_descriptor_t& type, const void* sample);
 
 /// Decodes `bytes` (header included, little- or big-endian CDR) into `sample`, which must be
-/// zero-initialised or hold contents of a previous decode. False, with `sample` untouched, for bytes
-/// that are not a valid `type` (short, bad lengths, unknown encapsulation): never reads past
+/// zero-initialised or hold contents of a previous decode. False, with `sample` untouched, for
+/// bytes that are not a valid `type` (short, bad lengths, unknown encapsulation): never reads past
 /// them.
 /// Release what was decoded with freeSampleContents().
 bool deserializeCdr(const std::vector<uint8_t>& bytes, const dds_topic_descriptor_t& type,

@@ -30,11 +30,11 @@ namespace dds {
 template <typename T>
 struct Message;
 
-#define SRD_DDS_MESSAGE(c_type, ros_name)                                                          \
-  template <>                                                                                      \
-  struct Message<c_type> {                                                                         \
-    static const dds_topic_descriptor_t& descriptor() { return c_type##_desc; }                    \
-    static constexpr const char* kRosName = ros_name;                                              \
+#define SRD_DDS_MESSAGE(c_type, ros_name)                                       \
+  template <>                                                                   \
+  struct Message<c_type> {                                                      \
+    static const dds_topic_descriptor_t& descriptor() { return c_type##_desc; } \
+    static constexpr const char* kRosName = ros_name;                           \
   }
 
 SRD_DDS_MESSAGE(builtin_interfaces_msg_dds__Time_, "builtin_interfaces/msg/Time");
