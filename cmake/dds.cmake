@@ -12,7 +12,7 @@ if(CycloneDDS_FOUND AND OPENSSL_FOUND AND SRD_IDLC)
   set(SRD_WITH_DDS ON)
 else()
   set(SRD_WITH_DDS OFF)
-  message(STATUS "serial_robot_driver: building WITHOUT the ROS 2 (DDS) front end: it needs "
+  message(STATUS "${PROJECT_NAME}: building WITHOUT the ROS 2 (DDS) front end: it needs "
     "Cyclone DDS and its idlc (apt install cyclonedds-dev cyclonedds-tools) and libcrypto (libssl-dev); "
     "scripts/install_deps.sh installs them")
   return()
@@ -57,16 +57,19 @@ endforeach()
 
 # ROS-free and ROS-1-free: no catkin include path, no catkin library.
 add_library(srd_dds STATIC
-  ${SRD_DDS_GENERATED_SOURCES}
+  src/dds/cdr.cpp
+  src/dds/discovery_info.cpp
+  src/dds/dispatch_thread.cpp
+  src/dds/domain_lease.cpp
+  src/dds/endpoint.cpp
+  src/dds/participant.cpp
+  src/dds/ros_conventions.cpp
   src/dds/type_descriptions.cpp
   src/dds/type_hash.cpp
-  src/dds/cdr.cpp
-  src/dds/ros_conventions.cpp
-  src/dds/domain_lease.cpp
-  src/dds/dispatch_thread.cpp
-  src/dds/discovery_info.cpp
-  src/dds/participant.cpp
-  src/dds/endpoint.cpp)
+  ${SRD_DDS_GENERATED_SOURCES})
+# The generated headers are part of srd_dds' interface (the message structs); they exist once idlc ran.
+#catkin_lint: ignore_once missing_directory
+#catkin_lint: ignore_once external_interface_path
 target_include_directories(srd_dds PUBLIC ${SRD_DDS_GENERATED_DIR})
 target_compile_definitions(srd_dds PUBLIC SRD_WITH_DDS=1)
 target_link_libraries(srd_dds PUBLIC CycloneDDS::ddsc Threads::Threads PRIVATE OpenSSL::Crypto)
@@ -100,6 +103,6 @@ if(CATKIN_ENABLE_TESTING)
     add_dependencies(dds_fast_dds_tests dds_test_peer)
   else()
     message(STATUS
-      "serial_robot_driver: Fast DDS not found (libfastrtps-dev): dds_fast_dds_tests left out")
+      "${PROJECT_NAME}: Fast DDS not found (libfastrtps-dev): dds_fast_dds_tests left out")
   endif()
 endif()
