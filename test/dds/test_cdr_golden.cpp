@@ -43,6 +43,14 @@ TEST(CdrGolden, UnsetStringIsTheEmptyString) {
   EXPECT_EQ(dds::text(decoded.sample.frame_id), "");
 }
 
+// What Cyclone itself sends for the same Bool: padded to 4, the padding counted in the options.
+TEST(CdrGolden, PaddedBoolDecodes) {
+  Decoded<std_msgs_msg_dds__Bool_> decoded(Bytes{0x00, 0x01, 0x00, 0x03, 0x01, 0x00, 0x00, 0x00});
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_TRUE(decoded.sample.data);
+  EXPECT_FALSE(Decoded<std_msgs_msg_dds__Bool_>(Bytes{0x00, 0x01, 0x00, 0x03, 0x01}).ok);
+}
+
 // --- geometry_msgs/Twist ----------------------------------------------------------------------
 const Bytes kTwist = cat({kHeader, kOne, kTwo, kThree, kZero, kZero, kHalf});
 
