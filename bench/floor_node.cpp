@@ -41,7 +41,7 @@ uint8_t g_seq = 0;  // guarded by g_write_mutex
 
 void writeSpeedFrame() {
   std::lock_guard<std::mutex> lock(g_write_mutex);
-  const auto frame = srd::protocol::base::encodeWheelSpeed(g_seq++, g_left, g_right);
+  const auto frame = srd::devices::base::encodeWheelSpeed(g_seq++, g_left, g_right);
   if (::write(g_fd, frame.data(), frame.size()) < 0) { /* the floor does not handle errors */
   }
 }
@@ -50,7 +50,7 @@ void writeSpeedFrame() {
 struct BodyJoints {
   std::vector<int> ids;
   std::vector<std::string> names;
-  std::vector<srd::device::JointCalibration> calibrations;
+  std::vector<srd::devices::body::JointCalibration> calibrations;
 };
 
 BodyJoints readBodyJoints(ros::NodeHandle& pnh) {
@@ -102,8 +102,8 @@ void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states) {
   const auto config = test_support::driverFramer({"body"}, count);
   srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
                                                  std::size_t size) {
-    if (family != srd::protocol::body::kTelemetryFrames) return;
-    const auto telemetry = srd::protocol::body::decodeTelemetry(data, size, count);
+    if (family != srd::devices::body::kTelemetryFrames) return;
+    const auto telemetry = srd::devices::body::decodeTelemetry(data, size, count);
     if (!telemetry) return;
     sensor_msgs::JointState msg;
     msg.header.stamp = ros::Time::now();
