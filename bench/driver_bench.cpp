@@ -1489,24 +1489,30 @@ void addUserRows(ResultTable& table, const UserRuns& runs) {
 
 void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
   const Options& o = context.options;
-  context.results.note(format(
+  ResultTable& table = context.results;
+  table.note(
       "driver_node in the configuration users run (the defaults: base, body and servo bus on one "
       "port, odom and /tf, diagnostics, battery poll; 20 body servos; speed_dithering off and "
       "max_wheel_speed 20 so each command is recognisable on the wire) and floor_node with the "
-      "same parameters, this process playing the robot (telemetry of 20 servos at 100 Hz, "
-      "battery answers). Subscribed throughout: joint_states (robot_state_publisher), "
-      "wheel_states (joint_state_publisher), imu/data, odom, /tf (rviz, navigation), "
-      "/diagnostics (diagnostic_aggregator). Per session: %zu frames at 100 Hz without cmd_vel "
-      "(CPU from the process's clock over that window, telemetry latency, loop periods from "
-      "speed frame arrivals), then %zu cmd_vel commands 10-40 ms apart while telemetry streams. "
-      "Load: one `sh` busy loop per core at nice 0 from 1 s before the window. RT on: "
-      "~realtime_priority %s for both programs (floor_node: SCHED_FIFO on its reader and loop "
-      "threads, memory locked). This benchmark's own threads ran at %s. %zu round(s); node and "
-      "floor back to back per condition, their order alternated.",
-      frames, commands, o.realtime_priority.c_str(),
+      "same parameters; this process plays the robot (telemetry of 20 servos at 100 Hz, battery "
+      "answers).");
+  table.note(
+      "Subscribed throughout: joint_states (robot_state_publisher), wheel_states "
+      "(joint_state_publisher), imu/data, odom, /tf (rviz, navigation), /diagnostics "
+      "(diagnostic_aggregator).");
+  table.note(format(
+      "Per session: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock over that "
+      "window, telemetry latency, loop periods from speed frame arrivals), then %zu cmd_vel "
+      "commands 10-40 ms apart while telemetry streams. %zu round(s); node and floor back to back "
+      "per condition, which goes first alternating.",
+      frames, commands, o.floor_rounds));
+  table.note(format(
+      "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
+      "~realtime_priority %s for both (floor_node: SCHED_FIFO on its reader and loop threads, "
+      "memory locked). This benchmark's own threads: %s.",
+      o.realtime_priority.c_str(),
       context.bench_priority > 0 ? format("SCHED_FIFO %d", context.bench_priority).c_str()
-                                 : "normal priority",
-      o.floor_rounds));
+                                 : "normal priority"));
 }
 
 /// Section 8: driver_node and floor_node in every condition (quiet / loaded, RT off / on), the

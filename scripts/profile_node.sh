@@ -139,21 +139,20 @@ done
 echo "profile_node.sh: ${tool}, warming up 8 s; then ${seconds} s profiled; output in ${out}" >&2
 sleep 8
 
-# utime + stime of each thread of the node, in clock ticks: "tid ticks" lines.
-thread_ticks() {
-  local stat fields tid
-  for stat in /proc/"${node_pid}"/task/*/stat; do
-    tid=${stat%/stat}
+# CPU time of each thread of the node so far, in ns (schedstat: its first field): "tid ns" lines.
+thread_cpu_ns() {
+  local stat tid
+  for stat in /proc/"${node_pid}"/task/*/schedstat; do
+    tid=${stat%/schedstat}
     tid=${tid##*/}
-    fields=$(sed 's/^.*) //' "${stat}" 2>/dev/null) || continue
-    awk -v tid="${tid}" '{ print tid, $12 + $13 }' <<<"${fields}"
+    awk -v tid="${tid}" '{ print tid, $1 }' "${stat}" 2>/dev/null || true
   done
 }
 # The CPU per thread from a window of its own: perf's sampling (stacks copied in the kernel) is
 # charged to the threads it samples. Callgrind's whole run is slow anyway: one window.
-thread_ticks >"${out}/ticks_start"
+thread_cpu_ns >"${out}/cpu_ns_start"
 sleep "${seconds}"
-thread_ticks >"${out}/ticks_end"
+thread_cpu_ns >"${out}/cpu_ns_end"
 if [[ "${tool}" == perf ]]; then
   echo "profile_node.sh: CPU window done; perf records ${seconds} s more" >&2
   perf record -e cpu-clock -F 4999 --call-graph dwarf,8192 -p "${node_pid}" -o "${out}/perf.data" \

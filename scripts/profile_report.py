@@ -3,11 +3,10 @@
 
 usage: scripts/profile_report.py perf|callgrind OUT_DIR SECONDS [TOP]
 
-OUT_DIR holds what profile_node.sh left there: ticks_start / ticks_end (per-thread utime+stime),
+OUT_DIR holds what profile_node.sh left there: cpu_ns_start / cpu_ns_end (per-thread CPU time),
 perf.data or callgrind.out.*, and the rostopic hz logs (hz_*.log). Prints Markdown.
 """
 import glob
-import os
 import re
 import subprocess
 import sys
@@ -38,20 +37,19 @@ DIAGNOSTICS_SYMBOL = "diagnostic_updater::Updater::force_update"
 OWN_PREFIXES = ("serial_robot_driver::", "diagnostic_updater::")
 
 
-def read_ticks(path):
-    ticks = {}
+def read_cpu_ns(path):
+    cpu_ns = {}
     with open(path) as stream:
         for line in stream:
             tid, value = line.split()
-            ticks[int(tid)] = int(value)
-    return ticks
+            cpu_ns[int(tid)] = int(value)
+    return cpu_ns
 
 
 def thread_cpu(out, seconds):
-    """CPU s/s per tid over the window, from /proc's utime + stime."""
-    start, end = read_ticks(f"{out}/ticks_start"), read_ticks(f"{out}/ticks_end")
-    hz = os.sysconf("SC_CLK_TCK")
-    return {tid: (end[tid] - start.get(tid, 0)) / hz / seconds for tid in end}
+    """CPU s/s per tid over the window, from /proc/<pid>/task/<tid>/schedstat."""
+    start, end = read_cpu_ns(f"{out}/cpu_ns_start"), read_cpu_ns(f"{out}/cpu_ns_end")
+    return {tid: (end[tid] - start.get(tid, 0)) / 1e9 / seconds for tid in end}
 
 
 def messages_per_second(out):
