@@ -11,8 +11,8 @@ import re
 import subprocess
 import sys
 
-# The function each thread of the node runs, first match wins (inclusive symbols), and the event
-# its CPU is divided by.
+# The function each thread of the node runs (the first of its inclusive symbols, highest share
+# first, that names one), its role, and the event its CPU is divided by.
 ROLES = [
     ("SerialLink::readerLoop", "port reader (frames in, readings published)", "telemetry frame"),
     ("BaseController::run", "base loop (speed frame, odom, /tf, wheel_states)", "loop tick"),
@@ -101,9 +101,11 @@ def perf_rows(out, children):
 
 
 def role_of(symbols):
-    for pattern, role, event in ROLES:
-        if any(pattern in symbol for symbol in symbols):
-            return role, event
+    """symbols: a thread's inclusive symbols, highest share first."""
+    for symbol in symbols:
+        for pattern, role, event in ROLES:
+            if pattern in symbol:
+                return role, event
     return "other", None
 
 
@@ -153,34 +155,45 @@ def callgrind_rows(path, inclusive):
     text = subprocess.run(
         ["callgrind_annotate", f"--inclusive={'yes' if inclusive else 'no'}", "--threshold=99.9",
          path], capture_output=True, text=True, check=True).stdout
-    rows = []
+    rows, total = [], 0
     for line in text.splitlines():
-        match = re.match(r"\s*([0-9,]+) \([ 0-9.]+%\)\s+(?:\S+:)?(.*?)(?: \[.*\])?$", line)
-        if match:
-            rows.append((int(match.group(1).replace(",", "")), match.group(2).strip()))
-    return rows
+        match = re.match(r"\s*([0-9,]+) \([ 0-9.]+%\)\s+(.*?)(?: \[.*\])?$", line)
+        if match and "PROGRAM TOTALS" in line:
+            total = int(match.group(1).replace(",", ""))
+        if not match or "PROGRAM TOTALS" in line:
+            continue
+        # "file:function": the first single colon ends the file ("???" when unknown).
+        parts = re.split(r"(?<!:):(?!:)", match.group(2), maxsplit=1)
+        symbol = parts[1] if len(parts) == 2 else parts[0]
+        rows.append((int(match.group(1).replace(",", "")), symbol.strip()))
+    return rows, total
 
 
 def callgrind_report(out, cpu, messages, top):
-    # --separate-threads numbers threads in creation order: the tids in ascending order.
-    files = sorted(glob.glob(f"{out}/callgrind.out.*-*"), key=lambda p: int(p.rsplit("-", 1)[1]))
-    tids = sorted(cpu)
-    for index, path in enumerate(files):
-        tid = tids[index] if index < len(tids) else -1
-        exclusive, inclusive = callgrind_rows(path, False), callgrind_rows(path, True)
-        total = sum(count for count, _ in exclusive)
-        if total <= 0:
+    """Instruction counts per thread (valgrind runs the threads one at a time, so /proc's CPU of
+    a thread says little): each thread's share of the node's instructions and its top items."""
+    del cpu, messages  # the time scale of a callgrind run is valgrind's
+    threads = []
+    for path in sorted(glob.glob(f"{out}/callgrind.out.*-*")):
+        (exclusive, total), (inclusive, _) = callgrind_rows(path, False), callgrind_rows(path, True)
+        inclusive.sort(key=lambda row: -row[0])
+        threads.append((total, exclusive, inclusive))
+    everything = sum(total for total, _, _ in threads) or 1
+    for total, exclusive, inclusive in sorted(threads, key=lambda thread: -thread[0]):
+        if total < everything / 200:
             continue
-        role, event = role_of([symbol for _, symbol in inclusive])
-        rate = events_per_second(event, messages)
-        scale = 1e6 / rate if rate else 1e6
-        relative = [(100 * count / total, symbol) for count, symbol in exclusive]
-        own = [(100 * count / total, symbol) for count, symbol in inclusive
-               if symbol.startswith(OWN_PREFIXES) and 100 * count / total < 99.5]
-        print(f"\n(callgrind: {total:,} instructions in this thread; us scale from /proc, "
-              "which counts valgrind's slowdown)")
-        print_thread(tid, cpu.get(tid, 0.0), role, event if rate else None, scale, relative, own,
-                     top)
+        role, _ = role_of([symbol for _, symbol in inclusive])
+        print(f"\n#### {role}: {total:,} instructions, {100 * total / everything:.1f} % of the "
+              "node's")
+        print(f"\n| % of thread | self (top {top}) |\n|---|---|")
+        for count, symbol in exclusive[:top]:
+            print(f"| {100 * count / total:.1f} | `{short(symbol)}` |")
+        own = [(count, symbol) for count, symbol in inclusive
+               if symbol.startswith(OWN_PREFIXES) and count < 0.995 * total]
+        if own:
+            print(f"\n| % of thread | the project's code, inclusive (top {top}) |\n|---|---|")
+            for count, symbol in own[:top]:
+                print(f"| {100 * count / total:.1f} | `{short(symbol)}` |")
 
 
 def main():
@@ -191,11 +204,9 @@ def main():
     print(f"### driver_node profile ({tool}, {seconds:.0f} s; 20 body servos at 100 Hz, loop "
           f"50 Hz, defaults; subscribed: joint_states, wheel_states, imu/data, odom, /tf, "
           f"/diagnostics)\n")
-    print(f"node CPU {sum(cpu.values()):.4f} s/s over the window (/proc, all threads); "
-          f"{len(cpu)} threads; messages sent to the subscribers {messages:.0f}/s")
-    print("\n| tid | CPU s/s |\n|---|---|")
-    for tid in sorted(cpu, key=lambda t: -cpu[t]):
-        print(f"| {tid} | {cpu[tid]:.4f} |")
+    print(f"node CPU {sum(cpu.values()):.4f} s/s over the window (/proc, all threads"
+          f"{', under valgrind' if tool == 'callgrind' else ''}); {len(cpu)} threads; messages "
+          f"sent to the subscribers {messages:.0f}/s")
     (perf_report if tool == "perf" else callgrind_report)(out, cpu, messages, top)
 
 
