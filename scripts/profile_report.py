@@ -147,6 +147,10 @@ def perf_report(out, cpu, messages, top):
                               if symbol.startswith(DIAGNOSTICS_SYMBOL))
         threads[f"{role} (tid {tid})"] = (cpu[tid], cpu[tid] * scale, event if rate else None)
         print_thread(tid, cpu[tid], role, event if rate else None, scale, relative, own, top)
+    node = sum(cpu.values()) or 1.0
+    print("\n#### Per thread\n\n| thread | CPU s/s | share of the node |\n|---|---|---|")
+    for name, (thread_cpu_share, _, _) in threads.items():
+        print(f"| {name} | {thread_cpu_share:.4f} | {100 * thread_cpu_share / node:.0f} % |")
     print("\n#### Per event (perf's shares of each thread, times its CPU from /proc)")
     print_per_event(threads, diagnostics_us / DIAGNOSTICS_HZ)
 
