@@ -5,7 +5,8 @@
 # side with the floor (bench/floor_node.cpp), quiet and under a CPU hog per core, with
 # ~realtime_priority off and on, each figure as node / floor / ratio. --all runs every section
 # (about 8 minutes), then the framer's (bench/bench_framer.cpp, Google Benchmark, a few seconds).
-# Prints the tables and writes them to bench/results/latest.md (or $SRD_BENCH_OUTPUT).
+# Prints the tables and writes them to bench/results/user_config.md (section 8 alone) or
+# bench/results/latest.md (--all or --sections), or $SRD_BENCH_OUTPUT.
 #
 # usage: bench/run_benchmarks.sh [--build] [--all] [--long] [driver_bench options, see --help]
 #   --all               every section (1-10) and bench_framer, instead of section 8 alone
@@ -81,6 +82,7 @@ if [[ -n "${SRD_BENCH_OUTPUT:-}" ]]; then
   output="${SRD_BENCH_OUTPUT}"
 elif [[ -w "${package_dir}" && -d "${package_dir}/bench" ]]; then
   output="${package_dir}/bench/results/latest.md"
+  if (( ! all && ! sections_given )); then output="${package_dir}/bench/results/user_config.md"; fi
 else
   output="${PWD}/driver_bench_latest.md"
 fi
