@@ -17,12 +17,6 @@ constexpr double kWarnThrottleS = 5.0;
 
 }  // namespace
 
-/// The core says "dangerous"; only this layer knows which parameter arms such writes.
-std::string servoStatusMessage(const ServoStatus& status) {
-  if (status.error != ServoError::kDangerous) return status.message;
-  return status.message + " (set ~servo_bus/allow_dangerous_writes to true to arm it)";
-}
-
 ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms) {
   return servo_bus::toServoMoves(msg.name, msg.position, msg.velocity, interval_ms);
 }

@@ -69,8 +69,7 @@ ServoBusConfig makeServoBusConfig(const ros_layer::DriverParams& params);
 using servo_bus::ServoCommandBatch;
 using servo_bus::servoIdFromJointName;
 using servo_bus::servoJointName;
-/// A servo call's message, naming the parameter that arms a refused dangerous write.
-std::string servoStatusMessage(const ServoStatus& status);
+using servo_bus::servoStatusMessage;  // the core's (servo_services.h)
 /// servo_bus::toServoMoves of the message's names, positions (rad) and velocities (rad/s).
 ServoCommandBatch toServoMoves(const sensor_msgs::JointState& msg, uint16_t interval_ms);
 
