@@ -35,6 +35,8 @@ set(SRD_CORE_SOURCES
   src/core/input_refusals.cpp
   src/core/guarded_call.cpp
   src/core/driver_core.cpp
+  src/core/log.cpp
+  src/core/port_log.cpp
   src/core/wire_capture_status.cpp
   src/core/capture_queue.cpp
   src/core/params_in_force.cpp

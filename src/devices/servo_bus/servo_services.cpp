@@ -1,28 +1,23 @@
 #include "serial_robot_driver/devices/servo_bus/servo_services.h"
 
+#include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_device.h"  // servoStatusMessage
+
 namespace serial_robot_driver::devices::servo_bus {
-
-/// The core says "dangerous"; the parameter that arms such writes is named here, once.
-std::string servoStatusMessage(const ServoStatus& status) {
-  if (status.error != ServoError::kDangerous) return status.message;
-  return status.message + " (set ~servo_bus/allow_dangerous_writes to true to arm it)";
-}
-
-void ServoServices::log(LogLevel level, const std::string& line) const {
-  if (log_) log_(level, line);
-}
 
 void ServoServices::conclude(const char* service, const ServoStatus& status, ServoReply& reply,
                              Announce announce) const {
   const std::string name(service);
   if (status.ok()) {
-    log(LogLevel::kDebug, name + ": " + status.message);
+    core::log(core::LogLevel::kDebug, "%s: %s", service, status.message.c_str());
   } else {
-    log(LogLevel::kDebug, name + " failed (" + toString(status.error) + "): " + status.message);
+    core::log(core::LogLevel::kDebug, "%s failed (%s): %s", service, toString(status.error),
+              status.message.c_str());
   }
   if (refusesRequest(status.error)) refusals_.refused(name);
-  if (status.ok() && announce == Announce::kInfo)
-    log(LogLevel::kInfo, name + ": " + status.message);
+  if (status.ok() && announce == Announce::kInfo) {
+    core::log(core::LogLevel::kInfo, "%s: %s", service, status.message.c_str());
+  }
   reply.ok = status.ok();
   reply.message = servoStatusMessage(status);
 }

@@ -1,13 +1,13 @@
 // The servo/* services, ROS-free: what each request does (a call on the client, the bus or the
 // motion claims) and the outcome handling every front end shares: the reply's message (naming the
 // parameter that arms a refused dangerous write), the refusal counted under the service's name,
-// the log lines (every outcome at debug; a changed setting at info). A front end copies its
-// request's fields into these calls and the reply's fields into its response, and serves them
-// on threads of its own (a stop service must never wait behind another call: servo_bus_ros.h).
+// the lines in the core's log (core/log.h: every outcome at debug; a changed setting at info). A
+// front end copies its request's fields into these calls and the reply's fields into its response,
+// and serves them on threads of its own (a stop service must never wait behind another call:
+// servo_bus_ros.h).
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,9 +36,6 @@ constexpr char kDamping[] = "servo/damping";
 constexpr char kRelax[] = "servo/relax";
 constexpr char kHold[] = "servo/hold";
 }  // namespace servo_service
-
-/// A servo call's message, naming the parameter that arms a refused dangerous write.
-std::string servoStatusMessage(const ServoStatus& status);
 
 /// What every servo/* answer carries: whether it succeeded (servo/ping: the servo is online;
 /// servo/scan has no flag) and the message.
@@ -72,13 +69,9 @@ struct ServoInfoReply : ServoReply {
 
 class ServoServices {
  public:
-  enum class LogLevel { kDebug, kInfo };
-  /// Where the services' log lines go (the front end's log); may be empty.
-  using Log = std::function<void(LogLevel, const std::string&)>;
-
   /// `bus`, `claims` and `refusals` (where refused requests are counted) must outlive this object.
-  ServoServices(ServoBus& bus, ServoMotionClaims& claims, core::InputRefusals& refusals, Log log)
-      : bus_(bus), claims_(claims), refusals_(refusals), log_(std::move(log)) {}
+  ServoServices(ServoBus& bus, ServoMotionClaims& claims, core::InputRefusals& refusals)
+      : bus_(bus), claims_(claims), refusals_(refusals) {}
 
   // Reads: allowed while the e-stop holds.
   ServoReply ping(uint8_t id);
@@ -106,12 +99,10 @@ class ServoServices {
                 Announce announce = Announce::kDebug) const;
   ServoReply concluded(const char* service, const ServoStatus& status,
                        Announce announce = Announce::kDebug) const;
-  void log(LogLevel level, const std::string& line) const;
 
   ServoBus& bus_;
   ServoMotionClaims& claims_;
   core::InputRefusals& refusals_;
-  const Log log_;
 };
 
 }  // namespace serial_robot_driver::devices::servo_bus

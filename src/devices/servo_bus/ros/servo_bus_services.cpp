@@ -49,14 +49,6 @@ template <typename Service>
       name, ros_layer::guardedService<Request, Response>(refusals, name, serve));
 }
 
-void logServoService(ServoServices::LogLevel level, const std::string& line) {
-  if (level == ServoServices::LogLevel::kInfo) {
-    ROS_INFO("%s", line.c_str());
-  } else {
-    ROS_DEBUG("%s", line.c_str());
-  }
-}
-
 MoveRequest toMoveRequest(const ServoMove::Request& req) {
   MoveRequest request;
   request.id = req.id;
@@ -97,7 +89,7 @@ ServoBusServices::ServoBusServices(::ros::NodeHandle& nh, ServoBus& bus, ServoMo
                                    core::InputRefusals& refusals)
     : client_(bus.client()),
       refusals_(refusals),
-      handlers_(bus, claims, refusals, logServoService),
+      handlers_(bus, claims, refusals),
       nh_(nh),
       stop_queue_([this] { client_.stopCallQueued(); }),
       stop_nh_(nh) {
