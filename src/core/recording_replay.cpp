@@ -20,6 +20,16 @@ std::string joined(const std::set<std::string>& names) {
 
 }  // namespace
 
+void addRecordedChunk(Recording& recording, const std::string& port, bool outbound,
+                      transport::RecordedStamp stamp, std::vector<uint8_t> data) {
+  if (outbound) {
+    ++recording.outbound_chunks;
+    return;
+  }
+  recording.ports[port].push_back({stamp, std::move(data)});
+  recording.end = std::max(recording.end, stamp);
+}
+
 bool isSerialRawTopic(const std::string& topic) {
   const std::size_t slash = topic.rfind('/');
   return topic.substr(slash == std::string::npos ? 0 : slash + 1) == kTopicName;

@@ -4,7 +4,6 @@
 #include <rosbag/view.h>
 #include <sys/stat.h>
 
-#include <algorithm>
 #include <set>
 
 #include "serial_robot_driver/SerialChunk.h"
@@ -39,13 +38,10 @@ Recording readRecording(const std::string& path) {
         throw ReplayError("replay bag " + path + ": " + recording.topic + " holds " +
                           message.getDataType() + ", not serial_robot_driver/SerialChunk");
       }
-      if (chunk->outbound) {
-        ++recording.outbound_chunks;
-        continue;
-      }
-      const transport::RecordedStamp stamp(static_cast<int64_t>(chunk->header.stamp.toNSec()));
-      recording.ports[chunk->port].push_back({stamp, chunk->data});
-      recording.end = std::max(recording.end, stamp);
+      core::addRecordedChunk(
+          recording, chunk->port, chunk->outbound,
+          transport::RecordedStamp(static_cast<int64_t>(chunk->header.stamp.toNSec())),
+          chunk->data);
     }
   } catch (const rosbag::BagException& e) {
     throw ReplayError("replay bag " + path + " is damaged: " + e.what());

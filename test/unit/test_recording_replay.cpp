@@ -37,6 +37,23 @@ Recording recordingOf(const std::string& port, std::vector<transport::RecordedCh
   return recording;
 }
 
+TEST(RecordingReplay, InboundChunksAreKeptPerPortInOrderAndWritesOnlyCounted) {
+  Recording recording;
+  recording.end = RecordedStamp(5);
+  addRecordedChunk(recording, "/dev/a", false, RecordedStamp(10), {0x01});
+  addRecordedChunk(recording, "/dev/a", true, RecordedStamp(99), {0x02});
+  addRecordedChunk(recording, "/dev/b", false, RecordedStamp(20), {});
+  addRecordedChunk(recording, "/dev/a", false, RecordedStamp(std::numeric_limits<int64_t>::min()),
+                   std::vector<uint8_t>(100000, 0xFF));
+  EXPECT_EQ(recording.outbound_chunks, 1u);
+  ASSERT_EQ(recording.ports.size(), 2u);
+  ASSERT_EQ(recording.ports["/dev/a"].size(), 2u);
+  EXPECT_EQ(recording.ports["/dev/a"][0].data, std::vector<uint8_t>{0x01});
+  EXPECT_EQ(recording.ports["/dev/a"][1].data.size(), 100000u);
+  EXPECT_TRUE(recording.ports["/dev/b"][0].data.empty()) << "a reopen mark";
+  EXPECT_EQ(recording.end, RecordedStamp(20)) << "the latest inbound stamp; writes do not count";
+}
+
 TEST(RecordingReplay, SerialRawIsFoundByItsLastName) {
   EXPECT_TRUE(isSerialRawTopic("serial_raw"));
   EXPECT_TRUE(isSerialRawTopic("/robot1/serial_raw"));

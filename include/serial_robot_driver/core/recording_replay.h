@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <set>
@@ -34,6 +35,12 @@ struct Recording {
   std::size_t outbound_chunks = 0;  ///< recorded writes: not replayed
   transport::RecordedStamp end{0};  ///< the recording's latest stamp (any topic)
 };
+
+/// Adds one recorded chunk of `port` stamped `stamp` to `recording`: an inbound one to its port's
+/// chunks (and the recording's end), a recorded write only to the count (writes are not
+/// replayed).
+void addRecordedChunk(Recording& recording, const std::string& port, bool outbound,
+                      transport::RecordedStamp stamp, std::vector<uint8_t> data);
 
 /// "serial_raw" itself or the last name of a namespaced one ("/robot1/serial_raw").
 bool isSerialRawTopic(const std::string& topic);
