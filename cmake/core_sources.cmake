@@ -24,6 +24,7 @@ set(SRD_CORE_SOURCES
   src/trajectory/bus_joint.cpp
   src/trajectory/joint_groups.cpp
   src/trajectory/goal.cpp
+  src/trajectory/message_time.cpp
   src/trajectory/executor.cpp
   src/core/e_stop.cpp
   src/core/motion_gate.cpp
@@ -32,10 +33,15 @@ set(SRD_CORE_SOURCES
   src/core/link_status.cpp
   src/core/e_stop_status.cpp
   src/core/input_refusals.cpp
+  src/core/guarded_call.cpp
   src/core/driver_core.cpp
   src/core/log.cpp
   src/core/port_log.cpp
   src/core/wire_capture_status.cpp
+  src/core/capture_queue.cpp
+  src/core/params_in_force.cpp
+  src/core/stop_signals.cpp
+  src/core/recording_replay.cpp
 )
 
 srd_device_sources(core srd_device_core_sources)

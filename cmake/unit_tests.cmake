@@ -15,6 +15,10 @@ catkin_add_gtest(core_tests
   test/unit/test_transport_errors_and_links.cpp
   test/unit/test_transport_baud_and_lock.cpp
   test/unit/test_recorded_stream.cpp
+  test/unit/test_recording_replay.cpp
+  test/unit/test_capture_queue.cpp
+  test/unit/test_params_in_force.cpp
+  test/unit/test_stop_signals.cpp
   test/unit/test_serial_link.cpp
   test/unit/test_sim_device_models.cpp
   test/unit/test_sim_pty_devices.cpp
@@ -26,6 +30,7 @@ catkin_add_gtest(core_tests
   test/unit/test_e_stop.cpp
   test/unit/test_input_refusals.cpp
   test/unit/test_log.cpp
+  test/unit/test_guarded_call.cpp
   test/unit/test_status_report.cpp
   test/unit/test_capabilities.cpp
   test/unit/test_event_rate.cpp)
@@ -71,7 +76,8 @@ add_dependencies(trajectory_action_definition_tests ${PROJECT_NAME}_generate_mes
 catkin_add_gtest(trajectory_tests test/unit/test_trajectory.cpp
   test/unit/test_trajectory_joints.cpp
   test/unit/test_trajectory_executor.cpp
-  test/unit/test_trajectory_executor_start.cpp)
+  test/unit/test_trajectory_executor_start.cpp
+  test/unit/test_trajectory_message_time.cpp)
 target_link_libraries(trajectory_tests srd_core gtest_main)
 # support/trajectory_executor_rig.h
 target_include_directories(trajectory_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)

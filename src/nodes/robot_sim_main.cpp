@@ -1,13 +1,12 @@
 // robot_sim: the simulated robot on pseudo-terminal(s). See `robot_sim --help` and
 // serial_robot_driver/sim/robot_sim.h. Prints one line per pty, runs until SIGINT/SIGTERM, then
 // prints a summary of its counters and exits 0.
-#include <signal.h>
-
+#include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <exception>
 #include <iostream>
 
+#include "serial_robot_driver/core/stop_signals.h"
 #include "serial_robot_driver/sim/command_line.h"
 #include "serial_robot_driver/sim/robot_sim.h"
 
@@ -24,12 +23,8 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  // Block the stop signals before any thread starts so only sigtimedwait() below sees them.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  // Before any thread starts, so only the wait below sees them.
+  const serial_robot_driver::core::StopSignals stop_signals;
 
   command_line.options.on_event = [](const std::string& text) {
     std::cout << text << std::endl;  // endl: flushed, a launcher may be reading line by line
@@ -48,9 +43,7 @@ int main(int argc, char** argv) {
               << (port.link.empty() ? "" : " (link " + port.link + ")") << std::endl;
   }
 
-  const timespec poll_interval{0, 200 * 1000 * 1000};
-  while (sigtimedwait(&stop_signals, nullptr, &poll_interval) < 0) {
-  }
+  stop_signals.wait(std::chrono::milliseconds(200));
   robot.stop();
   std::cout << "robot_sim: stopped\n" << sim::formatStats(robot.stats()) << std::flush;
   return 0;

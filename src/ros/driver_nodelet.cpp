@@ -13,6 +13,7 @@
 // stays loaded, idle; a bag that cannot be replayed is refused with the reason, and nothing starts.
 #include <nodelet/nodelet.h>
 
+#include <chrono>
 #include <memory>
 #include <pluginlib/class_list_macros.hpp>
 #include <string>
@@ -52,9 +53,7 @@ class DriverNodelet : public nodelet::Nodelet {
         NODELET_FATAL("%s; the driver does not start (no port is opened)", e.what());
         return;
       }
-      stream_factory = replay_->streamFactory();
-      params.replay_timeline = replay_->timeline();
-      params.reconnect_interval = 0.0;  // the recording paces its reopens
+      replay_->standIn(params, stream_factory);
       NODELET_INFO("replaying %s from %s (rate %g; 0: full speed)",
                    replay_->recording().topic.c_str(), params.replay_bag.c_str(),
                    params.replay_rate);
@@ -82,7 +81,8 @@ class DriverNodelet : public nodelet::Nodelet {
     });
   }
 
-  static inline const ros::WallDuration kReplaySettle{1.5};
+  static inline const ros::WallDuration kReplaySettle{
+      std::chrono::duration<double>(core::kReplaySettle).count()};
   // Declared first, destroyed last: the driver's links read from the replay's ports.
   std::unique_ptr<BagReplay> replay_;
   std::unique_ptr<DriverNode> driver_;

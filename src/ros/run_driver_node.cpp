@@ -1,14 +1,12 @@
 #include "serial_robot_driver/ros/run_driver_node.h"
 
-#include <pthread.h>
-
-#include <csignal>
-#include <ctime>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/core/stop_signals.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
@@ -16,25 +14,10 @@
 namespace serial_robot_driver::ros_layer {
 
 namespace {
-/// Waits for SIGINT/SIGTERM (blocked in every thread, taken here synchronously), for roscpp to
-/// shut down (rosnode kill) or for `done` (the end of a replay), checking the latter twice a second
-/// (20 times while replaying, whose end is worth noticing soon).
-/// Returns true when `done` ended the wait.
-bool waitForStopRequest(const sigset_t& stop_signals, const std::function<bool()>& done) {
-  const timespec period{0, done ? 50000000 : 500000000};
-  while (ros::ok()) {
-    if (done && done()) return true;
-    if (sigtimedwait(&stop_signals, nullptr, &period) > 0) return false;
-  }
-  return false;
-}
-
-/// After the last replayed chunk: how long the node stays up so that subscribers (rosbag record,
-/// a test) receive the tail of what it published before the connections close.
-constexpr std::chrono::milliseconds kReplayLinger{1500};
-/// Before the first replayed chunk: time for subscribers that are already running to connect to the
-/// topics the node has just advertised (a message nobody subscribes to is not even built).
-constexpr std::chrono::milliseconds kReplaySettle{1500};
+/// How often the wait for a stop checks whether roscpp shut down (rosnode kill): twice a second,
+/// 20 times while replaying, whose end is worth noticing soon.
+constexpr std::chrono::milliseconds kStopCheckPeriod{500};
+constexpr std::chrono::milliseconds kReplayCheckPeriod{50};
 }  // namespace
 
 DriverParams loadCheckedParams(const ros::NodeHandle& private_nh) {
@@ -54,22 +37,17 @@ namespace {
 std::unique_ptr<BagReplay> openReplay(DriverParams& params,
                                       core::SerialLink::StreamFactory& stream_factory) {
   auto replay = std::make_unique<BagReplay>(params);
-  stream_factory = replay->streamFactory();
-  params.replay_timeline = replay->timeline();
-  // The recording's stamps pace a recorded reopen; waiting reconnect_interval would not.
-  params.reconnect_interval = 0.0;
-  ROS_INFO(
-      "replaying %s from %s at %s", replay->recording().topic.c_str(), params.replay_bag.c_str(),
-      params.replay_rate > 0 ? (std::to_string(params.replay_rate) + "x the recorded pace").c_str()
-                             : "full speed");
+  replay->standIn(params, stream_factory);
+  ROS_INFO("replaying %s from %s at %s", replay->recording().topic.c_str(),
+           params.replay_bag.c_str(), core::replayPaceText(params.replay_rate).c_str());
   return replay;
 }
 
 /// Starts `node` (and the replay's clock) and serves it until a stop is asked for or the replay
 /// ends, then shuts it down.
-void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_signals) {
+void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignals& stop_signals) {
   if (replay) {
-    std::this_thread::sleep_for(kReplaySettle);
+    std::this_thread::sleep_for(core::kReplaySettle);
     replay->startClock();
   }
   node.start();
@@ -78,13 +56,14 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_s
   // ros::AsyncSpinner it does not wake every 100 ms while the node is idle.
   QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1);
   spinner.start();
-  const bool replay_done = waitForStopRequest(
-      stop_signals,
-      replay ? std::function<bool()>([&] { return replay->finished(); }) : std::function<bool()>());
+  const bool replay_done =
+      replay ? stop_signals.wait(
+                   kReplayCheckPeriod, [] { return ros::ok(); }, [&] { return replay->finished(); })
+             : stop_signals.wait(kStopCheckPeriod, [] { return ros::ok(); });
   if (replay_done) {
     node.updateDiagnostics();  // the counters at the end of the recording
     ROS_INFO("%s", replay->summary().c_str());
-    std::this_thread::sleep_for(kReplayLinger);
+    std::this_thread::sleep_for(core::kReplayLinger);
   }
   ROS_INFO("shutting down: stopping the wheels and the bus servos");
   node.shutdown();
@@ -96,11 +75,7 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_s
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
   // We take SIGINT ourselves: roscpp's handler would tear the node down before the zero-speed frame
   // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  const core::StopSignals stop_signals;
   ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
 
   ros::NodeHandle nh;

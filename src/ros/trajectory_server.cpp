@@ -1,8 +1,6 @@
 #include "serial_robot_driver/ros/trajectory_server.h"
 
-#include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <string>
 
 #include "serial_robot_driver/ros/guarded_callbacks.h"
@@ -32,11 +30,10 @@ serial_robot_driver::FollowJointTrajectoryFeedback toMsg(const trajectory::GoalF
   serial_robot_driver::FollowJointTrajectoryFeedback feedback;
   feedback.header.stamp = ros::Time::now();  // ROS time, as every stamp; the executor's is steady
   feedback.joint_names = in.joint_names;
-  // Clamped: ros::Duration throws beyond its 32-bit seconds (a goal may last that long).
-  constexpr double kLongestDuration = std::numeric_limits<int32_t>::max() - 1.0;
+  // ros::Duration throws beyond its 32-bit seconds (a goal may last that long).
   feedback.desired.time_from_start = feedback.actual.time_from_start =
       feedback.error.time_from_start =
-          ros::Duration(std::clamp(in.time_from_start, 0.0, kLongestDuration));
+          ros::Duration(trajectory::messageDuration(in.time_from_start));
   for (const trajectory::JointSample& d : in.desired) {
     feedback.desired.positions.push_back(d.position);
     feedback.desired.velocities.push_back(d.velocity);
@@ -67,22 +64,18 @@ void report(TrajectoryServer::GoalHandle& handle, const trajectory::GoalOutcome&
 
 }  // namespace
 
+trajectory::MessageStamp toMessageStamp(const ros::Time& stamp) { return {stamp.sec, stamp.nsec}; }
+
 double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
-  // A message's nsec is not normalised (any uint32): each part on its own, in int64.
-  const int64_t seconds = static_cast<int64_t>(later.sec) - static_cast<int64_t>(earlier.sec);
-  const int64_t nanoseconds = static_cast<int64_t>(later.nsec) - static_cast<int64_t>(earlier.nsec);
-  return static_cast<double>(seconds) + static_cast<double>(nanoseconds) * 1e-9;
+  return trajectory::secondsBetween(toMessageStamp(later), toMessageStamp(earlier));
 }
 
 bool actionlibCanTake(const ros::Time& stamp) {
-  constexpr uint32_t kSecondsLeft = 86400;
-  return stamp.nsec < 1000000000u &&
-         stamp.sec <= std::numeric_limits<uint32_t>::max() - kSecondsLeft;
+  return trajectory::actionTimersCanTake(toMessageStamp(stamp));
 }
 
 double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
-  if (stamp.isZero()) return steady_now;
-  return steady_now + secondsBetween(stamp, ros_now);
+  return trajectory::steadyStart(toMessageStamp(stamp), steady_now, toMessageStamp(ros_now));
 }
 
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg) {
@@ -147,17 +140,17 @@ void TrajectoryServer::onGoalGuarded(GoalHandle handle) {
   }
   // The goal must still be answered, or its client waits forever.
   runGuarded(input_refusals_, "follow_joint_trajectory", [&] {
-    Result result;
-    result.error_code = Result::INVALID_GOAL;
-    result.error_string = "internal error: " + error;
     const uint8_t status = handle.getGoalStatus().status;
+    trajectory::GoalPhase phase = trajectory::GoalPhase::kOver;
     if (status == actionlib_msgs::GoalStatus::PENDING ||
         status == actionlib_msgs::GoalStatus::RECALLING) {
-      handle.setRejected(result, result.error_string);
+      phase = trajectory::GoalPhase::kPending;
     } else if (status == actionlib_msgs::GoalStatus::ACTIVE ||
                status == actionlib_msgs::GoalStatus::PREEMPTING) {
-      handle.setAborted(result, result.error_string);
+      phase = trajectory::GoalPhase::kActive;
     }
+    if (const auto outcome = trajectory::internalErrorOutcome(phase, error))
+      report(handle, *outcome);
   });
 }
 

@@ -13,15 +13,15 @@
 #include <ros/ros.h>
 
 #include <cstdint>
-#include <limits>
 #include <string>
 
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/trajectory/message_time.h"
 
 namespace serial_robot_driver::ros_layer {
 
-/// Whether actionlib can add its timeouts (seconds) to `stamp`: nsec normalised and a day of
-/// seconds left before the end of uint32.
+/// Whether actionlib can add its timeouts (seconds) to `stamp`
+/// (trajectory::actionTimersCanTake()).
 bool actionlibCanTake(const ros::Time& stamp);
 /// `later` - `earlier` in seconds, for any two stamps (never throws; trajectory_server.h).
 double secondsBetween(const ros::Time& later, const ros::Time& earlier);
@@ -73,10 +73,8 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
   bool checkedStamp(const ros::Time& stamp) {
     if (actionlibCanTake(stamp)) return true;
     refusals_.refused(name_);
-    ROS_WARN_THROTTLE(1.0,
-                      "%s: goal or cancel refused: its goal_id.stamp (%u s, %u ns) is not a time "
-                      "the action server can compute with",
-                      name_.c_str(), stamp.sec, stamp.nsec);
+    ROS_WARN_THROTTLE(1.0, "%s",
+                      trajectory::unusableStampText(name_, {stamp.sec, stamp.nsec}).c_str());
     return false;
   }
 

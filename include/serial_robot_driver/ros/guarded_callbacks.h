@@ -1,9 +1,7 @@
-// The last line between an input and roscpp. Every subscription, service and action callback of
-// the node runs through runGuarded(): an exception it lets out (a bug, or an input no check
-// foresaw) is logged (throttled), counted as a "callback error" of its source
-// (device::InputRefusals, shown in /diagnostics) and, for a service, answered as a failure. It
-// never unwinds into roscpp, where it would end the process (in a nodelet, the whole manager).
-// Inputs are still checked first, where they arrive; this only catches what a check missed.
+// The last line between an input and roscpp: the core's guard (core/guarded_call.h: counted,
+// logged, a service answered as a failure) around every subscription, service and action callback
+// of the node, its errors in the ROS log (throttled). An exception never unwinds into roscpp, where
+// it would end the process (in a nodelet, the whole manager).
 #pragma once
 
 #include <ros/ros.h>
@@ -13,9 +11,8 @@
 #include <cstdint>
 #include <functional>
 #include <string>
-#include <type_traits>
-#include <utility>
 
+#include "serial_robot_driver/core/guarded_call.h"
 #include "serial_robot_driver/core/input_refusals.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -25,31 +22,11 @@ namespace serial_robot_driver::ros_layer {
 /// `error` (may be null) gets its text. Returns whether `callback` returned normally.
 bool runGuarded(core::InputRefusals& counters, const std::string& source,
                 const std::function<void()>& callback, std::string* error = nullptr);
+/// An error runGuarded() caught, as ROS_ERROR (at most once a second: a sender repeating the
+/// message must not flood the log; the count is exact).
+void logCallbackError(const std::string& line);
 
-namespace detail {
-template <typename T, typename = void>
-struct HasSuccess : std::false_type {};
-template <typename T>
-struct HasSuccess<T, std::void_t<decltype(std::declval<T&>().success)>> : std::true_type {};
-template <typename T, typename = void>
-struct HasOnline : std::false_type {};
-template <typename T>
-struct HasOnline<T, std::void_t<decltype(std::declval<T&>().online)>> : std::true_type {};
-template <typename T, typename = void>
-struct HasMessage : std::false_type {};
-template <typename T>
-struct HasMessage<T, std::void_t<decltype(std::declval<T&>().message)>> : std::true_type {};
-}  // namespace detail
-
-/// The answer to a request that failed: every field at its default, `success` (or servo/ping's
-/// `online`) false and `message` set, for those of these fields the response has.
-template <typename Response>
-void answerFailure(Response& res, const std::string& message) {
-  res = Response();
-  if constexpr (detail::HasSuccess<Response>::value) res.success = false;
-  if constexpr (detail::HasOnline<Response>::value) res.online = false;
-  if constexpr (detail::HasMessage<Response>::value) res.message = message;
-}
+using core::answerFailure;
 
 template <typename Message>
 using SubscriberCallback = boost::function<void(const boost::shared_ptr<const Message>&)>;
@@ -84,14 +61,8 @@ boost::function<bool(Request&, Response&)> guardedService(
     core::InputRefusals& counters, const std::string& service,
     boost::function<bool(Request&, Response&)> serve) {
   return [&counters, service, serve](Request& req, Response& res) {
-    bool answered = true;
-    std::string error;
-    if (runGuarded(
-            counters, service, [&] { answered = serve(req, res); }, &error)) {
-      return answered;
-    }
-    answerFailure(res, "internal error: " + error);
-    return true;
+    return core::serveGuarded(
+        counters, service, res, [&] { return serve(req, res); }, logCallbackError);
   };
 }
 

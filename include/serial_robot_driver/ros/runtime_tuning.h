@@ -4,25 +4,24 @@
 // .cfg defaults) and write every accepted change back to the parameter server, which therefore
 // always holds what is in force.
 //
-// A change is checked like the start-up parameters (DriverParams::validate()): a value the check
-// refuses is not applied, the value in force stays (logged once, with the reason) and the server's
-// answer shows it. dynamic_reconfigure itself clamps a value outside the .cfg range to the range.
-// An accepted change goes to every device's retune() at once; each device applies it from its next
-// loop tick or transaction under its own lock, so no thread sees half of it.
+// A change is checked and handed to the devices by the core (core/params_in_force.h): a value the
+// check refuses is not applied, the value in force stays (logged once, with the reason) and the
+// server's answer shows it. dynamic_reconfigure itself clamps a value outside the .cfg range to
+// the range.
 //
 // Threading: the servers' callbacks run on the node's global callback queue (the node's spinner or
-// the nodelet manager's threads); mutex_ makes them one at a time.
+// the nodelet manager's threads); the core makes them one at a time.
 #pragma once
 
 #include <ros/node_handle.h>
 
 #include <memory>
-#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "serial_robot_driver/core/device.h"
+#include "serial_robot_driver/core/params_in_force.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -60,11 +59,7 @@ class RuntimeTuning {
   using Servers = std::vector<std::unique_ptr<Server>>;
 
  private:
-  mutable std::mutex mutex_;
-  DriverParams in_force_;
-  bool stopped_ = false;
-  const std::vector<core::Device*> devices_;
-  trajectory::TrajectoryExecutor* const trajectory_;
+  core::ParamsInForce params_;
   Servers servers_;  // last: destroyed first
 };
 

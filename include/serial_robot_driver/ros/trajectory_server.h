@@ -26,14 +26,16 @@
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/guarded_action_server.h"
 #include "serial_robot_driver/trajectory/executor.h"
+#include "serial_robot_driver/trajectory/message_time.h"
 
 namespace serial_robot_driver::ros_layer {
 
 using trajectory::TrajectoryJoints;
 
-/// The steady time of a ROS `stamp` (zero: `steady_now`), given the two clocks read together.
-/// Computed in integers and doubles, never with ros::Duration, which throws beyond +-68 years:
-/// any stamp gives a finite time, and the executor refuses one too far ahead.
+/// A ROS stamp as the core's trajectories take it (trajectory/message_time.h).
+trajectory::MessageStamp toMessageStamp(const ros::Time& stamp);
+/// The steady time of a ROS `stamp` (zero: `steady_now`), given the two clocks read together:
+/// trajectory::steadyStart(), never ros::Duration, which throws beyond +-68 years.
 double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now);
 /// `later` - `earlier` in seconds, for any two stamps (never throws).
 double secondsBetween(const ros::Time& later, const ros::Time& earlier);

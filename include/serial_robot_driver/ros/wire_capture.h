@@ -3,35 +3,22 @@
 //
 // Threading model: onChunk() runs on whichever thread moved the bytes (a port's reader thread, the
 // base loop, a service or subscriber thread). It only stamps the chunk, copies it into a message
-// and queues it; its own thread publishes, so a slow serialization or a stalled subscriber never
-// delays the base loop or the telemetry path.
-//
-// Memory is bounded and every loss is counted, in one place: the capture's own queue. roscpp keeps
-// one outgoing queue per subscriber and silently discards the oldest message of a full one (its
-// statistics count a message as sent when it is queued), so its overflow cannot be counted.
-// Instead roscpp is never let to overflow: each message roscpp serializes for serial_raw (once, for
-// all its subscribers) gets a buffer whose release the capture sees, and the publishing thread
-// hands roscpp a new chunk only while fewer than max_in_roscpp such buffers are alive. A subscriber
-// whose queue holds that many unsent chunks (a slow rosbag, a stalled link) therefore holds the
-// publishing back; the capture's own queue fills, and past max_queued new chunks are dropped and
-// counted (diagnostics "wire capture"). Every subscriber sees the same stream: a chunk that was
-// published reached every subscriber's queue, a lost one is in "chunks dropped". The price: one
-// stalled subscriber holds back the others too. roscpp's own queue is set to max_in_roscpp as a
-// backstop that is never reached.
+// and queues it in the core's CaptureQueue (core/capture_queue.h: bounded, every loss counted),
+// whose own thread publishes, so a slow serialization or a stalled subscriber never delays the
+// base loop or the telemetry path. Each message roscpp serializes for serial_raw (once, for all
+// its subscribers) holds one of the queue's in-flight tokens until roscpp releases its buffer, so
+// roscpp's per-subscriber queues (which silently discard their oldest message when full) never
+// overflow; roscpp's own queue is set to max_in_roscpp as a backstop that is never reached.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
 #include <boost/shared_ptr.hpp>
-#include <condition_variable>
-#include <cstdint>
-#include <deque>
-#include <memory>
-#include <mutex>
-#include <thread>
+#include <cstddef>
 
 #include "serial_robot_driver/SerialChunk.h"
+#include "serial_robot_driver/core/capture_queue.h"
 #include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/core/wire_capture_status.h"
 #include "serial_robot_driver/ros/conversions.h"
@@ -41,11 +28,11 @@ namespace serial_robot_driver::ros_layer {
 // Its counters and status are the core's (device/wire_capture_status.h).
 using core::WireCaptureStats;
 
+/// The capture queue's limits (core/capture_queue.h), the in-flight ones being roscpp's.
 struct WireCaptureLimits {
-  /// About 10 s of a busy 1 Mbaud port; a backlog beyond this means the subscribers cannot keep up.
-  std::size_t max_queued = 20000;
+  std::size_t max_queued = core::CaptureQueueLimits{}.max_queued;
   /// Published chunks roscpp may hold unsent (its per-subscriber outgoing queues, the longest one).
-  std::size_t max_in_roscpp = 1000;
+  std::size_t max_in_roscpp = core::CaptureQueueLimits{}.max_in_flight;
 };
 
 class WireCapture : public core::ChunkObserver {
@@ -61,26 +48,14 @@ class WireCapture : public core::ChunkObserver {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) const;
 
  private:
-  /// What the buffers handed to roscpp report to; shared with them, as roscpp may release one
-  /// after the capture is gone.
-  struct Shared {
-    std::mutex mutex;  // guards the capture's queue, stats and stopping flag as well
-    std::condition_variable wake;
-    std::size_t in_roscpp = 0;
-  };
   struct Release;
 
-  void publishLoop();
-  void publish(const boost::shared_ptr<serial_robot_driver::SerialChunk>& msg);
+  /// Publishes `msg` and returns its size in bytes (on the queue's thread).
+  std::size_t publish(const boost::shared_ptr<serial_robot_driver::SerialChunk>& msg);
 
   const ArrivalStamps stamps_;
-  const WireCaptureLimits limits_;
-  const std::shared_ptr<Shared> shared_ = std::make_shared<Shared>();
   ros::Publisher publisher_;
-  std::deque<serial_robot_driver::SerialChunk> queue_;
-  bool stopping_ = false;
-  WireCaptureStats stats_;
-  std::thread thread_;
+  core::CaptureQueue queue_;  // after publisher_: its thread stops before publisher_ goes
 };
 
 }  // namespace serial_robot_driver::ros_layer

@@ -14,110 +14,39 @@ namespace {
 constexpr int kSpinnerThreads = 2;
 constexpr int kStopSpinnerThreads = 1;
 
-void logOutcome(const std::string& service, const ServoStatus& status) {
-  if (status.ok()) {
-    ROS_DEBUG("%s: %s", service.c_str(), status.message.c_str());
-  } else {
-    ROS_DEBUG("%s failed (%s): %s", service.c_str(), toString(status.error),
-              status.message.c_str());
-  }
-}
-
 // The outcome fields every servo/* response has; servo/ping calls its flag `online`.
 template <typename Response>
-void setOutcome(Response& res, bool ok, const std::string& message) {
-  res.success = ok;
-  res.message = message;
+void setOutcome(Response& res, const ServoReply& reply) {
+  res.success = reply.ok;
+  res.message = reply.message;
 }
-void setOutcome(ServoPing::Response& res, bool ok, const std::string& message) {
-  res.online = ok;
-  res.message = message;
+void setOutcome(ServoPing::Response& res, const ServoReply& reply) {
+  res.online = reply.ok;
+  res.message = reply.message;
 }
 // servo/scan has no flag: the ids it found are the outcome.
-void setOutcome(ServoScan::Response& res, bool /*ok*/, const std::string& message) {
-  res.message = message;
-}
+void setOutcome(ServoScan::Response& res, const ServoReply& reply) { res.message = reply.message; }
 
-/// Whether a successful call is logged at INFO (it changed a servo's settings) or DEBUG only.
-enum class Announce { kDebug, kInfo };
-
-/// The client operation behind one service: it fills the response's own fields (values, angle)
-/// and returns the status; the outcome fields are filled by advertiseServo().
+/// The core call behind one service (ServoServices): it copies the request's fields in and the
+/// reply's own fields (values, angle) out; the outcome fields are filled by advertiseServo().
 template <typename Service>
 using ServoCall =
-    std::function<ServoStatus(typename Service::Request&, typename Service::Response&)>;
+    std::function<ServoReply(typename Service::Request&, typename Service::Response&)>;
 
-/// The node handle the servo/* services are advertised on, and where their refusals are counted.
-struct ServoServiceSite {
-  ::ros::NodeHandle& nh;
-  core::InputRefusals& refusals;
-};
-
-/// Advertises one servo/* service from its call. The service logs the outcome, never throws
-/// through to its caller (guardedService) and always returns true, so the caller gets the message
-/// instead of a bare "service call failed".
+/// Advertises the servo/* service `name` on `nh` from its call. The service never throws through
+/// to its caller (guardedService, counted in `refusals`) and always returns true, so the caller
+/// gets the message instead of a bare "service call failed".
 template <typename Service>
-::ros::ServiceServer advertiseServo(ServoServiceSite site, const std::string& name,
-                                    ServoCall<Service> call, Announce announce = Announce::kDebug) {
+::ros::ServiceServer advertiseServo(::ros::NodeHandle& nh, core::InputRefusals& refusals,
+                                    const std::string& name, ServoCall<Service> call) {
   using Request = typename Service::Request;
   using Response = typename Service::Response;
-  core::InputRefusals& refusals = site.refusals;
-  const boost::function<bool(Request&, Response&)> serve = [name, call, announce, &refusals](
-                                                               Request& req, Response& res) {
-    const ServoStatus status = call(req, res);
-    logOutcome(name, status);
-    if (refusesRequest(status.error)) refusals.refused(name);
-    if (status.ok() && announce == Announce::kInfo) {
-      ROS_INFO("%s: %s", name.c_str(), status.message.c_str());
-    }
-    setOutcome(res, status.ok(), servoStatusMessage(status));
+  const boost::function<bool(Request&, Response&)> serve = [call](Request& req, Response& res) {
+    setOutcome(res, call(req, res));
     return true;
   };
-  return site.nh.advertiseService<Request, Response>(
+  return nh.advertiseService<Request, Response>(
       name, ros_layer::guardedService<Request, Response>(refusals, name, serve));
-}
-
-ServoStatus readAngle(ServoBusClient& client, const ServoReadAngle::Request& req,
-                      ServoReadAngle::Response& res) {
-  res.angle_deg = 0.0;
-  res.turns = 0;
-  if (req.multi_turn) {
-    MultiTurnReading reading;
-    const ServoStatus status = client.readMultiTurnAngle(req.id, &reading);
-    if (status.ok()) {
-      res.angle_deg = reading.angle_deg;
-      res.turns = reading.turns;
-    }
-    return status;
-  }
-  double angle_deg = 0.0;
-  const ServoStatus status = client.readAngle(req.id, &angle_deg);
-  if (status.ok()) res.angle_deg = angle_deg;
-  return status;
-}
-
-ServoStatus readAll(ServoBusClient& client, const ServoReadAll::Request& req,
-                    ServoReadAll::Response& res) {
-  std::vector<ServoParamValue> values;
-  const ServoStatus status = client.readAll(req.id, &values);
-  res.names.clear();
-  res.values.clear();
-  for (const ServoParamValue& value : values) {
-    res.names.push_back(value.name);
-    res.values.push_back(value.value);
-  }
-  return status;
-}
-
-ServoStatus readInfo(ServoBusClient& client, const ServoIdentityChecks& expected,
-                     const ServoInfo::Request& req, ServoInfo::Response& res) {
-  ServoIdentity identity;
-  const ServoStatus status = readServoInfo(client, req.id, expected, &identity);
-  res.servo_type = identity.servo_type;
-  res.firmware_version = identity.firmware_version;
-  res.serial_number = identity.serial_number;
-  res.response_switch = identity.response_switch;
-  return status;
 }
 
 MoveRequest toMoveRequest(const ServoMove::Request& req) {
@@ -130,6 +59,16 @@ MoveRequest toMoveRequest(const ServoMove::Request& req) {
   request.accel_ms = req.accel_ms;
   request.decel_ms = req.decel_ms;
   request.power_mw = req.power_mw;
+  return request;
+}
+
+RotateRequest toRotateRequest(const ServoRotate::Request& req) {
+  RotateRequest request;
+  request.id = req.id;
+  request.angle_deg = req.angle_deg;
+  request.interval_ms = req.interval_ms;
+  request.power_mw = req.power_mw;
+  request.wait = req.wait;
   return request;
 }
 
@@ -148,10 +87,9 @@ SpinRequest toSpinRequest(const ServoSpin::Request& req) {
 
 ServoBusServices::ServoBusServices(::ros::NodeHandle& nh, ServoBus& bus, ServoMotionClaims& claims,
                                    core::InputRefusals& refusals)
-    : bus_(bus),
-      client_(bus.client()),
-      claims_(claims),
+    : client_(bus.client()),
       refusals_(refusals),
+      handlers_(bus, claims, refusals),
       nh_(nh),
       stop_queue_([this] { client_.stopCallQueued(); }),
       stop_nh_(nh) {
@@ -189,91 +127,93 @@ void ServoBusServices::shutdown() {
 }
 
 void ServoBusServices::advertiseReads() {
-  const ServoServiceSite site{nh_, refusals_};
+  namespace name = servo_service;
   services_.push_back(advertiseServo<ServoPing>(
-      site, "servo/ping",
-      [this](ServoPing::Request& req, ServoPing::Response&) { return client_.ping(req.id); }));
+      nh_, refusals_, name::kPing,
+      [this](ServoPing::Request& req, ServoPing::Response&) { return handlers_.ping(req.id); }));
   services_.push_back(advertiseServo<ServoRead>(
-      site, "servo/read", [this](ServoRead::Request& req, ServoRead::Response& res) {
-        ServoParamValue value;
-        const ServoStatus status = client_.readParam(req.id, req.param, &value);
-        if (status.ok()) {
-          res.value = value.value;
-          res.unit = value.unit;
-        }
-        return status;
+      nh_, refusals_, name::kRead, [this](ServoRead::Request& req, ServoRead::Response& res) {
+        const ServoReadReply reply = handlers_.read(req.id, req.param);
+        res.value = reply.value;
+        res.unit = reply.unit;
+        return reply;
       }));
   services_.push_back(advertiseServo<ServoReadAngle>(
-      site, "servo/read_angle",
+      nh_, refusals_, name::kReadAngle,
       [this](ServoReadAngle::Request& req, ServoReadAngle::Response& res) {
-        return readAngle(client_, req, res);
+        const ServoAngleReply reply = handlers_.readAngle(req.id, req.multi_turn);
+        res.angle_deg = reply.angle_deg;
+        res.turns = reply.turns;
+        return reply;
       }));
   services_.push_back(advertiseServo<ServoScan>(
-      site, "servo/scan", [this](ServoScan::Request& req, ServoScan::Response& res) {
-        return client_.scan(req.first_id, req.last_id, &res.ids);
+      nh_, refusals_, name::kScan, [this](ServoScan::Request& req, ServoScan::Response& res) {
+        const ServoScanReply reply = handlers_.scan(req.first_id, req.last_id);
+        res.ids = reply.ids;
+        return reply;
       }));
-  services_.push_back(advertiseServo<ServoReadAll>(
-      site, "servo/read_all", [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
-        return readAll(client_, req, res);
-      }));
+  services_.push_back(
+      advertiseServo<ServoReadAll>(nh_, refusals_, name::kReadAll,
+                                   [this](ServoReadAll::Request& req, ServoReadAll::Response& res) {
+                                     const ServoReadAllReply reply = handlers_.readAll(req.id);
+                                     res.names = reply.names;
+                                     res.values = reply.values;
+                                     return reply;
+                                   }));
   services_.push_back(advertiseServo<ServoInfo>(
-      site, "servo/info", [this](ServoInfo::Request& req, ServoInfo::Response& res) {
-        return readInfo(client_, bus_.config().identity, req, res);
+      nh_, refusals_, name::kInfo, [this](ServoInfo::Request& req, ServoInfo::Response& res) {
+        const ServoInfoReply reply = handlers_.info(req.id);
+        res.servo_type = reply.identity.servo_type;
+        res.firmware_version = reply.identity.firmware_version;
+        res.serial_number = reply.identity.serial_number;
+        res.response_switch = reply.identity.response_switch;
+        return reply;
       }));
 }
 
 void ServoBusServices::advertiseWrites() {
-  const ServoServiceSite site{nh_, refusals_};
+  namespace name = servo_service;
   services_.push_back(advertiseServo<ServoWrite>(
-      site, "servo/write",
-      [this](ServoWrite::Request& req, ServoWrite::Response&) {
-        return bus_.writeParam(req.id, req.param, req.value);
-      },
-      Announce::kInfo));
+      nh_, refusals_, name::kWrite, [this](ServoWrite::Request& req, ServoWrite::Response&) {
+        return handlers_.write(req.id, req.param, req.value);
+      }));
   services_.push_back(advertiseServo<ServoResetUserData>(
-      site, "servo/reset_user_data",
+      nh_, refusals_, name::kResetUserData,
       [this](ServoResetUserData::Request& req, ServoResetUserData::Response&) {
-        return bus_.resetUserData(req.id);
-      },
-      Announce::kInfo));
+        return handlers_.resetUserData(req.id);
+      }));
 }
 
 void ServoBusServices::advertiseMoves() {
-  const ServoServiceSite site{nh_, refusals_};
+  namespace name = servo_service;
   services_.push_back(advertiseServo<ServoMove>(
-      site, "servo/move", [this](ServoMove::Request& req, ServoMove::Response&) {
-        return claims_.move(toMoveRequest(req), "servo/move");
+      nh_, refusals_, name::kMove, [this](ServoMove::Request& req, ServoMove::Response&) {
+        return handlers_.move(toMoveRequest(req));
       }));
   services_.push_back(advertiseServo<ServoRotate>(
-      site, "servo/rotate", [this](ServoRotate::Request& req, ServoRotate::Response&) {
-        RotateRequest request;
-        request.id = req.id;
-        request.angle_deg = req.angle_deg;
-        request.interval_ms = req.interval_ms;
-        request.power_mw = req.power_mw;
-        request.wait = req.wait;
-        return claims_.rotate(request, "servo/rotate");
+      nh_, refusals_, name::kRotate, [this](ServoRotate::Request& req, ServoRotate::Response&) {
+        return handlers_.rotate(toRotateRequest(req));
       }));
 }
 
 void ServoBusServices::advertiseStops() {
-  const ServoServiceSite site{stop_nh_, refusals_};
+  namespace name = servo_service;
   services_.push_back(advertiseServo<ServoSpin>(
-      site, "servo/spin", [this](ServoSpin::Request& req, ServoSpin::Response&) {
-        return claims_.spin(toSpinRequest(req), "servo/spin");
+      stop_nh_, refusals_, name::kSpin, [this](ServoSpin::Request& req, ServoSpin::Response&) {
+        return handlers_.spin(toSpinRequest(req));
       }));
-  services_.push_back(advertiseServo<ServoDamping>(
-      site, "servo/damping", [this](ServoDamping::Request& req, ServoDamping::Response&) {
-        return claims_.damping(req.id, req.power_mw, req.wait, "servo/damping");
-      }));
+  services_.push_back(
+      advertiseServo<ServoDamping>(stop_nh_, refusals_, name::kDamping,
+                                   [this](ServoDamping::Request& req, ServoDamping::Response&) {
+                                     return handlers_.damping(req.id, req.power_mw, req.wait);
+                                   }));
   services_.push_back(advertiseServo<ServoRelax>(
-      site, "servo/relax", [this](ServoRelax::Request& req, ServoRelax::Response&) {
-        return claims_.relax(req.ids, "servo/relax");
+      stop_nh_, refusals_, name::kRelax, [this](ServoRelax::Request& req, ServoRelax::Response&) {
+        return handlers_.relax(req.ids);
       }));
   services_.push_back(advertiseServo<ServoHold>(
-      site, "servo/hold", [this](ServoHold::Request& req, ServoHold::Response&) {
-        return claims_.hold(req.ids, "servo/hold");
-      }));
+      stop_nh_, refusals_, name::kHold,
+      [this](ServoHold::Request& req, ServoHold::Response&) { return handlers_.hold(req.ids); }));
 }
 
 }  // namespace serial_robot_driver::devices::servo_bus::ros

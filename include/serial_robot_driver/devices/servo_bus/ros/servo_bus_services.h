@@ -1,6 +1,7 @@
-// The servo/* services of the bus servos, each one a client or bus call behind the same outcome
-// handling (logged, never thrown through, the message always returned), served from queues of
-// their own (the threading model: servo_bus_ros.h): the stop services (servo/spin,
+// The servo/* services of the bus servos: each one copies its request into a call of the core's
+// ServoServices (servo_services.h: the call, its outcome, log lines and refusals) and the reply
+// into its response, never throws through (guarded) and always returns the message; served from
+// queues of their own (the threading model: servo_bus_ros.h): the stop services (servo/spin,
 // servo/relax, servo/damping, servo/hold) from the stop queue, whose bus turns are urgent work,
 // every other from the second one.
 #pragma once
@@ -15,6 +16,7 @@
 #include "serial_robot_driver/devices/servo_bus/ros/stop_call_queue.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus.h"
 #include "serial_robot_driver/devices/servo_bus/servo_motion_claims.h"
+#include "serial_robot_driver/devices/servo_bus/servo_services.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
 
 namespace serial_robot_driver::devices::servo_bus::ros {
@@ -45,10 +47,9 @@ class ServoBusServices {
   /// servo/spin, damping, relax, hold, on the stop queue.
   void advertiseStops();
 
-  ServoBus& bus_;
-  ServoBusClient& client_;  // bus_'s
-  ServoMotionClaims& claims_;
+  ServoBusClient& client_;  // the bus's: told of the stop calls queued
   core::InputRefusals& refusals_;
+  ServoServices handlers_;
   ::ros::CallbackQueue queue_;
   ::ros::NodeHandle nh_;  // the caller's namespace, bound to queue_
   StopCallQueue stop_queue_;

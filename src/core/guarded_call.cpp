@@ -1,0 +1,29 @@
+#include "serial_robot_driver/core/guarded_call.h"
+
+#include <exception>
+
+namespace serial_robot_driver::core {
+
+bool runGuarded(InputRefusals& counters, const std::string& source,
+                const std::function<void()>& callback, std::string* error,
+                const CallbackErrorLog& log) {
+  std::string what;
+  try {
+    callback();
+    return true;
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+    what = "an exception that is not a std::exception";
+  }
+  counters.failed(source);
+  if (log) {
+    log(source + ": internal error, this input was dropped (or answered as a failure): " + what);
+  }
+  if (error) *error = what;
+  return false;
+}
+
+std::string internalErrorText(const std::string& what) { return "internal error: " + what; }
+
+}  // namespace serial_robot_driver::core
