@@ -34,6 +34,7 @@ set(SRD_CORE_SOURCES
   src/core/input_refusals.cpp
   src/core/driver_core.cpp
   src/core/wire_capture_status.cpp
+  src/core/wall_stamps.cpp
 )
 
 srd_device_sources(core srd_device_core_sources)
