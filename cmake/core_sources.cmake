@@ -33,6 +33,8 @@ set(SRD_CORE_SOURCES
   src/core/e_stop_status.cpp
   src/core/input_refusals.cpp
   src/core/driver_core.cpp
+  src/core/log.cpp
+  src/core/port_log.cpp
   src/core/wire_capture_status.cpp
   src/core/wall_stamps.cpp
 )

@@ -34,6 +34,10 @@ class DriverMotion : public MotionQuery {
 
 }  // namespace
 
+DriverCore::DriverCore(const params::DriverParams& params, SerialLink::StreamFactory stream_factory,
+                       ChunkObserver* observer, trajectory::TrajectoryExecutor::Warn warn)
+    : DriverCore(params, MakeDevice(), std::move(stream_factory), observer, std::move(warn)) {}
+
 DriverCore::DriverCore(const params::DriverParams& params, const MakeDevice& make_device,
                        SerialLink::StreamFactory stream_factory, ChunkObserver* observer,
                        trajectory::TrajectoryExecutor::Warn warn)
@@ -58,6 +62,8 @@ void DriverCore::openPorts(const SerialLink::StreamFactory& stream_factory,
   for (const auto& [path, use] : users) {
     auto link = std::make_unique<SerialLink>(linkOptions(path, use), stream_factory);
     link->setChunkObserver(observer);
+    port_logs_.push_back(std::make_unique<PortLog>(*link, shutting_down_));
+    link->addListener(port_logs_.back().get());
     ports_[path] = std::move(link);
   }
 }
@@ -84,7 +90,15 @@ SerialLinkOptions DriverCore::linkOptions(const std::string& path,
 void DriverCore::makeDevices(const MakeDevice& make_device) {
   for (const DeviceModule* module : registeredDevices()) {
     if (!params_.enabled(*module)) continue;
-    devices_.push_back(make_device(*module, *ports_.at(params_.portOf(*module))));
+    SerialLink& link = *ports_.at(params_.portOf(*module));
+    if (make_device) {
+      devices_.push_back(make_device(*module, link));
+    } else if (module->make_device) {
+      devices_.push_back(module->make_device(params_, link));
+    } else {
+      throw params::ParameterError(std::string(module->name) + "/enabled",
+                                   "the device has no driver in this build");
+    }
     device_names_.emplace_back(module->name);
   }
 }
@@ -132,14 +146,20 @@ std::vector<Device*> DriverCore::devicePointers() const {
   return pointers;
 }
 
+Device* DriverCore::device(const std::string& name) const {
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
+    if (device_names_[i] == name) return devices_[i].get();
+  }
+  return nullptr;
+}
+
 void DriverCore::start() {
   for (auto& [path, link] : ports_) link->start();
   for (auto& device : devices_) device->start();
 }
 
 void DriverCore::shutdown() {
-  if (shut_down_) return;
-  shut_down_ = true;
+  if (shutting_down_.exchange(true)) return;
   // Base first: its zero-speed frame goes out while the port is still open.
   for (auto& device : devices_) device->shutdown();
   for (auto& [path, link] : ports_) link->stop();

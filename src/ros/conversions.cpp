@@ -41,10 +41,6 @@ ros::Time ArrivalStamps::operator()(std::chrono::steady_clock::time_point arriva
   return last_stamp;
 }
 
-JointCommand fromJointState(const sensor_msgs::JointState& msg) {
-  return JointCommand{msg.name, msg.position};
-}
-
 void writeStatusReport(const core::StatusReport& report,
                        diagnostic_updater::DiagnosticStatusWrapper& status, SummaryWrite summary) {
   static_assert(static_cast<unsigned char>(core::StatusLevel::kWarn) ==

@@ -4,8 +4,8 @@
 #include <utility>
 
 #include "serial_robot_driver/core/link_status.h"
+#include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/ros/conversions.h"
-#include "serial_robot_driver/ros/device_interface.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
@@ -14,49 +14,27 @@
 
 namespace serial_robot_driver::ros_layer {
 
-/// Logs a port's comings and goings once per event (reader thread), and the USB latency hint.
-/// Once the node shuts down, a port going down is the node closing it (or the robot's end going
-/// at the same moment): stopping is not losing, so nothing is logged as lost.
-class PortMonitor : public core::LinkListener {
- public:
-  PortMonitor(const core::SerialLink& link, const std::atomic<bool>& shutting_down)
-      : link_(link), shutting_down_(shutting_down) {}
+namespace {
 
-  void onLinkUp() override {
-    waiting_logged_ = false;
-    const core::LinkStats stats = link_.stats();
-    ROS_INFO("port %s connected (low latency: %s)", link_.options().path.c_str(),
-             stats.low_latency ? "yes" : "not supported");
-    if (stats.latency_timer_ms && *stats.latency_timer_ms > 1) {
-      ROS_WARN(
-          "port %s: the USB-serial adapter's latency_timer is %d ms, which delays every frame; "
-          "set it to 1 ms with a udev rule (see config/99-serial-robot.rules)",
-          link_.options().path.c_str(), *stats.latency_timer_ms);
-    }
+/// The core's log lines (core/log.h) as the node's.
+void logToRos(core::LogLevel level, const std::string& text) {
+  switch (level) {
+    case core::LogLevel::kDebug:
+      ROS_DEBUG("%s", text.c_str());
+      break;
+    case core::LogLevel::kInfo:
+      ROS_INFO("%s", text.c_str());
+      break;
+    case core::LogLevel::kWarn:
+      ROS_WARN("%s", text.c_str());
+      break;
+    case core::LogLevel::kError:
+      ROS_ERROR("%s", text.c_str());
+      break;
   }
-  void onLinkDown() override {
-    if (shutting_down_) {
-      ROS_DEBUG("port %s closed", link_.options().path.c_str());
-      return;
-    }
-    ROS_WARN("port %s lost (%s); reopening every %.1f s", link_.options().path.c_str(),
-             link_.stats().last_error.c_str(), link_.options().reconnect_interval);
-    waiting_logged_ = true;  // the retries that follow need no message of their own
-  }
-  void onOpenFailed(const std::string& error) override {
-    if (waiting_logged_ || shutting_down_) return;  // once per outage, not once per retry
-    waiting_logged_ = true;
-    ROS_WARN("waiting for port %s (%s); retrying every %.1f s", link_.options().path.c_str(),
-             error.c_str(), link_.options().reconnect_interval);
-  }
-  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t,
-               core::Clock::time_point) override {}
+}
 
- private:
-  const core::SerialLink& link_;
-  const std::atomic<bool>& shutting_down_;
-  bool waiting_logged_ = false;  // reader thread only
-};
+}  // namespace
 
 DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverParams params,
                        core::SerialLink::StreamFactory stream_factory)
@@ -71,12 +49,10 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
       capture_->diagnose(s);
     });
   }
-  core_ = std::make_unique<core::DriverCore>(
-      params_,
-      [this](const core::DeviceModule& module, core::SerialLink& link) {
-        return makeDevice(module, link);
-      },
-      stream_factory, capture_.get(), TrajectoryServer::logWarning());
+  core::setLogSink(logToRos);
+  core_ = std::make_unique<core::DriverCore>(params_, stream_factory, capture_.get(),
+                                             TrajectoryServer::logWarning());
+  attachFrontEnds();
   addPortsAndDevices();
   serveTrajectories();
   connectEStop();
@@ -93,21 +69,20 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
 
 DriverNode::~DriverNode() { shutdown(); }
 
-std::unique_ptr<core::Device> DriverNode::makeDevice(const core::DeviceModule& module,
-                                                     core::SerialLink& link) {
-  const RosDeviceModule* ros_side = findInterface(module.name);
-  if (ros_side == nullptr) {
-    throw ParameterError(std::string(module.name) + "/enabled",
-                         "the device has no ROS interface in this build");
+void DriverNode::attachFrontEnds() {
+  for (std::size_t i = 0; i < core_->devices().size(); ++i) {
+    const std::string& name = core_->deviceNames()[i];
+    const RosDeviceModule* ros_side = findInterface(name);
+    if (ros_side == nullptr || ros_side->attach == nullptr) {
+      throw ParameterError(name + "/enabled", "the device has no ROS interface in this build");
+    }
+    front_ends_.push_back(ros_side->attach(nh_, params_, *core_->devices()[i]));
   }
-  return ros_side->make(nh_, params_, link);
 }
 
 void DriverNode::addPortsAndDevices() {
   for (const auto& [path, link_ptr] : core_->ports()) {
     core::SerialLink& link = *link_ptr;
-    port_monitors_.push_back(std::make_unique<PortMonitor>(link, shut_down_));
-    link.addListener(port_monitors_.back().get());
     diagnostics_.add("port " + path, [&link](diagnostic_updater::DiagnosticStatusWrapper& s) {
       writeStatusReport(core::linkStatus(link.stats(), link.options()), s);
     });
@@ -162,6 +137,7 @@ void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
 
 void DriverNode::start() {
   core_->start();
+  for (auto& front_end : front_ends_) front_end->start();
   if (trajectory_) trajectory_->start();
   ROS_INFO("%s; diagnostics every %g s", core_->startupSummary().c_str(), diagnostics_period_);
 }
@@ -174,6 +150,7 @@ void DriverNode::shutdown() {
   e_stop_sub_.shutdown();
   if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop
   core_->shutdown();
+  for (auto& front_end : front_ends_) front_end->shutdown();
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -206,7 +206,7 @@ TEST(ConversionsJointCommand, NamesAndPositionsOnly) {
   msg.name = {"knee", "hip"};
   msg.position = {0.5, -0.25};
   msg.velocity = {1.0, 2.0};
-  const JointCommand command = fromJointState(msg);
+  const devices::body::JointCommand command = devices::body::ros::fromJointState(msg);
   EXPECT_EQ(command.names, msg.name);
   EXPECT_EQ(command.positions, msg.position);
 }

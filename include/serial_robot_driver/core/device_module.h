@@ -1,13 +1,14 @@
 // What makes a device known to the driver: one DeviceModule per device, defined in the device's
 // own folder (src/devices/<name>/) and registered by one line in cmake/devices.cmake. The framer
-// configuration, the parameter table and its checks, the node's interfaces
-// (ros/ros_device_module.h) and the simulator (sim/sim_device_module.h) all walk the registered
-// modules; none of them names a device. A module is declared with named fields (designated
-// initialisers); a field left out is empty or null.
+// configuration, the parameter table and its checks, the devices DriverCore builds, their front
+// ends (ros/ros_device_module.h) and the simulator (sim/sim_device_module.h) all walk the
+// registered modules; none of them names a device. A module is declared with named fields
+// (designated initialisers); a field left out is empty or null.
 #pragma once
 
 #include <chrono>
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct ParamSpec;
 }  // namespace serial_robot_driver::params
 
 namespace serial_robot_driver::core {
+
+class Device;
+class SerialLink;
 
 struct DeviceModule {
   /// The parameter namespace (~<name>/enabled, ~<name>/port, ~<name>/baud and the device's own),
@@ -52,7 +56,17 @@ struct DeviceModule {
   /// the framer gives up on it (a request/response bus: no longer than an answer may take);
   /// null: the link's default.
   std::chrono::milliseconds (*stale_frame_timeout)(const params::DriverParams& params) = nullptr;
+  /// Builds the device (its core class, e.g. devices::base::BaseDevice) on `link`, before the link
+  /// starts; DriverCore owns it. `params` outlives it. Front ends attach to what this returns.
+  std::unique_ptr<Device> (*make_device)(const params::DriverParams& params,
+                                         SerialLink& link) = nullptr;
 };
+
+/// DeviceModule::make_device for a device class constructed from (params, link).
+template <typename DeviceClass>
+std::unique_ptr<Device> makeDevice(const params::DriverParams& params, SerialLink& link) {
+  return std::make_unique<DeviceClass>(params, link);
+}
 
 /// The registered devices, in start and shutdown order (cmake/devices.cmake: the base first, so
 /// its zero-speed frame goes out before anything else stops).

@@ -1,10 +1,13 @@
 // The driver without its front end: the ports the enabled devices name, the devices on them in the
 // registered order, the trajectories over their joints, the wiring between them (the e-stop, the
-// capabilities, the MotionQuery over all of them), and their start and shutdown order. A front end
-// (the ROS DriverNode) builds each device's adapter through MakeDevice and adds only its own
-// things around this: status messages, the e_stop topic, the trajectory action, runtime tuning.
+// capabilities, the MotionQuery over all of them), their start and shutdown order and the ports'
+// log lines (core/port_log.h). It builds and owns every device (DeviceModule::make_device), so it
+// runs without any front end; a front end (the ROS DriverNode, ...) attaches to the devices before
+// start() and adds only its own things around this: status messages, the e_stop topic, the
+// trajectory action, runtime tuning.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -15,6 +18,7 @@
 #include "serial_robot_driver/core/device.h"
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/core/e_stop.h"
+#include "serial_robot_driver/core/port_log.h"
 #include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/trajectory/executor.h"
@@ -23,14 +27,20 @@ namespace serial_robot_driver::core {
 
 class DriverCore {
  public:
-  /// Builds the device of `module` on `link` (its front end's adapter around the core device).
+  /// Builds the device of `module` on `link` (tests: a device of their own).
   using MakeDevice =
       std::function<std::unique_ptr<Device>(const DeviceModule& module, SerialLink& link)>;
 
   /// Opens nothing yet: builds one SerialLink per path the enabled devices name (`stream_factory`
-  /// and `observer` as SerialLink takes them), the devices, one trajectory executor over their
-  /// joints (warning through `warn`), and wires the capabilities and the e-stop. `params` must
-  /// outlive this.
+  /// and `observer` as SerialLink takes them), each enabled device (its module's make_device), one
+  /// trajectory executor over their joints (warning through `warn`), and wires the capabilities
+  /// and the e-stop. `params` must outlive this. Throws params::ParameterError for an enabled
+  /// device that has no make_device.
+  explicit DriverCore(const params::DriverParams& params,
+                      SerialLink::StreamFactory stream_factory = {},
+                      ChunkObserver* observer = nullptr,
+                      trajectory::TrajectoryExecutor::Warn warn = {});
+  /// The same with the devices built by `make_device` (empty: their modules').
   DriverCore(const params::DriverParams& params, const MakeDevice& make_device,
              SerialLink::StreamFactory stream_factory = {}, ChunkObserver* observer = nullptr,
              trajectory::TrajectoryExecutor::Warn warn = {});
@@ -50,6 +60,8 @@ class DriverCore {
   const std::vector<std::unique_ptr<Device>>& devices() const { return devices_; }
   const std::vector<std::string>& deviceNames() const { return device_names_; }
   std::vector<Device*> devicePointers() const;
+  /// The device of the registered module called `name`, or null when it is not enabled.
+  Device* device(const std::string& name) const;
   /// The trajectories over every device's joints; null when no device has any.
   trajectory::TrajectoryExecutor* trajectories() const { return trajectories_.get(); }
   /// What is moving the robot now (device/capabilities.h), as the devices were offered it.
@@ -72,8 +84,11 @@ class DriverCore {
   void connectEStop();
 
   const params::DriverParams& params_;
+  /// Set when shutdown() begins: the ports' closing is no outage (PortLog). Outlives the ports.
+  std::atomic<bool> shutting_down_{false};
   /// Outlives the devices and the trajectories that registered with it.
   EStop e_stop_;
+  std::vector<std::unique_ptr<PortLog>> port_logs_;  ///< one per port; outlive the ports' readers
   std::map<std::string, std::unique_ptr<SerialLink>> ports_;
   /// Outlives the devices, which hold a reference to it.
   std::unique_ptr<trajectory::TrajectoryExecutor> trajectories_;
@@ -81,7 +96,6 @@ class DriverCore {
   std::unique_ptr<MotionQuery> motion_;
   std::vector<std::unique_ptr<Device>> devices_;
   std::vector<std::string> device_names_;
-  bool shut_down_ = false;
 };
 
 }  // namespace serial_robot_driver::core

@@ -38,13 +38,6 @@ class ArrivalStamps {
   std::shared_ptr<const transport::ReplayPacing> replay_timeline_;
 };
 
-/// A joint command taken out of a JointState (only name and position matter).
-struct JointCommand {
-  std::vector<std::string> names;
-  std::vector<double> positions;
-};
-JointCommand fromJointState(const sensor_msgs::JointState& msg);
-
 /// How writeStatusReport treats the status's summary so far.
 enum class SummaryWrite {
   kReplace,  ///< the report's level and message are the status's (the updater's fresh status)

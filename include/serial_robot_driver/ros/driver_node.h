@@ -1,7 +1,8 @@
 // driver_node: one node that owns the robot's serial port(s).
 //
-// The devices it drives are the registered ones (device/device_module.h); each has a ROS interface
-// of its own (ros/*_interface.h) with its topics and services, listed in full in docs/node_api.md:
+// The devices it drives are the registered ones (core/device_module.h), built and owned by
+// core::DriverCore; each has a ROS front end of its own (devices/<name>/ros/<name>_ros.h) with its
+// topics and services, listed in full in docs/node_api.md:
 //   base      in cmd_vel; out odom (+ tf), wheel_command, battery;
 //             base/reset, base/reset_odometry, base/clear_encoders
 //   body      in joint_commands; out joint_states, imu/data, foot_pressure, telemetry
@@ -41,12 +42,12 @@
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/core/input_refusals.h"
 #include "serial_robot_driver/core/serial_link.h"
+#include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::ros_layer {
 
 class RuntimeTuning;
-class PortMonitor;
 class TrajectoryServer;
 class WireCapture;
 
@@ -68,10 +69,9 @@ class DriverNode {
   void shutdown();
 
  private:
-  /// The ROS side of `module`'s device on `link` (its RosDeviceModule).
-  std::unique_ptr<core::Device> makeDevice(const core::DeviceModule& module,
-                                           core::SerialLink& link);
-  /// A monitor and a status per port, a status (and its extras) per device.
+  /// Each device's ROS front end (its RosDeviceModule), attached before the core starts.
+  void attachFrontEnds();
+  /// A status per port, a status (and its extras) per device.
   void addPortsAndDevices();
   /// follow_joint_trajectory / joint_trajectory when a device offers joints.
   void serveTrajectories();
@@ -85,11 +85,11 @@ class DriverNode {
   ros::Subscriber e_stop_sub_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it
-  std::atomic<bool> shut_down_{false};    // read by the ports' monitors on the reader threads
-  /// One per port; outlive the ports' reader threads.
-  std::vector<std::unique_ptr<PortMonitor>> port_monitors_;
+  std::atomic<bool> shut_down_{false};
   /// The ports, the devices, their wiring and their order.
   std::unique_ptr<core::DriverCore> core_;
+  /// The devices' topics and services, in the devices' order; destroyed before core_'s devices.
+  std::vector<std::unique_ptr<DeviceFrontEnd>> front_ends_;
   /// follow_joint_trajectory / joint_trajectory for the core's trajectories; null without joints.
   std::unique_ptr<TrajectoryServer> trajectory_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up

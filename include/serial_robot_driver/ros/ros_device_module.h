@@ -1,6 +1,7 @@
-// A device's ROS side, registered like its core module (device/device_module.h) and found by
-// the same name: DriverNode builds the interface of every enabled device from it. Defined in the
-// device's folder (src/devices/<name>/ros/).
+// A device's ROS side, registered like its core module (core/device_module.h) and found by the
+// same name: DriverNode attaches the front end of every enabled device to the device the core
+// built. Defined in the device's folder (src/devices/<name>/ros/), which is the one place that
+// knows the core device's class.
 #pragma once
 
 #include <ros/node_handle.h>
@@ -8,8 +9,9 @@
 #include <memory>
 #include <vector>
 
-#include "serial_robot_driver/core/serial_link.h"
-#include "serial_robot_driver/ros/device_interface.h"
+#include "serial_robot_driver/core/device.h"
+#include "serial_robot_driver/ros/device_front_end.h"
+#include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -18,9 +20,10 @@ namespace serial_robot_driver::ros_layer {
 struct RosDeviceModule {
   /// The core module's name (DeviceModule::name).
   const char* name = nullptr;
-  /// Builds the device's interface on its port (before the ports start).
-  std::unique_ptr<DeviceInterface> (*make)(ros::NodeHandle& nh, const DriverParams& params,
-                                           core::SerialLink& link) = nullptr;
+  /// Builds the device's front end on `device` (made by its core module's make_device), before
+  /// the core starts: it registers its outputs with the device. `device` outlives it.
+  std::unique_ptr<DeviceFrontEnd> (*attach)(ros::NodeHandle& nh, const DriverParams& params,
+                                            core::Device& device) = nullptr;
   /// Starts the device's runtime tuning servers (addGroupServer, ros/tuning_group_server.h) under
   /// `private_nh` into `servers`; RuntimeTuning calls it while the device is enabled. Null: the
   /// device has nothing to tune.
@@ -32,12 +35,5 @@ struct RosDeviceModule {
 const std::vector<const RosDeviceModule*>& registeredInterfaces();
 /// The ROS side of the device called `name`, or null.
 const RosDeviceModule* findInterface(const std::string& name);
-
-/// RosDeviceModule::make for an interface constructed from (nh, params, link).
-template <typename Interface>
-std::unique_ptr<DeviceInterface> makeInterface(ros::NodeHandle& nh, const DriverParams& params,
-                                               core::SerialLink& link) {
-  return std::make_unique<Interface>(nh, params, link);
-}
 
 }  // namespace serial_robot_driver::ros_layer

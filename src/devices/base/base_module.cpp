@@ -4,6 +4,7 @@
 
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
+#include "serial_robot_driver/devices/base/base_device.h"
 #include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/params/driver_params.h"
@@ -121,6 +122,7 @@ extern const core::DeviceModule kModule{
     .add_parameters = addParameters,
     .validate = validate,
     .resolve_frames = resolveFrames,
+    .make_device = core::makeDevice<BaseDevice>,
 };
 
 }  // namespace serial_robot_driver::devices::base

@@ -5,6 +5,7 @@
 
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
+#include "serial_robot_driver/devices/body/body_device.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/body/gyro_bias.h"
 #include "serial_robot_driver/params/driver_params.h"
@@ -111,6 +112,7 @@ extern const core::DeviceModule kModule{
     // A telemetry frame's LEN depends on how many servos it carries.
     .probe_argument =
         [](const DriverParams& p) { return p.section(kBodySection).servo_ids.size(); },
+    .make_device = core::makeDevice<BodyDevice>,
 };
 
 }  // namespace serial_robot_driver::devices::body

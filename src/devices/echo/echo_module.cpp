@@ -2,6 +2,7 @@
 // section is declared here like every device's: adding it edited no shared parameter struct.
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/echo/echo_codec.h"
+#include "serial_robot_driver/devices/echo/echo_device.h"
 #include "serial_robot_driver/devices/echo/echo_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
@@ -44,6 +45,7 @@ extern const core::DeviceModule kModule{
         [](const DriverParams& p) {
           return std::chrono::milliseconds(p.section(kEchoSection).timeout_ms);
         },
+    .make_device = core::makeDevice<EchoDevice>,
 };
 
 }  // namespace serial_robot_driver::devices::echo

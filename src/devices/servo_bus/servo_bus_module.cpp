@@ -7,6 +7,7 @@
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_codec.h"
+#include "serial_robot_driver/devices/servo_bus/servo_bus_device.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
 #include "serial_robot_driver/params/driver_params.h"
 
@@ -173,6 +174,7 @@ extern const core::DeviceModule kModule{
           return std::max(std::chrono::milliseconds(1),
                           p.section(kServoBusSection).bus.client.timeout);
         },
+    .make_device = core::makeDevice<ServoBusDevice>,
 };
 
 }  // namespace serial_robot_driver::devices::servo_bus

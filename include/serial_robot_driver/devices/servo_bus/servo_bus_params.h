@@ -16,7 +16,7 @@ namespace serial_robot_driver::devices::servo_bus {
 /// whose checks see the value as written); the rest are the ROS layer's and the checks'.
 struct ServoBusParams : params::DevicePortParams {
   /// The bus's configuration as the parameters set it; polled_ids is not a parameter:
-  /// ros::makeServoBusConfig fills it in from state_ids and joint_ids.
+  /// makeServoBusConfig (servo_bus_device.h) fills it in from state_ids and joint_ids.
   ServoBusConfig bus;
   std::vector<int> state_ids;   ///< bus servos polled for servo_states (empty: no poll)
   int command_interval_ms = 0;  ///< ROTATE interval for servo_commands without a velocity

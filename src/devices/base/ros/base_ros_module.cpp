@@ -7,6 +7,13 @@ namespace serial_robot_driver::devices::base {
 
 namespace {
 
+std::unique_ptr<ros_layer::DeviceFrontEnd> attach(::ros::NodeHandle& nh,
+                                                  const ros_layer::DriverParams& params,
+                                                  core::Device& device) {
+  // The core built it from kModule's make_device (base_module.cpp): a BaseDevice.
+  return std::make_unique<ros::BaseRos>(nh, params, static_cast<BaseDevice&>(device));
+}
+
 // The ~base group: the wheel, speed, battery and odometry tunables (BaseTuning.cfg).
 void addTuning(ros_layer::RuntimeTuning& tuning, const ::ros::NodeHandle& private_nh,
                ros_layer::RuntimeTuning::Servers& servers) {
@@ -17,7 +24,7 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ::ros::NodeHandle& privat
 
 extern const ros_layer::RosDeviceModule kRosModule{
     .name = "base",
-    .make = ros_layer::makeInterface<ros::BaseRos>,
+    .attach = attach,
     .add_tuning = addTuning,
 };
 

@@ -1,33 +1,20 @@
 #include "serial_robot_driver/devices/body/ros/body_ros.h"
 
 #include <sensor_msgs/Imu.h>
+#include <sensor_msgs/JointState.h>
 
 #include <boost/make_shared.hpp>
 
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
-#include "serial_robot_driver/devices/body/body_trajectory_joints.h"
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
-#include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/trigger_service.h"
 
 namespace serial_robot_driver::devices::body::ros {
 
-using body::gyroUnits;
-
-BodyRos::BodyRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params,
-                 core::SerialLink& link)
-    : link_(link),
-      arrival_stamps_(params),
-      imu_params_(std::make_shared<const ImuParams>(params.section(kImuSection))),
-      gyro_calibrator_([this] { return notStill(); }),
-      controller_(makeBodyJoints(params.section(kBodySection)), link.writer(),
-                  {[this](const Telemetry& telemetry, core::Clock::time_point arrival) {
-                    publishTelemetry(telemetry, arrival);
-                  }}),
-      // Expected telemetry rates; measured on ROS time, as diagnostic_updater's FrequencyStatus.
-      telemetry_rate_(1.0, 1000.0, [] { return ::ros::Time::now().toSec(); }),
-      calibration_nh_(nh) {
+BodyRos::BodyRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params, BodyDevice& device)
+    : device_(device), arrival_stamps_(params), calibration_nh_(nh) {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
   joint_states_pub_ =
       nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
@@ -36,24 +23,23 @@ BodyRos::BodyRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params,
       nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
   telemetry_pub_ =
       nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
+  device.addOutputs({[this](const BodyFrame& frame) { publishFrame(frame); }});
+
+  core::InputRefusals& refusals = device.inputRefusals();
   // tcpNoDelay: a joint command must not wait in Nagle's buffer.
-  joint_commands_sub_ = ros_layer::subscribeGuarded(nh, inputRefusals(), "joint_commands", 10,
-                                                    &BodyRos::onJointCommand, this,
-                                                    ::ros::TransportHints().tcpNoDelay());
-  link.addListener(&controller_);
+  const ros_layer::SubscriberCallback<sensor_msgs::JointState> on_command =
+      [this](const sensor_msgs::JointState::ConstPtr& msg) {
+        device_.commandJoints(fromJointState(*msg));
+      };
+  joint_commands_sub_ = nh.subscribe<sensor_msgs::JointState>(
+      "joint_commands", 10, ros_layer::guardedSubscriber(refusals, "joint_commands", on_command),
+      ::ros::VoidConstPtr(), ::ros::TransportHints().tcpNoDelay());
   calibration_nh_.setCallbackQueue(&calibration_queue_);
-  calibrate_srv_ = ros_layer::advertiseGuarded(calibration_nh_, inputRefusals(), "imu/calibrate",
-                                               &BodyRos::onCalibrate, this);
-  if (params.section(kImuSection).calibrate_on_start) {
-    gyro_calibrator_.calibrateOnStart([](const GyroCalibrationOutcome& outcome) {
-      if (outcome.success) {
-        ROS_INFO("imu/calibrate_on_start: %s", outcome.message.c_str());
-      } else {
-        ROS_WARN("imu/calibrate_on_start: %s", outcome.message.c_str());
-      }
-    });
-  }
+  calibrate_srv_ = ros_layer::advertiseTrigger(calibration_nh_, refusals, "imu/calibrate",
+                                               [&device] { return device.calibrateGyro(); });
 }
+
+BodyRos::~BodyRos() { shutdown(); }
 
 void BodyRos::start() {
   if (calibration_spinner_ || shut_down_) return;
@@ -61,133 +47,34 @@ void BodyRos::start() {
   calibration_spinner_->start();
 }
 
-std::string BodyRos::notStill() const {
-  if (e_stop_ && e_stop_->engaged()) return "the e-stop is engaged";
-  return motion_query_ ? motion_query_->motionInForce() : std::string();
-}
-
-bool BodyRos::onCalibrate(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-  // On calibration_queue_'s own thread: blocking here for the averaging holds up nothing else.
-  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
-  const GyroCalibrationOutcome outcome =
-      gyro_calibrator_.calibrate(imu->calibration_time, gyroUnits(*imu), "imu/calibrate");
-  res.success = outcome.success;
-  res.message = outcome.message;
-  if (outcome.success) {
-    ROS_INFO("%s", outcome.message.c_str());
-  } else {
-    ROS_WARN("%s", outcome.message.c_str());
-  }
-  return true;
-}
-
-void BodyRos::retune(const ros_layer::DriverParams& params) {
-  std::atomic_store(&imu_params_, std::make_shared<const ImuParams>(params.section(kImuSection)));
-}
-
 void BodyRos::shutdown() {
   joint_commands_sub_.shutdown();
-  controller_.gate().close();  // no position goes out once the node is shutting down
   if (shut_down_) return;
   shut_down_ = true;
-  gyro_calibrator_.cancel();  // a call waiting for its averaging returns now
   calibrate_srv_.shutdown();
   if (calibration_spinner_) calibration_spinner_->stop();
 }
 
-BodyRos::~BodyRos() { shutdown(); }
-
-void BodyRos::attachEStop(core::EStop& e_stop) {
-  e_stop_ = &e_stop;
-  e_stop.addListener([this](bool engaged) { controller_.gate().setLocked(engaged); });
-}
-
-std::vector<ros_layer::TrajectoryJoints> BodyRos::trajectoryJoints() {
-  return {bodyTrajectoryJoints(controller_)};
-}
-
-void BodyRos::publishTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival) {
+void BodyRos::publishFrame(const BodyFrame& frame) {
   // Runs on the link's reader thread; ros::Publisher::publish is thread-safe. A message nobody
   // subscribes to is not even built: at hundreds of frames per second that is most of the CPU.
-  telemetry_rate_.tick();
-  const ::ros::Time stamp = arrival_stamps_(arrival);
-  const auto& joints = controller_.joints();
-  // The trajectory server needs every frame: its goals are checked against it.
-  const auto joint_state =
-      boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
-  if (trajectory_) {
-    trajectory_->updateActual(joint_state->name, joint_state->position, joint_state->velocity);
-  }
+  const ::ros::Time stamp = arrival_stamps_(frame.arrival);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
   // gets this very message, not a serialized copy.
   if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(joint_state);
+    joint_states_pub_.publish(
+        boost::make_shared<sensor_msgs::JointState>(toJointState(frame.joints, stamp)));
   }
-  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
-  if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);
-  // Every frame feeds the calibration, subscribers or not (calibrate_on_start, imu/calibrate).
-  const GyroVector gyro_bias = gyro_calibrator_.onSample(
-      {static_cast<double>(telemetry.imu[kGyroX]), static_cast<double>(telemetry.imu[kGyroY]),
-       static_cast<double>(telemetry.imu[kGyroZ])},
-      arrival, gyroUnits(*imu), imu->calibration_time);
   if (imu_pub_.getNumSubscribers() > 0) {
-    imu_pub_.publish(
-        boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp, gyro_bias)));
+    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(
+        toImu(frame.telemetry, frame.imu, stamp, frame.gyro_bias)));
   }
   if (foot_pressure_pub_.getNumSubscribers() > 0) {
-    if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
+    if (auto foot = toFootPressure(frame.telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }
   if (telemetry_pub_.getNumSubscribers() > 0) {
-    telemetry_pub_.publish(toTelemetryMsg(telemetry, joints, stamp));
+    telemetry_pub_.publish(toTelemetryMsg(frame.telemetry, device_.controller().joints(), stamp));
   }
-}
-
-void BodyRos::onJointCommand(const sensor_msgs::JointState::ConstPtr& msg) {
-  // Accepted now: noted before the e-stop check, so an e-stop from here on voids it.
-  const core::MotionGate::Generation accepted = controller_.gate().generation();
-  if (e_stop_ && e_stop_->refuse("joint_commands")) {
-    ROS_WARN_THROTTLE(1.0, "joint_commands refused: e_stop is engaged");
-    return;
-  }
-  const ros_layer::JointCommand command = ros_layer::fromJointState(*msg);
-  JointCommandResult result;
-  const auto send = [&] {
-    result = controller_.sendJointCommand(command.names, command.positions, accepted);
-    return result.ok();
-  };
-  // A joint under a trajectory is taken over by this command, and its goal aborted.
-  if (trajectory_) {
-    trajectory_->takeOver(command.names, "joint_commands", send);
-  } else {
-    send();
-  }
-  if (!result.ok()) inputRefusals().refused("joint_commands");
-  if (!result.ok() || !result.out_of_range.empty()) {
-    ROS_WARN_THROTTLE(1.0, "joint_commands: %s", result.message().c_str());
-  }
-}
-
-core::StatusReport BodyRos::status() {
-  // As diagnostic_updater starts every status: it stands while the rate's window has no length.
-  core::StatusReport report;
-  report.summary(core::StatusLevel::kError, "No message was set");
-  telemetry_rate_.addTo(report);  // OK / WARN from the telemetry rate, plus its own keys
-  BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
-                                             {link_.options().path, link_.connected()});
-  gyro_calibrator_.report(update.report, gyroUnits(*std::atomic_load(&imu_params_)));
-  // Once per outage, not once per period.
-  if (update.flow == BodyStatus::FlowChange::kStopped) {
-    ROS_WARN(
-        "body on %s: telemetry stopped (no frame since the last diagnostics period); is the "
-        "board powered and streaming?",
-        link_.options().path.c_str());
-  } else if (update.flow == BodyStatus::FlowChange::kResumed) {
-    ROS_INFO("body on %s: telemetry resumed", link_.options().path.c_str());
-  }
-  report.mergeSummary(update.report.level, update.report.message);
-  if (!update.report.hardware_id.empty()) report.hardware_id = update.report.hardware_id;
-  for (auto& value : update.report.values) report.values.push_back(std::move(value));
-  return report;
 }
 
 }  // namespace serial_robot_driver::devices::body::ros

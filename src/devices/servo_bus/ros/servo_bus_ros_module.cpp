@@ -7,6 +7,13 @@ namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
+std::unique_ptr<ros_layer::DeviceFrontEnd> attach(::ros::NodeHandle& nh,
+                                                  const ros_layer::DriverParams& /*params*/,
+                                                  core::Device& device) {
+  // The core built it from kModule's make_device (servo_bus_module.cpp): a ServoBusDevice.
+  return std::make_unique<ros::ServoBusRos>(nh, static_cast<ServoBusDevice&>(device));
+}
+
 // The ~servo_bus group: the bus timing, polling and protection tunables (ServoBusTuning.cfg).
 void addTuning(ros_layer::RuntimeTuning& tuning, const ::ros::NodeHandle& private_nh,
                ros_layer::RuntimeTuning::Servers& servers) {
@@ -17,7 +24,7 @@ void addTuning(ros_layer::RuntimeTuning& tuning, const ::ros::NodeHandle& privat
 
 extern const ros_layer::RosDeviceModule kRosModule{
     .name = "servo_bus",
-    .make = ros_layer::makeInterface<ros::ServoBusRos>,
+    .attach = attach,
     .add_tuning = addTuning,
 };
 

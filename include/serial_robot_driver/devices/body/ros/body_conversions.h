@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "serial_robot_driver/devices/body/body_device.h"
 #include "serial_robot_driver/devices/body/body_readings.h"
 
 namespace serial_robot_driver::devices::body::ros {
@@ -25,6 +26,7 @@ using body::makeBodyJoints;
 sensor_msgs::JointState toJointState(const Telemetry& telemetry,
                                      const std::vector<BodyJoint>& joints,
                                      const ::ros::Time& stamp);
+sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros::Time& stamp);
 
 /// REP-145 IMU message: imuReading() (the bias subtracted), with diagonal covariances
 /// from `params`. A negative orientation_variance marks the orientation as unknown
@@ -36,6 +38,9 @@ sensor_msgs::Imu toImu(const Telemetry& telemetry, const ImuParams& params,
 std::optional<serial_robot_driver::FootPressure> toFootPressure(const Telemetry& telemetry,
                                                                 const ::ros::Time& stamp,
                                                                 const std::string& frame_id = "");
+
+/// A joint command taken out of a JointState (only name and position matter).
+JointCommand fromJointState(const sensor_msgs::JointState& msg);
 
 /// The whole frame in raw units (for rosbag). `joints` give the servo ids in frame order.
 serial_robot_driver::Telemetry toTelemetryMsg(const Telemetry& telemetry,

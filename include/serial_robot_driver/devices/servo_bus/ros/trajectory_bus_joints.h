@@ -13,7 +13,9 @@
 
 namespace serial_robot_driver::devices::servo_bus::ros {
 
-/// busJointPosition() stamped as a JointState.
+/// A polled servo's joint position (busJointPosition()) stamped as a JointState.
+sensor_msgs::JointState busJointState(const JointPosition& measured, const ::ros::Time& stamp);
+/// The same for servo `id` at `angle_deg`.
 sensor_msgs::JointState busJointState(const std::vector<trajectory::BusJoint>& joints, uint8_t id,
                                       double angle_deg, const ::ros::Time& stamp);
 

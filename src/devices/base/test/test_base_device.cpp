@@ -1,0 +1,185 @@
+// BaseDevice, the base whole in the core: built by its module in a DriverCore without any front
+// end, on a port in memory; its inputs check, refuse and count once for every front end, and every
+// front end's outputs receive the same readings.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <vector>
+
+#include "serial_robot_driver/core/driver_core.h"
+#include "serial_robot_driver/devices/base/base_device.h"
+#include "support/log_capture.h"
+#include "support/memory_stream.h"
+#include "support/test_helpers.h"
+
+namespace serial_robot_driver::devices::base {
+namespace {
+
+using test_support::waitFor;
+
+/// One front end's outputs: what it received, read from the test thread.
+class Listener {
+ public:
+  BaseOutputs outputs() {
+    BaseOutputs outputs;
+    outputs.wheel_frame = [this](const WheelFrameSent& sent) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      frames_.push_back(sent);
+    };
+    outputs.odometry = [this](const OdometrySample&) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++odometry_;
+    };
+    return outputs;
+  }
+  std::vector<WheelFrameSent> frames() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return frames_;
+  }
+  int odometry() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return odometry_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<WheelFrameSent> frames_;
+  int odometry_ = 0;
+};
+
+class BaseDeviceTest : public ::testing::Test {
+ protected:
+  BaseDeviceTest() {
+    params_.port = "memory";
+    for (const char* other : {"body", "servo_bus"}) {
+      params_.portParams(*core::findDevice(other)).enabled = false;
+    }
+  }
+  ~BaseDeviceTest() override {
+    if (core_) core_->shutdown();
+  }
+
+  BaseDevice& makeBase() {
+    core_ = std::make_unique<core::DriverCore>(params_, test_support::memoryStreams(wire_));
+    // Built by the base module's make_device: a BaseDevice.
+    return static_cast<BaseDevice&>(*core_->device("base"));
+  }
+  void start() {
+    core_->start();
+    ASSERT_TRUE(core_->ports().at("memory")->waitConnected(std::chrono::seconds(5)));
+  }
+
+  test_support::LogCapture logs_;  // outlives the core's threads, which may log
+  test_support::MemoryWire wire_;  // outlives the core's link
+  Listener first_;                 // the front ends' outputs outlive the core's threads
+  Listener second_;
+  params::DriverParams params_;
+  std::unique_ptr<core::DriverCore> core_;
+};
+
+TEST_F(BaseDeviceTest, TheCoreBuildsTheBaseFromItsModuleWithoutAFrontEnd) {
+  makeBase();
+  ASSERT_EQ(core_->devices().size(), 1u);
+  EXPECT_NE(dynamic_cast<BaseDevice*>(core_->device("base")), nullptr);
+  EXPECT_EQ(core_->device("body"), nullptr) << "disabled";
+}
+
+TEST_F(BaseDeviceTest, EveryFrontEndReceivesEachWheelFrameAndOdometrySample) {
+  BaseDevice& base = makeBase();
+  base.addOutputs(first_.outputs());
+  base.addOutputs(second_.outputs());
+  start();
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return first_.frames().size() >= 3 && second_.frames().size() >= 3 &&
+               first_.odometry() >= 1 && second_.odometry() >= 1;
+      },
+      5.0));
+  core_->shutdown();  // the last words reach both as well
+  const std::vector<WheelFrameSent> a = first_.frames();
+  const std::vector<WheelFrameSent> b = second_.frames();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].seq, b[i].seq);
+}
+
+TEST_F(BaseDeviceTest, ACommandThatIsNotFiniteIsRefusedCountedAndLoggedOncePerSecond) {
+  BaseDevice& base = makeBase();
+  start();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(base.commandTwist({0.1, 0.0}), "");
+  const std::string refusal = base.commandTwist({nan, 0.0});
+  EXPECT_NE(refusal.find("not finite"), std::string::npos) << refusal;
+  EXPECT_NE(base.commandTwist({0.0, inf}), "");
+  EXPECT_NE(base.commandTwist({-inf, nan}), "");
+  EXPECT_EQ(base.inputRefusalStats().refused.at("cmd_vel"), 3u);
+  EXPECT_EQ(base.controller().stats().rejected_commands, 3u) << "zero speed commanded instead";
+  EXPECT_EQ(logs_.count("cmd_vel rejected"), 1u) << "throttled: one line a second";
+}
+
+TEST_F(BaseDeviceTest, AHugeCommandIsObeyedAtNoMoreThanTheWheelSpeedLimit) {
+  BaseDevice& base = makeBase();
+  base.addOutputs(first_.outputs());
+  start();
+  const double huge = std::numeric_limits<double>::max();
+  EXPECT_EQ(base.commandTwist({huge, -huge}), "");
+  ASSERT_TRUE(waitFor(
+      [&] {
+        const auto frames = first_.frames();
+        return !frames.empty() && !frames.back().speeds.isZero(0.0);
+      },
+      5.0));
+  const double limit = params_.section(kBaseSection).controller.max_wheel_speed;
+  for (const WheelFrameSent& sent : first_.frames()) {
+    EXPECT_LE(std::abs(sent.speeds.x()), limit + 1e-9);
+    EXPECT_LE(std::abs(sent.speeds.y()), limit + 1e-9);
+  }
+  EXPECT_FALSE(base.inputRefusalStats().refused.count("cmd_vel"));
+}
+
+TEST_F(BaseDeviceTest, WhileTheEStopHoldsACommandIsRefusedAndCountedByTheEStop) {
+  BaseDevice& base = makeBase();
+  core_->eStop().set(true);
+  start();
+  EXPECT_NE(base.commandTwist({0.1, 0.0}), "");
+  EXPECT_EQ(core_->eStop().stats().refused.at("cmd_vel"), 1u);
+  EXPECT_FALSE(base.inputRefusalStats().refused.count("cmd_vel")) << "a good message";
+  EXPECT_EQ(base.motionInForce(), "");
+}
+
+TEST_F(BaseDeviceTest, RequestsAnswerWhatBecameOfThem) {
+  BaseDevice& base = makeBase();
+  const core::Outcome down = base.reset();
+  EXPECT_FALSE(down.success);
+  EXPECT_EQ(down.message, "base port memory is not connected");
+  start();
+  EXPECT_TRUE(base.reset().success);
+  EXPECT_TRUE(base.clearEncoders().success);
+  const core::Outcome odometry = base.resetOdometry();
+  EXPECT_TRUE(odometry.success);
+  EXPECT_EQ(odometry.message, "odometry pose reset to zero");
+}
+
+TEST_F(BaseDeviceTest, ARetuneTakesTheBaseSection) {
+  BaseDevice& base = makeBase();
+  BaseParams tuned = params_.section(kBaseSection);
+  tuned.controller.max_wheel_speed = 0.3;
+  tuned.battery_warn_percent = 50;
+  base.retune(tuned);
+  EXPECT_EQ(base.controller().config().max_wheel_speed, 0.3);
+  EXPECT_EQ(base.tuned()->battery_warn_percent, 50);
+  EXPECT_EQ(base.params().battery_warn_percent, 20) << "as started";
+}
+
+TEST_F(BaseDeviceTest, ThePortsComingsAndGoingsAreLoggedByTheCore) {
+  makeBase();
+  start();
+  EXPECT_TRUE(waitFor([&] { return logs_.count("port memory connected") == 1; }, 5.0));
+  core_->shutdown();
+  EXPECT_EQ(logs_.count("lost"), 0u) << "closing is no outage";
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::devices::base
