@@ -43,8 +43,11 @@ bool deserializeCdr(const std::vector<uint8_t>& bytes, const dds_topic_descripto
     return false;
   }
   const bool little_endian = bytes[1] == kCdrLittleEndian;
+  // XTypes: the options' two low bits count the padding that ends the payload (Cyclone pads to 4).
+  const size_t padding = bytes[3] & 0x03;
+  if (bytes.size() - kHeaderSize <= padding) return false;
   // Normalizing validates every length against the buffer (and swaps to host order) in place.
-  std::vector<char> payload(bytes.begin() + kHeaderSize, bytes.end());
+  std::vector<char> payload(bytes.begin() + kHeaderSize, bytes.end() - padding);
   uint32_t offset = 0;
   const auto size = static_cast<uint32_t>(payload.size());
   if (!dds_stream_normalize_data(payload.data(), &offset, size,

@@ -4,9 +4,9 @@
 // char -> uint8 (rosidl maps msg char to uint8), T[N] -> array (capacity N), T[] -> unbounded
 // sequence, string<=N -> bounded string (string_capacity N). Constants are not part of a type
 // description. The same types are in dds/idl/ for idlc.
-#include "serial_robot_driver/dds/type_description.h"
-
 #include <algorithm>
+
+#include "serial_robot_driver/dds/type_description.h"
 
 namespace serial_robot_driver {
 namespace dds {
@@ -75,7 +75,8 @@ TypeDescription batteryState() {
                            "design_capacity", "percentage"}) {
     fields.push_back(plain(name, kFloat));
   }
-  for (const char* name : {"power_supply_status", "power_supply_health", "power_supply_technology"}) {
+  for (const char* name :
+       {"power_supply_status", "power_supply_health", "power_supply_technology"}) {
     fields.push_back(plain(name, kUint8));
   }
   fields.push_back(plain("present", kBoolean));
@@ -114,8 +115,7 @@ std::vector<TypeDescription> diagnosticTrajectoryAndDiscoveryTypes() {
       {"diagnostic_msgs/msg/KeyValue", {plain("key", kString), plain("value", kString)}},
       {"diagnostic_msgs/msg/DiagnosticStatus",
        {plain("level", kByte), plain("name", kString), plain("message", kString),
-        plain("hardware_id", kString),
-        nestedSequence("values", "diagnostic_msgs/msg/KeyValue")}},
+        plain("hardware_id", kString), nestedSequence("values", "diagnostic_msgs/msg/KeyValue")}},
       {"diagnostic_msgs/msg/DiagnosticArray",
        {nested("header", "std_msgs/msg/Header"),
         nestedSequence("status", "diagnostic_msgs/msg/DiagnosticStatus")}},
@@ -155,8 +155,9 @@ const std::vector<TypeDescription>& typeDescriptions() {
 
 const TypeDescription* findTypeDescription(const std::string& type_name) {
   const auto& types = typeDescriptions();
-  auto found = std::find_if(types.begin(), types.end(),
-                            [&](const TypeDescription& type) { return type.type_name == type_name; });
+  auto found = std::find_if(types.begin(), types.end(), [&](const TypeDescription& type) {
+    return type.type_name == type_name;
+  });
   return found == types.end() ? nullptr : &*found;
 }
 

@@ -1,10 +1,10 @@
 // REP-2011 type hashes: the hashable JSON of a type description and its SHA-256 (libcrypto).
-#include "serial_robot_driver/dds/type_description.h"
-
 #include <openssl/evp.h>
 
 #include <set>
 #include <stdexcept>
+
+#include "serial_robot_driver/dds/type_description.h"
 
 namespace serial_robot_driver {
 namespace dds {
@@ -23,8 +23,9 @@ std::string jsonString(const std::string& text) {
 
 std::string fieldJson(const Field& field) {
   const FieldType& type = field.type;
-  return "{\"name\": " + jsonString(field.name) + ", \"type\": {\"type_id\": " +
-         std::to_string(type.type_id) + ", \"capacity\": " + std::to_string(type.capacity) +
+  return "{\"name\": " + jsonString(field.name) +
+         ", \"type\": {\"type_id\": " + std::to_string(type.type_id) +
+         ", \"capacity\": " + std::to_string(type.capacity) +
          ", \"string_capacity\": " + std::to_string(type.string_capacity) +
          ", \"nested_type_name\": " + jsonString(type.nested_type_name) + "}}";
 }
@@ -64,8 +65,8 @@ std::set<std::string> referencedTypeNames(const TypeDescription& type) {
 
 std::string hashableTypeDescriptionJson(const std::string& type_name) {
   const TypeDescription& type = describedType(type_name);
-  std::string json = "{\"type_description\": " + individualJson(type) +
-                     ", \"referenced_type_descriptions\": [";
+  std::string json =
+      "{\"type_description\": " + individualJson(type) + ", \"referenced_type_descriptions\": [";
   bool first = true;
   for (const std::string& referenced : referencedTypeNames(type)) {
     json += (first ? "" : ", ") + individualJson(describedType(referenced));

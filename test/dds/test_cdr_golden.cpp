@@ -29,6 +29,28 @@ TEST(CdrGolden, BoolBothWays) {
   EXPECT_TRUE(decoded.sample.data);
 }
 
+// A null string (a field left unset) goes out as the empty string: length 1, one NUL.
+TEST(CdrGolden, UnsetStringIsTheEmptyString) {
+  std_msgs_msg_dds__Header_ header{};
+  header.stamp = {-1, 999999999};
+  const Bytes expected =
+      cat({kHeader, {0xff, 0xff, 0xff, 0xff, 0xff, 0xc9, 0x9a, 0x3b}, {0x01, 0, 0, 0, 0x00}});
+  EXPECT_EQ(serialized(header), expected);
+  Decoded<std_msgs_msg_dds__Header_> decoded(expected);
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_EQ(decoded.sample.stamp.sec, -1);
+  EXPECT_EQ(decoded.sample.stamp.nanosec, 999999999u);
+  EXPECT_EQ(dds::text(decoded.sample.frame_id), "");
+}
+
+// What Cyclone itself sends for the same Bool: padded to 4, the padding counted in the options.
+TEST(CdrGolden, PaddedBoolDecodes) {
+  Decoded<std_msgs_msg_dds__Bool_> decoded(Bytes{0x00, 0x01, 0x00, 0x03, 0x01, 0x00, 0x00, 0x00});
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_TRUE(decoded.sample.data);
+  EXPECT_FALSE(Decoded<std_msgs_msg_dds__Bool_>(Bytes{0x00, 0x01, 0x00, 0x03, 0x01}).ok);
+}
+
 // --- geometry_msgs/Twist ----------------------------------------------------------------------
 const Bytes kTwist = cat({kHeader, kOne, kTwo, kThree, kZero, kZero, kHalf});
 
@@ -55,6 +77,8 @@ TEST(CdrGolden, BigEndianTwistDecodes) {
 
 // --- sensor_msgs/JointState -------------------------------------------------------------------
 // header {stamp {1, 2}, frame_id "base"}, name ["a", "bc"], position [1.5], velocity [], effort [].
+// One row per field, as on the wire.
+// clang-format off
 const Bytes kJointState = cat({kHeader,
                                {0x01, 0, 0, 0, 0x02, 0, 0, 0},              // 0: sec, nanosec
                                {0x05, 0, 0, 0, 'b', 'a', 's', 'e', 0x00},   // 8: "base"
@@ -65,6 +89,7 @@ const Bytes kJointState = cat({kHeader,
                                {0x01, 0, 0, 0, 0, 0, 0, 0},                 // 40: one position, pad
                                kOneAndHalf,                                 // 48: 1.5
                                {0, 0, 0, 0, 0, 0, 0, 0}});                  // 56: no vel., effort
+// clang-format on
 
 TEST(CdrGolden, JointStateSerializes) {
   const std::string frame = "base";

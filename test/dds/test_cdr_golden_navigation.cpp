@@ -15,6 +15,8 @@ namespace {
 // --- sensor_msgs/Imu --------------------------------------------------------------------------
 // header {stamp {10, 20}, frame_id "imu"}, orientation identity, orientation_covariance[0] -1,
 // angular_velocity (0.5, 0, 0), linear_acceleration (0, 0, 8), other covariances 0.
+// One row per field, as on the wire.
+// clang-format off
 const Bytes kImu = cat({kHeader,
                         {0x0a, 0, 0, 0, 0x14, 0, 0, 0},                // 0: sec, nanosec
                         {0x04, 0, 0, 0, 'i', 'm', 'u', 0x00},          // 8: "imu"
@@ -24,6 +26,7 @@ const Bytes kImu = cat({kHeader,
                         zeros(9 * 8),                                  // 144: covariance
                         kZero, kZero, kEight,                          // 216: linear_acceleration
                         zeros(9 * 8)});                                // 240: covariance
+// clang-format on
 
 TEST(CdrGolden, ImuSerializes) {
   const std::string frame = "imu";
@@ -54,6 +57,8 @@ TEST(CdrGolden, ImuDecodes) {
 // --- nav_msgs/Odometry ------------------------------------------------------------------------
 // header {stamp {3, 4}, frame_id "odom"}, child_frame_id "base_link", pose position (1, 2, 0),
 // identity orientation, covariance[0] 0.5, twist linear.x 0.25, angular.z -0.5, covariance 0.
+// One row per field, as on the wire.
+// clang-format off
 const Bytes kOdometry = cat({kHeader,
                              {0x03, 0, 0, 0, 0x04, 0, 0, 0},                        // 0
                              {0x05, 0, 0, 0, 'o', 'd', 'o', 'm', 0x00, 0, 0, 0},    // 8: "odom"
@@ -65,6 +70,7 @@ const Bytes kOdometry = cat({kHeader,
                              kQuarter, kZero, kZero,                                // 384
                              kZero, kZero, kMinusHalf,                              // 408
                              zeros(36 * 8)});                                       // 432
+// clang-format on
 
 TEST(CdrGolden, OdometrySerializes) {
   const std::string frame = "odom";
@@ -98,6 +104,8 @@ TEST(CdrGolden, OdometryDecodes) {
 // --- tf2_msgs/TFMessage -----------------------------------------------------------------------
 // one transform: header {stamp {5, 6}, frame_id "odom"}, child "base_link", translation (1, 0, 0),
 // identity rotation.
+// One row per field, as on the wire.
+// clang-format off
 const Bytes kTfMessage = cat({kHeader,
                               {0x01, 0, 0, 0},                                       // 0: count
                               {0x05, 0, 0, 0, 0x06, 0, 0, 0},                        // 4: stamp
@@ -106,6 +114,7 @@ const Bytes kTfMessage = cat({kHeader,
                               {0, 0},                                                // 38: pad
                               kOne, kZero, kZero,                                    // 40
                               kIdentityQuaternion});                                 // 64
+// clang-format on
 
 TEST(CdrGolden, TfMessageSerializes) {
   const std::string frame = "odom";

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "serial_robot_driver/dds/ros_conventions.h"
+#include "serial_robot_driver/dds/time.h"
 
 namespace dds = serial_robot_driver::dds;
 
@@ -60,4 +61,15 @@ TEST(RosConventions, AnyOtherPeerKeepsEveryInterfaceAndMulticast) {
   EXPECT_NE(xml.find("<Peer address=\"192.168.1.20\"/>"), std::string::npos);
   EXPECT_FALSE(dds::isLoopbackAddress("128.0.0.1"));
   EXPECT_TRUE(dds::isLoopbackAddress("127.1.2.3"));
+}
+
+TEST(RosConventions, StampsSplitAsRos2Does) {
+  const auto stamp = dds::timeFromNanoseconds(1700000000123456789LL);
+  EXPECT_EQ(stamp.sec, 1700000000);
+  EXPECT_EQ(stamp.nanosec, 123456789u);
+  EXPECT_EQ(dds::toNanoseconds(stamp), 1700000000123456789LL);
+  const auto before_zero = dds::durationFromNanoseconds(-1);
+  EXPECT_EQ(before_zero.sec, -1);
+  EXPECT_EQ(before_zero.nanosec, 999999999u);
+  EXPECT_EQ(dds::toNanoseconds(before_zero), -1);
 }

@@ -5,22 +5,17 @@
 // enclave, a joint_states sample with the right values, and the node with its endpoints' GIDs in
 // ros_discovery_info. Expected hashes are ROS 2's own (test_type_hash.cpp), not computed here.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "dds_test_peer_process.h"
 #include "dds_test_support.h"
 #include "serial_robot_driver/dds/messages.h"
 
 using dds_test::waitFor;
-
-extern char** environ;
 
 namespace {
 
@@ -83,40 +78,12 @@ class SecondParticipant : public ::testing::Test {
     ASSERT_GT(domain_, 0) << dds_strretcode(domain_);
     participant_ = dds_create_participant(domain_id_, nullptr, nullptr);
     ASSERT_GT(participant_, 0);
-    startPeer();
+    ASSERT_TRUE(peer_.start(domain_id_));
   }
 
   void TearDown() override {
-    stopPeer();
+    peer_.stop();
     if (domain_ > 0) dds_delete(domain_);
-  }
-
-  void startPeer() {
-    int input[2];
-    ASSERT_EQ(pipe(input), 0);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, input[0], STDIN_FILENO);
-    posix_spawn_file_actions_addclose(&actions, input[1]);
-    const std::string domain = std::to_string(domain_id_);
-    char* const argv[] = {const_cast<char*>(SRD_DDS_TEST_PEER), const_cast<char*>(domain.c_str()),
-                          nullptr};
-    ASSERT_EQ(posix_spawn(&peer_, SRD_DDS_TEST_PEER, &actions, nullptr, argv, environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-    close(input[0]);
-    peer_stdin_ = input[1];
-  }
-
-  // Closing its stdin ends the peer; one that does not end is killed (only our own child).
-  void stopPeer() {
-    if (peer_ <= 0) return;
-    close(peer_stdin_);
-    int status = 0;
-    if (!waitFor([&] { return waitpid(peer_, &status, WNOHANG) == peer_; })) {
-      kill(peer_, SIGKILL);
-      waitpid(peer_, &status, 0);
-    }
-    peer_ = 0;
   }
 
   std::optional<DiscoveredEndpoint> discover(dds_entity_t builtin_topic, const std::string& name) {
@@ -142,8 +109,7 @@ class SecondParticipant : public ::testing::Test {
   int domain_id_ = 0;
   dds_entity_t domain_ = 0;
   dds_entity_t participant_ = 0;
-  pid_t peer_ = 0;
-  int peer_stdin_ = -1;
+  dds_test::PeerProcess peer_;
 };
 
 TEST_F(SecondParticipant, SeesTopicsTypesHashesAndQos) {

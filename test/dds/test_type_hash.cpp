@@ -91,12 +91,15 @@ TEST(TypeHash, BoolJsonIsTheExactHashedForm) {
 
 TEST(TypeHash, ReferencedTypesAreListedOnceSortedByName) {
   const std::string json = dds::hashableTypeDescriptionJson("nav_msgs/msg/Odometry");
-  const char* referenced_in_order[] = {
-      "builtin_interfaces/msg/Time\", \"fields",  "geometry_msgs/msg/Point\", \"fields",
-      "geometry_msgs/msg/Pose\", \"fields",       "geometry_msgs/msg/PoseWithCovariance\", \"fields",
-      "geometry_msgs/msg/Quaternion\", \"fields", "geometry_msgs/msg/Twist\", \"fields",
-      "geometry_msgs/msg/TwistWithCovariance\", \"fields", "geometry_msgs/msg/Vector3\", \"fields",
-      "std_msgs/msg/Header\", \"fields"};
+  const char* referenced_in_order[] = {"builtin_interfaces/msg/Time\", \"fields",
+                                       "geometry_msgs/msg/Point\", \"fields",
+                                       "geometry_msgs/msg/Pose\", \"fields",
+                                       "geometry_msgs/msg/PoseWithCovariance\", \"fields",
+                                       "geometry_msgs/msg/Quaternion\", \"fields",
+                                       "geometry_msgs/msg/Twist\", \"fields",
+                                       "geometry_msgs/msg/TwistWithCovariance\", \"fields",
+                                       "geometry_msgs/msg/Vector3\", \"fields",
+                                       "std_msgs/msg/Header\", \"fields"};
   size_t position = json.find("referenced_type_descriptions");
   for (const char* name : referenced_in_order) {
     const size_t found = json.find(name, position);

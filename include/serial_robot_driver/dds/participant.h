@@ -28,6 +28,7 @@ struct NodeOptions {
   std::vector<std::string> peers;
 };
 
+/// Outlives its publishers and subscriptions (they hold a reference to it).
 class Participant {
  public:
   /// Throws std::invalid_argument (domain id) or std::runtime_error (DDS refused something).

@@ -31,6 +31,8 @@ class Subscription {
   Subscription(const Subscription&) = delete;
   Subscription& operator=(const Subscription&) = delete;
 
+  /// The DDS writer/reader, for DDS calls the wrapper does not offer (statuses, QoS).
+  dds_entity_t handle() const { return endpoint_.handle(); }
   const Gid& gid() const { return endpoint_.gid(); }
   const std::string& topicName() const { return endpoint_.topicName(); }
 

@@ -3,11 +3,12 @@
 // ROS 2 (Jazzy and later) puts `typehash=RIHS01_<hex>;` in each endpoint's USER_DATA; a peer that
 // computes a different hash for the same type name reports a type mismatch.
 //
-// The hash is the SHA-256 of the type description in one exact JSON form (what
-// rosidl_generator_type_description hashes): {"type_description": {...}, "referenced_type_descriptions":
-// [...]}, every type as {"type_name": ..., "fields": [{"name": ..., "type": {"type_id": ...,
+// The hash is the SHA-256 of the type description in the one JSON form that
+// rosidl_generator_type_description hashes:
+//   {"type_description": T, "referenced_type_descriptions": [T, ...]}
+// with every T as {"type_name": ..., "fields": [{"name": ..., "type": {"type_id": ...,
 // "capacity": ..., "string_capacity": ..., "nested_type_name": ...}}, ...]}, the referenced types
-// (all nested types, transitively) sorted by name, separators ", " and ": ", no default values.
+// (every nested type, transitively) sorted by name, separators ", " and ": ", no default values.
 
 #include <cstdint>
 #include <string>
@@ -64,7 +65,8 @@ std::string hashableTypeDescriptionJson(const std::string& type_name);
 /// "RIHS01_" + the lower-case hex SHA-256 of `json`.
 std::string rihs01(const std::string& json);
 
-/// The type hash of a type of the table ("RIHS01_<64 hex>"); throws std::invalid_argument if unknown.
+/// The type hash of a type of the table ("RIHS01_<64 hex>"); throws std::invalid_argument if
+/// unknown.
 std::string typeHash(const std::string& type_name);
 
 }  // namespace dds
