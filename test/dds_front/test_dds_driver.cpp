@@ -17,6 +17,8 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "../dds/published_type_hashes.h"
 #include "ros2_peer.h"
@@ -242,6 +244,33 @@ TEST_F(DdsDriver, ZSigtermStopsTheBaseAndExitsZero) {
     const auto stats = baseStats(robot_stats());
     return stats.last_left_speed == 0 && stats.last_right_speed == 0;
   })) << "the driver's last words: a zero-speed frame";
+}
+
+/// dds_driver's exit status and output for `args` (it ends by itself).
+std::pair<int, std::string> runToTheEnd(const std::vector<std::string>& args) {
+  test_support::ChildProcess driver(SRD_DDS_DRIVER, args);
+  const std::optional<int> status = driver.waitExit(30.0);
+  EXPECT_TRUE(status && WIFEXITED(*status));
+  return {status && WIFEXITED(*status) ? WEXITSTATUS(*status) : -1, driver.output()};
+}
+
+TEST(DdsDriverCommandLine, ABadParameterStopsItNamingTheParameter) {
+  const std::string config = "/tmp/srd_test_dds_driver_bad_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(config) << "ros2: {domain_id: 500}\n";
+  const auto [status, output] = runToTheEnd({"--config", config});
+  std::remove(config.c_str());
+  EXPECT_EQ(status, 2);
+  EXPECT_NE(output.find("~ros2/domain_id"), std::string::npos) << output;
+}
+
+TEST(DdsDriverCommandLine, AnUnknownArgumentOrNoConfigIsRefusedWithTheUsage) {
+  for (const auto& args :
+       {std::vector<std::string>{"--config"}, std::vector<std::string>{"--conifg", "robot.yaml"},
+        std::vector<std::string>{}}) {
+    const auto [status, output] = runToTheEnd(args);
+    EXPECT_EQ(status, 2) << output;
+    EXPECT_NE(output.find("usage: dds_driver --config FILE"), std::string::npos) << output;
+  }
 }
 
 }  // namespace
