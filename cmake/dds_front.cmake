@@ -13,7 +13,8 @@ add_library(srd_dds_front STATIC
   src/dds_front/dds_conversions.cpp
   src/dds_front/dds_device_module.cpp
   src/dds_front/dds_node.cpp
-  src/dds_front/run_dds_driver.cpp)
+  src/dds_front/run_dds_driver.cpp
+  src/dds_front/trajectory_loop.cpp)
 target_link_libraries(srd_dds_front PUBLIC srd_core srd_dds srd_yaml_params)
 set_target_properties(srd_dds_front PROPERTIES POSITION_INDEPENDENT_CODE ON)
 

@@ -14,6 +14,23 @@ std::chrono::nanoseconds fromTime(const builtin_interfaces_msg_dds__Time_& stamp
   return std::chrono::seconds(stamp.sec) + std::chrono::nanoseconds(stamp.nanosec);
 }
 
+trajectory::TrajectoryCommand toTrajectoryCommand(
+    const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+  trajectory::TrajectoryCommand command;
+  command.joint_names = dds::toStrings(msg.joint_names);
+  for (const auto& point : dds::toVector(msg.points)) {
+    command.points.push_back({point.time_from_start.sec + point.time_from_start.nanosec * 1e-9,
+                              dds::toVector(point.positions), dds::toVector(point.velocities),
+                              dds::toVector(point.accelerations)});
+  }
+  return command;
+}
+
+double executorStart(std::chrono::nanoseconds stamp, double executor_now,
+                     std::chrono::nanoseconds wall_now) {
+  return executor_now + std::chrono::duration<double>(stamp - wall_now).count();
+}
+
 void setHeader(std_msgs_msg_dds__Header_& header, std::chrono::nanoseconds stamp,
                const std::string& frame) {
   header.stamp = toTime(stamp);

@@ -1,6 +1,7 @@
 #include "serial_robot_driver/dds_front/dds_node.h"
 
 #include <chrono>
+#include <optional>
 
 #include "serial_robot_driver/core/e_stop_status.h"
 #include "serial_robot_driver/core/link_status.h"
@@ -40,6 +41,14 @@ DdsNode::DdsNode(const params::DriverParams& params, const dds::NodeOptions& opt
   // Queue 10 as on the ROS side, so no toggle is dropped.
   e_stop_ = std::make_unique<dds::Subscription<std_msgs_msg_dds__Bool_>>(
       *participant_, "e_stop", [this](const std_msgs_msg_dds__Bool_& msg) { onEStop(msg); });
+  if (core_.trajectories() != nullptr) {
+    joint_trajectory_ =
+        std::make_unique<dds::Subscription<trajectory_msgs_msg_dds__JointTrajectory_>>(
+            *participant_, "joint_trajectory",
+            [this](const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+              onJointTrajectory(msg);
+            });
+  }
 }
 
 DdsNode::~DdsNode() { shutdown(); }
@@ -61,6 +70,20 @@ void DdsNode::onEStop(const std_msgs_msg_dds__Bool_& msg) {
   if (core_.eStop().set(msg.data)) core::logEStopChange(msg.data);
 }
 
+void DdsNode::onJointTrajectory(const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+  trajectory::TrajectoryExecutor& executor = *core_.trajectories();
+  std::optional<double> start;  // a zero stamp: now
+  if (msg.header.stamp.sec != 0 || msg.header.stamp.nanosec != 0) {
+    const double executor_now = executor.now();
+    start = executorStart(fromTime(msg.header.stamp), executor_now,
+                          std::chrono::system_clock::now().time_since_epoch());
+  }
+  if (executor.submitTrajectory(toTrajectoryCommand(msg), start) ==
+      trajectory::TrajectoryExecutor::Submission::kInvalid) {
+    refusals_.refused("joint_trajectory");
+  }
+}
+
 void DdsNode::start() {
   diagnostics_thread_ = std::thread([this] { publishDiagnosticsUntilStopped(); });
 }
@@ -73,6 +96,7 @@ void DdsNode::shutdown() {
   stop_.notify_all();
   if (diagnostics_thread_.joinable()) diagnostics_thread_.join();
   e_stop_.reset();
+  joint_trajectory_.reset();
   for (auto& front_end : front_ends_) front_end->shutdown();
 }
 
@@ -90,7 +114,7 @@ void DdsNode::collectStatusSources() {
       status_sources_.push_back(std::move(extra));
     }
   }
-  status_sources_.push_back({"e_stop", [this] { return core_.eStopStatus({}); }});
+  status_sources_.push_back({"e_stop", [this] { return core_.eStopStatus(refusals_.stats()); }});
 }
 
 std::vector<NamedReport> DdsNode::statusReports() const {

@@ -11,6 +11,7 @@
 #include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/dds/ros_conventions.h"
 #include "serial_robot_driver/dds_front/dds_node.h"
+#include "serial_robot_driver/dds_front/trajectory_loop.h"
 #include "serial_robot_driver/params/yaml_param_source.h"
 
 namespace serial_robot_driver::dds_front {
@@ -63,9 +64,13 @@ params::DriverParams loadCheckedParams(const std::string& path) {
 /// the node's order: no more input, the devices' last words, the ports closed.
 void runUntilStopped(const params::DriverParams& params, const DdsDriverOptions& options,
                      const sigset_t& stop_signals) {
-  core::DriverCore core(params);
+  core::DriverCore core(
+      params, core::SerialLink::StreamFactory{}, nullptr,
+      [](const std::string& warning) { core::log(core::LogLevel::kWarn, "%s", warning.c_str()); });
   DdsNode node(params, nodeOptions(params.ros2, options.name, options.node_namespace), core);
+  TrajectoryLoop trajectories(core.trajectories(), params.loop_rate);
   core.start();
+  trajectories.start();
   node.start();
   core::log(core::LogLevel::kInfo, "%s; ROS 2 node %s on DDS domain %d",
             core.startupSummary().c_str(),
@@ -75,6 +80,7 @@ void runUntilStopped(const params::DriverParams& params, const DdsDriverOptions&
   sigwait(&stop_signals, &signal);
   core::log(core::LogLevel::kInfo, "shutting down: stopping the wheels and the bus servos");
   node.shutdown();
+  trajectories.shutdown();  // goals end before their joints' devices stop
   core.shutdown();
 }
 

@@ -107,6 +107,7 @@ TEST_F(DdsDriver, EveryTopicHasRos2sNameTypeHashAndQos) {
       {false, "rt/cmd_vel_stamped", "geometry_msgs/msg/TwistStamped", 10},
       {false, "rt/e_stop", "std_msgs/msg/Bool", 10},
       {false, "rt/joint_commands", "sensor_msgs/msg/JointState", 10},
+      {false, "rt/joint_trajectory", "trajectory_msgs/msg/JointTrajectory", 10},
   };
   for (const ExpectedTopic& topic : expected) {
     SCOPED_TRACE(topic.topic);
@@ -148,6 +149,28 @@ TEST_F(DdsDriver, JointStatesFollowJointCommands) {
                std::abs(state.position._buffer[0] - reached) < 1e-9 &&
                std::abs(state.position._buffer[1]) < 1e-9 && state.header.stamp.sec > 1700000000;
       }));
+}
+
+TEST_F(DdsDriver, JointTrajectoryMovesTheBodysJoints) {
+  const dds_entity_t trajectories =
+      peer_->writer(trajectory_msgs_msg_dds__JointTrajectory__desc, "rt/joint_trajectory");
+  ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(trajectories); }));
+  char joint_1[] = "joint_1", joint_2[] = "joint_2", empty[] = "";
+  char* names[] = {joint_1, joint_2};
+  double positions[] = {0.3, -0.2};
+  trajectory_msgs_msg_dds__JointTrajectoryPoint_ point{};
+  point.positions = {2, 2, positions, false};
+  point.time_from_start.sec = 1;
+  trajectory_msgs_msg_dds__JointTrajectory_ msg{};  // stamp zero: now
+  msg.header.frame_id = empty;
+  msg.joint_names = {2, 2, names, false};
+  msg.points = {1, 1, &point, false};
+  ASSERT_EQ(dds_write(trajectories, &msg), DDS_RETCODE_OK);
+  // 0.3 rad and -0.2 rad on 4096-tick turns around 2048: 2048 + 196 (195.6), 2048 - 130 (130.4).
+  EXPECT_TRUE(waitFor([] {
+    const auto servos = bodyStats(robot_stats()).servos;
+    return servos.size() == 2 && servos[0].target == 2244 && servos[1].target == 1918;
+  }));
 }
 
 /// Waits until the simulated base has applied `frames` more speed frames and each of them left

@@ -1,6 +1,7 @@
 // The driver on a ROS 2 graph: one DDS participant named like the ROS 1 node (dds::NodeOptions),
 // the DDS front end of every enabled device attached to the core's devices, and the node's own
-// topics: `e_stop` in (the core's one e-stop, whichever graph set it last) and `diagnostics` out
+// topics: `e_stop` in (the core's one e-stop, whichever graph set it last), `joint_trajectory` in
+// (the core's trajectories) and `diagnostics` out
 // (the very StatusReports the ROS node publishes). It runs inside driver_node (~ros2/enabled) and
 // alone in dds_driver (run_dds_driver.h); it adds no logic of its own.
 //
@@ -54,6 +55,9 @@ class DdsNode {
   void attachDevices();
   void collectStatusSources();
   void onEStop(const std_msgs_msg_dds__Bool_& msg);
+  /// joint_trajectory: the core's trajectories, as the ROS 1 topic (refused whole when it does
+  /// not check out, counted under its name).
+  void onJointTrajectory(const trajectory_msgs_msg_dds__JointTrajectory_& msg);
   void publishDiagnosticsUntilStopped();
 
   const params::DriverParams& params_;
@@ -64,6 +68,9 @@ class DdsNode {
   std::vector<core::Device::NamedStatus> status_sources_;  ///< what diagnostics publishes
   std::unique_ptr<dds::Publisher<diagnostic_msgs_msg_dds__DiagnosticArray_>> diagnostics_;
   std::unique_ptr<dds::Subscription<std_msgs_msg_dds__Bool_>> e_stop_;
+  /// Null when no device has joints.
+  std::unique_ptr<dds::Subscription<trajectory_msgs_msg_dds__JointTrajectory_>> joint_trajectory_;
+  core::InputRefusals refusals_;  ///< the node's own topics' (joint_trajectory)
   std::mutex stop_mutex_;  // guards stopping_
   std::condition_variable stop_;
   bool stopping_ = false;
