@@ -81,12 +81,12 @@ TEST(DeviceSections, TheBaseControllerTakesItsSectionAndTheNodeWideValues) {
   params.section(devices::base::kBaseSection).controller.cmd_vel_timeout = 0.25;
   params.loop_rate = 40.0;
   params.portParams(*core::findDevice("base")).baud = 9600;
-  params.section(devices::body::kImuSection).orientation_variance = 0.04;
   const devices::base::BaseConfig config = devices::base::makeBaseConfig(params);
   EXPECT_EQ(config.cmd_vel_timeout, 0.25) << "the section's own";
   EXPECT_EQ(config.loop_rate, 40.0);
   EXPECT_EQ(config.baud, 9600);
-  EXPECT_EQ(config.imu_yaw_variance, 0.04) << "the IMU's";
+  // The IMU's yaw variance (~imu/orientation_variance) now comes with its heading (the body's
+  // HeadingSource): BaseDeviceTest.TheImuHeadingsVarianceIsTheOneItsSourceGives.
 }
 
 TEST(DeviceSections, TheGyroUnitsAreTheImuSectionsScaleAndAxisMap) {

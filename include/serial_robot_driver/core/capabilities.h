@@ -30,6 +30,8 @@ class HeadingSource : public Capability {
   using Listener = std::function<void(double yaw, Clock::time_point arrival)>;
   /// Before the links start.
   virtual void addHeadingListener(Listener listener) = 0;
+  /// How far each heading is to be trusted (rad^2), as the measuring device knows it.
+  virtual double yawVariance() const = 0;
 };
 
 /// Kind: whether the robot is held still, for a sensor calibrated only then (the gyro bias):
@@ -43,6 +45,9 @@ class MotionQuery : public Capability {
 /// owns one and offers it).
 class HeadingFeed : public HeadingSource {
  public:
+  /// `yaw_variance`: the measuring device's (rad^2).
+  explicit HeadingFeed(double yaw_variance = 0.0) : yaw_variance_(yaw_variance) {}
+  double yawVariance() const override { return yaw_variance_; }
   void addHeadingListener(Listener listener) override { listeners_.push_back(std::move(listener)); }
   /// On the measuring device's thread; the listeners were all added before it runs.
   void publish(double yaw, Clock::time_point arrival) const {
@@ -51,6 +56,7 @@ class HeadingFeed : public HeadingSource {
   bool wanted() const { return !listeners_.empty(); }
 
  private:
+  const double yaw_variance_;
   std::vector<Listener> listeners_;
 };
 

@@ -128,6 +128,11 @@ void BaseController::onImuYaw(double yaw, core::Clock::time_point stamp) {
   odometry_.addImuYaw(yaw, stamp);
 }
 
+void BaseController::setImuYawVariance(double variance) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  odometry_.setImuYawVariance(variance);
+}
+
 bool BaseController::sendReset() {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::Clock::time_point now = clock_->now();

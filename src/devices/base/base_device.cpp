@@ -148,6 +148,7 @@ void BaseDevice::useCapabilities(const core::Capabilities& capabilities) {
   // Connected whenever a heading is measured: ~base/use_imu_heading can be switched on at runtime.
   core::HeadingSource* heading = capabilities.find<core::HeadingSource>();
   if (!heading) return;
+  controller_.setImuYawVariance(heading->yawVariance());
   heading->addHeadingListener([this](double yaw, core::Clock::time_point arrival) {
     // A replay's arrival times are the recording's; the base loop runs on this machine's clock.
     controller_.onImuYaw(yaw, replaying_ ? core::Clock::now() : arrival);

@@ -16,7 +16,6 @@ BaseConfig makeBaseConfig(const params::DriverParams& params) {
   BaseConfig config = params.section(kBaseSection).controller;
   config.loop_rate = params.loop_rate;
   config.baud = params.baudOf(*core::findDevice("base"));
-  config.imu_yaw_variance = params.section(body::kImuSection).orientation_variance;
   return config;
 }
 }  // namespace serial_robot_driver::devices::base

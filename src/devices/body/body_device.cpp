@@ -18,6 +18,7 @@ void logOutcome(const GyroCalibrationOutcome& outcome, const char* prefix) {
 BodyDevice::BodyDevice(const params::DriverParams& params, core::SerialLink& link)
     : link_(link),
       imu_params_(std::make_shared<const ImuParams>(params.section(kImuSection))),
+      imu_heading_(params.section(kImuSection).orientation_variance),
       gyro_calibrator_([this] { return notStill(); }),
       // Expected telemetry rates, as diagnostic_updater's FrequencyStatus.
       telemetry_rate_(

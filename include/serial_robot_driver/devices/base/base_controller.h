@@ -75,7 +75,8 @@ struct BaseConfig : BaseTuning {
   /// With battery polling on, this many poll periods without any reply mean the base is silent.
   double silent_after_polls = 3.0;
   kinematics::PoseCovarianceModel odometry_covariance;
-  double imu_yaw_variance = 0.0003;  ///< rad^2, odom's yaw variance while the IMU heading is used
+  /// rad^2, odom's yaw variance while the IMU heading is used (until setImuYawVariance()).
+  double imu_yaw_variance = 0.0003;
   core::Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
 };
 
@@ -198,6 +199,9 @@ class BaseController : public core::LinkListener {
   /// Any thread (the body port's reader): the yaw (rad) of the IMU on the base, measured at
   /// `stamp`. Used only with use_imu_heading.
   void onImuYaw(double yaw, core::Clock::time_point stamp);
+  /// The variance (rad^2) of the yaws given to onImuYaw() (what the measuring sensor says of
+  /// them): odom's yaw variance while the IMU heading is used. Before start().
+  void setImuYawVariance(double variance);
   /// The shortest spacing of speed frames sent at once for a new command: the frame's airtime at
   /// the port's baud (10 bits per byte) divided by immediate_line_share.
   core::Clock::duration minImmediateInterval() const { return min_immediate_interval_; }

@@ -33,6 +33,8 @@ class BaseOdometry {
   void advance(core::Clock::time_point now);
   /// A speed frame with these (robot-side, before wheel directions) ticks was accepted at `now`.
   void speedAccepted(const kinematics::WheelTicks& ticks, core::Clock::time_point now);
+  /// The yaw variance (rad^2) of the IMU's heading, while it is fused.
+  void setImuYawVariance(double variance) { imu_yaw_variance_ = variance; }
   /// The base reported its timeout error at `now`: it has stopped its wheels.
   void baseStopped(core::Clock::time_point now);
   /// Puts the pose (and its covariance) back to zero at `now`; a fused heading restarts at zero.
@@ -57,7 +59,7 @@ class BaseOdometry {
   kinematics::DiffDriveGeometry geometry_;  ///< changes in retune()
   const double heartbeat_gap_;              ///< s
   bool use_imu_heading_;
-  const double imu_yaw_variance_;
+  double imu_yaw_variance_;  ///< changes in setImuYawVariance()
   kinematics::Odometry odometry_;
   kinematics::HeadingFusion heading_;  ///< used with use_imu_heading only
   kinematics::HeadingSource reported_heading_source_ = kinematics::HeadingSource::kWaitingForImu;

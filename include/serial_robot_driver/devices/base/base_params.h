@@ -17,7 +17,8 @@ namespace serial_robot_driver::devices::base {
 /// `controller` (their defaults are its own); the rest are the ROS layer's and the checks'.
 struct BaseParams : params::DevicePortParams {
   /// The controller's configuration as the parameters set it. Not parameters of this section:
-  /// loop_rate, baud and imu_yaw_variance, which makeBaseConfig fills in from the node-wide values.
+  /// loop_rate and baud, which makeBaseConfig fills in from the node-wide values, and
+  /// imu_yaw_variance, which the heading's source gives (core::HeadingSource::yawVariance).
   BaseConfig controller;
   int battery_warn_percent = 20;   ///< below: diagnostics WARN
   int battery_error_percent = 10;  ///< below: diagnostics ERROR
@@ -31,8 +32,8 @@ struct BaseParams : params::DevicePortParams {
 /// The key of the base's section (DeviceModule::sections): params.section(kBaseSection).
 extern const params::SectionKey<BaseParams> kBaseSection;
 
-/// The controller's configuration in force: the base's own parameters (bound into `controller`
-/// already, base_module.cpp) plus those that come from node-wide or other devices' parameters.
+/// The controller's configuration to start with: the base's own parameters (bound into
+/// `controller` already, base_module.cpp) plus the node-wide loop rate and the port's baud.
 BaseConfig makeBaseConfig(const params::DriverParams& params);
 
 /// Below this loop rate the base's 1 s heartbeat is at risk (the base's checks say so).

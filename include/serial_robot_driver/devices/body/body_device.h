@@ -113,7 +113,8 @@ class BodyDevice : public core::Device {
   // Set before the links start, read on the reader and calibration threads.
   const core::MotionQuery* motion_query_ = nullptr;
   core::EStop* e_stop_ = nullptr;
-  core::HeadingFeed imu_heading_;  // listeners added before the link starts
+  /// Its yaw's variance is ~imu/orientation_variance; listeners added before the link starts.
+  core::HeadingFeed imu_heading_;
   // The trajectory executor (its own threading comment); set before the link starts.
   trajectory::TrajectoryExecutor* trajectory_ = nullptr;
   core::LogThrottle refused_log_{1.0};

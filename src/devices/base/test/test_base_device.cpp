@@ -10,6 +10,8 @@
 
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/devices/base/base_device.h"
+#include "serial_robot_driver/devices/body/body_params.h"
+#include "support/golden_frames.h"
 #include "support/log_capture.h"
 #include "support/memory_stream.h"
 #include "support/test_helpers.h"
@@ -28,9 +30,10 @@ class Listener {
       std::lock_guard<std::mutex> lock(mutex_);
       frames_.push_back(sent);
     };
-    outputs.odometry = [this](const OdometrySample&) {
+    outputs.odometry = [this](const OdometrySample& sample) {
       std::lock_guard<std::mutex> lock(mutex_);
       ++odometry_;
+      last_odometry_ = sample;
     };
     return outputs;
   }
@@ -42,11 +45,16 @@ class Listener {
     std::lock_guard<std::mutex> lock(mutex_);
     return odometry_;
   }
+  OdometrySample lastOdometry() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return last_odometry_;
+  }
 
  private:
   mutable std::mutex mutex_;
   std::vector<WheelFrameSent> frames_;
   int odometry_ = 0;
+  OdometrySample last_odometry_;
 };
 
 class BaseDeviceTest : public ::testing::Test {
@@ -179,6 +187,23 @@ TEST_F(BaseDeviceTest, ThePortsComingsAndGoingsAreLoggedByTheCore) {
   EXPECT_TRUE(waitFor([&] { return logs_.count("port memory connected") == 1; }, 5.0));
   core_->shutdown();
   EXPECT_EQ(logs_.count("lost"), 0u) << "closing is no outage";
+}
+
+TEST_F(BaseDeviceTest, TheImuHeadingsVarianceIsTheOneItsSourceGives) {
+  // The body on the same port offers its IMU's yaw with ~imu/orientation_variance.
+  params_.portParams(*core::findDevice("body")).enabled = true;
+  params_.section(body::kImuSection).orientation_variance = 0.05;
+  params_.section(kBaseSection).controller.use_imu_heading = true;
+  BaseDevice& base = makeBase();
+  base.addOutputs(first_.outputs());
+  start();
+  ASSERT_TRUE(waitFor(
+      [&] {
+        wire_.feed(golden::body::kTelemetryTwoServos);  // keeps the IMU's heading fresh
+        return first_.lastOdometry().imu_heading;
+      },
+      5.0));
+  EXPECT_EQ(first_.lastOdometry().yaw_variance, 0.05);
 }
 
 }  // namespace
