@@ -253,6 +253,52 @@ TEST_F(DdsDriver, DiagnosticsCarryTheNodesStatuses) {
       }));
 }
 
+/// Whether `array` has the status `name` with the value `key` at `value` or more.
+bool counts(const diagnostic_msgs_msg_dds__DiagnosticArray_& array, const std::string& name,
+            const std::string& key, int value) {
+  for (uint32_t i = 0; i < array.status._length; ++i) {
+    const auto& status = array.status._buffer[i];
+    for (uint32_t j = 0; name == status.name && j < status.values._length; ++j) {
+      if (key == status.values._buffer[j].key &&
+          std::stoi(status.values._buffer[j].value) >= value) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+TEST_F(DdsDriver, BadInputIsRefusedAndCountedByTheCoreAsFromRos1) {
+  const dds_entity_t cmd_vel = peer_->writer(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel");
+  const dds_entity_t trajectories =
+      peer_->writer(trajectory_msgs_msg_dds__JointTrajectory__desc, "rt/joint_trajectory");
+  const dds_entity_t diagnostics =
+      peer_->reader(diagnostic_msgs_msg_dds__DiagnosticArray__desc, "rt/diagnostics");
+  ASSERT_TRUE(waitFor([&] {
+    return dds_test::Ros2Peer::matched(cmd_vel) && dds_test::Ros2Peer::matched(trajectories);
+  }));
+  geometry_msgs_msg_dds__Twist_ twist{};
+  twist.linear.x = std::nan("");
+  ASSERT_EQ(dds_write(cmd_vel, &twist), DDS_RETCODE_OK);
+  char joint_1[] = "joint_1", empty[] = "";
+  char* names[] = {joint_1};
+  double positions[] = {std::nan("")};
+  trajectory_msgs_msg_dds__JointTrajectoryPoint_ point{};
+  point.positions = {1, 1, positions, false};
+  point.time_from_start.sec = 1;
+  trajectory_msgs_msg_dds__JointTrajectory_ trajectory{};
+  trajectory.header.frame_id = empty;
+  trajectory.joint_names = {1, 1, names, false};
+  trajectory.points = {1, 1, &point, false};
+  ASSERT_EQ(dds_write(trajectories, &trajectory), DDS_RETCODE_OK);
+  EXPECT_TRUE(dds_test::waitForSample<diagnostic_msgs_msg_dds__DiagnosticArray_>(
+      diagnostics, [](const auto& array) {
+        return counts(array, "driver_node: e_stop", "inputs refused: cmd_vel", 1) &&
+               counts(array, "driver_node: e_stop", "inputs refused: joint_trajectory", 1);
+      }));
+  EXPECT_TRUE(baseHoldsSpeed(false)) << "a NaN cmd_vel commands zero speed";
+}
+
 // Last: SIGTERM ends the driver as it ends driver_node, the base's zero-speed frame written.
 TEST_F(DdsDriver, ZSigtermStopsTheBaseAndExitsZero) {
   const dds_entity_t cmd_vel = peer_->writer(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel");
