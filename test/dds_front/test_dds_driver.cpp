@@ -64,7 +64,7 @@ class DdsDriver : public ::testing::Test {
     options.link = link_;
     robot_ = std::make_unique<sim::RobotSim>(options);
     robot_->start();
-    std::ofstream(config_) << "port: " << link_ << "\nservo_bus: {enabled: false}\n"
+    std::ofstream(config_) << "port: " << link_ << "\nservo_bus: {state_ids: [1]}\n"
                            << "base: {cmd_vel_timeout: 0.5}\n"
                            << "ros2: {domain_id: " << domain_ << ", peers: [127.0.0.1]}\n";
     driver_ = std::make_unique<test_support::ChildProcess>(
@@ -103,6 +103,7 @@ TEST_F(DdsDriver, EveryTopicHasRos2sNameTypeHashAndQos) {
       {true, "rt/battery", "sensor_msgs/msg/BatteryState", 10},
       {true, "rt/wheel_states", "sensor_msgs/msg/JointState", 10},
       {true, "rt/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", 10},
+      {true, "rt/servo_states", "sensor_msgs/msg/JointState", 10},
       {false, "rt/cmd_vel", "geometry_msgs/msg/Twist", 10},
       {false, "rt/cmd_vel_stamped", "geometry_msgs/msg/TwistStamped", 10},
       {false, "rt/e_stop", "std_msgs/msg/Bool", 10},
@@ -149,6 +150,16 @@ TEST_F(DdsDriver, JointStatesFollowJointCommands) {
                std::abs(state.position._buffer[0] - reached) < 1e-9 &&
                std::abs(state.position._buffer[1]) < 1e-9 && state.header.stamp.sec > 1700000000;
       }));
+}
+
+TEST_F(DdsDriver, ServoStatesCarryThePolledBusServo) {
+  const dds_entity_t states =
+      peer_->reader(sensor_msgs_msg_dds__JointState__desc, "rt/servo_states");
+  EXPECT_TRUE(dds_test::waitForSample<sensor_msgs_msg_dds__JointState_>(states, [](const auto& s) {
+    return s.name._length == 1 && std::strcmp(s.name._buffer[0], "servo_1") == 0 &&
+           s.position._length == 1 && std::isfinite(s.position._buffer[0]) &&
+           s.header.stamp.sec > 1700000000;
+  }));
 }
 
 TEST_F(DdsDriver, JointTrajectoryMovesTheBodysJoints) {
