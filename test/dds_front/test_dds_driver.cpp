@@ -218,6 +218,23 @@ TEST_F(DdsDriver, CmdVelDrivesTheBaseTheDeadmanAndEStopStopIt) {
   EXPECT_TRUE(baseHoldsSpeed(false)) << "cmd_vel stopped: the deadman stops the base";
 }
 
+TEST_F(DdsDriver, CmdVelStampedDrivesTheBaseToo) {
+  const dds_entity_t stamped =
+      peer_->writer(geometry_msgs_msg_dds__TwistStamped__desc, "rt/cmd_vel_stamped");
+  ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(stamped); }));
+  char frame[] = "base_link";
+  geometry_msgs_msg_dds__TwistStamped_ msg{};
+  msg.header.frame_id = frame;
+  msg.twist.linear.x = -0.2;
+  // Written on every check, as a teleop node streams it, until a frame moves the wheels backward.
+  EXPECT_TRUE(waitFor([&] {
+    dds_write(stamped, &msg);
+    const auto stats = baseStats(robot_stats());
+    return stats.last_left_speed < 0 && stats.last_right_speed < 0;
+  }));
+  EXPECT_TRUE(baseHoldsSpeed(false)) << "stopped writing: the deadman stops the base";
+}
+
 TEST_F(DdsDriver, TheNodeIsInRosDiscoveryInfoWithItsEndpoints) {
   const auto joint_states = peer_->discover(true, "rt/joint_states");
   const auto cmd_vel = peer_->discover(false, "rt/cmd_vel");
