@@ -42,6 +42,7 @@ set(SRD_CORE_SOURCES
   src/core/params_in_force.cpp
   src/core/stop_signals.cpp
   src/core/recording_replay.cpp
+  src/core/wall_stamps.cpp
 )
 
 srd_device_sources(core srd_device_core_sources)

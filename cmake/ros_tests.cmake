@@ -187,3 +187,13 @@ foreach(device ${SRD_DEVICES})
       ${PROJECT_NAME}_generate_messages_cpp)
   endforeach()
 endforeach()
+
+# driver_node with ~ros2/enabled: one process on both graphs (only with Cyclone DDS).
+if(SRD_WITH_DDS)
+  add_rostest_gtest(test_ros2_graph test/rostest/ros2_graph.test
+    test/rostest/test_ros2_graph.cpp
+    test/dds_front/ros2_peer.cpp)
+  target_include_directories(test_ros2_graph PRIVATE ${catkin_INCLUDE_DIRS})
+  target_link_libraries(test_ros2_graph srd_test_support srd_dds ${catkin_LIBRARIES})
+  add_dependencies(test_ros2_graph driver_node robot_sim ${PROJECT_NAME}_generate_messages_cpp)
+endif()

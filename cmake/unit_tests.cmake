@@ -45,6 +45,11 @@ target_include_directories(param_docs_tests PRIVATE ${YAML_CPP_INCLUDE_DIR})
 target_link_libraries(param_docs_tests srd_core ${YAML_CPP_LIBRARIES} gtest_main)
 target_compile_definitions(param_docs_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 
+# A parameter file through the parameter table (dds_driver --config, robot_description).
+catkin_add_gtest(yaml_params_tests test/unit/test_yaml_params.cpp)
+target_link_libraries(yaml_params_tests srd_yaml_params gtest_main)
+target_compile_definitions(yaml_params_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+
 # Conversions and parameter validation of the ROS layer (pure functions, no roscore needed).
 catkin_add_gtest(ros_layer_tests
   test/unit/test_conversions.cpp

@@ -1,5 +1,7 @@
 #include "serial_robot_driver/core/e_stop_status.h"
 
+#include "serial_robot_driver/core/log.h"
+
 namespace serial_robot_driver::core {
 
 StatusReport eStopStatus(const EStopStats& stats) {
@@ -18,6 +20,16 @@ StatusReport eStopStatus(const EStopStats& stats) {
   }
   status.add("commands refused", refused);
   return status;
+}
+
+void logEStopChange(bool engaged) {
+  if (engaged) {
+    log(LogLevel::kWarn,
+        "e_stop engaged: every actuator stopped (base at zero speed, trajectories aborted, bus "
+        "servos stopped); motion commands refused until e_stop is false");
+  } else {
+    log(LogLevel::kInfo, "e_stop released: motion commands obeyed from the next one");
+  }
 }
 
 }  // namespace serial_robot_driver::core

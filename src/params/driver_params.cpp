@@ -43,12 +43,27 @@ void addTrajectoryParameters(std::vector<ParamSpec>& table) {
       .add("max_start_delay", &TrajectoryParams::max_start_delay, positiveNumber);
 }
 
+/// ~ros2: the DDS front end (driver_node's ROS 2 graph; dds_driver reads the same rows).
+void addRos2Parameters(std::vector<ParamSpec>& table) {
+  SectionRows<Ros2Params>(table, "", "ros2", [](DriverParams& p) -> Ros2Params& { return p.ros2; })
+      .add("enabled", &Ros2Params::enabled)
+      .add("domain_id", &Ros2Params::domain_id,
+           [](const int& value, const std::string& key) {
+             // 232: the highest domain whose ports fit below 65536 (ROS 2's own limit).
+             require(value == -1 || (value >= 0 && value <= 232), key,
+                     "must be -1 ($ROS_DOMAIN_ID) or a domain 0..232 (got " +
+                         std::to_string(value) + ")");
+           })
+      .add("peers", &Ros2Params::peers, networkHosts);
+}
+
 std::vector<ParamSpec> buildTable() {
   std::vector<ParamSpec> table;
   addNodeParameters(table);
   SectionRows<EStopParams>(table, "", "e_stop", [](DriverParams& p) -> EStopParams& {
     return p.e_stop;
   }).add("start_engaged", &EStopParams::start_engaged);
+  addRos2Parameters(table);
   for (const core::DeviceModule* device : core::registeredDevices()) {
     // Every device's port parameters, then its own.
     const auto port = [device](DriverParams& p) -> DevicePortParams& {

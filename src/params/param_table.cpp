@@ -1,5 +1,7 @@
 #include "serial_robot_driver/params/param_table.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -13,6 +15,44 @@ namespace {
 template <typename T>
 constexpr bool kScalar = std::is_same_v<T, bool> || std::is_same_v<T, int> ||
                          std::is_same_v<T, double> || std::is_same_v<T, std::string>;
+
+/// The dot-separated parts of a host ("10.0.0.1" -> 10, 0, 0, 1); an empty part stays empty.
+std::vector<std::string> hostLabels(const std::string& host) {
+  std::vector<std::string> labels(1);
+  for (const char c : host) {
+    if (c == '.') {
+      labels.emplace_back();
+    } else {
+      labels.back() += c;
+    }
+  }
+  return labels;
+}
+
+bool allDigits(const std::string& text) {
+  return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+}
+
+/// Why `host` is neither an IPv4 address nor an RFC 1123 host name, or "" when it is one.
+std::string hostProblem(const std::string& host) {
+  const std::vector<std::string> labels = hostLabels(host);
+  if (std::all_of(labels.begin(), labels.end(), allDigits)) {  // numbers: it must be an address
+    const bool address = labels.size() == 4 &&
+                         std::all_of(labels.begin(), labels.end(), [](const std::string& part) {
+                           return part.size() <= 3 && std::stoi(part) <= 255;
+                         });
+    return address ? "" : "is not an IPv4 address (a.b.c.d, each 0..255)";
+  }
+  if (host.size() > 253) return "is longer than a host name may be (253 characters)";
+  for (const std::string& label : labels) {
+    const bool ok = !label.empty() && label.size() <= 63 && label.front() != '-' &&
+                    label.back() != '-' && std::all_of(label.begin(), label.end(), [](char c) {
+                      return std::isalnum(static_cast<unsigned char>(c)) || c == '-';
+                    });
+    if (!ok) return "is neither an IPv4 address nor a host name (letters, digits, '-', '.')";
+  }
+  return "";
+}
 
 std::string numberText(double value) {
   std::ostringstream text;
@@ -96,6 +136,15 @@ void uniqueNames(const std::vector<std::string>& names, const std::string& key) 
   for (const auto& name : names) {
     require(!name.empty(), key, "a joint name is empty");
     require(seen.insert(name).second, key, "'" + name + "' is listed twice");
+  }
+}
+
+void networkHosts(const std::vector<std::string>& hosts, const std::string& key) {
+  std::set<std::string> seen;
+  for (const auto& host : hosts) {
+    const std::string problem = hostProblem(host);
+    require(problem.empty(), key, "'" + host + "' " + problem);
+    require(seen.insert(host).second, key, "'" + host + "' is listed twice");
   }
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "serial_robot_driver/core/wall_stamps.h"
+
 namespace serial_robot_driver::ros_layer {
 
 ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time& ros_now,
@@ -22,12 +24,14 @@ ros::Time toRosTime(std::chrono::steady_clock::time_point event) {
 }
 
 ros::Time ArrivalStamps::operator()(std::chrono::steady_clock::time_point arrival) const {
-  if (replay_timeline_) {
-    const int64_t recorded_ns = replay_timeline_->recordedAt(arrival).count();
+  if (replay_timeline_ || !ros::Time::isSimTime()) {
+    // The core's stamp of the arrival (ros::Time::now() is the wall clock too), which every front
+    // end gives the same frame: the DDS one publishes the same stamp.
     ros::Time stamp;
-    stamp.fromNSec(static_cast<uint64_t>(std::max<int64_t>(recorded_ns, 0)));
+    stamp.fromNSec(static_cast<uint64_t>(core::WallStamps(replay_timeline_)(arrival).count()));
     return stamp;
   }
+  // Simulated time: the same conversion against ros::Time::now().
   thread_local std::chrono::steady_clock::time_point last_arrival{};
   thread_local ros::Time last_stamp;
   if (arrival != last_arrival || last_stamp.isZero()) {

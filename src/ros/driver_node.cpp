@@ -3,10 +3,12 @@
 #include <atomic>
 #include <utility>
 
+#include "serial_robot_driver/core/e_stop_status.h"
 #include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/ros2_graph.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
@@ -53,6 +55,8 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
   core_ = std::make_unique<core::DriverCore>(params_, stream_factory, capture_.get(),
                                              TrajectoryServer::logWarning());
   attachFrontEnds();
+  // ~ros2/enabled: the same devices on the ROS 2 graph, named like this node.
+  ros2_ = std::make_unique<Ros2Graph>(params_, private_nh.getNamespace(), *core_);
   addPortsAndDevices();
   serveTrajectories();
   connectEStop();
@@ -125,20 +129,14 @@ void DriverNode::connectEStop() {
 }
 
 void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
-  if (!core_->eStop().set(msg->data)) return;
-  if (msg->data) {
-    ROS_WARN(
-        "e_stop engaged: every actuator stopped (base at zero speed, trajectories aborted, "
-        "bus servos stopped); motion commands refused until e_stop is false");
-  } else {
-    ROS_INFO("e_stop released: motion commands obeyed from the next one");
-  }
+  if (core_->eStop().set(msg->data)) core::logEStopChange(msg->data);
 }
 
 void DriverNode::start() {
   core_->start();
   for (auto& front_end : front_ends_) front_end->start();
   if (trajectory_) trajectory_->start();
+  ros2_->start();
   ROS_INFO("%s; diagnostics every %g s", core_->startupSummary().c_str(), diagnostics_period_);
 }
 
@@ -148,6 +146,7 @@ void DriverNode::shutdown() {
   if (tuning_) tuning_->stop();  // no retune while the devices stop
   diagnostics_timer_.stop();
   e_stop_sub_.shutdown();
+  ros2_->shutdown();                         // no input from the ROS 2 graph either
   if (trajectory_) trajectory_->shutdown();  // goals end before their joints' devices stop
   core_->shutdown();
   for (auto& front_end : front_ends_) front_end->shutdown();

@@ -10,6 +10,7 @@
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
+#include "serial_robot_driver/ros/ros2_graph.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -27,6 +28,7 @@ DriverParams loadCheckedParams(const ros::NodeHandle& private_nh) {
     ROS_WARN("unknown parameter ~%s is ignored (a typo?)", key.c_str());
   }
   params.validate();
+  requireRos2Support(params);
   return params;
 }
 

@@ -143,9 +143,27 @@ INSTANTIATE_TEST_SUITE_P(
                 [](DriverParams& p) { params::specFor("servo_bus/relax_power_mw").set(p, -1); }},
         BadCase{"servo_bus/health_rate",
                 [](DriverParams& p) { p.section(devices::servo_bus::kServoBusSection).bus.health_rate = -1.0; }},
+        BadCase{"ros2/domain_id", [](DriverParams& p) { p.ros2.domain_id = 233; }},
+        BadCase{"ros2/domain_id", [](DriverParams& p) { p.ros2.domain_id = -2; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {"10.0.0.256"}; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {"10.0.1"}; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {"robot 2"}; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {"-robot"}; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {""}; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {"robot..lan"}; }},
+        BadCase{"ros2/peers", [](DriverParams& p) { p.ros2.peers = {"127.0.0.1", "127.0.0.1"}; }},
         BadCase{"base/enabled", [](DriverParams& p) {
                   p.section(devices::base::kBaseSection).enabled = p.section(devices::body::kBodySection).enabled = p.section(devices::servo_bus::kServoBusSection).enabled = false;
                 }}));
+
+TEST(DriverParams, Ros2DomainsAndPeersAtTheirLimitsPass) {
+  DriverParams params;
+  params.ros2.peers = {"127.0.0.1", "255.255.255.255", "robot-2.local", "base7"};
+  for (const int domain : {-1, 0, 232}) {
+    params.ros2.domain_id = domain;
+    EXPECT_NO_THROW(params.validate()) << domain;
+  }
+}
 
 TEST(DriverParams, ImuHeadingNeedsTheBodysImuOrientation) {
   DriverParams params;

@@ -15,35 +15,16 @@
 
 // DriverParams and ParamSource: the parameter table, on its way into the core.
 #include "serial_robot_driver/description/urdf_writer.h"
+#include "serial_robot_driver/params/yaml_param_source.h"
 #include "serial_robot_driver/ros/driver_params.h"
-
-namespace YAML {
-class Node;
-}
 
 namespace serial_robot_driver::description {
 
+using params::YamlParamSource;
 using ros_layer::DriverParams;
 using ros_layer::ParameterError;
 using ros_layer::ParamSource;
 using ros_layer::ParamValue;
-
-/// A parameter file (YAML, as `rosparam load` reads it) as a ParamSource, so loadParams gives the
-/// driver's own defaults and checks for it. Keys are paths below the file's top level
-/// ("base/port").
-class YamlParamSource : public ParamSource {
- public:
-  /// Throws std::runtime_error when the file cannot be read or is not a YAML mapping.
-  explicit YamlParamSource(const std::string& path);
-  ~YamlParamSource() override;
-
-  bool has(const std::string& key) const override;
-  bool get(const std::string& key, ParamValue* value) const override;
-  std::vector<std::string> keys() const override;
-
- private:
-  std::unique_ptr<YAML::Node> root_;
-};
 
 /// Where a part sits on the chassis (a --<name>-xyz / --<name>-rpy argument).
 struct Mount {

@@ -32,6 +32,15 @@ struct EStopParams {
   bool start_engaged = false;
 };
 
+/// ~ros2: the same robot also on a ROS 2 graph, through DDS (docs/ros2.md).
+struct Ros2Params {
+  bool enabled = false;  ///< driver_node serves the ROS 2 graph too (dds_driver always does)
+  /// The DDS domain: -1 takes $ROS_DOMAIN_ID (0 when unset), as every ROS 2 node does; else 0..232.
+  int domain_id = -1;
+  /// Unicast discovery peers (IPv4 addresses or host names) for networks without multicast.
+  std::vector<std::string> peers;
+};
+
 /// The tf frame name of a frame parameter under `tf_prefix`, as robot_state_publisher resolves its
 /// links: "<prefix>/<frame>" with the prefix's own leading and trailing slashes dropped
 /// ("/robot1/" and "robot1" alike); a frame written with a leading '/' is taken as it is, without
@@ -57,6 +66,7 @@ struct DriverParams {
   DeviceSections sections;
   TrajectoryParams trajectory;
   EStopParams e_stop;
+  Ros2Params ros2;
   /// Not a ~ parameter: `tf_prefix` searched upward from the node's namespace (as
   /// robot_state_publisher does), so one value in a robot's namespace serves all its nodes.
   std::string tf_prefix;

@@ -68,6 +68,8 @@ void directionList(const std::vector<int>& values, const std::string& key);
 void frameId(const std::string& value, const std::string& key);
 /// Names that are not empty and not listed twice.
 void uniqueNames(const std::vector<std::string>& names, const std::string& key);
+/// Network hosts: each an IPv4 address (a.b.c.d) or a host name (RFC 1123 labels), none twice.
+void networkHosts(const std::vector<std::string>& hosts, const std::string& key);
 /// A baud rate the serial port supports; `baudOrInherit` also takes 0 (the node-wide ~baud).
 void baudRate(const int& value, const std::string& key);
 void baudOrInherit(const int& value, const std::string& key);

@@ -47,6 +47,7 @@
 
 namespace serial_robot_driver::ros_layer {
 
+class Ros2Graph;
 class RuntimeTuning;
 class TrajectoryServer;
 class WireCapture;
@@ -90,6 +91,8 @@ class DriverNode {
   std::unique_ptr<core::DriverCore> core_;
   /// The devices' topics and services, in the devices' order; destroyed before core_'s devices.
   std::vector<std::unique_ptr<DeviceFrontEnd>> front_ends_;
+  /// ~ros2/enabled: the DDS front end on the same devices (nothing otherwise).
+  std::unique_ptr<Ros2Graph> ros2_;
   /// follow_joint_trajectory / joint_trajectory for the core's trajectories; null without joints.
   std::unique_ptr<TrajectoryServer> trajectory_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up

@@ -93,4 +93,18 @@ ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
   return reading;
 }
 
+ImuCovariances imuCovariances(const ImuParams& params) {
+  ImuCovariances covariances;
+  for (std::size_t i = 0; i < 3; ++i) {  // the diagonal: elements 0, 4, 8
+    covariances.orientation[4 * i] = params.orientation_variance;
+    covariances.angular_velocity[4 * i] = params.angular_velocity_variance;
+    covariances.linear_acceleration[4 * i] = params.linear_acceleration_variance;
+  }
+  if (params.orientation_variance < 0) {
+    covariances.orientation = {};
+    covariances.orientation[0] = -1.0;
+  }
+  return covariances;
+}
+
 }  // namespace serial_robot_driver::devices::body

@@ -3,6 +3,7 @@
 // these fields into its messages.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 namespace serial_robot_driver::devices::base {
@@ -27,5 +28,16 @@ constexpr double kTwistLateralVariance = 1e-6;   ///< a differential drive canno
 constexpr double kTwistAngularVariance = 0.01;   ///< (rad/s)^2: std 0.1 rad/s
 /// The variance of what the odometry does not estimate at all (z, roll, pitch).
 constexpr double kNotEstimatedVariance = 1e6;
+
+/// The odometry's covariances as nav_msgs/Odometry carries them (row-major 6x6: x, y, z, roll,
+/// pitch, yaw), from a sample's variances, for every front end to copy.
+struct OdometryCovariances {
+  std::array<double, 36> pose{};
+  std::array<double, 36> twist{};
+};
+/// Open loop: x, y and yaw grow with the distance travelled (kinematics::PoseCovarianceModel); z,
+/// roll and pitch are not estimated at all. While the IMU's yaw is fused, `yaw_variance` is the
+/// IMU's ~imu/orientation_variance.
+OdometryCovariances odometryCovariances(double position_variance, double yaw_variance);
 
 }  // namespace serial_robot_driver::devices::base

@@ -52,6 +52,16 @@ struct ImuReading {
 ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
                       const std::array<double, 3>& gyro_bias = {});
 
+/// The IMU's covariances as sensor_msgs/Imu carries them (row-major 3x3, diagonal from `params`'s
+/// variances; REP-145: a negative orientation_variance marks the orientation as unknown, element
+/// 0 = -1 and the rest 0), for every front end to copy.
+struct ImuCovariances {
+  std::array<double, 9> orientation{};
+  std::array<double, 9> angular_velocity{};
+  std::array<double, 9> linear_acceleration{};
+};
+ImuCovariances imuCovariances(const ImuParams& params);
+
 /// The yaw (rad, [-pi, pi]) of imuReading()'s orientation: the board's attitude through
 /// ~imu/axis_map, i.e. the heading of the imu frame (~base/use_imu_heading feeds it to odometry).
 double imuYaw(const Telemetry& telemetry, const ImuParams& params);

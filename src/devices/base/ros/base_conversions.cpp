@@ -1,5 +1,6 @@
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 
+#include <algorithm>
 #include <limits>
 
 namespace serial_robot_driver::devices::base::ros {
@@ -32,17 +33,10 @@ nav_msgs::Odometry toOdometry(const OdometrySample& sample, const OdomFrames& fr
   odom.pose.pose.orientation.w = rotation.w;
   odom.twist.twist.linear.x = sample.linear;
   odom.twist.twist.angular.z = sample.angular;
-  // Row-major 6x6 (x, y, z, roll, pitch, yaw). Open loop: x, y and yaw grow with the distance
-  // travelled (kinematics::PoseCovarianceModel); z, roll and pitch are not estimated at all. While
-  // the IMU's yaw is fused, the yaw variance is the IMU's ~imu/orientation_variance instead.
-  constexpr double kNotEstimated = kNotEstimatedVariance;
-  odom.pose.covariance[0] = odom.pose.covariance[7] = sample.position_variance;
-  odom.pose.covariance[14] = odom.pose.covariance[21] = odom.pose.covariance[28] = kNotEstimated;
-  odom.pose.covariance[35] = sample.yaw_variance;
-  odom.twist.covariance[0] = kTwistLinearVariance;
-  odom.twist.covariance[7] = kTwistLateralVariance;
-  odom.twist.covariance[14] = odom.twist.covariance[21] = odom.twist.covariance[28] = kNotEstimated;
-  odom.twist.covariance[35] = kTwistAngularVariance;
+  const OdometryCovariances covariances =
+      odometryCovariances(sample.position_variance, sample.yaw_variance);
+  std::copy(covariances.pose.begin(), covariances.pose.end(), odom.pose.covariance.begin());
+  std::copy(covariances.twist.begin(), covariances.twist.end(), odom.twist.covariance.begin());
   return odom;
 }
 

@@ -1,5 +1,7 @@
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 
+#include <algorithm>
+
 namespace serial_robot_driver::devices::body::ros {
 
 namespace {
@@ -49,17 +51,13 @@ sensor_msgs::Imu toImu(const Telemetry& telemetry, const ImuParams& params,
   msg.linear_acceleration = toVector3(reading.linear_acceleration);
   msg.angular_velocity = toVector3(reading.angular_velocity);
   msg.orientation = toQuaternion(reading.orientation);
-  // Row-major 3x3 matrices: the diagonal is elements 0, 4, 8.
-  for (std::size_t i = 0; i < 3; ++i) {
-    msg.orientation_covariance[4 * i] = params.orientation_variance;
-    msg.angular_velocity_covariance[4 * i] = params.angular_velocity_variance;
-    msg.linear_acceleration_covariance[4 * i] = params.linear_acceleration_variance;
-  }
-  if (params.orientation_variance < 0) {
-    // REP-145: element 0 = -1 says "no orientation estimate"; the rest is ignored.
-    msg.orientation_covariance = {};
-    msg.orientation_covariance[0] = -1.0;
-  }
+  const ImuCovariances covariances = imuCovariances(params);
+  std::copy(covariances.orientation.begin(), covariances.orientation.end(),
+            msg.orientation_covariance.begin());
+  std::copy(covariances.angular_velocity.begin(), covariances.angular_velocity.end(),
+            msg.angular_velocity_covariance.begin());
+  std::copy(covariances.linear_acceleration.begin(), covariances.linear_acceleration.end(),
+            msg.linear_acceleration_covariance.begin());
   return msg;
 }
 

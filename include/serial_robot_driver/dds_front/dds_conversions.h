@@ -1,0 +1,77 @@
+// What every device's DDS front end shares: stamps, headers, JointState and DiagnosticArray
+// samples built from core values. The generated C structs point into storage these own (a sample
+// only has to live until publish() returns), so each sample is a small non-copyable object. No
+// participant, no I/O: unit-tested against the CDR bytes without a network.
+#pragma once
+
+#include <chrono>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "serial_robot_driver/core/status_report.h"
+#include "serial_robot_driver/dds/c_types.h"
+#include "serial_robot_driver/dds/messages.h"
+#include "serial_robot_driver/trajectory/command.h"
+
+namespace serial_robot_driver::dds_front {
+
+/// builtin_interfaces/Time of a wall-clock time (core/wall_stamps.h), nanoseconds since the epoch.
+builtin_interfaces_msg_dds__Time_ toTime(std::chrono::nanoseconds since_epoch);
+/// The wall-clock time a received stamp stands for (negative fields count as they are).
+std::chrono::nanoseconds fromTime(const builtin_interfaces_msg_dds__Time_& stamp);
+
+/// A received trajectory_msgs/JointTrajectory as the core's trajectories take it.
+trajectory::TrajectoryCommand toTrajectoryCommand(
+    const trajectory_msgs_msg_dds__JointTrajectory_& msg);
+/// When a command stamped `stamp` (wall clock) starts on the executor's clock, given both clocks
+/// read together: `executor_now` + (`stamp` - `wall_now`), in integers then seconds, so any stamp
+/// gives a finite time (the executor refuses one too far ahead).
+double executorStart(std::chrono::nanoseconds stamp, double executor_now,
+                     std::chrono::nanoseconds wall_now);
+
+/// `header` stamped and in `frame` (lent: `frame` must outlive the publish).
+void setHeader(std_msgs_msg_dds__Header_& header, std::chrono::nanoseconds stamp,
+               const std::string& frame);
+
+/// A sensor_msgs/JointState sample and its storage; empty velocities stay empty, effort is empty.
+class JointStateSample {
+ public:
+  JointStateSample(std::chrono::nanoseconds stamp, std::string frame,
+                   std::vector<std::string> names, std::vector<double> positions,
+                   std::vector<double> velocities = {});
+  JointStateSample(const JointStateSample&) = delete;
+  JointStateSample& operator=(const JointStateSample&) = delete;
+  const sensor_msgs_msg_dds__JointState_& sample() const { return sample_; }
+
+ private:
+  std::string frame_;
+  std::vector<std::string> names_;
+  std::vector<double> positions_, velocities_, effort_;
+  dds::StringPointers name_pointers_;
+  sensor_msgs_msg_dds__JointState_ sample_{};
+};
+
+/// One diagnostic status: its name as published ("driver_node: base") and its core report.
+using NamedReport = std::pair<std::string, core::StatusReport>;
+
+/// A diagnostic_msgs/DiagnosticArray sample of `reports` and its storage, as diagnostic_updater
+/// writes it: a report without a hardware_id gets `default_hardware_id` (the node's ~port).
+class DiagnosticsSample {
+ public:
+  DiagnosticsSample(std::chrono::nanoseconds stamp, std::vector<NamedReport> reports,
+                    std::string default_hardware_id);
+  DiagnosticsSample(const DiagnosticsSample&) = delete;
+  DiagnosticsSample& operator=(const DiagnosticsSample&) = delete;
+  const diagnostic_msgs_msg_dds__DiagnosticArray_& sample() const { return sample_; }
+
+ private:
+  std::vector<NamedReport> reports_;
+  std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> values_;  // one list per status
+  std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> statuses_;
+  std::string default_hardware_id_;
+  std::string no_frame_;
+  diagnostic_msgs_msg_dds__DiagnosticArray_ sample_{};
+};
+
+}  // namespace serial_robot_driver::dds_front

@@ -1,0 +1,138 @@
+#include "serial_robot_driver/dds_front/dds_node.h"
+
+#include <chrono>
+#include <optional>
+
+#include "serial_robot_driver/core/e_stop_status.h"
+#include "serial_robot_driver/core/link_status.h"
+#include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/core/wall_stamps.h"
+#include "serial_robot_driver/dds/ros_conventions.h"
+
+namespace serial_robot_driver::dds_front {
+
+namespace {
+/// diagnostic_updater's default period, which the ROS node keeps unless ~diagnostic_period says.
+constexpr std::chrono::seconds kDiagnosticsPeriod{1};
+}  // namespace
+
+dds::NodeOptions nodeOptions(const params::Ros2Params& ros2, const std::string& name,
+                             const std::string& node_namespace) {
+  dds::NodeOptions options;
+  options.name = name;
+  options.node_namespace = node_namespace;
+  options.domain_id = ros2.domain_id;
+  options.peers = ros2.peers;
+  return options;
+}
+
+DdsNode::DdsNode(const params::DriverParams& params, const dds::NodeOptions& options,
+                 core::DriverCore& core)
+    : params_(params),
+      core_(core),
+      // As diagnostic_updater names a node's statuses: its full name without the leading slash.
+      status_prefix_(dds::fullyQualifiedName(options.node_namespace, options.name).substr(1) +
+                     ": "),
+      participant_(std::make_unique<dds::Participant>(options)) {
+  attachDevices();
+  collectStatusSources();
+  diagnostics_ = std::make_unique<dds::Publisher<diagnostic_msgs_msg_dds__DiagnosticArray_>>(
+      *participant_, "/diagnostics");
+  // Queue 10 as on the ROS side, so no toggle is dropped.
+  e_stop_ = std::make_unique<dds::Subscription<std_msgs_msg_dds__Bool_>>(
+      *participant_, "e_stop", [this](const std_msgs_msg_dds__Bool_& msg) { onEStop(msg); });
+  if (core_.trajectories() != nullptr) {
+    joint_trajectory_ =
+        std::make_unique<dds::Subscription<trajectory_msgs_msg_dds__JointTrajectory_>>(
+            *participant_, "joint_trajectory",
+            [this](const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+              onJointTrajectory(msg);
+            });
+  }
+}
+
+DdsNode::~DdsNode() { shutdown(); }
+
+void DdsNode::attachDevices() {
+  for (std::size_t i = 0; i < core_.devices().size(); ++i) {
+    const std::string& name = core_.deviceNames()[i];
+    const DdsDeviceModule* module = findDdsFrontEnd(name);
+    if (module == nullptr) {  // it still runs, and its statuses are in diagnostics
+      core::log(core::LogLevel::kWarn, "%s has no topics on the ROS 2 graph (ROS 1 only)",
+                name.c_str());
+      continue;
+    }
+    front_ends_.push_back(module->attach(*participant_, params_, *core_.devices()[i]));
+  }
+}
+
+void DdsNode::onEStop(const std_msgs_msg_dds__Bool_& msg) {
+  if (core_.eStop().set(msg.data)) core::logEStopChange(msg.data);
+}
+
+void DdsNode::onJointTrajectory(const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+  trajectory::TrajectoryExecutor& executor = *core_.trajectories();
+  std::optional<double> start;  // a zero stamp: now
+  if (msg.header.stamp.sec != 0 || msg.header.stamp.nanosec != 0) {
+    const double executor_now = executor.now();
+    start = executorStart(fromTime(msg.header.stamp), executor_now,
+                          std::chrono::system_clock::now().time_since_epoch());
+  }
+  if (executor.submitTrajectory(toTrajectoryCommand(msg), start) ==
+      trajectory::TrajectoryExecutor::Submission::kInvalid) {
+    refusals_.refused("joint_trajectory");
+  }
+}
+
+void DdsNode::start() {
+  diagnostics_thread_ = std::thread([this] { publishDiagnosticsUntilStopped(); });
+}
+
+void DdsNode::shutdown() {
+  {
+    std::lock_guard<std::mutex> lock(stop_mutex_);
+    stopping_ = true;
+  }
+  stop_.notify_all();
+  if (diagnostics_thread_.joinable()) diagnostics_thread_.join();
+  e_stop_.reset();
+  joint_trajectory_.reset();
+  for (auto& front_end : front_ends_) front_end->shutdown();
+}
+
+void DdsNode::collectStatusSources() {
+  // The ROS node's statuses, in its order: each port, each device and its own, the e-stop.
+  for (const auto& [path, link_ptr] : core_.ports()) {
+    const core::SerialLink* link = link_ptr.get();
+    status_sources_.push_back(
+        {"port " + path, [link] { return core::linkStatus(link->stats(), link->options()); }});
+  }
+  for (std::size_t i = 0; i < core_.devices().size(); ++i) {
+    core::Device* device = core_.devices()[i].get();
+    status_sources_.push_back({core_.deviceNames()[i], [device] { return device->status(); }});
+    for (core::Device::NamedStatus& extra : device->extraStatuses()) {
+      status_sources_.push_back(std::move(extra));
+    }
+  }
+  status_sources_.push_back({"e_stop", [this] { return core_.eStopStatus(refusals_.stats()); }});
+}
+
+std::vector<NamedReport> DdsNode::statusReports() const {
+  std::vector<NamedReport> reports;
+  for (const core::Device::NamedStatus& source : status_sources_) {
+    reports.emplace_back(status_prefix_ + source.name, source.report());
+  }
+  return reports;
+}
+
+void DdsNode::publishDiagnosticsUntilStopped() {
+  std::unique_lock<std::mutex> lock(stop_mutex_);
+  while (!stop_.wait_for(lock, kDiagnosticsPeriod, [this] { return stopping_; })) {
+    if (!diagnostics_->hasSubscribers()) continue;  // nothing built that nobody reads
+    const core::WallStamps stamps;
+    const DiagnosticsSample sample(stamps(core::Clock::now()), statusReports(), params_.port);
+    diagnostics_->publish(sample.sample());
+  }
+}
+
+}  // namespace serial_robot_driver::dds_front

@@ -1,0 +1,154 @@
+#include "ros2_peer.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "serial_robot_driver/dds/messages.h"
+
+namespace dds_test {
+
+namespace {
+
+std::string userData(const dds_qos_t* qos) {
+  void* data = nullptr;
+  size_t size = 0;
+  if (!qos || !dds_qget_userdata(qos, &data, &size) || !data) return "";
+  std::string text(static_cast<const char*>(data), size);
+  dds_free(data);
+  return text;
+}
+
+SeenEndpoint seen(const dds_builtintopic_endpoint_t& endpoint) {
+  SeenEndpoint out;
+  out.guid = endpoint.key;
+  out.participant = endpoint.participant_key;
+  out.type_name = endpoint.type_name;
+  out.user_data = userData(endpoint.qos);
+  dds_qget_reliability(endpoint.qos, &out.reliability, nullptr);
+  dds_qget_durability(endpoint.qos, &out.durability);
+  dds_qget_history(endpoint.qos, &out.history, &out.depth);
+  return out;
+}
+
+dds_qos_t* ros2Qos(dds_durability_kind_t durability) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(qos, durability);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+  return qos;
+}
+
+}  // namespace
+
+bool waitFor(const std::function<bool()>& done, int seconds) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > give_up) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+bool writeBool(dds_entity_t writer, bool data) {
+  std_msgs_msg_dds__Bool_ msg{data};
+  return dds_write(writer, &msg) == DDS_RETCODE_OK;
+}
+
+int privateDomain(int first, int count) { return first + static_cast<int>(getpid()) % count; }
+
+Ros2Peer::Ros2Peer(int domain) {
+  const std::string config =
+      "<CycloneDDS><Domain><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
+      "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+      "<ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
+      "</Discovery></Domain></CycloneDDS>";
+  domain_ = dds_create_domain(domain, config.c_str());
+  EXPECT_GT(domain_, 0) << dds_strretcode(domain_);
+  participant_ = dds_create_participant(domain, nullptr, nullptr);
+  EXPECT_GT(participant_, 0) << dds_strretcode(participant_);
+}
+
+Ros2Peer::~Ros2Peer() {
+  if (domain_ > 0) dds_delete(domain_);
+}
+
+std::optional<SeenEndpoint> Ros2Peer::discover(bool publication, const std::string& topic) {
+  const dds_entity_t reader = dds_create_reader(
+      participant_,
+      publication ? DDS_BUILTIN_TOPIC_DCPSPUBLICATION : DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr,
+      nullptr);
+  std::optional<SeenEndpoint> found;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!found && std::chrono::steady_clock::now() < give_up) {
+    takeAll(reader, [&](const void* sample) {
+      const auto* endpoint = static_cast<const dds_builtintopic_endpoint_t*>(sample);
+      if (topic == endpoint->topic_name) found = seen(*endpoint);
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  dds_delete(reader);
+  return found;
+}
+
+dds_entity_t Ros2Peer::topic(const dds_topic_descriptor_t& type, const std::string& name) {
+  const dds_entity_t topic = dds_create_topic(participant_, &type, name.c_str(), nullptr, nullptr);
+  EXPECT_GT(topic, 0) << name << ": " << dds_strretcode(topic);
+  return topic;
+}
+
+dds_entity_t Ros2Peer::reader(const dds_topic_descriptor_t& type, const std::string& name,
+                              dds_durability_kind_t durability) {
+  dds_qos_t* qos = ros2Qos(durability);
+  const dds_entity_t reader = dds_create_reader(participant_, topic(type, name), qos, nullptr);
+  dds_delete_qos(qos);
+  EXPECT_GT(reader, 0) << name;
+  return reader;
+}
+
+dds_entity_t Ros2Peer::writer(const dds_topic_descriptor_t& type, const std::string& name) {
+  dds_qos_t* qos = ros2Qos(DDS_DURABILITY_VOLATILE);
+  const dds_entity_t writer = dds_create_writer(participant_, topic(type, name), qos, nullptr);
+  dds_delete_qos(qos);
+  EXPECT_GT(writer, 0) << name;
+  return writer;
+}
+
+bool Ros2Peer::matched(dds_entity_t writer) {
+  dds_publication_matched_status_t status{};
+  return dds_get_publication_matched_status(writer, &status) == DDS_RETCODE_OK &&
+         status.current_count > 0;
+}
+
+TwistStream::TwistStream(dds_entity_t writer, double linear_x) {
+  thread_ = std::thread([this, writer, linear_x] {
+    geometry_msgs_msg_dds__Twist_ twist{};
+    twist.linear.x = linear_x;
+    while (!stop_) {
+      dds_write(writer, &twist);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+}
+
+TwistStream::~TwistStream() {
+  stop_ = true;
+  thread_.join();
+}
+
+void takeAll(dds_entity_t reader, const std::function<void(const void* sample)>& visit) {
+  void* samples[32] = {nullptr};
+  dds_sample_info_t infos[32];
+  dds_return_t count;
+  while ((count = dds_take(reader, samples, infos, 32, 32)) > 0) {
+    for (dds_return_t i = 0; i < count; ++i) {
+      if (infos[i].valid_data) visit(samples[i]);
+    }
+    dds_return_loan(reader, samples, count);
+    samples[0] = nullptr;  // the next take lends again
+  }
+}
+
+}  // namespace dds_test
