@@ -26,11 +26,6 @@ trajectory::TrajectoryCommand toTrajectoryCommand(
   return command;
 }
 
-double executorStart(std::chrono::nanoseconds stamp, double executor_now,
-                     std::chrono::nanoseconds wall_now) {
-  return executor_now + std::chrono::duration<double>(stamp - wall_now).count();
-}
-
 void setHeader(std_msgs_msg_dds__Header_& header, std::chrono::nanoseconds stamp,
                const std::string& frame) {
   header.stamp = toTime(stamp);

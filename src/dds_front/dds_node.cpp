@@ -8,6 +8,7 @@
 #include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/core/wall_stamps.h"
 #include "serial_robot_driver/dds/ros_conventions.h"
+#include "serial_robot_driver/trajectory/message_time.h"
 
 namespace serial_robot_driver::dds_front {
 
@@ -73,10 +74,13 @@ void DdsNode::onEStop(const std_msgs_msg_dds__Bool_& msg) {
 void DdsNode::onJointTrajectory(const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
   trajectory::TrajectoryExecutor& executor = *core_.trajectories();
   std::optional<double> start;  // a zero stamp: now
-  if (msg.header.stamp.sec != 0 || msg.header.stamp.nanosec != 0) {
+  const trajectory::MessageStamp stamp{msg.header.stamp.sec, msg.header.stamp.nanosec};
+  if (!stamp.isZero()) {
     const double executor_now = executor.now();
-    start = executorStart(fromTime(msg.header.stamp), executor_now,
-                          std::chrono::system_clock::now().time_since_epoch());
+    const auto wall_now = std::chrono::system_clock::now().time_since_epoch();
+    const auto wall_sec = std::chrono::duration_cast<std::chrono::seconds>(wall_now);
+    start = trajectory::steadyStart(stamp, executor_now,
+                                    {wall_sec.count(), (wall_now - wall_sec).count()});
   }
   if (executor.submitTrajectory(toTrajectoryCommand(msg), start) ==
       trajectory::TrajectoryExecutor::Submission::kInvalid) {

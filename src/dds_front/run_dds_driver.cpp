@@ -1,14 +1,13 @@
 #include "serial_robot_driver/dds_front/run_dds_driver.h"
 
-#include <pthread.h>
-
-#include <csignal>
+#include <chrono>
 #include <iostream>
 #include <stdexcept>
 #include <vector>
 
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/core/stop_signals.h"
 #include "serial_robot_driver/dds/ros_conventions.h"
 #include "serial_robot_driver/dds_front/dds_node.h"
 #include "serial_robot_driver/dds_front/trajectory_loop.h"
@@ -63,7 +62,7 @@ params::DriverParams loadCheckedParams(const std::string& path) {
 /// Runs the core and its DDS front end until one of `stop_signals` arrives, then shuts down in
 /// the node's order: no more input, the devices' last words, the ports closed.
 void runUntilStopped(const params::DriverParams& params, const DdsDriverOptions& options,
-                     const sigset_t& stop_signals) {
+                     const core::StopSignals& stop_signals) {
   core::DriverCore core(
       params, core::SerialLink::StreamFactory{}, nullptr,
       [](const std::string& warning) { core::log(core::LogLevel::kWarn, "%s", warning.c_str()); });
@@ -76,8 +75,7 @@ void runUntilStopped(const params::DriverParams& params, const DdsDriverOptions&
             core.startupSummary().c_str(),
             dds::fullyQualifiedName(options.node_namespace, options.name).c_str(),
             node.participant().domainId());
-  int signal = 0;
-  sigwait(&stop_signals, &signal);
+  stop_signals.wait(std::chrono::hours(1));
   core::log(core::LogLevel::kInfo, "shutting down: stopping the wheels and the bus servos");
   node.shutdown();
   trajectories.shutdown();  // goals end before their joints' devices stop
@@ -87,12 +85,7 @@ void runUntilStopped(const params::DriverParams& params, const DdsDriverOptions&
 }  // namespace
 
 int runDdsDriver(int argc, const char* const* argv) {
-  // Taken synchronously here: blocked before any thread starts, so every thread inherits the mask.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  const core::StopSignals stop_signals;  // before any thread starts: every thread inherits it
   DdsDriverOptions options;
   params::DriverParams params;
   try {

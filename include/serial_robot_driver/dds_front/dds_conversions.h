@@ -24,12 +24,6 @@ std::chrono::nanoseconds fromTime(const builtin_interfaces_msg_dds__Time_& stamp
 /// A received trajectory_msgs/JointTrajectory as the core's trajectories take it.
 trajectory::TrajectoryCommand toTrajectoryCommand(
     const trajectory_msgs_msg_dds__JointTrajectory_& msg);
-/// When a command stamped `stamp` (wall clock) starts on the executor's clock, given both clocks
-/// read together: `executor_now` + (`stamp` - `wall_now`), in integers then seconds, so any stamp
-/// gives a finite time (the executor refuses one too far ahead).
-double executorStart(std::chrono::nanoseconds stamp, double executor_now,
-                     std::chrono::nanoseconds wall_now);
-
 /// `header` stamped and in `frame` (lent: `frame` must outlive the publish).
 void setHeader(std_msgs_msg_dds__Header_& header, std::chrono::nanoseconds stamp,
                const std::string& frame);
