@@ -61,7 +61,8 @@ target_link_libraries(ros_layer_tests srd_ros gtest_main)
 
 # The robot description: robot_description's URDF through check_urdf and urdf::Model.
 find_package(urdf REQUIRED)
-catkin_add_gtest(description_tests test/unit/test_robot_description.cpp)
+catkin_add_gtest(description_tests test/unit/test_robot_description.cpp
+  test/unit/test_robot_description_command.cpp)
 target_include_directories(description_tests PRIVATE ${catkin_INCLUDE_DIRS} ${urdf_INCLUDE_DIRS})
 target_link_libraries(description_tests srd_description ${urdf_LIBRARIES} gtest_main)
 target_compile_definitions(description_tests PRIVATE SRD_SOURCE_DIR="${PROJECT_SOURCE_DIR}"

@@ -8,12 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include "serial_robot_driver/description/robot_description.h"
 #include "serial_robot_driver/devices/base/base_params.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/servo_bus/servo_bus_params.h"
-#include "serial_robot_driver/ros/robot_description.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::description {
 namespace {
 
 const std::string kDefaultConfig = std::string(SRD_SOURCE_DIR) + "/config/robot.yaml";
@@ -189,4 +189,4 @@ TEST(RobotDescription, LinkNamesDropALeadingSlash) {
 }
 
 }  // namespace
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::description

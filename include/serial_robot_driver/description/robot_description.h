@@ -13,18 +13,17 @@
 #include <string>
 #include <vector>
 
-// DriverParams and ParamSource: the parameter table, on its way into the core.
 #include "serial_robot_driver/description/urdf_writer.h"
+#include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/params/yaml_param_source.h"
-#include "serial_robot_driver/ros/driver_params.h"
 
 namespace serial_robot_driver::description {
 
+using params::DriverParams;
+using params::ParameterError;
+using params::ParamSource;
+using params::ParamValue;
 using params::YamlParamSource;
-using ros_layer::DriverParams;
-using ros_layer::ParameterError;
-using ros_layer::ParamSource;
-using ros_layer::ParamValue;
 
 /// Where a part sits on the chassis (a --<name>-xyz / --<name>-rpy argument).
 struct Mount {

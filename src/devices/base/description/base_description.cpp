@@ -29,7 +29,7 @@ void drawWheel(UrdfWriter& urdf, const std::string& base_link, const std::string
              numbers({0, side * separation / 2.0, radius}), "0 0 0", "    <axis xyz=\"0 1 0\"/>\n");
 }
 
-Chassis drawChassis(const ros_layer::DriverParams& params, UrdfWriter& urdf) {
+Chassis drawChassis(const description::DriverParams& params, UrdfWriter& urdf) {
   // Simple shapes sized from the wheel geometry: base_link on the ground between the wheels
   // (REP-105), the axle at the wheel radius, a box chassis and a rear caster ball.
   const BaseParams& section = params.section(kBaseSection);

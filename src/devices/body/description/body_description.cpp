@@ -13,7 +13,7 @@ namespace {
 
 using description::numbers;
 
-void drawImu(const ros_layer::DriverParams& params, const description::Chassis& chassis,
+void drawImu(const description::DriverParams& params, const description::Chassis& chassis,
              const description::Mounts& mounts, description::UrdfWriter& urdf) {
   const std::string imu_link = description::linkName(params.section(kImuSection).frame_id);
   const description::Mount mount = description::mountOf(mounts, "imu");
@@ -24,7 +24,7 @@ void drawImu(const ros_layer::DriverParams& params, const description::Chassis& 
              numbers({mount.rpy[0], mount.rpy[1], mount.rpy[2]}), "");
 }
 
-std::vector<description::ServoJoint> servoJoints(const ros_layer::DriverParams& params) {
+std::vector<description::ServoJoint> servoJoints(const description::DriverParams& params) {
   std::vector<description::ServoJoint> servos;
   if (!params.section(kBodySection).enabled) return servos;
   for (const BodyJoint& joint : makeBodyJoints(params.section(kBodySection))) {

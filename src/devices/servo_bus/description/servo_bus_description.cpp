@@ -11,7 +11,7 @@ namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
-std::vector<description::ServoJoint> servoJoints(const ros_layer::DriverParams& params) {
+std::vector<description::ServoJoint> servoJoints(const description::DriverParams& params) {
   std::vector<description::ServoJoint> servos;
   if (!params.section(kServoBusSection).enabled) return servos;
   constexpr double kMaxBusServoSpeedDps = 750.0;  // servo/move's velocity limit
