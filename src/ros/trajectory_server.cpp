@@ -66,18 +66,6 @@ void report(TrajectoryServer::GoalHandle& handle, const trajectory::GoalOutcome&
 
 trajectory::MessageStamp toMessageStamp(const ros::Time& stamp) { return {stamp.sec, stamp.nsec}; }
 
-double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
-  return trajectory::secondsBetween(toMessageStamp(later), toMessageStamp(earlier));
-}
-
-bool actionlibCanTake(const ros::Time& stamp) {
-  return trajectory::actionTimersCanTake(toMessageStamp(stamp));
-}
-
-double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
-  return trajectory::steadyStart(toMessageStamp(stamp), steady_now, toMessageStamp(ros_now));
-}
-
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg) {
   trajectory::TrajectoryCommand command;
   command.joint_names = msg.joint_names;
@@ -129,7 +117,8 @@ trajectory::TrajectoryExecutor::Warn TrajectoryServer::logWarning() {
 
 std::optional<double> TrajectoryServer::startOf(const ros::Time& stamp) const {
   if (stamp.isZero()) return std::nullopt;
-  return steadyStart(stamp, executor_.now(), ros::Time::now());
+  return trajectory::steadyStart(toMessageStamp(stamp), executor_.now(),
+                                 toMessageStamp(ros::Time::now()));
 }
 
 void TrajectoryServer::onGoalGuarded(GoalHandle handle) {

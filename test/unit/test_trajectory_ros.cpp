@@ -16,6 +16,14 @@ namespace {
 
 using devices::servo_bus::ServoBusParams;
 
+/// A goal's ROS stamp as the server starts it: converted, then the core's steadyStart().
+double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now) {
+  return trajectory::steadyStart(toMessageStamp(stamp), steady_now, toMessageStamp(ros_now));
+}
+double secondsBetween(const ros::Time& later, const ros::Time& earlier) {
+  return trajectory::secondsBetween(toMessageStamp(later), toMessageStamp(earlier));
+}
+
 TEST(TrajectoryRos, CommandFromMessageKeepsEveryField) {
   trajectory_msgs::JointTrajectory msg;
   msg.joint_names = {"a", "b"};

@@ -20,12 +20,6 @@
 
 namespace serial_robot_driver::ros_layer {
 
-/// Whether actionlib can add its timeouts (seconds) to `stamp`
-/// (trajectory::actionTimersCanTake()).
-bool actionlibCanTake(const ros::Time& stamp);
-/// `later` - `earlier` in seconds, for any two stamps (never throws; trajectory_server.h).
-double secondsBetween(const ros::Time& later, const ros::Time& earlier);
-
 template <class ActionSpec>
 class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
  public:
@@ -71,10 +65,10 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
 
   /// Refuses (logs, counts) a goal_id stamp actionlib cannot compute with.
   bool checkedStamp(const ros::Time& stamp) {
-    if (actionlibCanTake(stamp)) return true;
+    const trajectory::MessageStamp as_sent{stamp.sec, stamp.nsec};
+    if (trajectory::actionTimersCanTake(as_sent)) return true;
     refusals_.refused(name_);
-    ROS_WARN_THROTTLE(1.0, "%s",
-                      trajectory::unusableStampText(name_, {stamp.sec, stamp.nsec}).c_str());
+    ROS_WARN_THROTTLE(1.0, "%s", trajectory::unusableStampText(name_, as_sent).c_str());
     return false;
   }
 
@@ -107,7 +101,9 @@ class GuardedActionServer : public actionlib::ActionServerBase<ActionSpec> {
     for (auto it = this->status_list_.begin(); it != this->status_list_.end();) {
       array.status_list.push_back(it->status_);
       const ros::Time& destruction = it->handle_destruction_time_;
-      if (!destruction.isZero() && secondsBetween(now, destruction) > kStatusListTimeout) {
+      const double age =
+          trajectory::secondsBetween({now.sec, now.nsec}, {destruction.sec, destruction.nsec});
+      if (!destruction.isZero() && age > kStatusListTimeout) {
         it = this->status_list_.erase(it);
       } else {
         ++it;

@@ -32,13 +32,9 @@ namespace serial_robot_driver::ros_layer {
 
 using trajectory::TrajectoryJoints;
 
-/// A ROS stamp as the core's trajectories take it (trajectory/message_time.h).
+/// A ROS stamp as the core's trajectories take it (trajectory/message_time.h: steadyStart(),
+/// never ros::Duration, which throws beyond +-68 years).
 trajectory::MessageStamp toMessageStamp(const ros::Time& stamp);
-/// The steady time of a ROS `stamp` (zero: `steady_now`), given the two clocks read together:
-/// trajectory::steadyStart(), never ros::Duration, which throws beyond +-68 years.
-double steadyStart(const ros::Time& stamp, double steady_now, const ros::Time& ros_now);
-/// `later` - `earlier` in seconds, for any two stamps (never throws).
-double secondsBetween(const ros::Time& later, const ros::Time& earlier);
 
 /// A ROS-free command from a JointTrajectory message (stamps are left to the caller).
 trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTrajectory& msg);
