@@ -11,7 +11,6 @@ add_library(srd_dds_front STATIC
   ${srd_device_dds_sources}
   "${CMAKE_BINARY_DIR}/srd_generated/registered_dds_front_ends.cpp"
   src/dds_front/dds_conversions.cpp
-  src/dds_front/dds_device_module.cpp
   src/dds_front/dds_node.cpp
   src/dds_front/run_dds_driver.cpp
   src/dds_front/trajectory_loop.cpp)

@@ -3,10 +3,7 @@
 namespace serial_robot_driver::core {
 
 const DeviceModule* findDevice(const std::string& name) {
-  for (const DeviceModule* device : registeredDevices()) {
-    if (name == device->name) return device;
-  }
-  return nullptr;
+  return findByName(registeredDevices(), name);
 }
 
 protocol::FramerConfig framerFor(const std::vector<const DeviceModule*>& devices,

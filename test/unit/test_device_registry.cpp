@@ -39,6 +39,20 @@ TEST(DeviceRegistry, UniqueNamesTheBaseFirst) {
   EXPECT_EQ(findDevice("no_such_device"), nullptr);
 }
 
+TEST(DeviceRegistry, FindByNameGivesTheFirstOfThatNameOrNull) {
+  struct Named {
+    const char* name;
+  };
+  const Named a{"a"}, b{"b"}, a_again{"a"};
+  EXPECT_EQ(findByName(std::vector<const Named*>{}, "a"), nullptr);
+  const std::vector<const Named*> registry{&a, &b, &a_again};
+  EXPECT_EQ(findByName(registry, "a"), &a);
+  EXPECT_EQ(findByName(registry, "b"), &b);
+  for (const char* other : {"", "A", "a ", "ab"}) {
+    EXPECT_EQ(findByName(registry, other), nullptr) << "'" << other << "'";
+  }
+}
+
 TEST(DeviceRegistry, FrameFamiliesHaveUniqueNames) {
   std::set<std::string> names;
   std::set<const char*> seen;

@@ -68,6 +68,16 @@ std::unique_ptr<Device> makeDevice(const params::DriverParams& params, SerialLin
   return std::make_unique<DeviceClass>(params, link);
 }
 
+/// The module called `name` in `registry`, or null: one lookup for every registry of a device's
+/// sides (its core module here, its ROS and DDS front ends), which name the device alike.
+template <typename Module>
+const Module* findByName(const std::vector<const Module*>& registry, const std::string& name) {
+  for (const Module* module : registry) {
+    if (name == module->name) return module;
+  }
+  return nullptr;
+}
+
 /// The registered devices, in start and shutdown order (cmake/devices.cmake: the base first, so
 /// its zero-speed frame goes out before anything else stops).
 const std::vector<const DeviceModule*>& registeredDevices();

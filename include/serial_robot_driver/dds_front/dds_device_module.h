@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "serial_robot_driver/core/device.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/dds/participant.h"
 #include "serial_robot_driver/params/driver_params.h"
 
@@ -38,6 +39,8 @@ struct DdsDeviceModule {
 /// The registered devices' DDS front ends, in the order of the devices (cmake/devices.cmake).
 const std::vector<const DdsDeviceModule*>& registeredDdsFrontEnds();
 /// The DDS front end of the device called `name`, or null.
-const DdsDeviceModule* findDdsFrontEnd(const std::string& name);
+inline const DdsDeviceModule* findDdsFrontEnd(const std::string& name) {
+  return core::findByName(registeredDdsFrontEnds(), name);
+}
 
 }  // namespace serial_robot_driver::dds_front

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "serial_robot_driver/core/device.h"
+#include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
@@ -34,6 +35,8 @@ struct RosDeviceModule {
 /// The registered devices' ROS sides, in the order of the devices (cmake/devices.cmake).
 const std::vector<const RosDeviceModule*>& registeredInterfaces();
 /// The ROS side of the device called `name`, or null.
-const RosDeviceModule* findInterface(const std::string& name);
+inline const RosDeviceModule* findInterface(const std::string& name) {
+  return core::findByName(registeredInterfaces(), name);
+}
 
 }  // namespace serial_robot_driver::ros_layer
