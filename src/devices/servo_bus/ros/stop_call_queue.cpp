@@ -7,38 +7,23 @@ namespace serial_robot_driver::devices::servo_bus::ros {
 
 namespace {
 
-/// A queued call, counted as waiting from its queuing until it starts (or is dropped unstarted).
+/// A queued call with its ticket in the queue's count of waiting calls.
 class CountedCall : public ::ros::CallbackInterface {
  public:
-  CountedCall(::ros::CallbackInterfacePtr call, std::shared_ptr<std::atomic<int>> waiting)
-      : call_(std::move(call)), waiting_(std::move(waiting)) {
-    waiting_->fetch_add(1);
-  }
-  ~CountedCall() override { started(); }
-  CountedCall(const CountedCall&) = delete;
-  CountedCall& operator=(const CountedCall&) = delete;
+  CountedCall(::ros::CallbackInterfacePtr call, const WaitingCalls& waiting)
+      : call_(std::move(call)), ticket_(waiting.queued()) {}
 
   CallResult call() override {
-    // Started: a motion wait of this very call must not give way to itself.
-    started();
+    ticket_.started();
     const CallResult result = call_->call();
-    if (result == TryAgain) {  // the queue keeps it: waiting again
-      counted_ = true;
-      waiting_->fetch_add(1);
-    }
+    if (result == TryAgain) ticket_.requeued();  // the queue keeps it
     return result;
   }
   bool ready() override { return call_->ready(); }
 
  private:
-  void started() {
-    if (counted_) waiting_->fetch_sub(1);
-    counted_ = false;
-  }
-
   const ::ros::CallbackInterfacePtr call_;
-  const std::shared_ptr<std::atomic<int>> waiting_;
-  bool counted_ = true;  // one thread at a time calls or destroys a queued call
+  WaitingCalls::Ticket ticket_;
 };
 
 }  // namespace

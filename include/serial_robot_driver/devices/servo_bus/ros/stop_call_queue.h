@@ -4,16 +4,16 @@
 // with wait: true) gives way to the stop queued behind it
 // (device::ServoTransactions::setStopCallsQueued).
 //
-// Threading: any thread. waiting() reads an atomic count, so it may be asked under another lock;
-// `on_queued` runs on the thread that queued the call (roscpp's), after the call is in the queue.
+// Threading: any thread (waiting(): WaitingCalls::any()); `on_queued` runs on the thread that
+// queued the call (roscpp's), after the call is in the queue.
 #pragma once
 
 #include <ros/callback_queue.h>
 
-#include <atomic>
 #include <cstdint>
 #include <functional>
-#include <memory>
+
+#include "serial_robot_driver/devices/servo_bus/waiting_calls.h"
 
 namespace serial_robot_driver::devices::servo_bus::ros {
 
@@ -23,12 +23,12 @@ class StopCallQueue : public ::ros::CallbackQueue {
 
   void addCallback(const ::ros::CallbackInterfacePtr& callback, uint64_t removal_id = 0) override;
   /// Whether a call waits in the queue (queued, not started yet).
-  bool waiting() const { return waiting_->load() > 0; }
+  bool waiting() const { return waiting_.any(); }
 
  private:
   const std::function<void()> on_queued_;
-  // Shared with the queued calls: the base class destroys those after this class's members.
-  std::shared_ptr<std::atomic<int>> waiting_ = std::make_shared<std::atomic<int>>(0);
+  // The queued calls' tickets outlive it: the base class destroys the calls after our members.
+  WaitingCalls waiting_;
 };
 
 }  // namespace serial_robot_driver::devices::servo_bus::ros
