@@ -1,19 +1,16 @@
 #include "serial_robot_driver/ros/conversions.h"
 
-#include <algorithm>
-
 #include "serial_robot_driver/core/wall_stamps.h"
 
 namespace serial_robot_driver::ros_layer {
 
 ros::Time toRosTime(std::chrono::steady_clock::time_point event, const ros::Time& ros_now,
                     std::chrono::steady_clock::time_point steady_now) {
-  const auto age = std::chrono::duration_cast<std::chrono::nanoseconds>(steady_now - event);
-  const ros::Duration age_ros(std::chrono::duration<double>(age).count());
-  // An event "in the future" (clock read order) is now; one before the epoch is the epoch.
-  if (age_ros <= ros::Duration(0)) return ros_now;
-  if (ros_now.toSec() <= age_ros.toSec()) return ros::Time(0);
-  return ros_now - age_ros;
+  // core::wallTimeOf() on the ROS clock (which may be simulated) instead of the wall clock.
+  const std::chrono::system_clock::time_point now{std::chrono::nanoseconds(ros_now.toNSec())};
+  ros::Time stamp;
+  stamp.fromNSec(static_cast<uint64_t>(core::wallTimeOf(event, now, steady_now).count()));
+  return stamp;
 }
 
 ros::Time toRosTime(std::chrono::steady_clock::time_point event) {
