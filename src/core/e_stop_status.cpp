@@ -11,8 +11,8 @@ StatusReport eStopStatus(const EStopStats& stats) {
   } else {
     status.summary(StatusLevel::kOk, "released");
   }
-  status.add("engaged", stats.engaged);
-  status.add("engagements", stats.engagements);
+  status.add(kEStopEngagedKey, stats.engaged);
+  status.add(kEStopEngagementsKey, stats.engagements);
   uint64_t refused = 0;
   for (const auto& [source, count] : stats.refused) {
     status.add("refused: " + source, count);

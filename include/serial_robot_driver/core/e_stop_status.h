@@ -7,6 +7,10 @@
 
 namespace serial_robot_driver::core {
 
+/// The keys of the values a client of the status reads back (calibrate_base).
+inline constexpr const char* kEStopEngagedKey = "engaged";          ///< "True" or "False"
+inline constexpr const char* kEStopEngagementsKey = "engagements";  ///< a count
+
 /// WARN while engaged, else OK "released".
 StatusReport eStopStatus(const EStopStats& stats);
 

@@ -30,6 +30,14 @@ std::string stopSignalMessage(int signal_number) {
   return signal_number == SIGINT ? "interrupted (SIGINT)" : "terminated";
 }
 
+std::string noCalibrationDriverText(int stop_signal, bool ros_ok, const std::string& topic) {
+  if (stop_signal != 0) return stopSignalMessage(stop_signal);
+  if (!ros_ok) return "ROS shut down";
+  return "no driver publishes " + topic +
+         ": start it first (roslaunch serial_robot_driver sim.launch), or run the tool in its "
+         "namespace (ROS_NAMESPACE=...)";
+}
+
 ParsedCalibrationOptions parseCalibrationOptions(const std::vector<std::string>& args) {
   ParsedCalibrationOptions parsed;
   CalibrationOptions options;

@@ -2,9 +2,21 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 
+#include "serial_robot_driver/core/e_stop_status.h"
+
 namespace serial_robot_driver::devices::base {
+
+void printCalibrationLines(const std::vector<CalibrationLine>& lines, std::ostream& out,
+                           std::ostream& err) {
+  for (const CalibrationLine& line : lines) {
+    if (line.stream == CalibrationLine::Stream::kErr) err << line.text << std::endl;
+    if (line.stream == CalibrationLine::Stream::kOut) out << line.text << std::endl;
+    if (line.stream == CalibrationLine::Stream::kPrompt) out << line.text << std::flush;
+  }
+}
 
 namespace {
 
@@ -65,6 +77,13 @@ void TurnCalibrationRun::setEStopEngaged(bool engaged) {
 }
 
 void TurnCalibrationRun::setEStopEngagements(uint64_t count) { engagements_ = count; }
+
+void TurnCalibrationRun::setEStopStatusValue(const std::string& key, const std::string& value) {
+  if (key == core::kEStopEngagedKey) setEStopEngaged(value == "True");
+  if (key == core::kEStopEngagementsKey) {
+    setEStopEngagements(std::strtoull(value.c_str(), nullptr, 10));
+  }
+}
 
 bool TurnCalibrationRun::eStopEngagedSinceCheck() const {
   return e_stop_engaged_since_check_ ||

@@ -35,6 +35,10 @@ struct ParsedCalibrationOptions {
 /// 128 + the signal's number.
 std::string stopSignalMessage(int signal_number);
 
+/// Why no driver to calibrate was found on `topic` (wheel_command): the signal that ended the
+/// search, ROS shutting down (`ros_ok` false), or none publishing it.
+std::string noCalibrationDriverText(int stop_signal, bool ros_ok, const std::string& topic);
+
 /// Parses the arguments after the program's name, once ros::init removed the ROS remappings.
 ParsedCalibrationOptions parseCalibrationOptions(const std::vector<std::string>& args);
 

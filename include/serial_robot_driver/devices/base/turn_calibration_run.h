@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,11 @@ struct CalibrationLine {
   Stream stream = Stream::kOut;
   std::string text;
 };
+
+/// Shows `lines` as the tool does: kOut on `out` and kErr on `err`, each a line (std::endl), and
+/// kPrompt on `out` without a newline, flushed.
+void printCalibrationLines(const std::vector<CalibrationLine>& lines, std::ostream& out,
+                           std::ostream& err);
 
 /// The answer to a step.
 struct CalibrationStep {
@@ -71,6 +77,9 @@ class TurnCalibrationRun {
   /// The driver's count of e-stop engagements (its e_stop status): a rise after the check is an
   /// engagement the topic did not show (published before the tool subscribed, say).
   void setEStopEngagements(uint64_t count);
+  /// One value of the driver's e_stop status (core::eStopStatus()): its engaged state or its
+  /// count of engagements, as above; other values say nothing here.
+  void setEStopStatusValue(const std::string& key, const std::string& value);
   /// The distance the user typed; unset when none could be read.
   void setMeasuredDistance(std::optional<double> metres);
   /// An error outside the run (ROS): aborts, stopping the base if it may have moved.

@@ -34,6 +34,7 @@ struct FakeRobot {
   /// driver's count shows).
   bool e_stop_visible = true;
   uint64_t engagements = 0;              ///< the driver's count of engagements (its e_stop status)
+  bool status_values = false;  ///< the tool reads both as the e_stop status's values (text)
   bool telemetry = true;                 ///< IMU samples arrive
   bool frames = true;                    ///< the driver writes wheel frames
   bool ignores_zero = false;             ///< a wedged driver: keeps writing the last moving frame
@@ -67,6 +68,12 @@ struct FakeRobot {
     }
     if (e_stop && !was_engaged_) ++engagements;
     was_engaged_ = e_stop;
+    if (status_values) {  // as the status says them on /diagnostics, among others
+      run.setEStopStatusValue("engaged", e_stop && e_stop_visible ? "True" : "False");
+      run.setEStopStatusValue("commands refused", "7");
+      run.setEStopStatusValue("engagements", std::to_string(engagements));
+      return;
+    }
     run.setEStopEngaged(e_stop && e_stop_visible);
     run.setEStopEngagements(engagements);
   }

@@ -6,6 +6,7 @@
 
 #include <csignal>
 #include <regex>
+#include <sstream>
 
 #include "calibration_fake_robot.h"
 #include "serial_robot_driver/devices/base/turn_calibration_options.h"
@@ -14,7 +15,9 @@ namespace {
 
 using namespace calibration_test;
 using serial_robot_driver::devices::base::CalibrationOptions;
+using serial_robot_driver::devices::base::noCalibrationDriverText;
 using serial_robot_driver::devices::base::parseCalibrationOptions;
+using serial_robot_driver::devices::base::printCalibrationLines;
 
 constexpr double kEffectiveSeparation = 0.40 / 0.85;  // slip 0.15
 
@@ -314,6 +317,54 @@ TEST(TurnCalibrationRun, RefusedWithTheEStopEngagedBeforeMoving) {
       << outcome.err;
   EXPECT_FALSE(contains(outcome.out, "turning"));
   EXPECT_FALSE(outcome.anyMovingCommandFrom(0));
+}
+
+// The driver's e_stop status, as its values read on /diagnostics: "engaged" refuses the run, a
+// rise of "engagements" ends it.
+TEST(TurnCalibrationRun, TheEStopStatusValuesSayTheEStop) {
+  FakeRobot engaged;
+  engaged.status_values = true;
+  engaged.e_stop = true;
+  auto run = makeRun();
+  Outcome outcome = runToEnd(run, engaged);
+  EXPECT_EQ(outcome.exit_status, 1);
+  EXPECT_TRUE(contains(outcome.err, "calibrate_base: refused: the e-stop is engaged"))
+      << outcome.err;
+  EXPECT_FALSE(outcome.anyMovingCommandFrom(0));
+
+  FakeRobot counted;
+  counted.status_values = true;
+  counted.e_stop_visible = false;
+  counted.engagements = 4294967296;  // beyond 32 bits
+  MidTurn mid;
+  mid.act = [](FakeRobot& r) { ++r.engagements; };
+  auto second = makeRun();
+  outcome = runToEnd(second, counted, mid.script());
+  ASSERT_GE(mid.at, 0) << "released: the run moved";
+  EXPECT_EQ(outcome.exit_status, 1);
+  EXPECT_TRUE(contains(outcome.err, "calibrate_base: aborted: the e-stop engaged")) << outcome.err;
+  expectStoppedAtOnce(outcome, mid.at);
+}
+
+TEST(TurnCalibrationRun, LinesGoToTheirStreams) {
+  std::ostringstream out, err;
+  printCalibrationLines({{CalibrationLine::Stream::kOut, "a"},
+                         {CalibrationLine::Stream::kErr, "b"},
+                         {CalibrationLine::Stream::kPrompt, "c? "},
+                         {CalibrationLine::Stream::kOut, ""}},
+                        out, err);
+  EXPECT_EQ(out.str(), "a\nc? \n");
+  EXPECT_EQ(err.str(), "b\n");
+}
+
+TEST(TurnCalibrationRun, WhyNoDriverWasFound) {
+  EXPECT_EQ(noCalibrationDriverText(SIGINT, false, "/w"), "interrupted (SIGINT)");
+  EXPECT_EQ(noCalibrationDriverText(SIGTERM, true, "/w"), "terminated");
+  EXPECT_EQ(noCalibrationDriverText(0, false, "/w"), "ROS shut down");
+  EXPECT_EQ(
+      noCalibrationDriverText(0, true, "/robot1/wheel_command"),
+      "no driver publishes /robot1/wheel_command: start it first (roslaunch "
+      "serial_robot_driver sim.launch), or run the tool in its namespace (ROS_NAMESPACE=...)");
 }
 
 TEST(TurnCalibrationRun, RefusedWithoutTelemetryBeforeMoving) {

@@ -5,8 +5,6 @@
 #include <sensor_msgs/Imu.h>
 #include <std_msgs/Bool.h>
 
-#include <cstdlib>
-
 #include "serial_robot_driver/WheelCommand.h"
 
 namespace serial_robot_driver::devices::base::ros {
@@ -31,11 +29,7 @@ std::optional<std::string> findCalibrationDriver(const std::string& named,
       if (payload[0][i][1].size() == 1) return std::string(payload[0][i][1][0]);
     }
   }
-  *why = stop_signal != 0 ? stopSignalMessage(stop_signal)
-         : !::ros::ok()   ? "ROS shut down"
-                          : "no driver publishes " + topic +
-                              ": start it first (roslaunch serial_robot_driver sim.launch), or run "
-                              "the tool in its namespace (ROS_NAMESPACE=...)";
+  *why = noCalibrationDriverText(stop_signal, ::ros::ok(), topic);
   return std::nullopt;
 }
 
@@ -54,12 +48,7 @@ CalibrationTopics::CalibrationTopics(TurnCalibrationRun& run) {
       [&run, name = run.eStopStatusName()](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
         for (const auto& status : msg->status) {
           if (status.name != name) continue;
-          for (const auto& value : status.values) {
-            if (value.key == "engaged") run.setEStopEngaged(value.value == "True");
-            if (value.key == "engagements") {
-              run.setEStopEngagements(std::strtoull(value.value.c_str(), nullptr, 10));
-            }
-          }
+          for (const auto& value : status.values) run.setEStopStatusValue(value.key, value.value);
         }
       });
   // The driver's own input: every engagement published on it, however short (the once-a-second

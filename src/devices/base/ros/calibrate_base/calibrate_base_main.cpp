@@ -26,14 +26,6 @@ using serial_robot_driver::devices::base::ros::CalibrationTopics;
 std::atomic<int> g_signal{0};
 void onSignal(int signal_number) { g_signal = signal_number; }
 
-void print(const std::vector<CalibrationLine>& lines) {
-  for (const CalibrationLine& line : lines) {
-    if (line.stream == CalibrationLine::Stream::kErr) std::cerr << line.text << std::endl;
-    if (line.stream == CalibrationLine::Stream::kOut) std::cout << line.text << std::endl;
-    if (line.stream == CalibrationLine::Stream::kPrompt) std::cout << line.text << std::flush;
-  }
-}
-
 /// Steps the run to its end with what arrived; its exit status.
 int spinRun(TurnCalibrationRun& run) {
   CalibrationTopics topics(run);
@@ -50,7 +42,7 @@ int spinRun(TurnCalibrationRun& run) {
     const CalibrationStep step =
         run.step({::ros::WallTime::now().toSec(), ::ros::Time::now().toSec(), g_signal.exchange(0),
                   ::ros::ok(), topics.commandSubscribed()});
-    print(step.lines);
+    printCalibrationLines(step.lines, std::cout, std::cerr);
     if (step.command) guarded([&] { topics.command(*step.command); });
     if (step.finished) return step.exit_status;
     if (step.wants_measured_distance) {
