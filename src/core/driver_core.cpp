@@ -69,6 +69,7 @@ SerialLinkOptions DriverCore::linkOptions(const std::string& path,
   // validate() made every device on a shared port agree on the baud rate.
   options.baud = static_cast<unsigned>(params_.baudOf(*users.front()));
   options.reconnect_interval = params_.reconnect_interval;
+  options.realtime_priority = params_.realtime_priority;
   options.framer = framerFor(users, params_);
   for (const DeviceModule* device : users) {
     if (!device->stale_frame_timeout) continue;
@@ -133,6 +134,8 @@ std::vector<Device*> DriverCore::devicePointers() const {
 }
 
 void DriverCore::start() {
+  // Before any thread that takes the priority starts: their stacks are locked with the rest.
+  realtime_ = prepareRealtime(params_.realtime_priority);
   for (auto& [path, link] : ports_) link->start();
   for (auto& device : devices_) device->start();
 }

@@ -162,6 +162,12 @@ void DriverNode::onEStop(const std_msgs::Bool::ConstPtr& msg) {
 
 void DriverNode::start() {
   core_->start();
+  const core::RealtimeStatus& realtime = core_->realtime();
+  if (realtime.refused) {
+    ROS_WARN("%s", realtime.message.c_str());
+  } else if (!realtime.message.empty()) {
+    ROS_INFO("%s", realtime.message.c_str());
+  }
   if (trajectory_) trajectory_->start();
   ROS_INFO("%s; diagnostics every %g s", core_->startupSummary().c_str(), diagnostics_period_);
 }

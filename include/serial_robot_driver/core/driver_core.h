@@ -15,6 +15,7 @@
 #include "serial_robot_driver/core/device.h"
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/core/e_stop.h"
+#include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/trajectory/executor.h"
@@ -38,8 +39,11 @@ class DriverCore {
   DriverCore(const DriverCore&) = delete;
   DriverCore& operator=(const DriverCore&) = delete;
 
-  /// Starts the ports, then the devices.
+  /// Locks the memory and checks SCHED_FIFO for ~realtime_priority (core/realtime.h), then starts
+  /// the ports, then the devices.
   void start();
+  /// What start() found of ~realtime_priority: the front end logs its message once.
+  const RealtimeStatus& realtime() const { return realtime_; }
   /// Shuts the devices down in order (the base first, its last words while the port is still
   /// open), then stops the ports. Idempotent.
   void shutdown();
@@ -82,6 +86,7 @@ class DriverCore {
   std::vector<std::unique_ptr<Device>> devices_;
   std::vector<std::string> device_names_;
   bool shut_down_ = false;
+  RealtimeStatus realtime_;
 };
 
 }  // namespace serial_robot_driver::core
