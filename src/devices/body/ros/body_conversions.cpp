@@ -24,12 +24,15 @@ geometry_msgs::Quaternion toQuaternion(const Quaternion& q) {
 sensor_msgs::JointState toJointState(const Telemetry& telemetry,
                                      const std::vector<BodyJoint>& joints,
                                      const ::ros::Time& stamp) {
-  JointReadings readings = jointReadings(telemetry, joints);
+  return toJointState(jointReadings(telemetry, joints), stamp);
+}
+
+sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros::Time& stamp) {
   sensor_msgs::JointState msg;
   msg.header.stamp = stamp;
-  msg.name = std::move(readings.names);
-  msg.position = std::move(readings.positions);
-  msg.velocity = std::move(readings.velocities);
+  msg.name = readings.names;
+  msg.position = readings.positions;
+  msg.velocity = readings.velocities;
   return msg;
 }
 

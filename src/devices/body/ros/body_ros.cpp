@@ -10,6 +10,7 @@
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 
 namespace serial_robot_driver::devices::body::ros {
 
@@ -112,16 +113,18 @@ void BodyRos::publishTelemetry(const Telemetry& telemetry, core::Clock::time_poi
   telemetry_rate_.tick();
   const ::ros::Time stamp = arrival_stamps_(arrival);
   const auto& joints = controller_.joints();
-  // The trajectory server needs every frame: its goals are checked against it.
-  const auto joint_state =
-      boost::make_shared<sensor_msgs::JointState>(toJointState(telemetry, joints, stamp));
+  // Converted once per frame for every consumer, into vectors that keep their capacity. The
+  // trajectories need every frame: their goals are checked against it.
+  updateJointReadings(telemetry, joints, &joint_readings_);
   if (trajectory_) {
-    trajectory_->updateActual(joint_state->name, joint_state->position, joint_state->velocity);
+    trajectory_->updateActual(joint_readings_.names, joint_readings_.positions,
+                              joint_readings_.velocities);
   }
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
-  // gets this very message, not a serialized copy.
-  if (joint_states_pub_.getNumSubscribers() > 0) {
-    joint_states_pub_.publish(joint_state);
+  // gets this very message, not a serialized copy (so each is a message of its own).
+  if (ros_layer::wanted(joint_states_pub_)) {
+    joint_states_pub_.publish(
+        boost::make_shared<sensor_msgs::JointState>(toJointState(joint_readings_, stamp)));
   }
   const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
   if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);
@@ -130,14 +133,14 @@ void BodyRos::publishTelemetry(const Telemetry& telemetry, core::Clock::time_poi
       {static_cast<double>(telemetry.imu[kGyroX]), static_cast<double>(telemetry.imu[kGyroY]),
        static_cast<double>(telemetry.imu[kGyroZ])},
       arrival, gyroUnits(*imu), imu->calibration_time);
-  if (imu_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(imu_pub_)) {
     imu_pub_.publish(
         boost::make_shared<sensor_msgs::Imu>(toImu(telemetry, *imu, stamp, gyro_bias)));
   }
-  if (foot_pressure_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(foot_pressure_pub_)) {
     if (auto foot = toFootPressure(telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }
-  if (telemetry_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(telemetry_pub_)) {
     telemetry_pub_.publish(toTelemetryMsg(telemetry, joints, stamp));
   }
 }

@@ -7,6 +7,7 @@
 
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 
 namespace serial_robot_driver::devices::servo_bus::ros {
 
@@ -49,12 +50,12 @@ ServoBusEvents ServoBusRos::makeEvents() {
   ServoBusEvents events;
   // On the bus worker thread.
   events.on_angle = [this](const ServoAngleSample& sample) {
+    trajectory::TrajectoryExecutor* trajectories = claims_.trajectories();
+    if (!trajectories && !ros_layer::wanted(states_pub_)) return;  // nobody asked for it
     const sensor_msgs::JointState msg = busJointState(bus_joints_, sample.id, sample.angle_deg,
                                                       ros_layer::toRosTime(sample.arrival));
-    states_pub_.publish(msg);
-    if (trajectory::TrajectoryExecutor* trajectories = claims_.trajectories()) {
-      trajectories->updateActual(msg.name, msg.position, msg.velocity);
-    }
+    if (ros_layer::wanted(states_pub_)) states_pub_.publish(msg);
+    if (trajectories) trajectories->updateActual(msg.name, msg.position, msg.velocity);
   };
   events.on_servo_silent = [](uint8_t id, const ServoStatus& status,
                               std::chrono::milliseconds backoff) {

@@ -6,9 +6,9 @@
 #pragma once
 
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include <memory>
 
@@ -46,6 +46,9 @@ class BaseRos : public ros_layer::DeviceInterface {
   BaseEvents events();
   void onCmdVel(const geometry_msgs::Twist::ConstPtr& msg);
   void publishOdometry(const OdometrySample& sample);
+  /// odom's pose as odom -> base_link on /tf.
+  void publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample);
+  static ::ros::Publisher advertiseTf();
   void publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp);
   bool onResetOdometry(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
@@ -60,7 +63,7 @@ class BaseRos : public ros_layer::DeviceInterface {
   std::shared_ptr<const BaseParams> tuned() const { return std::atomic_load(&tuned_); }
   std::shared_ptr<const BaseParams> tuned_;
   // Before the controller: its loop publishes through them until it stops.
-  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
+  ::ros::Publisher tf_pub_;  // /tf; advertised by the loop thread when first needed
   ::ros::Publisher odom_pub_;
   ::ros::Publisher wheel_states_pub_;  // advertised in the constructor's body
   BaseController controller_;

@@ -15,6 +15,7 @@
 
 #include "serial_robot_driver/core/event_rate.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/devices/body/body_readings.h"
 #include "serial_robot_driver/devices/body/body_status.h"
 #include "serial_robot_driver/devices/body/gyro_bias.h"
 #include "serial_robot_driver/ros/conversions.h"
@@ -86,6 +87,8 @@ class BodyRos : public ros_layer::DeviceInterface {
   GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   BodyController controller_;
   core::EventRate telemetry_rate_;  // ticked on the reader thread (locks)
+  JointReadings joint_readings_;    // reader thread only: each frame's, reused
+
   ::ros::Publisher joint_states_pub_;
   ::ros::Publisher imu_pub_;
   ::ros::Publisher foot_pressure_pub_;
