@@ -16,6 +16,7 @@ catkin_add_gtest(core_tests
   test/unit/test_transport_baud_and_lock.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_serial_link.cpp
+  test/unit/test_realtime.cpp
   test/unit/test_sim_device_models.cpp
   test/unit/test_sim_pty_devices.cpp
   test/unit/test_sim_whole_robot.cpp

@@ -67,7 +67,8 @@ std::unique_ptr<BagReplay> openReplay(DriverParams& params,
 
 /// Starts `node` (and the replay's clock) and serves it until a stop is asked for or the replay
 /// ends, then shuts it down.
-void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_signals) {
+void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_signals,
+                     int realtime_priority) {
   if (replay) {
     std::this_thread::sleep_for(kReplaySettle);
     replay->startClock();
@@ -75,8 +76,9 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_s
   node.start();
   // Global queue: cmd_vel, joint_commands, base services and the diagnostics timer. None of them
   // waits on the wire (servo/* services have their own queue), so one thread keeps up. Unlike
-  // ros::AsyncSpinner it does not wake every 100 ms while the node is idle.
-  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1);
+  // ros::AsyncSpinner it does not wake every 100 ms while the node is idle. On the way of a command
+  // to the wire, so at ~realtime_priority too.
+  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1, realtime_priority);
   spinner.start();
   const bool replay_done = waitForStopRequest(
       stop_signals,
@@ -122,7 +124,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
     return 1;
   }
   DriverNode node(nh, private_nh, params, stream_factory);
-  runUntilStopped(node, replay.get(), stop_signals);
+  runUntilStopped(node, replay.get(), stop_signals, params.realtime_priority);
   ros::shutdown();
   return 0;
 }

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "serial_robot_driver/core/realtime.h"
+
 namespace serial_robot_driver::devices::base {
 
 using kinematics::WheelSpeeds;
@@ -154,7 +156,11 @@ bool BaseController::sendClearEncoders() {
 
 void BaseController::start() {
   if (loop_.joinable()) return;
-  loop_ = std::thread([this] { run(); });
+  const int priority = config_.realtime_priority;  // not tunable: read before the thread runs
+  loop_ = std::thread([this, priority] {
+    core::enterRealtime(priority);  // refused: the loop runs at the normal policy
+    run();
+  });
 }
 
 void BaseController::stop() {

@@ -48,8 +48,10 @@ std::string BodyDevice::notStill() const {
 void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival) {
   // On the link's reader thread.
   telemetry_rate_.tick();
-  const JointReadings joints = jointReadings(telemetry, controller_.joints());
-  // The trajectories need every frame: their goals are checked against it.
+  // Converted once per frame for every consumer, into vectors that keep their capacity. The
+  // trajectories need every frame: their goals are checked against it.
+  updateJointReadings(telemetry, controller_.joints(), &joint_readings_);
+  const JointReadings& joints = joint_readings_;
   if (trajectory_) trajectory_->updateActual(joints.names, joints.positions, joints.velocities);
   const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
   if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);

@@ -3,7 +3,8 @@
 // ROS-free: the ROS layer feeds commands in and publishes the events it reports.
 //
 // Threading model:
-//  - start() runs the control loop on its own thread: absolute deadlines on the LoopClock (the
+//  - start() runs the control loop on its own thread (SCHED_FIFO with config.realtime_priority,
+//    where the process may): absolute deadlines on the LoopClock (the
 //    steady clock unless a test passes its own) (deadline += period, never "sleep one period"), so
 //    the period does not drift. Each tick writes
 //    the current wheel frame, which is also the heartbeat.
@@ -78,6 +79,8 @@ struct BaseConfig : BaseTuning {
   /// rad^2, odom's yaw variance while the IMU heading is used (until setImuYawVariance()).
   double imu_yaw_variance = 0.0003;
   core::Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
+  /// The loop thread's SCHED_FIFO priority (core/realtime.h: ~realtime_priority); 0: normal.
+  int realtime_priority = 0;
 };
 
 /// Where the odometry stood after a scheduled tick.

@@ -121,6 +121,7 @@ class BodyDevice : public core::Device {
   core::LogThrottle command_log_{1.0};
   GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   core::EventRate telemetry_rate_;      // ticked on the reader thread (locks)
+  JointReadings joint_readings_;        // reader thread only: each frame's, reused
   BodyStatus status_;                   // diagnostics thread only
   BodyController controller_;           // last: its frames use the members above
 };

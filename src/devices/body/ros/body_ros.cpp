@@ -9,6 +9,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 #include "serial_robot_driver/ros/trigger_service.h"
 
 namespace serial_robot_driver::devices::body::ros {
@@ -60,19 +61,19 @@ void BodyRos::publishFrame(const BodyFrame& frame) {
   // subscribes to is not even built: at hundreds of frames per second that is most of the CPU.
   const ::ros::Time stamp = arrival_stamps_(frame.arrival);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
-  // gets this very message, not a serialized copy.
-  if (joint_states_pub_.getNumSubscribers() > 0) {
+  // gets this very message, not a serialized copy (so each is a message of its own).
+  if (ros_layer::wanted(joint_states_pub_)) {
     joint_states_pub_.publish(
         boost::make_shared<sensor_msgs::JointState>(toJointState(frame.joints, stamp)));
   }
-  if (imu_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(imu_pub_)) {
     imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(
         toImu(frame.telemetry, frame.imu, stamp, frame.gyro_bias)));
   }
-  if (foot_pressure_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(foot_pressure_pub_)) {
     if (auto foot = toFootPressure(frame.telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }
-  if (telemetry_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(telemetry_pub_)) {
     telemetry_pub_.publish(toTelemetryMsg(frame.telemetry, device_.controller().joints(), stamp));
   }
 }

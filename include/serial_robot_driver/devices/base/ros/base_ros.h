@@ -5,9 +5,9 @@
 #pragma once
 
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include <memory>
 
@@ -28,11 +28,14 @@ class BaseRos : public ros_layer::DeviceFrontEnd {
   BaseOutputs outputs();
   void publishWheelCommand(const WheelFrameSent& sent);
   void publishOdometry(const OdometrySample& sample);
+  /// odom's pose as odom -> base_link on /tf.
+  void publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample);
+  static ::ros::Publisher advertiseTf();
   void publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp);
 
   BaseDevice& device_;
   ros_layer::ArrivalStamps arrival_stamps_;
-  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
+  ::ros::Publisher tf_pub_;  // /tf; advertised by the loop thread when first needed
   ::ros::Publisher odom_pub_;
   ::ros::Publisher wheel_states_pub_;
   ::ros::Publisher wheel_command_pub_;
