@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <netinet/in.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
@@ -145,7 +146,10 @@ ChildProcess::ChildProcess(std::string label, std::vector<std::string> argv,
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error("fork failed: " + std::string(std::strerror(errno)));
   if (pid == 0) {
-    // Child: own process group (so the whole tree can be signalled), dies with the benchmark.
+    // Child: the normal policy even when the benchmark's threads run SCHED_FIFO; its own
+    // process group (so the whole tree can be signalled); dies with the benchmark.
+    const sched_param normal{};
+    ::sched_setscheduler(0, SCHED_OTHER, &normal);
     ::setpgid(0, 0);
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != parent) ::_exit(127);

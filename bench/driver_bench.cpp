@@ -10,19 +10,27 @@
 //  6. servo/read round trip (new connection per call and persistent), wheel loop under service
 //  stress
 //  7. 1, 4 and 5 again with polling_driver_node (the same node reading every 20 ms), and the ratios
-//  8. driver_node against floor_node (bench/floor_node.cpp, the least a roscpp driver must do):
-//     cmd_vel latency, telemetry latency, CPU at 100 Hz telemetry and idle loop jitter, the two
-//     processes' runs alternated in rounds, and the ratios node / floor
+//  8. the configuration users run (every default device, 20 body servos at 100 Hz, the topics a
+//     user subscribes) against floor_node (bench/floor_node.cpp, the least a roscpp driver must
+//     do), side by side, quiet and under a CPU hog per core, ~realtime_priority off and on: CPU,
+//     cmd_vel latency, telemetry latency, loop jitter, and the ratios node / floor
 //  9. ~capture on vs off: base loop period and CPU (2, 3), telemetry -> joint_states and CPU (4),
 //     with a subscriber on serial_raw as rosbag record would be
 // 10. the servo bus at the wire's pace: READ_ANGLE transactions per second and CPU per
 //     transaction of servo_states (20 servos) against servo_floor (bench/servo_floor.cpp, one
 //     blocking request/answer loop), on robot_sim at pty speed and paced at 115200 baud; and how
 //     closely the paced robot_sim keeps to the line's time
+// 11. (not run by default) the earlier comparison with the floor: each device alone, one
+//     subscriber (joint_states), idle loop; kept to show how far that differs from section 8
 // Run it through bench/run_benchmarks.sh; `driver_bench --help` lists the knobs.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sched.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,6 +39,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -77,19 +86,27 @@ struct Options {
   std::vector<double> rates{100, 200, 500, 1000, 2000, 5000};
   std::size_t service_calls = 200;  ///< 6: calls timed per client kind
   double stress_seconds = 5;        ///< 6: idle and stress windows of the wheel loop
-  std::size_t floor_rounds = 2;     ///< 8: alternated node/floor rounds
+  std::size_t floor_rounds = 1;     ///< 8, 11: node/floor rounds
   double bus_seconds = 5;           ///< 10: window of each servo bus run
+  std::string realtime_priority = "50";  ///< 8: ~realtime_priority when RT is on
+  int bench_priority = 90;               ///< SCHED_FIFO of this process's threads; 0: normal
 
   bool runs(int section) const { return sections.count(section) > 0; }
 };
 
 const char* const kUsage = R"(usage: driver_bench [options]
   --long                  longer runs (5000 commands, 120 s loop window, 6000 frames, ...)
-  --sections 1,2,...      run only these sections (7 repeats those of 1, 4, 5 that run;
-                          8 compares driver_node with floor_node, runs alternated;
-                          9 repeats 2, 3, 4 with ~capture, and runs 2-4 without it if
-                          they did not run)
-  --floor-rounds N        8: alternated node/floor rounds (default 2)
+  --sections 1,2,...      run only these sections (default 1-10; 7 repeats those of 1, 4, 5
+                          that run; 8 compares driver_node in the configuration users run
+                          with floor_node, quiet and loaded, RT off and on; 9 repeats 2, 3,
+                          4 with ~capture, and runs 2-4 without it if they did not run;
+                          11 is the earlier per-device comparison with floor_node)
+  --floor-rounds N        8, 11: node/floor rounds, each with its share of the frames and
+                          commands (default 1)
+  --realtime-priority V   8: the ~realtime_priority given for "RT on" (default 50; "true"
+                          passes a bool)
+  --bench-priority N      SCHED_FIFO priority of this benchmark's own threads, so a load
+                          delays the node, not the measuring (default 90; 0: normal)
   --bus-seconds S         10: window of each servo bus run (default 5)
   --output FILE           also write the results (Markdown) to FILE
   --bin-dir DIR           where driver_node and robot_sim are (default: next to driver_bench)
@@ -108,7 +125,7 @@ std::set<int> parseSections(const std::string& text) {
   std::string item;
   while (std::getline(stream, item, ',')) {
     const int section = std::stoi(item);
-    if (section < 1 || section > 10) throw std::invalid_argument("no section " + item);
+    if (section < 1 || section > 11) throw std::invalid_argument("no section " + item);
     sections.insert(section);
   }
   return sections;
@@ -158,6 +175,10 @@ Options parseOptions(int argc, char** argv) {
       options.service_calls = std::stoul(value);
     } else if (flag == "--floor-rounds") {
       options.floor_rounds = std::max<std::size_t>(1, std::stoul(value));
+    } else if (flag == "--realtime-priority") {
+      options.realtime_priority = value;
+    } else if (flag == "--bench-priority") {
+      options.bench_priority = std::stoi(value);
     } else if (flag == "--bus-seconds") {
       options.bus_seconds = std::stod(value);
     } else if (flag == "--stress-seconds") {
@@ -181,7 +202,7 @@ struct Variant {
   std::string tag;  ///< part of the node namespace
   std::string program;
   double read_poll_interval;    ///< 0: event-driven
-  bool spaced_cmd_vel = false;  ///< section 8: commands 10-40 ms apart instead of one per tick
+  bool spaced_cmd_vel = false;  ///< section 11: commands 10-40 ms apart instead of one per tick
   bool capture = false;         ///< ~capture on, with a subscriber on serial_raw
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
@@ -195,6 +216,7 @@ struct Context {
   ros::NodeHandle nh;
   ResultTable results;
   std::size_t failures = 0;  ///< measurements that could not complete
+  int bench_priority = 0;    ///< SCHED_FIFO priority this process's threads run at; 0: normal
 };
 
 void require(bool condition, const std::string& what) {
@@ -376,9 +398,9 @@ LatencyResult timeCmdVel(ros::Publisher& publisher, const SpeedFrameLog& log,
   return latencyResult(samples_ms, measured);
 }
 
-/// Section 8: cmd_vel commands 10-40 ms apart (uniform, fixed seed), not aligned with the loop,
-/// each timed to the first speed frame carrying its ticks. A command overtaken by the next one
-/// before any frame carries it counts as lost.
+/// Sections 8 and 11: cmd_vel commands 10-40 ms apart (uniform, fixed seed), not aligned with the
+/// loop, each timed to the first speed frame carrying its ticks. A command overtaken by the next
+/// one before any frame carries it counts as lost.
 LatencyResult timeCmdVelSpaced(ros::Publisher& publisher, const SpeedFrameLog& log,
                                std::size_t commands) {
   constexpr std::size_t kWarmUp = 20;
@@ -521,6 +543,13 @@ class TelemetryProbe {
     return true;
   }
 
+  /// Writes another device's frame under the same lock, so it never lands inside a telemetry
+  /// frame written from another thread.
+  bool writeOther(sim::PseudoTerminal& pty, const std::vector<uint8_t>& frame) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return writeFrameOrDrop(pty, frame);
+  }
+
   std::size_t delivered(uint32_t begin, uint32_t end) const {
     std::lock_guard<std::mutex> lock(mutex_);
     std::size_t count = 0;
@@ -610,6 +639,21 @@ struct TelemetrySessionResult {
   std::optional<double> max_rate_hz;  ///< highest step with >= 99.9 % delivered
 };
 
+/// Writes frames 0, 1, ... at 50 Hz (at most `frames`) until the node is connected, publishing,
+/// and the probe's subscriber is attached; `log` is named in the error when it never is.
+void warmUpTelemetry(TelemetryProbe& probe, sim::PseudoTerminal& pty, uint32_t frames,
+                     const std::string& log) {
+  uint32_t seq = 0;
+  const Clock::time_point give_up = Clock::now() + 30s;
+  while (probe.delivered(0, seq) == 0 && Clock::now() < give_up && !stopRequested() &&
+         seq < frames) {
+    probe.write(pty, seq++);
+    std::this_thread::sleep_for(20ms);
+  }
+  require(probe.delivered(0, seq) > 0, "no joint_states for the telemetry written; see " + log);
+  sleepUntil(Clock::now() + 300ms);
+}
+
 /// driver_node with the body alone on a pty owned here; this process plays the servo board.
 TelemetrySessionResult runTelemetrySession(Context& context, const Variant& variant,
                                            bool time_latency, bool step_rates) {
@@ -629,18 +673,8 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
   const CaptureListener capture(context.nh, driver, variant);
   TelemetryProbe probe(context.nh, driver.topic("joint_states"), capacity);
 
-  // Warm-up: 50 Hz until the node is connected, publishing, and this subscriber is attached.
-  uint32_t seq = 0;
-  const Clock::time_point give_up = Clock::now() + 30s;
-  while (probe.delivered(0, seq) == 0 && Clock::now() < give_up && !stopRequested() &&
-         seq < kWarmUpFrames) {
-    probe.write(pty, seq++);
-    std::this_thread::sleep_for(20ms);
-  }
-  require(probe.delivered(0, seq) > 0,
-          "no joint_states for the telemetry written; see " + context.paths.log(ns));
-  sleepUntil(Clock::now() + 300ms);
-  seq = kWarmUpFrames;
+  warmUpTelemetry(probe, pty, kWarmUpFrames, context.paths.log(ns));
+  uint32_t seq = kWarmUpFrames;
 
   TelemetrySessionResult result;
   if (time_latency) {
@@ -1095,22 +1129,22 @@ std::string ratio(double polling, double event) {
   return event > 0 ? format("%.1fx", polling / event) : "-";
 }
 
-/// Section 8: driver_node and floor_node, each measured `floor_rounds` times, their runs
+/// Section 11: driver_node and floor_node, each measured `floor_rounds` times, their runs
 /// alternated (node first in even rounds, floor first in odd ones) so that a change of machine
 /// load falls on both. Each round takes its share of the commands, frames and idle window; a
 /// figure is the mean over the rounds.
-/// Section 8's figures of one program (driver_node or the floor), one entry per round.
+/// Section 11's figures of one program (driver_node or the floor), one entry per round.
 struct FloorFigures {
   std::vector<double> cmd_p50, cmd_p99, cmd_lost, telemetry_p50, telemetry_p99, cpu, idle_cpu,
       jitter;
 };
 
-/// One program's base and telemetry sessions in one round of section 8.
+/// One program's base and telemetry sessions in one round of section 11.
 void runFloorRound(Context& context, const Variant& variant, std::size_t round,
                    FloorFigures* figures) {
   const Variant tagged{variant.name, variant.tag + "_r" + std::to_string(round), variant.program,
                        variant.read_poll_interval, true};
-  attempt(context, format("8. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
+  attempt(context, format("11. %s base, round %zu", variant.program.c_str(), round + 1), [&] {
     const BaseSessionResult base = runBaseSession(context, tagged, true, true);
     figures->cmd_p50.push_back(base.cmd_vel->ms.p50);
     figures->cmd_p99.push_back(base.cmd_vel->ms.p99);
@@ -1119,7 +1153,7 @@ void runFloorRound(Context& context, const Variant& variant, std::size_t round,
     figures->jitter.push_back(base.idle_loop->period_ms.stddev);
     figures->idle_cpu.push_back(base.idle_loop->cpu_percent / 100.0);
   });
-  attempt(context, format("8. %s telemetry, round %zu", variant.program.c_str(), round + 1), [&] {
+  attempt(context, format("11. %s telemetry, round %zu", variant.program.c_str(), round + 1), [&] {
     const TelemetrySessionResult body = runTelemetrySession(context, tagged, true, false);
     figures->telemetry_p50.push_back(body.latency->ms.p50);
     figures->telemetry_p99.push_back(body.latency->ms.p99);
@@ -1135,7 +1169,7 @@ std::optional<double> meanOf(const std::vector<double>& values) {
 }
 
 void addFloorRows(ResultTable& table, const FloorFigures& node, const FloorFigures& floor) {
-  table.section("8. driver_node vs the floor (bench/floor_node.cpp), runs alternated",
+  table.section("11. Each device alone vs the floor (bench/floor_node.cpp), runs alternated",
                 {"measurement", "driver_node", "floor", "node / floor"});
   auto compare = [&](const std::string& what, const std::vector<double>& node_values,
                      const std::vector<double>& floor_values, const char* unit, int decimals) {
@@ -1180,6 +1214,335 @@ void runFloorComparison(Context& context) {
       rounds, std::max<std::size_t>(50, saved.commands / rounds),
       std::max<std::size_t>(100, saved.telemetry_frames / rounds),
       std::max(5.0, saved.loop_seconds / rounds)));
+}
+
+// --- 8. the configuration users run, against the floor ------------------------------------------
+
+/// Section 8's conditions: a background load or not, ~realtime_priority on or off.
+struct UserCondition {
+  bool loaded = false;
+  bool realtime = false;
+  std::string load() const { return loaded ? "CPU hog per core" : "quiet"; }
+  std::string rt() const { return realtime ? "on" : "off"; }
+  std::string tag() const {
+    return std::string(loaded ? "load" : "quiet") + (realtime ? "_rt" : "");
+  }
+};
+const UserCondition kQuiet{false, false}, kQuietRt{false, true}, kLoaded{true, false},
+    kLoadedRt{true, true};
+const std::vector<UserCondition> kUserConditions{kQuiet, kQuietRt, kLoaded, kLoadedRt};
+
+/// One CPU hog per core at nice 0 (a shell's busy loop) while it lives; none when `on` is false.
+class BackgroundLoad {
+ public:
+  BackgroundLoad(const RunPaths& paths, bool on) {
+    if (!on) return;
+    const long cores = std::max(1L, ::sysconf(_SC_NPROCESSORS_ONLN));
+    for (long core = 0; core < cores; ++core) {
+      hogs_.push_back(std::make_unique<ChildProcess>(
+          "cpu hog", std::vector<std::string>{"sh", "-c", "while :; do :; done"},
+          paths.log("cpu_hog")));
+    }
+  }
+
+ private:
+  std::vector<std::unique_ptr<ChildProcess>> hogs_;
+};
+
+/// The subscribers a user's robot has besides joint_states (the probe's): joint_state_publisher
+/// (wheel_states, as launch/description.launch merges it), rviz (imu/data, odom, /tf), the
+/// navigation stack (odom, /tf) and diagnostic_aggregator (/diagnostics). Each counts messages.
+class UserSubscribers {
+ public:
+  UserSubscribers(ros::NodeHandle& nh, const std::string& ns) {
+    add<sensor_msgs::Imu>(nh, "/" + ns + "/imu/data");
+    add<nav_msgs::Odometry>(nh, "/" + ns + "/odom");
+    add<sensor_msgs::JointState>(nh, "/" + ns + "/wheel_states");
+    add<tf2_msgs::TFMessage>(nh, "/tf");
+    add<diagnostic_msgs::DiagnosticArray>(nh, "/diagnostics");
+  }
+
+ private:
+  template <typename Message>
+  void add(ros::NodeHandle& nh, const std::string& topic) {
+    subscribers_.push_back(nh.subscribe<Message>(
+        topic, 100, [this](const typename Message::ConstPtr&) { ++messages_; }));
+  }
+  std::atomic<std::size_t> messages_{0};
+  std::vector<ros::Subscriber> subscribers_;
+};
+
+/// The base's side of the shared pty: every speed frame logged, battery requests answered (87 %)
+/// as the AP1 answers them, so the node's battery poll runs as on a robot.
+class PlayedBase {
+ public:
+  PlayedBase(sim::PseudoTerminal& pty, TelemetryProbe& probe)
+      : reader_(pty, baseFrames(),
+                [this, &pty, &probe](auto family, auto data, auto size, auto arrival) {
+                  log_.onFrame(family, data, size, arrival);
+                  const auto frame = base::decodeFrame(data, size);
+                  if (frame && frame->msg_id == static_cast<uint8_t>(base::MsgId::kBattery)) {
+                    probe.writeOther(pty, base::encodeBatteryReply(frame->seq, 87));
+                  }
+                }) {}
+  const SpeedFrameLog& log() const { return log_; }
+
+ private:
+  static protocol::FramerConfig baseFrames() {
+    protocol::FramerConfig framer;
+    framer.accept(devices::base::kFrames);
+    return framer;
+  }
+  SpeedFrameLog log_;
+  PtyFrameReader reader_;
+};
+
+/// ~realtime_priority as --realtime-priority gives it: "true" a bool, else an integer.
+XmlRpc::XmlRpcValue realtimeValue(const std::string& text) {
+  if (text == "true") return XmlRpc::XmlRpcValue(true);
+  return XmlRpc::XmlRpcValue(std::stoi(text));
+}
+
+/// The configuration users run: the defaults (base, body and servo bus on one port, odom and
+/// tf, diagnostics, battery poll) with 20 body servos. Two base settings differ so that each
+/// command is recognisable on the wire (one tick value per command, room for 600 of them); they
+/// change no work per frame. floor_node reads the same parameters for what it does.
+ParamList userParams(const std::string& port, const UserCondition& condition,
+                     const Options& options) {
+  ParamList params = commonParams(port, kEventDriven);
+  const ParamList body = TelemetryProbe::nodeParams();
+  params.insert(params.end(), body.begin(), body.end());
+  params.insert(params.end(), {{"base/speed_dithering", false}, {"base/max_wheel_speed", 20.0}});
+  if (condition.realtime) {
+    params.emplace_back("realtime_priority", realtimeValue(options.realtime_priority));
+  }
+  return params;
+}
+
+/// What one session of section 8 measured.
+struct UserFigures {
+  double cpu = 0;  ///< s/s over the streaming window (telemetry at 100 Hz, no cmd_vel)
+  LatencyResult telemetry, cmd_vel;
+  LoopResult loop;  ///< speed frame periods over the streaming window
+};
+
+/// Telemetry at 100 Hz, `frames` frames numbered from *seq, no cmd_vel: the process's CPU,
+/// telemetry -> joint_states and the loop's periods over that window.
+UserFigures measureStreamingWindow(TelemetryProbe& probe, sim::PseudoTerminal& pty,
+                                   const SpeedFrameLog& log, pid_t pid, std::size_t frames,
+                                   uint32_t* seq) {
+  const uint32_t first = *seq;
+  const std::size_t first_speed_frame = log.count();
+  const double cpu_start = processCpuSeconds(pid);
+  const Clock::time_point start = Clock::now();
+  const RateStep run = streamTelemetry(probe, pty, 100.0, frames, seq);
+  UserFigures figures;
+  figures.cpu = (processCpuSeconds(pid) - cpu_start) / toSeconds(Clock::now() - start);
+  figures.loop = analyzePeriods(log.arrivalSeconds(first_speed_frame, log.count()));
+  figures.telemetry = latencyResult(probe.latenciesMs(first, *seq), run.attempted);
+  return figures;
+}
+
+/// cmd_vel commands 10-40 ms apart, timed to the wire, while a second thread keeps telemetry
+/// streaming at 100 Hz (those frames are not timed), numbered from `first_seq`.
+LatencyResult timeCmdVelWhileStreaming(TelemetryProbe& probe, sim::PseudoTerminal& pty,
+                                       uint32_t first_seq, ros::Publisher& cmd_vel,
+                                       const SpeedFrameLog& log, std::size_t commands) {
+  std::atomic<bool> done{false};
+  std::thread stream([&] {
+    const Clock::time_point start = Clock::now();
+    for (uint32_t seq = first_seq; !done && seq < probe.capacity(); ++seq) {
+      std::this_thread::sleep_until(start + fromSeconds((seq - first_seq) / 100.0));
+      probe.write(pty, seq);
+    }
+  });
+  const LatencyResult result = timeCmdVelSpaced(cmd_vel, log, commands);
+  done = true;
+  stream.join();
+  return result;
+}
+
+/// One session: `variant`'s program in the configuration users run, this process playing the
+/// robot on one pty (base and body; the servo bus has nothing to poll by default), the user's
+/// subscribers attached; the load (if any) starts once the node runs.
+UserFigures runUserSession(Context& context, const Variant& variant, const UserCondition& condition,
+                           std::size_t round) {
+  constexpr uint32_t kWarmUpFrames = 2000;
+  const std::size_t frames = context.options.telemetry_frames;
+  const std::size_t commands = context.options.commands;
+  const std::string ns =
+      "user_" + variant.tag + "_" + condition.tag() + "_r" + std::to_string(round);
+  sim::PseudoTerminal pty(context.paths.link(ns));
+  // Commands 10-40 ms apart: at most 4 frames streamed per command.
+  TelemetryProbe probe(context.nh, "/" + ns + "/joint_states",
+                       kWarmUpFrames + frames + 4 * commands + 200);
+  const PlayedBase base(pty, probe);
+  DriverProcess driver(context.paths, ns, userParams(pty.linkPath(), condition, context.options),
+                       variant.program);
+  const UserSubscribers subscribers(context.nh, ns);
+  ros::Publisher cmd_vel = context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
+  warmUpTelemetry(probe, pty, kWarmUpFrames, context.paths.log(ns));
+  require(waitUntil([&] { return base.log().count() > 0 && cmd_vel.getNumSubscribers() > 0; }, 30s),
+          "no speed frame or no cmd_vel subscriber; see " + context.paths.log(ns));
+  const BackgroundLoad load(context.paths, condition.loaded);
+  require(sleepUntil(Clock::now() + 1s), "stopped");
+  uint32_t seq = kWarmUpFrames;
+  UserFigures figures = measureStreamingWindow(probe, pty, base.log(), driver.pid(), frames, &seq);
+  figures.cmd_vel = timeCmdVelWhileStreaming(probe, pty, seq, cmd_vel, base.log(), commands);
+  return figures;
+}
+
+/// One figure of section 8, taken from a session's UserFigures.
+struct UserFigure {
+  const char* name;
+  const char* unit;
+  int decimals;
+  double (*of)(const UserFigures&);
+};
+const std::vector<UserFigure> kUserFigures{
+    {"CPU at 100 Hz telemetry, 20 servos", "s/s", 4, [](const UserFigures& f) { return f.cpu; }},
+    {"cmd_vel -> speed frame p50", "ms", 3, [](const UserFigures& f) { return f.cmd_vel.ms.p50; }},
+    {"cmd_vel -> speed frame p99", "ms", 3, [](const UserFigures& f) { return f.cmd_vel.ms.p99; }},
+    {"cmd_vel never on the wire", "%", 1,
+     [](const UserFigures& f) {
+       return 100.0 * f.cmd_vel.lost / std::max<std::size_t>(1, f.cmd_vel.attempted);
+     }},
+    {"telemetry -> joint_states p50", "ms", 3,
+     [](const UserFigures& f) { return f.telemetry.ms.p50; }},
+    {"telemetry -> joint_states p99", "ms", 3,
+     [](const UserFigures& f) { return f.telemetry.ms.p99; }},
+    {"50 Hz loop jitter (std) while telemetry streams", "ms", 3,
+     [](const UserFigures& f) { return f.loop.period_ms.stddev; }},
+    {"50 Hz loop worst period", "ms", 3, [](const UserFigures& f) { return f.loop.period_ms.max; }},
+};
+
+/// Every session of section 8, per condition (kUserConditions' order), one entry per round.
+struct UserRuns {
+  std::vector<std::vector<UserFigures>> node{kUserConditions.size()};
+  std::vector<std::vector<UserFigures>> floor{kUserConditions.size()};
+};
+
+/// The mean of `figure` over the rounds of one condition; nullopt when none completed.
+std::optional<double> meanFigure(const std::vector<UserFigures>& rounds, const UserFigure& figure) {
+  std::vector<double> values;
+  for (const UserFigures& round : rounds) values.push_back(figure.of(round));
+  return meanOf(values);
+}
+
+/// "node, floor, node / floor" cells of one figure in one condition (kUserConditions' index).
+std::vector<std::string> userCells(const UserRuns& runs, std::size_t condition,
+                                   const UserFigure& figure) {
+  const auto node = meanFigure(runs.node[condition], figure);
+  const auto floor = meanFigure(runs.floor[condition], figure);
+  auto cell = [&](std::optional<double> value) {
+    return value ? format("%.*f %s", figure.decimals, *value, figure.unit) : std::string("-");
+  };
+  return {cell(node), cell(floor),
+          node && floor && *floor > 0 ? format("%.2fx", *node / *floor) : "-"};
+}
+
+/// Indices into kUserFigures and kUserConditions for the summary.
+enum UserFigureIndex { kCpuFigure = 0, kCmdVelP99 = 2, kTelemetryP99 = 5, kLoopJitter = 6 };
+enum UserConditionIndex { kQuietIndex = 0, kLoadedIndex = 2, kLoadedRtIndex = 3 };
+
+/// Issue 43's table: its rows, in its order, from section 8's sessions.
+void addUserSummary(ResultTable& table, const UserRuns& runs) {
+  table.section("8. The configuration users run against the floor: summary (issue 43's rows)",
+                {"figure", "driver_node", "floor", "node / floor", "goal"});
+  struct Row {
+    const char* what;
+    UserFigureIndex figure;
+    UserConditionIndex condition;
+    const char* goal;
+  };
+  const Row rows[] = {
+      {"CPU at 100 Hz telemetry, 20 servos", kCpuFigure, kQuietIndex, "<= 1.1x"},
+      {"cmd_vel -> speed frame on the wire, p99", kCmdVelP99, kQuietIndex, "<= 1 ms and <= 1.2x"},
+      {"telemetry last byte -> joint_states, p99 (quiet)", kTelemetryP99, kQuietIndex, "keep"},
+      {"the same with a CPU hog at nice 0 on each core", kTelemetryP99, kLoadedIndex, "<= 1.2x"},
+      {"the same, ~realtime_priority on", kTelemetryP99, kLoadedRtIndex, "<= 1.0x"},
+      {"50 Hz loop jitter (std) while telemetry streams, under that load", kLoopJitter,
+       kLoadedIndex, "<= 1.2x"},
+      {"the same, ~realtime_priority on", kLoopJitter, kLoadedRtIndex, "<= 1.0x"},
+      {"CPU under that load", kCpuFigure, kLoadedIndex, "<= 1.1x"},
+  };
+  for (const Row& row : rows) {
+    const auto cells = userCells(runs, row.condition, kUserFigures[row.figure]);
+    table.row({row.what, cells[0], cells[1], cells[2], row.goal});
+  }
+}
+
+/// Every figure in every condition.
+void addUserRows(ResultTable& table, const UserRuns& runs) {
+  table.section("8. The configuration users run against the floor: every figure",
+                {"figure", "load", "RT", "driver_node", "floor", "node / floor"});
+  for (const UserFigure& figure : kUserFigures) {
+    for (std::size_t condition = 0; condition < kUserConditions.size(); ++condition) {
+      std::vector<std::string> row{figure.name, kUserConditions[condition].load(),
+                                   kUserConditions[condition].rt()};
+      const auto cells = userCells(runs, condition, figure);
+      row.insert(row.end(), cells.begin(), cells.end());
+      table.row(row);
+    }
+  }
+}
+
+void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
+  const Options& o = context.options;
+  ResultTable& table = context.results;
+  table.note(
+      "driver_node in the configuration users run (the defaults: base, body and servo bus on one "
+      "port, odom and /tf, diagnostics, battery poll; 20 body servos; speed_dithering off and "
+      "max_wheel_speed 20 so each command is recognisable on the wire) and floor_node with the "
+      "same parameters; this process plays the robot (telemetry of 20 servos at 100 Hz, battery "
+      "answers).");
+  table.note(
+      "Subscribed throughout: joint_states (robot_state_publisher), wheel_states "
+      "(joint_state_publisher), imu/data, odom, /tf (rviz, navigation), /diagnostics "
+      "(diagnostic_aggregator).");
+  table.note(format(
+      "Per session: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock over that "
+      "window, telemetry latency, loop periods from speed frame arrivals), then %zu cmd_vel "
+      "commands 10-40 ms apart while telemetry streams. %zu round(s); node and floor back to back "
+      "per condition, which goes first alternating.",
+      frames, commands, o.floor_rounds));
+  table.note(format(
+      "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
+      "~realtime_priority %s for both (floor_node: SCHED_FIFO on its reader and loop threads, "
+      "memory locked). This benchmark's own threads: %s.",
+      o.realtime_priority.c_str(),
+      context.bench_priority > 0 ? format("SCHED_FIFO %d", context.bench_priority).c_str()
+                                 : "normal priority"));
+}
+
+/// Section 8: driver_node and floor_node in every condition (quiet / loaded, RT off / on), the
+/// two back to back per condition and round, which one goes first alternating.
+void runUserConfiguration(Context& context) {
+  const Options saved = context.options;
+  const std::size_t rounds = saved.floor_rounds;
+  context.options.telemetry_frames = std::max<std::size_t>(200, saved.telemetry_frames / rounds);
+  context.options.commands = std::max<std::size_t>(100, saved.commands / (2 * rounds));
+  UserRuns runs;
+  for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
+    for (std::size_t c = 0; c < kUserConditions.size(); ++c) {
+      const UserCondition& condition = kUserConditions[c];
+      for (int k = 0; k < 2; ++k) {
+        const bool floor_turn = (k == 1) != ((c + round) % 2 == 1);
+        const Variant& variant = floor_turn ? kFloor : kEventDriven;
+        auto& into = floor_turn ? runs.floor[c] : runs.node[c];
+        attempt(context,
+                format("8. %s, %s, RT %s, round %zu", variant.program.c_str(),
+                       condition.load().c_str(), condition.rt().c_str(), round + 1),
+                [&] { into.push_back(runUserSession(context, variant, condition, round)); });
+      }
+    }
+  }
+  const std::size_t frames = context.options.telemetry_frames;
+  const std::size_t commands = context.options.commands;
+  context.options = saved;
+  addUserSummary(context.results, runs);
+  addUserRows(context.results, runs);
+  addUserNote(context, frames, commands);
 }
 
 /// What the sessions of sections 1-5 measured, compared again in 7 and 9.
@@ -1377,11 +1740,12 @@ void run(Context& context) {
   runTelemetrySections(context, &results);
   if (o.runs(6)) runServoSessionSection(context);
   if (o.runs(7)) runPollingComparison(context, &results);
-  if (o.runs(8)) runFloorComparison(context);
+  if (o.runs(8)) runUserConfiguration(context);
   if (o.runs(9)) runCaptureComparison(context, &results);
   if (o.runs(10)) {
     attempt(context, "servo bus at the wire's pace (10)", [&] { runServoBusSection(context); });
   }
+  if (o.runs(11)) runFloorComparison(context);
 }
 
 std::string executableDirectory() {
@@ -1416,11 +1780,28 @@ bool programsFound(const RunPaths& paths) {
   return true;
 }
 
+/// This process's threads (and every thread it starts from now on: the robot it plays, the
+/// subscribers that time the node) at SCHED_FIFO `priority`, so that a background load delays the
+/// node under test rather than the measuring. Children start with the normal policy
+/// (ChildProcess). Returns the priority applied; 0 when off or not allowed (said on stderr).
+int raiseOwnPriority(int priority) {
+  if (priority <= 0) return 0;
+  sched_param param{};
+  param.sched_priority = priority;
+  if (::sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
+    std::cerr << "driver_bench: SCHED_FIFO " << priority << " not allowed (" << std::strerror(errno)
+              << "); measuring at normal priority" << std::endl;
+    return 0;
+  }
+  return priority;
+}
+
 /// Runs the sections against a roscore of our own; the exit status, the report in `report`
 /// (empty when the run never got to it).
 int runWithMaster(int argc, char** argv, const Options& options, const RunPaths& paths,
                   std::string* report) {
   const std::string started = header(options);
+  const int bench_priority = raiseOwnPriority(options.bench_priority);
   int status = 0;
   try {
     RosMaster master(paths, options.master_port ? options.master_port : findFreeTcpPort());
@@ -1432,7 +1813,7 @@ int runWithMaster(int argc, char** argv, const Options& options, const RunPaths&
     std::cerr << "driver_bench: roscore at " << master.uri() << ", logs in " << paths.work_dir
               << std::endl;
     master.waitUntilUp(std::chrono::seconds(60));
-    Context context{options, paths, ros::NodeHandle(), {}};
+    Context context{options, paths, ros::NodeHandle(), {}, 0, bench_priority};
     ros::AsyncSpinner spinner(2);
     spinner.start();
     run(context);

@@ -1,7 +1,8 @@
 // floor_node: the least any roscpp driver of this robot must do, as the yardstick of driver_bench.
 // Benchmark only, never installed. It reads the same parameters as driver_node for what it does:
 // ~port, ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids, ~body/joint_names,
-// ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution.
+// ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution, ~realtime_priority (1..99, or
+// true for 50: SCHED_FIFO on the reader and loop threads, memory locked, as driver_node does).
 //
 // Threading: one reader thread blocks on the port, frames telemetry and publishes one JointState
 // per frame; the cmd_vel callback (ros::spin thread) writes its speed frame at once; the main
@@ -9,8 +10,11 @@
 // from the two writers are serialised by one mutex. No validation, diagnostics or services.
 #include <fcntl.h>
 #include <geometry_msgs/Twist.h>
+#include <pthread.h>
 #include <ros/ros.h>
+#include <sched.h>
 #include <sensor_msgs/JointState.h>
+#include <sys/mman.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -41,16 +45,33 @@ uint8_t g_seq = 0;  // guarded by g_write_mutex
 
 void writeSpeedFrame() {
   std::lock_guard<std::mutex> lock(g_write_mutex);
-  const auto frame = srd::protocol::base::encodeWheelSpeed(g_seq++, g_left, g_right);
+  const auto frame = srd::devices::base::encodeWheelSpeed(g_seq++, g_left, g_right);
   if (::write(g_fd, frame.data(), frame.size()) < 0) { /* the floor does not handle errors */
   }
+}
+
+/// ~realtime_priority: an integer priority, or true for 50; 0 (or absent, or false) is off.
+int realtimePriority(ros::NodeHandle& pnh) {
+  int priority = 0;
+  if (pnh.getParam("realtime_priority", priority)) return priority;
+  bool on = false;
+  return pnh.getParam("realtime_priority", on) && on ? 50 : 0;
+}
+
+/// SCHED_FIFO at `priority` for the calling thread (0: nothing); says so when not allowed.
+void runRealtime(int priority, const char* thread) {
+  if (priority <= 0) return;
+  sched_param param{};
+  param.sched_priority = priority;
+  const int error = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &param);
+  if (error != 0) ROS_WARN("floor: %s thread: SCHED_FIFO %d not allowed", thread, priority);
 }
 
 /// The body's joints as ~body/* gives them.
 struct BodyJoints {
   std::vector<int> ids;
   std::vector<std::string> names;
-  std::vector<srd::device::JointCalibration> calibrations;
+  std::vector<srd::devices::body::JointCalibration> calibrations;
 };
 
 BodyJoints readBodyJoints(ros::NodeHandle& pnh) {
@@ -102,8 +123,8 @@ void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states) {
   const auto config = test_support::driverFramer({"body"}, count);
   srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
                                                  std::size_t size) {
-    if (family != srd::protocol::body::kTelemetryFrames) return;
-    const auto telemetry = srd::protocol::body::decodeTelemetry(data, size, count);
+    if (family != srd::devices::body::kTelemetryFrames) return;
+    const auto telemetry = srd::devices::body::decodeTelemetry(data, size, count);
     if (!telemetry) return;
     sensor_msgs::JointState msg;
     msg.header.stamp = ros::Time::now();
@@ -147,6 +168,8 @@ int main(int argc, char** argv) {
   const bool base = pnh.param("base/enabled", true);
   const bool body = pnh.param("body/enabled", true);
   const BodyJoints joints = readBodyJoints(pnh);
+  const int priority = realtimePriority(pnh);
+  if (priority > 0 && ::mlockall(MCL_CURRENT | MCL_FUTURE) != 0) ROS_WARN("floor: mlockall failed");
   if (!openRawPort(port)) {
     ROS_FATAL("floor: cannot open %s", port.c_str());
     return 1;
@@ -157,11 +180,17 @@ int main(int argc, char** argv) {
   ros::Subscriber cmd_vel;
   if (base) cmd_vel = subscribeCmdVel(nh, geometry);
   std::thread reader;
-  if (body) reader = std::thread([&] { publishTelemetry(joints, joint_states); });
+  if (body) {
+    reader = std::thread([&] {
+      runRealtime(priority, "reader");
+      publishTelemetry(joints, joint_states);
+    });
+  }
 
   ros::AsyncSpinner spinner(1);
   spinner.start();
   if (base) {
+    runRealtime(priority, "loop");
     runBaseLoop(loop_rate);
   } else {
     ros::waitForShutdown();

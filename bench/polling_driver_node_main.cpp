@@ -21,7 +21,7 @@ serial_robot_driver::core::SerialLink::StreamFactory pollingStreams(ros::NodeHan
     throw ros_layer::ParameterError("read_poll_interval", "must be > 0 s for the polling node");
   }
   return [interval](
-             const device::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
+             const core::SerialLinkOptions& options) -> std::unique_ptr<transport::ByteStream> {
     return std::make_unique<bench::PollingStream>(
         std::make_unique<transport::SerialPort>(
             transport::SerialPortOptions{options.path, options.baud}),

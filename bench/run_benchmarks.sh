@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
-# Runs the driver_node benchmarks (bench/driver_bench.cpp): a private roscore, driver_node and
-# robot_sim over pseudo-terminals, about 3 minutes; then the framer's (bench/bench_framer.cpp,
-# Google Benchmark, a few seconds). Prints the tables and writes them to bench/results/latest.md
-# (or $SRD_BENCH_OUTPUT).
+# Runs the driver_node benchmarks (bench/driver_bench.cpp, a private roscore, the nodes over
+# pseudo-terminals). By default section 8 alone, about 4 minutes: driver_node in the configuration
+# users run (every default device, 20 body servos at 100 Hz, the topics a user subscribes) side by
+# side with the floor (bench/floor_node.cpp), quiet and under a CPU hog per core, with
+# ~realtime_priority off and on, each figure as node / floor / ratio. --all runs every section
+# (about 8 minutes), then the framer's (bench/bench_framer.cpp, Google Benchmark, a few seconds).
+# Prints the tables and writes them to bench/results/user_config.md (section 8 alone) or
+# bench/results/latest.md (--all or --sections), or $SRD_BENCH_OUTPUT.
 #
-# usage: bench/run_benchmarks.sh [--build] [--long] [driver_bench options, see --help]
+# usage: bench/run_benchmarks.sh [--build] [--all] [--long] [driver_bench options, see --help]
+#   --all               every section (1-10) and bench_framer, instead of section 8 alone
 #   --build             build driver_bench (and driver_node, robot_sim, floor_node, servo_floor,
 #                       polling_driver_node) first, -j2, with -DSRD_BUILD_BENCHMARKS=ON (benchmarks
 #                       are off by default): in SRD_BENCH_WS, or else in the clone's own .ws/ with
@@ -19,13 +24,18 @@ script_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 package_dir=$(cd "${script_dir}/.." && pwd)
 
 build=0
+all=0
+sections_given=0
 args=()
 for arg in "$@"; do
   case "${arg}" in
     --build) build=1 ;;
+    --all) all=1 ;;
+    --sections) sections_given=1; args+=("${arg}") ;;
     *) args+=("${arg}") ;;
   esac
 done
+if (( ! all && ! sections_given )); then args+=(--sections 8); fi
 if [[ "${SRD_BENCH_LONG:-0}" == "1" ]]; then args+=(--long); fi
 
 own_ws="${package_dir}/.ws"
@@ -72,6 +82,7 @@ if [[ -n "${SRD_BENCH_OUTPUT:-}" ]]; then
   output="${SRD_BENCH_OUTPUT}"
 elif [[ -w "${package_dir}" && -d "${package_dir}/bench" ]]; then
   output="${package_dir}/bench/results/latest.md"
+  if (( ! all && ! sections_given )); then output="${package_dir}/bench/results/user_config.md"; fi
 else
   output="${PWD}/driver_bench_latest.md"
 fi
@@ -87,7 +98,7 @@ wait "${bench_pid}" || status=$?
 if kill -0 "${bench_pid}" 2>/dev/null; then wait "${bench_pid}" || status=$?; fi
 # The framer's throughput (Google Benchmark), appended to the same file, when it is built.
 framer="$(dirname "${bench}")/bench_framer"
-if [[ "${status}" -eq 0 && -x "${framer}" ]]; then
+if [[ "${status}" -eq 0 && "${all}" -eq 1 && -x "${framer}" ]]; then
   framer_out=$(mktemp)
   "${framer}" --benchmark_min_time=0.2 | tee "${framer_out}"
   {

@@ -27,6 +27,9 @@ PACKAGES+=(libyaml-cpp-dev liburdf-dev liburdfdom-tools ros-robot-state-publishe
            joint-state-publisher topic-tools rviz)
 # Runtime tuning: the dynamic_reconfigure server, its .cfg generator, its Python client and dynparam.
 PACKAGES+=(libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure)
+# ROS 2 through DDS (srd_dds, optional in CMake): Cyclone DDS, its IDL compiler idlc, libcrypto for
+# the REP-2011 type hashes; Fast DDS and its generator for tests against an independent DDS.
+PACKAGES+=(cyclonedds-dev cyclonedds-tools libssl-dev libfastrtps-dev fastddsgen)
 # --dev: what scripts/screenshot_view.sh needs to remake docs/images/ (a virtual display, a grab).
 [ "${1:-}" != "--dev" ] || PACKAGES+=(xvfb imagemagick)
 

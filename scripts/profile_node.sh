@@ -1,0 +1,163 @@
+#!/usr/bin/env bash
+# Profiles driver_node in the configuration users run (the defaults: base, body and servo bus on
+# one port, odom and /tf, diagnostics, battery poll; 20 body servos streaming at 100 Hz) against
+# robot_sim, with the subscribers a user has (joint_states, wheel_states, imu/data, odom, /tf,
+# /diagnostics, as robot_state_publisher, joint_state_publisher, rviz, the navigation stack and
+# diagnostic_aggregator would subscribe; here `rostopic hz`). Prints, per thread of the node: its
+# role, its CPU (s/s, from /proc), its CPU per event (telemetry frame, loop tick, ...) and its top
+# items. docs/performance.md explains the output; paste it there as is.
+#
+# usage: scripts/profile_node.sh [--seconds S] [--tool perf|callgrind] [--out DIR] [--top N]
+#   --seconds S   the profiled window (default 30; callgrind: default 20, the node runs ~50x slower)
+#   --tool        perf (default when `perf` runs) or callgrind (valgrind; instruction counts)
+#   --out DIR     keep the data, logs and report there (default: a new /tmp/srd_profile_XXXXXX)
+#   --top N       items per thread (default 8)
+#   SRD_BENCH_WS  the catkin workspace holding driver_node and robot_sim (default: the clone's
+#                 .ws/, built by scripts/build.sh; else the sourced one)
+#
+# Needs (installs nothing): a built driver_node and robot_sim; ROS (roscore, rosparam, rostopic);
+# perf (Debian: `apt-get install linux-perf`; perf_event_paranoid <= 1 or root) or valgrind
+# (`apt-get install valgrind`, with callgrind_annotate).
+set -euo pipefail
+export PATH="/usr/bin:$PATH"  # Debian's python3 for the ROS tools
+
+script_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+package_dir=$(cd "${script_dir}/.." && pwd)
+seconds=""
+tool=""
+out=""
+top=8
+while (($#)); do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    --tool) tool="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --top) top="$2"; shift 2 ;;
+    -h | --help) sed -n '2,22p' "$0"; exit 0 ;;
+    *) echo "profile_node.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+need() {  # need <command> <what to install>
+  command -v "$1" >/dev/null || { echo "profile_node.sh: needs $1 ($2)" >&2; exit 2; }
+}
+if [[ -z "${tool}" ]]; then
+  if command -v perf >/dev/null && perf stat -e cpu-clock true >/dev/null 2>&1; then
+    tool=perf
+  else
+    tool=callgrind
+  fi
+fi
+case "${tool}" in
+  perf) need perf "apt-get install linux-perf; and perf_event_paranoid <= 1 or root" ;;
+  callgrind)
+    need valgrind "apt-get install valgrind"
+    need callgrind_annotate "apt-get install valgrind"
+    ;;
+  *) echo "profile_node.sh: --tool perf or callgrind" >&2; exit 2 ;;
+esac
+[[ -n "${seconds}" ]] || { [[ "${tool}" == perf ]] && seconds=30 || seconds=20; }
+
+ws="${SRD_BENCH_WS:-}"
+if [[ -z "${ws}" && -x "${package_dir}/.ws/devel/lib/serial_robot_driver/driver_node" ]]; then
+  ws="${package_dir}/.ws"
+fi
+load_workspace() {  # a function, so setup.bash does not see this script's arguments
+  set +u  # ROS's setup scripts read unset variables
+  # shellcheck disable=SC1091
+  if [[ -n "${ws}" ]]; then source "${ws}/devel/setup.bash"; fi
+  set -u
+}
+load_workspace
+need roscore "ROS (scripts/install_deps.sh)"
+need rostopic "ROS (scripts/install_deps.sh)"
+bin=""
+if [[ -n "${ws}" ]]; then bin="${ws}/devel/lib/serial_robot_driver"; fi
+if [[ -z "${bin}" || ! -x "${bin}/driver_node" ]]; then
+  bin=$(dirname "$(catkin_find --first-only serial_robot_driver driver_node 2>/dev/null)" || true)
+fi
+for program in driver_node robot_sim; do
+  [[ -x "${bin}/${program}" ]] || {
+    echo "profile_node.sh: ${program} not found: run scripts/build.sh (or set SRD_BENCH_WS)" >&2
+    exit 2
+  }
+done
+
+out="${out:-$(mktemp -d /tmp/srd_profile_XXXXXX)}"
+mkdir -p "${out}"
+export ROS_LOG_DIR="${out}/ros_log" ROS_HOME="${out}"
+port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
+export ROS_MASTER_URI="http://localhost:${port}"
+
+pids=()
+cleanup() {  # only what this script started, by pid, newest first
+  local i
+  for ((i = ${#pids[@]} - 1; i >= 0; i--)); do kill -INT "${pids[i]}" 2>/dev/null || true; done
+  sleep 1
+  for ((i = ${#pids[@]} - 1; i >= 0; i--)); do kill -KILL "${pids[i]}" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+start() {  # start <log> <command...>: in the background, remembered for cleanup
+  local log="$1"
+  shift
+  "$@" >"${out}/${log}.log" 2>&1 &
+  pids+=($!)
+}
+
+servos=20
+ids=$(seq -s, 1 "${servos}")
+names=$(seq -f 'joint_%g' -s, 1 "${servos}")
+zeros=$(printf '2048,%.0s' $(seq "${servos}"))
+ones=$(printf '1,%.0s' $(seq "${servos}"))
+pty="${out}/robot.pty"
+cat >"${out}/params.yaml" <<EOF
+port: ${pty}
+body:
+  servo_ids: [${ids}]
+  joint_names: [${names}]
+  zero_ticks: [${zeros%,}]
+  directions: [${ones%,}]
+EOF
+
+start roscore roscore -p "${port}"
+for _ in $(seq 100); do rostopic list >/dev/null 2>&1 && break; sleep 0.2; done
+start robot_sim "${bin}/robot_sim" --link "${pty}" --servo-ids "${ids}" --telemetry-rate 100
+for _ in $(seq 100); do [[ -e "${pty}" ]] && break; sleep 0.1; done
+rosparam load "${out}/params.yaml" /profile/driver
+node_args=(__name:=driver __ns:=/profile)
+if [[ "${tool}" == callgrind ]]; then
+  start driver_node valgrind --tool=callgrind --separate-threads=yes \
+    --callgrind-out-file="${out}/callgrind.out.%p" "${bin}/driver_node" "${node_args[@]}"
+else
+  start driver_node "${bin}/driver_node" "${node_args[@]}"
+fi
+node_pid=${pids[-1]}
+for topic in /profile/joint_states /profile/wheel_states /profile/imu/data /profile/odom /tf \
+  /diagnostics; do
+  start "hz_$(echo "${topic}" | tr / _)" rostopic hz "${topic}"
+done
+echo "profile_node.sh: ${tool}, warming up 8 s; then ${seconds} s profiled; output in ${out}" >&2
+sleep 8
+
+# CPU time of each thread of the node so far, in ns (schedstat: its first field): "tid ns" lines.
+thread_cpu_ns() {
+  local stat tid
+  for stat in /proc/"${node_pid}"/task/*/schedstat; do
+    tid=${stat%/schedstat}
+    tid=${tid##*/}
+    awk -v tid="${tid}" '{ print tid, $1 }' "${stat}" 2>/dev/null || true
+  done
+}
+# The CPU per thread from a window of its own: perf's sampling (stacks copied in the kernel) is
+# charged to the threads it samples. Callgrind's whole run is slow anyway: one window.
+thread_cpu_ns >"${out}/cpu_ns_start"
+sleep "${seconds}"
+thread_cpu_ns >"${out}/cpu_ns_end"
+if [[ "${tool}" == perf ]]; then
+  echo "profile_node.sh: CPU window done; perf records ${seconds} s more" >&2
+  perf record -e cpu-clock -F 4999 --call-graph dwarf,8192 -p "${node_pid}" -o "${out}/perf.data" \
+    -- sleep "${seconds}" >"${out}/perf_record.log" 2>&1
+fi
+if [[ "${tool}" == callgrind ]]; then kill -INT "${node_pid}"; wait "${node_pid}" || true; fi
+
+python3 "${script_dir}/profile_report.py" "${tool}" "${out}" "${seconds}" "${top}" | tee "${out}/report.md"

@@ -1,0 +1,134 @@
+// Golden CDR bytes, written by hand from the ROS 2 message definitions and the CDR (XCDR1) rules:
+// a 4-byte encapsulation header 00 01 00 00 (CDR, little-endian), every primitive aligned to its
+// size relative to the end of the header (doubles to 8), strings as a uint32 length that counts
+// the terminating NUL then the bytes and the NUL, sequences as a uint32 count then the elements
+// (aligned only when there is one), fixed arrays as their elements. Both directions: a sample
+// serializes to the bytes, the bytes decode to the sample.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "cdr_golden_support.h"
+#include "serial_robot_driver/dds/c_types.h"
+
+namespace dds = serial_robot_driver::dds;
+
+namespace {
+
+using namespace cdr_golden;
+
+// --- std_msgs/Bool --------------------------------------------------------------------------
+const Bytes kBoolTrue = cat({kHeader, {0x01}});
+
+TEST(CdrGolden, BoolBothWays) {
+  std_msgs_msg_dds__Bool_ value{true};
+  EXPECT_EQ(serialized(value), kBoolTrue);
+  Decoded<std_msgs_msg_dds__Bool_> decoded(kBoolTrue);
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_TRUE(decoded.sample.data);
+}
+
+// A null string (a field left unset) goes out as the empty string: length 1, one NUL.
+TEST(CdrGolden, UnsetStringIsTheEmptyString) {
+  std_msgs_msg_dds__Header_ header{};
+  header.stamp = {-1, 999999999};
+  const Bytes expected =
+      cat({kHeader, {0xff, 0xff, 0xff, 0xff, 0xff, 0xc9, 0x9a, 0x3b}, {0x01, 0, 0, 0, 0x00}});
+  EXPECT_EQ(serialized(header), expected);
+  Decoded<std_msgs_msg_dds__Header_> decoded(expected);
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_EQ(decoded.sample.stamp.sec, -1);
+  EXPECT_EQ(decoded.sample.stamp.nanosec, 999999999u);
+  EXPECT_EQ(dds::text(decoded.sample.frame_id), "");
+}
+
+// What Cyclone itself sends for the same Bool: padded to 4, the padding counted in the options.
+TEST(CdrGolden, PaddedBoolDecodes) {
+  Decoded<std_msgs_msg_dds__Bool_> decoded(Bytes{0x00, 0x01, 0x00, 0x03, 0x01, 0x00, 0x00, 0x00});
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_TRUE(decoded.sample.data);
+  EXPECT_FALSE(Decoded<std_msgs_msg_dds__Bool_>(Bytes{0x00, 0x01, 0x00, 0x03, 0x01}).ok);
+}
+
+// --- geometry_msgs/Twist ----------------------------------------------------------------------
+const Bytes kTwist = cat({kHeader, kOne, kTwo, kThree, kZero, kZero, kHalf});
+
+TEST(CdrGolden, TwistBothWays) {
+  geometry_msgs_msg_dds__Twist_ twist{};
+  twist.linear = {1.0, 2.0, 3.0};
+  twist.angular.z = 0.5;
+  EXPECT_EQ(serialized(twist), kTwist);
+  Decoded<geometry_msgs_msg_dds__Twist_> decoded(kTwist);
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_EQ(decoded.sample.linear.x, 1.0);
+  EXPECT_EQ(decoded.sample.linear.y, 2.0);
+  EXPECT_EQ(decoded.sample.linear.z, 3.0);
+  EXPECT_EQ(decoded.sample.angular.z, 0.5);
+}
+
+TEST(CdrGolden, BigEndianTwistDecodes) {
+  const Bytes big_endian_one{0x3f, 0xf0, 0, 0, 0, 0, 0, 0};
+  const Bytes bytes = cat({{0x00, 0x00, 0x00, 0x00}, big_endian_one, zeros(40)});
+  Decoded<geometry_msgs_msg_dds__Twist_> decoded(bytes);
+  ASSERT_TRUE(decoded.ok);
+  EXPECT_EQ(decoded.sample.linear.x, 1.0);
+}
+
+// --- sensor_msgs/JointState -------------------------------------------------------------------
+// header {stamp {1, 2}, frame_id "base"}, name ["a", "bc"], position [1.5], velocity [], effort [].
+// One row per field, as on the wire.
+// clang-format off
+const Bytes kJointState = cat({kHeader,
+                               {0x01, 0, 0, 0, 0x02, 0, 0, 0},              // 0: sec, nanosec
+                               {0x05, 0, 0, 0, 'b', 'a', 's', 'e', 0x00},   // 8: "base"
+                               {0, 0, 0},                                   // 17: pad to 4
+                               {0x02, 0, 0, 0},                             // 20: two names
+                               {0x02, 0, 0, 0, 'a', 0x00, 0, 0},            // 24: "a", pad
+                               {0x03, 0, 0, 0, 'b', 'c', 0x00, 0},          // 32: "bc", pad
+                               {0x01, 0, 0, 0, 0, 0, 0, 0},                 // 40: one position, pad
+                               kOneAndHalf,                                 // 48: 1.5
+                               {0, 0, 0, 0, 0, 0, 0, 0}});                  // 56: no vel., effort
+// clang-format on
+
+TEST(CdrGolden, JointStateSerializes) {
+  const std::string frame = "base";
+  std::vector<std::string> names{"a", "bc"};
+  std::vector<double> positions{1.5};
+  dds::StringPointers name_pointers(names);
+  sensor_msgs_msg_dds__JointState_ state{};
+  state.header.stamp = {1, 2};
+  dds::lend(state.header.frame_id, frame);
+  name_pointers.lendTo(state.name);
+  dds::lend(state.position, positions);
+  EXPECT_EQ(serialized(state), kJointState);
+}
+
+TEST(CdrGolden, JointStateDecodes) {
+  Decoded<sensor_msgs_msg_dds__JointState_> decoded(kJointState);
+  ASSERT_TRUE(decoded.ok);
+  const auto& state = decoded.sample;
+  EXPECT_EQ(state.header.stamp.sec, 1);
+  EXPECT_EQ(state.header.stamp.nanosec, 2u);
+  EXPECT_EQ(dds::text(state.header.frame_id), "base");
+  EXPECT_EQ(dds::toStrings(state.name), (std::vector<std::string>{"a", "bc"}));
+  EXPECT_EQ(dds::toVector(state.position), std::vector<double>{1.5});
+  EXPECT_TRUE(dds::toVector(state.velocity).empty());
+  EXPECT_TRUE(dds::toVector(state.effort).empty());
+}
+
+TEST(CdrGolden, TruncatedOrForeignBytesAreRefused) {
+  for (size_t keep : {0u, 3u, 4u, 20u, 47u, 63u}) {
+    const Bytes truncated(kJointState.begin(), kJointState.begin() + keep);
+    Decoded<sensor_msgs_msg_dds__JointState_> decoded(truncated);
+    EXPECT_FALSE(decoded.ok) << keep << " bytes";
+  }
+  Bytes huge_name_count = kJointState;
+  huge_name_count[4 + 20 + 3] = 0x7f;  // 2 names -> 0x7f000002
+  EXPECT_FALSE(Decoded<sensor_msgs_msg_dds__JointState_>(huge_name_count).ok);
+  Bytes parameter_list = kBoolTrue;
+  parameter_list[1] = 0x03;  // PL_CDR_LE: not what ROS 2 sends
+  EXPECT_FALSE(Decoded<std_msgs_msg_dds__Bool_>(parameter_list).ok);
+}
+
+}  // namespace
