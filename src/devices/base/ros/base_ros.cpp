@@ -27,7 +27,7 @@ BaseRos::BaseRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params, B
   device.addOutputs(outputs());
 
   core::InputRefusals& refusals = device.inputRefusals();
-  // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.
+  // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; its callback writes it at once.
   const ros_layer::SubscriberCallback<geometry_msgs::Twist> on_cmd_vel =
       [this](const geometry_msgs::Twist::ConstPtr& msg) {
         device_.commandTwist({msg->linear.x, msg->angular.z});
