@@ -27,6 +27,12 @@ class DriverMotion : public MotionQuery {
     const std::string trajectories = trajectories_ ? trajectories_->motionInForce() : std::string();
     return trajectories.empty() ? trajectories : "trajectories: " + trajectories;
   }
+  bool inMotion() const override {
+    for (const auto& entry : devices_) {
+      if (entry.second->inMotion()) return true;
+    }
+    return trajectories_ && trajectories_->inMotion();
+  }
 
  private:
   std::vector<std::pair<std::string, const Device*>> devices_;

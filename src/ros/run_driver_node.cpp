@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
@@ -95,6 +96,17 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const sigset_t& stop_s
 
 }  // namespace
 
+/// ~realtime_priority on the main thread before roscpp starts its threads (with the first
+/// NodeHandle; ros::param needs none): every thread of the process inherits SCHED_FIFO, roscpp's
+/// too (the poll thread that carries messages to and from the sockets, its timers), so the whole
+/// path of a frame or a command runs at the priority. Checked and logged once by
+/// DriverCore::start(); a value validate() refuses is not applied here either.
+void enterRealtimeBeforeRoscpp() {
+  int priority = 0;
+  if (!ros::param::get("~realtime_priority", priority)) return;
+  if (priority > 0 && priority <= core::kMaxRealtimePriority) core::enterRealtime(priority);
+}
+
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
   // We take SIGINT ourselves: roscpp's handler would tear the node down before the zero-speed frame
   // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
@@ -104,6 +116,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
+  enterRealtimeBeforeRoscpp();
 
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");

@@ -428,14 +428,26 @@ void TrajectoryExecutor::writeTracks(double now) {
   dropVoided(voided_joints, now);
 }
 
+bool TrajectoryExecutor::jointInMotionLocked(std::size_t j) const {
+  return tracks_[j].writing ||
+         std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
+           return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
+         });
+}
+
+bool TrajectoryExecutor::inMotion() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (std::size_t j = 0; j < tracks_.size(); ++j) {
+    if (jointInMotionLocked(j)) return true;
+  }
+  return false;
+}
+
 std::string TrajectoryExecutor::motionInForce() {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> moving;
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
-    const bool in_goal = std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
-      return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
-    });
-    if (tracks_[j].writing || in_goal) moving.push_back(ranges_[j].name);
+    if (jointInMotionLocked(j)) moving.push_back(ranges_[j].name);
   }
   if (moving.empty()) return {};
   std::string text = "trajectory in progress (";

@@ -13,8 +13,11 @@
 //    put on the wire at once;
 //  - the front end's callback thread for commands (the ROS node's global-queue spinner: cmd_vel,
 //    joint_commands written at once, trajectory ticks).
-// Every other thread (service spinners, the gyro calibration, roscpp's own) keeps the normal
-// policy. A thread that may not switch (EPERM) goes on at the normal policy: nothing else changes.
+// The driver_node executable also puts its main thread at the priority before roscpp starts its
+// threads (ros_layer::runDriverNode), so every thread of the process inherits it: roscpp's poll
+// thread (which carries messages between the sockets and the callback queues) and timers, the
+// service spinners and the gyro calibration. In a nodelet manager only the threads above take it.
+// A thread that may not switch (EPERM) goes on at the normal policy: nothing else changes.
 #pragma once
 
 #include <cstdint>

@@ -104,8 +104,12 @@ class TrajectoryExecutor {
   /// Why trajectories may be moving joints now: a goal in progress or joints still being written
   /// or moved; "" when none. Any thread (a sensor calibration asks it once per frame).
   std::string motionInForce();
+  /// Whether motionInForce() would name something, without building its text. Any thread.
+  bool inMotion();
 
  private:
+  /// Requires mutex_: joint `j` is being written or is in a goal.
+  bool jointInMotionLocked(std::size_t j) const;
   struct Track {
     std::size_t group = 0;  ///< index into groups_
     std::size_t local = 0;  ///< index into that group's joints

@@ -129,18 +129,29 @@ void BaseController::setEStop(bool engaged) {
   wake_.notify_all();
 }
 
+bool BaseController::commandMovesLocked(core::Clock::time_point now) const {
+  const bool command_live =
+      !e_stop_ && last_command_ && seconds(now - *last_command_) <= config_.cmd_vel_timeout;
+  return command_live && (linear_x_ != 0.0 || angular_z_ != 0.0);
+}
+
+bool BaseController::rampingLocked() const { return !e_stop_ && !limiter_.current().isZero(0.0); }
+
+bool BaseController::inMotion() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return commandMovesLocked(clock_->now()) || rampingLocked();
+}
+
 std::string BaseController::motionInForce() const {
   std::lock_guard<std::mutex> lock(mutex_);
   char text[128];
-  const bool command_live = !e_stop_ && last_command_ &&
-                            seconds(clock_->now() - *last_command_) <= config_.cmd_vel_timeout;
-  if (command_live && (linear_x_ != 0.0 || angular_z_ != 0.0)) {
+  if (commandMovesLocked(clock_->now())) {
     std::snprintf(text, sizeof text, "cmd_vel of %.3g m/s, %.3g rad/s in force", linear_x_,
                   angular_z_);
     return text;
   }
-  const WheelSpeeds& ramp = limiter_.current();
-  if (!e_stop_ && !ramp.isZero(0.0)) {
+  if (rampingLocked()) {
+    const WheelSpeeds& ramp = limiter_.current();
     std::snprintf(text, sizeof text, "wheels still ramping (%.3g, %.3g m/s)", ramp.x(), ramp.y());
     return text;
   }

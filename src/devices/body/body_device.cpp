@@ -19,7 +19,7 @@ BodyDevice::BodyDevice(const params::DriverParams& params, core::SerialLink& lin
     : link_(link),
       imu_params_(std::make_shared<const ImuParams>(params.section(kImuSection))),
       imu_heading_(params.section(kImuSection).orientation_variance),
-      gyro_calibrator_([this] { return notStill(); }),
+      gyro_calibrator_([this] { return notStill(); }, {}, [this] { return moving(); }),
       // Expected telemetry rates, as diagnostic_updater's FrequencyStatus.
       telemetry_rate_(
           1.0, 1000.0,
@@ -43,6 +43,10 @@ BodyDevice::~BodyDevice() { shutdown(); }
 std::string BodyDevice::notStill() const {
   if (e_stop_ && e_stop_->engaged()) return "the e-stop is engaged";
   return motion_query_ ? motion_query_->motionInForce() : std::string();
+}
+
+bool BodyDevice::moving() const {
+  return (e_stop_ && e_stop_->engaged()) || (motion_query_ && motion_query_->inMotion());
 }
 
 void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival) {

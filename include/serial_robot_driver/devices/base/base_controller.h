@@ -217,6 +217,8 @@ class BaseController : public core::LinkListener {
   /// Why the wheels may be moving now, or "" when they are commanded still: a non-zero cmd_vel in
   /// force (not timed out, no e-stop) or wheels still ramping toward zero. Any thread.
   std::string motionInForce() const;
+  /// Whether motionInForce() would name something, without building its text. Any thread.
+  bool inMotion() const;
   /// Writes a Reset now (base/reset). False when the port is down.
   bool sendReset();
   /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.
@@ -263,6 +265,10 @@ class BaseController : public core::LinkListener {
   /// last immediate frame is minImmediateInterval() ago).
   bool mayRushLocked(core::Clock::time_point now) const;
   bool lineAllowsImmediateLocked(core::Clock::time_point now) const;
+  /// Requires mutex_: a non-zero cmd_vel in force (not timed out, no e-stop).
+  bool commandMovesLocked(core::Clock::time_point now) const;
+  /// Requires mutex_: the wheels still ramping toward zero (no e-stop).
+  bool rampingLocked() const;
   /// Requires mutex_. Writes one frame with the next SEQ; false on failure.
   bool writeLocked(const std::vector<uint8_t>& frame, core::Clock::time_point now);
   /// `timed_out_now`: set when the cmd_vel timeout started with this call.

@@ -96,6 +96,7 @@ class BodyDevice : public core::Device {
   std::string motionInForce() const override {
     return controller_.motionInForce(core::Clock::now());
   }
+  bool inMotion() const override { return controller_.inMotion(core::Clock::now()); }
 
   const BodyController& controller() const { return controller_; }
 
@@ -103,6 +104,8 @@ class BodyDevice : public core::Device {
   void onTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival);
   /// Why the robot is not held still now, "" when it is (reader and calibration threads).
   std::string notStill() const;
+  /// notStill() as a bool that builds no text: asked once per frame.
+  bool moving() const;
   void logFlow(BodyStatus::FlowChange flow) const;
 
   core::SerialLink& link_;
