@@ -26,6 +26,7 @@ catkin_add_gtest(core_tests
   test/unit/test_device_sections.cpp
   test/unit/test_e_stop.cpp
   test/unit/test_input_refusals.cpp
+  test/unit/test_log.cpp
   test/unit/test_status_report.cpp
   test/unit/test_capabilities.cpp
   test/unit/test_event_rate.cpp)
