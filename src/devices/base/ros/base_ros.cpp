@@ -19,11 +19,13 @@ namespace serial_robot_driver::devices::base::ros {
 BaseRos::BaseRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params, BaseDevice& device)
     : device_(device),
       arrival_stamps_(params),
-      tf_pub_(device.params().publish_tf ? advertiseTf() : ::ros::Publisher()) {
-  odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", 50);
-  wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
-  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
-  wheel_states_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
+      tf_pub_(device.params().publish_tf ? advertiseTf() : ros_layer::CountedPublisher()) {
+  odom_pub_ = ros_layer::advertiseCounted<nav_msgs::Odometry>(nh, "odom", 50);
+  wheel_command_pub_ =
+      ros_layer::advertiseCounted<serial_robot_driver::WheelCommand>(nh, "wheel_command", 50);
+  battery_pub_ = ros_layer::advertiseCounted<sensor_msgs::BatteryState>(nh, "battery",
+                                                                        params.publisherQueue(5));
+  wheel_states_pub_ = ros_layer::advertiseCounted<sensor_msgs::JointState>(nh, "wheel_states", 50);
   device.addOutputs(outputs());
 
   core::InputRefusals& refusals = device.inputRefusals();
@@ -97,10 +99,11 @@ void BaseRos::publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sa
   tf_pub_.publish(tf);
 }
 
-::ros::Publisher BaseRos::advertiseTf() {
+ros_layer::CountedPublisher BaseRos::advertiseTf() {
   // As tf2_ros::TransformBroadcaster advertises it, with a publisher whose subscribers we can
   // count.
-  return ::ros::NodeHandle().advertise<tf2_msgs::TFMessage>("/tf", 100);
+  ::ros::NodeHandle global;
+  return ros_layer::advertiseCounted<tf2_msgs::TFMessage>(global, "/tf", 100);
 }
 
 void BaseRos::publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp) {

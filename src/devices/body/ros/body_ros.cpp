@@ -17,13 +17,14 @@ namespace serial_robot_driver::devices::body::ros {
 BodyRos::BodyRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params, BodyDevice& device)
     : device_(device), arrival_stamps_(params), calibration_nh_(nh) {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
-  joint_states_pub_ =
-      nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
-  imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", params.publisherQueue(20));
-  foot_pressure_pub_ =
-      nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
-  telemetry_pub_ =
-      nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
+  joint_states_pub_ = ros_layer::advertiseCounted<sensor_msgs::JointState>(
+      nh, "joint_states", params.publisherQueue(20));
+  imu_pub_ =
+      ros_layer::advertiseCounted<sensor_msgs::Imu>(nh, "imu/data", params.publisherQueue(20));
+  foot_pressure_pub_ = ros_layer::advertiseCounted<serial_robot_driver::FootPressure>(
+      nh, "foot_pressure", params.publisherQueue(20));
+  telemetry_pub_ = ros_layer::advertiseCounted<serial_robot_driver::Telemetry>(
+      nh, "telemetry", params.publisherQueue(20));
   device.addOutputs({[this](const BodyFrame& frame) { publishFrame(frame); }});
 
   core::InputRefusals& refusals = device.inputRefusals();

@@ -8,7 +8,7 @@ namespace serial_robot_driver::devices::servo_bus::ros {
 
 ServoBusRos::ServoBusRos(::ros::NodeHandle& nh, ServoBusDevice& device)
     : device_(device), services_(nh, device.bus(), device.claims(), device.inputRefusals()) {
-  states_pub_ = nh.advertise<sensor_msgs::JointState>("servo_states", 10);
+  states_pub_ = ros_layer::advertiseCounted<sensor_msgs::JointState>(nh, "servo_states", 10);
   ServoBusOutputs outputs;
   outputs.servo_state = [this](const JointPosition& state, core::Clock::time_point arrival) {
     if (!ros_layer::wanted(states_pub_)) return;  // nobody asked for it

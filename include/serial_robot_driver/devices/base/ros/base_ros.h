@@ -15,6 +15,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 
 namespace serial_robot_driver::devices::base::ros {
 
@@ -30,16 +31,16 @@ class BaseRos : public ros_layer::DeviceFrontEnd {
   void publishOdometry(const OdometrySample& sample);
   /// odom's pose as odom -> base_link on /tf.
   void publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample);
-  static ::ros::Publisher advertiseTf();
+  static ros_layer::CountedPublisher advertiseTf();
   void publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp);
 
   BaseDevice& device_;
   ros_layer::ArrivalStamps arrival_stamps_;
-  ::ros::Publisher tf_pub_;  // /tf; advertised by the loop thread when first needed
-  ::ros::Publisher odom_pub_;
-  ::ros::Publisher wheel_states_pub_;
-  ::ros::Publisher wheel_command_pub_;
-  ::ros::Publisher battery_pub_;
+  ros_layer::CountedPublisher tf_pub_;  // /tf; advertised by the loop thread when first needed
+  ros_layer::CountedPublisher odom_pub_;
+  ros_layer::CountedPublisher wheel_states_pub_;
+  ros_layer::CountedPublisher wheel_command_pub_;
+  ros_layer::CountedPublisher battery_pub_;
   ::ros::Subscriber cmd_vel_sub_;
   ::ros::ServiceServer reset_odometry_srv_;
   ::ros::ServiceServer reset_srv_;
