@@ -204,10 +204,12 @@ struct Variant {
   double read_poll_interval;    ///< 0: event-driven
   bool spaced_cmd_vel = false;  ///< section 11: commands 10-40 ms apart instead of one per tick
   bool capture = false;         ///< ~capture on, with a subscriber on serial_raw
+  bool same_job = false;        ///< floor_node's ~same_job: the user's topics, done minimally
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
 const Variant kFloor{"floor", "floor", "floor_node", 0.0, true};
+const Variant kSameJobFloor{"same-job floor", "floorjob", "floor_node", 0.0, true, false, true};
 const Variant kCapturing{"capture on", "capture", "driver_node", 0.0, false, true};
 
 struct Context {
@@ -217,6 +219,8 @@ struct Context {
   ResultTable results;
   std::size_t failures = 0;  ///< measurements that could not complete
   int bench_priority = 0;    ///< SCHED_FIFO priority this process's threads run at; 0: normal
+  /// Section 8: statuses per /diagnostics message of driver_node (the same-job floor's count).
+  std::size_t node_diagnostic_statuses = 0;
 };
 
 void require(bool condition, const std::string& what) {
@@ -228,6 +232,7 @@ ParamList commonParams(const std::string& port, const Variant& variant) {
   if (variant.read_poll_interval > 0)
     params.emplace_back("read_poll_interval", variant.read_poll_interval);
   if (variant.capture) params.emplace_back("capture", true);
+  if (variant.same_job) params.emplace_back("same_job", true);
   return params;
 }
 
@@ -1259,8 +1264,14 @@ class UserSubscribers {
     add<nav_msgs::Odometry>(nh, "/" + ns + "/odom");
     add<sensor_msgs::JointState>(nh, "/" + ns + "/wheel_states");
     add<tf2_msgs::TFMessage>(nh, "/tf");
-    add<diagnostic_msgs::DiagnosticArray>(nh, "/diagnostics");
+    subscribers_.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+        "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+          ++messages_;
+          statuses_ = array->status.size();
+        }));
   }
+  /// Statuses in the last /diagnostics message (0 before the first).
+  std::size_t diagnosticStatuses() const { return statuses_; }
 
  private:
   template <typename Message>
@@ -1269,6 +1280,7 @@ class UserSubscribers {
         topic, 100, [this](const typename Message::ConstPtr&) { ++messages_; }));
   }
   std::atomic<std::size_t> messages_{0};
+  std::atomic<std::size_t> statuses_{0};
   std::vector<ros::Subscriber> subscribers_;
 };
 
@@ -1308,8 +1320,15 @@ XmlRpc::XmlRpcValue realtimeValue(const std::string& text) {
 /// command is recognisable on the wire (one tick value per command, room for 600 of them); they
 /// change no work per frame. floor_node reads the same parameters for what it does.
 ParamList userParams(const std::string& port, const UserCondition& condition,
-                     const Options& options) {
-  ParamList params = commonParams(port, kEventDriven);
+                     const Context& context, const Variant& variant) {
+  const Options& options = context.options;
+  ParamList params = commonParams(port, variant);
+  if (variant.same_job) {
+    // As many statuses as driver_node's (it ran first); 5 (port, three devices, e_stop) before.
+    const std::size_t statuses =
+        context.node_diagnostic_statuses > 0 ? context.node_diagnostic_statuses : 5;
+    params.emplace_back("same_job_statuses", static_cast<int>(statuses));
+  }
   const ParamList body = TelemetryProbe::nodeParams();
   params.insert(params.end(), body.begin(), body.end());
   params.insert(params.end(), {{"base/speed_dithering", false}, {"base/max_wheel_speed", 20.0}});
@@ -1377,7 +1396,7 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   TelemetryProbe probe(context.nh, "/" + ns + "/joint_states",
                        kWarmUpFrames + frames + 4 * commands + 200);
   const PlayedBase base(pty, probe);
-  DriverProcess driver(context.paths, ns, userParams(pty.linkPath(), condition, context.options),
+  DriverProcess driver(context.paths, ns, userParams(pty.linkPath(), condition, context, variant),
                        variant.program);
   const UserSubscribers subscribers(context.nh, ns);
   ros::Publisher cmd_vel = context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
@@ -1389,6 +1408,9 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   uint32_t seq = kWarmUpFrames;
   UserFigures figures = measureStreamingWindow(probe, pty, base.log(), driver.pid(), frames, &seq);
   figures.cmd_vel = timeCmdVelWhileStreaming(probe, pty, seq, cmd_vel, base.log(), commands);
+  if (variant.program == kEventDriven.program) {
+    context.node_diagnostic_statuses = subscribers.diagnosticStatuses();
+  }
   return figures;
 }
 
@@ -1416,10 +1438,16 @@ const std::vector<UserFigure> kUserFigures{
     {"50 Hz loop worst period", "ms", 3, [](const UserFigures& f) { return f.loop.period_ms.max; }},
 };
 
-/// Every session of section 8, per condition (kUserConditions' order), one entry per round.
+/// Every session of section 8, per condition (kUserConditions' order), one entry per round: the
+/// node's, the same-job floor's (floor_node ~same_job) and the minimal floor's.
 struct UserRuns {
   std::vector<std::vector<UserFigures>> node{kUserConditions.size()};
+  std::vector<std::vector<UserFigures>> same_job{kUserConditions.size()};
   std::vector<std::vector<UserFigures>> floor{kUserConditions.size()};
+  std::vector<std::vector<UserFigures>>& of(const Variant& variant) {
+    if (variant.same_job) return same_job;
+    return variant.program == kFloor.program ? floor : node;
+  }
 };
 
 /// The mean of `figure` over the rounds of one condition; nullopt when none completed.
@@ -1429,17 +1457,26 @@ std::optional<double> meanFigure(const std::vector<UserFigures>& rounds, const U
   return meanOf(values);
 }
 
-/// "node, floor, node / floor" cells of one figure in one condition (kUserConditions' index).
+/// "node, same-job floor, node / same job, minimal floor, node / minimal" cells of one figure in
+/// one condition (kUserConditions' index).
 std::vector<std::string> userCells(const UserRuns& runs, std::size_t condition,
                                    const UserFigure& figure) {
   const auto node = meanFigure(runs.node[condition], figure);
+  const auto same_job = meanFigure(runs.same_job[condition], figure);
   const auto floor = meanFigure(runs.floor[condition], figure);
   auto cell = [&](std::optional<double> value) {
     return value ? format("%.*f %s", figure.decimals, *value, figure.unit) : std::string("-");
   };
-  return {cell(node), cell(floor),
-          node && floor && *floor > 0 ? format("%.2fx", *node / *floor) : "-"};
+  auto ratio = [&](std::optional<double> yardstick) {
+    return node && yardstick && *yardstick > 0 ? format("%.2fx", *node / *yardstick)
+                                               : std::string("-");
+  };
+  return {cell(node), cell(same_job), ratio(same_job), cell(floor), ratio(floor)};
 }
+
+/// The columns userCells() fills.
+const std::vector<std::string> kUserColumns{"driver_node", "same-job floor", "node / same job",
+                                            "minimal floor", "node / minimal"};
 
 /// Indices into kUserFigures and kUserConditions for the summary.
 enum UserFigureIndex { kCpuFigure = 0, kCmdVelP99 = 2, kTelemetryP99 = 5, kLoopJitter = 6 };
@@ -1447,8 +1484,11 @@ enum UserConditionIndex { kQuietIndex = 0, kLoadedIndex = 2, kLoadedRtIndex = 3 
 
 /// Issue 43's table: its rows, in its order, from section 8's sessions.
 void addUserSummary(ResultTable& table, const UserRuns& runs) {
+  std::vector<std::string> columns{"figure"};
+  columns.insert(columns.end(), kUserColumns.begin(), kUserColumns.end());
+  columns.push_back("goal (node / same job)");
   table.section("8. The configuration users run against the floor: summary (issue 43's rows)",
-                {"figure", "driver_node", "floor", "node / floor", "goal"});
+                columns);
   struct Row {
     const char* what;
     UserFigureIndex figure;
@@ -1467,15 +1507,19 @@ void addUserSummary(ResultTable& table, const UserRuns& runs) {
       {"CPU under that load", kCpuFigure, kLoadedIndex, "<= 1.1x"},
   };
   for (const Row& row : rows) {
-    const auto cells = userCells(runs, row.condition, kUserFigures[row.figure]);
-    table.row({row.what, cells[0], cells[1], cells[2], row.goal});
+    std::vector<std::string> cells{row.what};
+    const auto figures = userCells(runs, row.condition, kUserFigures[row.figure]);
+    cells.insert(cells.end(), figures.begin(), figures.end());
+    cells.push_back(row.goal);
+    table.row(cells);
   }
 }
 
 /// Every figure in every condition.
 void addUserRows(ResultTable& table, const UserRuns& runs) {
-  table.section("8. The configuration users run against the floor: every figure",
-                {"figure", "load", "RT", "driver_node", "floor", "node / floor"});
+  std::vector<std::string> columns{"figure", "load", "RT"};
+  columns.insert(columns.end(), kUserColumns.begin(), kUserColumns.end());
+  table.section("8. The configuration users run against the floor: every figure", columns);
   for (const UserFigure& figure : kUserFigures) {
     for (std::size_t condition = 0; condition < kUserConditions.size(); ++condition) {
       std::vector<std::string> row{figure.name, kUserConditions[condition].load(),
@@ -1494,8 +1538,10 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
       "driver_node in the configuration users run (the defaults: base, body and servo bus on one "
       "port, odom and /tf, diagnostics, battery poll; 20 body servos; speed_dithering off and "
       "max_wheel_speed 20 so each command is recognisable on the wire) and floor_node with the "
-      "same parameters; this process plays the robot (telemetry of 20 servos at 100 Hz, battery "
-      "answers).");
+      "same parameters, twice: the same-job floor (~same_job: besides joint_states, imu/data per "
+      "frame, odom + /tf + wheel_states per tick, /diagnostics at 1 Hz with as many statuses as "
+      "driver_node's, all as minimally as possible) and the minimal floor (joint_states only); "
+      "this process plays the robot (telemetry of 20 servos at 100 Hz, battery answers).");
   table.note(
       "Subscribed throughout: joint_states (robot_state_publisher), wheel_states "
       "(joint_state_publisher), imu/data, odom, /tf (rviz, navigation), /diagnostics "
@@ -1503,20 +1549,21 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
   table.note(format(
       "Per session: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock over that "
       "window, telemetry latency, loop periods from speed frame arrivals), then %zu cmd_vel "
-      "commands 10-40 ms apart while telemetry streams. %zu round(s); node and floor back to back "
-      "per condition, which goes first alternating.",
+      "commands 10-40 ms apart while telemetry streams. %zu round(s); node and both floors back to "
+      "back per condition, which goes first rotating.",
       frames, commands, o.floor_rounds));
   table.note(format(
       "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
-      "~realtime_priority %s for both (floor_node: SCHED_FIFO on its reader and loop threads, "
-      "memory locked). This benchmark's own threads: %s.",
+      "~realtime_priority %s for all (each takes SCHED_FIFO on its main thread before roscpp "
+      "starts, so every thread inherits it; memory locked). This benchmark's own threads: %s.",
       o.realtime_priority.c_str(),
       context.bench_priority > 0 ? format("SCHED_FIFO %d", context.bench_priority).c_str()
                                  : "normal priority"));
 }
 
-/// Section 8: driver_node and floor_node in every condition (quiet / loaded, RT off / on), the
-/// two back to back per condition and round, which one goes first alternating.
+/// Section 8: driver_node and floor_node (same job, minimal) in every condition (quiet / loaded, RT
+/// off / on), the three back to back per condition and round, which one goes first rotating
+/// (driver_node first of all: the same-job floor takes its count of diagnostic statuses).
 void runUserConfiguration(Context& context) {
   const Options saved = context.options;
   const std::size_t rounds = saved.floor_rounds;
@@ -1526,12 +1573,13 @@ void runUserConfiguration(Context& context) {
   for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
     for (std::size_t c = 0; c < kUserConditions.size(); ++c) {
       const UserCondition& condition = kUserConditions[c];
-      for (int k = 0; k < 2; ++k) {
-        const bool floor_turn = (k == 1) != ((c + round) % 2 == 1);
-        const Variant& variant = floor_turn ? kFloor : kEventDriven;
-        auto& into = floor_turn ? runs.floor[c] : runs.node[c];
+      const Variant* const programs[] = {&kEventDriven, &kSameJobFloor, &kFloor};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Variant& variant = *programs[(k + c + round) % 3];
+        auto& into = runs.of(variant)[c];
         attempt(context,
-                format("8. %s, %s, RT %s, round %zu", variant.program.c_str(),
+                format("8. %s, %s, RT %s, round %zu",
+                       variant.same_job ? "floor_node ~same_job" : variant.program.c_str(),
                        condition.load().c_str(), condition.rt().c_str(), round + 1),
                 [&] { into.push_back(runUserSession(context, variant, condition, round)); });
       }

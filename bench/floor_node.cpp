@@ -2,25 +2,37 @@
 // Benchmark only, never installed. It reads the same parameters as driver_node for what it does:
 // ~port, ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids, ~body/joint_names,
 // ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution, ~realtime_priority (1..99, or
-// true for 50: SCHED_FIFO on the reader and loop threads, memory locked, as driver_node does).
+// true for 50: SCHED_FIFO on the main thread before roscpp starts its threads, so every thread
+// inherits it, as driver_node does; memory locked).
+// ~same_job (default false: the minimal floor) makes it do the job a user's driver_node does, as
+// minimally as possible: besides joint_states, imu/data per telemetry frame, odom + /tf +
+// wheel_states per loop tick (the commanded motion integrated), and /diagnostics at 1 Hz with
+// ~same_job_statuses statuses.
 //
 // Threading: one reader thread blocks on the port, frames telemetry and publishes one JointState
-// per frame; the cmd_vel callback (ros::spin thread) writes its speed frame at once; the main
-// thread writes the speed frame every loop period on absolute clock_nanosleep deadlines. Writes
-// from the two writers are serialised by one mutex. No validation, diagnostics or services.
+// (and one Imu) per frame; the cmd_vel callback (the AsyncSpinner's thread) writes its speed frame
+// at once; the main thread writes the speed frame (and publishes odom, /tf, wheel_states) every
+// loop period on absolute clock_nanosleep deadlines; the diagnostics timer runs on the spinner's
+// thread. Writes from the two writers are serialised by one mutex. No validation or services.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <fcntl.h>
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <pthread.h>
 #include <ros/ros.h>
 #include <sched.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
 #include <sys/mman.h>
 #include <termios.h>
+#include <tf2_msgs/TFMessage.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -29,6 +41,7 @@
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
+#include "serial_robot_driver/devices/body/body_readings.h"
 #include "serial_robot_driver/kinematics/diff_drive.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "support/framer_configs.h"
@@ -41,7 +54,16 @@ std::atomic<bool> g_running{true};
 int g_fd = -1;
 std::mutex g_write_mutex;
 std::atomic<int16_t> g_left{0}, g_right{0};
+std::atomic<double> g_linear{0.0}, g_angular{0.0};  // the twist commanded last (same job)
 uint8_t g_seq = 0;  // guarded by g_write_mutex
+
+/// ~same_job's publishers (advertised only with it on).
+struct SameJob {
+  bool on = false;
+  int statuses = 5;
+  ros::Publisher imu, odom, tf, wheel_states, diagnostics;
+  ros::SteadyTimer diagnostics_timer;
+};
 
 void writeSpeedFrame() {
   std::lock_guard<std::mutex> lock(g_write_mutex);
@@ -50,21 +72,25 @@ void writeSpeedFrame() {
   }
 }
 
-/// ~realtime_priority: an integer priority, or true for 50; 0 (or absent, or false) is off.
-int realtimePriority(ros::NodeHandle& pnh) {
+/// ~realtime_priority: an integer priority, or true for 50; 0 (or absent, or false) is off. Read
+/// before any NodeHandle exists (ros::param needs none), so no roscpp thread runs yet.
+int realtimePriority() {
   int priority = 0;
-  if (pnh.getParam("realtime_priority", priority)) return priority;
+  if (ros::param::get("~realtime_priority", priority)) return priority;
   bool on = false;
-  return pnh.getParam("realtime_priority", on) && on ? 50 : 0;
+  return ros::param::get("~realtime_priority", on) && on ? 50 : 0;
 }
 
-/// SCHED_FIFO at `priority` for the calling thread (0: nothing); says so when not allowed.
-void runRealtime(int priority, const char* thread) {
+/// SCHED_FIFO at `priority` for the calling thread (0: nothing); says so when not allowed. On the
+/// main thread before roscpp starts its threads: the reader, the loop, the spinner and roscpp's
+/// own (poll, timers, XML-RPC) inherit it, as driver_node's do.
+void runRealtime(int priority) {
   if (priority <= 0) return;
+  if (::mlockall(MCL_CURRENT | MCL_FUTURE) != 0) std::fprintf(stderr, "floor: mlockall failed\n");
   sched_param param{};
   param.sched_priority = priority;
   const int error = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &param);
-  if (error != 0) ROS_WARN("floor: %s thread: SCHED_FIFO %d not allowed", thread, priority);
+  if (error != 0) std::fprintf(stderr, "floor: SCHED_FIFO %d not allowed\n", priority);
 }
 
 /// The body's joints as ~body/* gives them.
@@ -111,14 +137,38 @@ ros::Subscriber subscribeCmdVel(ros::NodeHandle& nh,
       "cmd_vel", 10, [&geometry](const geometry_msgs::Twist::ConstPtr& twist) {
         const auto speeds =
             srd::kinematics::wheelSpeedsFromTwist(geometry, twist->linear.x, twist->angular.z);
+        g_linear = twist->linear.x;
+        g_angular = twist->angular.z;
         g_left = static_cast<int16_t>(speeds[0] * geometry.ticksPerPeriodPerMps());
         g_right = static_cast<int16_t>(speeds[1] * geometry.ticksPerPeriodPerMps());
         writeSpeedFrame();
       });
 }
 
-/// The reader thread: one JointState per telemetry frame, until g_running ends.
-void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states) {
+/// Same job: one frame's IMU values as imu/data (the core's scaling, no bias, no covariances).
+void publishImu(const srd::devices::body::Telemetry& telemetry, const ros::Time& stamp,
+                ros::Publisher& imu) {
+  const srd::devices::body::ImuReading reading =
+      srd::devices::body::imuReading(telemetry, srd::devices::body::ImuParams{});
+  sensor_msgs::Imu msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = "imu_link";
+  msg.orientation.w = reading.orientation.w;
+  msg.orientation.x = reading.orientation.x;
+  msg.orientation.y = reading.orientation.y;
+  msg.orientation.z = reading.orientation.z;
+  msg.angular_velocity.x = reading.angular_velocity.x();
+  msg.angular_velocity.y = reading.angular_velocity.y();
+  msg.angular_velocity.z = reading.angular_velocity.z();
+  msg.linear_acceleration.x = reading.linear_acceleration.x();
+  msg.linear_acceleration.y = reading.linear_acceleration.y();
+  msg.linear_acceleration.z = reading.linear_acceleration.z();
+  imu.publish(msg);
+}
+
+/// The reader thread: one JointState (and with ~same_job one Imu) per telemetry frame, until
+/// g_running ends.
+void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states, SameJob& job) {
   const std::size_t count = joints.ids.size();
   const auto config = test_support::driverFramer({"body"}, count);
   srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
@@ -134,6 +184,7 @@ void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states) {
       msg.velocity.push_back(joints.calibrations[i].toRadiansPerSecond(telemetry->servos[i].speed));
     }
     joint_states.publish(msg);
+    if (job.on) publishImu(*telemetry, msg.header.stamp, job.imu);
   });
   uint8_t buffer[1024];
   while (g_running) {
@@ -142,8 +193,90 @@ void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states) {
   }
 }
 
-/// The speed frame every loop period on absolute deadlines, until ROS shuts down.
-void runBaseLoop(double loop_rate) {
+/// Same job: the commanded motion integrated over one loop period, published as odom, its
+/// transform on /tf and the wheels' angles on wheel_states.
+class SameJobOdometry {
+ public:
+  SameJobOdometry(SameJob& job, const srd::kinematics::DiffDriveGeometry& geometry)
+      : job_(job), geometry_(geometry) {
+    wheels_.name = {"left_wheel_joint", "right_wheel_joint"};
+    wheels_.position = {0.0, 0.0};
+    wheels_.velocity = {0.0, 0.0};
+  }
+
+  void tick(double dt) {
+    const double linear = g_linear, angular = g_angular;
+    x_ += linear * std::cos(yaw_) * dt;
+    y_ += linear * std::sin(yaw_) * dt;
+    yaw_ += angular * dt;
+    const auto speeds = srd::kinematics::wheelSpeedsFromTwist(geometry_, linear, angular);
+    const ros::Time stamp = ros::Time::now();
+    nav_msgs::Odometry odom;
+    odom.header.stamp = stamp;
+    odom.header.frame_id = "odom";
+    odom.child_frame_id = "base_link";
+    odom.pose.pose.position.x = x_;
+    odom.pose.pose.position.y = y_;
+    odom.pose.pose.orientation.z = std::sin(yaw_ / 2);
+    odom.pose.pose.orientation.w = std::cos(yaw_ / 2);
+    odom.twist.twist.linear.x = linear;
+    odom.twist.twist.angular.z = angular;
+    job_.odom.publish(odom);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.resize(1);
+    tf.transforms[0].header = odom.header;
+    tf.transforms[0].child_frame_id = odom.child_frame_id;
+    tf.transforms[0].transform.translation.x = x_;
+    tf.transforms[0].transform.translation.y = y_;
+    tf.transforms[0].transform.rotation = odom.pose.pose.orientation;
+    job_.tf.publish(tf);
+    wheels_.header.stamp = stamp;
+    for (int i = 0; i < 2; ++i) {
+      wheels_.velocity[i] = speeds[i] / (geometry_.wheel_diameter / 2);
+      wheels_.position[i] += wheels_.velocity[i] * dt;
+    }
+    job_.wheel_states.publish(wheels_);
+  }
+
+ private:
+  SameJob& job_;
+  const srd::kinematics::DiffDriveGeometry& geometry_;
+  double x_ = 0, y_ = 0, yaw_ = 0;
+  sensor_msgs::JointState wheels_;
+};
+
+/// Same job: /diagnostics once a second, job.statuses statuses (as many as driver_node's).
+void startDiagnostics(ros::NodeHandle& nh, SameJob& job) {
+  job.diagnostics_timer = nh.createSteadyTimer(ros::WallDuration(1.0), [&job](const auto&) {
+    diagnostic_msgs::DiagnosticArray array;
+    array.header.stamp = ros::Time::now();
+    array.status.resize(static_cast<std::size_t>(std::max(0, job.statuses)));
+    for (std::size_t i = 0; i < array.status.size(); ++i) {
+      array.status[i].name = "floor: status " + std::to_string(i);
+      array.status[i].message = "OK";
+      array.status[i].hardware_id = "floor";
+    }
+    job.diagnostics.publish(array);
+  });
+}
+
+/// Advertises ~same_job's topics and starts its diagnostics (nothing without it).
+void advertiseSameJob(ros::NodeHandle& nh, ros::NodeHandle& pnh, SameJob& job) {
+  job.on = pnh.param("same_job", false);
+  job.statuses = pnh.param("same_job_statuses", job.statuses);
+  if (!job.on) return;
+  job.imu = nh.advertise<sensor_msgs::Imu>("imu/data", 10);
+  job.odom = nh.advertise<nav_msgs::Odometry>("odom", 50);
+  job.tf = ros::NodeHandle().advertise<tf2_msgs::TFMessage>("/tf", 100);
+  job.wheel_states = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
+  job.diagnostics =
+      ros::NodeHandle().advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
+  startDiagnostics(nh, job);
+}
+
+/// The speed frame every loop period on absolute deadlines (with ~same_job the odometry's topics
+/// after it), until ROS shuts down.
+void runBaseLoop(double loop_rate, SameJobOdometry* odometry) {
   const long period_ns = static_cast<long>(1e9 / loop_rate);
   timespec deadline{};
   ::clock_gettime(CLOCK_MONOTONIC, &deadline);
@@ -155,6 +288,7 @@ void runBaseLoop(double loop_rate) {
     }
     ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
     writeSpeedFrame();
+    if (odometry) odometry->tick(1.0 / loop_rate);
   }
 }
 
@@ -162,36 +296,32 @@ void runBaseLoop(double loop_rate) {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "floor");
+  runRealtime(realtimePriority());
   ros::NodeHandle nh, pnh("~");
   const std::string port = pnh.param<std::string>("port", "/dev/ttyUSB0");
   const double loop_rate = pnh.param("loop_rate", 50.0);
   const bool base = pnh.param("base/enabled", true);
   const bool body = pnh.param("body/enabled", true);
   const BodyJoints joints = readBodyJoints(pnh);
-  const int priority = realtimePriority(pnh);
-  if (priority > 0 && ::mlockall(MCL_CURRENT | MCL_FUTURE) != 0) ROS_WARN("floor: mlockall failed");
   if (!openRawPort(port)) {
     ROS_FATAL("floor: cannot open %s", port.c_str());
     return 1;
   }
 
   ros::Publisher joint_states = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
+  SameJob job;
+  advertiseSameJob(nh, pnh, job);
   const srd::kinematics::DiffDriveGeometry geometry;
   ros::Subscriber cmd_vel;
   if (base) cmd_vel = subscribeCmdVel(nh, geometry);
   std::thread reader;
-  if (body) {
-    reader = std::thread([&] {
-      runRealtime(priority, "reader");
-      publishTelemetry(joints, joint_states);
-    });
-  }
+  if (body) reader = std::thread([&] { publishTelemetry(joints, joint_states, job); });
 
   ros::AsyncSpinner spinner(1);
   spinner.start();
   if (base) {
-    runRealtime(priority, "loop");
-    runBaseLoop(loop_rate);
+    SameJobOdometry odometry(job, geometry);
+    runBaseLoop(loop_rate, job.on ? &odometry : nullptr);
   } else {
     ros::waitForShutdown();
   }

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "serial_robot_driver/core/e_stop_status.h"
+#include "serial_robot_driver/core/log.h"
 
 namespace serial_robot_driver::core {
 
@@ -25,6 +26,12 @@ class DriverMotion : public MotionQuery {
     }
     const std::string trajectories = trajectories_ ? trajectories_->motionInForce() : std::string();
     return trajectories.empty() ? trajectories : "trajectories: " + trajectories;
+  }
+  bool inMotion() const override {
+    for (const auto& entry : devices_) {
+      if (entry.second->inMotion()) return true;
+    }
+    return trajectories_ && trajectories_->inMotion();
   }
 
  private:
@@ -75,6 +82,7 @@ SerialLinkOptions DriverCore::linkOptions(const std::string& path,
   // validate() made every device on a shared port agree on the baud rate.
   options.baud = static_cast<unsigned>(params_.baudOf(*users.front()));
   options.reconnect_interval = params_.reconnect_interval;
+  options.realtime_priority = params_.realtime_priority;
   options.framer = framerFor(users, params_);
   for (const DeviceModule* device : users) {
     if (!device->stale_frame_timeout) continue;
@@ -154,6 +162,12 @@ Device* DriverCore::device(const std::string& name) const {
 }
 
 void DriverCore::start() {
+  // Before any thread that takes the priority starts: their stacks are locked with the rest.
+  realtime_ = prepareRealtime(params_.realtime_priority);
+  // Once, whichever front ends run: what applies, or what refused it and how to allow it.
+  if (!realtime_.message.empty()) {
+    log(realtime_.refused ? LogLevel::kWarn : LogLevel::kInfo, "%s", realtime_.message.c_str());
+  }
   for (auto& [path, link] : ports_) link->start();
   for (auto& device : devices_) device->start();
 }

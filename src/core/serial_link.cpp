@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/transport/serial_port.h"
 
 namespace serial_robot_driver::core {
@@ -188,6 +189,7 @@ void SerialLink::waitForRetry(Clock::time_point until) {
 }
 
 void SerialLink::readerLoop() {
+  enterRealtime(options_.realtime_priority);  // refused: it reads at the normal policy
   while (!stopping_) {
     const Clock::time_point work_due =
         worker_ != nullptr ? worker_->nextWork() : Clock::time_point::max();

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "serial_robot_driver/core/device_module.h"
+#include "serial_robot_driver/core/realtime.h"
 
 namespace serial_robot_driver::params {
 
@@ -27,6 +28,11 @@ void addNodeParameters(std::vector<ParamSpec>& table) {
   });
   node("reconnect_interval", &P::reconnect_interval, positiveNumber);
   node("capture", &P::capture, Rule<bool>{});
+  node("realtime_priority", &P::realtime_priority, [](const int& v, const std::string& key) {
+    require(v >= 0 && v <= core::kMaxRealtimePriority, key,
+            "must be 0 (off) or a SCHED_FIFO priority 1.." +
+                std::to_string(core::kMaxRealtimePriority));
+  });
   node("replay_bag", &P::replay_bag, Rule<std::string>{});
   node("replay_rate", &P::replay_rate, nonNegativeNumber);
 }

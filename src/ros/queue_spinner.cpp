@@ -1,5 +1,7 @@
 #include "serial_robot_driver/ros/queue_spinner.h"
 
+#include "serial_robot_driver/core/realtime.h"
+
 namespace serial_robot_driver::ros_layer {
 
 namespace {
@@ -8,8 +10,8 @@ namespace {
 const ros::WallDuration kIdleWait(5.0);
 }  // namespace
 
-QueueSpinner::QueueSpinner(ros::CallbackQueue* queue, int threads)
-    : queue_(queue), thread_count_(threads) {}
+QueueSpinner::QueueSpinner(ros::CallbackQueue* queue, int threads, int realtime_priority)
+    : queue_(queue), thread_count_(threads), realtime_priority_(realtime_priority) {}
 
 QueueSpinner::~QueueSpinner() { stop(); }
 
@@ -17,6 +19,7 @@ void QueueSpinner::start() {
   if (!threads_.empty() || stopping_) return;
   for (int i = 0; i < thread_count_; ++i) {
     threads_.emplace_back([this] {
+      core::enterRealtime(realtime_priority_);  // refused: it spins at the normal policy
       while (!stopping_ && ros::ok()) queue_->callAvailable(kIdleWait);
     });
   }

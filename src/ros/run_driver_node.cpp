@@ -6,6 +6,7 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/stop_signals.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
@@ -47,7 +48,8 @@ std::unique_ptr<BagReplay> openReplay(DriverParams& params,
 
 /// Starts `node` (and the replay's clock) and serves it until a stop is asked for or the replay
 /// ends, then shuts it down.
-void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignals& stop_signals) {
+void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignals& stop_signals,
+                     int realtime_priority) {
   if (replay) {
     std::this_thread::sleep_for(core::kReplaySettle);
     replay->startClock();
@@ -55,8 +57,9 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignal
   node.start();
   // Global queue: cmd_vel, joint_commands, base services and the diagnostics timer. None of them
   // waits on the wire (servo/* services have their own queue), so one thread keeps up. Unlike
-  // ros::AsyncSpinner it does not wake every 100 ms while the node is idle.
-  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1);
+  // ros::AsyncSpinner it does not wake every 100 ms while the node is idle. On the way of a command
+  // to the wire, so at ~realtime_priority too.
+  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1, realtime_priority);
   spinner.start();
   const bool replay_done =
       replay ? stop_signals.wait(
@@ -72,6 +75,17 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignal
   spinner.stop();
 }
 
+/// ~realtime_priority on the main thread before roscpp starts its threads (with the first
+/// NodeHandle; ros::param needs none): every thread of the process inherits SCHED_FIFO, roscpp's
+/// too (the poll thread that carries messages to and from the sockets, its timers), so the whole
+/// path of a frame or a command runs at the priority. Checked and logged once by
+/// DriverCore::start(); a value validate() refuses is not applied here either.
+void enterRealtimeBeforeRoscpp() {
+  int priority = 0;
+  if (!ros::param::get("~realtime_priority", priority)) return;
+  if (priority > 0 && priority <= core::kMaxRealtimePriority) core::enterRealtime(priority);
+}
+
 }  // namespace
 
 int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_factory) {
@@ -79,6 +93,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
   const core::StopSignals stop_signals;
   ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
+  enterRealtimeBeforeRoscpp();
 
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
@@ -99,7 +114,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
     return 1;
   }
   DriverNode node(nh, private_nh, params, stream_factory);
-  runUntilStopped(node, replay.get(), stop_signals);
+  runUntilStopped(node, replay.get(), stop_signals, params.realtime_priority);
   ros::shutdown();
   return 0;
 }

@@ -92,23 +92,29 @@ TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& para
 TrajectoryServer::~TrajectoryServer() { shutdown(); }
 
 void TrajectoryServer::start() {
+  // Steady: a step of the ROS or wall clock must not skip or replay a trajectory. Started while
+  // the executor has work (its ticker, under its lock), so an idle node wakes no thread for it.
+  timer_ = nh_.createSteadyTimer(
+      ros::WallDuration(loop_period_),
+      [this](const ros::SteadyTimerEvent&) {
+        runGuarded(input_refusals_, "trajectory loop", [this] { executor_.tick(); });
+      },
+      false, false);
+  executor_.setTicker([this](bool on) { on ? timer_.start() : timer_.stop(); });
   if (!executor_.start()) return;
   action_server_.start();
   // tcpNoDelay: a trajectory must not wait in Nagle's buffer.
   trajectory_sub_ =
       subscribeGuarded(nh_, input_refusals_, "joint_trajectory", 10,
                        &TrajectoryServer::onTrajectory, this, ros::TransportHints().tcpNoDelay());
-  // Steady: a step of the ROS or wall clock must not skip or replay a trajectory.
-  timer_ =
-      nh_.createSteadyTimer(ros::WallDuration(loop_period_), [this](const ros::SteadyTimerEvent&) {
-        runGuarded(input_refusals_, "trajectory loop", [this] { executor_.tick(); });
-      });
 }
 
 void TrajectoryServer::shutdown() {
-  timer_.stop();
-  trajectory_sub_.shutdown();
+  // The executor first: once it is shut down its ticker is never switched again.
   executor_.shutdown();
+  timer_.stop();
+  executor_.setTicker({});  // the executor outlives this server
+  trajectory_sub_.shutdown();
 }
 
 trajectory::TrajectoryExecutor::Warn TrajectoryServer::logWarning() {

@@ -43,7 +43,15 @@ bool TrajectoryExecutor::start() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (running_) return false;
   running_ = true;
+  if (busyLocked()) setTickingLocked(true);
   return true;
+}
+
+void TrajectoryExecutor::setTicker(std::function<void(bool on)> ticker) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ticker_ = std::move(ticker);
+  ticking_ = false;
+  if (busyLocked()) setTickingLocked(true);
 }
 
 void TrajectoryExecutor::shutdown() {
@@ -164,6 +172,7 @@ void TrajectoryExecutor::apply(const TrajectoryCommand& command,
     track.writing = true;
     track.sent_segment = -std::numeric_limits<double>::infinity();  // no move went out yet
   }
+  setTickingLocked(true);
 }
 
 std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, double now) {
@@ -203,6 +212,7 @@ std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, dou
     track.spline = JointSpline(*position);
     track.writing = true;  // written once, then the servo keeps it
   }
+  if (busyLocked()) setTickingLocked(true);
   return leftAloneText(left_alone);
 }
 
@@ -340,15 +350,26 @@ void TrajectoryExecutor::tick() {
   const double now = this->now();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return;
-  // Idle (the usual case) costs one scan of the tracks.
-  const bool busy = !goals_.empty() || std::any_of(tracks_.begin(), tracks_.end(),
-                                                   [](const Track& t) { return t.writing; });
-  if (!busy) return;
-  const std::vector<Measured> actual = measured();
-  for (auto it = goals_.begin(); it != goals_.end();) {
-    it = superviseGoal(*it, now, actual) ? goals_.erase(it) : std::next(it);
+  // Idle costs one scan of the tracks (and with a ticker, no tick until there is work again).
+  if (busyLocked()) {
+    const std::vector<Measured> actual = measured();
+    for (auto it = goals_.begin(); it != goals_.end();) {
+      it = superviseGoal(*it, now, actual) ? goals_.erase(it) : std::next(it);
+    }
+    writeTracks(now);
   }
-  writeTracks(now);
+  if (!busyLocked()) setTickingLocked(false);
+}
+
+bool TrajectoryExecutor::busyLocked() const {
+  return !goals_.empty() ||
+         std::any_of(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.writing; });
+}
+
+void TrajectoryExecutor::setTickingLocked(bool on) {
+  if (!ticker_ || !running_ || on == ticking_) return;
+  ticking_ = on;
+  ticker_(on);
 }
 
 void TrajectoryExecutor::writeTracks(double now) {
@@ -407,14 +428,26 @@ void TrajectoryExecutor::writeTracks(double now) {
   dropVoided(voided_joints, now);
 }
 
+bool TrajectoryExecutor::jointInMotionLocked(std::size_t j) const {
+  return tracks_[j].writing ||
+         std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
+           return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
+         });
+}
+
+bool TrajectoryExecutor::inMotion() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (std::size_t j = 0; j < tracks_.size(); ++j) {
+    if (jointInMotionLocked(j)) return true;
+  }
+  return false;
+}
+
 std::string TrajectoryExecutor::motionInForce() {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> moving;
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
-    const bool in_goal = std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
-      return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
-    });
-    if (tracks_[j].writing || in_goal) moving.push_back(ranges_[j].name);
+    if (jointInMotionLocked(j)) moving.push_back(ranges_[j].name);
   }
   if (moving.empty()) return {};
   std::string text = "trajectory in progress (";

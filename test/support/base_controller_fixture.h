@@ -38,6 +38,19 @@ inline std::unique_ptr<BaseController> startOnManualClock(
   return controller;
 }
 
+/// A cmd_vel as the device gives it (submitCommand()), returning once its frame is written: at
+/// once on this thread, or by the loop (woken for it) when the line had no room yet.
+inline CommandOutcome command(core::ManualClock& clock, BaseController& controller, double linear_x,
+                              double angular_z,
+                              std::optional<BaseController::Generation> accepted = std::nullopt) {
+  CommandOutcome outcome = CommandOutcome::kStored;
+  clock.stepIf([&] {
+    outcome = controller.submitCommand(linear_x, angular_z, accepted);
+    return outcome == CommandOutcome::kStored || outcome == CommandOutcome::kNotFinite;
+  });
+  return outcome;
+}
+
 /// The controller's loop runs at 50 Hz on a ManualClock that starts at t0: the first tick falls
 /// due at t0 + 20 ms.
 class BaseControllerTest : public ::testing::Test {

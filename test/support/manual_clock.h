@@ -48,6 +48,14 @@ class ManualClock : public LoopClock {
     settleAfter(seen);
   }
 
+  /// As step(), for an action that may not wake the loop: it returns whether it did (then this
+  /// returns once the loop has handled it and waits again).
+  template <typename Action>
+  void stepIf(Action action) {
+    const uint64_t seen = waits();
+    if (action()) settleAfter(seen);
+  }
+
   /// Moves time forward in one jump (a stalled machine, when `d` spans several periods).
   void advance(Clock::duration d) {
     step([&] {

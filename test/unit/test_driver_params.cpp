@@ -51,6 +51,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"baud", [](DriverParams& p) { p.baud = 12345; }},
         BadCase{"loop_rate", [](DriverParams& p) { p.loop_rate = 0; }},
         BadCase{"reconnect_interval", [](DriverParams& p) { p.reconnect_interval = -1; }},
+        BadCase{"realtime_priority", [](DriverParams& p) { p.realtime_priority = -1; }},
+        BadCase{"realtime_priority", [](DriverParams& p) { p.realtime_priority = 100; }},
         BadCase{"replay_rate", [](DriverParams& p) { p.replay_rate = -1; }},
         BadCase{"capture",
                 [](DriverParams& p) {
@@ -239,6 +241,14 @@ TEST(DriverParams, SlowLoopRateIsRefusedWithTheReason) {
   params.section(devices::base::kBaseSection).enabled = true;
   params.loop_rate = kMinBaseLoopRate;
   EXPECT_NO_THROW(params.validate());
+}
+
+TEST(DriverParams, RealtimePriorityTakesOffAndEverySchedFifoPriority) {
+  DriverParams params;
+  for (int priority : {0, 1, 50, 99}) {
+    params.realtime_priority = priority;
+    EXPECT_NO_THROW(params.validate()) << priority;
+  }
 }
 
 /// A parameter server stand-in: keys relative to ~ and their values.

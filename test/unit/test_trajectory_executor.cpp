@@ -310,5 +310,41 @@ TEST_F(ExecutorRig, WriteErrorsAreLoggedAtMostOnceASecond) {
   EXPECT_EQ(warnings, std::vector<std::string>(2, "trajectory: joint 'arm_1' out of range"));
 }
 
+// The node's loop timer runs only while the executor has work: an idle node wakes no thread.
+TEST_F(ExecutorRig, TheTickerRunsOnlyWhileThereIsWork) {
+  std::vector<bool> switched;
+  executor.setTicker([&switched](bool on) { switched.push_back(on); });
+  tickAt(100.1);
+  EXPECT_TRUE(switched.empty()) << "idle: never switched on";
+
+  measure({"arm_1"}, {0.0}, {0.0});
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_1"}, {1.0}), log.callbacks());
+  EXPECT_EQ(switched, std::vector<bool>{true});
+  measure({"arm_1"}, {1.0});
+  tickAt(101.0);  // reached
+  ASSERT_TRUE(log.over());
+  tickAt(101.1);  // the end written once more: nothing left to do
+  EXPECT_EQ(switched, (std::vector<bool>{true, false}));
+  tickAt(101.2);
+  EXPECT_EQ(switched.size(), 2u);
+
+  body_last_commanded = 0.7;
+  Goal stop = goalTo({"arm_1"}, {1.0}, 1.0, "stop");
+  stop.command.points.clear();  // an empty trajectory: a hold to write where the body last was
+  GoalLog stop_log;
+  executor.submitGoal(stop, stop_log.callbacks());
+  ASSERT_TRUE(stop_log.over());
+  EXPECT_EQ(stop_log.outcome().text, "stopped where they were last commanded");
+  EXPECT_EQ(switched, (std::vector<bool>{true, false, true}));
+  tickAt(101.3);
+  EXPECT_EQ(switched, (std::vector<bool>{true, false, true, false}));
+
+  executor.shutdown();
+  GoalLog late;
+  executor.submitGoal(goalTo({"arm_1"}, {0.0}, 1.0, "late"), late.callbacks());
+  EXPECT_EQ(switched.size(), 4u) << "never switched once shut down";
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::trajectory

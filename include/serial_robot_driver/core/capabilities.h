@@ -39,6 +39,9 @@ class HeadingSource : public Capability {
 class MotionQuery : public Capability {
  public:
   virtual std::string motionInForce() const = 0;
+  /// Whether motionInForce() would name something, without building its text: cheap enough to
+  /// ask once per sensor frame.
+  virtual bool inMotion() const { return !motionInForce().empty(); }
 };
 
 /// A HeadingSource that hands each heading it is given to its listeners (the measuring device

@@ -60,6 +60,8 @@ class Device {
   /// at rest), "" when they are held still. Any thread, cheap: a sensor being calibrated asks it
   /// once per frame.
   virtual std::string motionInForce() const { return {}; }
+  /// Whether motionInForce() would name something, without building its text (per frame).
+  virtual bool inMotion() const { return !motionInForce().empty(); }
 
   /// Offers what other devices may use (capabilities.h); before any device asks.
   virtual void offerCapabilities(Capabilities& /*capabilities*/) {}

@@ -19,6 +19,7 @@
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/core/e_stop.h"
 #include "serial_robot_driver/core/port_log.h"
+#include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/params/driver_params.h"
 #include "serial_robot_driver/trajectory/executor.h"
@@ -48,8 +49,11 @@ class DriverCore {
   DriverCore(const DriverCore&) = delete;
   DriverCore& operator=(const DriverCore&) = delete;
 
-  /// Starts the ports, then the devices.
+  /// Locks the memory and checks SCHED_FIFO for ~realtime_priority (core/realtime.h; its one line
+  /// to the core log), then starts the ports, then the devices.
   void start();
+  /// What start() found of ~realtime_priority.
+  const RealtimeStatus& realtime() const { return realtime_; }
   /// Shuts the devices down in order (the base first, its last words while the port is still
   /// open), then stops the ports. Idempotent.
   void shutdown();
@@ -96,6 +100,7 @@ class DriverCore {
   std::unique_ptr<MotionQuery> motion_;
   std::vector<std::unique_ptr<Device>> devices_;
   std::vector<std::string> device_names_;
+  RealtimeStatus realtime_;
 };
 
 }  // namespace serial_robot_driver::core

@@ -16,6 +16,8 @@
 //    capture has the writes in the order they went on the wire. It must copy what it keeps and
 //    return at once (it holds up every writer of the port); without one, the only cost is a null
 //    check per read and per write.
+//  - With options.realtime_priority the reader thread runs SCHED_FIFO (core/realtime.h), or at the
+//    normal policy where the process may not.
 //  - An idle reader sleeps in its read until data comes; stop(), wake() and a writer that saw the
 //    port fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
 //  - A LinkWorker (setWorker: the servo bus, a request/response device) runs ON the reader thread,
@@ -103,6 +105,8 @@ struct SerialLinkOptions {
   /// An incomplete frame with no new byte for this long is given up on, so the frames behind a
   /// stray header are not held back (the servo bus uses its answer timeout). 0: never.
   std::chrono::milliseconds stale_frame_timeout{0};
+  /// The reader thread's SCHED_FIFO priority (core/realtime.h: ~realtime_priority); 0: normal.
+  int realtime_priority = 0;
 };
 
 struct LinkStats {

@@ -56,6 +56,8 @@ struct DriverParams {
   double loop_rate = 50.0;  ///< Hz: the devices' control loop
   double reconnect_interval = 1.0;
   bool capture = false;      ///< publish every chunk in and out on serial_raw
+  /// SCHED_FIFO priority of the threads that carry frames (core/realtime.h), memory locked; 0: off
+  int realtime_priority = 0;
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
   double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
   /// Not a parameter: the running replay's timeline (set by the node once the bag is read), which

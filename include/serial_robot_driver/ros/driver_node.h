@@ -19,7 +19,8 @@
 //    as soon as their last byte is read;
 //  - the base control loop runs on its own thread (device::BaseController);
 //  - cmd_vel, joint_commands and base/* services run on the global callback queue (a QueueSpinner
-//    in main, or the nodelet manager's threads); servo/* services have their own queue and
+//    in main, or the nodelet manager's threads), and write their frame from there at once (the
+//    base under its loop's lock, BaseController::submitCommand); servo/* services have their own queue and
 //    spinner because they wait on the bus;
 //  - diagnostics are published from a steady timer on the global queue, every ~diagnostic_period.
 //  - the dynamic_reconfigure servers (~base, ~imu, ~servo_bus, ~trajectory; ros/runtime_tuning.h)
@@ -28,6 +29,8 @@
 //    trajectory server's mutex), from its next tick, frame or transaction on.
 //  - trajectory goals, cancels, joint_trajectory and the trajectory timer (one sync-write per loop
 //    tick) run on the global queue too (ros/trajectory_server.h).
+//  - with ~realtime_priority the reader threads, the base loop and the global queue's spinner run
+//    SCHED_FIFO where the process may (core/realtime.h); the core logs once what applies.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>

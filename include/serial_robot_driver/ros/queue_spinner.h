@@ -18,7 +18,8 @@ namespace serial_robot_driver::ros_layer {
 
 class QueueSpinner {
  public:
-  QueueSpinner(ros::CallbackQueue* queue, int threads);
+  /// `realtime_priority` > 0: the threads run SCHED_FIFO at it (core/realtime.h), where allowed.
+  QueueSpinner(ros::CallbackQueue* queue, int threads, int realtime_priority = 0);
   ~QueueSpinner();
   QueueSpinner(const QueueSpinner&) = delete;
   QueueSpinner& operator=(const QueueSpinner&) = delete;
@@ -30,6 +31,7 @@ class QueueSpinner {
  private:
   ros::CallbackQueue* queue_;
   int thread_count_;
+  int realtime_priority_;
   std::atomic<bool> stopping_{false};
   std::vector<std::thread> threads_;
 };

@@ -95,12 +95,21 @@ class TrajectoryExecutor {
   /// One loop tick: supervises the goals (ending them, else giving feedback), then writes or
   /// queues what the splines ask for.
   void tick();
+  /// What calls tick() (the node's loop timer): switched on (true) when there is work from now on
+  /// (a goal, a trajectory, a hold to write), off (false) after the tick that left none, so an
+  /// idle executor wakes no thread. Called under the executor's lock: it may only start or stop
+  /// a timer. Unset, tick() is the caller's to call.
+  void setTicker(std::function<void(bool on)> ticker);
 
   /// Why trajectories may be moving joints now: a goal in progress or joints still being written
   /// or moved; "" when none. Any thread (a sensor calibration asks it once per frame).
   std::string motionInForce();
+  /// Whether motionInForce() would name something, without building its text. Any thread.
+  bool inMotion();
 
  private:
+  /// Requires mutex_: joint `j` is being written or is in a goal.
+  bool jointInMotionLocked(std::size_t j) const;
   struct Track {
     std::size_t group = 0;  ///< index into groups_
     std::size_t local = 0;  ///< index into that group's joints
@@ -159,6 +168,10 @@ class TrajectoryExecutor {
   bool judgeTolerances(ActiveGoal& goal, double now, const std::vector<JointSample>& desired,
                        const std::vector<JointSample>& measured);
   void warn(const std::string& text) const;
+  /// A goal, or a joint still to be written or moved (mutex_ held).
+  bool busyLocked() const;
+  /// Switches the ticker (mutex_ held); nothing once shut down.
+  void setTickingLocked(bool on);
   void warnThrottled(ThrottledWarning kind, const std::string& text, double now);
 
   const std::vector<TrajectoryJoints> groups_;
@@ -166,6 +179,7 @@ class TrajectoryExecutor {
   std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track
   const Clock clock_;
   const Warn warn_;
+  std::function<void(bool)> ticker_;
 
   mutable std::mutex actual_mutex_;  // guards the measurements below
   std::vector<Measured> actual_;
@@ -175,6 +189,7 @@ class TrajectoryExecutor {
   std::vector<Track> tracks_;
   std::vector<ActiveGoal> goals_;
   bool running_ = false;
+  bool ticking_ = false;  ///< the ticker is on
   core::EStop* e_stop_ = nullptr;
   std::array<std::optional<double>, kThrottledKinds> last_warned_;
 };

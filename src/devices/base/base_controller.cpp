@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "serial_robot_driver/core/realtime.h"
+
 namespace serial_robot_driver::devices::base {
 
 using kinematics::WheelSpeeds;
@@ -57,6 +59,8 @@ BaseController::~BaseController() {
 CommandOutcome BaseController::submitCommand(double linear_x, double angular_z,
                                              std::optional<Generation> accepted) {
   const bool valid = std::isfinite(linear_x) && std::isfinite(angular_z);
+  SpeedFrameReport report;
+  bool written_here = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (e_stop_) {
@@ -69,12 +73,37 @@ CommandOutcome BaseController::submitCommand(double linear_x, double angular_z,
     }
     linear_x_ = valid ? linear_x : 0.0;
     angular_z_ = valid ? angular_z : 0.0;
-    last_command_ = clock_->now();
-    command_pending_ = true;
+    const core::Clock::time_point now = clock_->now();
+    last_command_ = now;
     if (!valid) ++stats_.rejected_commands;
+    // Written here and now, on the caller's thread, under the lock every base write takes: the
+    // e-stop, the deadman, the limits, the ramp and the sequence are decided at the moment of
+    // writing, and the loop's next tick goes on from this frame. A flood beyond the line's share
+    // (or a command before start()) is left to the loop, which writes it as soon as it may.
+    written_here = valid && mayRushLocked(now);
+    if (written_here) {
+      command_pending_ = false;  // this frame carries whatever was pending
+      sendSpeedLocked(now, true, &report);
+    } else {
+      command_pending_ = true;
+    }
   }
-  wake_.notify_all();
-  return valid ? CommandOutcome::kStored : CommandOutcome::kNotFinite;
+  if (!written_here) {
+    wake_.notify_all();
+    return valid ? CommandOutcome::kStored : CommandOutcome::kNotFinite;
+  }
+  reportSpeedFrame(report);
+  return CommandOutcome::kSent;
+}
+
+bool BaseController::mayRushLocked(core::Clock::time_point now) const {
+  return running_ && lineAllowsImmediateLocked(now);
+}
+
+bool BaseController::lineAllowsImmediateLocked(core::Clock::time_point now) const {
+  // The 50 Hz ticks are not counted against the line's share: they are a small, fixed load, and
+  // counting them would hold back every command that follows a tick.
+  return !last_immediate_frame_ || now - *last_immediate_frame_ >= min_immediate_interval_;
 }
 
 BaseController::Generation BaseController::generation() const {
@@ -100,18 +129,29 @@ void BaseController::setEStop(bool engaged) {
   wake_.notify_all();
 }
 
+bool BaseController::commandMovesLocked(core::Clock::time_point now) const {
+  const bool command_live =
+      !e_stop_ && last_command_ && seconds(now - *last_command_) <= config_.cmd_vel_timeout;
+  return command_live && (linear_x_ != 0.0 || angular_z_ != 0.0);
+}
+
+bool BaseController::rampingLocked() const { return !e_stop_ && !limiter_.current().isZero(0.0); }
+
+bool BaseController::inMotion() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return commandMovesLocked(clock_->now()) || rampingLocked();
+}
+
 std::string BaseController::motionInForce() const {
   std::lock_guard<std::mutex> lock(mutex_);
   char text[128];
-  const bool command_live = !e_stop_ && last_command_ &&
-                            seconds(clock_->now() - *last_command_) <= config_.cmd_vel_timeout;
-  if (command_live && (linear_x_ != 0.0 || angular_z_ != 0.0)) {
+  if (commandMovesLocked(clock_->now())) {
     std::snprintf(text, sizeof text, "cmd_vel of %.3g m/s, %.3g rad/s in force", linear_x_,
                   angular_z_);
     return text;
   }
-  const WheelSpeeds& ramp = limiter_.current();
-  if (!e_stop_ && !ramp.isZero(0.0)) {
+  if (rampingLocked()) {
+    const WheelSpeeds& ramp = limiter_.current();
     std::snprintf(text, sizeof text, "wheels still ramping (%.3g, %.3g m/s)", ramp.x(), ramp.y());
     return text;
   }
@@ -154,7 +194,15 @@ bool BaseController::sendClearEncoders() {
 
 void BaseController::start() {
   if (loop_.joinable()) return;
-  loop_ = std::thread([this] { run(); });
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    running_ = !stopping_;  // from now on a cmd_vel is written by its caller, at once
+  }
+  const int priority = config_.realtime_priority;  // not tunable: read before the thread runs
+  loop_ = std::thread([this, priority] {
+    core::enterRealtime(priority);  // refused: the loop runs at the normal policy
+    run();
+  });
 }
 
 void BaseController::stop() {
@@ -163,6 +211,7 @@ void BaseController::stop() {
     if (stopped_) return;
     stopping_ = true;
     stopped_ = true;
+    running_ = false;  // no cmd_vel written after the last words below
   }
   wake_.notify_all();
   if (loop_.joinable()) loop_.join();
@@ -338,47 +387,57 @@ kinematics::WheelTicks BaseController::onWire(const kinematics::WheelTicks& tick
 }
 
 void BaseController::sendSpeed(core::Clock::time_point now, bool immediate) {
-  WheelFrameSent sent;
-  bool written = false;
-  bool timed_out_now = false;
+  SpeedFrameReport report;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    const double dt = last_speed_frame_ ? seconds(now - *last_speed_frame_) : seconds(period_);
-    const WheelSpeeds target = targetSpeedsLocked(now, &timed_out_now);
-    if (e_stop_) {
-      limiter_.reset();  // an e-stop does not ramp down
-      quantizer_.reset();
-    }
-    const WheelSpeeds speeds = e_stop_ ? target : limiter_.step(target, dt);
-
-    // The base drops into its timeout error after 1 s without a frame; if our own gap reached that,
-    // assume it did, even if its FF frame was lost.
-    if (last_write_ && seconds(now - *last_write_) >= config_.heartbeat_gap) needs_reset_ = true;
-    if (needs_reset_) {
-      if (!writeLocked(encodeReset(seq_.peek()), now)) return;
-      ++stats_.resets_sent;
-      needs_reset_ = false;
-      last_reset_sent_ = now;
-      sent.reset_before = true;
-    }
-    const kinematics::WheelTicks ticks = quantizer_.quantize(speeds);
-    sent.ticks = onWire(ticks);
-    sent.seq = seq_.peek();
-    sent.speeds = speeds;
-    sent.time = now;
-    written = writeLocked(encodeWheelSpeed(sent.seq, sent.ticks.left, sent.ticks.right), now);
-    if (written) {
-      ++stats_.speed_frames;
-      if (immediate) {
-        ++stats_.immediate_frames;
-        last_immediate_frame_ = now;
-      }
-      last_speed_frame_ = now;
-      odometry_.speedAccepted(ticks, now);  // a Reset went out before it whenever one was due
-    }
+    sendSpeedLocked(now, immediate, &report);
   }
-  if (timed_out_now && events_.on_cmd_vel_timeout) events_.on_cmd_vel_timeout();
-  if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
+  reportSpeedFrame(report);
+}
+
+void BaseController::sendSpeedLocked(core::Clock::time_point now, bool immediate,
+                                     SpeedFrameReport* report) {
+  // A tick that read the clock before a cmd_vel's frame took the lock goes on from that frame:
+  // frame times (and so the ramp's steps and the odometry's intervals) never run backwards.
+  if (last_write_ && now < *last_write_) now = *last_write_;
+  const double dt = last_speed_frame_ ? seconds(now - *last_speed_frame_) : seconds(period_);
+  const WheelSpeeds target = targetSpeedsLocked(now, &report->timed_out_now);
+  if (e_stop_) {
+    limiter_.reset();  // an e-stop does not ramp down
+    quantizer_.reset();
+  }
+  const WheelSpeeds speeds = e_stop_ ? target : limiter_.step(target, dt);
+
+  // The base drops into its timeout error after 1 s without a frame; if our own gap reached that,
+  // assume it did, even if its FF frame was lost.
+  if (last_write_ && seconds(now - *last_write_) >= config_.heartbeat_gap) needs_reset_ = true;
+  WheelFrameSent sent;
+  if (needs_reset_) {
+    if (!writeLocked(encodeReset(seq_.peek()), now)) return;
+    ++stats_.resets_sent;
+    needs_reset_ = false;
+    last_reset_sent_ = now;
+    sent.reset_before = true;
+  }
+  const kinematics::WheelTicks ticks = quantizer_.quantize(speeds);
+  sent.ticks = onWire(ticks);
+  sent.seq = seq_.peek();
+  sent.speeds = speeds;
+  sent.time = now;
+  if (!writeLocked(encodeWheelSpeed(sent.seq, sent.ticks.left, sent.ticks.right), now)) return;
+  ++stats_.speed_frames;
+  if (immediate) {
+    ++stats_.immediate_frames;
+    last_immediate_frame_ = now;
+  }
+  last_speed_frame_ = now;
+  odometry_.speedAccepted(ticks, now);  // a Reset went out before it whenever one was due
+  report->sent = sent;
+}
+
+void BaseController::reportSpeedFrame(const SpeedFrameReport& report) {
+  if (report.timed_out_now && events_.on_cmd_vel_timeout) events_.on_cmd_vel_timeout();
+  if (report.sent && events_.on_wheel_frame) events_.on_wheel_frame(*report.sent);
 }
 
 void BaseController::tick(core::Clock::time_point now) {
@@ -435,13 +494,10 @@ void BaseController::run() {
     if (stopping_) break;
     const core::Clock::time_point now = clock_->now();
     if (now < deadline) {
-      // Woken early by a command: send it at once unless the last rushed frame is so recent that
-      // a flood would take more than its share of the line; then it goes when the line allows (or
-      // with the tick). The 50 Hz ticks are not counted against the share: they are a small,
-      // fixed load, and counting them would hold back every command that follows a tick.
-      const bool may_rush =
-          !last_immediate_frame_ || now - *last_immediate_frame_ >= min_immediate_interval_;
-      if (!may_rush) {
+      // Woken early (an e-stop, an FF error, a link up, or a cmd_vel its caller could not write
+      // yet): send it at once unless the last rushed frame is so recent that a flood would take
+      // more than its share of the line; then it goes when the line allows (or with the tick).
+      if (!lineAllowsImmediateLocked(now)) {
         const core::Clock::time_point until =
             std::min(deadline, *last_immediate_frame_ + min_immediate_interval_);
         while (!stopping_ && clock_->now() < until) clock_->waitUntil(lock, wake_, until);

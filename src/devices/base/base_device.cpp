@@ -96,6 +96,7 @@ std::string BaseDevice::commandTwist(const TwistCommand& command) {
       return text;
     case CommandOutcome::kEStopEngaged:
       return "cmd_vel ignored: e_stop is engaged";
+    case CommandOutcome::kSent:
     case CommandOutcome::kStored:
       break;
   }

@@ -15,6 +15,7 @@ extern const params::SectionKey<BaseParams> kBaseSection{"base"};
 BaseConfig makeBaseConfig(const params::DriverParams& params) {
   BaseConfig config = params.section(kBaseSection).controller;
   config.loop_rate = params.loop_rate;
+  config.realtime_priority = params.realtime_priority;
   config.baud = params.baudOf(*core::findDevice("base"));
   return config;
 }

@@ -222,9 +222,18 @@ JointCommandStatus BodyController::writeTargetsLocked(const std::vector<ServoTar
   return JointCommandStatus::kSent;
 }
 
+bool BodyController::writtenLatelyLocked(core::Clock::time_point now) const {
+  return last_written_ && now - *last_written_ < kJointCommandMotion;
+}
+
+bool BodyController::inMotion(core::Clock::time_point now) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return writtenLatelyLocked(now);
+}
+
 std::string BodyController::motionInForce(core::Clock::time_point now) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!last_written_ || now - *last_written_ >= kJointCommandMotion) return {};
+  if (!writtenLatelyLocked(now)) return {};
   char text[96];
   std::snprintf(text, sizeof text, "joint command written %.2f s ago",
                 std::chrono::duration<double>(now - *last_written_).count());

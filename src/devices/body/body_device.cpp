@@ -19,7 +19,7 @@ BodyDevice::BodyDevice(const params::DriverParams& params, core::SerialLink& lin
     : link_(link),
       imu_params_(std::make_shared<const ImuParams>(params.section(kImuSection))),
       imu_heading_(params.section(kImuSection).orientation_variance),
-      gyro_calibrator_([this] { return notStill(); }),
+      gyro_calibrator_([this] { return notStill(); }, {}, [this] { return moving(); }),
       // Expected telemetry rates, as diagnostic_updater's FrequencyStatus.
       telemetry_rate_(
           1.0, 1000.0,
@@ -45,11 +45,17 @@ std::string BodyDevice::notStill() const {
   return motion_query_ ? motion_query_->motionInForce() : std::string();
 }
 
+bool BodyDevice::moving() const {
+  return (e_stop_ && e_stop_->engaged()) || (motion_query_ && motion_query_->inMotion());
+}
+
 void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival) {
   // On the link's reader thread.
   telemetry_rate_.tick();
-  const JointReadings joints = jointReadings(telemetry, controller_.joints());
-  // The trajectories need every frame: their goals are checked against it.
+  // Converted once per frame for every consumer, into vectors that keep their capacity. The
+  // trajectories need every frame: their goals are checked against it.
+  updateJointReadings(telemetry, controller_.joints(), &joint_readings_);
+  const JointReadings& joints = joint_readings_;
   if (trajectory_) trajectory_->updateActual(joints.names, joints.positions, joints.velocities);
   const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
   if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);

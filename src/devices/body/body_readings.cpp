@@ -22,22 +22,29 @@ std::vector<BodyJoint> makeBodyJoints(const BodyParams& params) {
 
 JointReadings jointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints) {
   JointReadings readings;
+  updateJointReadings(telemetry, joints, &readings);
+  return readings;
+}
+
+void updateJointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints,
+                         JointReadings* readings) {
   const std::size_t count = std::min(joints.size(), telemetry.servo_count);
-  readings.names.reserve(count);
-  readings.positions.reserve(count);
+  if (readings->names.size() != count) {
+    readings->names.clear();
+    for (std::size_t i = 0; i < count; ++i) readings->names.push_back(joints[i].name);
+  }
   // The speed's unit is not documented: without a known scale the velocity stays empty rather
   // than guessed.
   const bool velocity_known = count > 0 && joints.front().calibration.velocity_scale > 0;
-  if (velocity_known) readings.velocities.reserve(count);
+  readings->positions.resize(count);
+  readings->velocities.resize(velocity_known ? count : 0);
   for (std::size_t i = 0; i < count; ++i) {
     const JointCalibration& calibration = joints[i].calibration;
-    readings.names.push_back(joints[i].name);
-    readings.positions.push_back(calibration.toRadians(telemetry.servos[i].position));
+    readings->positions[i] = calibration.toRadians(telemetry.servos[i].position);
     if (velocity_known) {
-      readings.velocities.push_back(calibration.toRadiansPerSecond(telemetry.servos[i].speed));
+      readings->velocities[i] = calibration.toRadiansPerSecond(telemetry.servos[i].speed);
     }
   }
-  return readings;
 }
 
 Quaternion quaternionFromRollPitchYaw(double roll, double pitch, double yaw) {

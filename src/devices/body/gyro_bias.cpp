@@ -102,38 +102,58 @@ std::string describeGyroBias(const GyroVector& raw, const GyroUnits& units) {
   return triple(rad) + " rad/s = " + triple(deg) + " deg/s";
 }
 
-GyroBiasCalibrator::GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimits limits)
-    : still_(std::move(still)), limits_(limits) {}
+GyroBiasCalibrator::GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimits limits,
+                                       MotionCheck moving)
+    : still_(std::move(still)), moving_(std::move(moving)), limits_(limits) {}
+
+std::optional<std::string> GyroBiasCalibrator::motionNow(bool name_it) const {
+  if (moving_ && !moving_()) return std::nullopt;
+  if (moving_ && !name_it) return std::string();
+  std::string why = still_();
+  if (why.empty()) return std::nullopt;  // (it stopped between the two questions)
+  return why;
+}
+
+void GyroBiasCalibrator::noteMotionLocked(const std::optional<std::string>& motion,
+                                          core::Clock::time_point arrival, bool after_gap) {
+  if (motion) {
+    still_since_.reset();
+    if (!motion->empty()) last_motion_ = *motion;
+  } else if (!still_since_ || after_gap) {
+    if (after_gap) last_motion_.clear();  // still since the gap, for all anyone knows
+    still_since_ = arrival;
+  }
+}
 
 GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, core::Clock::time_point arrival,
                                         const GyroUnits& units, double seconds) {
   bool after_gap = false;
+  bool name_motion = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     after_gap = !last_arrival_ || arrival - *last_arrival_ > limits_.max_telemetry_age;
     last_arrival_ = arrival;
+    // What moves is named only where it is kept: a motion starting, or a calibration under way.
+    name_motion = still_since_ || session_ || last_motion_.empty();
   }
   // Asked on every frame, calibrating or not: the settle time counts from the end of a motion.
   // Without mutex_ held: the check takes the other devices' locks.
-  const std::string not_still = still_();
+  const std::optional<std::string> motion = motionNow(name_motion);
   std::optional<GyroCalibrationOutcome> start_outcome;
   StartReport report;
   GyroVector bias{};
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!not_still.empty()) {
-      still_since_.reset();
-      last_motion_ = not_still;
-    } else if (!still_since_ || after_gap) {
-      if (after_gap) last_motion_.clear();  // still since the gap, for all anyone knows
-      still_since_ = arrival;
-    }
-    if (!session_ && start_report_ && !cancelled_ && not_still.empty() && settledLocked(arrival)) {
+    noteMotionLocked(motion, arrival, after_gap);
+    if (!session_ && start_report_ && !cancelled_ && !motion && settledLocked(arrival)) {
       session_ = Session{
           "calibrate_on_start", arrival, arrival + fromSeconds(seconds), seconds, {}, {}, true};
     }
     if (session_ && arrival >= session_->begin) {
-      if (!not_still.empty() && session_->not_still.empty()) session_->not_still = not_still;
+      if (motion && session_->not_still.empty()) {
+        session_->not_still = !motion->empty() ? *motion : last_motion_;
+        if (session_->not_still.empty()) session_->not_still = "the robot moved";
+      }
       if (session_->automatic) {
         if (!session_->not_still.empty()) {
           session_.reset();  // started again from the first frame the robot is still

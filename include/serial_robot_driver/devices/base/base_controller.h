@@ -3,15 +3,19 @@
 // ROS-free: the ROS layer feeds commands in and publishes the events it reports.
 //
 // Threading model:
-//  - start() runs the control loop on its own thread: absolute deadlines on the LoopClock (the
+//  - start() runs the control loop on its own thread (SCHED_FIFO with config.realtime_priority,
+//    where the process may): absolute deadlines on the LoopClock (the
 //    steady clock unless a test passes its own) (deadline += period, never "sleep one period"), so
 //    the period does not drift. Each tick writes
 //    the current wheel frame, which is also the heartbeat.
-//  - setCommand() (cmd_vel callback) and setEStop() only store and wake the loop, which puts the
-//    frame on the wire at once. Such immediate frames are spaced from each other by what the line
-//    can carry (minImmediateInterval()), never by the loop rate or the last tick, and never move
-//    the tick deadlines.
-//    Callbacks never touch the port.
+//  - submitCommand() (the cmd_vel callback's thread) writes the command's wheel frame itself, at
+//    once, under mutex_: what goes out (e-stop, deadman, limits, ramp, SEQ) is decided at the
+//    moment of writing, exactly as a tick decides it, and the next tick goes on from that frame.
+//    Such immediate frames are spaced from each other by what the line can carry
+//    (minImmediateInterval()), never by the loop rate or the last tick, and never move the tick
+//    deadlines; a command that comes sooner (a flood), or before start(), is stored and the loop
+//    writes it when the line allows. setEStop() stores and wakes the loop, which writes the zero
+//    frame at once.
 //  - onFrame() runs on the port's reader thread: an FF error frame wakes the loop to send a Reset.
 //  - Every base write happens with mutex_ held, so the sequence counter and "Reset before the next
 //    speed frame" are consistent whichever thread writes (loop, or a base/* service).
@@ -78,6 +82,8 @@ struct BaseConfig : BaseTuning {
   /// rad^2, odom's yaw variance while the IMU heading is used (until setImuYawVariance()).
   double imu_yaw_variance = 0.0003;
   core::Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
+  /// The loop thread's SCHED_FIFO priority (core/realtime.h: ~realtime_priority); 0: normal.
+  int realtime_priority = 0;
 };
 
 /// Where the odometry stood after a scheduled tick.
@@ -162,7 +168,8 @@ struct BaseEvents {
 
 /// What became of a cmd_vel (submitCommand()).
 enum class CommandOutcome {
-  kStored,        ///< obeyed from the next frame on
+  kSent,          ///< obeyed: its frame was written at once, on the caller's thread
+  kStored,        ///< obeyed from the next frame on (the loop writes it when the line allows)
   kNotFinite,     ///< NaN/Inf: zero speed commanded instead
   kEStopEngaged,  ///< ignored: the e-stop is engaged
   kVoided,        ///< ignored: an e-stop engaged after it was accepted (even if released since)
@@ -178,9 +185,11 @@ class BaseController : public core::LinkListener {
                  std::shared_ptr<core::LoopClock> clock = {});
   ~BaseController() override;
 
-  /// Stores a cmd_vel. NaN/Inf components are rejected: zero speed is commanded. Ignored (and
-  /// counted) while the e-stop is engaged, and when `accepted` (generation() when the command was
-  /// accepted, noted before its e-stop check) is older than the last engagement.
+  /// Obeys a cmd_vel: its wheel frame is written before this returns (kSent) while the loop runs
+  /// and the line has room for it; otherwise the loop writes it as soon as it may (kStored).
+  /// NaN/Inf components are rejected: zero speed is commanded (by the loop). Ignored (and counted)
+  /// while the e-stop is engaged, and when `accepted` (generation() when the command was accepted,
+  /// noted before its e-stop check) is older than the last engagement: then nothing is written.
   CommandOutcome submitCommand(double linear_x, double angular_z,
                                std::optional<Generation> accepted = std::nullopt);
   /// submitCommand() accepted now; false for NaN/Inf components.
@@ -208,6 +217,8 @@ class BaseController : public core::LinkListener {
   /// Why the wheels may be moving now, or "" when they are commanded still: a non-zero cmd_vel in
   /// force (not timed out, no e-stop) or wheels still ramping toward zero. Any thread.
   std::string motionInForce() const;
+  /// Whether motionInForce() would name something, without building its text. Any thread.
+  bool inMotion() const;
   /// Writes a Reset now (base/reset). False when the port is down.
   bool sendReset();
   /// Writes a clear-encoders frame now (base/clear_encoders). False when the port is down.
@@ -239,8 +250,25 @@ class BaseController : public core::LinkListener {
   void run();
   /// A scheduled tick: battery poll when due, then the wheel frame.
   void tick(core::Clock::time_point now);
+  /// What a written wheel frame reports once mutex_ is released.
+  struct SpeedFrameReport {
+    std::optional<WheelFrameSent> sent;  ///< set when the speed frame was written
+    bool timed_out_now = false;          ///< the cmd_vel timeout started with it
+  };
   /// Sends the wheel frame for the current command (Reset first when needed).
   void sendSpeed(core::Clock::time_point now, bool immediate);
+  /// Requires mutex_: sendSpeed()'s decision and writes, its report in `report`.
+  void sendSpeedLocked(core::Clock::time_point now, bool immediate, SpeedFrameReport* report);
+  /// Without mutex_: the events of a frame sendSpeedLocked() wrote.
+  void reportSpeedFrame(const SpeedFrameReport& report);
+  /// Requires mutex_: whether a cmd_vel may be written by its caller now (the loop runs, and the
+  /// last immediate frame is minImmediateInterval() ago).
+  bool mayRushLocked(core::Clock::time_point now) const;
+  bool lineAllowsImmediateLocked(core::Clock::time_point now) const;
+  /// Requires mutex_: a non-zero cmd_vel in force (not timed out, no e-stop).
+  bool commandMovesLocked(core::Clock::time_point now) const;
+  /// Requires mutex_: the wheels still ramping toward zero (no e-stop).
+  bool rampingLocked() const;
   /// Requires mutex_. Writes one frame with the next SEQ; false on failure.
   bool writeLocked(const std::vector<uint8_t>& frame, core::Clock::time_point now);
   /// `timed_out_now`: set when the cmd_vel timeout started with this call.
@@ -260,6 +288,7 @@ class BaseController : public core::LinkListener {
   std::condition_variable wake_;
   bool stopping_ = false;
   bool stopped_ = false;
+  bool running_ = false;          ///< between start() and stop(): cmd_vel written by its caller
   bool command_pending_ = false;  ///< a new cmd_vel or an FF error wants an early frame
   SequenceCounter seq_;
   kinematics::AccelerationLimiter limiter_;

@@ -78,6 +78,7 @@ class BaseDevice : public core::Device {
   std::string startupSummary() const override;
   /// A command in force or wheels still ramping down.
   std::string motionInForce() const override { return controller_.motionInForce(); }
+  bool inMotion() const override { return controller_.inMotion(); }
 
   /// ~base as started: frames and joint names (the tunables: tuned()).
   const BaseParams& params() const { return params_; }

@@ -136,12 +136,16 @@ class BodyController : public core::LinkListener {
   /// Why the joints may be moving at `now`: a joint command written less than kJointCommandMotion
   /// before it; "" when none was. Any thread.
   std::string motionInForce(core::Clock::time_point now) const;
+  /// Whether motionInForce(now) would name something, without building its text. Any thread.
+  bool inMotion(core::Clock::time_point now) const;
 
   const std::vector<BodyJoint>& joints() const { return joints_; }
   std::size_t servoCount() const { return joints_.size(); }
   BodyStats stats() const;
 
  private:
+  /// Requires mutex_: a joint command written less than kJointCommandMotion before `now`.
+  bool writtenLatelyLocked(core::Clock::time_point now) const;
   /// Sync-writes `targets` through the motion gate (mutex_ held): kSent, or why not (counted).
   JointCommandStatus writeTargetsLocked(const std::vector<ServoTarget>& targets,
                                         core::MotionGate::Generation generation);

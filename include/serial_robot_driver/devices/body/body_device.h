@@ -96,6 +96,7 @@ class BodyDevice : public core::Device {
   std::string motionInForce() const override {
     return controller_.motionInForce(core::Clock::now());
   }
+  bool inMotion() const override { return controller_.inMotion(core::Clock::now()); }
 
   const BodyController& controller() const { return controller_; }
 
@@ -103,6 +104,8 @@ class BodyDevice : public core::Device {
   void onTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival);
   /// Why the robot is not held still now, "" when it is (reader and calibration threads).
   std::string notStill() const;
+  /// notStill() as a bool that builds no text: asked once per frame.
+  bool moving() const;
   void logFlow(BodyStatus::FlowChange flow) const;
 
   core::SerialLink& link_;
@@ -121,6 +124,7 @@ class BodyDevice : public core::Device {
   core::LogThrottle command_log_{1.0};
   GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   core::EventRate telemetry_rate_;      // ticked on the reader thread (locks)
+  JointReadings joint_readings_;        // reader thread only: each frame's, reused
   BodyStatus status_;                   // diagnostics thread only
   BodyController controller_;           // last: its frames use the members above
 };

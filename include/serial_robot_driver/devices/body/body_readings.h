@@ -28,6 +28,10 @@ struct JointReadings {
 /// Joints beyond the frame's servo_count are left out (cannot happen when the frame was decoded
 /// for these joints).
 JointReadings jointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints);
+/// jointReadings() into `readings`, which keeps its vectors' capacity (and its names while the
+/// joints are the same), so the reader thread converts each frame once without allocating.
+void updateJointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints,
+                         JointReadings* readings);
 
 /// A rotation as a unit quaternion.
 struct Quaternion {

@@ -97,10 +97,16 @@ class GyroBiasCalibrator {
   /// engaged), or "" when it is. Thread-safe and cheap: it is asked once per IMU frame (the
   /// settle time counts from the first frame it answers "" after a motion).
   using StillnessCheck = std::function<std::string()>;
+  /// Whether anything may be moving the robot now: what StillnessCheck answers, as a bool that
+  /// builds no text. Thread-safe.
+  using MotionCheck = std::function<bool()>;
   /// calibrate_on_start's verdict, called once on the reader thread (log it).
   using StartReport = std::function<void(const GyroCalibrationOutcome&)>;
 
-  explicit GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimits limits = {});
+  /// With `moving`, each frame asks only it, and `still` only for the text where it is kept: the
+  /// frame a motion starts on, and while a calibration averages. Without it, `still` every frame.
+  explicit GyroBiasCalibrator(StillnessCheck still, GyroCalibrationLimits limits = {},
+                              MotionCheck moving = {});
 
   /// Reader thread: one frame's raw gyro (LSB, sensor axes) arrived at `arrival`. `units` and
   /// `seconds` (~imu/calibration_time) are the ones in force for this frame. Returns the bias to
@@ -151,8 +157,14 @@ class GyroBiasCalibrator {
   std::string unsettledLocked(core::Clock::time_point now) const;
   GyroCalibrationOutcome refuseLocked(const std::string& how, const std::string& why,
                                       const GyroUnits& units, bool not_still);
+  /// Without mutex_: nullopt while nothing moves; else what moves, "" when `name_it` is false.
+  std::optional<std::string> motionNow(bool name_it) const;
+  /// Requires mutex_: a frame at `arrival` found `motion` (motionNow()).
+  void noteMotionLocked(const std::optional<std::string>& motion, core::Clock::time_point arrival,
+                        bool after_gap);
 
   const StillnessCheck still_;
+  const MotionCheck moving_;
   const GyroCalibrationLimits limits_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -162,7 +174,7 @@ class GyroBiasCalibrator {
   /// Since when every frame found the robot still (the end of the last motion, or the first frame
   /// after a telemetry gap: what happened in the gap is unknown); unset while it moves.
   std::optional<core::Clock::time_point> still_since_;
-  std::string last_motion_;   ///< what moved last, when still_since_ is the end of a motion
+  std::string last_motion_;   ///< what the last motion began with (still_since_ its end)
   std::string last_refusal_;  ///< since the last good calibration
   StartReport start_report_;  ///< set while calibrate_on_start waits for its result
   bool cancelled_ = false;

@@ -84,6 +84,7 @@ class ServoBusDevice : public core::Device {
   std::vector<trajectory::TrajectoryJoints> trajectoryJoints() override;
   /// The servos set moving (ServoBus::motionInForce()).
   std::string motionInForce() const override { return bus_.motionInForce(); }
+  bool inMotion() const override { return !bus_.movingIds().empty(); }
   void attachTrajectories(trajectory::TrajectoryExecutor& executor) override {
     claims_.attachTrajectories(executor);
   }

@@ -4,10 +4,14 @@
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/BatteryState.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <optional>
 
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 #include "serial_robot_driver/ros/trigger_service.h"
 
 namespace serial_robot_driver::devices::base::ros {
@@ -15,16 +19,17 @@ namespace serial_robot_driver::devices::base::ros {
 BaseRos::BaseRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params, BaseDevice& device)
     : device_(device),
       arrival_stamps_(params),
-      tf_broadcaster_(device.params().publish_tf ? std::make_unique<tf2_ros::TransformBroadcaster>()
-                                                 : nullptr) {
-  odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", 50);
-  wheel_command_pub_ = nh.advertise<serial_robot_driver::WheelCommand>("wheel_command", 50);
-  battery_pub_ = nh.advertise<sensor_msgs::BatteryState>("battery", params.publisherQueue(5));
-  wheel_states_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_states", 50);
+      tf_pub_(device.params().publish_tf ? advertiseTf() : ros_layer::CountedPublisher()) {
+  odom_pub_ = ros_layer::advertiseCounted<nav_msgs::Odometry>(nh, "odom", 50);
+  wheel_command_pub_ =
+      ros_layer::advertiseCounted<serial_robot_driver::WheelCommand>(nh, "wheel_command", 50);
+  battery_pub_ = ros_layer::advertiseCounted<sensor_msgs::BatteryState>(nh, "battery",
+                                                                        params.publisherQueue(5));
+  wheel_states_pub_ = ros_layer::advertiseCounted<sensor_msgs::JointState>(nh, "wheel_states", 50);
   device.addOutputs(outputs());
 
   core::InputRefusals& refusals = device.inputRefusals();
-  // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; the loop puts it on the wire at once.
+  // tcpNoDelay: a cmd_vel must not sit in Nagle's buffer; its callback writes it at once.
   const ros_layer::SubscriberCallback<geometry_msgs::Twist> on_cmd_vel =
       [this](const geometry_msgs::Twist::ConstPtr& msg) {
         device_.commandTwist({msg->linear.x, msg->angular.z});
@@ -45,13 +50,14 @@ BaseOutputs BaseRos::outputs() {
   outputs.wheel_frame = [this](const WheelFrameSent& sent) { publishWheelCommand(sent); };
   outputs.odometry = [this](const OdometrySample& sample) { publishOdometry(sample); };
   outputs.battery = [this](const BatteryReading& reading, core::Clock::time_point arrival) {
+    if (!ros_layer::wanted(battery_pub_)) return;
     battery_pub_.publish(toBatteryState(reading, arrival_stamps_(arrival)));
   };
   return outputs;
 }
 
 void BaseRos::publishWheelCommand(const WheelFrameSent& sent) {
-  if (wheel_command_pub_.getNumSubscribers() == 0) return;  // 50 Hz: skip work nobody reads
+  if (!ros_layer::wanted(wheel_command_pub_)) return;  // 50 Hz: skip work nobody reads
   serial_robot_driver::WheelCommand msg;
   msg.header.stamp = ::ros::Time::now();
   msg.left_ticks = sent.ticks.left;
@@ -64,24 +70,40 @@ void BaseRos::publishWheelCommand(const WheelFrameSent& sent) {
 }
 
 void BaseRos::publishOdometry(const OdometrySample& sample) {
-  // Called on the control loop's thread once per tick; never touches the port.
+  // Called on the control loop's thread once per tick; never touches the port. What nobody
+  // subscribes to is not built (/tf included: it goes out whenever anyone listens to /tf).
   const ::ros::Time stamp = ::ros::Time::now();
-  const BaseParams& started = device_.params();
-  const nav_msgs::Odometry odom =
-      toOdometry(sample, {started.odom_frame, started.base_frame}, stamp);
-  odom_pub_.publish(odom);
-  publishWheelStates(sample, stamp);
-
-  if (!device_.tuned()->publish_tf) return;
   // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
-  if (!tf_broadcaster_) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
-  geometry_msgs::TransformStamped transform;
+  if (device_.tuned()->publish_tf && !tf_pub_) tf_pub_ = advertiseTf();
+  const bool odom_wanted = ros_layer::wanted(odom_pub_);
+  const bool tf_wanted = device_.tuned()->publish_tf && ros_layer::wanted(tf_pub_);
+  std::optional<nav_msgs::Odometry> odom;
+  if (odom_wanted || tf_wanted) {
+    const BaseParams& started = device_.params();
+    odom = toOdometry(sample, {started.odom_frame, started.base_frame}, stamp);
+  }
+  if (odom_wanted) odom_pub_.publish(*odom);
+  if (ros_layer::wanted(wheel_states_pub_)) publishWheelStates(sample, stamp);
+  if (tf_wanted) publishTf(*odom, sample);
+}
+
+void BaseRos::publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample) {
+  tf2_msgs::TFMessage tf;
+  tf.transforms.resize(1);
+  geometry_msgs::TransformStamped& transform = tf.transforms[0];
   transform.header = odom.header;
   transform.child_frame_id = odom.child_frame_id;
   transform.transform.translation.x = sample.pose.x;
   transform.transform.translation.y = sample.pose.y;
   transform.transform.rotation = odom.pose.pose.orientation;
-  tf_broadcaster_->sendTransform(transform);
+  tf_pub_.publish(tf);
+}
+
+ros_layer::CountedPublisher BaseRos::advertiseTf() {
+  // As tf2_ros::TransformBroadcaster advertises it, with a publisher whose subscribers we can
+  // count.
+  ::ros::NodeHandle global;
+  return ros_layer::advertiseCounted<tf2_msgs::TFMessage>(global, "/tf", 100);
 }
 
 void BaseRos::publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp) {

@@ -33,7 +33,7 @@ TEST_F(BaseControllerTest, HeartbeatFramesCountSequenceWithoutResets) {
 }
 
 TEST_F(BaseControllerTest, NewCommandGoesOutAtOnceWithEqualPositiveTicksWhenStraight) {
-  clock_->step([&] { controller_.setCommand(0.1, 0.0); });
+  command(*clock_, controller_, 0.1, 0.0);
   ASSERT_EQ(frames_.size(), 2u) << "sent before the first tick is due";
   // 0.1 m/s = 4.07 ticks per period -> 4 on the first frame; SEQ 01: XOR = F7 ^ 01 = F6
   EXPECT_EQ(frames_[1], golden::base::kBoth4Seq1);
@@ -41,7 +41,7 @@ TEST_F(BaseControllerTest, NewCommandGoesOutAtOnceWithEqualPositiveTicksWhenStra
 }
 
 TEST_F(BaseControllerTest, TurnInPlaceGivesOppositeTicks) {
-  clock_->step([&] { controller_.setCommand(0.0, 1.0); });  // wheels at -/+ 0.2 m/s
+  command(*clock_, controller_, 0.0, 1.0);  // wheels at -/+ 0.2 m/s
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_LT(sent_[0].ticks.left, 0);
   EXPECT_EQ(sent_[0].ticks.left, -sent_[0].ticks.right);
@@ -49,8 +49,7 @@ TEST_F(BaseControllerTest, TurnInPlaceGivesOppositeTicks) {
 }
 
 TEST_F(BaseControllerTest, HugeCommandKeepsItsDirectionAtFullSpeed) {
-  clock_->step(
-      [&] { controller_.setCommand(1e308, 1e308); });  // the wheel sum would overflow to inf
+  command(*clock_, controller_, 1e308, 1e308);  // the wheel sum would overflow to inf
   ASSERT_EQ(sent_.size(), 1u);
   EXPECT_NEAR(sent_[0].speeds.y(), 1.0, 1e-9) << "the faster wheel at max_wheel_speed";
   EXPECT_GT(sent_[0].speeds.x(), 0.0);
@@ -59,7 +58,7 @@ TEST_F(BaseControllerTest, HugeCommandKeepsItsDirectionAtFullSpeed) {
 }
 
 TEST_F(BaseControllerTest, CommandTimesOutToZero) {
-  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
+  command(*clock_, controller_, 0.5, 0.0);
   ASSERT_GT(sent_.back().ticks.left, 0);
   clock_->tick(24);  // 480 ms: cmd_vel_timeout is 0.5 s
   EXPECT_GT(sent_.back().ticks.left, 0);
@@ -70,11 +69,9 @@ TEST_F(BaseControllerTest, CommandTimesOutToZero) {
 }
 
 TEST_F(BaseControllerTest, NonFiniteCommandIsRejectedAsZero) {
-  clock_->step([&] {
-    controller_.setCommand(0.5, 0.0);
-    EXPECT_FALSE(controller_.setCommand(std::nan(""), 0.0));
-    EXPECT_FALSE(controller_.setCommand(0.1, INFINITY));
-  });
+  command(*clock_, controller_, 0.5, 0.0);
+  EXPECT_EQ(command(*clock_, controller_, std::nan(""), 0.0), CommandOutcome::kNotFinite);
+  EXPECT_EQ(command(*clock_, controller_, 0.1, INFINITY), CommandOutcome::kNotFinite);
   clock_->tick(1);  // the latest command goes out by the next tick at the latest
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
   EXPECT_EQ(controller_.stats().rejected_commands, 2u);
@@ -132,7 +129,7 @@ TEST_F(BaseControllerTest, ResetAndClearEncodersServicesWriteTheirFrames) {
 }
 
 TEST_F(BaseControllerTest, StopWritesAZeroSpeedFrame) {
-  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
+  command(*clock_, controller_, 0.5, 0.0);
   frames_.clear();
   controller_.stop();
   ASSERT_EQ(frames_.size(), 1u);
@@ -173,7 +170,7 @@ TEST_F(BaseControllerTest, CmdVelAt300HzGoesOutAtOnceEveryTime) {
     const core::Clock::time_point at = t0_ + std::chrono::microseconds(2900) + k * spacing;
     advanceTo(*clock_, t0_, at);
     const double speed = 0.05 + 0.005 * (k % 20);
-    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    command(*clock_, controller_, speed, 0.0);
     ASSERT_FALSE(sent_.empty());
     EXPECT_EQ(sent_.back().time, at) << "command " << k << " was held back";
     EXPECT_NEAR(sent_.back().speeds.x(), speed, 1e-12) << "command " << k;
@@ -186,7 +183,7 @@ TEST_F(BaseControllerTest, CmdVelFloodIsLimitedToTheLineShareAndTicksKeepTheirSc
   const auto spacing = std::chrono::microseconds(100);
   for (int k = 1; k <= 2000; ++k) {
     advanceTo(*clock_, t0_, t0_ + k * spacing);
-    clock_->step([&] { controller_.setCommand(0.1 + 0.0001 * (k % 100), 0.0); });
+    command(*clock_, controller_, 0.1 + 0.0001 * (k % 100), 0.0);
   }
   const uint64_t immediate = controller_.stats().immediate_frames;
   // 200 ms / 2.43 ms = 82.3: at most 83 rushed frames, and they did keep coming.
@@ -211,7 +208,7 @@ TEST_F(BaseControllerTest, CmdVelFloodIsLimitedToTheLineShareAndTicksKeepTheirSc
 // --- e-stop ----------------------------------------------------------------------------------
 
 TEST_F(BaseControllerTest, EStopZeroesAtOnceIgnoresCmdVelAndKeepsTheHeartbeat) {
-  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
+  command(*clock_, controller_, 0.5, 0.0);
   clock_->tick(2);
   ASSERT_GT(sent_.back().ticks.left, 0);
   const std::size_t before = sent_.size();
@@ -235,7 +232,7 @@ TEST_F(BaseControllerTest, EStopZeroesAtOnceIgnoresCmdVelAndKeepsTheHeartbeat) {
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{0, 0}));
   EXPECT_FALSE(controller_.stats().e_stop);
   clock_->advance(milliseconds(5));
-  clock_->step([&] { controller_.setCommand(0.1, 0.0); });
+  command(*clock_, controller_, 0.1, 0.0);
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{4, 4}));  // 4.07 ticks
 }
 
@@ -243,7 +240,7 @@ TEST_F(BaseControllerTest, EStopZeroesAtOnceIgnoresCmdVelAndKeepsTheHeartbeat) {
 // (however short it is), and a cmd_vel accepted before it (its generation noted before the e-stop
 // check) never drives after the release; only one accepted after the release does.
 TEST_F(BaseControllerTest, ACmdVelAcceptedBeforeAnEStopNeverDrivesAfterTheRelease) {
-  clock_->step([&] { controller_.setCommand(0.5, 0.0); });
+  command(*clock_, controller_, 0.5, 0.0);
   clock_->tick(2);
   ASSERT_GT(sent_.back().ticks.left, 0);
   const BaseController::Generation accepted = controller_.generation();
@@ -265,8 +262,8 @@ TEST_F(BaseControllerTest, ACmdVelAcceptedBeforeAnEStopNeverDrivesAfterTheReleas
     EXPECT_EQ(sent_[i].ticks, (kinematics::WheelTicks{0, 0})) << "frame " << i;
   }
   clock_->advance(milliseconds(5));
-  clock_->step([&] { outcome = controller_.submitCommand(0.1, 0.0, controller_.generation()); });
-  EXPECT_EQ(outcome, CommandOutcome::kStored);
+  outcome = command(*clock_, controller_, 0.1, 0.0, controller_.generation());
+  EXPECT_EQ(outcome, CommandOutcome::kSent);
   EXPECT_EQ(sent_.back().ticks, (kinematics::WheelTicks{4, 4}));
 }
 
@@ -281,7 +278,7 @@ TEST(BaseControllerEStop, StopsWithoutTheAccelerationRamp) {
   auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, events, clock);
   BaseController& controller = *started;
-  clock->step([&] { controller.setCommand(0.5, 0.0); });
+  command(*clock, controller, 0.5, 0.0);
   clock->tick(100);
   ASSERT_GT(sent.back().ticks.left, 15);
   clock->advance(milliseconds(5));
@@ -299,16 +296,16 @@ TEST(BaseControllerMotion, MotionInForceNamesTheCommandThenTheRampUntilTheWheels
   auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   auto controller = startOnManualClock(config, {}, clock);
   EXPECT_EQ(controller->motionInForce(), "") << "never commanded";
-  clock->step([&] { controller->setCommand(0.5, 0.0); });
+  command(*clock, *controller, 0.5, 0.0);
   EXPECT_EQ(controller->motionInForce(), "cmd_vel of 0.5 m/s, 0 rad/s in force");
   clock->tick(30);  // 600 ms: the command timed out after 0.5 s, the wheels are ramping down
   EXPECT_NE(controller->motionInForce().find("wheels still ramping"), std::string::npos)
       << controller->motionInForce();
   clock->tick(40);
   EXPECT_EQ(controller->motionInForce(), "") << "at rest";
-  clock->step([&] { controller->setCommand(0.0, 0.0); });
+  command(*clock, *controller, 0.0, 0.0);
   EXPECT_EQ(controller->motionInForce(), "") << "a zero cmd_vel commands stillness";
-  clock->step([&] { controller->setCommand(0.0, 0.3); });
+  command(*clock, *controller, 0.0, 0.3);
   EXPECT_NE(controller->motionInForce(), "");
   controller->setEStop(true);
   EXPECT_EQ(controller->motionInForce(), "") << "the e-stop holds zero at once";

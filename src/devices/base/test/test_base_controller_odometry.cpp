@@ -15,9 +15,9 @@ TEST_F(BaseControllerTest, OdometryIntegratesTheTicksSent) {
   // 8 ticks per period exactly: 8 / 40.7437 = 0.19635 m/s on both wheels.
   const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
   const double speed = 8 * per_tick;
-  clock_->step([&] { controller_.setCommand(speed, 0.0); });  // at t0, Reset + frame
+  command(*clock_, controller_, speed, 0.0);  // at t0, Reset + frame
   for (int i = 0; i < 20; ++i) {
-    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    command(*clock_, controller_, speed, 0.0);
     clock_->tick(1);
   }
   ASSERT_FALSE(odometry_.empty());
@@ -37,7 +37,7 @@ TEST_F(BaseControllerTest, OdometryIntegratesTheTicksSent) {
 TEST_F(BaseControllerTest, OdometryUsesTheRobotsTicksNotTheWheelDirections) {
   // The fixture's base has both directions 1; a base with a flipped left wheel is checked in
   // BaseControllerDirections. Here: turning on the spot turns the pose.
-  clock_->step([&] { controller_.setCommand(0.0, 1.0); });  // -/+ 8 ticks
+  command(*clock_, controller_, 0.0, 1.0);  // -/+ 8 ticks
   clock_->tick(50);  // 1 s, but cmd_vel_timeout stops it after 0.5 s
   EXPECT_GT(odometry_.back().pose.yaw, 0.3);
   EXPECT_NEAR(odometry_.back().pose.x, 0.0, 1e-9);
@@ -47,7 +47,7 @@ TEST_F(BaseControllerTest, WheelTravelFollowsTheAcceptedTicksAndSurvivesAnOdomet
   // Turning on the spot: -8 / +8 ticks per period, so the wheels travel opposite ways.
   const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
   for (int i = 0; i < 10; ++i) {
-    clock_->step([&] { controller_.setCommand(0.0, 1.0); });
+    command(*clock_, controller_, 0.0, 1.0);
     clock_->tick(1);
   }
   ASSERT_EQ(sent_.back().ticks, (kinematics::WheelTicks{-8, 8}));
@@ -74,14 +74,14 @@ TEST_F(BaseControllerTest, PortDownStopsIntegratingAfterTheBasesOwnTimeout) {
   const double per_tick = 1.0 / kinematics::DiffDriveGeometry{}.ticksPerPeriodPerMps();
   const double speed = 8 * per_tick;
   for (int i = 0; i < 10; ++i) {  // 200 ms of driving
-    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    command(*clock_, controller_, speed, 0.0);
     clock_->tick(1);
   }
   // The port goes away: nothing more reaches the base, which runs on until its 1 s timeout.
   port_up_ = false;
   controller_.onLinkDown();
   for (int i = 0; i < 150; ++i) {  // 3 s of commands that never reach the wheels
-    clock_->step([&] { controller_.setCommand(speed, 0.0); });
+    command(*clock_, controller_, speed, 0.0);
     clock_->tick(1);
   }
   EXPECT_NEAR(odometry_.back().pose.x, speed * (0.2 + 1.0), 1e-9);
@@ -99,7 +99,7 @@ TEST(BaseControllerDirections, FlippedWheelNegatesItsTicksOnTheWireOnly) {
   auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
   const auto started = startOnManualClock(config, events, clock, &frames);
   BaseController& controller = *started;
-  clock->step([&] { controller.setCommand(0.1, 0.0); });
+  command(*clock, controller, 0.1, 0.0);
   // 0.1 m/s = 4.07 -> 4 ticks; left flipped: FF FC, right 00 04; XOR 55^AA^09^01^01^FF^FC^04 = F1
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[1], golden::base::kLeftMinus4Right4Seq1);
@@ -138,7 +138,7 @@ TEST(BaseControllerImuHeading, FollowsTheImuFallsBackWithoutAJumpAndResumesWitho
   ASSERT_EQ(sources, std::vector<kinematics::HeadingSource>{kinematics::HeadingSource::kImu});
 
   // Commanded 0.5 rad/s; the IMU says the base turns at 0.35 rad/s (slip): odom follows the IMU.
-  clock->step([&] { controller->setCommand(0.0, 0.5); });
+  command(*clock, *controller, 0.0, 0.5);
   for (int i = 0; i < 50; ++i) {
     imu_yaw += 0.35 * 0.02;
     feed();

@@ -21,7 +21,7 @@ void expectOneUnbrokenSequence(const std::vector<WheelFrameSent>& sent) {
 
 TEST_F(BaseControllerTest, RetunedSpeedLimitAppliesFromTheNextTickWithoutAReset) {
   for (int i = 0; i < 5; ++i) {
-    clock_->step([&] { controller_.setCommand(2.0, 0.0); });  // clamped to 1 m/s: ~40.7 ticks
+    command(*clock_, controller_, 2.0, 0.0);  // clamped to 1 m/s: ~40.7 ticks
     clock_->tick(1);
   }
   EXPECT_NEAR(sent_.back().ticks.left, 40.7, 1.0);
@@ -41,7 +41,7 @@ TEST_F(BaseControllerTest, RetunedSpeedLimitAppliesFromTheNextTickWithoutAReset)
 
 TEST_F(BaseControllerTest, RetunedWheelSeparationKeepsThePoseAndTurnsAtTheCommandedRate) {
   for (int i = 0; i < 10; ++i) {
-    clock_->step([&] { controller_.setCommand(0.0, 1.0); });  // -/+ 0.2 m/s at 0.40 m
+    command(*clock_, controller_, 0.0, 1.0);  // -/+ 0.2 m/s at 0.40 m
     clock_->tick(1);
   }
   const double yaw_before = odometry_.back().pose.yaw;
@@ -50,7 +50,7 @@ TEST_F(BaseControllerTest, RetunedWheelSeparationKeepsThePoseAndTurnsAtTheComman
   wider.geometry.wheel_separation = 0.80;
   controller_.retune(wider);
   for (int i = 0; i < 10; ++i) {
-    clock_->step([&] { controller_.setCommand(0.0, 1.0); });  // now -/+ 0.4 m/s
+    command(*clock_, controller_, 0.0, 1.0);  // now -/+ 0.4 m/s
     clock_->tick(1);
   }
   const OdometrySample after = odometry_.back();
@@ -68,7 +68,7 @@ TEST_F(BaseControllerTest, ShortenedCmdVelTimeoutStopsTheWheelsSooner) {
   BaseConfig impatient = controller_.config();
   impatient.cmd_vel_timeout = 0.1;
   controller_.retune(impatient);
-  clock_->step([&] { controller_.setCommand(0.2, 0.0); });
+  command(*clock_, controller_, 0.2, 0.0);
   clock_->tick(4);  // 80 ms: still driving
   EXPECT_GT(sent_.back().ticks.left, 0);
   clock_->tick(2);  // 120 ms: the 0.1 s timeout (not the 0.5 s one it started with) has passed
@@ -78,7 +78,7 @@ TEST_F(BaseControllerTest, ShortenedCmdVelTimeoutStopsTheWheelsSooner) {
 
 TEST_F(BaseControllerTest, RetunedWheelDiameterChangesTheTicksAndKeepsTheWheelAngles) {
   for (int i = 0; i < 10; ++i) {
-    clock_->step([&] { controller_.setCommand(0.2, 0.0); });  // ~8.1 ticks with 0.25 m wheels
+    command(*clock_, controller_, 0.2, 0.0);  // ~8.1 ticks with 0.25 m wheels
     clock_->tick(1);
   }
   const OdometrySample before = odometry_.back();
@@ -160,7 +160,7 @@ TEST(BaseControllerRetune, ImuHeadingSwitchedOnAndOffWithoutAJump) {
   auto controller = startOnManualClock(config, events, clock);
   double imu_yaw = 2.0;  // far from odom's heading: fusion must anchor, not jump to it
   const auto feed = [&] { controller->onImuYaw(imu_yaw, clock->now()); };
-  clock->step([&] { controller->setCommand(0.0, 0.5); });
+  command(*clock, *controller, 0.0, 0.5);
   for (int i = 0; i < 20; ++i) {
     imu_yaw += 0.35 * 0.02;  // the IMU says 0.35 rad/s
     feed();

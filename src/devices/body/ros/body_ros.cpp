@@ -9,6 +9,7 @@
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 #include "serial_robot_driver/ros/trigger_service.h"
 
 namespace serial_robot_driver::devices::body::ros {
@@ -16,13 +17,14 @@ namespace serial_robot_driver::devices::body::ros {
 BodyRos::BodyRos(::ros::NodeHandle& nh, const ros_layer::DriverParams& params, BodyDevice& device)
     : device_(device), arrival_stamps_(params), calibration_nh_(nh) {
   // Queues hold a few frames: a slow subscriber should drop old frames, not delay new ones.
-  joint_states_pub_ =
-      nh.advertise<sensor_msgs::JointState>("joint_states", params.publisherQueue(20));
-  imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu/data", params.publisherQueue(20));
-  foot_pressure_pub_ =
-      nh.advertise<serial_robot_driver::FootPressure>("foot_pressure", params.publisherQueue(20));
-  telemetry_pub_ =
-      nh.advertise<serial_robot_driver::Telemetry>("telemetry", params.publisherQueue(20));
+  joint_states_pub_ = ros_layer::advertiseCounted<sensor_msgs::JointState>(
+      nh, "joint_states", params.publisherQueue(20));
+  imu_pub_ =
+      ros_layer::advertiseCounted<sensor_msgs::Imu>(nh, "imu/data", params.publisherQueue(20));
+  foot_pressure_pub_ = ros_layer::advertiseCounted<serial_robot_driver::FootPressure>(
+      nh, "foot_pressure", params.publisherQueue(20));
+  telemetry_pub_ = ros_layer::advertiseCounted<serial_robot_driver::Telemetry>(
+      nh, "telemetry", params.publisherQueue(20));
   device.addOutputs({[this](const BodyFrame& frame) { publishFrame(frame); }});
 
   core::InputRefusals& refusals = device.inputRefusals();
@@ -60,19 +62,19 @@ void BodyRos::publishFrame(const BodyFrame& frame) {
   // subscribes to is not even built: at hundreds of frames per second that is most of the CPU.
   const ::ros::Time stamp = arrival_stamps_(frame.arrival);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
-  // gets this very message, not a serialized copy.
-  if (joint_states_pub_.getNumSubscribers() > 0) {
+  // gets this very message, not a serialized copy (so each is a message of its own).
+  if (ros_layer::wanted(joint_states_pub_)) {
     joint_states_pub_.publish(
         boost::make_shared<sensor_msgs::JointState>(toJointState(frame.joints, stamp)));
   }
-  if (imu_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(imu_pub_)) {
     imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(
         toImu(frame.telemetry, frame.imu, stamp, frame.gyro_bias)));
   }
-  if (foot_pressure_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(foot_pressure_pub_)) {
     if (auto foot = toFootPressure(frame.telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }
-  if (telemetry_pub_.getNumSubscribers() > 0) {
+  if (ros_layer::wanted(telemetry_pub_)) {
     telemetry_pub_.publish(toTelemetryMsg(frame.telemetry, device_.controller().joints(), stamp));
   }
 }

@@ -66,6 +66,30 @@ TEST(BodyReadingsJoints, JointsBeyondTheFramesServoCountAreLeftOut) {
   EXPECT_EQ(jointReadings(telemetry, hipAndKnee()).names, (std::vector<std::string>{"hip"}));
 }
 
+TEST(BodyReadingsJoints, UpdatedInPlaceFrameAfterFrameWithoutNewStorage) {
+  JointReadings readings;
+  updateJointReadings(goldenBodyTelemetry(), hipAndKnee(-1, 0.02), &readings);
+  const std::string* names = readings.names.data();
+  const double* positions = readings.positions.data();
+  Telemetry next = goldenBodyTelemetry();
+  next.servos[1].position = static_cast<uint16_t>(next.servos[1].position + 512);  // knee moved
+  updateJointReadings(next, hipAndKnee(-1, 0.02), &readings);
+  EXPECT_EQ(readings.names.data(), names) << "the names are kept";
+  EXPECT_EQ(readings.positions.data(), positions) << "the storage is reused";
+  EXPECT_EQ(readings.names, (std::vector<std::string>{"hip", "knee"}));
+  const JointReadings fresh = jointReadings(next, hipAndKnee(-1, 0.02));
+  EXPECT_EQ(readings.positions, fresh.positions);
+  EXPECT_EQ(readings.velocities, fresh.velocities);
+  EXPECT_NE(readings.positions[1],
+            jointReadings(goldenBodyTelemetry(), hipAndKnee(-1, 0.02)).positions[1]);
+
+  next.servo_count = 1;  // fewer joints in the frame: the names follow
+  updateJointReadings(next, hipAndKnee(-1, 0.02), &readings);
+  EXPECT_EQ(readings.names, (std::vector<std::string>{"hip"}));
+  EXPECT_EQ(readings.positions.size(), 1u);
+  EXPECT_EQ(readings.velocities.size(), 1u);
+}
+
 // --- quaternion ----------------------------------------------------------------------------------
 
 TEST(BodyReadingsQuaternion, Identity) {

@@ -390,5 +390,38 @@ TEST(GyroBiasStatus, ShowsTheBiasInForceAndWarnsAboutARefusalUntilAGoodCalibrati
   EXPECT_EQ(calibrated.find("gyro calibration refused"), nullptr);
 }
 
+// With a MotionCheck, a frame asks only the bool: the motion's text is built once when it starts
+// (and while a calibration averages), not per frame, and still names it in a refusal.
+TEST(GyroBiasCalibratorMotionCheck, FramesAskTheBoolAndNameAMotionOnceWhenItStarts) {
+  int texts = 0;
+  bool moving = false;
+  GyroBiasCalibrator calibrator(
+      [&] {
+        ++texts;
+        return moving ? std::string("base: cmd_vel of 0.2 m/s, 0 rad/s in force") : std::string();
+      },
+      GyroCalibrationLimits{}, [&] { return moving; });
+  const core::Clock::time_point t0 = core::Clock::now() - milliseconds(700);
+  int frame = 0;
+  const auto feed = [&](int frames) {
+    for (int end = frame + frames; frame < end; ++frame) {
+      calibrator.onSample({0, 0, 0}, t0 + frame * milliseconds(2), kUnits, 0.3);
+    }
+  };
+  feed(100);
+  EXPECT_EQ(texts, 0) << "no text while nothing moves";
+  moving = true;
+  feed(100);
+  EXPECT_EQ(texts, 1) << "named once, on the frame the motion starts";
+  moving = false;
+  feed(100);
+  EXPECT_EQ(texts, 1);
+  const GyroCalibrationOutcome outcome = calibrator.calibrate(0.3, kUnits, "imu/calibrate");
+  EXPECT_FALSE(outcome.success);
+  EXPECT_TRUE(outcome.not_still);
+  EXPECT_TRUE(contains(outcome.message, "the robot was moving until")) << outcome.message;
+  EXPECT_TRUE(contains(outcome.message, "base: cmd_vel of 0.2 m/s")) << outcome.message;
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::devices::body

@@ -2,14 +2,16 @@
 
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 
 namespace serial_robot_driver::devices::servo_bus::ros {
 
 ServoBusRos::ServoBusRos(::ros::NodeHandle& nh, ServoBusDevice& device)
     : device_(device), services_(nh, device.bus(), device.claims(), device.inputRefusals()) {
-  states_pub_ = nh.advertise<sensor_msgs::JointState>("servo_states", 10);
+  states_pub_ = ros_layer::advertiseCounted<sensor_msgs::JointState>(nh, "servo_states", 10);
   ServoBusOutputs outputs;
   outputs.servo_state = [this](const JointPosition& state, core::Clock::time_point arrival) {
+    if (!ros_layer::wanted(states_pub_)) return;  // nobody asked for it
     states_pub_.publish(busJointState(state, ros_layer::toRosTime(arrival)));
   };
   device.addOutputs(std::move(outputs));

@@ -5,9 +5,9 @@
 #pragma once
 
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include <memory>
 
@@ -15,6 +15,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 
 namespace serial_robot_driver::devices::base::ros {
 
@@ -28,15 +29,18 @@ class BaseRos : public ros_layer::DeviceFrontEnd {
   BaseOutputs outputs();
   void publishWheelCommand(const WheelFrameSent& sent);
   void publishOdometry(const OdometrySample& sample);
+  /// odom's pose as odom -> base_link on /tf.
+  void publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample);
+  static ros_layer::CountedPublisher advertiseTf();
   void publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp);
 
   BaseDevice& device_;
   ros_layer::ArrivalStamps arrival_stamps_;
-  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;  // loop thread, made when needed
-  ::ros::Publisher odom_pub_;
-  ::ros::Publisher wheel_states_pub_;
-  ::ros::Publisher wheel_command_pub_;
-  ::ros::Publisher battery_pub_;
+  ros_layer::CountedPublisher tf_pub_;  // /tf; advertised by the loop thread when first needed
+  ros_layer::CountedPublisher odom_pub_;
+  ros_layer::CountedPublisher wheel_states_pub_;
+  ros_layer::CountedPublisher wheel_command_pub_;
+  ros_layer::CountedPublisher battery_pub_;
   ::ros::Subscriber cmd_vel_sub_;
   ::ros::ServiceServer reset_odometry_srv_;
   ::ros::ServiceServer reset_srv_;

@@ -26,6 +26,7 @@ using body::makeBodyJoints;
 sensor_msgs::JointState toJointState(const Telemetry& telemetry,
                                      const std::vector<BodyJoint>& joints,
                                      const ::ros::Time& stamp);
+/// The same from readings already converted.
 sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros::Time& stamp);
 
 /// REP-145 IMU message: imuReading() (the bias subtracted), with diagonal covariances

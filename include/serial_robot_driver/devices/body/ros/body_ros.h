@@ -14,6 +14,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
 
 namespace serial_robot_driver::devices::body::ros {
@@ -35,10 +36,10 @@ class BodyRos : public ros_layer::DeviceFrontEnd {
 
   BodyDevice& device_;
   const ros_layer::ArrivalStamps arrival_stamps_;
-  ::ros::Publisher joint_states_pub_;
-  ::ros::Publisher imu_pub_;
-  ::ros::Publisher foot_pressure_pub_;
-  ::ros::Publisher telemetry_pub_;
+  ros_layer::CountedPublisher joint_states_pub_;
+  ros_layer::CountedPublisher imu_pub_;
+  ros_layer::CountedPublisher foot_pressure_pub_;
+  ros_layer::CountedPublisher telemetry_pub_;
   ::ros::Subscriber joint_commands_sub_;
   // imu/calibrate: its own queue and one thread, as a call blocks for ~imu/calibration_time.
   ::ros::CallbackQueue calibration_queue_;

@@ -52,6 +52,7 @@
 #include "serial_robot_driver/devices/servo_bus/servo_bus_device.h"
 #include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
+#include "serial_robot_driver/ros/publish_wanted.h"
 
 namespace serial_robot_driver::devices::servo_bus::ros {
 
@@ -81,7 +82,7 @@ class ServoBusRos : public ros_layer::DeviceFrontEnd {
   ServoBusServices services_;  // servo/*, on queues and threads of their own
   bool started_ = false;
   bool shut_down_ = false;
-  ::ros::Publisher states_pub_;
+  ros_layer::CountedPublisher states_pub_;
   ::ros::Subscriber commands_sub_;
 };
 

@@ -1,0 +1,159 @@
+// BaseController: a cmd_vel's wheel frame written at once by the thread that delivers it, under the
+// loop's lock, so the loop and the immediate writes never interleave, and an e-stop engaged before
+// a write means no motion frame.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
+
+#include "support/base_controller_fixture.h"
+
+namespace serial_robot_driver::devices::base {
+namespace {
+
+using namespace base_controller_test;  // NOLINT: the shared fixture
+
+/// Every frame written to the fake port, with the thread that wrote it and whether the test had
+/// the e-stop engaged (set once setEStop(true) returned, cleared before setEStop(false)).
+class WireLog {
+ public:
+  struct Written {
+    Bytes frame;
+    std::thread::id thread;
+    bool under_e_stop = false;
+  };
+
+  bool write(const Bytes& frame) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    written_.push_back({frame, std::this_thread::get_id(), e_stop_engaged.load()});
+    return true;
+  }
+  std::vector<Written> written() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return written_;
+  }
+
+  std::atomic<bool> e_stop_engaged{false};
+
+ private:
+  std::mutex mutex_;
+  std::vector<Written> written_;
+};
+
+// Speed frame (docs/protocols.md): 55 AA 09 SEQ 01, then left and right ticks, 8 bytes.
+bool isMotionFrame(const Bytes& frame) {
+  if (frame.size() < 13 || frame[4] != 0x01) return false;
+  for (std::size_t i = 5; i < 13; ++i) {
+    if (frame[i] != 0) return true;
+  }
+  return false;
+}
+
+std::unique_ptr<BaseController> controllerWritingTo(WireLog& log, const BaseConfig& config,
+                                                    std::shared_ptr<core::LoopClock> clock = {}) {
+  return std::make_unique<BaseController>(
+      config, [&log](const Bytes& frame) { return log.write(frame); }, BaseEvents{},
+      std::move(clock));
+}
+
+BaseConfig quietConfig() {
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  return config;
+}
+
+TEST(BaseControllerImmediate, ACmdVelIsWrittenByItsCallerBeforeTheCallReturns) {
+  WireLog log;
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
+  auto controller = controllerWritingTo(log, quietConfig(), clock);
+  controller->start();
+  clock->waitForLoop();
+  EXPECT_EQ(controller->submitCommand(0.2, 0.0), CommandOutcome::kSent);
+  const std::vector<WireLog::Written> written = log.written();
+  ASSERT_EQ(written.size(), 2u) << "the Reset and the speed frame, before the call returned";
+  EXPECT_EQ(written[0].frame[4], 0x05);
+  EXPECT_EQ(written[1].frame[4], 0x01);
+  EXPECT_EQ(written[1].frame[6], 8) << "0.2 m/s = 8.15 ticks per period";
+  for (const WireLog::Written& w : written) EXPECT_EQ(w.thread, std::this_thread::get_id());
+  controller->stop();
+}
+
+TEST(BaseControllerImmediate, NoCmdVelIsWrittenAfterTheLastWords) {
+  WireLog log;
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
+  auto controller = controllerWritingTo(log, quietConfig(), clock);
+  controller->start();
+  clock->waitForLoop();
+  controller->stop();
+  const std::size_t last_words = log.written().size();
+  ASSERT_GT(last_words, 0u);
+  EXPECT_NE(controller->submitCommand(0.5, 0.0), CommandOutcome::kSent);
+  EXPECT_EQ(log.written().size(), last_words) << "the zero frame of stop() stays the last";
+}
+
+TEST(BaseControllerImmediate, AnEStopEngagedBeforeTheWriteMeansNoMotionFrame) {
+  WireLog log;
+  auto clock = std::make_shared<core::ManualClock>(core::Clock::now());
+  auto controller = controllerWritingTo(log, quietConfig(), clock);
+  controller->start();
+  clock->waitForLoop();
+  const BaseController::Generation accepted = controller->generation();
+  clock->step([&] { controller->setEStop(true); });  // between the acceptance and the write
+  log.e_stop_engaged = true;
+  EXPECT_EQ(controller->submitCommand(0.5, 0.0, accepted), CommandOutcome::kEStopEngaged);
+  log.e_stop_engaged = false;
+  clock->step([&] { controller->setEStop(false); });
+  EXPECT_EQ(controller->submitCommand(0.5, 0.0, accepted), CommandOutcome::kVoided);
+  clock->tick(5);
+  for (const WireLog::Written& w : log.written()) EXPECT_FALSE(isMotionFrame(w.frame));
+  controller->stop();
+}
+
+// The real clock, a 1 kHz loop and a fast line, so the loop's ticks, the commands written by their
+// caller and the e-stop's zero frames race each other for the port.
+TEST(BaseControllerImmediate, CommandsRacingTheLoopAndTheEStopKeepOneSequenceAndStopWhenTold) {
+  BaseConfig config = quietConfig();
+  config.loop_rate = 1000.0;
+  config.baud = 4000000;  // an immediate frame may follow the last after ~70 us
+  config.cmd_vel_timeout = 5.0;
+  WireLog log;
+  auto controller = controllerWritingTo(log, config);
+  controller->start();
+  std::atomic<bool> done{false};
+  std::thread e_stop([&] {
+    for (int i = 0; i < 300; ++i) {
+      controller->setEStop(true);
+      log.e_stop_engaged = true;
+      std::this_thread::sleep_for(std::chrono::microseconds(300));
+      log.e_stop_engaged = false;
+      controller->setEStop(false);
+      std::this_thread::sleep_for(std::chrono::microseconds(300));
+    }
+    done = true;
+  });
+  for (int k = 0; !done; ++k) {
+    const BaseController::Generation accepted = controller->generation();
+    controller->submitCommand(0.3, 0.1 * (k % 3), accepted);
+  }
+  e_stop.join();
+  const std::vector<WireLog::Written> written = log.written();  // not stop()'s zero frame
+  controller->stop();
+
+  std::size_t by_caller = 0, motion = 0;
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    const Bytes& frame = written[i].frame;
+    if (i > 0) {
+      ASSERT_EQ(frame[3], static_cast<uint8_t>(written[i - 1].frame[3] + 1))
+          << "SEQ of frame " << i << ": one sequence, no frame written twice or interleaved";
+    }
+    EXPECT_FALSE(written[i].under_e_stop && isMotionFrame(frame)) << "frame " << i;
+    by_caller += written[i].thread == std::this_thread::get_id();
+    motion += isMotionFrame(frame);
+  }
+  EXPECT_GT(by_caller, 0u) << "commands were written by their caller";
+  EXPECT_LT(by_caller, written.size()) << "and the loop wrote too";
+  EXPECT_GT(motion, 0u) << "between the e-stops the robot was driven";
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::devices::base

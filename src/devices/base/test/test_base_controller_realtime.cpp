@@ -1,0 +1,55 @@
+// The base's control loop at ~realtime_priority: where this process may use SCHED_FIFO (root in a
+// container), the loop thread really runs at it; where it may not, the loop runs on all the same.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+
+#include "serial_robot_driver/devices/base/base_controller.h"
+#include "support/realtime_support.h"
+#include "support/test_helpers.h"
+
+namespace serial_robot_driver::devices::base {
+namespace {
+
+using test_support::currentThreadPolicy;
+using test_support::ThreadPolicy;
+
+/// The policy of the thread that reported the first odometry sample: the loop's.
+ThreadPolicy loopPolicyAt(int priority) {
+  BaseConfig config;
+  config.realtime_priority = priority;
+  std::mutex mutex;
+  std::optional<ThreadPolicy> seen;
+  BaseEvents events;
+  events.on_odometry = [&](const OdometrySample&) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!seen) seen = currentThreadPolicy();
+  };
+  BaseController controller(
+      config, [](const std::vector<uint8_t>&) { return true; }, events);
+  controller.start();
+  const bool ticked = test_support::waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return seen.has_value();
+      },
+      3.0);
+  controller.stop();
+  EXPECT_TRUE(ticked) << "the loop ticks whatever its policy";
+  return seen.value_or(ThreadPolicy{});
+}
+
+TEST(BaseControllerRealtime, TheLoopRunsAtTheConfiguredPriority) {
+  if (!test_support::fifoAllowed(11)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
+  const ThreadPolicy policy = loopPolicyAt(11);
+  EXPECT_EQ(policy.policy, SCHED_FIFO);
+  EXPECT_EQ(policy.priority, 11);
+}
+
+TEST(BaseControllerRealtime, WithoutAPriorityTheLoopKeepsTheNormalPolicy) {
+  EXPECT_EQ(loopPolicyAt(0).policy, SCHED_OTHER);
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::devices::base

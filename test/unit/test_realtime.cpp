@@ -1,0 +1,165 @@
+// ~realtime_priority (core/realtime.h): the one log line for each way the system answers, the
+// refusal of a process that may not (a thread without the capabilities, as an unprivileged user),
+// and, where this process may use SCHED_FIFO (root in a container), the policy the reader thread
+// really runs at. Nothing here locks the test process's memory.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <atomic>
+#include <string>
+
+#include "serial_robot_driver/core/realtime.h"
+#include "serial_robot_driver/core/serial_link.h"
+#include "serial_robot_driver/sim/pseudo_terminal.h"
+#include "support/framer_configs.h"
+#include "support/realtime_support.h"
+#include "support/test_helpers.h"
+
+namespace serial_robot_driver::core {
+namespace {
+
+using test_support::currentThreadPolicy;
+using test_support::fifoAllowed;
+using test_support::ThreadPolicy;
+
+::testing::AssertionResult mentions(const std::string& message, const std::string& part) {
+  if (message.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << part << "' is not in: " << message;
+}
+
+RealtimeFacts allowed(int priority) {
+  RealtimeFacts facts;
+  facts.priority = priority;
+  facts.rtprio_limit = 0;
+  facts.memlock_limit = std::nullopt;
+  facts.cap_sys_nice = true;
+  facts.cap_ipc_lock = true;
+  return facts;
+}
+
+TEST(Realtime, OffSaysNothingAndTriesNothing) {
+  const RealtimeStatus status = prepareRealtime(0);
+  EXPECT_EQ(status.priority, 0);
+  EXPECT_FALSE(status.memory_locked);
+  EXPECT_FALSE(status.refused);
+  EXPECT_TRUE(status.message.empty());
+}
+
+TEST(Realtime, GrantedSaysWhatApplies) {
+  const RealtimeStatus status = judgeRealtime(allowed(50));
+  EXPECT_EQ(status.priority, 50);
+  EXPECT_TRUE(status.memory_locked);
+  EXPECT_FALSE(status.refused);
+  EXPECT_TRUE(mentions(status.message, "SCHED_FIFO priority 50"));
+  EXPECT_TRUE(mentions(status.message, "memory locked"));
+}
+
+TEST(Realtime, RefusedByTheRtprioLimitNamesItAndHowToAllowIt) {
+  RealtimeFacts facts = allowed(50);
+  facts.cap_sys_nice = false;
+  facts.sched_error = EPERM;
+  const RealtimeStatus status = judgeRealtime(facts);
+  EXPECT_EQ(status.priority, 0);
+  EXPECT_TRUE(status.refused);
+  EXPECT_TRUE(mentions(status.message, "RLIMIT_RTPRIO is 0"));
+  EXPECT_TRUE(mentions(status.message, "CAP_SYS_NICE"));
+  EXPECT_TRUE(mentions(status.message, "rtprio 90"));
+  EXPECT_TRUE(mentions(status.message, "/etc/security/limits.conf"));
+  EXPECT_TRUE(mentions(status.message, "runs on"));
+  EXPECT_EQ(status.message.find('\n'), std::string::npos) << "one line";
+}
+
+TEST(Realtime, RefusedDespiteTheLimitBlamesTheMissingRealtimeBudget) {
+  RealtimeFacts facts = allowed(50);
+  facts.cap_sys_nice = false;
+  facts.rtprio_limit = 99;
+  facts.sched_error = EPERM;
+  const RealtimeStatus status = judgeRealtime(facts);
+  EXPECT_TRUE(status.refused);
+  EXPECT_TRUE(mentions(status.message, "RLIMIT_RTPRIO is 99"));
+  EXPECT_TRUE(mentions(status.message, "real-time budget"));
+}
+
+TEST(Realtime, ALimitedMemoryLockIsNotTakenAndSaysHowToAllowIt) {
+  RealtimeFacts facts = allowed(50);
+  facts.cap_ipc_lock = false;
+  facts.memlock_limit = 8192 * 1024;
+  facts.memory_skipped = true;
+  const RealtimeStatus status = judgeRealtime(facts);
+  EXPECT_EQ(status.priority, 50) << "the scheduling still applies";
+  EXPECT_FALSE(status.memory_locked);
+  EXPECT_TRUE(status.refused);
+  EXPECT_TRUE(mentions(status.message, "RLIMIT_MEMLOCK is 8192 KiB"));
+  EXPECT_TRUE(mentions(status.message, "memlock unlimited"));
+}
+
+TEST(Realtime, AnUnprivilegedProcessIsRefusedAndItsThreadKeepsItsPolicy) {
+  rlimit rtprio{};
+  rlimit memlock{};
+  ASSERT_EQ(getrlimit(RLIMIT_RTPRIO, &rtprio), 0);
+  ASSERT_EQ(getrlimit(RLIMIT_MEMLOCK, &memlock), 0);
+  if (rtprio.rlim_cur == RLIM_INFINITY || rtprio.rlim_cur >= 20 ||
+      memlock.rlim_cur == RLIM_INFINITY) {
+    GTEST_SKIP() << "this user's limits allow SCHED_FIFO 20 or an unlimited memory lock";
+  }
+  RealtimeStatus status;
+  ThreadPolicy before;
+  ThreadPolicy after;
+  test_support::runWithoutRealtimeCapabilities([&] {
+    before = currentThreadPolicy();
+    status = prepareRealtime(20);
+    after = currentThreadPolicy();
+  });
+  EXPECT_EQ(status.priority, 0);
+  EXPECT_FALSE(status.memory_locked);
+  EXPECT_TRUE(status.refused);
+  EXPECT_TRUE(mentions(status.message, "RLIMIT_RTPRIO is " + std::to_string(rtprio.rlim_cur)));
+  EXPECT_TRUE(mentions(status.message, "RLIMIT_MEMLOCK"));
+  EXPECT_EQ(after.policy, before.policy);
+  EXPECT_EQ(after.priority, before.priority);
+}
+
+TEST(Realtime, EnterRealtimeGivesTheThreadFifoWhereAllowed) {
+  if (!fifoAllowed(10)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
+  ThreadPolicy policy;
+  std::thread worker([&] {
+    EXPECT_EQ(enterRealtime(10), 0);
+    policy = currentThreadPolicy();
+  });
+  worker.join();
+  EXPECT_EQ(policy.policy, SCHED_FIFO);
+  EXPECT_EQ(policy.priority, 10);
+}
+
+/// Notes the policy of the thread that calls onLinkUp: the link's reader thread.
+class PolicyListener : public LinkListener {
+ public:
+  void onLinkUp() override {
+    policy = currentThreadPolicy();
+    up = true;
+  }
+  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t, Clock::time_point) override {}
+  ThreadPolicy policy;
+  std::atomic<bool> up{false};
+};
+
+TEST(Realtime, TheReaderThreadRunsAtTheLinksPriority) {
+  if (!fifoAllowed(12)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
+  const std::string path = "/tmp/srd_realtime_test_" + std::to_string(::getpid());
+  sim::PseudoTerminal pty(path);
+  SerialLinkOptions options;
+  options.path = path;
+  options.framer = test_support::driverFramer({"base"}, 2);
+  options.realtime_priority = 12;
+  SerialLink link(options);
+  PolicyListener listener;
+  link.addListener(&listener);
+  link.start();
+  ASSERT_TRUE(test_support::waitFor([&] { return listener.up.load(); }, 3.0));
+  link.stop();
+  EXPECT_EQ(listener.policy.policy, SCHED_FIFO);
+  EXPECT_EQ(listener.policy.priority, 12);
+}
+
+}  // namespace
+}  // namespace serial_robot_driver::core
