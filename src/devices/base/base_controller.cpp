@@ -226,9 +226,10 @@ void BaseController::stop() {
     if (written) {
       ++stats_.speed_frames;
       if (!needs_reset_) odometry_.speedAccepted(kinematics::WheelTicks{}, sent.time);
+      unreported_frames_.push_back(sent);
     }
   }
-  if (written && events_.on_wheel_frame) events_.on_wheel_frame(sent);
+  reportWrittenFrames();
 }
 
 void BaseController::retune(const BaseTuning& next) {
@@ -433,11 +434,26 @@ void BaseController::sendSpeedLocked(core::Clock::time_point now, bool immediate
   last_speed_frame_ = now;
   odometry_.speedAccepted(ticks, now);  // a Reset went out before it whenever one was due
   report->sent = sent;
+  unreported_frames_.push_back(sent);
 }
 
 void BaseController::reportSpeedFrame(const SpeedFrameReport& report) {
   if (report.timed_out_now && events_.on_cmd_vel_timeout) events_.on_cmd_vel_timeout();
-  if (report.sent && events_.on_wheel_frame) events_.on_wheel_frame(*report.sent);
+  if (report.sent) reportWrittenFrames();
+}
+
+void BaseController::reportWrittenFrames() {
+  std::lock_guard<std::mutex> reporting(report_mutex_);
+  while (true) {
+    WheelFrameSent sent;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (unreported_frames_.empty()) return;
+      sent = unreported_frames_.front();
+      unreported_frames_.pop_front();
+    }
+    if (events_.on_wheel_frame) events_.on_wheel_frame(sent);
+  }
 }
 
 void BaseController::tick(core::Clock::time_point now) {

@@ -20,7 +20,8 @@
 //  - Every base write happens with mutex_ held, so the sequence counter and "Reset before the next
 //    speed frame" are consistent whichever thread writes (loop, or a base/* service).
 //  - The BaseEvents hooks are called without mutex_ held, on the thread that caused them (loop,
-//    reader, or the caller of stop()). Stats are one struct under mutex_; stats() is a snapshot.
+//    reader, or the caller of stop()); on_wheel_frame in the order the frames were written (the
+//    loop and a cmd_vel's caller may both write: report_mutex_ keeps one reporter at a time). Stats are one struct under mutex_; stats() is a snapshot.
 //  - Odometry (mutex_) integrates the wheel speeds of each speed frame the base accepted, from its
 //    write until the next accepted frame, the base's own 1 s timeout, or an FF error, whichever
 //    comes first. The loop reports a sample after every scheduled tick (on_odometry).
@@ -31,6 +32,7 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -261,6 +263,8 @@ class BaseController : public core::LinkListener {
   void sendSpeedLocked(core::Clock::time_point now, bool immediate, SpeedFrameReport* report);
   /// Without mutex_: the events of a frame sendSpeedLocked() wrote.
   void reportSpeedFrame(const SpeedFrameReport& report);
+  /// Without mutex_: on_wheel_frame for every written frame not reported yet, in write order.
+  void reportWrittenFrames();
   /// Requires mutex_: whether a cmd_vel may be written by its caller now (the loop runs, and the
   /// last immediate frame is minImmediateInterval() ago).
   bool mayRushLocked(core::Clock::time_point now) const;
@@ -285,6 +289,8 @@ class BaseController : public core::LinkListener {
   const core::Clock::duration min_immediate_interval_;
 
   mutable std::mutex mutex_;
+  std::mutex report_mutex_;  ///< taken before mutex_, never while holding it
+  std::deque<WheelFrameSent> unreported_frames_;  ///< under mutex_: written, not yet reported
   std::condition_variable wake_;
   bool stopping_ = false;
   bool stopped_ = false;

@@ -155,5 +155,39 @@ TEST(BaseControllerImmediate, CommandsRacingTheLoopAndTheEStopKeepOneSequenceAnd
   EXPECT_GT(motion, 0u) << "between the e-stops the robot was driven";
 }
 
+// The loop and a cmd_vel's caller both write frames; every front end (wheel_command, the DDS
+// graph) still hears of them once each, in the order they went out.
+TEST(BaseControllerImmediate, WrittenFramesAreReportedOnceEachInWriteOrderWhileTheLoopRaces) {
+  BaseConfig config = quietConfig();
+  config.loop_rate = 1000.0;
+  config.baud = 4000000;
+  config.cmd_vel_timeout = 5.0;
+  WireLog log;
+  std::mutex reported_mutex;
+  std::vector<uint8_t> reported;
+  BaseEvents events;
+  events.on_wheel_frame = [&](const WheelFrameSent& sent) {
+    std::this_thread::yield();  // widen the window between the write and its report
+    std::lock_guard<std::mutex> lock(reported_mutex);
+    reported.push_back(sent.seq);
+  };
+  auto controller = std::make_unique<BaseController>(
+      config, [&log](const Bytes& frame) { return log.write(frame); }, std::move(events));
+  controller->start();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+  for (int k = 0; std::chrono::steady_clock::now() < until; ++k) {
+    controller->submitCommand(0.3, 0.1 * (k % 3), controller->generation());
+  }
+  controller->stop();
+
+  const std::vector<WireLog::Written> written = log.written();
+  std::vector<uint8_t> written_speed_seqs;
+  for (const WireLog::Written& w : written) {
+    if (w.frame.size() >= 5 && w.frame[4] == 0x01) written_speed_seqs.push_back(w.frame[3]);
+  }
+  std::lock_guard<std::mutex> lock(reported_mutex);
+  EXPECT_EQ(reported, written_speed_seqs);
+}
+
 }  // namespace
 }  // namespace serial_robot_driver::devices::base
