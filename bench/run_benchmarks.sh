@@ -15,6 +15,10 @@
 #                       are off by default): in SRD_BENCH_WS, or else in the clone's own .ws/ with
 #                       scripts/build.sh, so `bench/run_benchmarks.sh --build` works on a fresh clone
 #   --long              longer runs (about 15 minutes); also SRD_BENCH_LONG=1
+#   --dds               instead: dds_bench alone (bench/dds_bench.cpp, built with Cyclone DDS only),
+#                       about 2-3 minutes: telemetry -> joint_states over DDS (p50/p99) and the CPU of
+#                       driver_node with ~ros2/enabled on and off and of dds_driver, alternating
+#                       rounds; its table goes to bench/results/dds.md (or $SRD_BENCH_OUTPUT)
 #   SRD_BENCH_WS=DIR    the catkin workspace to use (default: the clone's .ws/ when it holds
 #                       driver_bench or --build is given, else the sourced one)
 set -euo pipefail
@@ -25,17 +29,19 @@ package_dir=$(cd "${script_dir}/.." && pwd)
 
 build=0
 all=0
+dds=0
 sections_given=0
 args=()
 for arg in "$@"; do
   case "${arg}" in
     --build) build=1 ;;
     --all) all=1 ;;
+    --dds) dds=1 ;;
     --sections) sections_given=1; args+=("${arg}") ;;
     *) args+=("${arg}") ;;
   esac
 done
-if (( ! all && ! sections_given )); then args+=(--sections 8); fi
+if (( ! all && ! sections_given && ! dds )); then args+=(--sections 8); fi
 if [[ "${SRD_BENCH_LONG:-0}" == "1" ]]; then args+=(--long); fi
 
 own_ws="${package_dir}/.ws"
@@ -55,6 +61,7 @@ if [[ -n "${SRD_BENCH_WS:-}" ]]; then
     else
       (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DSRD_BUILD_BENCHMARKS=ON "${launcher[@]}" --make-args -j2 driver_bench)
     fi
+    if (( dds )); then (cd "${SRD_BENCH_WS}/build" && make -j2 dds_bench); fi
     # bench_framer exists only where Google Benchmark is installed (libbenchmark-dev).
     (cd "${SRD_BENCH_WS}/build" && make -j2 bench_framer) ||
       echo "run_benchmarks.sh: bench_framer not built (no Google Benchmark); its section is skipped" >&2
@@ -76,6 +83,19 @@ if [[ -z "${bench}" || ! -x "${bench}" ]]; then
   echo "run_benchmarks.sh: driver_bench not found. Run bench/run_benchmarks.sh --build (builds it" \
        "in ${own_ws}), or set SRD_BENCH_WS=<workspace> where it is built." >&2
   exit 2
+fi
+
+# --dds: the ROS 2 front end's benchmark alone (it starts its own roscore and cleans up on SIGINT).
+if (( dds )); then
+  dds_bench="$(dirname "${bench}")/dds_bench"
+  if [[ ! -x "${dds_bench}" ]]; then
+    echo "run_benchmarks.sh: ${dds_bench} not built (it needs Cyclone DDS: scripts/install_deps.sh;" \
+         "then --build --dds)" >&2
+    exit 2
+  fi
+  output="${SRD_BENCH_OUTPUT:-${package_dir}/bench/results/dds.md}"
+  mkdir -p "$(dirname "${output}")"
+  exec "${dds_bench}" --output "${output}" "${args[@]}"
 fi
 
 if [[ -n "${SRD_BENCH_OUTPUT:-}" ]]; then

@@ -36,6 +36,20 @@ target_link_libraries(polling_driver_node srd_ros)
 # The benchmark launches these executables, so building it builds them.
 add_dependencies(driver_bench driver_node polling_driver_node floor_node robot_sim servo_floor
   ${PROJECT_NAME}_generate_messages_cpp)
+# The ROS 2 front end's cost and latency (bench/run_benchmarks.sh --dds), with Cyclone DDS only.
+# It receives as the DDS tests' second participant does (test/dds_front/ros2_peer.*, which reports
+# through gtest's EXPECTs).
+if(SRD_WITH_DDS)
+  add_executable(dds_bench
+    bench/dds_bench.cpp
+    bench/bench_support.cpp
+    bench/ros_bench_support.cpp
+    test/dds_front/ros2_peer.cpp)
+  target_include_directories(dds_bench PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})
+  target_link_libraries(dds_bench srd_core srd_sim srd_dds gtest ${catkin_LIBRARIES})
+  add_dependencies(dds_bench driver_node dds_driver)
+endif()
+
 # Benchmarks run from the build tree and are never installed (hence the catkin_lint pragmas).
 #catkin_lint: ignore uninstalled_target
 #catkin_lint: ignore uninstalled_script
