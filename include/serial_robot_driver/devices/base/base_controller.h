@@ -21,7 +21,8 @@
 //    speed frame" are consistent whichever thread writes (loop, or a base/* service).
 //  - The BaseEvents hooks are called without mutex_ held, on the thread that caused them (loop,
 //    reader, or the caller of stop()); on_wheel_frame in the order the frames were written (the
-//    loop and a cmd_vel's caller may both write: report_mutex_ keeps one reporter at a time). Stats are one struct under mutex_; stats() is a snapshot.
+//    loop and a cmd_vel's caller may both write: report_mutex_ keeps one reporter at a time).
+//    Stats are one struct under mutex_; stats() is a snapshot.
 //  - Odometry (mutex_) integrates the wheel speeds of each speed frame the base accepted, from its
 //    write until the next accepted frame, the base's own 1 s timeout, or an FF error, whichever
 //    comes first. The loop reports a sample after every scheduled tick (on_odometry).
@@ -289,8 +290,10 @@ class BaseController : public core::LinkListener {
   const core::Clock::duration min_immediate_interval_;
 
   mutable std::mutex mutex_;
-  std::mutex report_mutex_;  ///< taken before mutex_, never while holding it
-  std::deque<WheelFrameSent> unreported_frames_;  ///< under mutex_: written, not yet reported
+  /// Taken before mutex_, never while holding it.
+  std::mutex report_mutex_;
+  /// Under mutex_: frames written, not yet reported.
+  std::deque<WheelFrameSent> unreported_frames_;
   std::condition_variable wake_;
   bool stopping_ = false;
   bool stopped_ = false;
