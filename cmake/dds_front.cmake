@@ -17,7 +17,7 @@ add_library(srd_dds_front STATIC
 target_link_libraries(srd_dds_front PUBLIC srd_core srd_dds srd_yaml_params)
 set_target_properties(srd_dds_front PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
-# driver_node serves the ROS 2 graph too with ~ros2/enabled (ros/ros2_graph.h).
+# driver_node serves the ROS 2 graph too with ~ros2/enabled (dds_front/ros2_graph.h).
 target_link_libraries(srd_ros PUBLIC srd_dds_front)
 
 add_executable(dds_driver src/nodes/dds_driver_main.cpp)

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "serial_robot_driver/core/e_stop_status.h"
+#include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/core/log.h"
 
 namespace serial_robot_driver::core {
@@ -185,6 +186,25 @@ StatusReport DriverCore::eStopStatus(InputRefusalStats own) const {
   for (const auto& device : devices_) own += device->inputRefusalStats();
   addInputRefusals(own, report);
   return report;
+}
+
+std::vector<Device::NamedStatus> DriverCore::statusSources(
+    std::function<InputRefusalStats()> own_refusals) const {
+  std::vector<Device::NamedStatus> sources;
+  for (const auto& [path, link_ptr] : ports_) {
+    const SerialLink* link = link_ptr.get();
+    sources.push_back(
+        {"port " + path, [link] { return linkStatus(link->stats(), link->options()); }});
+  }
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
+    Device* device = devices_[i].get();
+    sources.push_back({device_names_[i], [device] { return device->status(); }});
+    for (Device::NamedStatus& extra : device->extraStatuses()) sources.push_back(std::move(extra));
+  }
+  sources.push_back({"e_stop", [this, own_refusals = std::move(own_refusals)] {
+                       return eStopStatus(own_refusals());
+                     }});
+  return sources;
 }
 
 std::string DriverCore::startupSummary() const {

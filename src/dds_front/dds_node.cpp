@@ -4,7 +4,6 @@
 #include <optional>
 
 #include "serial_robot_driver/core/e_stop_status.h"
-#include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/core/wall_stamps.h"
 #include "serial_robot_driver/dds/ros_conventions.h"
@@ -36,7 +35,7 @@ DdsNode::DdsNode(const params::DriverParams& params, const dds::NodeOptions& opt
                      ": "),
       participant_(std::make_unique<dds::Participant>(options)) {
   attachDevices();
-  collectStatusSources();
+  status_sources_ = core_.statusSources([this] { return refusals_.stats(); });
   diagnostics_ = std::make_unique<dds::Publisher<diagnostic_msgs_msg_dds__DiagnosticArray_>>(
       *participant_, "/diagnostics");
   // Queue 10 as on the ROS side, so no toggle is dropped.
@@ -102,23 +101,6 @@ void DdsNode::shutdown() {
   e_stop_.reset();
   joint_trajectory_.reset();
   for (auto& front_end : front_ends_) front_end->shutdown();
-}
-
-void DdsNode::collectStatusSources() {
-  // The ROS node's statuses, in its order: each port, each device and its own, the e-stop.
-  for (const auto& [path, link_ptr] : core_.ports()) {
-    const core::SerialLink* link = link_ptr.get();
-    status_sources_.push_back(
-        {"port " + path, [link] { return core::linkStatus(link->stats(), link->options()); }});
-  }
-  for (std::size_t i = 0; i < core_.devices().size(); ++i) {
-    core::Device* device = core_.devices()[i].get();
-    status_sources_.push_back({core_.deviceNames()[i], [device] { return device->status(); }});
-    for (core::Device::NamedStatus& extra : device->extraStatuses()) {
-      status_sources_.push_back(std::move(extra));
-    }
-  }
-  status_sources_.push_back({"e_stop", [this] { return core_.eStopStatus(refusals_.stats()); }});
 }
 
 std::vector<NamedReport> DdsNode::statusReports() const {

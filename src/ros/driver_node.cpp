@@ -4,11 +4,10 @@
 #include <utility>
 
 #include "serial_robot_driver/core/e_stop_status.h"
-#include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/dds_front/ros2_graph.h"
 #include "serial_robot_driver/ros/conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
-#include "serial_robot_driver/ros/ros2_graph.h"
 #include "serial_robot_driver/ros/ros_device_module.h"
 #include "serial_robot_driver/ros/runtime_tuning.h"
 #include "serial_robot_driver/ros/trajectory_server.h"
@@ -56,10 +55,10 @@ DriverNode::DriverNode(ros::NodeHandle nh, ros::NodeHandle private_nh, DriverPar
                                              TrajectoryServer::logWarning());
   attachFrontEnds();
   // ~ros2/enabled: the same devices on the ROS 2 graph, named like this node.
-  ros2_ = std::make_unique<Ros2Graph>(params_, private_nh.getNamespace(), *core_);
-  addPortsAndDevices();
+  ros2_ = std::make_unique<dds_front::Ros2Graph>(params_, private_nh.getNamespace(), *core_);
   serveTrajectories();
   connectEStop();
+  addStatuses();
   // The timer's period is the updater's (~diagnostic_period, default 1 s) and it forces the
   // update: update() would skip a tick that fires a hair before the updater's own deadline.
   diagnostics_period_ = diagnostics_.getPeriod();
@@ -84,26 +83,17 @@ void DriverNode::attachFrontEnds() {
   }
 }
 
-void DriverNode::addPortsAndDevices() {
-  for (const auto& [path, link_ptr] : core_->ports()) {
-    core::SerialLink& link = *link_ptr;
-    diagnostics_.add("port " + path, [&link](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      writeStatusReport(core::linkStatus(link.stats(), link.options()), s);
+void DriverNode::addStatuses() {
+  const auto own_refusals = [this] {  // the node's e_stop topic and its trajectory server
+    core::InputRefusalStats own = input_refusals_.stats();
+    if (trajectory_) own += trajectory_->inputRefusalStats();
+    return own;
+  };
+  for (core::Device::NamedStatus& source : core_->statusSources(own_refusals)) {
+    diagnostics_.add(source.name, [report = std::move(source.report)](
+                                      diagnostic_updater::DiagnosticStatusWrapper& s) {
+      writeStatusReport(report(), s);
     });
-  }
-  for (std::size_t i = 0; i < core_->devices().size(); ++i) {
-    // The device's status carries its registered name; its own statuses theirs.
-    core::Device* device = core_->devices()[i].get();
-    diagnostics_.add(core_->deviceNames()[i],
-                     [device](diagnostic_updater::DiagnosticStatusWrapper& s) {
-                       writeStatusReport(device->status(), s);
-                     });
-    for (core::Device::NamedStatus& extra : device->extraStatuses()) {
-      diagnostics_.add(extra.name, [report = std::move(extra.report)](
-                                       diagnostic_updater::DiagnosticStatusWrapper& s) {
-        writeStatusReport(report(), s);
-      });
-    }
   }
 }
 
@@ -116,11 +106,6 @@ void DriverNode::connectEStop() {
   // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
   e_stop_sub_ = subscribeGuarded(nh_, input_refusals_, "e_stop", 10, &DriverNode::onEStop, this,
                                  ros::TransportHints().tcpNoDelay());
-  diagnostics_.add("e_stop", [this](diagnostic_updater::DiagnosticStatusWrapper& s) {
-    core::InputRefusalStats own = input_refusals_.stats();
-    if (trajectory_) own += trajectory_->inputRefusalStats();
-    writeStatusReport(core_->eStopStatus(own), s);
-  });
   if (params_.e_stop.start_engaged) {
     ROS_WARN(
         "e_stop engaged at start-up (~e_stop/start_engaged): nothing moves until e_stop "

@@ -8,10 +8,10 @@
 
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/stop_signals.h"
+#include "serial_robot_driver/dds_front/ros2_graph.h"
 #include "serial_robot_driver/ros/bag_replay.h"
 #include "serial_robot_driver/ros/driver_node.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
-#include "serial_robot_driver/ros/ros2_graph.h"
 
 namespace serial_robot_driver::ros_layer {
 
@@ -29,7 +29,7 @@ DriverParams loadCheckedParams(const ros::NodeHandle& private_nh) {
     ROS_WARN("unknown parameter ~%s is ignored (a typo?)", key.c_str());
   }
   params.validate();
-  requireRos2Support(params);
+  dds_front::requireRos2Support(params);
   return params;
 }
 

@@ -23,6 +23,9 @@ class LoggingDevice : public Device {
   void start() override { log_.push_back("start " + name_); }
   void shutdown() override { log_.push_back("shutdown " + name_); }
   StatusReport status() override { return {}; }
+  std::vector<NamedStatus> extraStatuses() override {
+    return {{name_ + " extra", [] { return StatusReport{}; }}};
+  }
   void attachEStop(EStop& e_stop) override {
     e_stop_ = &e_stop;
     log_.push_back("e_stop " + name_);
@@ -139,6 +142,31 @@ TEST_F(DriverCoreTest, TheEStopStatusCountsTheDevicesRefusalsWithTheFrontEndsOwn
   EXPECT_EQ(value("inputs refused: servo/move"), "1");
   EXPECT_EQ(value("inputs refused: e_stop"), "2");
   EXPECT_EQ(value("inputs refused"), "4");
+}
+
+TEST_F(DriverCoreTest, EveryFrontEndReportsThePortsTheDevicesWithTheirOwnThenTheEStop) {
+  auto core = makeCore();
+  int asked = 0;
+  std::vector<Device::NamedStatus> sources = core->statusSources([&asked] {
+    ++asked;
+    InputRefusalStats own;
+    own.refused["e_stop"] = 3;
+    return own;
+  });
+  std::vector<std::string> names;
+  for (const auto& source : sources) names.push_back(source.name);
+  const std::string prefix = "port /tmp/srd_core_test_" + std::to_string(::getpid());
+  const std::vector<std::string> expected{
+      prefix + "_bus", prefix + "_shared", "base",  "base extra", "body", "body extra",
+      "servo_bus",     "servo_bus extra",  "e_stop"};
+  EXPECT_EQ(names, expected);
+  EXPECT_EQ(asked, 0) << "the front end's refusals are asked when the status is";
+  const StatusReport e_stop = sources.back().report();
+  EXPECT_EQ(asked, 1);
+  bool counted = false;
+  for (const auto& [key, value] : e_stop.values)
+    counted |= key == "inputs refused: e_stop" && value == "3";
+  EXPECT_TRUE(counted);
 }
 
 }  // namespace

@@ -75,6 +75,11 @@ class DriverCore {
 
   /// The e-stop's status with every input refusal: the devices' and the front end's `own`.
   StatusReport eStopStatus(InputRefusalStats own) const;
+  /// Every status a front end reports, in one order for all of them: each port ("port <path>"),
+  /// each device (its registered name) followed by its own statuses, then "e_stop" with the
+  /// inputs the front end itself refused (`own_refusals`, asked on the reporting thread).
+  std::vector<Device::NamedStatus> statusSources(
+      std::function<InputRefusalStats()> own_refusals) const;
   /// e.g. "driving port /dev/ttyUSB0 (115200 baud: base, body); loop 50 Hz, battery poll 1 Hz".
   std::string startupSummary() const;
 

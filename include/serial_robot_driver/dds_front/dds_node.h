@@ -53,7 +53,6 @@ class DdsNode {
 
  private:
   void attachDevices();
-  void collectStatusSources();
   void onEStop(const std_msgs_msg_dds__Bool_& msg);
   /// joint_trajectory: the core's trajectories, as the ROS 1 topic (refused whole when it does
   /// not check out, counted under its name).

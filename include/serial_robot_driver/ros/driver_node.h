@@ -48,9 +48,12 @@
 #include "serial_robot_driver/ros/device_front_end.h"
 #include "serial_robot_driver/ros/driver_params.h"
 
+namespace serial_robot_driver::dds_front {
+class Ros2Graph;
+}  // namespace serial_robot_driver::dds_front
+
 namespace serial_robot_driver::ros_layer {
 
-class Ros2Graph;
 class RuntimeTuning;
 class TrajectoryServer;
 class WireCapture;
@@ -75,12 +78,12 @@ class DriverNode {
  private:
   /// Each device's ROS front end (its RosDeviceModule), attached before the core starts.
   void attachFrontEnds();
-  /// A status per port, a status (and its extras) per device.
-  void addPortsAndDevices();
   /// follow_joint_trajectory / joint_trajectory when a device offers joints.
   void serveTrajectories();
-  /// Subscribes e_stop and reports it.
+  /// Subscribes e_stop.
   void connectEStop();
+  /// The core's statuses (ports, devices and their own, the e-stop) on the diagnostics updater.
+  void addStatuses();
   void onEStop(const std_msgs::Bool::ConstPtr& msg);
 
   ros::NodeHandle nh_;
@@ -95,7 +98,7 @@ class DriverNode {
   /// The devices' topics and services, in the devices' order; destroyed before core_'s devices.
   std::vector<std::unique_ptr<DeviceFrontEnd>> front_ends_;
   /// ~ros2/enabled: the DDS front end on the same devices (nothing otherwise).
-  std::unique_ptr<Ros2Graph> ros2_;
+  std::unique_ptr<dds_front::Ros2Graph> ros2_;
   /// follow_joint_trajectory / joint_trajectory for the core's trajectories; null without joints.
   std::unique_ptr<TrajectoryServer> trajectory_;
   double diagnostics_period_ = 1.0;  ///< s; the updater's ~diagnostic_period at start-up

@@ -1,6 +1,7 @@
-// driver_node's ROS 2 side (~ros2/enabled): the DDS front end (dds_front/dds_node.h) on the node's
-// own core, named like the ROS 1 node, so one process serves both graphs. A build without Cyclone
-// DDS has none: ~ros2/enabled true is then a parameter error (requireRos2Support).
+// The ROS 2 side of a process that hosts the core for another graph (driver_node, ~ros2/enabled):
+// the DDS front end (dds_node.h) on that process's core, named like its ROS 1 node, so one process
+// serves both graphs. ROS-free, and built with or without Cyclone DDS (srd_ros compiles it): a
+// build without it has no graph to join, and ~ros2/enabled true is then a parameter error.
 #pragma once
 
 #include <memory>
@@ -9,7 +10,7 @@
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/params/driver_params.h"
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::dds_front {
 
 /// With ~ros2/enabled: throws params::ParameterError naming ~ros2/enabled in a build without DDS,
 /// ~ros2/domain_id when it is -1 and $ROS_DOMAIN_ID is no domain.
@@ -33,4 +34,4 @@ class Ros2Graph {
   std::unique_ptr<Node> node_;  // null without ~ros2/enabled
 };
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::dds_front

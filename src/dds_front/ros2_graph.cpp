@@ -1,4 +1,4 @@
-#include "serial_robot_driver/ros/ros2_graph.h"
+#include "serial_robot_driver/dds_front/ros2_graph.h"
 
 #if defined(SRD_WITH_DDS) && SRD_WITH_DDS
 #include <cstdlib>
@@ -8,12 +8,12 @@
 #include "serial_robot_driver/dds_front/dds_node.h"
 #endif
 
-namespace serial_robot_driver::ros_layer {
+namespace serial_robot_driver::dds_front {
 
 #if defined(SRD_WITH_DDS) && SRD_WITH_DDS
 
 struct Ros2Graph::Node {
-  dds_front::DdsNode dds;
+  DdsNode dds;
 };
 
 void requireRos2Support(const params::DriverParams& params) {
@@ -31,9 +31,8 @@ Ros2Graph::Ros2Graph(const params::DriverParams& params, const std::string& node
   const std::size_t slash = node_name.rfind('/');
   const std::string node_namespace = slash == 0 ? "/" : node_name.substr(0, slash);
   try {
-    node_.reset(new Node{dds_front::DdsNode(
-        params, dds_front::nodeOptions(params.ros2, node_name.substr(slash + 1), node_namespace),
-        core)});
+    node_.reset(new Node{DdsNode(
+        params, nodeOptions(params.ros2, node_name.substr(slash + 1), node_namespace), core)});
   } catch (const params::ParameterError&) {
     throw;
   } catch (const std::exception& e) {  // DDS refused the participant, a bad $ROS_DOMAIN_ID
@@ -72,4 +71,4 @@ void Ros2Graph::shutdown() {}
 
 Ros2Graph::~Ros2Graph() = default;
 
-}  // namespace serial_robot_driver::ros_layer
+}  // namespace serial_robot_driver::dds_front
