@@ -71,8 +71,9 @@ void BaseRos::publishWheelCommand(const WheelFrameSent& sent) {
 
 void BaseRos::publishOdometry(const OdometrySample& sample) {
   // Called on the control loop's thread once per tick; never touches the port. What nobody
-  // subscribes to is not built (/tf included: it goes out whenever anyone listens to /tf).
-  const ::ros::Time stamp = ::ros::Time::now();
+  // subscribes to is not built (/tf included: it goes out whenever anyone listens to /tf). Stamped
+  // with the tick's time, as on every front end (the DDS one gives the same sample that stamp).
+  const ::ros::Time stamp = arrival_stamps_(sample.time);
   // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
   if (device_.tuned()->publish_tf && !tf_pub_) tf_pub_ = advertiseTf();
   const bool odom_wanted = ros_layer::wanted(odom_pub_);

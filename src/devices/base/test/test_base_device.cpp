@@ -11,6 +11,7 @@
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/devices/base/base_device.h"
 #include "serial_robot_driver/devices/body/body_params.h"
+#include "support/device_core_fixture.h"
 #include "support/golden_frames.h"
 #include "support/log_capture.h"
 #include "support/memory_stream.h"
@@ -57,34 +58,10 @@ class Listener {
   OdometrySample last_odometry_;
 };
 
-class BaseDeviceTest : public ::testing::Test {
+class BaseDeviceTest : public test_support::DeviceCoreFixture<BaseDevice, Listener> {
  protected:
-  BaseDeviceTest() {
-    params_.port = "memory";
-    for (const char* other : {"body", "servo_bus"}) {
-      params_.portParams(*core::findDevice(other)).enabled = false;
-    }
-  }
-  ~BaseDeviceTest() override {
-    if (core_) core_->shutdown();
-  }
-
-  BaseDevice& makeBase() {
-    core_ = std::make_unique<core::DriverCore>(params_, test_support::memoryStreams(wire_));
-    // Built by the base module's make_device: a BaseDevice.
-    return static_cast<BaseDevice&>(*core_->device("base"));
-  }
-  void start() {
-    core_->start();
-    ASSERT_TRUE(core_->ports().at("memory")->waitConnected(std::chrono::seconds(5)));
-  }
-
-  test_support::LogCapture logs_;  // outlives the core's threads, which may log
-  test_support::MemoryWire wire_;  // outlives the core's link
-  Listener first_;                 // the front ends' outputs outlive the core's threads
-  Listener second_;
-  params::DriverParams params_;
-  std::unique_ptr<core::DriverCore> core_;
+  BaseDeviceTest() : DeviceCoreFixture("base") {}
+  BaseDevice& makeBase() { return makeDevice(); }
 };
 
 TEST_F(BaseDeviceTest, TheCoreBuildsTheBaseFromItsModuleWithoutAFrontEnd) {

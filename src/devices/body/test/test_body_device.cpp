@@ -9,6 +9,7 @@
 
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/devices/body/body_device.h"
+#include "support/device_core_fixture.h"
 #include "support/golden_frames.h"
 #include "support/log_capture.h"
 #include "support/memory_stream.h"
@@ -45,34 +46,10 @@ class Listener {
   double angle_scale_ = 0.0;
 };
 
-class BodyDeviceTest : public ::testing::Test {
+class BodyDeviceTest : public test_support::DeviceCoreFixture<BodyDevice, Listener> {
  protected:
-  BodyDeviceTest() {
-    params_.port = "memory";
-    for (const char* other : {"base", "servo_bus"}) {
-      params_.portParams(*core::findDevice(other)).enabled = false;
-    }
-  }
-  ~BodyDeviceTest() override {
-    if (core_) core_->shutdown();
-  }
-
-  BodyDevice& makeBody() {
-    core_ = std::make_unique<core::DriverCore>(params_, test_support::memoryStreams(wire_));
-    // Built by the body module's make_device: a BodyDevice.
-    return static_cast<BodyDevice&>(*core_->device("body"));
-  }
-  void start() {
-    core_->start();
-    ASSERT_TRUE(core_->ports().at("memory")->waitConnected(std::chrono::seconds(5)));
-  }
-
-  test_support::LogCapture logs_;  // outlives the core's threads, which may log
-  test_support::MemoryWire wire_;  // outlives the core's link
-  Listener first_;                 // the front ends' outputs outlive the core's threads
-  Listener second_;
-  params::DriverParams params_;
-  std::unique_ptr<core::DriverCore> core_;
+  BodyDeviceTest() : DeviceCoreFixture("body") {}
+  BodyDevice& makeBody() { return makeDevice(); }
 };
 
 TEST_F(BodyDeviceTest, EveryFrontEndReceivesEachFramesJointReadings) {
