@@ -13,6 +13,7 @@
 
 #include "dds_test_peer_process.h"
 #include "dds_test_support.h"
+#include "loopback_observer_config.h"
 #include "serial_robot_driver/dds/messages.h"
 
 using dds_test::waitFor;
@@ -69,12 +70,7 @@ class SecondParticipant : public ::testing::Test {
  protected:
   void SetUp() override {
     domain_id_ = dds_test::privateDomainId(175, 50);
-    const std::string config =
-        "<CycloneDDS><Domain><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
-        "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-        "<ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-        "</Discovery></Domain></CycloneDDS>";
-    domain_ = dds_create_domain(domain_id_, config.c_str());
+    domain_ = dds_create_domain(domain_id_, dds_test::kLoopbackObserverConfig);
     ASSERT_GT(domain_, 0) << dds_strretcode(domain_);
     participant_ = dds_create_participant(domain_id_, nullptr, nullptr);
     ASSERT_GT(participant_, 0);

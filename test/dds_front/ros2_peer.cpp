@@ -6,6 +6,7 @@
 #include <chrono>
 #include <thread>
 
+#include "../dds/loopback_observer_config.h"
 #include "serial_robot_driver/dds/messages.h"
 
 namespace dds_test {
@@ -60,12 +61,7 @@ bool writeBool(dds_entity_t writer, bool data) {
 int privateDomain(int first, int count) { return first + static_cast<int>(getpid()) % count; }
 
 Ros2Peer::Ros2Peer(int domain) {
-  const std::string config =
-      "<CycloneDDS><Domain><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
-      "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-      "<ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-      "</Discovery></Domain></CycloneDDS>";
-  domain_ = dds_create_domain(domain, config.c_str());
+  domain_ = dds_create_domain(domain, dds_test::kLoopbackObserverConfig);
   EXPECT_GT(domain_, 0) << dds_strretcode(domain_);
   participant_ = dds_create_participant(domain, nullptr, nullptr);
   EXPECT_GT(participant_, 0) << dds_strretcode(participant_);
