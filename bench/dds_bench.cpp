@@ -433,7 +433,7 @@ std::string runWithMaster(int argc, char** argv, const Options& options, const R
   ros::init(argc, argv, "dds_bench", ros::init_options::NoSigintHandler);
   std::cerr << "dds_bench: roscore at " << master.uri() << ", logs in " << paths.work_dir << "\n";
   master.waitUntilUp(60s);
-  const int domain = dds_test::privateDomain(180, 40);  // the DDS tests use 120-169
+  const int domain = dds_test::privateDomainId(180, 40);  // the DDS tests use 120-169
   dds_test::Ros2Peer peer(domain);
   Context context{options, paths, ros::NodeHandle(), domain, peer};
   ros::AsyncSpinner spinner(1);

@@ -31,6 +31,7 @@ if(CATKIN_ENABLE_TESTING)
   # machine sees it.
   catkin_add_gtest(dds_driver_tests
     test/dds_front/test_dds_driver.cpp
+    test/dds_front/hostile_dds_inputs.cpp
     test/dds_front/ros2_peer.cpp
     test/support/process_support.cpp)
   target_include_directories(dds_driver_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)

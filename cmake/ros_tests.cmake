@@ -192,6 +192,7 @@ endforeach()
 if(SRD_WITH_DDS)
   add_rostest_gtest(test_ros2_graph test/rostest/ros2_graph.test
     test/rostest/test_ros2_graph.cpp
+    test/dds_front/hostile_dds_inputs.cpp
     test/dds_front/ros2_peer.cpp)
   target_include_directories(test_ros2_graph PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_ros2_graph srd_test_support srd_dds ${catkin_LIBRARIES})

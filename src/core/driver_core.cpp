@@ -180,16 +180,16 @@ void DriverCore::shutdown() {
   for (auto& [path, link] : ports_) link->stop();
 }
 
-StatusReport DriverCore::eStopStatus(InputRefusalStats own) const {
+StatusReport DriverCore::eStopStatus() const {
   StatusReport report = core::eStopStatus(e_stop_.stats());
   // Node-wide, next to what the e-stop refused: what every input's checks refused.
+  InputRefusalStats own = input_refusals_.stats();
   for (const auto& device : devices_) own += device->inputRefusalStats();
   addInputRefusals(own, report);
   return report;
 }
 
-std::vector<Device::NamedStatus> DriverCore::statusSources(
-    std::function<InputRefusalStats()> own_refusals) const {
+std::vector<Device::NamedStatus> DriverCore::statusSources() const {
   std::vector<Device::NamedStatus> sources;
   for (const auto& [path, link_ptr] : ports_) {
     const SerialLink* link = link_ptr.get();
@@ -201,9 +201,7 @@ std::vector<Device::NamedStatus> DriverCore::statusSources(
     sources.push_back({device_names_[i], [device] { return device->status(); }});
     for (Device::NamedStatus& extra : device->extraStatuses()) sources.push_back(std::move(extra));
   }
-  sources.push_back({"e_stop", [this, own_refusals = std::move(own_refusals)] {
-                       return eStopStatus(own_refusals());
-                     }});
+  sources.push_back({"e_stop", [this] { return eStopStatus(); }});
   return sources;
 }
 

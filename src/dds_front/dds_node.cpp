@@ -35,7 +35,7 @@ DdsNode::DdsNode(const params::DriverParams& params, const dds::NodeOptions& opt
                      ": "),
       participant_(std::make_unique<dds::Participant>(options)) {
   attachDevices();
-  status_sources_ = core_.statusSources([this] { return refusals_.stats(); });
+  status_sources_ = core_.statusSources();
   diagnostics_ = std::make_unique<dds::Publisher<diagnostic_msgs_msg_dds__DiagnosticArray_>>(
       *participant_, "/diagnostics");
   // Queue 10 as on the ROS side, so no toggle is dropped.
@@ -83,7 +83,7 @@ void DdsNode::onJointTrajectory(const trajectory_msgs_msg_dds__JointTrajectory_&
   }
   if (executor.submitTrajectory(toTrajectoryCommand(msg), start) ==
       trajectory::TrajectoryExecutor::Submission::kInvalid) {
-    refusals_.refused("joint_trajectory");
+    core_.inputRefusals().refused("joint_trajectory");
   }
 }
 

@@ -84,12 +84,7 @@ void DriverNode::attachFrontEnds() {
 }
 
 void DriverNode::addStatuses() {
-  const auto own_refusals = [this] {  // the node's e_stop topic and its trajectory server
-    core::InputRefusalStats own = input_refusals_.stats();
-    if (trajectory_) own += trajectory_->inputRefusalStats();
-    return own;
-  };
-  for (core::Device::NamedStatus& source : core_->statusSources(own_refusals)) {
+  for (core::Device::NamedStatus& source : core_->statusSources()) {
     diagnostics_.add(source.name, [report = std::move(source.report)](
                                       diagnostic_updater::DiagnosticStatusWrapper& s) {
       writeStatusReport(report(), s);
@@ -99,13 +94,14 @@ void DriverNode::addStatuses() {
 
 void DriverNode::serveTrajectories() {
   if (core_->trajectories() == nullptr) return;
-  trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, *core_->trajectories());
+  trajectory_ = std::make_unique<TrajectoryServer>(nh_, params_, *core_->trajectories(),
+                                                   core_->inputRefusals());
 }
 
 void DriverNode::connectEStop() {
   // A latched publisher's last message arrives on connection; queue 10 so no toggle is dropped.
-  e_stop_sub_ = subscribeGuarded(nh_, input_refusals_, "e_stop", 10, &DriverNode::onEStop, this,
-                                 ros::TransportHints().tcpNoDelay());
+  e_stop_sub_ = subscribeGuarded(nh_, core_->inputRefusals(), "e_stop", 10, &DriverNode::onEStop,
+                                 this, ros::TransportHints().tcpNoDelay());
   if (params_.e_stop.start_engaged) {
     ROS_WARN(
         "e_stop engaged at start-up (~e_stop/start_engaged): nothing moves until e_stop "

@@ -77,8 +77,10 @@ trajectory::TrajectoryCommand toTrajectoryCommand(const trajectory_msgs::JointTr
 }
 
 TrajectoryServer::TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
-                                   trajectory::TrajectoryExecutor& executor)
-    : executor_(executor),
+                                   trajectory::TrajectoryExecutor& executor,
+                                   core::InputRefusals& refusals)
+    : input_refusals_(refusals),
+      executor_(executor),
       loop_period_(1.0 / params.loop_rate),
       nh_(nh),
       action_server_(

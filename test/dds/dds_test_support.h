@@ -1,5 +1,6 @@
 #pragma once
-// Shared by the DDS runtime tests: a domain id of this test process's own, condition waits.
+// Shared by the DDS runtime tests (test/dds, test/dds_front, the ROS 2 rostest, dds_bench): a
+// domain id of this test process's own, condition waits.
 
 #include <unistd.h>
 
@@ -8,6 +9,7 @@
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 namespace dds_test {
 
@@ -19,7 +21,7 @@ inline int privateDomainId(int first, int count) {
 /// Waits until `done` holds; false if it still does not after `deadline` (generous: no timing is
 /// asserted, only that the condition comes true).
 inline bool waitFor(const std::function<bool()>& done,
-                    std::chrono::seconds deadline = std::chrono::seconds(20)) {
+                    std::chrono::seconds deadline = std::chrono::seconds(30)) {
   const auto give_up = std::chrono::steady_clock::now() + deadline;
   while (!done()) {
     if (std::chrono::steady_clock::now() > give_up) return false;

@@ -7,11 +7,18 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
+
+#include "../dds/dds_test_support.h"
 
 namespace dds_test {
+
+struct RawType;
 
 /// One endpoint of another participant, as the builtin topics describe it.
 struct SeenEndpoint {
@@ -39,13 +46,22 @@ class Ros2Peer {
   dds_entity_t reader(const dds_topic_descriptor_t& type, const std::string& topic,
                       dds_durability_kind_t durability = DDS_DURABILITY_VOLATILE);
   dds_entity_t writer(const dds_topic_descriptor_t& type, const std::string& topic);
+  /// A writer of sequence<octet> samples that calls its type `dds_type_name` (a type the driver
+  /// reads): peers match on the type name alone, so the driver receives the bytes written as a
+  /// sample of its own type, whatever they are (hostile_dds_inputs.h). From a participant of its
+  /// own, as the topic has another type here.
+  dds_entity_t rawWriter(const std::string& dds_type_name, const std::string& topic);
   /// Whether `writer` matches a reader now (the driver's subscription was discovered).
   static bool matched(dds_entity_t writer);
 
  private:
   dds_entity_t topic(const dds_topic_descriptor_t& type, const std::string& name);
+  int domain_id_ = 0;
   dds_entity_t domain_ = 0;
   dds_entity_t participant_ = 0;
+  dds_entity_t raw_participant_ = 0;
+  /// The raw writers' type descriptors: they outlive the topics made of them.
+  std::vector<std::unique_ptr<RawType>> raw_types_;
 };
 
 /// geometry_msgs/Twist samples written by `writer` at about 20 Hz from a thread of its own while
@@ -65,10 +81,6 @@ class TwistStream {
 /// Takes every sample `reader` holds, calling `visit` with each valid one.
 void takeAll(dds_entity_t reader, const std::function<void(const void* sample)>& visit);
 
-/// Waits until `done` holds; false if it still does not after a generous deadline (no timing is
-/// asserted, only that the condition comes true).
-bool waitFor(const std::function<bool()>& done, int seconds = 30);
-
 /// Waits until `reader` has received a sample of T that `wanted` accepts.
 template <typename T>
 bool waitForSample(dds_entity_t reader, const std::function<bool(const T&)>& wanted) {
@@ -80,10 +92,25 @@ bool waitForSample(dds_entity_t reader, const std::function<bool(const T&)>& wan
   });
 }
 
+/// The driver's "driver_node: e_stop" status as `peer` last received it on diagnostics: the
+/// e-stop's state and every count of refused inputs.
+class EStopStatus {
+ public:
+  explicit EStopStatus(Ros2Peer& peer);
+  /// Waits until `key` counts `expected` (absent: 0); false if it never does.
+  bool waitForCount(const std::string& key, uint64_t expected);
+  /// `key`'s count in the latest status (waits for the first one).
+  uint64_t count(const std::string& key);
+  /// `key`'s value in the latest status ("" when absent; waits for the first one).
+  std::string value(const std::string& key);
+
+ private:
+  void takeAll();
+  dds_entity_t reader_;
+  std::map<std::string, std::string> values_;
+};
+
 /// Writes a std_msgs/Bool (an e_stop); false when DDS refused it.
 bool writeBool(dds_entity_t writer, bool data);
-
-/// A domain no other test process of the suite uses at the same time.
-int privateDomain(int first, int count);
 
 }  // namespace dds_test

@@ -12,15 +12,18 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <string>
 #include <thread>
 #include <utility>
 #include <vector>
 
 #include "../dds/published_type_hashes.h"
+#include "hostile_dds_inputs.h"
 #include "ros2_peer.h"
 #include "serial_robot_driver/dds/messages.h"
 #include "serial_robot_driver/devices/base/sim/base_sim.h"
@@ -58,7 +61,7 @@ class DdsDriver : public ::testing::Test {
     const std::string id = std::to_string(getpid());
     link_ = "/tmp/srd_test_dds_driver_" + id;
     config_ = link_ + ".yaml";
-    domain_ = dds_test::privateDomain(120, 50);
+    domain_ = dds_test::privateDomainId(120, 50);
     test_support::removeStaleLink(link_);
     sim::SimOptions options;
     options.link = link_;
@@ -325,6 +328,195 @@ TEST_F(DdsDriver, BadInputIsRefusedAndCountedByTheCoreAsFromRos1) {
                counts(array, "driver_node: e_stop", "inputs refused: joint_trajectory", 1);
       }));
   EXPECT_TRUE(baseHoldsSpeed(false)) << "a NaN cmd_vel commands zero speed";
+}
+
+/// What the simulated devices hold: the base's encoder ticks and the body's servo targets.
+struct AtRest {
+  int64_t left = 0, right = 0;
+  std::vector<uint16_t> targets;
+  bool operator==(const AtRest& other) const {
+    return left == other.left && right == other.right && targets == other.targets;
+  }
+};
+
+AtRest atRest() {
+  const auto base = baseStats(robot_stats());
+  AtRest rest{base.left_ticks, base.right_ticks, {}};
+  for (const auto& servo : bodyStats(robot_stats()).servos) rest.targets.push_back(servo.target);
+  return rest;
+}
+
+/// The base stopped and both joints commanded to 0 rad (tick 2048): what the hostile samples must
+/// leave as it is.
+AtRest bringToRest() {
+  const dds_entity_t commands =
+      peer_->writer(sensor_msgs_msg_dds__JointState__desc, "rt/joint_commands");
+  EXPECT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(commands); }));
+  char joint_1[] = "joint_1", joint_2[] = "joint_2", empty[] = "";
+  char* names[] = {joint_1, joint_2};
+  double zeros[] = {0.0, 0.0};
+  sensor_msgs_msg_dds__JointState_ command{};
+  command.header.frame_id = empty;
+  command.name = {2, 2, names, false};
+  command.position = {2, 2, zeros, false};
+  EXPECT_EQ(dds_write(commands, &command), DDS_RETCODE_OK);
+  EXPECT_TRUE(waitFor([] {
+    const auto servos = bodyStats(robot_stats()).servos;
+    return servos.size() == 2 && servos[0].target == 2048 && servos[1].target == 2048;
+  }));
+  EXPECT_TRUE(baseHoldsSpeed(false));
+  return atRest();
+}
+
+/// Writes `samples` in batches that the driver's reader (keep-last 10) holds whole, waiting after
+/// each until the core counted under `key` exactly those it must refuse; nothing may move.
+void expectRefused(dds_entity_t writer, const std::vector<dds_test::HostileSample>& samples,
+                   const std::string& key, dds_test::EStopStatus& status, const AtRest& rest) {
+  constexpr std::size_t kBatch = 8;
+  uint64_t expected = status.count(key);
+  for (std::size_t first = 0; first < samples.size(); first += kBatch) {
+    std::string batch;
+    for (std::size_t i = first; i < std::min(first + kBatch, samples.size()); ++i) {
+      ASSERT_EQ(samples[i].write(writer), DDS_RETCODE_OK) << samples[i].what;
+      expected += samples[i].refused ? 1 : 0;
+      batch += samples[i].what + "; ";
+    }
+    EXPECT_TRUE(status.waitForCount(key, expected))
+        << key << " after " << batch << ": " << status.count(key) << " != " << expected;
+    EXPECT_TRUE(atRest() == rest) << "moved by one of " << batch;
+    ASSERT_TRUE(driver_->running()) << batch;
+  }
+}
+
+const std::vector<std::string> kJoints{"joint_1", "joint_2"};
+
+/// A valid cmd_vel still drives the base, and stopping it stops it: the driver goes on.
+void expectTheBaseStillDrives() {
+  const dds_entity_t cmd_vel = peer_->writer(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel");
+  ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(cmd_vel); }));
+  {
+    const dds_test::TwistStream driving(cmd_vel, 0.2);
+    EXPECT_TRUE(baseHoldsSpeed(true)) << "a valid cmd_vel after the hostile ones drives the base";
+  }
+  EXPECT_TRUE(baseHoldsSpeed(false));
+}
+
+TEST_F(DdsDriver, HostileSamplesOnEveryInputAreRefusedMoveNothingAndTheDriverGoesOn) {
+  dds_test::EStopStatus status(*peer_);
+  const AtRest rest = bringToRest();
+  const dds_entity_t cmd_vel = peer_->writer(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel");
+  const dds_entity_t stamped =
+      peer_->writer(geometry_msgs_msg_dds__TwistStamped__desc, "rt/cmd_vel_stamped");
+  const dds_entity_t commands =
+      peer_->writer(sensor_msgs_msg_dds__JointState__desc, "rt/joint_commands");
+  const dds_entity_t trajectories =
+      peer_->writer(trajectory_msgs_msg_dds__JointTrajectory__desc, "rt/joint_trajectory");
+  ASSERT_TRUE(waitFor([&] {
+    for (dds_entity_t writer : {cmd_vel, stamped, commands, trajectories}) {
+      if (!dds_test::Ros2Peer::matched(writer)) return false;
+    }
+    return true;
+  }));
+  expectRefused(cmd_vel, dds_test::hostileTwists(false), "inputs refused: cmd_vel", status, rest);
+  expectRefused(stamped, dds_test::hostileStampedTwists(), "inputs refused: cmd_vel", status, rest);
+  expectRefused(commands, dds_test::hostileJointCommands(kJoints), "inputs refused: joint_commands",
+                status, rest);
+  expectRefused(trajectories, dds_test::hostileTrajectories(kJoints),
+                "inputs refused: joint_trajectory", status, rest);
+  expectTheBaseStillDrives();
+}
+
+TEST_F(DdsDriver, FiniteExtremesUnderTheEStopMoveNothing) {
+  dds_test::EStopStatus status(*peer_);
+  const AtRest rest = bringToRest();
+  const dds_entity_t cmd_vel = peer_->writer(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel");
+  const dds_entity_t e_stop = peer_->writer(std_msgs_msg_dds__Bool__desc, "rt/e_stop");
+  ASSERT_TRUE(waitFor(
+      [&] { return dds_test::Ros2Peer::matched(cmd_vel) && dds_test::Ros2Peer::matched(e_stop); }));
+  ASSERT_TRUE(dds_test::writeBool(e_stop, true));
+  ASSERT_TRUE(waitFor([&] { return status.value("engaged") == "True"; }));
+  std::vector<dds_test::HostileSample> samples = dds_test::hostileTwists(true);
+  for (auto& sample : samples) sample.refused = true;  // every one, by the e-stop
+  expectRefused(cmd_vel, samples, "refused: cmd_vel", status, rest);
+  ASSERT_TRUE(dds_test::writeBool(e_stop, false));
+  expectTheBaseStillDrives();
+}
+
+TEST_F(DdsDriver, MalformedCdrOnEveryInputIsDroppedAndTheDriverGoesOn) {
+  dds_test::EStopStatus status(*peer_);
+  const AtRest rest = bringToRest();
+  for (const dds_test::MalformedInput& input : dds_test::malformedInputs()) {
+    SCOPED_TRACE(input.topic);
+    const dds_entity_t writer = peer_->rawWriter(input.dds_type, input.topic);
+    ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(writer); }));
+    const std::string key = std::string("inputs refused: ") + input.counted;
+    const uint64_t before = status.count(key);
+    for (const std::vector<uint8_t>& payload : input.payloads) {
+      ASSERT_EQ(dds_test::writeRaw(writer, payload), DDS_RETCODE_OK);
+    }
+    // Only the last, well-formed payload reaches the core (and is refused there).
+    if (*input.counted != 0) EXPECT_TRUE(status.waitForCount(key, before + 1)) << status.count(key);
+    ASSERT_TRUE(driver_->running());
+    EXPECT_TRUE(atRest() == rest);
+  }
+  // A Bool of 2, if Cyclone took it, engaged the e-stop: released, the base drives again.
+  const dds_entity_t e_stop = peer_->writer(std_msgs_msg_dds__Bool__desc, "rt/e_stop");
+  ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(e_stop); }));
+  ASSERT_TRUE(dds_test::writeBool(e_stop, false));
+  expectTheBaseStillDrives();
+}
+
+/// SRD_DDS_FUZZ_COUNT (default 40) seeded random picks (SRD_FUZZ_SEED, default from the clock) of
+/// the hostile samples and of random bytes on every input (scripts/fuzz_dds_interface.sh runs it
+/// long): the driver lives through them and drives the base afterwards.
+TEST_F(DdsDriver, SeededRandomHostileInputLeavesTheDriverWorking) {
+  const char* seed_text = std::getenv("SRD_FUZZ_SEED");
+  const char* count_text = std::getenv("SRD_DDS_FUZZ_COUNT");
+  const uint64_t seed = seed_text ? std::stoull(seed_text) : static_cast<uint64_t>(time(nullptr));
+  const int count = count_text ? std::stoi(count_text) : 40;
+  std::cout << "dds fuzz: seed " << seed << ", " << count << " inputs" << std::endl;
+  std::mt19937_64 rng(seed);
+  std::vector<std::pair<dds_entity_t, dds_test::HostileSample>> pool;
+  const auto add = [&](const dds_topic_descriptor_t& type, const char* topic,
+                       const std::vector<dds_test::HostileSample>& samples) {
+    const dds_entity_t writer = peer_->writer(type, topic);
+    ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(writer); }));
+    for (const auto& sample : samples) pool.emplace_back(writer, sample);
+  };
+  add(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel", dds_test::hostileTwists(true));
+  add(geometry_msgs_msg_dds__Twist__desc, "rt/cmd_vel", dds_test::hostileTwists(false));
+  add(geometry_msgs_msg_dds__TwistStamped__desc, "rt/cmd_vel_stamped",
+      dds_test::hostileStampedTwists());
+  add(sensor_msgs_msg_dds__JointState__desc, "rt/joint_commands",
+      dds_test::hostileJointCommands(kJoints));
+  add(trajectory_msgs_msg_dds__JointTrajectory__desc, "rt/joint_trajectory",
+      dds_test::hostileTrajectories(kJoints));
+  std::vector<dds_entity_t> raw_writers;
+  for (const dds_test::MalformedInput& input : dds_test::malformedInputs()) {
+    raw_writers.push_back(peer_->rawWriter(input.dds_type, input.topic));
+  }
+  ASSERT_TRUE(waitFor([&] {
+    for (dds_entity_t writer : raw_writers) {
+      if (!dds_test::Ros2Peer::matched(writer)) return false;
+    }
+    return true;
+  }));
+  for (int i = 0; i < count && driver_->running(); ++i) {
+    if (rng() % 3 == 0) {  // random bytes of a random length on a random input
+      std::vector<uint8_t> bytes(rng() % 96);
+      for (uint8_t& byte : bytes) byte = static_cast<uint8_t>(rng());
+      dds_test::writeRaw(raw_writers[rng() % raw_writers.size()], bytes);
+    } else {
+      const auto& [writer, sample] = pool[rng() % pool.size()];
+      sample.write(writer);
+    }
+  }
+  ASSERT_TRUE(driver_->running()) << "seed " << seed;
+  const dds_entity_t e_stop = peer_->writer(std_msgs_msg_dds__Bool__desc, "rt/e_stop");
+  ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(e_stop); }));
+  ASSERT_TRUE(dds_test::writeBool(e_stop, false));  // random bytes may have engaged it
+  expectTheBaseStillDrives();
+  EXPECT_TRUE(driver_->running()) << "seed " << seed;
 }
 
 // Last: SIGTERM ends the driver as it ends driver_node, the base's zero-speed frame written.

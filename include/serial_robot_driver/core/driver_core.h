@@ -73,13 +73,16 @@ class DriverCore {
   /// The one e-stop of every actuator.
   EStop& eStop() { return e_stop_; }
 
-  /// The e-stop's status with every input refusal: the devices' and the front end's `own`.
-  StatusReport eStopStatus(InputRefusalStats own) const;
+  /// Where every front end counts what it refuses of its own inputs (its e_stop topic, its
+  /// trajectories): one count for the node, whichever graph sent the input.
+  InputRefusals& inputRefusals() { return input_refusals_; }
+
+  /// The e-stop's status with every input refusal: the devices' and inputRefusals()'.
+  StatusReport eStopStatus() const;
   /// Every status a front end reports, in one order for all of them: each port ("port <path>"),
-  /// each device (its registered name) followed by its own statuses, then "e_stop" with the
-  /// inputs the front end itself refused (`own_refusals`, asked on the reporting thread).
-  std::vector<Device::NamedStatus> statusSources(
-      std::function<InputRefusalStats()> own_refusals) const;
+  /// each device (its registered name) followed by its own statuses, then "e_stop". Every front
+  /// end's sources report the same values (one e-stop, one count of refusals).
+  std::vector<Device::NamedStatus> statusSources() const;
   /// e.g. "driving port /dev/ttyUSB0 (115200 baud: base, body); loop 50 Hz, battery poll 1 Hz".
   std::string startupSummary() const;
 
@@ -97,6 +100,7 @@ class DriverCore {
   std::atomic<bool> shutting_down_{false};
   /// Outlives the devices and the trajectories that registered with it.
   EStop e_stop_;
+  InputRefusals input_refusals_;                     ///< the front ends' own inputs', every graph's
   std::vector<std::unique_ptr<PortLog>> port_logs_;  ///< one per port; outlive the ports' readers
   std::map<std::string, std::unique_ptr<SerialLink>> ports_;
   /// Outlives the devices, which hold a reference to it.

@@ -55,7 +55,7 @@ class DdsNode {
   void attachDevices();
   void onEStop(const std_msgs_msg_dds__Bool_& msg);
   /// joint_trajectory: the core's trajectories, as the ROS 1 topic (refused whole when it does
-  /// not check out, counted under its name).
+  /// not check out, counted under its name in the core's one count).
   void onJointTrajectory(const trajectory_msgs_msg_dds__JointTrajectory_& msg);
   void publishDiagnosticsUntilStopped();
 
@@ -69,7 +69,6 @@ class DdsNode {
   std::unique_ptr<dds::Subscription<std_msgs_msg_dds__Bool_>> e_stop_;
   /// Null when no device has joints.
   std::unique_ptr<dds::Subscription<trajectory_msgs_msg_dds__JointTrajectory_>> joint_trajectory_;
-  core::InputRefusals refusals_;  ///< the node's own topics' (joint_trajectory)
   std::mutex stop_mutex_;  // guards stopping_
   std::condition_variable stop_;
   bool stopping_ = false;

@@ -88,7 +88,6 @@ class DriverNode {
 
   ros::NodeHandle nh_;
   DriverParams params_;
-  core::InputRefusals input_refusals_;  // the node's own topic's (e_stop)
   ros::Subscriber e_stop_sub_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<WireCapture> capture_;  // ~capture; outlives the ports that report to it

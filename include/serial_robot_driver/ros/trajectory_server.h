@@ -45,9 +45,10 @@ class TrajectoryServer {
   using GoalHandle = actionlib::ServerGoalHandle<Action>;
 
   /// Advertises follow_joint_trajectory and joint_trajectory in `nh`'s namespace (started by
-  /// start()) for `executor`, which outlives this object.
+  /// start()) for `executor`, which outlives this object; what it refuses is counted in
+  /// `refusals` (the core's, DriverCore::inputRefusals(), which outlives this object too).
   TrajectoryServer(ros::NodeHandle& nh, const DriverParams& params,
-                   trajectory::TrajectoryExecutor& executor);
+                   trajectory::TrajectoryExecutor& executor, core::InputRefusals& refusals);
   ~TrajectoryServer();
   /// The executor's warnings (a goal's stop, a late sample) for the ROS log.
   static trajectory::TrajectoryExecutor::Warn logWarning();
@@ -57,9 +58,6 @@ class TrajectoryServer {
   /// Aborts every goal and stops the timer. Idempotent.
   void shutdown();
 
-  /// The goals and messages refused for what they ask, and its callbacks' errors, by source.
-  core::InputRefusalStats inputRefusalStats() const { return input_refusals_.stats(); }
-
  private:
   /// onGoal() guarded: an error rejects the goal (or aborts it, once accepted).
   void onGoalGuarded(GoalHandle handle);
@@ -68,7 +66,7 @@ class TrajectoryServer {
   /// The steady start of a message stamped `stamp`; nothing: at once.
   std::optional<double> startOf(const ros::Time& stamp) const;
 
-  core::InputRefusals input_refusals_;  // before the callbacks that count into it
+  core::InputRefusals& input_refusals_;  // before the callbacks that count into it
   trajectory::TrajectoryExecutor& executor_;
   const double loop_period_;
   ros::NodeHandle nh_;
