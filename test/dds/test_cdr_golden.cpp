@@ -131,4 +131,39 @@ TEST(CdrGolden, TruncatedOrForeignBytesAreRefused) {
   EXPECT_FALSE(Decoded<std_msgs_msg_dds__Bool_>(parameter_list).ok);
 }
 
+/// kJointState with the 4 bytes at payload offset `at` replaced by `value` (little-endian).
+Bytes jointStateWith(size_t at, uint32_t value) {
+  Bytes bytes = kJointState;
+  for (int i = 0; i < 4; ++i) bytes[4 + at + i] = static_cast<uint8_t>(value >> (8 * i));
+  return bytes;
+}
+
+// Hostile lengths (a peer's bytes): refused before anything is allocated or read past the payload.
+// Each would otherwise ask for gigabytes (2^32-1 strings, 2^29 doubles: 2^32 bytes, 0 in 32 bits).
+TEST(CdrGolden, OversizeLengthsAreRefusedBeforeAnythingIsAllocated) {
+  const struct {
+    size_t at;
+    uint32_t value;
+    const char* what;
+  } hostile[] = {
+      {8, 0xffffffff, "frame_id of 2^32-1 bytes"},
+      {8, 0x40, "frame_id longer than the payload"},
+      {8, 0, "frame_id of 0 bytes (no NUL)"},
+      {8, 4, "frame_id without its NUL"},
+      {20, 0xffffffff, "2^32-1 names"},
+      {24, 0xffffffff, "a name of 2^32-1 bytes"},
+      {40, 0x20000000, "2^29 positions"},
+      {40, 0xffffffff, "2^32-1 positions"},
+      {56, 0x1fffffff, "2^29-1 velocities"},
+  };
+  for (const auto& bad : hostile) {
+    Decoded<sensor_msgs_msg_dds__JointState_> decoded(jointStateWith(bad.at, bad.value));
+    EXPECT_FALSE(decoded.ok) << bad.what;
+  }
+  // trajectory_msgs/JointTrajectory: header {0, 0, ""}, no joint names, 2^32-1 points.
+  const Bytes trajectory =
+      cat({kHeader, zeros(8), {0x01, 0, 0, 0, 0x00, 0, 0, 0}, zeros(4), {0xff, 0xff, 0xff, 0xff}});
+  EXPECT_FALSE(Decoded<trajectory_msgs_msg_dds__JointTrajectory_>(trajectory).ok);
+}
+
 }  // namespace

@@ -277,7 +277,7 @@ std::vector<MalformedInput> malformedInputs() {
       {"rt/cmd_vel",
        "geometry_msgs::msg::dds_::Twist_",
        "cmd_vel",
-       {{}, std::vector<uint8_t>(20, 0xff), std::vector<uint8_t>(43, 0), nan_linear_x}},
+       {{}, std::vector<uint8_t>(20, 0xff), std::vector<uint8_t>(40, 0), nan_linear_x}},
       {"rt/cmd_vel_stamped",
        "geometry_msgs::msg::dds_::TwistStamped_",
        "cmd_vel",
@@ -285,7 +285,7 @@ std::vector<MalformedInput> malformedInputs() {
         Cdr().u32(0).u32(3).raw({'a', 'b', 'c'}).bytes(), Cdr().u32(0).u32(0).bytes(),
         header("base_link").bytes(),
         header("").f64(kNaN).f64(0).f64(0).f64(0).f64(0).f64(0).bytes()}},
-      // A Bool of 2 (the leading length's low byte): no bool; if taken, it engages the e-stop.
+      // A Bool of 2 (the leading length's low byte): no bool; taken, it would engage the e-stop.
       {"rt/e_stop", "std_msgs::msg::dds_::Bool_", "", {{0x00, 0x00}}},
       {"rt/joint_commands",
        "sensor_msgs::msg::dds_::JointState_",

@@ -37,7 +37,9 @@ std::vector<HostileSample> hostileTrajectories(const std::vector<std::string>& j
 /// that the core refuses and counts (`counted_last`): once it is counted, every payload before it
 /// from the same writer has arrived (reliable, in order) and was dropped. The first 4 bytes of
 /// every payload are its remaining length (rawWriter()'s sequence<octet>), the rest is written
-/// here by hand from the CDR rules.
+/// here by hand from the CDR rules. Cyclone pads a payload to a multiple of 4 on the wire, so the
+/// truncated ones are short by 4 bytes or more (1 to 3 would arrive as a whole, zero-padded
+/// sample).
 struct MalformedInput {
   const char* topic;     ///< "rt/cmd_vel", ...
   const char* dds_type;  ///< the type name the driver's reader has

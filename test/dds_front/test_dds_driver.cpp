@@ -442,6 +442,16 @@ TEST_F(DdsDriver, FiniteExtremesUnderTheEStopMoveNothing) {
   expectTheBaseStillDrives();
 }
 
+/// How often `text` stands in `output`.
+std::size_t occurrences(const std::string& output, const std::string& text) {
+  std::size_t count = 0;
+  for (std::size_t at = output.find(text); at != std::string::npos;
+       at = output.find(text, at + 1)) {
+    ++count;
+  }
+  return count;
+}
+
 TEST_F(DdsDriver, MalformedCdrOnEveryInputIsDroppedAndTheDriverGoesOn) {
   dds_test::EStopStatus status(*peer_);
   const AtRest rest = bringToRest();
@@ -451,15 +461,25 @@ TEST_F(DdsDriver, MalformedCdrOnEveryInputIsDroppedAndTheDriverGoesOn) {
     ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(writer); }));
     const std::string key = std::string("inputs refused: ") + input.counted;
     const uint64_t before = status.count(key);
+    // What Cyclone's deserializer says of each sample it drops, on the driver's stderr.
+    const std::string dropped =
+        std::string("deserialization ") + input.topic + "/" + input.dds_type + " failed";
+    const std::size_t dropped_before = occurrences(driver_->output(), dropped);
     for (const std::vector<uint8_t>& payload : input.payloads) {
       ASSERT_EQ(dds_test::writeRaw(writer, payload), DDS_RETCODE_OK);
     }
-    // Only the last, well-formed payload reaches the core (and is refused there).
+    // Every malformed payload is dropped, and said so; only the last, well-formed one reaches the
+    // core (and is refused there).
+    const std::size_t malformed = input.payloads.size() - (*input.counted != 0 ? 1 : 0);
+    EXPECT_TRUE(waitFor([&] {
+      return occurrences(driver_->output(), dropped) == dropped_before + malformed;
+    })) << occurrences(driver_->output(), dropped) - dropped_before
+        << " of " << malformed;
     if (*input.counted != 0) EXPECT_TRUE(status.waitForCount(key, before + 1)) << status.count(key);
     ASSERT_TRUE(driver_->running());
     EXPECT_TRUE(atRest() == rest);
   }
-  // A Bool of 2, if Cyclone took it, engaged the e-stop: released, the base drives again.
+  // Had Cyclone taken the Bool of 2, it would have engaged the e-stop: released all the same.
   const dds_entity_t e_stop = peer_->writer(std_msgs_msg_dds__Bool__desc, "rt/e_stop");
   ASSERT_TRUE(waitFor([&] { return dds_test::Ros2Peer::matched(e_stop); }));
   ASSERT_TRUE(dds_test::writeBool(e_stop, false));
