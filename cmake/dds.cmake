@@ -88,7 +88,8 @@ if(CATKIN_ENABLE_TESTING)
   # process) makes with the wrappers.
   add_executable(dds_test_peer test/dds/dds_test_peer_main.cpp)
   target_link_libraries(dds_test_peer srd_dds)
-  catkin_add_gtest(dds_discovery_tests test/dds/test_second_participant.cpp)
+  catkin_add_gtest(dds_discovery_tests test/dds/test_second_participant.cpp
+    test/dds_front/ros2_peer.cpp)
   target_link_libraries(dds_discovery_tests srd_dds gtest_main)
   target_compile_definitions(dds_discovery_tests PRIVATE
     SRD_DDS_TEST_PEER="$<TARGET_FILE:dds_test_peer>")

@@ -7,13 +7,14 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "../dds_front/ros2_peer.h"
 #include "dds_test_peer_process.h"
 #include "dds_test_support.h"
-#include "loopback_observer_config.h"
 #include "serial_robot_driver/dds/messages.h"
 
 using dds_test::waitFor;
@@ -27,102 +28,41 @@ const char* kBoolHash =
 const char* kDiscoveryInfoHash =
     "typehash=RIHS01_91a0593bacdcc50ea9bdcf849a938b128412cc1ea821245c663bcd26f83c295e;";
 
-struct DiscoveredEndpoint {
-  dds_guid_t guid;
-  dds_guid_t participant;
-  std::string type_name;
-  std::string user_data;
-  dds_reliability_kind_t reliability = DDS_RELIABILITY_BEST_EFFORT;
-  dds_durability_kind_t durability = DDS_DURABILITY_VOLATILE;
-};
-
-std::string userData(const dds_qos_t* qos) {
-  void* data = nullptr;
-  size_t size = 0;
-  if (!qos || !dds_qget_userdata(qos, &data, &size) || !data) return "";
-  std::string text(static_cast<const char*>(data), size);
-  dds_free(data);
-  return text;
-}
-
 bool sameGuid(const dds_guid_t& a, const uint8_t (&b)[16]) { return std::memcmp(a.v, b, 16) == 0; }
 
-// Takes every builtin-topic sample of `reader`, keeping the endpoint on `topic_name`.
-std::optional<DiscoveredEndpoint> takeEndpoint(dds_entity_t reader, const std::string& topic_name) {
-  void* samples[32] = {nullptr};
-  dds_sample_info_t infos[32];
-  const dds_return_t count = dds_take(reader, samples, infos, 32, 32);
-  std::optional<DiscoveredEndpoint> found;
-  for (dds_return_t i = 0; i < count; ++i) {
-    const auto* endpoint = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
-    if (!infos[i].valid_data || topic_name != endpoint->topic_name) continue;
-    DiscoveredEndpoint seen{endpoint->key, endpoint->participant_key, endpoint->type_name,
-                            userData(endpoint->qos)};
-    dds_qget_reliability(endpoint->qos, &seen.reliability, nullptr);
-    dds_qget_durability(endpoint->qos, &seen.durability);
-    found = seen;
-  }
-  if (count > 0) dds_return_loan(reader, samples, count);
-  return found;
-}
-
+/// A ROS 2 machine (ros2_peer.h, plain Cyclone) and dds_test_peer, in a domain of their own.
 class SecondParticipant : public ::testing::Test {
  protected:
   void SetUp() override {
-    domain_id_ = dds_test::privateDomainId(175, 50);
-    domain_ = dds_create_domain(domain_id_, dds_test::kLoopbackObserverConfig);
-    ASSERT_GT(domain_, 0) << dds_strretcode(domain_);
-    participant_ = dds_create_participant(domain_id_, nullptr, nullptr);
-    ASSERT_GT(participant_, 0);
-    ASSERT_TRUE(peer_.start(domain_id_));
+    const int domain_id = dds_test::privateDomainId(175, 50);
+    observer_ = std::make_unique<dds_test::Ros2Peer>(domain_id);
+    ASSERT_TRUE(peer_.start(domain_id));
   }
 
   void TearDown() override {
     peer_.stop();
-    if (domain_ > 0) dds_delete(domain_);
+    observer_.reset();
   }
 
-  std::optional<DiscoveredEndpoint> discover(dds_entity_t builtin_topic, const std::string& name) {
-    const dds_entity_t reader = dds_create_reader(participant_, builtin_topic, nullptr, nullptr);
-    std::optional<DiscoveredEndpoint> found;
-    waitFor([&] { return (found = takeEndpoint(reader, name)).has_value(); });
-    dds_delete(reader);
-    return found;
-  }
-
-  dds_entity_t reliableReader(const dds_topic_descriptor_t& type, const char* topic_name,
-                              dds_durability_kind_t durability) {
-    const dds_entity_t topic = dds_create_topic(participant_, &type, topic_name, nullptr, nullptr);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_INFINITY);
-    dds_qset_durability(qos, durability);
-    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
-    const dds_entity_t reader = dds_create_reader(participant_, topic, qos, nullptr);
-    dds_delete_qos(qos);
-    return reader;
-  }
-
-  int domain_id_ = 0;
-  dds_entity_t domain_ = 0;
-  dds_entity_t participant_ = 0;
+  std::unique_ptr<dds_test::Ros2Peer> observer_;
   dds_test::PeerProcess peer_;
 };
 
 TEST_F(SecondParticipant, SeesTopicsTypesHashesAndQos) {
-  const auto joint_states = discover(DDS_BUILTIN_TOPIC_DCPSPUBLICATION, "rt/dds_test/joint_states");
+  const auto joint_states = observer_->discover(true, "rt/dds_test/joint_states");
   ASSERT_TRUE(joint_states);
   EXPECT_EQ(joint_states->type_name, "sensor_msgs::msg::dds_::JointState_");
   EXPECT_EQ(joint_states->user_data, kJointStateHash);
   EXPECT_EQ(joint_states->reliability, DDS_RELIABILITY_RELIABLE);
   EXPECT_EQ(joint_states->durability, DDS_DURABILITY_VOLATILE);
 
-  const auto e_stop = discover(DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, "rt/dds_test/e_stop");
+  const auto e_stop = observer_->discover(false, "rt/dds_test/e_stop");
   ASSERT_TRUE(e_stop);
   EXPECT_EQ(e_stop->type_name, "std_msgs::msg::dds_::Bool_");
   EXPECT_EQ(e_stop->user_data, kBoolHash);
   EXPECT_EQ(e_stop->reliability, DDS_RELIABILITY_RELIABLE);
 
-  const auto graph = discover(DDS_BUILTIN_TOPIC_DCPSPUBLICATION, "ros_discovery_info");
+  const auto graph = observer_->discover(true, "ros_discovery_info");
   ASSERT_TRUE(graph);
   EXPECT_EQ(graph->type_name, "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_");
   EXPECT_EQ(graph->user_data, kDiscoveryInfoHash);
@@ -131,10 +71,10 @@ TEST_F(SecondParticipant, SeesTopicsTypesHashesAndQos) {
 }
 
 TEST_F(SecondParticipant, SeesTheParticipantsEnclave) {
-  const auto joint_states = discover(DDS_BUILTIN_TOPIC_DCPSPUBLICATION, "rt/dds_test/joint_states");
+  const auto joint_states = observer_->discover(true, "rt/dds_test/joint_states");
   ASSERT_TRUE(joint_states);
-  const dds_entity_t reader =
-      dds_create_reader(participant_, DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr);
+  const dds_entity_t reader = dds_create_reader(
+      observer_->participant(), DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr);
   std::string enclave;
   EXPECT_TRUE(waitFor([&] {
     void* samples[32] = {nullptr};
@@ -144,7 +84,7 @@ TEST_F(SecondParticipant, SeesTheParticipantsEnclave) {
       const auto* participant = static_cast<const dds_builtintopic_participant_t*>(samples[i]);
       if (infos[i].valid_data &&
           std::memcmp(participant->key.v, joint_states->participant.v, 16) == 0) {
-        enclave = userData(participant->qos);
+        enclave = dds_test::userData(participant->qos);
       }
     }
     if (count > 0) dds_return_loan(reader, samples, count);
@@ -154,35 +94,41 @@ TEST_F(SecondParticipant, SeesTheParticipantsEnclave) {
 }
 
 TEST_F(SecondParticipant, ReceivesJointStatesWithTheirValues) {
-  const dds_entity_t reader = reliableReader(sensor_msgs_msg_dds__JointState__desc,
-                                             "rt/dds_test/joint_states", DDS_DURABILITY_VOLATILE);
+  const dds_entity_t reader =
+      observer_->reader(sensor_msgs_msg_dds__JointState__desc, "rt/dds_test/joint_states");
   ASSERT_GT(reader, 0);
-  void* samples[1] = {nullptr};
-  dds_sample_info_t info;
-  ASSERT_TRUE(
-      waitFor([&] { return dds_take(reader, samples, &info, 1, 1) == 1 && info.valid_data; }));
-  const auto* state = static_cast<const sensor_msgs_msg_dds__JointState_*>(samples[0]);
-  EXPECT_EQ(state->header.stamp.sec, 7);
-  EXPECT_EQ(state->header.stamp.nanosec, 8u);
-  EXPECT_STREQ(state->header.frame_id, "base_link");
-  ASSERT_EQ(state->name._length, 2u);
-  EXPECT_STREQ(state->name._buffer[0], "left");
-  EXPECT_STREQ(state->name._buffer[1], "right");
-  ASSERT_EQ(state->position._length, 2u);
-  EXPECT_EQ(state->position._buffer[0], 0.25);
-  EXPECT_EQ(state->position._buffer[1], -1.5);
-  EXPECT_EQ(state->velocity._length, 0u);
-  dds_return_loan(reader, samples, 1);
+  // Copied out: the sample lives only during the call.
+  int32_t sec = 0;
+  uint32_t nanosec = 0, velocities = 1;
+  std::string frame;
+  std::vector<std::string> names;
+  std::vector<double> positions;
+  ASSERT_TRUE(dds_test::waitForSample<sensor_msgs_msg_dds__JointState_>(reader, [&](const auto& s) {
+    sec = s.header.stamp.sec;
+    nanosec = s.header.stamp.nanosec;
+    frame = s.header.frame_id;
+    names.assign(s.name._buffer, s.name._buffer + s.name._length);
+    positions.assign(s.position._buffer, s.position._buffer + s.position._length);
+    velocities = s.velocity._length;
+    return true;
+  }));
+  EXPECT_EQ(sec, 7);
+  EXPECT_EQ(nanosec, 8u);
+  EXPECT_EQ(frame, "base_link");
+  EXPECT_EQ(names, (std::vector<std::string>{"left", "right"}));
+  EXPECT_EQ(positions, (std::vector<double>{0.25, -1.5}));
+  EXPECT_EQ(velocities, 0u);
 }
 
 // The node as `ros2 node list` finds it: the participant's GID, name and namespace, and the GIDs
 // of its writer (joint_states) and reader (e_stop) as the builtin topics give them.
 TEST_F(SecondParticipant, ReadsTheNodeInRosDiscoveryInfo) {
-  const auto joint_states = discover(DDS_BUILTIN_TOPIC_DCPSPUBLICATION, "rt/dds_test/joint_states");
-  const auto e_stop = discover(DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, "rt/dds_test/e_stop");
+  const auto joint_states = observer_->discover(true, "rt/dds_test/joint_states");
+  const auto e_stop = observer_->discover(false, "rt/dds_test/e_stop");
   ASSERT_TRUE(joint_states && e_stop);
-  const dds_entity_t reader = reliableReader(rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc,
-                                             "ros_discovery_info", DDS_DURABILITY_TRANSIENT_LOCAL);
+  const dds_entity_t reader =
+      observer_->reader(rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc, "ros_discovery_info",
+                        DDS_DURABILITY_TRANSIENT_LOCAL);
   ASSERT_GT(reader, 0);
   auto describesTheNode = [&](const rmw_dds_common_msg_dds__ParticipantEntitiesInfo_& info) {
     if (!sameGuid(joint_states->participant, info.gid.data) ||
@@ -196,21 +142,8 @@ TEST_F(SecondParticipant, ReadsTheNodeInRosDiscoveryInfo) {
            node.reader_gid_seq._length == 1 &&
            sameGuid(e_stop->guid, node.reader_gid_seq._buffer[0].data);
   };
-  EXPECT_TRUE(waitFor([&] {
-    void* samples[8] = {nullptr};
-    dds_sample_info_t infos[8];
-    const dds_return_t count = dds_take(reader, samples, infos, 8, 8);
-    bool found = false;
-    for (dds_return_t i = 0; i < count; ++i) {
-      found =
-          found ||
-          (infos[i].valid_data &&
-           describesTheNode(
-               *static_cast<const rmw_dds_common_msg_dds__ParticipantEntitiesInfo_*>(samples[i])));
-    }
-    if (count > 0) dds_return_loan(reader, samples, count);
-    return found;
-  }));
+  EXPECT_TRUE(dds_test::waitForSample<rmw_dds_common_msg_dds__ParticipantEntitiesInfo_>(
+      reader, describesTheNode));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <limits>
+#include <utility>
 
 #include "serial_robot_driver/dds/messages.h"
 
@@ -67,6 +68,20 @@ HostileSample twist(const std::string& what, bool refused, std::vector<double> f
           }};
 }
 
+/// A sample of Msg from `spec`: its header and its names (the field `names`) set here, the rest
+/// by `write_rest(msg, spec, writer)`, which writes it.
+template <typename Msg, typename Spec, typename WriteRest>
+HostileSample named(const std::string& what, bool refused, Spec spec,
+                    dds_sequence_string Msg::*names, WriteRest write_rest) {
+  return {what, refused, [spec, names, write_rest](dds_entity_t writer) mutable {
+            Msg msg{};
+            setHeader(msg.header, spec.header);
+            StringSeq strings(spec.names);
+            msg.*names = strings.seq();
+            return write_rest(msg, spec, writer);
+          }};
+}
+
 struct JointStateSpec {
   HeaderSpec header;
   std::vector<std::string> names;
@@ -74,16 +89,14 @@ struct JointStateSpec {
 };
 
 HostileSample jointState(const std::string& what, bool refused, JointStateSpec spec) {
-  return {what, refused, [spec](dds_entity_t writer) mutable {
-            sensor_msgs_msg_dds__JointState_ msg{};
-            setHeader(msg.header, spec.header);
-            StringSeq names(spec.names);
-            msg.name = names.seq();
-            msg.position = seqOf(spec.position);
-            msg.velocity = seqOf(spec.velocity);
-            msg.effort = seqOf(spec.effort);
-            return dds_write(writer, &msg);
-          }};
+  using Msg = sensor_msgs_msg_dds__JointState_;
+  return named(what, refused, std::move(spec), &Msg::name,
+               [](Msg& msg, JointStateSpec& spec, dds_entity_t writer) {
+                 msg.position = seqOf(spec.position);
+                 msg.velocity = seqOf(spec.velocity);
+                 msg.effort = seqOf(spec.effort);
+                 return dds_write(writer, &msg);
+               });
 }
 
 struct PointSpec {
@@ -99,23 +112,21 @@ struct TrajectorySpec {
 };
 
 HostileSample trajectory(const std::string& what, bool refused, TrajectorySpec spec) {
-  return {what, refused, [spec](dds_entity_t writer) mutable {
-            trajectory_msgs_msg_dds__JointTrajectory_ msg{};
-            setHeader(msg.header, spec.header);
-            StringSeq names(spec.names);
-            msg.joint_names = names.seq();
-            std::vector<trajectory_msgs_msg_dds__JointTrajectoryPoint_> points;
-            for (PointSpec& point : spec.points) {
-              points.push_back({seqOf(point.positions),
-                                seqOf(point.velocities),
-                                seqOf(point.accelerations),
-                                seqOf(point.effort),
-                                {point.sec, point.nanosec}});
-            }
-            const auto n = static_cast<uint32_t>(points.size());
-            msg.points = {n, n, points.data(), false};
-            return dds_write(writer, &msg);
-          }};
+  using Msg = trajectory_msgs_msg_dds__JointTrajectory_;
+  return named(what, refused, std::move(spec), &Msg::joint_names,
+               [](Msg& msg, TrajectorySpec& spec, dds_entity_t writer) {
+                 std::vector<trajectory_msgs_msg_dds__JointTrajectoryPoint_> points;
+                 for (PointSpec& point : spec.points) {
+                   points.push_back({seqOf(point.positions),
+                                     seqOf(point.velocities),
+                                     seqOf(point.accelerations),
+                                     seqOf(point.effort),
+                                     {point.sec, point.nanosec}});
+                 }
+                 const auto n = static_cast<uint32_t>(points.size());
+                 msg.points = {n, n, points.data(), false};
+                 return dds_write(writer, &msg);
+               });
 }
 
 /// Little-endian CDR written by hand after a payload's leading 4-byte length: `at` counts from
@@ -267,6 +278,11 @@ std::vector<HostileSample> hostileTrajectories(const std::vector<std::string>& j
   many.back().positions.back() = kNaN;
   samples.push_back(trajectory("100000 points, the last NaN", true, {{}, joints, many}));
   return samples;
+}
+
+HostileSample nanTrajectory(const std::vector<std::string>& joints) {
+  const PointSpec point{std::vector<double>(joints.size(), kNaN), {}, {}, {}, 1, 0};
+  return trajectory("every position NaN", true, {{}, joints, {point}});
 }
 
 std::vector<MalformedInput> malformedInputs() {

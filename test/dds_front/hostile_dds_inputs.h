@@ -33,6 +33,9 @@ std::vector<HostileSample> hostileJointCommands(const std::vector<std::string>& 
 /// trajectory_msgs/JointTrajectory on joint_trajectory, for the same joints.
 std::vector<HostileSample> hostileTrajectories(const std::vector<std::string>& joints);
 
+/// A trajectory_msgs/JointTrajectory whose one point puts `joints` at NaN: refused.
+HostileSample nanTrajectory(const std::vector<std::string>& joints);
+
 /// CDR payloads that are no valid sample of the input's type, then one last, well-formed payload
 /// that the core refuses and counts (`counted_last`): once it is counted, every payload before it
 /// from the same writer has arrived (reliable, in order) and was dropped. The first 4 bytes of

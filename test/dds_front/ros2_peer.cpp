@@ -11,8 +11,6 @@
 
 namespace dds_test {
 
-namespace {
-
 std::string userData(const dds_qos_t* qos) {
   void* data = nullptr;
   size_t size = 0;
@@ -21,6 +19,8 @@ std::string userData(const dds_qos_t* qos) {
   dds_free(data);
   return text;
 }
+
+namespace {
 
 SeenEndpoint seen(const dds_builtintopic_endpoint_t& endpoint) {
   SeenEndpoint out;

@@ -51,6 +51,8 @@ class Ros2Peer {
   /// sample of its own type, whatever they are (hostile_dds_inputs.h). From a participant of its
   /// own, as the topic has another type here.
   dds_entity_t rawWriter(const std::string& dds_type_name, const std::string& topic);
+  /// The participant, for DDS calls the peer does not offer (builtin topics).
+  dds_entity_t participant() const { return participant_; }
   /// Whether `writer` matches a reader now (the driver's subscription was discovered).
   static bool matched(dds_entity_t writer);
 
@@ -77,6 +79,9 @@ class TwistStream {
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
+
+/// The USER_DATA of `qos` as text ("" when it has none).
+std::string userData(const dds_qos_t* qos);
 
 /// Takes every sample `reader` holds, calling `visit` with each valid one.
 void takeAll(dds_entity_t reader, const std::function<void(const void* sample)>& visit);
