@@ -3,8 +3,10 @@
 
 #include <cstdint>
 #include <initializer_list>
+#include <string>
 #include <vector>
 
+#include "serial_robot_driver/dds/c_types.h"
 #include "serial_robot_driver/dds/cdr.h"
 #include "serial_robot_driver/dds/messages.h"
 
@@ -45,6 +47,28 @@ struct Decoded {
   ~Decoded() { dds::freeSampleContents(dds::Message<T>::descriptor(), &sample); }
   T sample{};
   bool ok = false;
+};
+
+/// The sensor_msgs/JointState of the golden bytes (test_cdr_golden.cpp's kJointState) and its
+/// storage: header {stamp {1, 2}, frame_id "base"}, name ["a", "bc"], position [1.5].
+class GoldenJointState {
+ public:
+  GoldenJointState() : name_pointers_(names_) {
+    state_.header.stamp = {1, 2};
+    dds::lend(state_.header.frame_id, frame_);
+    name_pointers_.lendTo(state_.name);
+    dds::lend(state_.position, positions_);
+  }
+  GoldenJointState(const GoldenJointState&) = delete;
+  GoldenJointState& operator=(const GoldenJointState&) = delete;
+  const sensor_msgs_msg_dds__JointState_& sample() const { return state_; }
+
+ private:
+  const std::string frame_ = "base";
+  const std::vector<std::string> names_{"a", "bc"};
+  std::vector<double> positions_{1.5};
+  dds::StringPointers name_pointers_;
+  sensor_msgs_msg_dds__JointState_ state_{};
 };
 
 template <typename T>

@@ -92,16 +92,8 @@ const Bytes kJointState = cat({kHeader,
 // clang-format on
 
 TEST(CdrGolden, JointStateSerializes) {
-  const std::string frame = "base";
-  std::vector<std::string> names{"a", "bc"};
-  std::vector<double> positions{1.5};
-  dds::StringPointers name_pointers(names);
-  sensor_msgs_msg_dds__JointState_ state{};
-  state.header.stamp = {1, 2};
-  dds::lend(state.header.frame_id, frame);
-  name_pointers.lendTo(state.name);
-  dds::lend(state.position, positions);
-  EXPECT_EQ(serialized(state), kJointState);
+  const GoldenJointState state;
+  EXPECT_EQ(serialized(state.sample()), kJointState);
 }
 
 TEST(CdrGolden, JointStateDecodes) {

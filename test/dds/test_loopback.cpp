@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "cdr_golden_support.h"
 #include "dds_test_support.h"
 #include "serial_robot_driver/dds/c_types.h"
 #include "serial_robot_driver/dds/cdr.h"
@@ -137,18 +138,10 @@ std::vector<uint8_t> wireBytes(dds::Participant& participant, const std::string&
 
 TEST(DdsLoopback, WireBytesAreTheGoldenCdr) {
   dds::Participant participant(loopbackNode("wire_node"));
-  const std::string frame = "base";
-  std::vector<std::string> names{"a", "bc"};
-  std::vector<double> positions{1.5};
-  dds::StringPointers name_pointers(names);
-  sensor_msgs_msg_dds__JointState_ state{};
-  state.header.stamp = {1, 2};
-  dds::lend(state.header.frame_id, frame);
-  name_pointers.lendTo(state.name);
-  dds::lend(state.position, positions);
-  const auto wire = wireBytes(participant, "joint_states", state);
+  const cdr_golden::GoldenJointState state;
+  const auto wire = wireBytes(participant, "joint_states", state.sample());
   EXPECT_EQ(wire, dds::serializeCdr(dds::Message<sensor_msgs_msg_dds__JointState_>::descriptor(),
-                                    &state));
+                                    &state.sample()));
 }
 
 // A payload that is not a multiple of 4 bytes goes out padded, the padding in the options.
