@@ -5,7 +5,7 @@
 # robot_sim, then a valid cmd_vel must still drive the base. Needs a workspace built with Cyclone
 # DDS (scripts/build.sh; make dds_driver_tests). The sibling of scripts/fuzz_ros_interface.sh.
 #   bash scripts/fuzz_dds_interface.sh [COUNT [SEED]]
-# COUNT: inputs per run (default 5000, bounded: at most 200000); SEED: the first run's seed
+# COUNT: inputs per run (default 5000, about 2 minutes; at most 200000); SEED: the first run's seed
 # (default: from the clock). RUNS=N repeats with SEED, SEED+1, ... A failure prints the seed.
 set -euo pipefail
 cd "$(dirname "$0")/.."

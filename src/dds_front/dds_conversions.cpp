@@ -1,6 +1,13 @@
 #include "serial_robot_driver/dds_front/dds_conversions.h"
 
+#include "serial_robot_driver/core/log.h"
+
 namespace serial_robot_driver::dds_front {
+
+void logCallbackError(const std::string& line) {
+  static core::LogThrottle throttle(1.0);  // a sender repeating the sample must not flood the log
+  if (throttle.pass()) core::log(core::LogLevel::kError, "%s", line.c_str());
+}
 
 builtin_interfaces_msg_dds__Time_ toTime(std::chrono::nanoseconds since_epoch) {
   const int64_t ns = since_epoch.count();

@@ -40,14 +40,19 @@ DdsNode::DdsNode(const params::DriverParams& params, const dds::NodeOptions& opt
       *participant_, "/diagnostics");
   // Queue 10 as on the ROS side, so no toggle is dropped.
   e_stop_ = std::make_unique<dds::Subscription<std_msgs_msg_dds__Bool_>>(
-      *participant_, "e_stop", [this](const std_msgs_msg_dds__Bool_& msg) { onEStop(msg); });
+      *participant_, "e_stop",
+      guarded<std_msgs_msg_dds__Bool_>(
+          core_.inputRefusals(), "e_stop",
+          [this](const std_msgs_msg_dds__Bool_& msg) { onEStop(msg); }));
   if (core_.trajectories() != nullptr) {
     joint_trajectory_ =
         std::make_unique<dds::Subscription<trajectory_msgs_msg_dds__JointTrajectory_>>(
             *participant_, "joint_trajectory",
-            [this](const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
-              onJointTrajectory(msg);
-            });
+            guarded<trajectory_msgs_msg_dds__JointTrajectory_>(
+                core_.inputRefusals(), "joint_trajectory",
+                [this](const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+                  onJointTrajectory(msg);
+                }));
   }
 }
 

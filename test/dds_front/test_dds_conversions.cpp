@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <stdexcept>
 
 #include "serial_robot_driver/dds_front/dds_conversions.h"
 
@@ -53,6 +54,22 @@ TEST(DdsConversions, DiagnosticsAreTheReportsWithTheNodesHardwareIdAsFallback) {
   EXPECT_STREQ(first.values._buffer[0].value, "7");
   EXPECT_STREQ(sample.status._buffer[1].hardware_id, "/dev/ttyUSB1");
   EXPECT_EQ(sample.status._buffer[1].values._length, 0u);
+}
+
+TEST(DdsConversions, AGuardedCallbacksErrorIsCountedNotLetOut) {
+  core::InputRefusals counters;
+  int calls = 0;
+  const auto callback = guarded<std_msgs_msg_dds__Bool_>(
+      counters, "e_stop", [&calls](const std_msgs_msg_dds__Bool_& msg) {
+        ++calls;
+        if (msg.data) throw std::runtime_error("a check missed this sample");
+      });
+  EXPECT_NO_THROW(callback(std_msgs_msg_dds__Bool_{true}));
+  EXPECT_NO_THROW(callback(std_msgs_msg_dds__Bool_{false}));
+  EXPECT_EQ(calls, 2) << "the next sample is taken as usual";
+  const core::InputRefusalStats stats = counters.stats();
+  ASSERT_EQ(stats.errors.count("e_stop"), 1u);
+  EXPECT_EQ(stats.errors.at("e_stop"), 1u);
 }
 
 }  // namespace

@@ -5,16 +5,35 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "serial_robot_driver/core/guarded_call.h"
+#include "serial_robot_driver/core/input_refusals.h"
 #include "serial_robot_driver/core/status_report.h"
 #include "serial_robot_driver/dds/c_types.h"
 #include "serial_robot_driver/dds/messages.h"
 #include "serial_robot_driver/trajectory/command.h"
 
 namespace serial_robot_driver::dds_front {
+
+/// An error a guarded() callback let out, as the core's log writes it (at most once a second).
+void logCallbackError(const std::string& line);
+
+/// `callback` guarded as the ROS side guards its subscriptions (core/guarded_call.h): an
+/// exception it lets out is counted in `counters` ("callback errors: <source>"), logged and
+/// dropped; the dispatch thread never sees it. `counters` outlives the callback.
+template <typename Message>
+std::function<void(const Message&)> guarded(core::InputRefusals& counters, std::string source,
+                                            std::function<void(const Message&)> callback) {
+  return
+      [&counters, source = std::move(source), callback = std::move(callback)](const Message& msg) {
+        core::runGuarded(
+            counters, source, [&] { callback(msg); }, nullptr, logCallbackError);
+      };
+}
 
 /// builtin_interfaces/Time of a wall-clock time (core/wall_stamps.h), nanoseconds since the epoch.
 builtin_interfaces_msg_dds__Time_ toTime(std::chrono::nanoseconds since_epoch);

@@ -53,14 +53,18 @@ class BaseDds : public dds_front::DeviceFrontEnd {
         battery_(participant, "battery"),
         tf_(device.params().publish_tf ? std::make_unique<Tf>(participant, "/tf") : nullptr),
         cmd_vel_(std::make_unique<Twists>(participant, "cmd_vel",
-                                          [this](const geometry_msgs_msg_dds__Twist_& msg) {
-                                            device_.commandTwist({msg.linear.x, msg.angular.z});
-                                          })),
+                                          dds_front::guarded<geometry_msgs_msg_dds__Twist_>(
+                                              device.inputRefusals(), "cmd_vel",
+                                              [this](const geometry_msgs_msg_dds__Twist_& msg) {
+                                                device_.commandTwist({msg.linear.x, msg.angular.z});
+                                              }))),
         cmd_vel_stamped_(std::make_unique<StampedTwists>(
             participant, "cmd_vel_stamped",
-            [this](const geometry_msgs_msg_dds__TwistStamped_& msg) {
-              device_.commandTwist({msg.twist.linear.x, msg.twist.angular.z});
-            })) {
+            dds_front::guarded<geometry_msgs_msg_dds__TwistStamped_>(
+                device.inputRefusals(), "cmd_vel_stamped",
+                [this](const geometry_msgs_msg_dds__TwistStamped_& msg) {
+                  device_.commandTwist({msg.twist.linear.x, msg.twist.angular.z});
+                }))) {
     BaseOutputs outputs;
     outputs.odometry = [this](const OdometrySample& sample) { publishOdometry(sample); };
     outputs.battery = [this](const BatteryReading& reading, core::Clock::time_point arrival) {

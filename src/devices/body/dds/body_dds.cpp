@@ -48,9 +48,12 @@ class BodyDds : public dds_front::DeviceFrontEnd {
         joint_states_(participant, "joint_states"),
         imu_(participant, "imu/data"),
         joint_commands_(std::make_unique<Commands>(
-            participant, "joint_commands", [&device](const sensor_msgs_msg_dds__JointState_& msg) {
-              device.commandJoints({ddsl::toStrings(msg.name), ddsl::toVector(msg.position)});
-            })) {
+            participant, "joint_commands",
+            dds_front::guarded<sensor_msgs_msg_dds__JointState_>(
+                device.inputRefusals(), "joint_commands",
+                [&device](const sensor_msgs_msg_dds__JointState_& msg) {
+                  device.commandJoints({ddsl::toStrings(msg.name), ddsl::toVector(msg.position)});
+                }))) {
     device.addOutputs({[this](const BodyFrame& frame) { publishFrame(frame); }});
   }
 
