@@ -7,9 +7,14 @@
 # role, its CPU (s/s, from /proc), its CPU per event (telemetry frame, loop tick, ...) and its top
 # items. docs/performance.md explains the output; paste it there as is.
 #
-# usage: scripts/profile_node.sh [--seconds S] [--tool perf|callgrind] [--out DIR] [--top N]
+# usage: scripts/profile_node.sh [--seconds S] [--tool perf|callgrind] [--floor] [--cmd-vel]
+#                                [--out DIR] [--top N]
 #   --seconds S   the profiled window (default 30; callgrind: default 20, the node runs ~50x slower)
-#   --tool        perf (default when `perf` runs) or callgrind (valgrind; instruction counts)
+#   --tool        perf (default when `perf` runs) or callgrind (valgrind; instruction counts of the
+#                 window alone, per thread and per event: telemetry frame, loop tick, cmd_vel)
+#   --floor       profile the same-job floor instead (bench/floor_node.cpp ~same_job, built with
+#                 -DSRD_BUILD_BENCHMARKS=ON), the same way, to compare item by item
+#   --cmd-vel     also publish cmd_vel at 20 Hz (off by default, as in the benchmark's CPU window)
 #   --out DIR     keep the data, logs and report there (default: a new /tmp/srd_profile_XXXXXX)
 #   --top N       items per thread (default 8)
 #   SRD_BENCH_WS  the catkin workspace holding driver_node and robot_sim (default: the clone's
@@ -27,13 +32,17 @@ seconds=""
 tool=""
 out=""
 top=8
+program=driver_node
+cmd_vel=0
 while (($#)); do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --tool) tool="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --top) top="$2"; shift 2 ;;
-    -h | --help) sed -n '2,22p' "$0"; exit 0 ;;
+    --floor) program=floor_node; shift ;;
+    --cmd-vel) cmd_vel=1; shift ;;
+    -h | --help) sed -n '2,26p' "$0"; exit 0 ;;
     *) echo "profile_node.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -76,9 +85,9 @@ if [[ -n "${ws}" ]]; then bin="${ws}/devel/lib/serial_robot_driver"; fi
 if [[ -z "${bin}" || ! -x "${bin}/driver_node" ]]; then
   bin=$(dirname "$(catkin_find --first-only serial_robot_driver driver_node 2>/dev/null)" || true)
 fi
-for program in driver_node robot_sim; do
-  [[ -x "${bin}/${program}" ]] || {
-    echo "profile_node.sh: ${program} not found: run scripts/build.sh (or set SRD_BENCH_WS)" >&2
+for needed in "${program}" robot_sim; do
+  [[ -x "${bin}/${needed}" ]] || {
+    echo "profile_node.sh: ${needed} not found: run scripts/build.sh (or set SRD_BENCH_WS)" >&2
     exit 2
   }
 done
@@ -112,6 +121,8 @@ ones=$(printf '1,%.0s' $(seq "${servos}"))
 pty="${out}/robot.pty"
 cat >"${out}/params.yaml" <<EOF
 port: ${pty}
+same_job: true  # floor_node's (driver_node ignores it)
+same_job_statuses: 5
 body:
   servo_ids: [${ids}]
   joint_names: [${names}]
@@ -126,16 +137,21 @@ for _ in $(seq 100); do [[ -e "${pty}" ]] && break; sleep 0.1; done
 rosparam load "${out}/params.yaml" /profile/driver
 node_args=(__name:=driver __ns:=/profile)
 if [[ "${tool}" == callgrind ]]; then
-  start driver_node valgrind --tool=callgrind --separate-threads=yes \
-    --callgrind-out-file="${out}/callgrind.out.%p" "${bin}/driver_node" "${node_args[@]}"
+  # Counting starts after the warm-up (callgrind_control -i on): start-up is not in the figures.
+  start node valgrind --tool=callgrind --separate-threads=yes --instr-atstart=no \
+    --callgrind-out-file="${out}/callgrind.out.%p" "${bin}/${program}" "${node_args[@]}"
 else
-  start driver_node "${bin}/driver_node" "${node_args[@]}"
+  start node "${bin}/${program}" "${node_args[@]}"
 fi
 node_pid=${pids[-1]}
 for topic in /profile/joint_states /profile/wheel_states /profile/imu/data /profile/odom /tf \
   /diagnostics; do
   start "hz_$(echo "${topic}" | tr / _)" rostopic hz "${topic}"
 done
+if ((cmd_vel)); then  # each is written at once by the thread that receives it
+  start cmd_vel rostopic pub -r 20 /profile/cmd_vel geometry_msgs/Twist \
+    '{linear: {x: 0.1}, angular: {z: 0.2}}'
+fi
 echo "profile_node.sh: ${tool}, warming up 8 s; then ${seconds} s profiled; output in ${out}" >&2
 sleep 8
 
@@ -150,6 +166,7 @@ thread_cpu_ns() {
 }
 # The CPU per thread from a window of its own: perf's sampling (stacks copied in the kernel) is
 # charged to the threads it samples. Callgrind's whole run is slow anyway: one window.
+if [[ "${tool}" == callgrind ]]; then callgrind_control -i on "${node_pid}" >/dev/null; fi
 thread_cpu_ns >"${out}/cpu_ns_start"
 sleep "${seconds}"
 thread_cpu_ns >"${out}/cpu_ns_end"
@@ -158,6 +175,13 @@ if [[ "${tool}" == perf ]]; then
   perf record -e cpu-clock -F 4999 --call-graph dwarf,8192 -p "${node_pid}" -o "${out}/perf.data" \
     -- sleep "${seconds}" >"${out}/perf_record.log" 2>&1
 fi
-if [[ "${tool}" == callgrind ]]; then kill -INT "${node_pid}"; wait "${node_pid}" || true; fi
+if [[ "${tool}" == callgrind ]]; then
+  # The window's counts in their own files (callgrind.out.<pid>.1-<thread>); exit adds none.
+  callgrind_control -i off "${node_pid}" >/dev/null
+  callgrind_control -d "${node_pid}" >/dev/null
+  kill -INT "${node_pid}"
+  wait "${node_pid}" || true
+fi
 
-python3 "${script_dir}/profile_report.py" "${tool}" "${out}" "${seconds}" "${top}" | tee "${out}/report.md"
+python3 "${script_dir}/profile_report.py" "${tool}" "${out}" "${seconds}" "${top}" "${program}" |
+  tee "${out}/report.md"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The report of scripts/profile_node.sh: per thread of driver_node, its role, CPU and top items.
 
-usage: scripts/profile_report.py perf|callgrind OUT_DIR SECONDS [TOP]
+usage: scripts/profile_report.py perf|callgrind OUT_DIR SECONDS [TOP] [PROGRAM]
 
 OUT_DIR holds what profile_node.sh left there: cpu_ns_start / cpu_ns_end (per-thread CPU time),
 perf.data or callgrind.out.*, and the rostopic hz logs (hz_*.log). Prints Markdown.
@@ -15,18 +15,32 @@ import sys
 # first, that names one), its role, and the event its CPU is divided by.
 ROLES = [
     ("SerialLink::readerLoop", "port reader (frames in, readings published)", "telemetry frame"),
+    # (callgrind counts from inside the loop: readerLoop itself may not be seen)
+    ("SerialLink::readOnce", "port reader (frames in, readings published)", "telemetry frame"),
     ("BaseController::run", "base loop (speed frame, odom, /tf, wheel_states)", "loop tick"),
     ("ServoBus::workerLoop", "servo bus worker", None),
     ("WireCapture::publishLoop", "wire capture", None),
     ("QueueSpinner", "callbacks (cmd_vel, timers: diagnostics, trajectories, action status)",
-     None),
+     "cmd_vel"),
     ("PollManager::threadFunc", "roscpp poll (writes messages to subscribers)", "message sent"),
     ("XMLRPCManager::serverThreadFunc", "roscpp xmlrpc", None),
     ("ROSOutAppender::logThread", "roscpp rosout", None),
     ("internalCallbackQueueThreadFunc", "roscpp internal queue", None),
     ("TimerManager", "roscpp timers", None),
+    # floor_node (--floor): its reader, its loop (on the main thread) and its spinner.
+    ("publishTelemetry", "reader (frames in, readings published)", "telemetry frame"),
+    ("AsyncSpinnerImpl::threadFunc", "callbacks (cmd_vel, diagnostics timer)", "cmd_vel"),
+    ("writeSpeedFrame", "loop on the main thread (speed frame, odom, /tf, wheel_states)",
+     "loop tick"),
     ("main", "main", None),
 ]
+# callgrind: the function called once per event, in the node and in floor_node, whose calls in a
+# thread count that thread's events.
+EVENT_CALLS = {
+    "telemetry frame": ("BodyDevice::onTelemetry", "publishTelemetry("),
+    "loop tick": ("BaseController::tick(", "writeSpeedFrame"),
+    "cmd_vel": ("BaseDevice::commandTwist", "subscribeCmdVel"),
+}
 TELEMETRY_HZ = 100.0
 LOOP_HZ = 50.0
 DIAGNOSTICS_HZ = 1.0
@@ -101,12 +115,16 @@ def perf_rows(out, children):
 
 
 def role_of(symbols):
-    """symbols: a thread's inclusive symbols, highest share first."""
+    """symbols: a thread's inclusive symbols, highest share first ("main" only when nothing more
+    telling matches: floor_node runs its loop on the main thread)."""
+    found = None
     for symbol in symbols:
         for pattern, role, event in ROLES:
             if pattern in symbol:
-                return role, event
-    return "other", None
+                if pattern != "main":
+                    return role, event
+                found = found or (role, event)
+    return found or ("other", None)
 
 
 def short(symbol, width=110):
@@ -173,22 +191,52 @@ def callgrind_rows(path, inclusive):
     return rows, total
 
 
-def callgrind_report(out, cpu, messages, top):
-    """Instruction counts per thread (valgrind runs the threads one at a time, so /proc's CPU of
-    a thread says little): each thread's share of the node's instructions and its top items."""
-    del cpu, messages  # the time scale of a callgrind run is valgrind's
+def callgrind_calls(path):
+    """Calls per function name in a callgrind file (its "calls=" lines; names compressed)."""
+    names, calls, callee = {}, {}, None
+    for line in open(path, errors="replace"):
+        match = re.match(r"c?fn=\((\d+)\)(?: (.*))?$", line.rstrip("\n"))
+        if match:
+            if match.group(2):
+                names[match.group(1)] = match.group(2)
+            if line.startswith("cfn="):
+                callee = names.get(match.group(1))
+            continue
+        if line.startswith("calls=") and callee:
+            calls[callee] = calls.get(callee, 0) + int(line[6:].split()[0])
+    return calls
+
+
+def events_in(calls, event):
+    """How many `event`s a thread handled: the most calls of its EVENT_CALLS functions."""
+    patterns = EVENT_CALLS.get(event, ())
+    return max((n for name, n in calls.items() if any(p in name for p in patterns)), default=0)
+
+
+def callgrind_report(out, cpu, messages, top, seconds):
+    """Instruction counts per thread over the window (valgrind runs the threads one at a time, so
+    /proc's CPU of a thread says little): each thread's share, its instructions per event (from the
+    calls of EVENT_CALLS' functions; the poll thread's per message sent) and its top items."""
+    del cpu  # the time scale of a callgrind run is valgrind's
+    paths = sorted(glob.glob(f"{out}/callgrind.out.*.1-*")) or sorted(
+        glob.glob(f"{out}/callgrind.out.*-*"))
     threads = []
-    for path in sorted(glob.glob(f"{out}/callgrind.out.*-*")):
+    for path in paths:
         (exclusive, total), (inclusive, _) = callgrind_rows(path, False), callgrind_rows(path, True)
         inclusive.sort(key=lambda row: -row[0])
-        threads.append((total, exclusive, inclusive))
-    everything = sum(total for total, _, _ in threads) or 1
-    for total, exclusive, inclusive in sorted(threads, key=lambda thread: -thread[0]):
+        threads.append((total, exclusive, inclusive, callgrind_calls(path)))
+    everything = sum(thread[0] for thread in threads) or 1
+    per_event = []
+    for total, exclusive, inclusive, calls in sorted(threads, key=lambda thread: -thread[0]):
         if total < everything / 200:
             continue
-        role, _ = role_of([symbol for _, symbol in inclusive])
+        role, event = role_of([symbol for _, symbol in inclusive])
+        count = messages * seconds if event == "message sent" else events_in(calls, event)
+        events = {event: count} if count else {}
+        per_event += [(event, role, total / n) for event, n in events.items()]
         print(f"\n#### {role}: {total:,} instructions, {100 * total / everything:.1f} % of the "
-              "node's")
+              "program's" + "".join(f"; {total / n:,.0f} per {event} ({n:,.0f})"
+                                    for event, n in events.items()))
         print(f"\n| % of thread | self (top {top}) |\n|---|---|")
         for count, symbol in exclusive[:top]:
             print(f"| {100 * count / total:.1f} | `{short(symbol)}` |")
@@ -198,20 +246,28 @@ def callgrind_report(out, cpu, messages, top):
             print(f"\n| % of thread | the project's code, inclusive (top {top}) |\n|---|---|")
             for count, symbol in own[:top]:
                 print(f"| {100 * count / total:.1f} | `{short(symbol)}` |")
+    print(f"\n#### Per event\n\n{everything / seconds:,.0f} instructions per second in all."
+          "\n\n| event | thread | instructions per event, that thread |\n|---|---|---|")
+    for event, role, count in per_event:
+        print(f"| {event} | {role} | {count:,.0f} |")
 
 
 def main():
     tool, out, seconds = sys.argv[1], sys.argv[2], float(sys.argv[3])
     top = int(sys.argv[4]) if len(sys.argv) > 4 else 8
+    program = sys.argv[5] if len(sys.argv) > 5 else "driver_node"
     cpu = thread_cpu(out, seconds)
     messages = messages_per_second(out)
-    print(f"### driver_node profile ({tool}, {seconds:.0f} s; 20 body servos at 100 Hz, loop "
-          f"50 Hz, defaults; subscribed: joint_states, wheel_states, imu/data, odom, /tf, "
-          f"/diagnostics)\n")
-    print(f"node CPU {sum(cpu.values()):.4f} s/s over the window (/proc, all threads"
+    print(f"### {program}{' ~same_job' if program == 'floor_node' else ''} profile ({tool}, "
+          f"{seconds:.0f} s; 20 body servos at 100 Hz, loop 50 Hz, defaults; subscribed: "
+          f"joint_states, wheel_states, imu/data, odom, /tf, /diagnostics)\n")
+    print(f"CPU {sum(cpu.values()):.4f} s/s over the window (/proc, all threads"
           f"{', under valgrind' if tool == 'callgrind' else ''}); {len(cpu)} threads; messages "
           f"sent to the subscribers {messages:.0f}/s")
-    (perf_report if tool == "perf" else callgrind_report)(out, cpu, messages, top)
+    if tool == "perf":
+        perf_report(out, cpu, messages, top)
+    else:
+        callgrind_report(out, cpu, messages, top, seconds)
 
 
 if __name__ == "__main__":

@@ -68,15 +68,30 @@ void TrajectoryExecutor::shutdown() {
 void TrajectoryExecutor::updateActual(const std::vector<std::string>& names,
                                       const std::vector<double>& positions,
                                       const std::vector<double>& velocities) {
-  const std::size_t count = std::min(names.size(), positions.size());
+  updateActual(tracksOf(names), positions, velocities);
+}
+
+std::vector<std::size_t> TrajectoryExecutor::tracksOf(const std::vector<std::string>& names) const {
+  std::vector<std::size_t> tracks;
+  tracks.reserve(names.size());
+  for (const std::string& name : names) {
+    const auto joint = index_.find(name);
+    tracks.push_back(joint == index_.end() ? kNoTrack : joint->second);
+  }
+  return tracks;
+}
+
+void TrajectoryExecutor::updateActual(const std::vector<std::size_t>& tracks,
+                                      const std::vector<double>& positions,
+                                      const std::vector<double>& velocities) {
+  const std::size_t count = std::min(tracks.size(), positions.size());
   const bool velocity_known = velocities.size() >= count;
   // Freshness is the time of receipt: a message's stamp is on a clock that may step.
   const double received = now();
   std::lock_guard<std::mutex> lock(actual_mutex_);
   for (std::size_t i = 0; i < count; ++i) {
-    const auto joint = index_.find(names[i]);
-    if (joint == index_.end()) continue;
-    Measured& m = actual_[joint->second];
+    if (tracks[i] >= actual_.size()) continue;  // kNoTrack
+    Measured& m = actual_[tracks[i]];
     m.sample.position = positions[i];
     m.sample.velocity = velocity_known ? velocities[i] : 0.0;
     m.velocity_known = velocity_known;

@@ -9,6 +9,7 @@
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
 #include "serial_robot_driver/ros/conversions.h"
+#include "serial_robot_driver/ros/reused_message.h"
 #include "support/body_telemetry_fixture.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -63,6 +64,38 @@ TEST(ConversionsJointState, ReversedJointAndVelocityScale) {
   EXPECT_NEAR(msg.position[1], M_PI / 2, 1e-12);
   EXPECT_NEAR(msg.velocity[0], 0.2, 1e-12);  // 10 * 0.02
   EXPECT_NEAR(msg.velocity[1], 0.1, 1e-12);  // -1 * 0.02 * -5
+}
+
+// A message filled again (the reader thread's, reused) is the one toJointState() builds afresh:
+// nothing of the earlier contents survives.
+TEST(ConversionsJointState, FillingAgainLeavesNothingOfTheLastMessage) {
+  sensor_msgs::JointState msg;
+  msg.header.frame_id = "stale";
+  msg.name = {"a", "b", "c"};
+  msg.position = {1, 2, 3};
+  msg.velocity = {4, 5, 6};
+  msg.effort = {7};
+  const devices::body::JointReadings readings =
+      devices::body::jointReadings(goldenBodyTelemetry(), hipAndKnee());
+  devices::body::ros::fillJointState(readings, ros::Time(3, 4), &msg);
+  EXPECT_EQ(msg, devices::body::ros::toJointState(readings, ros::Time(3, 4)));
+  EXPECT_TRUE(msg.header.frame_id.empty());
+  EXPECT_TRUE(msg.effort.empty());
+}
+
+// The message published as a shared pointer is reused only while nobody else holds it (an
+// in-process subscriber may keep the one it got).
+TEST(ReusedMessage, ReusedOnlyWhenNobodyElseHoldsIt) {
+  ReusedMessage<sensor_msgs::JointState> reused;
+  sensor_msgs::JointState* first = &reused.next();
+  EXPECT_EQ(&reused.next(), first);  // only ours: filled again
+  sensor_msgs::JointState::ConstPtr kept = reused.get();
+  first->name = {"kept"};
+  sensor_msgs::JointState& second = reused.next();
+  EXPECT_NE(&second, first);  // the subscriber's stays as it was
+  second.name = {"new"};
+  EXPECT_EQ(kept->name, std::vector<std::string>{"kept"});
+  EXPECT_EQ(reused.get()->name, std::vector<std::string>{"new"});
 }
 
 // --- Imu -----------------------------------------------------------------------------------------
@@ -249,6 +282,18 @@ TEST(ConversionsOdometry, PoseTwistFramesAndCovariances) {
   EXPECT_EQ(odom.twist.covariance[0], 0.0025);
   EXPECT_EQ(odom.twist.covariance[7], 1e-6);
   EXPECT_EQ(odom.twist.covariance[35], 0.01);
+}
+
+TEST(ConversionsOdometry, WheelStatesFilledAgainAreTheOnesBuiltAfresh) {
+  devices::base::OdometrySample sample;
+  sample.wheel_angles = {1.5, -0.5};
+  sample.wheel_rates = {0.25, -0.125};
+  sensor_msgs::JointState msg;
+  msg.name = {"a_long_joint_name_of_the_last_tick", "b", "c"};
+  msg.position = {1, 2, 3};
+  msg.effort = {7};
+  devices::base::ros::fillWheelStates(sample, "base_link", "l", "r", ros::Time(1, 0), &msg);
+  EXPECT_EQ(msg, devices::base::ros::toWheelStates(sample, "base_link", "l", "r", ros::Time(1, 0)));
 }
 
 TEST(ConversionsOdometry, WheelStatesAreTheSamplesAnglesAndRates) {

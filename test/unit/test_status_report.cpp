@@ -3,6 +3,7 @@
 // capture.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -63,6 +64,21 @@ TEST(StatusReport, ValuesReadAsDiagnosticUpdaterWritesThem) {
   ASSERT_NE(status.find("rate"), nullptr);
   EXPECT_EQ(*status.find("rate"), "2.5");
   EXPECT_EQ(status.find("missing"), nullptr);
+}
+
+// Integers are written without a stream now: the text must stay what a stream wrote.
+TEST(StatusReport, NumbersReadAsAStreamWritesThem) {
+  StatusReport status;
+  status.add("min", std::numeric_limits<int64_t>::min());
+  status.add("max", std::numeric_limits<uint64_t>::max());
+  status.add("short", int16_t{-300});
+  status.add("byte", uint8_t{65});  // a stream writes a char type as its character
+  status.add("float", 0.1f);
+  EXPECT_EQ(status.values, (Values{{"min", "-9223372036854775808"},
+                                   {"max", "18446744073709551615"},
+                                   {"short", "-300"},
+                                   {"byte", "A"},
+                                   {"float", "0.1"}}));
 }
 
 TEST(StatusReport, LevelsNameDiagnosticStatusLevels) {

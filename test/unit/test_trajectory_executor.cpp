@@ -281,6 +281,26 @@ TEST_F(ExecutorRig, StaleBusJointAbortsAndStopsItsServo) {
   EXPECT_EQ(stops, std::vector<std::size_t>{0});
 }
 
+// A device whose joints never change looks their tracks up once; its measurements by track keep
+// exactly those joints fresh.
+TEST_F(ExecutorRig, MeasurementsByTrackKeepTheirJointsFresh) {
+  EXPECT_EQ(executor.tracksOf({"arm_2"}), std::vector<std::size_t>{1});
+  const std::vector<std::size_t> tracks = executor.tracksOf({"not_a_joint", "pan"});
+  EXPECT_EQ(tracks, (std::vector<std::size_t>{TrajectoryExecutor::kNoTrack, 2}));
+  executor.setStateTimeout({"pan"}, 1.0);
+  executor.updateActual(tracks, {5.0, 0.0}, {});
+  GoalLog log;
+  executor.submitGoal(goalTo({"pan"}, {1.0}, 2.0), log.callbacks());
+  tickAt(100.9);
+  executor.updateActual(tracks, {5.0, 0.4}, {});  // pan measured again at 100.9
+  tickAt(101.5);
+  EXPECT_FALSE(log.over());  // stale at 101.1 had the measurement gone to another joint
+  tickAt(101.95);
+  ASSERT_TRUE(log.over());
+  EXPECT_EQ(log.outcome().error_code, result_code::kPathToleranceViolated);
+  EXPECT_NE(log.outcome().text.find("no state of joint 'pan'"), std::string::npos);
+}
+
 TEST_F(ExecutorRig, TakeOverStopsTheTrajectoryOnlyWhenTheOtherCommandWrote) {
   measure({"arm_1"}, {0.0});
   GoalLog log;

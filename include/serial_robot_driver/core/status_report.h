@@ -44,9 +44,14 @@ struct StatusReport {
   }
   template <typename Number, typename = std::enable_if_t<std::is_arithmetic_v<Number>>>
   void add(std::string key, Number value) {
-    std::ostringstream text;
-    text << value;
-    add(std::move(key), text.str());
+    if constexpr (std::is_integral_v<Number> && sizeof(Number) > 1) {
+      // The same digits as a stream's, without building one (most values are counters).
+      add(std::move(key), std::to_string(value));
+    } else {
+      std::ostringstream text;  // chars as characters, floating point as %g: a stream's text
+      text << value;
+      add(std::move(key), text.str());
+    }
   }
   void addf(std::string key, const char* format, ...) __attribute__((format(printf, 3, 4)));
 

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <ros/node_handle.h>
+#include <ros/publication.h>
 #include <ros/publisher.h>
+#include <ros/topic_manager.h>
 
 #include <atomic>
 #include <memory>
@@ -23,12 +25,23 @@ class CountedPublisher : public ros::Publisher {
  public:
   CountedPublisher() = default;
   CountedPublisher(ros::Publisher publisher, std::shared_ptr<const std::atomic<int>> count)
-      : ros::Publisher(std::move(publisher)), count_(std::move(count)) {}
+      : ros::Publisher(std::move(publisher)),
+        count_(std::move(count)),
+        // The topic's publication, kept while this publisher advertises it: asked directly, it
+        // answers without the search by name through every advertised topic.
+        publication_(*this ? ros::TopicManager::instance()->lookupPublication(getTopic())
+                           : ros::PublicationPtr()) {}
   /// Subscribers counted so far (0 until the callback of the first one ran).
   int counted() const { return count_ ? count_->load(std::memory_order_relaxed) : 0; }
+  /// Subscribers connected now, as roscpp knows them (a callback may not have counted them yet).
+  bool connected() const {
+    if (!*this) return false;  // not advertised (any more)
+    return publication_ ? publication_->getNumSubscribers() > 0 : getNumSubscribers() > 0;
+  }
 
  private:
   std::shared_ptr<const std::atomic<int>> count_;
+  ros::PublicationPtr publication_;
 };
 
 /// nh.advertise<Message>(topic, queue_size), counting its subscribers.
@@ -45,7 +58,7 @@ CountedPublisher advertiseCounted(ros::NodeHandle& nh, const std::string& topic,
 /// wanted() without the lookup while the count says yes; a subscriber whose callback has not run
 /// yet is still seen (roscpp is asked when the count is 0), so none misses a message.
 inline bool wanted(const CountedPublisher& publisher) {
-  return publisher.counted() > 0 || wanted(static_cast<const ros::Publisher&>(publisher));
+  return publisher.counted() > 0 || publisher.connected();
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -67,6 +67,14 @@ class TrajectoryExecutor {
   /// unknown). Any thread; freshness is the time of this call.
   void updateActual(const std::vector<std::string>& names, const std::vector<double>& positions,
                     const std::vector<double>& velocities);
+  /// tracksOf()'s answer for a name that is none of the executor's joints.
+  static constexpr std::size_t kNoTrack = static_cast<std::size_t>(-1);
+  /// Each name's track (kNoTrack: not a joint of this executor), for a caller whose joints never
+  /// change to look them up once rather than by name with every measurement. Any thread.
+  std::vector<std::size_t> tracksOf(const std::vector<std::string>& names) const;
+  /// updateActual() of the joints tracks[i] (from tracksOf()), measured positions[i].
+  void updateActual(const std::vector<std::size_t>& tracks, const std::vector<double>& positions,
+                    const std::vector<double>& velocities);
 
   /// What became of a goal or message: accepted, or why not (the goal's callbacks say it too).
   enum class Submission { kAccepted, kNotRunning, kEStopped, kInvalid };
@@ -176,7 +184,7 @@ class TrajectoryExecutor {
 
   const std::vector<TrajectoryJoints> groups_;
   std::vector<JointRange> ranges_;                      ///< every joint, in track order
-  std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track
+  std::unordered_map<std::string, std::size_t> index_;  ///< joint name -> track (never changes)
   const Clock clock_;
   const Warn warn_;
   std::function<void(bool)> ticker_;

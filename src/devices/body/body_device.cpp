@@ -17,7 +17,7 @@ void logOutcome(const GyroCalibrationOutcome& outcome, const char* prefix) {
 
 BodyDevice::BodyDevice(const params::DriverParams& params, core::SerialLink& link)
     : link_(link),
-      imu_params_(std::make_shared<const ImuParams>(params.section(kImuSection))),
+      imu_(std::make_shared<const ImuInForce>(params.section(kImuSection))),
       imu_heading_(params.section(kImuSection).orientation_variance),
       gyro_calibrator_([this] { return notStill(); }, {}, [this] { return moving(); }),
       // Expected telemetry rates, as diagnostic_updater's FrequencyStatus.
@@ -56,15 +56,19 @@ void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point
   // trajectories need every frame: their goals are checked against it.
   updateJointReadings(telemetry, controller_.joints(), &joint_readings_);
   const JointReadings& joints = joint_readings_;
-  if (trajectory_) trajectory_->updateActual(joints.names, joints.positions, joints.velocities);
-  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
-  if (imu_heading_.wanted()) imu_heading_.publish(imuYaw(telemetry, *imu), arrival);
+  if (trajectory_) {
+    trajectory_->updateActual(trajectory_tracks_, joints.positions, joints.velocities);
+  }
+  const std::shared_ptr<const ImuInForce> imu = std::atomic_load(&imu_);
+  if (imu_heading_.wanted()) {
+    imu_heading_.publish(imuYaw(telemetry, imu->params, imu->axes), arrival);
+  }
   // Every frame feeds the calibration (calibrate_on_start, imu/calibrate).
   const GyroVector gyro_bias = gyro_calibrator_.onSample(
       {static_cast<double>(telemetry.imu[kGyroX]), static_cast<double>(telemetry.imu[kGyroY]),
        static_cast<double>(telemetry.imu[kGyroZ])},
-      arrival, gyroUnits(*imu), imu->calibration_time);
-  const BodyFrame frame{telemetry, arrival, joints, *imu, gyro_bias};
+      arrival, imu->gyro_units, imu->params.calibration_time);
+  const BodyFrame frame{telemetry, arrival, joints, imu->params, gyro_bias, imu->axes};
   for (const BodyOutputs& outputs : outputs_) {
     if (outputs.frame) outputs.frame(frame);
   }
@@ -96,15 +100,15 @@ std::string BodyDevice::commandJoints(const JointCommand& command) {
 }
 
 core::Outcome BodyDevice::calibrateGyro() {
-  const std::shared_ptr<const ImuParams> imu = std::atomic_load(&imu_params_);
+  const std::shared_ptr<const ImuInForce> imu = std::atomic_load(&imu_);
   const GyroCalibrationOutcome outcome =
-      gyro_calibrator_.calibrate(imu->calibration_time, gyroUnits(*imu), "imu/calibrate");
+      gyro_calibrator_.calibrate(imu->params.calibration_time, imu->gyro_units, "imu/calibrate");
   logOutcome(outcome, "");
   return {outcome.success, outcome.message};
 }
 
 void BodyDevice::retune(const ImuParams& tuned) {
-  std::atomic_store(&imu_params_, std::make_shared<const ImuParams>(tuned));
+  std::atomic_store(&imu_, std::make_shared<const ImuInForce>(tuned));
 }
 
 void BodyDevice::retune(const params::DriverParams& in_force) {
@@ -121,6 +125,14 @@ void BodyDevice::attachEStop(core::EStop& e_stop) {
   e_stop.addListener([this](bool engaged) { controller_.gate().setLocked(engaged); });
 }
 
+void BodyDevice::attachTrajectories(trajectory::TrajectoryExecutor& executor) {
+  // The joints never change: each frame's readings (in joint order) go to these tracks.
+  std::vector<std::string> names;
+  for (const BodyJoint& joint : controller_.joints()) names.push_back(joint.name);
+  trajectory_tracks_ = executor.tracksOf(names);
+  trajectory_ = &executor;
+}
+
 std::vector<trajectory::TrajectoryJoints> BodyDevice::trajectoryJoints() {
   return {bodyTrajectoryJoints(controller_)};
 }
@@ -132,7 +144,7 @@ core::StatusReport BodyDevice::status() {
   telemetry_rate_.addTo(report);  // OK / WARN from the telemetry rate, plus its own keys
   BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
                                              {link_.options().path, link_.connected()});
-  gyro_calibrator_.report(update.report, gyroUnits(*std::atomic_load(&imu_params_)));
+  gyro_calibrator_.report(update.report, std::atomic_load(&imu_)->gyro_units);
   logFlow(update.flow);
   report.mergeSummary(update.report.level, update.report.message);
   if (!update.report.hardware_id.empty()) report.hardware_id = update.report.hardware_id;

@@ -75,8 +75,11 @@ Eigen::Quaterniond imuOrientation(const Telemetry& telemetry, double angle_scale
 }  // namespace
 
 double imuYaw(const Telemetry& telemetry, const ImuParams& params) {
-  const Eigen::Quaterniond q =
-      imuOrientation(telemetry, params.angle_scale, axisMapMatrix(params.axis_map));
+  return imuYaw(telemetry, params, axisMapMatrix(params.axis_map));
+}
+
+double imuYaw(const Telemetry& telemetry, const ImuParams& params, const Eigen::Matrix3d& axes) {
+  const Eigen::Quaterniond q = imuOrientation(telemetry, params.angle_scale, axes);
   // The Z (yaw) angle of a Z-Y-X decomposition.
   return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()),
                     1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
@@ -84,10 +87,14 @@ double imuYaw(const Telemetry& telemetry, const ImuParams& params) {
 
 ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
                       const std::array<double, 3>& gyro_bias) {
+  return imuReading(telemetry, params, axisMapMatrix(params.axis_map), gyro_bias);
+}
+
+ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
+                      const Eigen::Matrix3d& map, const std::array<double, 3>& gyro_bias) {
   const auto& raw = telemetry.imu;
   // The axis map M turns sensor-frame vectors into imu-frame ones (v_imu = M v_sensor); the
   // sensor's orientation R_world_sensor becomes R_world_imu = R_world_sensor * M^T.
-  const Eigen::Matrix3d map = axisMapMatrix(params.axis_map);
   ImuReading reading;
   reading.linear_acceleration =
       map * Eigen::Vector3d(raw[kAccelX], raw[kAccelY], raw[kAccelZ]) * params.accel_scale;

@@ -39,6 +39,17 @@ struct BodyFrame {
   const JointReadings& joints;      ///< positions (rad) and velocities (rad/s)
   const ImuParams& imu;             ///< the ~imu values in force for this frame
   GyroVector gyro_bias;             ///< raw LSB (sensor axes) to subtract from the frame's gyro
+  const Eigen::Matrix3d& imu_axes;  ///< axisMapMatrix(imu.axis_map), for imuReading()
+};
+
+/// The ~imu values in force, with what each frame's conversion derives from them worked out once
+/// per set of values (at start and on each retune) instead of once per frame and consumer.
+struct ImuInForce {
+  explicit ImuInForce(const ImuParams& tuned)
+      : params(tuned), axes(axisMapMatrix(tuned.axis_map)), gyro_units(gyroUnits(tuned)) {}
+  ImuParams params;
+  Eigen::Matrix3d axes;  ///< the axis map's matrix
+  GyroUnits gyro_units;
 };
 
 /// What a front end receives; every listener may be empty.
@@ -85,9 +96,7 @@ class BodyDevice : public core::Device {
   }
   /// The body's joints, streamed: one sync-write frame per loop tick.
   std::vector<trajectory::TrajectoryJoints> trajectoryJoints() override;
-  void attachTrajectories(trajectory::TrajectoryExecutor& executor) override {
-    trajectory_ = &executor;
-  }
+  void attachTrajectories(trajectory::TrajectoryExecutor& executor) override;
   /// Engaged: the controller's motion gate is locked, so no sync-write goes out from then on,
   /// even one already waiting; joint commands are refused and counted.
   void attachEStop(core::EStop& e_stop) override;
@@ -111,7 +120,7 @@ class BodyDevice : public core::Device {
   core::SerialLink& link_;
   /// Swapped whole by retune() and loaded once per frame by the reader thread, so a frame is
   /// converted with one set of scales (std::atomic_load / atomic_store).
-  std::shared_ptr<const ImuParams> imu_params_;
+  std::shared_ptr<const ImuInForce> imu_;
   std::vector<BodyOutputs> outputs_;  // added before start(), then only read
   // Set before the links start, read on the reader and calibration threads.
   const core::MotionQuery* motion_query_ = nullptr;
@@ -120,6 +129,7 @@ class BodyDevice : public core::Device {
   core::HeadingFeed imu_heading_;
   // The trajectory executor (its own threading comment); set before the link starts.
   trajectory::TrajectoryExecutor* trajectory_ = nullptr;
+  std::vector<std::size_t> trajectory_tracks_;  // each joint's track in it, looked up once
   core::LogThrottle refused_log_{1.0};
   core::LogThrottle command_log_{1.0};
   GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it

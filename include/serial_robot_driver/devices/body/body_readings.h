@@ -55,6 +55,10 @@ struct ImuReading {
 /// LSB, the sensor's axes) is subtracted from the gyro before it is scaled and mapped.
 ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
                       const std::array<double, 3>& gyro_bias = {});
+/// The same with the axis map's matrix (axisMapMatrix(params.axis_map)) worked out beforehand, as
+/// the reader thread does once per set of ~imu values rather than once per frame.
+ImuReading imuReading(const Telemetry& telemetry, const ImuParams& params,
+                      const Eigen::Matrix3d& axes, const std::array<double, 3>& gyro_bias);
 
 /// The IMU's covariances as sensor_msgs/Imu carries them (row-major 3x3, diagonal from `params`'s
 /// variances; REP-145: a negative orientation_variance marks the orientation as unknown, element
@@ -69,5 +73,7 @@ ImuCovariances imuCovariances(const ImuParams& params);
 /// The yaw (rad, [-pi, pi]) of imuReading()'s orientation: the board's attitude through
 /// ~imu/axis_map, i.e. the heading of the imu frame (~base/use_imu_heading feeds it to odometry).
 double imuYaw(const Telemetry& telemetry, const ImuParams& params);
+/// The same with axisMapMatrix(params.axis_map) worked out beforehand.
+double imuYaw(const Telemetry& telemetry, const ImuParams& params, const Eigen::Matrix3d& axes);
 
 }  // namespace serial_robot_driver::devices::body

@@ -44,13 +44,22 @@ sensor_msgs::JointState toWheelStates(const OdometrySample& sample, const std::s
                                       const std::string& left, const std::string& right,
                                       const ::ros::Time& stamp) {
   sensor_msgs::JointState wheels;
-  wheels.header.stamp = stamp;
-  wheels.header.frame_id = frame;
-  wheels.name = {left, right};
-  // In rad, from the controller: with the diameter each stretch of travel ran under.
-  wheels.position = {sample.wheel_angles.x(), sample.wheel_angles.y()};
-  wheels.velocity = {sample.wheel_rates.x(), sample.wheel_rates.y()};
+  fillWheelStates(sample, frame, left, right, stamp, &wheels);
   return wheels;
+}
+
+void fillWheelStates(const OdometrySample& sample, const std::string& frame,
+                     const std::string& left, const std::string& right, const ::ros::Time& stamp,
+                     sensor_msgs::JointState* msg) {
+  msg->header.stamp = stamp;
+  msg->header.frame_id = frame;
+  msg->name.resize(2);  // assigned element by element: each string keeps its buffer
+  msg->name[0] = left;
+  msg->name[1] = right;
+  // In rad, from the controller: with the diameter each stretch of travel ran under.
+  msg->position.assign({sample.wheel_angles.x(), sample.wheel_angles.y()});
+  msg->velocity.assign({sample.wheel_rates.x(), sample.wheel_rates.y()});
+  msg->effort.clear();
 }
 
 }  // namespace serial_robot_driver::devices::base::ros

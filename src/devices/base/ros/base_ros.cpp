@@ -74,30 +74,35 @@ void BaseRos::publishOdometry(const OdometrySample& sample) {
   // subscribes to is not built (/tf included: it goes out whenever anyone listens to /tf). Stamped
   // with the tick's time, as on every front end (the DDS one gives the same sample that stamp).
   const ::ros::Time stamp = arrival_stamps_(sample.time);
+  const bool publish_tf = device_.tuned()->publish_tf;
   // ~base/publish_tf switched on at runtime: /tf is advertised from then on.
-  if (device_.tuned()->publish_tf && !tf_pub_) tf_pub_ = advertiseTf();
+  if (publish_tf && !tf_pub_) tf_pub_ = advertiseTf();
   const bool odom_wanted = ros_layer::wanted(odom_pub_);
-  const bool tf_wanted = device_.tuned()->publish_tf && ros_layer::wanted(tf_pub_);
+  const bool tf_wanted = publish_tf && ros_layer::wanted(tf_pub_);
+  const bool wheels_wanted = ros_layer::wanted(wheel_states_pub_);
+  // Every message is built before the first goes out: roscpp's sending thread, woken by the first,
+  // then finds the others queued too instead of being woken once more for each.
   std::optional<nav_msgs::Odometry> odom;
   if (odom_wanted || tf_wanted) {
     const BaseParams& started = device_.params();
     odom = toOdometry(sample, {started.odom_frame, started.base_frame}, stamp);
   }
+  if (wheels_wanted) buildWheelStates(sample, stamp);
+  if (tf_wanted) buildTf(*odom, sample);
   if (odom_wanted) odom_pub_.publish(*odom);
-  if (ros_layer::wanted(wheel_states_pub_)) publishWheelStates(sample, stamp);
-  if (tf_wanted) publishTf(*odom, sample);
+  if (wheels_wanted) wheel_states_pub_.publish(wheel_states_);
+  if (tf_wanted) tf_pub_.publish(tf_);
 }
 
-void BaseRos::publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample) {
-  tf2_msgs::TFMessage tf;
-  tf.transforms.resize(1);
-  geometry_msgs::TransformStamped& transform = tf.transforms[0];
+void BaseRos::buildTf(const nav_msgs::Odometry& odom, const OdometrySample& sample) {
+  tf_.transforms.resize(1);
+  geometry_msgs::TransformStamped& transform = tf_.transforms[0];
   transform.header = odom.header;
   transform.child_frame_id = odom.child_frame_id;
   transform.transform.translation.x = sample.pose.x;
   transform.transform.translation.y = sample.pose.y;
+  transform.transform.translation.z = 0.0;
   transform.transform.rotation = odom.pose.pose.orientation;
-  tf_pub_.publish(tf);
 }
 
 ros_layer::CountedPublisher BaseRos::advertiseTf() {
@@ -107,11 +112,11 @@ ros_layer::CountedPublisher BaseRos::advertiseTf() {
   return ros_layer::advertiseCounted<tf2_msgs::TFMessage>(global, "/tf", 100);
 }
 
-void BaseRos::publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp) {
+void BaseRos::buildWheelStates(const OdometrySample& sample, const ::ros::Time& stamp) {
   // The wheels' angles as robot_state_publisher wants them: the same accepted motion as odom.
   const BaseParams& started = device_.params();
-  wheel_states_pub_.publish(toWheelStates(sample, started.base_frame, started.left_wheel_joint,
-                                          started.right_wheel_joint, stamp));
+  fillWheelStates(sample, started.base_frame, started.left_wheel_joint, started.right_wheel_joint,
+                  stamp, &wheel_states_);
 }
 
 }  // namespace serial_robot_driver::devices::base::ros

@@ -23,7 +23,8 @@ geometry_msgs_msg_dds__Vector3_ toVector3(const Eigen::Vector3d& v) {
 
 /// REP-145 sensor_msgs/Imu of a frame (imuReading(), the gyro bias subtracted), header left out.
 sensor_msgs_msg_dds__Imu_ toImu(const BodyFrame& frame) {
-  const ImuReading reading = imuReading(frame.telemetry, frame.imu, frame.gyro_bias);
+  const ImuReading reading =
+      imuReading(frame.telemetry, frame.imu, frame.imu_axes, frame.gyro_bias);
   sensor_msgs_msg_dds__Imu_ msg{};
   msg.linear_acceleration = toVector3(reading.linear_acceleration);
   msg.angular_velocity = toVector3(reading.angular_velocity);

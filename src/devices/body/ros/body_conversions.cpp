@@ -31,11 +31,18 @@ sensor_msgs::JointState toJointState(const Telemetry& telemetry,
 
 sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros::Time& stamp) {
   sensor_msgs::JointState msg;
-  msg.header.stamp = stamp;
-  msg.name = readings.names;
-  msg.position = readings.positions;
-  msg.velocity = readings.velocities;
+  fillJointState(readings, stamp, &msg);
   return msg;
+}
+
+void fillJointState(const JointReadings& readings, const ::ros::Time& stamp,
+                    sensor_msgs::JointState* msg) {
+  msg->header.stamp = stamp;
+  msg->header.frame_id.clear();
+  msg->name = readings.names;
+  msg->position = readings.positions;
+  msg->velocity = readings.velocities;
+  msg->effort.clear();
 }
 
 JointCommand fromJointState(const sensor_msgs::JointState& msg) {
@@ -44,21 +51,25 @@ JointCommand fromJointState(const sensor_msgs::JointState& msg) {
 
 sensor_msgs::Imu toImu(const Telemetry& telemetry, const ImuParams& params,
                        const ::ros::Time& stamp, const std::array<double, 3>& gyro_bias) {
-  const ImuReading reading = imuReading(telemetry, params, gyro_bias);
   sensor_msgs::Imu msg;
-  msg.header.stamp = stamp;
-  msg.header.frame_id = params.frame_id;
-  msg.linear_acceleration = toVector3(reading.linear_acceleration);
-  msg.angular_velocity = toVector3(reading.angular_velocity);
-  msg.orientation = toQuaternion(reading.orientation);
+  fillImu(imuReading(telemetry, params, gyro_bias), params, stamp, &msg);
+  return msg;
+}
+
+void fillImu(const ImuReading& reading, const ImuParams& params, const ::ros::Time& stamp,
+             sensor_msgs::Imu* msg) {
+  msg->header.stamp = stamp;
+  msg->header.frame_id = params.frame_id;
+  msg->linear_acceleration = toVector3(reading.linear_acceleration);
+  msg->angular_velocity = toVector3(reading.angular_velocity);
+  msg->orientation = toQuaternion(reading.orientation);
   const ImuCovariances covariances = imuCovariances(params);
   std::copy(covariances.orientation.begin(), covariances.orientation.end(),
-            msg.orientation_covariance.begin());
+            msg->orientation_covariance.begin());
   std::copy(covariances.angular_velocity.begin(), covariances.angular_velocity.end(),
-            msg.angular_velocity_covariance.begin());
+            msg->angular_velocity_covariance.begin());
   std::copy(covariances.linear_acceleration.begin(), covariances.linear_acceleration.end(),
-            msg.linear_acceleration_covariance.begin());
-  return msg;
+            msg->linear_acceleration_covariance.begin());
 }
 
 std::optional<serial_robot_driver::FootPressure> toFootPressure(const Telemetry& telemetry,

@@ -3,8 +3,6 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
 
-#include <boost/make_shared.hpp>
-
 #include "serial_robot_driver/FootPressure.h"
 #include "serial_robot_driver/Telemetry.h"
 #include "serial_robot_driver/devices/body/ros/body_conversions.h"
@@ -62,15 +60,19 @@ void BodyRos::publishFrame(const BodyFrame& frame) {
   // subscribes to is not even built: at hundreds of frames per second that is most of the CPU.
   const ::ros::Time stamp = arrival_stamps_(frame.arrival);
   // joint_states and imu/data go out as shared pointers: a subscriber in the same nodelet manager
-  // gets this very message, not a serialized copy (so each is a message of its own).
-  if (ros_layer::wanted(joint_states_pub_)) {
-    joint_states_pub_.publish(
-        boost::make_shared<sensor_msgs::JointState>(toJointState(frame.joints, stamp)));
+  // gets this very message, not a serialized copy (so a message is reused only once it is ours).
+  // Both are built before the first goes out: roscpp's sending thread, woken by the first, then
+  // finds the second queued too instead of being woken once more.
+  const bool joint_states_wanted = ros_layer::wanted(joint_states_pub_);
+  const bool imu_wanted = ros_layer::wanted(imu_pub_);
+  if (joint_states_wanted) fillJointState(frame.joints, stamp, &joint_states_.next());
+  if (imu_wanted) {
+    const ImuReading reading =
+        imuReading(frame.telemetry, frame.imu, frame.imu_axes, frame.gyro_bias);
+    fillImu(reading, frame.imu, stamp, &imu_.next());
   }
-  if (ros_layer::wanted(imu_pub_)) {
-    imu_pub_.publish(boost::make_shared<sensor_msgs::Imu>(
-        toImu(frame.telemetry, frame.imu, stamp, frame.gyro_bias)));
-  }
+  if (joint_states_wanted) joint_states_pub_.publish(joint_states_.get());
+  if (imu_wanted) imu_pub_.publish(imu_.get());
   if (ros_layer::wanted(foot_pressure_pub_)) {
     if (auto foot = toFootPressure(frame.telemetry, stamp)) foot_pressure_pub_.publish(*foot);
   }

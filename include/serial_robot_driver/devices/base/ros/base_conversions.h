@@ -32,5 +32,10 @@ nav_msgs::Odometry toOdometry(const OdometrySample& sample, const OdomFrames& fr
 sensor_msgs::JointState toWheelStates(const OdometrySample& sample, const std::string& frame,
                                       const std::string& left, const std::string& right,
                                       const ::ros::Time& stamp);
+/// The same into `msg` (every field), reusing its strings and vectors: the loop's message of the
+/// last tick, filled again without allocating.
+void fillWheelStates(const OdometrySample& sample, const std::string& frame,
+                     const std::string& left, const std::string& right, const ::ros::Time& stamp,
+                     sensor_msgs::JointState* msg);
 
 }  // namespace serial_robot_driver::devices::base::ros

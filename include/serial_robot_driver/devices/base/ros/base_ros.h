@@ -7,7 +7,9 @@
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <memory>
 
@@ -29,10 +31,11 @@ class BaseRos : public ros_layer::DeviceFrontEnd {
   BaseOutputs outputs();
   void publishWheelCommand(const WheelFrameSent& sent);
   void publishOdometry(const OdometrySample& sample);
-  /// odom's pose as odom -> base_link on /tf.
-  void publishTf(const nav_msgs::Odometry& odom, const OdometrySample& sample);
+  /// odom's pose as odom -> base_link, into tf_.
+  void buildTf(const nav_msgs::Odometry& odom, const OdometrySample& sample);
   static ros_layer::CountedPublisher advertiseTf();
-  void publishWheelStates(const OdometrySample& sample, const ::ros::Time& stamp);
+  /// The wheels' joint states, into wheel_states_.
+  void buildWheelStates(const OdometrySample& sample, const ::ros::Time& stamp);
 
   BaseDevice& device_;
   ros_layer::ArrivalStamps arrival_stamps_;
@@ -41,6 +44,10 @@ class BaseRos : public ros_layer::DeviceFrontEnd {
   ros_layer::CountedPublisher wheel_states_pub_;
   ros_layer::CountedPublisher wheel_command_pub_;
   ros_layer::CountedPublisher battery_pub_;
+  // The loop thread's messages of the last tick, filled again (published by value: roscpp
+  // serializes them before publish() returns).
+  sensor_msgs::JointState wheel_states_;
+  tf2_msgs::TFMessage tf_;
   ::ros::Subscriber cmd_vel_sub_;
   ::ros::ServiceServer reset_odometry_srv_;
   ::ros::ServiceServer reset_srv_;

@@ -28,12 +28,18 @@ sensor_msgs::JointState toJointState(const Telemetry& telemetry,
                                      const ::ros::Time& stamp);
 /// The same from readings already converted.
 sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros::Time& stamp);
+/// The same into `msg` (every field that toJointState() sets), reusing its vectors' capacity.
+void fillJointState(const JointReadings& readings, const ::ros::Time& stamp,
+                    sensor_msgs::JointState* msg);
 
 /// REP-145 IMU message: imuReading() (the bias subtracted), with diagonal covariances
 /// from `params`. A negative orientation_variance marks the orientation as unknown
 /// (orientation_covariance[0] = -1).
 sensor_msgs::Imu toImu(const Telemetry& telemetry, const ImuParams& params,
                        const ::ros::Time& stamp, const std::array<double, 3>& gyro_bias = {});
+/// toImu() of a reading already converted, into `msg` (every field), reusing its frame_id's buffer.
+void fillImu(const ImuReading& reading, const ImuParams& params, const ::ros::Time& stamp,
+             sensor_msgs::Imu* msg);
 
 /// The 8 raw foot readings, or nothing when the frame did not carry the foot block.
 std::optional<serial_robot_driver::FootPressure> toFootPressure(const Telemetry& telemetry,

@@ -7,6 +7,8 @@
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/JointState.h>
 
 #include <memory>
 
@@ -16,6 +18,7 @@
 #include "serial_robot_driver/ros/driver_params.h"
 #include "serial_robot_driver/ros/publish_wanted.h"
 #include "serial_robot_driver/ros/queue_spinner.h"
+#include "serial_robot_driver/ros/reused_message.h"
 
 namespace serial_robot_driver::devices::body::ros {
 
@@ -40,6 +43,9 @@ class BodyRos : public ros_layer::DeviceFrontEnd {
   ros_layer::CountedPublisher imu_pub_;
   ros_layer::CountedPublisher foot_pressure_pub_;
   ros_layer::CountedPublisher telemetry_pub_;
+  // Reader thread only: the messages of the last frame, filled again when nobody else holds them.
+  ros_layer::ReusedMessage<sensor_msgs::JointState> joint_states_;
+  ros_layer::ReusedMessage<sensor_msgs::Imu> imu_;
   ::ros::Subscriber joint_commands_sub_;
   // imu/calibrate: its own queue and one thread, as a call blocks for ~imu/calibration_time.
   ::ros::CallbackQueue calibration_queue_;
