@@ -275,9 +275,13 @@ TEST_F(GyroSettleTest, RefusedRightAfterAMotionEndsUntilTheSettleTimeHasPassed) 
                        "last motion (settle time)"))
       << outcome.message;
   EXPECT_EQ(calibrator_.bias(), (GyroVector{0, 0, 0}));
-  // Once settled it goes through (waited for, bounded).
+  // Once settled it goes through (waited for, bounded). A loaded machine may stretch the feeder's
+  // 5 ms sleeps so that a 0.1 s window holds too few samples: that window is tried again too.
   const auto give_up = core::Clock::now() + std::chrono::seconds(10);
-  while (!outcome.success && outcome.not_still && core::Clock::now() < give_up) {
+  const auto retried = [](const GyroCalibrationOutcome& o) {
+    return o.not_still || contains(o.message, "too few IMU samples");
+  };
+  while (!outcome.success && retried(outcome) && core::Clock::now() < give_up) {
     outcome = calibrator_.calibrate(0.1, kUnits, "imu/calibrate");
   }
   EXPECT_TRUE(outcome.success) << outcome.message;
