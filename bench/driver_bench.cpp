@@ -87,6 +87,7 @@ struct Options {
   std::size_t service_calls = 200;  ///< 6: calls timed per client kind
   double stress_seconds = 5;        ///< 6: idle and stress windows of the wheel loop
   std::size_t floor_rounds = 1;     ///< 8, 11: node/floor rounds
+  std::set<std::string> conditions;  ///< 8: the conditions run (UserCondition::tag()); empty: all
   double bus_seconds = 5;           ///< 10: window of each servo bus run
   std::string realtime_priority = "50";  ///< 8: ~realtime_priority when RT is on
   int bench_priority = 90;               ///< SCHED_FIFO of this process's threads; 0: normal
@@ -103,6 +104,8 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           11 is the earlier per-device comparison with floor_node)
   --floor-rounds N        8, 11: node/floor rounds, each with its share of the frames and
                           commands (default 1)
+  --conditions A,B,...    8: only these conditions (quiet, quiet_rt, load, load_rt; default
+                          all); the others' cells stay empty
   --realtime-priority V   8: the ~realtime_priority given for "RT on" (default 50; "true"
                           passes a bool)
   --bench-priority N      SCHED_FIFO priority of this benchmark's own threads, so a load
@@ -129,6 +132,14 @@ std::set<int> parseSections(const std::string& text) {
     sections.insert(section);
   }
   return sections;
+}
+
+std::set<std::string> splitList(const std::string& text) {
+  std::set<std::string> items;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) items.insert(item);
+  return items;
 }
 
 Options parseOptions(int argc, char** argv) {
@@ -175,6 +186,8 @@ Options parseOptions(int argc, char** argv) {
       options.service_calls = std::stoul(value);
     } else if (flag == "--floor-rounds") {
       options.floor_rounds = std::max<std::size_t>(1, std::stoul(value));
+    } else if (flag == "--conditions") {
+      options.conditions = splitList(value);
     } else if (flag == "--realtime-priority") {
       options.realtime_priority = value;
     } else if (flag == "--bench-priority") {
@@ -1554,8 +1567,10 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
       frames, commands, o.floor_rounds));
   table.note(format(
       "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
-      "~realtime_priority %s for all (each takes SCHED_FIFO on its main thread before roscpp "
-      "starts, so every thread inherits it; memory locked). This benchmark's own threads: %s.",
+      "~realtime_priority %s for all (the floors take SCHED_FIFO at it on their main thread before "
+      "roscpp starts, so every thread inherits it; driver_node takes one below there and the "
+      "priority itself on its port readers and base loop; memory locked). This benchmark's own "
+      "threads: %s.",
       o.realtime_priority.c_str(),
       context.bench_priority > 0 ? format("SCHED_FIFO %d", context.bench_priority).c_str()
                                  : "normal priority"));
@@ -1573,6 +1588,7 @@ void runUserConfiguration(Context& context) {
   for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
     for (std::size_t c = 0; c < kUserConditions.size(); ++c) {
       const UserCondition& condition = kUserConditions[c];
+      if (!saved.conditions.empty() && saved.conditions.count(condition.tag()) == 0) continue;
       const Variant* const programs[] = {&kEventDriven, &kSameJobFloor, &kFloor};
       for (std::size_t k = 0; k < 3; ++k) {
         const Variant& variant = *programs[(k + c + round) % 3];

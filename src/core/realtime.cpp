@@ -43,7 +43,10 @@ std::string limitText(const std::optional<uint64_t>& limit) {
 std::string schedulingText(const RealtimeFacts& facts) {
   const std::string fifo = "SCHED_FIFO priority " + std::to_string(facts.priority);
   if (facts.sched_error == 0) {
-    return fifo + " for the port readers, the base loop and the command callbacks";
+    const int rest = supportPriority(facts.priority);
+    return fifo + " for the port readers and the base loop, " +
+           (rest < facts.priority ? std::to_string(rest) : std::string("the same")) +
+           " for driver_node's other threads (roscpp's, the command callbacks, the services)";
   }
   if (facts.sched_error != EPERM)
     return fifo + " refused (" + std::strerror(facts.sched_error) + ")";
@@ -83,6 +86,8 @@ std::string memoryText(const RealtimeFacts& facts) {
 }
 
 }  // namespace
+
+int supportPriority(int priority) { return priority > 1 ? priority - 1 : priority; }
 
 RealtimeStatus judgeRealtime(const RealtimeFacts& facts) {
   RealtimeStatus status;

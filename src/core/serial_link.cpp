@@ -1,5 +1,7 @@
 #include "serial_robot_driver/core/serial_link.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 
 #include "serial_robot_driver/core/realtime.h"
@@ -189,6 +191,7 @@ void SerialLink::waitForRetry(Clock::time_point until) {
 }
 
 void SerialLink::readerLoop() {
+  ::pthread_setname_np(::pthread_self(), "srd_reader");  // as ps -L, top -H and perf show it
   enterRealtime(options_.realtime_priority);  // refused: it reads at the normal policy
   while (!stopping_) {
     const Clock::time_point work_due =

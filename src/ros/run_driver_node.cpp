@@ -58,8 +58,9 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignal
   // Global queue: cmd_vel, joint_commands, base services and the diagnostics timer. None of them
   // waits on the wire (servo/* services have their own queue), so one thread keeps up. Unlike
   // ros::AsyncSpinner it does not wake every 100 ms while the node is idle. On the way of a command
-  // to the wire, so at ~realtime_priority too.
-  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1, realtime_priority);
+  // to the wire, so real-time too, but below the frame threads like roscpp's poll thread that
+  // hands it the commands (core/realtime.h): its diagnostics and services never hold up a frame.
+  QueueSpinner spinner(ros::getGlobalCallbackQueue(), 1, core::supportPriority(realtime_priority));
   spinner.start();
   const bool replay_done =
       replay ? stop_signals.wait(
@@ -75,15 +76,19 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignal
   spinner.stop();
 }
 
-/// ~realtime_priority on the main thread before roscpp starts its threads (with the first
-/// NodeHandle; ros::param needs none): every thread of the process inherits SCHED_FIFO, roscpp's
-/// too (the poll thread that carries messages to and from the sockets, its timers), so the whole
-/// path of a frame or a command runs at the priority. Checked and logged once by
-/// DriverCore::start(); a value validate() refuses is not applied here either.
+/// ~realtime_priority's lower level (core::supportPriority) on the main thread before roscpp starts
+/// its threads (with the first NodeHandle; ros::param needs none): every thread of the process
+/// inherits SCHED_FIFO one below the frame threads, roscpp's too (the poll thread that carries
+/// messages to and from the sockets, its timers), so the whole path of a frame or a command runs
+/// ahead of normal processes, and the port readers and the base loop (which take the priority
+/// itself) preempt all of them. Checked and logged once by DriverCore::start(); a value
+/// validate() refuses is not applied here either.
 void enterRealtimeBeforeRoscpp() {
   int priority = 0;
   if (!ros::param::get("~realtime_priority", priority)) return;
-  if (priority > 0 && priority <= core::kMaxRealtimePriority) core::enterRealtime(priority);
+  if (priority > 0 && priority <= core::kMaxRealtimePriority) {
+    core::enterRealtime(core::supportPriority(priority));
+  }
 }
 
 }  // namespace

@@ -1,10 +1,14 @@
 // driver_node processes this test starts itself (base_node.test): a port that appears later, a bad
-// parameter, SIGINT while driving, a node that starts with the e-stop engaged; and the main() of
-// the test_base_node target.
+// parameter, SIGINT while driving, a node that starts with the e-stop engaged, the threads'
+// priorities with ~realtime_priority; and the main() of the test_base_node target.
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <std_msgs/Bool.h>
 
+#include <fstream>
+
 #include "support/base_node_fixture.h"
+#include "support/realtime_support.h"
 
 namespace {
 
@@ -133,6 +137,57 @@ TEST(BaseNodeProcess, StartEngagedHoldsTheBaseUntilReleased) {
       << node.output();
 
   streamer.stop(true);
+  node.signal(SIGTERM);
+  EXPECT_TRUE(node.waitExit(10.0).has_value()) << "driver_node did not exit on SIGTERM";
+}
+
+/// A thread's name and its scheduling policy and priority, as the kernel holds them.
+struct NodeThread {
+  std::string name;
+  int policy = -1;
+  int priority = -1;
+};
+
+std::vector<NodeThread> nodeThreads(pid_t pid) {
+  std::vector<NodeThread> threads;
+  const std::string tasks = "/proc/" + std::to_string(pid) + "/task/";
+  for (const std::string& tid : test_support::listDirectory(tasks)) {
+    NodeThread thread;
+    std::ifstream(tasks + tid + "/comm") >> thread.name;
+    thread.policy = sched_getscheduler(std::stoi(tid));
+    sched_param param{};
+    if (sched_getparam(std::stoi(tid), &param) == 0) thread.priority = param.sched_priority;
+    threads.push_back(thread);
+  }
+  return threads;
+}
+
+// 16. ~realtime_priority where this process may use SCHED_FIFO (root in a container): the
+// threads that carry frames (the port's reader, the base loop) run at the priority, every other
+// thread of the node (roscpp's, the spinners) one below, so a frame thread that wakes preempts
+// them instead of waiting for one to block.
+TEST(BaseNodeProcess, RealtimeFrameThreadsRunAboveTheRestOfTheNode) {
+  ASSERT_FALSE(g_driver_path.empty());
+  if (!test_support::fifoAllowed(30)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
+  const std::string port = g_port + "_rt";
+  FakeBase base(port);
+  std::vector<std::string> args = driverArgs("/rt", "driver_rt", port);
+  args.push_back("_realtime_priority:=30");
+  ChildProcess node(g_driver_path, args);
+  ASSERT_TRUE(node.started());
+  ros::Publisher cmd_vel = g_ros->nh().advertise<geometry_msgs::Twist>("/rt/cmd_vel", 10);
+  ASSERT_TRUE(waitFor([&] { return cmd_vel.getNumSubscribers() > 0; }, 20.0)) << node.output();
+  ASSERT_TRUE(base.waitForCount(2, 10.0)) << node.output();  // the reader and the loop run
+
+  std::size_t frame_threads = 0;
+  for (const NodeThread& thread : nodeThreads(node.pid())) {
+    SCOPED_TRACE(thread.name);
+    const bool carries_frames = thread.name == "srd_reader" || thread.name == "srd_base_loop";
+    frame_threads += carries_frames ? 1 : 0;
+    EXPECT_EQ(thread.policy, SCHED_FIFO);
+    EXPECT_EQ(thread.priority, carries_frames ? 30 : 29);
+  }
+  EXPECT_EQ(frame_threads, 2u) << "one port reader and the base loop";
   node.signal(SIGTERM);
   EXPECT_TRUE(node.waitExit(10.0).has_value()) << "driver_node did not exit on SIGTERM";
 }

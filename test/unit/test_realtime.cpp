@@ -50,8 +50,20 @@ TEST(Realtime, GrantedSaysWhatApplies) {
   EXPECT_EQ(status.priority, 50);
   EXPECT_TRUE(status.memory_locked);
   EXPECT_FALSE(status.refused);
-  EXPECT_TRUE(mentions(status.message, "SCHED_FIFO priority 50"));
+  EXPECT_TRUE(mentions(status.message,
+                       "SCHED_FIFO priority 50 for the port readers and the base "
+                       "loop, 49 for driver_node's other threads"));
   EXPECT_TRUE(mentions(status.message, "memory locked"));
+}
+
+TEST(Realtime, TheRestOfTheProcessRunsOneBelowTheFrameThreads) {
+  EXPECT_EQ(supportPriority(50), 49);
+  EXPECT_EQ(supportPriority(2), 1);
+  EXPECT_EQ(supportPriority(1), 1);  // nothing below 1: all at the same level
+  EXPECT_EQ(supportPriority(0), 0);  // off
+  EXPECT_TRUE(mentions(judgeRealtime(allowed(1)).message,
+                       "SCHED_FIFO priority 1 for the port readers and the base loop, the same "
+                       "for driver_node's other threads"));
 }
 
 TEST(Realtime, RefusedByTheRtprioLimitNamesItAndHowToAllowIt) {

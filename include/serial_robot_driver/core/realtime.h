@@ -5,18 +5,22 @@
 // Threading model: a scheduling policy belongs to a thread. prepareRealtime() runs once per
 // process, before those threads start (DriverCore::start()): it locks the memory (mlockall, process
 // wide) and checks that SCHED_FIFO is allowed, so the core logs ONE line saying what applies,
-// or what refused it and how to allow it. Each of these threads then calls enterRealtime() first
-// thing where it starts:
-//  - every port's reader thread (core::SerialLink): reads, frames, decodes and publishes telemetry
-//    and replies; the servo bus's transactions run on it;
-//  - the base's control loop (devices::base::BaseController): the 50 Hz wheel frames, and a cmd_vel
-//    put on the wire at once;
-//  - the front end's callback thread for commands (the ROS node's global-queue spinner: cmd_vel,
-//    joint_commands written at once, trajectory ticks).
-// The driver_node executable also puts its main thread at the priority before roscpp starts its
-// threads (ros_layer::runDriverNode), so every thread of the process inherits it: roscpp's poll
-// thread (which carries messages between the sockets and the callback queues) and timers, the
-// service spinners and the gyro calibration. In a nodelet manager only the threads above take it.
+// or what refused it and how to allow it. Two levels, because SCHED_FIFO threads of EQUAL priority
+// never preempt one another: at one level a woken loop or reader waits until whichever thread of
+// the node holds a core blocks (traced on 2 cores under a CPU hog: the loop and the readers queued
+// behind roscpp's poll thread, the process's busiest, while a higher-priority process held the
+// other core; docs/performance.md).
+//  - At `priority` (enterRealtime() first thing where each starts), the threads that carry frames:
+//    every port's reader thread (core::SerialLink: reads, frames, decodes and publishes telemetry
+//    and replies; the servo bus's transactions run on it) and the base's control loop
+//    (devices::base::BaseController: the 50 Hz wheel frames). They preempt the rest at once.
+//  - At supportPriority(priority), one below, the rest of the process: driver_node puts its main
+//    thread there before roscpp starts its threads (ros_layer::runDriverNode), so every other
+//    thread inherits it: roscpp's poll thread (which carries messages between the sockets and the
+//    callback queues) and timers, the global queue's spinner (cmd_vel and joint_commands written
+//    at once, trajectory ticks, services, diagnostics), the servo/* and calibration spinners. Still
+//    ahead of every normal process, but never ahead of a frame. In a nodelet manager only the
+//    frame threads take a priority.
 // A thread that may not switch (EPERM) goes on at the normal policy: nothing else changes.
 #pragma once
 
@@ -28,6 +32,10 @@ namespace serial_robot_driver::core {
 
 /// ~realtime_priority's range: 0 is off, 1..kMaxRealtimePriority SCHED_FIFO at that priority.
 constexpr int kMaxRealtimePriority = 99;
+
+/// The SCHED_FIFO priority of the process's threads that do not carry frames when those that do
+/// run at `priority`: one below (1 stays 1: there is nothing below it), 0 when off.
+int supportPriority(int priority);
 
 /// What the system said when real-time scheduling was asked for (prepareRealtime()).
 struct RealtimeFacts {

@@ -29,8 +29,9 @@
 //    trajectory server's mutex), from its next tick, frame or transaction on.
 //  - trajectory goals, cancels, joint_trajectory and the trajectory timer (one sync-write per loop
 //    tick) run on the global queue too (ros/trajectory_server.h).
-//  - with ~realtime_priority the reader threads, the base loop and the global queue's spinner run
-//    SCHED_FIFO where the process may (core/realtime.h); the core logs once what applies.
+//  - with ~realtime_priority the reader threads and the base loop run SCHED_FIFO at it, the node's
+//    other threads (roscpp's, the spinners) one below, where the process may (core/realtime.h);
+//    the core logs once what applies.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>

@@ -1,5 +1,7 @@
 #include "serial_robot_driver/devices/base/base_controller.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -200,6 +202,7 @@ void BaseController::start() {
   }
   const int priority = config_.realtime_priority;  // not tunable: read before the thread runs
   loop_ = std::thread([this, priority] {
+    ::pthread_setname_np(::pthread_self(), "srd_base_loop");  // as ps -L, top -H and perf show it
     core::enterRealtime(priority);  // refused: the loop runs at the normal policy
     run();
   });

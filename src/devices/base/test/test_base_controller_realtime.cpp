@@ -1,10 +1,13 @@
 // The base's control loop at ~realtime_priority: where this process may use SCHED_FIFO (root in a
-// container), the loop thread really runs at it; where it may not, the loop runs on all the same.
+// container), the loop thread really runs at it, above the thread that started it (driver_node's
+// threads run one below, core/realtime.h); where it may not, the loop runs on all the same.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <mutex>
+#include <thread>
 
+#include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/devices/base/base_controller.h"
 #include "support/realtime_support.h"
 #include "support/test_helpers.h"
@@ -45,6 +48,21 @@ TEST(BaseControllerRealtime, TheLoopRunsAtTheConfiguredPriority) {
   const ThreadPolicy policy = loopPolicyAt(11);
   EXPECT_EQ(policy.policy, SCHED_FIFO);
   EXPECT_EQ(policy.priority, 11);
+}
+
+TEST(BaseControllerRealtime, TheLoopRunsAboveTheProcessThreadThatStartsIt) {
+  if (!test_support::fifoAllowed(11)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
+  ThreadPolicy starter;
+  ThreadPolicy loop;
+  std::thread process_thread([&] {  // as driver_node's main thread, whose policy threads inherit
+    core::enterRealtime(core::supportPriority(11));
+    starter = test_support::currentThreadPolicy();
+    loop = loopPolicyAt(11);
+  });
+  process_thread.join();
+  EXPECT_EQ(starter.policy, SCHED_FIFO);
+  EXPECT_EQ(loop.policy, SCHED_FIFO);
+  EXPECT_GT(loop.priority, starter.priority);
 }
 
 TEST(BaseControllerRealtime, WithoutAPriorityTheLoopKeepsTheNormalPolicy) {
