@@ -4,8 +4,12 @@
 # scratch_dir.sh; kept between runs, so a second run only rebuilds what changed), then runs sim.launch from that
 # install space alone and checks that joint_states flow and the servo/ping service is up.
 # Tests are not built here (scripts/build.sh's workspace runs them); ccache is used when present.
-# Usage: scripts/test_catkin_build.sh. Prints "catkin build test passed" or what failed.
+# Usage: scripts/test_catkin_build.sh [--build-only] [extra cmake arguments]. Prints "catkin build
+# test passed" or what failed. --build-only stops after the build (.ci/run builds ahead with it while
+# the tests run; the check itself runs afterwards with the same cmake arguments).
 set -euo pipefail
+build_only=false
+if [ "${1:-}" = --build-only ]; then build_only=true; shift; fi
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 source "$repo/scripts/scratch_dir.sh"
 ws="${SRD_CATKIN_TOOLS_WS:-$(scratch_dir "$repo" catkin_tools)}"
@@ -24,6 +28,7 @@ ln -sfn "$repo" "$ws/src/serial_robot_driver"
 cd "$ws"
 cmake_args=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=OFF)
 if command -v ccache >/dev/null; then cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake_args+=("$@")
 [ -d .catkin_tools ] || catkin init > /dev/null
 catkin config --install --cmake-args "${cmake_args[@]}" > /dev/null
 catkin build --no-status --no-notify -j2 serial_robot_driver > "$ws/build.log" 2>&1 ||
@@ -32,6 +37,7 @@ catkin build --no-status --no-notify -j2 serial_robot_driver > "$ws/build.log" 2
 install="$ws/install"
 [ -x "$install/lib/serial_robot_driver/driver_node" ] || fail "no driver_node in $install"
 [ -f "$install/share/serial_robot_driver/launch/sim.launch" ] || fail "no sim.launch in $install"
+if [ "$build_only" = true ]; then echo "catkin build done"; exit 0; fi
 
 # The install space alone (with the system's ROS), as in scripts/test_install.sh.
 install_prefix="$install"
