@@ -14,6 +14,27 @@ namespace {
 
 using namespace base_node_test;  // NOLINT: the shared fixture
 
+/// A driver_node of the test's own, named `driver_<name>` in namespace `/<name>` on a FakeBase of
+/// its own port, with one extra parameter; `ready()` once its cmd_vel is subscribed.
+struct OwnDriver {
+  OwnDriver(const std::string& name, const std::string& extra_param)
+      : base(g_port + "_" + name),
+        node(g_driver_path,
+             withParam(driverArgs("/" + name, "driver_" + name, g_port + "_" + name), extra_param)),
+        cmd_vel(g_ros->nh().advertise<geometry_msgs::Twist>("/" + name + "/cmd_vel", 10)) {}
+  static std::vector<std::string> withParam(std::vector<std::string> args,
+                                            const std::string& param) {
+    args.push_back(param);
+    return args;
+  }
+  bool ready() {
+    return node.started() && waitFor([&] { return cmd_vel.getNumSubscribers() > 0; }, 20.0);
+  }
+  FakeBase base;
+  ChildProcess node;
+  ros::Publisher cmd_vel;
+};
+
 // 12. A node started while its port does not exist yet keeps retrying and connects when the
 // device appears, starting with a Reset.
 TEST(BaseNodeProcess, ConnectsWhenThePortAppearsLater) {
@@ -106,15 +127,12 @@ TEST(BaseNodeProcess, SigintStopsTheWheelsBeforeExit) {
 // start, yet every speed frame is zero until an e_stop false arrives; only then does it drive.
 TEST(BaseNodeProcess, StartEngagedHoldsTheBaseUntilReleased) {
   ASSERT_FALSE(g_driver_path.empty());
-  const std::string port = g_port + "_engaged";
-  FakeBase base(port);
-  std::vector<std::string> args = driverArgs("/engaged", "driver_engaged", port);
-  args.push_back("_e_stop/start_engaged:=true");
-  ChildProcess node(g_driver_path, args);
-  ASSERT_TRUE(node.started());
-  ros::Publisher cmd_vel = g_ros->nh().advertise<geometry_msgs::Twist>("/engaged/cmd_vel", 10);
+  OwnDriver driver("engaged", "_e_stop/start_engaged:=true");
+  FakeBase& base = driver.base;
+  ChildProcess& node = driver.node;
+  ros::Publisher& cmd_vel = driver.cmd_vel;
   ros::Publisher e_stop = g_ros->nh().advertise<std_msgs::Bool>("/engaged/e_stop", 1, true);
-  ASSERT_TRUE(waitFor([&] { return cmd_vel.getNumSubscribers() > 0; }, 20.0)) << node.output();
+  ASSERT_TRUE(driver.ready()) << node.output();
 
   CmdVelStreamer streamer(cmd_vel);
   streamer.set(0.5, 0.0);
@@ -169,14 +187,10 @@ std::vector<NodeThread> nodeThreads(pid_t pid) {
 TEST(BaseNodeProcess, RealtimeFrameThreadsRunAboveTheRestOfTheNode) {
   ASSERT_FALSE(g_driver_path.empty());
   if (!test_support::fifoAllowed(30)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
-  const std::string port = g_port + "_rt";
-  FakeBase base(port);
-  std::vector<std::string> args = driverArgs("/rt", "driver_rt", port);
-  args.push_back("_realtime_priority:=30");
-  ChildProcess node(g_driver_path, args);
-  ASSERT_TRUE(node.started());
-  ros::Publisher cmd_vel = g_ros->nh().advertise<geometry_msgs::Twist>("/rt/cmd_vel", 10);
-  ASSERT_TRUE(waitFor([&] { return cmd_vel.getNumSubscribers() > 0; }, 20.0)) << node.output();
+  OwnDriver driver("rt", "_realtime_priority:=30");
+  FakeBase& base = driver.base;
+  ChildProcess& node = driver.node;
+  ASSERT_TRUE(driver.ready()) << node.output();
   ASSERT_TRUE(base.waitForCount(2, 10.0)) << node.output();  // the reader and the loop run
 
   std::size_t frame_threads = 0;
