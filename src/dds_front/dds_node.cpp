@@ -7,6 +7,7 @@
 #include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/core/wall_stamps.h"
 #include "serial_robot_driver/dds/ros_conventions.h"
+#include "serial_robot_driver/dds_front/guarded_subscription.h"
 #include "serial_robot_driver/trajectory/message_time.h"
 
 namespace serial_robot_driver::dds_front {
@@ -39,20 +40,13 @@ DdsNode::DdsNode(const params::DriverParams& params, const dds::NodeOptions& opt
   diagnostics_ = std::make_unique<dds::Publisher<diagnostic_msgs_msg_dds__DiagnosticArray_>>(
       *participant_, "/diagnostics");
   // Queue 10 as on the ROS side, so no toggle is dropped.
-  e_stop_ = std::make_unique<dds::Subscription<std_msgs_msg_dds__Bool_>>(
-      *participant_, "e_stop",
-      guarded<std_msgs_msg_dds__Bool_>(
-          core_.inputRefusals(), "e_stop",
-          [this](const std_msgs_msg_dds__Bool_& msg) { onEStop(msg); }));
+  e_stop_ = subscribeGuarded<std_msgs_msg_dds__Bool_>(
+      *participant_, core_.inputRefusals(), "e_stop",
+      [this](const std_msgs_msg_dds__Bool_& msg) { onEStop(msg); });
   if (core_.trajectories() != nullptr) {
-    joint_trajectory_ =
-        std::make_unique<dds::Subscription<trajectory_msgs_msg_dds__JointTrajectory_>>(
-            *participant_, "joint_trajectory",
-            guarded<trajectory_msgs_msg_dds__JointTrajectory_>(
-                core_.inputRefusals(), "joint_trajectory",
-                [this](const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
-                  onJointTrajectory(msg);
-                }));
+    joint_trajectory_ = subscribeGuarded<trajectory_msgs_msg_dds__JointTrajectory_>(
+        *participant_, core_.inputRefusals(), "joint_trajectory",
+        [this](const trajectory_msgs_msg_dds__JointTrajectory_& msg) { onJointTrajectory(msg); });
   }
 }
 

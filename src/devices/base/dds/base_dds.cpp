@@ -10,6 +10,7 @@
 #include "serial_robot_driver/dds/subscription.h"
 #include "serial_robot_driver/dds_front/dds_conversions.h"
 #include "serial_robot_driver/dds_front/dds_device_module.h"
+#include "serial_robot_driver/dds_front/guarded_subscription.h"
 #include "serial_robot_driver/devices/base/base_device.h"
 
 namespace serial_robot_driver::devices::base::dds {
@@ -52,19 +53,16 @@ class BaseDds : public dds_front::DeviceFrontEnd {
         wheel_states_(participant, "wheel_states"),
         battery_(participant, "battery"),
         tf_(device.params().publish_tf ? std::make_unique<Tf>(participant, "/tf") : nullptr),
-        cmd_vel_(std::make_unique<Twists>(participant, "cmd_vel",
-                                          dds_front::guarded<geometry_msgs_msg_dds__Twist_>(
-                                              device.inputRefusals(), "cmd_vel",
-                                              [this](const geometry_msgs_msg_dds__Twist_& msg) {
-                                                device_.commandTwist({msg.linear.x, msg.angular.z});
-                                              }))),
-        cmd_vel_stamped_(std::make_unique<StampedTwists>(
-            participant, "cmd_vel_stamped",
-            dds_front::guarded<geometry_msgs_msg_dds__TwistStamped_>(
-                device.inputRefusals(), "cmd_vel_stamped",
-                [this](const geometry_msgs_msg_dds__TwistStamped_& msg) {
-                  device_.commandTwist({msg.twist.linear.x, msg.twist.angular.z});
-                }))) {
+        cmd_vel_(dds_front::subscribeGuarded<geometry_msgs_msg_dds__Twist_>(
+            participant, device.inputRefusals(), "cmd_vel",
+            [this](const geometry_msgs_msg_dds__Twist_& msg) {
+              device_.commandTwist({msg.linear.x, msg.angular.z});
+            })),
+        cmd_vel_stamped_(dds_front::subscribeGuarded<geometry_msgs_msg_dds__TwistStamped_>(
+            participant, device.inputRefusals(), "cmd_vel_stamped",
+            [this](const geometry_msgs_msg_dds__TwistStamped_& msg) {
+              device_.commandTwist({msg.twist.linear.x, msg.twist.angular.z});
+            })) {
     BaseOutputs outputs;
     outputs.odometry = [this](const OdometrySample& sample) { publishOdometry(sample); };
     outputs.battery = [this](const BatteryReading& reading, core::Clock::time_point arrival) {

@@ -9,6 +9,7 @@
 #include "serial_robot_driver/dds/subscription.h"
 #include "serial_robot_driver/dds_front/dds_conversions.h"
 #include "serial_robot_driver/dds_front/dds_device_module.h"
+#include "serial_robot_driver/dds_front/guarded_subscription.h"
 #include "serial_robot_driver/devices/body/body_device.h"
 
 namespace serial_robot_driver::devices::body::dds {
@@ -48,13 +49,11 @@ class BodyDds : public dds_front::DeviceFrontEnd {
       : stamps_(params.replay_timeline),
         joint_states_(participant, "joint_states"),
         imu_(participant, "imu/data"),
-        joint_commands_(std::make_unique<Commands>(
-            participant, "joint_commands",
-            dds_front::guarded<sensor_msgs_msg_dds__JointState_>(
-                device.inputRefusals(), "joint_commands",
-                [&device](const sensor_msgs_msg_dds__JointState_& msg) {
-                  device.commandJoints({ddsl::toStrings(msg.name), ddsl::toVector(msg.position)});
-                }))) {
+        joint_commands_(dds_front::subscribeGuarded<sensor_msgs_msg_dds__JointState_>(
+            participant, device.inputRefusals(), "joint_commands",
+            [&device](const sensor_msgs_msg_dds__JointState_& msg) {
+              device.commandJoints({ddsl::toStrings(msg.name), ddsl::toVector(msg.position)});
+            })) {
     device.addOutputs({[this](const BodyFrame& frame) { publishFrame(frame); }});
   }
 
