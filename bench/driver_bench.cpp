@@ -217,7 +217,9 @@ struct Variant {
   double read_poll_interval;    ///< 0: event-driven
   bool spaced_cmd_vel = false;  ///< section 11: commands 10-40 ms apart instead of one per tick
   bool capture = false;         ///< ~capture on, with a subscriber on serial_raw
-  bool same_job = false;        ///< floor_node's ~same_job: the user's topics, done minimally
+  /// floor_node's ~same_job and ~same_interface: the user's topics and driver_node's interface,
+  /// done minimally.
+  bool same_job = false;
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
@@ -245,7 +247,10 @@ ParamList commonParams(const std::string& port, const Variant& variant) {
   if (variant.read_poll_interval > 0)
     params.emplace_back("read_poll_interval", variant.read_poll_interval);
   if (variant.capture) params.emplace_back("capture", true);
-  if (variant.same_job) params.emplace_back("same_job", true);
+  if (variant.same_job) {
+    params.emplace_back("same_job", true);
+    params.emplace_back("same_interface", true);
+  }
   return params;
 }
 
@@ -1553,7 +1558,9 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
       "max_wheel_speed 20 so each command is recognisable on the wire) and floor_node with the "
       "same parameters, twice: the same-job floor (~same_job: besides joint_states, imu/data per "
       "frame, odom + /tf + wheel_states per tick, /diagnostics at 1 Hz with as many statuses as "
-      "driver_node's, all as minimally as possible) and the minimal floor (joint_states only); "
+      "driver_node's, all as minimally as possible; ~same_interface: the rest of driver_node's "
+      "publications, subscriptions, dynamic_reconfigure servers and action server, each doing "
+      "nothing but exist, and the 1 Hz battery poll) and the minimal floor (joint_states only); "
       "this process plays the robot (telemetry of 20 servos at 100 Hz, battery answers).");
   table.note(
       "Subscribed throughout: joint_states (robot_state_publisher), wheel_states "

@@ -8,6 +8,11 @@
 // minimally as possible: besides joint_states, imu/data per telemetry frame, odom + /tf +
 // wheel_states per loop tick (the commanded motion integrated), and /diagnostics at 1 Hz with
 // ~same_job_statuses statuses.
+// ~same_interface (default false) adds the rest of driver_node's interface, each piece doing
+// nothing but exist (floor_interface.h: its other publications, subscriptions, dynamic_reconfigure
+// servers and action server), and the base's battery poll (~base/battery_poll_rate, 1 Hz: a request
+// written on the loop, the reply framed): the least a node offering driver_node's interface
+// spends on it whoever listens.
 //
 // Threading: one reader thread blocks on the port, frames telemetry and publishes one JointState
 // (and one Imu) per frame; the cmd_vel callback (the AsyncSpinner's thread) writes its speed frame
@@ -32,12 +37,15 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "floor_interface.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
@@ -56,6 +64,7 @@ std::mutex g_write_mutex;
 std::atomic<int16_t> g_left{0}, g_right{0};
 std::atomic<double> g_linear{0.0}, g_angular{0.0};  // the twist commanded last (same job)
 uint8_t g_seq = 0;  // guarded by g_write_mutex
+int g_battery_every = 0;  // ~same_interface: a battery request every this many loop ticks; 0: none
 
 /// ~same_job's publishers (advertised only with it on).
 struct SameJob {
@@ -65,11 +74,21 @@ struct SameJob {
   ros::SteadyTimer diagnostics_timer;
 };
 
-void writeSpeedFrame() {
-  std::lock_guard<std::mutex> lock(g_write_mutex);
-  const auto frame = srd::devices::base::encodeWheelSpeed(g_seq++, g_left, g_right);
+void writeFrame(const std::vector<uint8_t>& frame) {
   if (::write(g_fd, frame.data(), frame.size()) < 0) { /* the floor does not handle errors */
   }
+}
+
+void writeSpeedFrame() {
+  std::lock_guard<std::mutex> lock(g_write_mutex);
+  writeFrame(srd::devices::base::encodeWheelSpeed(g_seq++, g_left, g_right));
+}
+
+/// ~same_interface: the battery request, every g_battery_every loop ticks.
+void pollBattery(long tick) {
+  if (g_battery_every <= 0 || tick % g_battery_every != 0) return;
+  std::lock_guard<std::mutex> lock(g_write_mutex);
+  writeFrame(srd::devices::base::encodeBatteryRequest(g_seq++));
 }
 
 /// ~realtime_priority: an integer priority, or true for 50; 0 (or absent, or false) is off. Read
@@ -170,7 +189,11 @@ void publishImu(const srd::devices::body::Telemetry& telemetry, const ros::Time&
 /// g_running ends.
 void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states, SameJob& job) {
   const std::size_t count = joints.ids.size();
-  const auto config = test_support::driverFramer({"body"}, count);
+  // With the battery poll its replies are framed too (and dropped: nobody listens to battery).
+  const auto config =
+      test_support::driverFramer(g_battery_every > 0 ? std::vector<std::string>{"base", "body"}
+                                                     : std::vector<std::string>{"body"},
+                                 count);
   srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
                                                  std::size_t size) {
     if (family != srd::devices::body::kTelemetryFrames) return;
@@ -280,13 +303,14 @@ void runBaseLoop(double loop_rate, SameJobOdometry* odometry) {
   const long period_ns = static_cast<long>(1e9 / loop_rate);
   timespec deadline{};
   ::clock_gettime(CLOCK_MONOTONIC, &deadline);
-  while (ros::ok()) {
+  for (long tick = 1; ros::ok(); ++tick) {
     deadline.tv_nsec += period_ns;
     while (deadline.tv_nsec >= 1000000000L) {
       deadline.tv_nsec -= 1000000000L;
       ++deadline.tv_sec;
     }
     ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
+    pollBattery(tick);
     writeSpeedFrame();
     if (odometry) odometry->tick(1.0 / loop_rate);
   }
@@ -311,6 +335,13 @@ int main(int argc, char** argv) {
   ros::Publisher joint_states = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
   SameJob job;
   advertiseSameJob(nh, pnh, job);
+  std::unique_ptr<floor_bench::FloorInterface> interface;
+  if (pnh.param("same_interface", false)) {
+    interface = std::make_unique<floor_bench::FloorInterface>(nh, pnh);
+    const double battery_rate = pnh.param("base/battery_poll_rate", 1.0);
+    if (base && battery_rate > 0)
+      g_battery_every = std::max(1, static_cast<int>(loop_rate / battery_rate));
+  }
   const srd::kinematics::DiffDriveGeometry geometry;
   ros::Subscriber cmd_vel;
   if (base) cmd_vel = subscribeCmdVel(nh, geometry);
