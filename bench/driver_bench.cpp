@@ -236,6 +236,7 @@ struct Context {
   int bench_priority = 0;    ///< SCHED_FIFO priority this process's threads run at; 0: normal
   /// Section 8: statuses per /diagnostics message of driver_node (the same-job floor's count).
   std::size_t node_diagnostic_statuses = 0;
+  std::size_t node_diagnostic_values = 0;  ///< their key/values in all (the same-job floor's)
 };
 
 void require(bool condition, const std::string& what) {
@@ -1285,11 +1286,16 @@ class UserSubscribers {
     subscribers_.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
         "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
           ++messages_;
+          std::size_t values = 0;
+          for (const auto& status : array->status) values += status.values.size();
           statuses_ = array->status.size();
+          values_ = values;
         }));
   }
   /// Statuses in the last /diagnostics message (0 before the first).
   std::size_t diagnosticStatuses() const { return statuses_; }
+  /// Key/values of all statuses in the last /diagnostics message.
+  std::size_t diagnosticValues() const { return values_; }
 
  private:
   template <typename Message>
@@ -1299,6 +1305,7 @@ class UserSubscribers {
   }
   std::atomic<std::size_t> messages_{0};
   std::atomic<std::size_t> statuses_{0};
+  std::atomic<std::size_t> values_{0};
   std::vector<ros::Subscriber> subscribers_;
 };
 
@@ -1346,6 +1353,7 @@ ParamList userParams(const std::string& port, const UserCondition& condition,
     const std::size_t statuses =
         context.node_diagnostic_statuses > 0 ? context.node_diagnostic_statuses : 5;
     params.emplace_back("same_job_statuses", static_cast<int>(statuses));
+    params.emplace_back("same_job_values", static_cast<int>(context.node_diagnostic_values));
   }
   const ParamList body = TelemetryProbe::nodeParams();
   params.insert(params.end(), body.begin(), body.end());
@@ -1428,6 +1436,7 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   figures.cmd_vel = timeCmdVelWhileStreaming(probe, pty, seq, cmd_vel, base.log(), commands);
   if (variant.program == kEventDriven.program) {
     context.node_diagnostic_statuses = subscribers.diagnosticStatuses();
+    context.node_diagnostic_values = subscribers.diagnosticValues();
   }
   return figures;
 }
@@ -1557,7 +1566,8 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
       "port, odom and /tf, diagnostics, battery poll; 20 body servos; speed_dithering off and "
       "max_wheel_speed 20 so each command is recognisable on the wire) and floor_node with the "
       "same parameters, twice: the same-job floor (~same_job: besides joint_states, imu/data per "
-      "frame, odom + /tf + wheel_states per tick, /diagnostics at 1 Hz with as many statuses as "
+      "frame, odom + /tf + wheel_states per tick, /diagnostics at 1 Hz with as many statuses and "
+      "key/values as "
       "driver_node's, all as minimally as possible; ~same_interface: the rest of driver_node's "
       "publications, subscriptions, dynamic_reconfigure servers and action server, each doing "
       "nothing but exist, and the 1 Hz battery poll) and the minimal floor (joint_states only); "

@@ -16,7 +16,8 @@ namespace floor_bench {
 namespace {
 template <typename M>
 ros::Subscriber ignore(ros::NodeHandle& nh, const std::string& topic) {
-  return nh.subscribe<M>(topic, 10, [](const typename M::ConstPtr&) {});
+  const boost::function<void(const typename M::ConstPtr&)> nothing = [](const auto&) {};
+  return nh.subscribe<M>(topic, 10, nothing);
 }
 }  // namespace
 

@@ -7,7 +7,7 @@
 // ~same_job (default false: the minimal floor) makes it do the job a user's driver_node does, as
 // minimally as possible: besides joint_states, imu/data per telemetry frame, odom + /tf +
 // wheel_states per loop tick (the commanded motion integrated), and /diagnostics at 1 Hz with
-// ~same_job_statuses statuses.
+// ~same_job_statuses statuses carrying ~same_job_values key/values in all.
 // ~same_interface (default false) adds the rest of driver_node's interface, each piece doing
 // nothing but exist (floor_interface.h: its other publications, subscriptions, dynamic_reconfigure
 // servers and action server), and the base's battery poll (~base/battery_poll_rate, 1 Hz: a request
@@ -70,6 +70,8 @@ int g_battery_every = 0;  // ~same_interface: a battery request every this many 
 struct SameJob {
   bool on = false;
   int statuses = 5;
+  int values = 0;  ///< key/values in all, spread over the statuses
+  unsigned long values_sent = 0;
   ros::Publisher imu, odom, tf, wheel_states, diagnostics;
   ros::SteadyTimer diagnostics_timer;
 };
@@ -279,6 +281,13 @@ void startDiagnostics(ros::NodeHandle& nh, SameJob& job) {
       array.status[i].message = "OK";
       array.status[i].hardware_id = "floor";
     }
+    // driver_node's values are counters and settings: a number each, under a fixed key.
+    for (int v = 0; v < job.values && !array.status.empty(); ++v) {
+      diagnostic_msgs::KeyValue value;
+      value.key = "value " + std::to_string(v);
+      value.value = std::to_string(job.values_sent++);
+      array.status[v % array.status.size()].values.push_back(std::move(value));
+    }
     job.diagnostics.publish(array);
   });
 }
@@ -287,6 +296,7 @@ void startDiagnostics(ros::NodeHandle& nh, SameJob& job) {
 void advertiseSameJob(ros::NodeHandle& nh, ros::NodeHandle& pnh, SameJob& job) {
   job.on = pnh.param("same_job", false);
   job.statuses = pnh.param("same_job_statuses", job.statuses);
+  job.values = pnh.param("same_job_values", job.values);
   if (!job.on) return;
   job.imu = nh.advertise<sensor_msgs::Imu>("imu/data", 10);
   job.odom = nh.advertise<nav_msgs::Odometry>("odom", 50);
