@@ -9,6 +9,7 @@ set(SRD_CORE_SOURCES
   src/kinematics/odometry.cpp
   src/kinematics/heading_fusion.cpp
   src/transport/serial_port.cpp
+  src/transport/tcp_stream.cpp
   src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
   src/core/serial_link.cpp
@@ -60,6 +61,7 @@ set(SRD_SIM_SOURCES
   src/sim/robot_sim.cpp
   src/sim/robot_sim_line.cpp
   src/sim/robot_sim_plug.cpp
+  src/sim/robot_sim_tcp.cpp
   src/sim/robot_sim_hosted.cpp
   src/sim/command_line.cpp
   src/sim/sim_stats.cpp
