@@ -6,6 +6,7 @@
 #include "serial_robot_driver/core/e_stop_status.h"
 #include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/transport/tcp_stream.h"
 
 namespace serial_robot_driver::core {
 
@@ -210,7 +211,13 @@ std::string DriverCore::startupSummary() const {
   text << "driving";
   const char* separator = " port ";
   for (const auto& [path, link] : ports_) {
-    text << separator << path << " (" << link->options().baud << " baud:";
+    // Over TCP the serial server sets the line's baud: naming ~baud there would mislead.
+    text << separator << path << " (";
+    if (transport::isTcpUrl(path)) {
+      text << "TCP:";
+    } else {
+      text << link->options().baud << " baud:";
+    }
     const char* comma = " ";
     for (std::size_t i = 0; i < devices_.size(); ++i) {
       if (params_.portOf(*findDevice(device_names_[i])) != path) continue;

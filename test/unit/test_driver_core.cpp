@@ -97,6 +97,13 @@ TEST_F(DriverCoreTest, BuildsEveryEnabledDeviceOnItsPortInTheRegisteredOrderThen
   EXPECT_NE(summary.find(params.port + " (115200 baud: base, body)"), std::string::npos) << summary;
 }
 
+TEST_F(DriverCoreTest, TheStartupSummaryNamesNoBaudForAPortOverTcp) {
+  params.port = "tcp://127.0.0.1:4001";
+  const std::string summary = makeCore()->startupSummary();
+  EXPECT_NE(summary.find("tcp://127.0.0.1:4001 (TCP: base, body)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("_bus (115200 baud: servo_bus)"), std::string::npos) << summary;
+}
+
 TEST_F(DriverCoreTest, StartsTheDevicesAfterThePortsAndShutsThemDownOnceInTheSameOrder) {
   auto core = makeCore();
   log.clear();
