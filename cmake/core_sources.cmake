@@ -9,6 +9,7 @@ set(SRD_CORE_SOURCES
   src/kinematics/odometry.cpp
   src/kinematics/heading_fusion.cpp
   src/transport/serial_port.cpp
+  src/transport/tcp_stream.cpp
   src/transport/termios2_baud.cpp
   src/transport/recorded_stream.cpp
   src/core/serial_link.cpp

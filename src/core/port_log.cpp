@@ -1,6 +1,7 @@
 #include "serial_robot_driver/core/port_log.h"
 
 #include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/transport/tcp_stream.h"
 
 namespace serial_robot_driver::core {
 
@@ -8,6 +9,12 @@ void PortLog::onLinkUp() {
   waiting_logged_ = false;
   const LinkStats stats = link_.stats();
   const char* path = link_.options().path.c_str();
+  if (transport::isTcpUrl(link_.options().path)) {
+    // No local serial line to configure: the server's settings apply.
+    log(LogLevel::kInfo,
+        "port %s connected (TCP; the serial server sets the baud, ~baud is unused)", path);
+    return;
+  }
   log(LogLevel::kInfo, "port %s connected (low latency: %s)", path,
       stats.low_latency ? "yes" : "not supported");
   if (stats.latency_timer_ms && *stats.latency_timer_ms > 1) {

@@ -6,6 +6,7 @@
 
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/transport/serial_port.h"
+#include "serial_robot_driver/transport/tcp_stream.h"
 
 namespace serial_robot_driver::core {
 
@@ -19,7 +20,12 @@ constexpr int kWakeableReadTimeoutMs = 5000;
 /// The longest a reader with nothing to do waits for its port to be reopened in one go.
 constexpr int kLongestIdleWaitS = 3600;
 
+/// The one place a port path becomes a stream: a device path is a serial port, a tcp:// URL a
+/// connection to a network serial server (whose own line settings make the baud meaningless here).
 std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& options) {
+  if (transport::isTcpUrl(options.path)) {
+    return std::make_unique<transport::TcpStream>(options.path);
+  }
   return std::make_unique<transport::SerialPort>(
       transport::SerialPortOptions{options.path, options.baud});
 }

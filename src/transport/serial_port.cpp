@@ -7,6 +7,7 @@
 #include <sys/file.h>
 #include <sys/eventfd.h>
 #include <sys/ioctl.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <termios.h>
@@ -32,9 +33,13 @@ namespace {
 std::string errnoText(int error_number) { return std::strerror(error_number); }
 
 bool isDisconnectErrno(int error_number) {
-  // EIO: pty whose master closed / USB adapter gone; ENXIO, ENODEV: device node vanished.
+  // EIO: pty whose master closed / USB adapter gone; ENXIO, ENODEV: device node vanished. The
+  // socket errors (a tty never reports them): the peer reset or closed the connection, or
+  // keepalive / TCP_USER_TIMEOUT gave up on a peer that went silent (a pulled cable).
   return error_number == EIO || error_number == EPIPE || error_number == ENXIO ||
-         error_number == ENODEV || error_number == EBADF;
+         error_number == ENODEV || error_number == EBADF || error_number == ECONNRESET ||
+         error_number == ECONNABORTED || error_number == ETIMEDOUT || error_number == ENOTCONN ||
+         error_number == EHOSTUNREACH || error_number == ENETUNREACH;
 }
 
 [[noreturn]] void throwErrno(TransportErrorKind kind, const std::string& message,
@@ -195,13 +200,15 @@ std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeou
 }
 
 void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::string& what,
-                  std::chrono::milliseconds stall_limit) {
+                  std::chrono::milliseconds stall_limit, FdKind kind) {
   if (fd < 0) throw TransportError(TransportErrorKind::kDisconnected, what + " is not open");
   using Clock = std::chrono::steady_clock;
   std::size_t written = 0;
   auto last_progress = Clock::now();
   while (written < size) {
-    const ssize_t count = ::write(fd, data + written, size - written);
+    const ssize_t count = kind == FdKind::kSocket
+                              ? ::send(fd, data + written, size - written, MSG_NOSIGNAL)
+                              : ::write(fd, data + written, size - written);
     if (count > 0) {
       written += static_cast<std::size_t>(count);
       last_progress = Clock::now();
@@ -323,20 +330,22 @@ void takeExclusively(int fd, const std::string& path) {
 
 }  // namespace
 
-SerialPort::SerialPort(SerialPortOptions options)
-    : options_(std::move(options)), wake_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
+ReadWaker::ReadWaker() : fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
 
-SerialPort::~SerialPort() {
-  close();
-  if (wake_fd_ >= 0) ::close(wake_fd_);
+ReadWaker::~ReadWaker() {
+  if (fd_ >= 0) ::close(fd_);
 }
 
-void SerialPort::wakeRead() {
-  if (wake_fd_ < 0) return;
+void ReadWaker::wake() {
+  if (fd_ < 0) return;
   const uint64_t one = 1;
-  if (::write(wake_fd_, &one, sizeof(one)) < 0) { /* the count is already non-zero: still woken */
+  if (::write(fd_, &one, sizeof(one)) < 0) { /* the count is already non-zero: still woken */
   }
 }
+
+SerialPort::SerialPort(SerialPortOptions options) : options_(std::move(options)) {}
+
+SerialPort::~SerialPort() { close(); }
 
 void SerialPort::open() {
   close();
@@ -386,7 +395,7 @@ void SerialPort::close() {
 }
 
 std::size_t SerialPort::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {
-  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path, wake_fd_);
+  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path, waker_.fd());
 }
 
 void SerialPort::write(const uint8_t* data, std::size_t size) {

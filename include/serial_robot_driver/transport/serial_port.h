@@ -14,6 +14,25 @@
 
 namespace serial_robot_driver::transport {
 
+/// The eventfd a stream polls beside its fd so that another thread can end a read at once
+/// (ByteStream::wakeRead): shared by SerialPort and TcpStream. Lives as long as its stream.
+class ReadWaker {
+ public:
+  ReadWaker();
+  ~ReadWaker();
+  ReadWaker(const ReadWaker&) = delete;
+  ReadWaker& operator=(const ReadWaker&) = delete;
+
+  /// -1 if the kernel refused an eventfd: the stream is then not wakeable.
+  int fd() const { return fd_; }
+  bool valid() const { return fd_ >= 0; }
+  /// Thread-safe; a read in progress (or the next one) returns 0 at once.
+  void wake();
+
+ private:
+  int fd_;
+};
+
 struct SerialPortOptions {
   std::string path;
   unsigned baud = 115200;
@@ -54,15 +73,15 @@ class SerialPort : public ByteStream {
 
   /// An eventfd polled beside the port wakes a read (stop, or a writer that saw the port fail),
   /// so an idle reader needs no periodic time-out.
-  bool wakeable() const override { return wake_fd_ >= 0; }
-  void wakeRead() override;
+  bool wakeable() const override { return waker_.valid(); }
+  void wakeRead() override { waker_.wake(); }
 
  private:
   SerialPortOptions options_;
   std::atomic<int> fd_{-1};
   bool low_latency_ = false;
   std::optional<int> latency_timer_ms_;
-  int wake_fd_ = -1;  // eventfd, for the object's lifetime; -1 if the kernel refused one
+  ReadWaker waker_;
 };
 
 /// Who holds a port: a pid and where it was found (a lock file's path, or "/proc/locks").
@@ -92,16 +111,23 @@ std::optional<unsigned> readBaudRate(int fd);
 /// Reads /sys/bus/usb-serial/devices/<ttyX>/latency_timer for a device path (symlinks resolved).
 std::optional<int> readLatencyTimerMs(const std::string& device_path);
 
-/// Shared by SerialPort and sim::PseudoTerminal: waits up to `timeout_ms` for input on the non-blocking
-/// `fd` and reads what is there (0 on timeout or EAGAIN/EINTR). Hang-up, EOF and EIO throw
-/// TransportError kDisconnected; `what` names the device in error messages. When `wake_fd` (an
-/// eventfd) is readable the wait ends at once: its count is consumed and 0 returned.
+/// Shared by SerialPort, TcpStream and sim::PseudoTerminal: waits up to `timeout_ms` for input on
+/// the non-blocking `fd` and reads what is there (0 on timeout or EAGAIN/EINTR). Hang-up, EOF, EIO
+/// and a socket's reset or time-out (ECONNRESET, ETIMEDOUT, ...) throw TransportError
+/// kDisconnected; `what` names the device in error messages. When `wake_fd` (an eventfd) is
+/// readable the wait ends at once: its count is consumed and 0 returned.
 std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
                        const std::string& what, int wake_fd = -1);
 
-/// Shared by SerialPort and sim::PseudoTerminal: writes all bytes to the non-blocking `fd`, waiting for
-/// room at most `stall_limit` without progress (then kIoError). EIO/EPIPE/hang-up → kDisconnected.
+/// What writeAllToFd() writes to: a socket is written with send(MSG_NOSIGNAL), so a closed peer is
+/// an EPIPE error and not a SIGPIPE that would end the process.
+enum class FdKind { kTerminal, kSocket };
+
+/// Shared by SerialPort, TcpStream and sim::PseudoTerminal: writes all bytes to the non-blocking
+/// `fd`, waiting for room at most `stall_limit` without progress (then kIoError).
+/// EIO/EPIPE/ECONNRESET/hang-up → kDisconnected.
 void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::string& what,
-                  std::chrono::milliseconds stall_limit = std::chrono::milliseconds(100));
+                  std::chrono::milliseconds stall_limit = std::chrono::milliseconds(100),
+                  FdKind kind = FdKind::kTerminal);
 
 }  // namespace serial_robot_driver::transport
