@@ -99,11 +99,11 @@ struct Options {
   double tcp_window = 0;  ///< 8: TCP sessions' share of the frames and commands; 0: tcpWindow()
 
   bool runs(int section) const { return sections.count(section) > 0; }
-  /// With both transports a TCP session takes 0.6 of a pty session's frames and commands (the
+  /// With both transports a TCP session takes half a pty session's frames and commands (the
   /// default run stays under 9 minutes); over TCP alone all of them.
   double tcpWindow() const {
     if (tcp_window > 0) return tcp_window;
-    return transports.size() > 1 ? 0.6 : 1.0;
+    return transports.size() > 1 ? 0.5 : 1.0;
   }
 };
 
@@ -127,7 +127,7 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           both (default: each condition over the pty, then over TCP; a
                           summary and a table of every figure per transport)
   --tcp-window F          8: a TCP session's share of the frames and commands of a pty
-                          session (default 0.6 with both transports, 1 with tcp alone)
+                          session (default 0.5 with both transports, 1 with tcp alone)
   --bench-priority N      SCHED_FIFO priority of this benchmark's own threads, so a load
                           delays the node, not the measuring (default 90; 0: normal)
   --bus-seconds S         10: window of each servo bus run (default 5)
