@@ -5,8 +5,9 @@
 # subscribes) side by side with the floor (bench/floor_node.cpp), quiet and under a CPU hog per
 # core, with ~realtime_priority off and on, each figure as node / floor / ratio, the robot played
 # over a pty and over loopback TCP (--transport pty|tcp|both; pty alone about 5 minutes; TCP has no
-# kernel pty worker in the path: the programs' own latency). --all runs every section
-# (about 8 minutes), then the framer's (bench/bench_framer.cpp, Google Benchmark, a few seconds).
+# kernel pty worker in the path: the programs' own latency). --all runs every section (about 12
+# minutes; 8 with --transport pty), then the framer's (bench/bench_framer.cpp, Google Benchmark, a
+# few seconds).
 # Prints the tables and writes them to bench/results/user_config.md (section 8 alone) or
 # bench/results/latest.md (--all or --sections), or $SRD_BENCH_OUTPUT.
 #
