@@ -251,7 +251,9 @@ struct Variant {
   double read_poll_interval;    ///< 0: event-driven
   bool spaced_cmd_vel = false;  ///< section 11: commands 10-40 ms apart instead of one per tick
   bool capture = false;         ///< ~capture on, with a subscriber on serial_raw
-  bool same_job = false;        ///< floor_node's ~same_job: the user's topics, done minimally
+  /// floor_node's ~same_job and ~same_interface: the user's topics and driver_node's interface,
+  /// done minimally.
+  bool same_job = false;
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
@@ -268,6 +270,7 @@ struct Context {
   int bench_priority = 0;    ///< SCHED_FIFO priority this process's threads run at; 0: normal
   /// Section 8: statuses per /diagnostics message of driver_node (the same-job floor's count).
   std::size_t node_diagnostic_statuses = 0;
+  std::size_t node_diagnostic_values = 0;  ///< their key/values in all (the same-job floor's)
 };
 
 void require(bool condition, const std::string& what) {
@@ -279,7 +282,10 @@ ParamList commonParams(const std::string& port, const Variant& variant) {
   if (variant.read_poll_interval > 0)
     params.emplace_back("read_poll_interval", variant.read_poll_interval);
   if (variant.capture) params.emplace_back("capture", true);
-  if (variant.same_job) params.emplace_back("same_job", true);
+  if (variant.same_job) {
+    params.emplace_back("same_job", true);
+    params.emplace_back("same_interface", true);
+  }
   return params;
 }
 
@@ -1314,11 +1320,16 @@ class UserSubscribers {
     subscribers_.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
         "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
           ++messages_;
+          std::size_t values = 0;
+          for (const auto& status : array->status) values += status.values.size();
           statuses_ = array->status.size();
+          values_ = values;
         }));
   }
   /// Statuses in the last /diagnostics message (0 before the first).
   std::size_t diagnosticStatuses() const { return statuses_; }
+  /// Key/values of all statuses in the last /diagnostics message.
+  std::size_t diagnosticValues() const { return values_; }
 
  private:
   template <typename Message>
@@ -1328,6 +1339,7 @@ class UserSubscribers {
   }
   std::atomic<std::size_t> messages_{0};
   std::atomic<std::size_t> statuses_{0};
+  std::atomic<std::size_t> values_{0};
   std::vector<ros::Subscriber> subscribers_;
 };
 
@@ -1378,6 +1390,7 @@ ParamList userParams(const std::string& port, const UserCondition& condition,
     const std::size_t statuses =
         context.node_diagnostic_statuses > 0 ? context.node_diagnostic_statuses : 5;
     params.emplace_back("same_job_statuses", static_cast<int>(statuses));
+    params.emplace_back("same_job_values", static_cast<int>(context.node_diagnostic_values));
   }
   const ParamList body = TelemetryProbe::nodeParams();
   params.insert(params.end(), body.begin(), body.end());
@@ -1467,6 +1480,7 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   figures.cmd_vel = timeCmdVelWhileStreaming(probe, *robot, seq, cmd_vel, base.log(), commands);
   if (variant.program == kEventDriven.program) {
     context.node_diagnostic_statuses = subscribers.diagnosticStatuses();
+    context.node_diagnostic_values = subscribers.diagnosticValues();
   }
   return figures;
 }
@@ -1615,8 +1629,11 @@ void addUserNote(Context& context) {
       "port, odom and /tf, diagnostics, battery poll; 20 body servos; speed_dithering off and "
       "max_wheel_speed 20 so each command is recognisable on the wire) and floor_node with the "
       "same parameters, twice: the same-job floor (~same_job: besides joint_states, imu/data per "
-      "frame, odom + /tf + wheel_states per tick, /diagnostics at 1 Hz with as many statuses as "
-      "driver_node's, all as minimally as possible) and the minimal floor (joint_states only); "
+      "frame, odom + /tf + wheel_states per tick, /diagnostics at 1 Hz with as many statuses and "
+      "key/values as "
+      "driver_node's, all as minimally as possible; ~same_interface: the rest of driver_node's "
+      "publications, subscriptions, dynamic_reconfigure servers and action server, each doing "
+      "nothing but exist, and the 1 Hz battery poll) and the minimal floor (joint_states only); "
       "this process plays the robot (telemetry of 20 servos at 100 Hz, battery answers).");
   table.note(
       "Subscribed throughout: joint_states (robot_state_publisher), wheel_states "

@@ -4,11 +4,16 @@
 // a lost connection ends the floor), ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids,
 // ~body/joint_names, ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution,
 // ~realtime_priority (1..99, or true for 50: SCHED_FIFO on the main thread before roscpp starts its
-// threads, so every thread inherits it, as driver_node does; memory locked). ~same_job (default
-// false: the minimal floor) makes it do the job a user's driver_node does, as minimally as
-// possible: besides joint_states, imu/data per telemetry frame, odom + /tf + wheel_states per loop
-// tick (the commanded motion integrated), and /diagnostics at 1 Hz with ~same_job_statuses
-// statuses.
+// threads, so every thread inherits it, as driver_node does; memory locked).
+// ~same_job (default false: the minimal floor) makes it do the job a user's driver_node does, as
+// minimally as possible: besides joint_states, imu/data per telemetry frame, odom + /tf +
+// wheel_states per loop tick (the commanded motion integrated), and /diagnostics at 1 Hz with
+// ~same_job_statuses statuses carrying ~same_job_values key/values in all.
+// ~same_interface (default false) adds the rest of driver_node's interface, each piece doing
+// nothing but exist (floor_interface.h: its other publications, subscriptions, dynamic_reconfigure
+// servers and action server), and the base's battery poll (~base/battery_poll_rate, 1 Hz: a request
+// written on the loop, the reply framed): the least a node offering driver_node's interface
+// spends on it whoever listens.
 //
 // Threading: one reader thread blocks on the port, frames telemetry and publishes one JointState
 // (and one Imu) per frame; the cmd_vel callback (the AsyncSpinner's thread) writes its speed frame
@@ -39,12 +44,15 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "floor_interface.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
@@ -63,20 +71,33 @@ std::mutex g_write_mutex;
 std::atomic<int16_t> g_left{0}, g_right{0};
 std::atomic<double> g_linear{0.0}, g_angular{0.0};  // the twist commanded last (same job)
 uint8_t g_seq = 0;  // guarded by g_write_mutex
+int g_battery_every = 0;  // ~same_interface: a battery request every this many loop ticks; 0: none
 
 /// ~same_job's publishers (advertised only with it on).
 struct SameJob {
   bool on = false;
   int statuses = 5;
+  int values = 0;  ///< key/values in all, spread over the statuses
+  unsigned long values_sent = 0;
   ros::Publisher imu, odom, tf, wheel_states, diagnostics;
   ros::SteadyTimer diagnostics_timer;
 };
 
-void writeSpeedFrame() {
-  std::lock_guard<std::mutex> lock(g_write_mutex);
-  const auto frame = srd::devices::base::encodeWheelSpeed(g_seq++, g_left, g_right);
+void writeFrame(const std::vector<uint8_t>& frame) {
   if (::write(g_fd, frame.data(), frame.size()) < 0) { /* the floor does not handle errors */
   }
+}
+
+void writeSpeedFrame() {
+  std::lock_guard<std::mutex> lock(g_write_mutex);
+  writeFrame(srd::devices::base::encodeWheelSpeed(g_seq++, g_left, g_right));
+}
+
+/// ~same_interface: the battery request, every g_battery_every loop ticks.
+void pollBattery(long tick) {
+  if (g_battery_every <= 0 || tick % g_battery_every != 0) return;
+  std::lock_guard<std::mutex> lock(g_write_mutex);
+  writeFrame(srd::devices::base::encodeBatteryRequest(g_seq++));
 }
 
 /// ~realtime_priority: an integer priority, or true for 50; 0 (or absent, or false) is off. Read
@@ -208,7 +229,11 @@ void publishImu(const srd::devices::body::Telemetry& telemetry, const ros::Time&
 /// g_running ends or the connection is lost (then the floor ends).
 void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states, SameJob& job) {
   const std::size_t count = joints.ids.size();
-  const auto config = test_support::driverFramer({"body"}, count);
+  // With the battery poll its replies are framed too (and dropped: nobody listens to battery).
+  const auto config =
+      test_support::driverFramer(g_battery_every > 0 ? std::vector<std::string>{"base", "body"}
+                                                     : std::vector<std::string>{"body"},
+                                 count);
   srd::protocol::StreamFramer framer(config, [&](auto family, const uint8_t* data,
                                                  std::size_t size) {
     if (family != srd::devices::body::kTelemetryFrames) return;
@@ -300,6 +325,13 @@ void startDiagnostics(ros::NodeHandle& nh, SameJob& job) {
       array.status[i].message = "OK";
       array.status[i].hardware_id = "floor";
     }
+    // driver_node's values are counters and settings: a number each, under a fixed key.
+    for (int v = 0; v < job.values && !array.status.empty(); ++v) {
+      diagnostic_msgs::KeyValue value;
+      value.key = "value " + std::to_string(v);
+      value.value = std::to_string(job.values_sent++);
+      array.status[v % array.status.size()].values.push_back(std::move(value));
+    }
     job.diagnostics.publish(array);
   });
 }
@@ -308,6 +340,7 @@ void startDiagnostics(ros::NodeHandle& nh, SameJob& job) {
 void advertiseSameJob(ros::NodeHandle& nh, ros::NodeHandle& pnh, SameJob& job) {
   job.on = pnh.param("same_job", false);
   job.statuses = pnh.param("same_job_statuses", job.statuses);
+  job.values = pnh.param("same_job_values", job.values);
   if (!job.on) return;
   job.imu = nh.advertise<sensor_msgs::Imu>("imu/data", 10);
   job.odom = nh.advertise<nav_msgs::Odometry>("odom", 50);
@@ -324,13 +357,14 @@ void runBaseLoop(double loop_rate, SameJobOdometry* odometry) {
   const long period_ns = static_cast<long>(1e9 / loop_rate);
   timespec deadline{};
   ::clock_gettime(CLOCK_MONOTONIC, &deadline);
-  while (ros::ok()) {
+  for (long tick = 1; ros::ok(); ++tick) {
     deadline.tv_nsec += period_ns;
     while (deadline.tv_nsec >= 1000000000L) {
       deadline.tv_nsec -= 1000000000L;
       ++deadline.tv_sec;
     }
     ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
+    pollBattery(tick);
     writeSpeedFrame();
     if (odometry) odometry->tick(1.0 / loop_rate);
   }
@@ -355,6 +389,13 @@ int main(int argc, char** argv) {
   ros::Publisher joint_states = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
   SameJob job;
   advertiseSameJob(nh, pnh, job);
+  std::unique_ptr<floor_bench::FloorInterface> interface;
+  if (pnh.param("same_interface", false)) {
+    interface = std::make_unique<floor_bench::FloorInterface>(nh, pnh);
+    const double battery_rate = pnh.param("base/battery_poll_rate", 1.0);
+    if (base && battery_rate > 0)
+      g_battery_every = std::max(1, static_cast<int>(loop_rate / battery_rate));
+  }
   const srd::kinematics::DiffDriveGeometry geometry;
   ros::Subscriber cmd_vel;
   if (base) cmd_vel = subscribeCmdVel(nh, geometry);

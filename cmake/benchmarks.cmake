@@ -9,7 +9,7 @@ if(benchmark_FOUND)
 endif()
 
 # The floor: the least a roscpp driver of this robot must do, driver_bench's yardstick.
-add_executable(floor_node bench/floor_node.cpp)
+add_executable(floor_node bench/floor_node.cpp bench/floor_interface.cpp)
 target_include_directories(floor_node PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})
 target_link_libraries(floor_node srd_core ${catkin_LIBRARIES})
 add_dependencies(floor_node ${catkin_EXPORTED_TARGETS})

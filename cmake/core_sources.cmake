@@ -61,6 +61,7 @@ set(SRD_SIM_SOURCES
   src/sim/robot_sim.cpp
   src/sim/robot_sim_line.cpp
   src/sim/robot_sim_plug.cpp
+  src/sim/robot_sim_tcp.cpp
   src/sim/robot_sim_hosted.cpp
   src/sim/command_line.cpp
   src/sim/sim_stats.cpp

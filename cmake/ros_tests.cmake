@@ -86,6 +86,13 @@ target_include_directories(test_odom PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(test_odom srd_test_support srd_sim ${catkin_LIBRARIES})
 add_dependencies(test_odom driver_node ${PROJECT_NAME}_generate_messages_cpp)
 
+# A port reached over TCP (tcp://): driver_node against sim::RobotSim serving the base on a
+# loopback socket, through the server dropping the connection and coming back.
+add_rostest_gtest(test_tcp_port test/rostest/tcp_port.test test/rostest/test_tcp_port.cpp)
+target_include_directories(test_tcp_port PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_tcp_port srd_test_support srd_sim ${catkin_LIBRARIES})
+add_dependencies(test_tcp_port driver_node ${PROJECT_NAME}_generate_messages_cpp)
+
 # sim.launch + description.launch: every link of the description on tf, wheel_states against odom.
 # (urdf: found in unit_tests.cmake, included first.)
 add_rostest_gtest(test_description test/rostest/description.test test/rostest/test_description.cpp)

@@ -14,6 +14,7 @@ catkin_add_gtest(core_tests
   test/unit/test_transport_pty_io.cpp
   test/unit/test_transport_errors_and_links.cpp
   test/unit/test_transport_baud_and_lock.cpp
+  test/unit/test_transport_tcp.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_recording_replay.cpp
   test/unit/test_capture_queue.cpp

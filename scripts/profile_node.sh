@@ -8,12 +8,14 @@
 # items. docs/performance.md explains the output; paste it there as is.
 #
 # usage: scripts/profile_node.sh [--seconds S] [--tool perf|callgrind] [--floor] [--cmd-vel]
-#                                [--out DIR] [--top N]
+#                                [--no-interface] [--out DIR] [--top N]
 #   --seconds S   the profiled window (default 30; callgrind: default 20, the node runs ~50x slower)
 #   --tool        perf (default when `perf` runs) or callgrind (valgrind; instruction counts of the
 #                 window alone, per thread and per event: telemetry frame, loop tick, cmd_vel)
 #   --floor       profile the same-job floor instead (bench/floor_node.cpp ~same_job, built with
-#                 -DSRD_BUILD_BENCHMARKS=ON), the same way, to compare item by item
+#                 -DSRD_BUILD_BENCHMARKS=ON), the same way, to compare item by item; with
+#                 ~same_interface (the rest of driver_node's interface offered, as driver_bench's
+#                 same-job floor) unless --no-interface
 #   --cmd-vel     also publish cmd_vel at 20 Hz (off by default, as in the benchmark's CPU window)
 #   --out DIR     keep the data, logs and report there (default: a new /tmp/srd_profile_XXXXXX)
 #   --top N       items per thread (default 8)
@@ -34,6 +36,7 @@ out=""
 top=8
 program=driver_node
 cmd_vel=0
+same_interface=true
 while (($#)); do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -41,8 +44,9 @@ while (($#)); do
     --out) out="$2"; shift 2 ;;
     --top) top="$2"; shift 2 ;;
     --floor) program=floor_node; shift ;;
+    --no-interface) same_interface=false; shift ;;
     --cmd-vel) cmd_vel=1; shift ;;
-    -h | --help) sed -n '2,26p' "$0"; exit 0 ;;
+    -h | --help) sed -n '2,28p' "$0"; exit 0 ;;
     *) echo "profile_node.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -122,7 +126,9 @@ pty="${out}/robot.pty"
 cat >"${out}/params.yaml" <<EOF
 port: ${pty}
 same_job: true  # floor_node's (driver_node ignores it)
-same_job_statuses: 5
+same_job_statuses: 5  # and key/values: as many as driver_node's here
+same_job_values: 97
+same_interface: ${same_interface}
 body:
   servo_ids: [${ids}]
   joint_names: [${names}]

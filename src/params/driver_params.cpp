@@ -18,9 +18,7 @@ void addNodeParameters(std::vector<ParamSpec>& table) {
     table.push_back(makeRow<T>(
         key, "", [field](P& p) -> T& { return p.*field; }, Rule<T>(rule)));
   };
-  node("port", &P::port, [](const std::string& v, const std::string& key) {
-    require(!v.empty(), key, "must name a serial device, e.g. /dev/ttyUSB0");
-  });
+  node("port", &P::port, portPath);
   node("baud", &P::baud, baudRate);
   node("loop_rate", &P::loop_rate, [](const double& v, const std::string& key) {
     positiveNumber(v, key);
@@ -77,7 +75,7 @@ std::vector<ParamSpec> buildTable() {
     };
     SectionRows<DevicePortParams>(table, device->name, device->name, port)
         .add("enabled", &DevicePortParams::enabled)
-        .add("port", &DevicePortParams::port)
+        .add("port", &DevicePortParams::port, portOrInherit)
         .add("baud", &DevicePortParams::baud, baudOrInherit);
     if (device->add_parameters) device->add_parameters(table);
   }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "serial_robot_driver/transport/serial_port.h"
+#include "serial_robot_driver/transport/tcp_stream.h"
 
 namespace serial_robot_driver::params {
 
@@ -146,6 +147,22 @@ void networkHosts(const std::vector<std::string>& hosts, const std::string& key)
     require(problem.empty(), key, "'" + host + "' " + problem);
     require(seen.insert(host).second, key, "'" + host + "' is listed twice");
   }
+}
+
+void portPath(const std::string& value, const std::string& key) {
+  require(!value.empty(), key, "must name a serial device, e.g. /dev/ttyUSB0");
+  if (!transport::isTcpUrl(value)) return;
+  std::string problem;
+  if (!transport::parseTcpUrl(value, &problem)) {
+    constexpr std::size_t kLongestQuoted = 80;  // a hostile value must not flood the log
+    const std::string shown =
+        value.size() <= kLongestQuoted ? value : value.substr(0, kLongestQuoted) + "...";
+    require(false, key, shown + ": " + problem);
+  }
+}
+
+void portOrInherit(const std::string& value, const std::string& key) {
+  if (!value.empty()) portPath(value, key);
 }
 
 void baudRate(const int& value, const std::string& key) {

@@ -1,5 +1,7 @@
 #include "serial_robot_driver/ros/conversions.h"
 
+#include <utility>
+
 #include "serial_robot_driver/core/wall_stamps.h"
 
 namespace serial_robot_driver::ros_layer {
@@ -38,7 +40,7 @@ ros::Time ArrivalStamps::operator()(std::chrono::steady_clock::time_point arriva
   return last_stamp;
 }
 
-void writeStatusReport(const core::StatusReport& report,
+void writeStatusReport(core::StatusReport report,
                        diagnostic_updater::DiagnosticStatusWrapper& status, SummaryWrite summary) {
   static_assert(static_cast<unsigned char>(core::StatusLevel::kWarn) ==
                         diagnostic_msgs::DiagnosticStatus::WARN &&
@@ -53,8 +55,14 @@ void writeStatusReport(const core::StatusReport& report,
   } else {
     status.mergeSummary(level, report.message);
   }
-  if (!report.hardware_id.empty()) status.hardware_id = report.hardware_id;
-  for (const auto& [key, value] : report.values) status.add(key, value);
+  if (!report.hardware_id.empty()) status.hardware_id = std::move(report.hardware_id);
+  status.values.reserve(status.values.size() + report.values.size());
+  for (auto& [key, value] : report.values) {
+    diagnostic_msgs::KeyValue entry;
+    entry.key = std::move(key);
+    entry.value = std::move(value);
+    status.values.push_back(std::move(entry));
+  }
 }
 
 }  // namespace serial_robot_driver::ros_layer

@@ -210,7 +210,10 @@ std::string usage() {
          "A simulated robot ("
       << robot
       << ") on pseudo-terminal(s).\n"
-         "Prints one line per pty: \"robot_sim: <devices> on <slave path> (link <link>)\".\n";
+         "Prints one line per pty: \"robot_sim: <devices> on <slave path> (link <link>)\".\n"
+         "A link tcp://HOST:PORT (--link, --<device>-link) is served on a listening TCP socket\n"
+         "instead of a pty, one client at a time, as a network serial server (ser2net) would;\n"
+         "port 0 takes a free one (printed as the slave path). --unplug-every closes it.\n";
   const SimOptions defaults;
   const auto row = [&out](const std::string& left, const std::string& help) {
     out << "  " << std::left << std::setw(22) << left << (left.size() < 22 ? "  " : " ") << help

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -113,9 +114,7 @@ Port* RobotSim::portFor(const std::string& link, const std::string& device_name)
 }
 
 void RobotSim::openPort(Port* port, TimePoint now) {
-  port->pty = std::make_unique<PseudoTerminal>(port->link);
-  port->slave_path = port->pty->slavePath();
-  setNonBlocking(port->pty->masterFd());
+  detail::openEndpoint(port);
   plug_faults_->schedule(port, now);
   line_->scheduleGarbage(port, now);
 }
@@ -179,12 +178,18 @@ void RobotSim::preparePoll(PollSet* poll) {
   poll->fds.push_back(pollfd{wake_pipe_[0], POLLIN, 0});
   poll->ports.push_back(nullptr);
   for (auto& port : ports_) {
-    if (!port->plugged || !port->pty) continue;
+    if (!port->plugged || !port->isOpen()) continue;
+    if (port->tcp && port->tcp->clientFd() < 0) {  // a TCP port without a client: wait for one
+      poll->fds.push_back(pollfd{port->tcp->listenFd(), POLLIN, 0});
+      poll->ports.push_back(port.get());
+      continue;
+    }
+    if (port->dataFd() < 0) continue;
     // Paced: no POLLOUT while the line is busy, or poll would return at once until it frees.
     const bool may_send = !port->backlog.empty() && (options_.pace_baud == 0 ||
                                                      Clock::now() >= line_->nextSendAt(port.get()));
     const short events = may_send ? (POLLIN | POLLOUT) : POLLIN;
-    poll->fds.push_back(pollfd{port->pty->masterFd(), events, 0});
+    poll->fds.push_back(pollfd{port->dataFd(), events, 0});
     poll->ports.push_back(port.get());
   }
 }
@@ -194,15 +199,41 @@ void RobotSim::readPorts(const PollSet& poll) {
   const TimePoint read_at = Clock::now();
   for (std::size_t i = 1; i < poll.fds.size(); ++i) {
     Port* port = poll.ports[i];
-    if ((poll.fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0 || !port->pty) continue;
-    const int fd = port->pty->masterFd();
+    if ((poll.fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0 || !port->isOpen()) continue;
+    const int fd = port->dataFd();
+    if (port->tcp && poll.fds[i].fd == port->tcp->listenFd()) {
+      attachClient(port);
+      continue;
+    }
+    if (fd < 0) continue;
     for (int reads = 0; reads < kReadsPerWake; ++reads) {
       const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+      if (port->tcp && (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR))) {
+        detachClient(port);  // the host closed its connection
+        break;
+      }
       if (n <= 0) break;
       counters_.bytes_received += static_cast<uint64_t>(n);
       line_->receive(port, buffer.data(), static_cast<std::size_t>(n), read_at);
     }
   }
+}
+
+void RobotSim::attachClient(Port* port) {
+  if (!port->tcp->accept()) return;
+  // A new connection starts with fresh bytes, as a serial line read from now on.
+  detail::discardBacklog(port, counters_);
+  port->framer->reset();
+  event("robot_sim: " + detail::joinNames(port->device_names) + ": a client connected on " +
+        port->slave_path);
+}
+
+void RobotSim::detachClient(Port* port) {
+  port->tcp->dropClient();
+  detail::discardBacklog(port, counters_);
+  port->framer->reset();
+  event("robot_sim: " + detail::joinNames(port->device_names) + ": the client on " +
+        port->slave_path + " disconnected");
 }
 
 TimePoint RobotSim::nextWakeUp(TimePoint now) const {

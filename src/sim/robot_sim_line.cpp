@@ -83,8 +83,7 @@ TimePoint Line::nextSendAt(const Port* port) const {
 }
 
 void Line::flush(Port* port) {
-  if (!port->pty || !port->pty->isOpen()) return;
-  const int fd = port->pty->masterFd();
+  if (port->dataFd() < 0) return;
   const bool paced = options_.pace_baud > 0;
   const TimePoint now = paced ? Clock::now() : TimePoint{};
   while (!port->backlog.empty()) {
@@ -102,7 +101,7 @@ void Line::flush(Port* port) {
       remaining = std::min(remaining, through);
       if (remaining == 0) return;
     }
-    const ssize_t written = ::write(fd, pending.bytes.data() + pending.offset, remaining);
+    const ssize_t written = port->writeSome(pending.bytes.data() + pending.offset, remaining);
     if (written < 0) {
       if (errno == EINTR) continue;
       return;  // EAGAIN: the host is not reading right now; retry when poll says writable

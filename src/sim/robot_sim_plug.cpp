@@ -48,10 +48,12 @@ void PlugFaults::beginDrain(Port* port, TimePoint now) {
   port->draining = true;
   port->next_unplug = TimePoint::max();  // replug() schedules the next one
   port->drain_deadline = now + kDrainTimeout;
-  port->drain_probe_fd = ::open(port->slave_path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+  if (port->pty)
+    port->drain_probe_fd = ::open(port->slave_path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
 }
 
 bool PlugFaults::drained(const Port& port) {
+  if (port.tcp) return port.backlog.empty() && port.tcp->allSent();
   int unread = 0;
   const bool probe_ok =
       port.drain_probe_fd >= 0 && ::ioctl(port.drain_probe_fd, FIONREAD, &unread) == 0;
@@ -59,18 +61,14 @@ bool PlugFaults::drained(const Port& port) {
 }
 
 void PlugFaults::unplug(Port* port, TimePoint now) {
-  for (const Port::PendingWrite& pending : port->backlog) {
-    if (pending.is_frame) ++sendCounters(counters_, pending.kind).discarded;
-  }
-  port->backlog.clear();
-  port->backlog_bytes = 0;
-  port->rx_in_flight.clear();
+  discardBacklog(port, counters_);
   if (port->drain_probe_fd >= 0) {
     ::close(port->drain_probe_fd);
     port->drain_probe_fd = -1;
   }
-  port->pty->close();  // closes both sides and removes the symlink
+  if (port->pty) port->pty->close();  // closes both sides and removes the symlink
   port->pty.reset();
+  port->tcp.reset();  // the client reads EOF, new ones are refused until the replug
   port->draining = false;
   port->plugged = false;
   port->replug_at = now + fromSeconds(options_.faults.unplug_duration_s);
@@ -80,14 +78,12 @@ void PlugFaults::unplug(Port* port, TimePoint now) {
 
 void PlugFaults::replug(Port* port, TimePoint now) {
   try {
-    port->pty = std::make_unique<PseudoTerminal>(port->link);
+    openEndpoint(port);
   } catch (const transport::TransportError& error) {
     port->replug_at = now + kReplugRetry;
     event_(std::string("robot_sim: replug failed, retrying: ") + error.what());
     return;
   }
-  port->slave_path = port->pty->slavePath();
-  setNonBlocking(port->pty->masterFd());
   port->framer->reset();  // a partial frame from before the unplug is meaningless now
   port->plugged = true;
   port->replug_at = TimePoint::max();

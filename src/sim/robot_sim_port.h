@@ -1,8 +1,10 @@
 // RobotSim's private parts shared by its classes (robot_sim.cpp, robot_sim_line.cpp,
-// robot_sim_plug.cpp, robot_sim_hosted.cpp): one pty with its framer, backlog and fault timers.
+// robot_sim_plug.cpp, robot_sim_hosted.cpp): one pty (or TCP listener) with its framer, backlog and
+// fault timers.
 #pragma once
 
 #include <fcntl.h>
+#include <unistd.h>
 
 #include <deque>
 #include <memory>
@@ -11,9 +13,11 @@
 #include <utility>
 #include <vector>
 
+#include "robot_sim_tcp.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/sim/robot_sim.h"
+#include "serial_robot_driver/transport/tcp_stream.h"
 
 namespace serial_robot_driver::sim {
 
@@ -54,7 +58,9 @@ struct Port {
   std::string link;
   std::vector<std::string> device_names;
   std::unique_ptr<PseudoTerminal> pty;
-  std::string slave_path;
+  /// Instead of the pty when the link is a tcp:// URL (a network serial server's stand-in).
+  std::unique_ptr<TcpListener> tcp;
+  std::string slave_path;  ///< the pty's slave, or the URL the listener is bound to
   std::unique_ptr<protocol::StreamFramer> framer;
   std::deque<PendingWrite> backlog;
   std::size_t backlog_bytes = 0;
@@ -74,7 +80,43 @@ struct Port {
   TimePoint replug_at = TimePoint::max();
   TimePoint next_garbage = TimePoint::max();
   std::mt19937 rng;
+
+  bool isOpen() const { return pty != nullptr || tcp != nullptr; }
+  /// Where the host's bytes come from and the devices' go: the pty master or the TCP client; -1
+  /// when there is none (unplugged, or no client connected).
+  int dataFd() const {
+    if (tcp) return tcp->clientFd();
+    return pty && pty->isOpen() ? pty->masterFd() : -1;
+  }
+  /// Writes what dataFd() takes now, never blocking; -1 and errno as write(2).
+  ssize_t writeSome(const uint8_t* data, std::size_t size) const {
+    return tcp ? tcp->send(data, size) : ::write(pty->masterFd(), data, size);
+  }
 };
+
+/// Opens the port's pty at its link, or listens at its tcp:// link (a replug where the first open
+/// did: the kernel may have picked the port).
+inline void openEndpoint(Port* port) {
+  if (transport::isTcpUrl(port->link)) {
+    port->tcp =
+        std::make_unique<TcpListener>(port->slave_path.empty() ? port->link : port->slave_path);
+    port->slave_path = port->tcp->url();
+    return;
+  }
+  port->pty = std::make_unique<PseudoTerminal>(port->link);
+  port->slave_path = port->pty->slavePath();
+  setNonBlocking(port->pty->masterFd());
+}
+
+/// Frames queued for a host that is gone or was not there yet: they never reach anyone.
+inline void discardBacklog(Port* port, SimStats& counters) {
+  for (const Port::PendingWrite& pending : port->backlog) {
+    if (pending.is_frame) ++sendCounters(counters, pending.kind).discarded;
+  }
+  port->backlog.clear();
+  port->backlog_bytes = 0;
+  port->rx_in_flight.clear();
+}
 
 }  // namespace detail
 

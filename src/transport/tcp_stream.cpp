@@ -57,14 +57,14 @@ std::string hostProblem(const std::string& host) {
   return "";
 }
 
-/// Why `text` is no port 1..65535, or "" with `port` set.
-std::string portProblem(const std::string& text, uint16_t* port) {
+/// Why `text` is no port 1..65535 (0.. with `any_port`), or "" with `port` set.
+std::string portProblem(const std::string& text, bool any_port, uint16_t* port) {
   if (text.empty()) return "the port is missing (tcp://HOST:PORT)";
   if (text.size() > 5 || text.find_first_not_of("0123456789") != std::string::npos) {
     return "port must be 1-65535 (got " + quoted(text) + ")";
   }
   const unsigned long value = std::stoul(text);
-  if (value < 1 || value > 65535) return "port must be 1-65535";
+  if (value > 65535 || (value == 0 && !any_port)) return "port must be 1-65535";
   *port = static_cast<uint16_t>(value);
   return "";
 }
@@ -160,7 +160,7 @@ void configureSocket(int fd) {
 
 bool isTcpUrl(const std::string& path) { return path.compare(0, kSchemeLength, kScheme) == 0; }
 
-std::optional<TcpAddress> parseTcpUrl(const std::string& url, std::string* problem) {
+std::optional<TcpAddress> parseTcpUrl(const std::string& url, std::string* problem, bool any_port) {
   std::string why;
   TcpAddress address;
   std::string port_text;
@@ -168,7 +168,7 @@ std::optional<TcpAddress> parseTcpUrl(const std::string& url, std::string* probl
     why = "must start with tcp://";
   } else {
     why = splitHostPort(url.substr(kSchemeLength), &address.host, &port_text);
-    if (why.empty()) why = portProblem(port_text, &address.port);
+    if (why.empty()) why = portProblem(port_text, any_port, &address.port);
   }
   if (why.empty()) return address;
   if (problem) *problem = why;

@@ -207,6 +207,35 @@ TEST(DriverParams, EveryRateThePortOpensAtPasses) {
   EXPECT_THROW(params.validate(), ParameterError);
 }
 
+// A port may be a network serial server's tcp://HOST:PORT; one that does not parse is refused at
+// start-up, naming the parameter and what is wrong.
+TEST(DriverParams, TcpPortsAreCheckedAtStartUp) {
+  DriverParams params;
+  params.port = "tcp://127.0.0.1:4001";
+  params.section(devices::servo_bus::kServoBusSection).port = "tcp://[::1]:4002";
+  EXPECT_NO_THROW(params.validate());
+
+  params.section(devices::base::kBaseSection).port = "tcp://host:99999";
+  try {
+    params.validate();
+    FAIL() << "port 99999 accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "base/port");
+    EXPECT_NE(std::string(e.what()).find("tcp://host:99999: port must be 1-65535"),
+              std::string::npos)
+        << e.what();
+  }
+  params.section(devices::base::kBaseSection).port.clear();
+  params.port = "tcp://" + std::string(100000, 'x');
+  try {
+    params.validate();
+    FAIL() << "a URL without a port accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.name(), "port");
+    EXPECT_LT(std::string(e.what()).size(), 300u) << "a hostile value must not flood the log";
+  }
+}
+
 TEST(DriverParams, DevicesOnSeparatePortsMayUseDifferentBauds) {
   DriverParams params;
   params.section(devices::servo_bus::kServoBusSection).port = "/dev/ttyUSB1";

@@ -70,6 +70,10 @@ void frameId(const std::string& value, const std::string& key);
 void uniqueNames(const std::vector<std::string>& names, const std::string& key);
 /// Network hosts: each an IPv4 address (a.b.c.d) or a host name (RFC 1123 labels), none twice.
 void networkHosts(const std::vector<std::string>& hosts, const std::string& key);
+/// A port: a device path, or a tcp:// URL that parses (transport::parseTcpUrl); `portOrInherit`
+/// also takes "" (the node-wide ~port).
+void portPath(const std::string& value, const std::string& key);
+void portOrInherit(const std::string& value, const std::string& key);
 /// A baud rate the serial port supports; `baudOrInherit` also takes 0 (the node-wide ~baud).
 void baudRate(const int& value, const std::string& key);
 void baudOrInherit(const int& value, const std::string& key);

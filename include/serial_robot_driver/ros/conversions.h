@@ -44,8 +44,9 @@ enum class SummaryWrite {
   kMerge,    ///< merged into another check's verdict (DiagnosticStatusWrapper::mergeSummary)
 };
 /// A core status report as the updater publishes it: its summary, its hardware_id when it has
-/// one, and its values appended in order.
-void writeStatusReport(const core::StatusReport& report,
+/// one, and its values appended in order. Taken by value: its strings move into the status (the
+/// callers hand over a report made for this call), once a second for each of ~100 values.
+void writeStatusReport(core::StatusReport report,
                        diagnostic_updater::DiagnosticStatusWrapper& status,
                        SummaryWrite summary = SummaryWrite::kReplace);
 

@@ -30,11 +30,13 @@ class HostedDevices;
 class PlugFaults;
 }  // namespace detail
 
-/// One pty and the devices on it.
+/// One pty (or, for a tcp:// link, one listening socket) and the devices on it.
 struct SimPort {
   std::vector<std::string> devices;  ///< the hosted devices' names
   std::string link;                  ///< "" when none
-  std::string slave_path;            ///< changes after a replug
+  /// Changes after a replug; for a tcp:// link the URL listened on, its port as bound (a link
+  /// with port 0 gets one from the kernel).
+  std::string slave_path;
   bool plugged = true;
 };
 
@@ -68,8 +70,12 @@ class RobotSim {
   void run();
   /// The ports to poll now (mutex_ held while it reads them).
   void preparePoll(PollSet* poll);
-  /// Reads what the host wrote on every port the poll found readable.
+  /// Reads what the host wrote on every port the poll found readable (and takes a TCP port's
+  /// waiting client).
   void readPorts(const PollSet& poll);
+  /// A TCP port's client connected / closed its connection.
+  void attachClient(detail::Port* port);
+  void detachClient(detail::Port* port);
   void step(TimePoint now);
   /// The first of every device's, line's and fault's next event (a wake-up at least every 100 ms).
   TimePoint nextWakeUp(TimePoint now) const;

@@ -24,8 +24,10 @@ bool isTcpUrl(const std::string& path);
 
 /// Parses "tcp://HOST:PORT": HOST is a host name, an IPv4 address or an IPv6 address in brackets
 /// ("tcp://[::1]:4001"), PORT 1..65535. Nullopt for anything else, with `problem` (when given)
-/// saying what is wrong, e.g. "port must be 1-65535".
-std::optional<TcpAddress> parseTcpUrl(const std::string& url, std::string* problem = nullptr);
+/// saying what is wrong, e.g. "port must be 1-65535". `any_port`: port 0 is taken too (a
+/// listener's "any free port"; robot_sim).
+std::optional<TcpAddress> parseTcpUrl(const std::string& url, std::string* problem = nullptr,
+                                      bool any_port = false);
 
 /// Threading as SerialPort: one thread may read while another writes; open() and close() must not
 /// race with either. The baud rate means nothing here: the server sets its serial line's.
