@@ -13,7 +13,8 @@
 //  8. the configuration users run (every default device, 20 body servos at 100 Hz, the topics a
 //     user subscribes) against floor_node (bench/floor_node.cpp, the least a roscpp driver must
 //     do), side by side, quiet and under a CPU hog per core, ~realtime_priority off and on: CPU,
-//     cmd_vel latency, telemetry latency, loop jitter, and the ratios node / floor
+//     cmd_vel latency, telemetry latency, loop jitter, and the ratios node / floor; the robot
+//     played over a pty and over loopback TCP (no pty worker in the path), per --transport
 //  9. ~capture on vs off: base loop period and CPU (2, 3), telemetry -> joint_states and CPU (4),
 //     with a subscriber on serial_raw as rosbag record would be
 // 10. the servo bus at the wire's pace: READ_ANGLE transactions per second and CPU per
@@ -44,6 +45,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <random>
@@ -55,6 +57,7 @@
 #include <vector>
 
 #include "bench_support.h"
+#include "robot_end.h"
 #include "ros_bench_support.h"
 #include "serial_robot_driver/SerialChunk.h"
 #include "serial_robot_driver/ServoRead.h"
@@ -91,8 +94,17 @@ struct Options {
   double bus_seconds = 5;           ///< 10: window of each servo bus run
   std::string realtime_priority = "50";  ///< 8: ~realtime_priority when RT is on
   int bench_priority = 90;               ///< SCHED_FIFO of this process's threads; 0: normal
+  /// 8: the lines the robot is played on, in this order within each condition.
+  std::vector<Transport> transports{Transport::kPty, Transport::kTcp};
+  double tcp_window = 0;  ///< 8: TCP sessions' share of the frames and commands; 0: tcpWindow()
 
   bool runs(int section) const { return sections.count(section) > 0; }
+  /// With both transports a TCP session takes half a pty session's frames and commands (the
+  /// default run stays under 9 minutes); over TCP alone all of them.
+  double tcpWindow() const {
+    if (tcp_window > 0) return tcp_window;
+    return transports.size() > 1 ? 0.5 : 1.0;
+  }
 };
 
 const char* const kUsage = R"(usage: driver_bench [options]
@@ -108,6 +120,14 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           all); the others' cells stay empty
   --realtime-priority V   8: the ~realtime_priority given for "RT on" (default 50; "true"
                           passes a bool)
+  --transport T           8: the line the robot is played on: pty (the program opens a
+                          pseudo-terminal; the kernel's pty worker carries the bytes), tcp
+                          (the program connects to tcp://127.0.0.1:<port>, where this
+                          benchmark listens: no pty worker, the programs' own latency) or
+                          both (default: each condition over the pty, then over TCP; a
+                          summary and a table of every figure per transport)
+  --tcp-window F          8: a TCP session's share of the frames and commands of a pty
+                          session (default 0.5 with both transports, 1 with tcp alone)
   --bench-priority N      SCHED_FIFO priority of this benchmark's own threads, so a load
                           delays the node, not the measuring (default 90; 0: normal)
   --bus-seconds S         10: window of each servo bus run (default 5)
@@ -134,6 +154,13 @@ std::set<int> parseSections(const std::string& text) {
   return sections;
 }
 
+std::vector<Transport> parseTransports(const std::string& text) {
+  if (text == "pty") return {Transport::kPty};
+  if (text == "tcp") return {Transport::kTcp};
+  if (text == "both") return {Transport::kPty, Transport::kTcp};
+  throw std::invalid_argument("--transport takes pty, tcp or both, not " + text);
+}
+
 std::set<std::string> splitList(const std::string& text) {
   std::set<std::string> items;
   std::stringstream stream(text);
@@ -142,20 +169,23 @@ std::set<std::string> splitList(const std::string& text) {
   return items;
 }
 
+/// --long's windows.
+void lengthen(Options& options) {
+  options.long_run = true;
+  options.commands = 5000;
+  options.loop_seconds = 120;
+  options.telemetry_frames = 6000;
+  options.rate_step_seconds = 10;
+  options.service_calls = 2000;
+  options.stress_seconds = 30;
+  options.bus_seconds = 20;
+}
+
 Options parseOptions(int argc, char** argv) {
   Options options;
   // --long first, so explicit knobs override it wherever they stand.
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--long") {
-      options.long_run = true;
-      options.commands = 5000;
-      options.loop_seconds = 120;
-      options.telemetry_frames = 6000;
-      options.rate_step_seconds = 10;
-      options.service_calls = 2000;
-      options.stress_seconds = 30;
-      options.bus_seconds = 20;
-    }
+    if (std::string(argv[i]) == "--long") lengthen(options);
   }
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -188,6 +218,10 @@ Options parseOptions(int argc, char** argv) {
       options.floor_rounds = std::max<std::size_t>(1, std::stoul(value));
     } else if (flag == "--conditions") {
       options.conditions = splitList(value);
+    } else if (flag == "--transport") {
+      options.transports = parseTransports(value);
+    } else if (flag == "--tcp-window") {
+      options.tcp_window = std::stod(value);
     } else if (flag == "--realtime-priority") {
       options.realtime_priority = value;
     } else if (flag == "--bench-priority") {
@@ -557,21 +591,21 @@ class TelemetryProbe {
 
   std::size_t capacity() const { return written_.size(); }
 
-  /// Writes frame `seq`; false when the pty could not take it at once (dropped, like an overrun).
-  bool write(sim::PseudoTerminal& pty, uint32_t seq) {
+  /// Writes frame `seq`; false when the line could not take it at once (dropped, like an overrun).
+  bool write(RobotEnd& robot, uint32_t seq) {
     const std::vector<uint8_t> frame = encode(seq);
     // Locked across write + timestamp so the answer cannot be matched before its write time.
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!writeFrameOrDrop(pty, frame)) return false;
+    if (!robot.writeFrame(frame)) return false;
     written_[seq] = Clock::now();
     return true;
   }
 
   /// Writes another device's frame under the same lock, so it never lands inside a telemetry
   /// frame written from another thread.
-  bool writeOther(sim::PseudoTerminal& pty, const std::vector<uint8_t>& frame) {
+  bool writeOther(RobotEnd& robot, const std::vector<uint8_t>& frame) {
     std::lock_guard<std::mutex> lock(mutex_);
-    return writeFrameOrDrop(pty, frame);
+    return robot.writeFrame(frame);
   }
 
   std::size_t delivered(uint32_t begin, uint32_t end) const {
@@ -635,8 +669,8 @@ struct RateStep {
 
 /// Writes `count` frames at `rate_hz` (absolute schedule), numbered from *next_seq, then waits up
 /// to 1 s for the last joint_states to come in.
-RateStep streamTelemetry(TelemetryProbe& probe, sim::PseudoTerminal& pty, double rate_hz,
-                         std::size_t count, uint32_t* next_seq) {
+RateStep streamTelemetry(TelemetryProbe& probe, RobotEnd& robot, double rate_hz, std::size_t count,
+                         uint32_t* next_seq) {
   RateStep step;
   step.target_hz = rate_hz;
   const uint32_t first = *next_seq;
@@ -644,7 +678,7 @@ RateStep streamTelemetry(TelemetryProbe& probe, sim::PseudoTerminal& pty, double
   const Clock::time_point start = Clock::now();
   for (std::size_t k = 0; k < count && !stopRequested(); ++k) {
     std::this_thread::sleep_until(start + fromSeconds(k / rate_hz));
-    if (!probe.write(pty, (*next_seq)++)) ++step.dropped_at_pty;
+    if (!probe.write(robot, (*next_seq)++)) ++step.dropped_at_pty;
     ++step.attempted;
   }
   // Frames over the time between the first and the last write.
@@ -665,13 +699,13 @@ struct TelemetrySessionResult {
 
 /// Writes frames 0, 1, ... at 50 Hz (at most `frames`) until the node is connected, publishing,
 /// and the probe's subscriber is attached; `log` is named in the error when it never is.
-void warmUpTelemetry(TelemetryProbe& probe, sim::PseudoTerminal& pty, uint32_t frames,
+void warmUpTelemetry(TelemetryProbe& probe, RobotEnd& robot, uint32_t frames,
                      const std::string& log) {
   uint32_t seq = 0;
   const Clock::time_point give_up = Clock::now() + 30s;
   while (probe.delivered(0, seq) == 0 && Clock::now() < give_up && !stopRequested() &&
          seq < frames) {
-    probe.write(pty, seq++);
+    probe.write(robot, seq++);
     std::this_thread::sleep_for(20ms);
   }
   require(probe.delivered(0, seq) > 0, "no joint_states for the telemetry written; see " + log);
@@ -685,8 +719,8 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
   constexpr double kLatencyRateHz = 100.0;
   const Options& options = context.options;
   const std::string ns = "body_" + variant.tag;
-  sim::PseudoTerminal pty(context.paths.link(ns));
-  ParamList params = commonParams(pty.linkPath(), variant);
+  const auto robot = openRobotEnd(Transport::kPty, context.paths.link(ns));
+  ParamList params = commonParams(robot->port(), variant);
   params.insert(params.end(), {{"base/enabled", false}, {"servo_bus/enabled", false}});
   const ParamList body_params = TelemetryProbe::nodeParams();
   params.insert(params.end(), body_params.begin(), body_params.end());
@@ -697,7 +731,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
   const CaptureListener capture(context.nh, driver, variant);
   TelemetryProbe probe(context.nh, driver.topic("joint_states"), capacity);
 
-  warmUpTelemetry(probe, pty, kWarmUpFrames, context.paths.log(ns));
+  warmUpTelemetry(probe, *robot, kWarmUpFrames, context.paths.log(ns));
   uint32_t seq = kWarmUpFrames;
 
   TelemetrySessionResult result;
@@ -705,7 +739,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
     const uint32_t first = seq;
     const CpuWindow cpu(driver.pid());
     const RateStep run =
-        streamTelemetry(probe, pty, kLatencyRateHz, options.telemetry_frames, &seq);
+        streamTelemetry(probe, *robot, kLatencyRateHz, options.telemetry_frames, &seq);
     result.cpu_percent = cpu.percent();
     result.latency = latencyResult(probe.latenciesMs(first, seq), run.attempted);
   }
@@ -713,7 +747,7 @@ TelemetrySessionResult runTelemetrySession(Context& context, const Variant& vari
     for (double rate : options.rates) {
       if (stopRequested()) break;
       const auto count = static_cast<std::size_t>(std::lround(rate * options.rate_step_seconds));
-      result.steps.push_back(streamTelemetry(probe, pty, rate, count, &seq));
+      result.steps.push_back(streamTelemetry(probe, *robot, rate, count, &seq));
       if (result.steps.back().ratio() >= 0.999) result.max_rate_hz = rate;
     }
   }
@@ -1309,17 +1343,20 @@ class UserSubscribers {
   std::vector<ros::Subscriber> subscribers_;
 };
 
-/// The base's side of the shared pty: every speed frame logged, battery requests answered (87 %)
-/// as the AP1 answers them, so the node's battery poll runs as on a robot.
+/// The base's side of the shared line: every speed frame logged, battery requests answered (87 %)
+/// as the AP1 answers them, so the node's battery poll runs as on a robot. Its reader thread is
+/// the one that reads `robot` (over TCP it accepts the program's connection).
 class PlayedBase {
  public:
-  PlayedBase(sim::PseudoTerminal& pty, TelemetryProbe& probe)
-      : reader_(pty, baseFrames(),
-                [this, &pty, &probe](auto family, auto data, auto size, auto arrival) {
+  PlayedBase(RobotEnd& robot, TelemetryProbe& probe)
+      : reader_([&robot](uint8_t* buffer, std::size_t capacity,
+                         int timeout_ms) { return robot.read(buffer, capacity, timeout_ms); },
+                baseFrames(),
+                [this, &robot, &probe](auto family, auto data, auto size, auto arrival) {
                   log_.onFrame(family, data, size, arrival);
                   const auto frame = base::decodeFrame(data, size);
                   if (frame && frame->msg_id == static_cast<uint8_t>(base::MsgId::kBattery)) {
-                    probe.writeOther(pty, base::encodeBatteryReply(frame->seq, 87));
+                    probe.writeOther(robot, base::encodeBatteryReply(frame->seq, 87));
                   }
                 }) {}
   const SpeedFrameLog& log() const { return log_; }
@@ -1373,14 +1410,13 @@ struct UserFigures {
 
 /// Telemetry at 100 Hz, `frames` frames numbered from *seq, no cmd_vel: the process's CPU,
 /// telemetry -> joint_states and the loop's periods over that window.
-UserFigures measureStreamingWindow(TelemetryProbe& probe, sim::PseudoTerminal& pty,
-                                   const SpeedFrameLog& log, pid_t pid, std::size_t frames,
-                                   uint32_t* seq) {
+UserFigures measureStreamingWindow(TelemetryProbe& probe, RobotEnd& robot, const SpeedFrameLog& log,
+                                   pid_t pid, std::size_t frames, uint32_t* seq) {
   const uint32_t first = *seq;
   const std::size_t first_speed_frame = log.count();
   const double cpu_start = processCpuSeconds(pid);
   const Clock::time_point start = Clock::now();
-  const RateStep run = streamTelemetry(probe, pty, 100.0, frames, seq);
+  const RateStep run = streamTelemetry(probe, robot, 100.0, frames, seq);
   UserFigures figures;
   figures.cpu = (processCpuSeconds(pid) - cpu_start) / toSeconds(Clock::now() - start);
   figures.loop = analyzePeriods(log.arrivalSeconds(first_speed_frame, log.count()));
@@ -1390,15 +1426,15 @@ UserFigures measureStreamingWindow(TelemetryProbe& probe, sim::PseudoTerminal& p
 
 /// cmd_vel commands 10-40 ms apart, timed to the wire, while a second thread keeps telemetry
 /// streaming at 100 Hz (those frames are not timed), numbered from `first_seq`.
-LatencyResult timeCmdVelWhileStreaming(TelemetryProbe& probe, sim::PseudoTerminal& pty,
-                                       uint32_t first_seq, ros::Publisher& cmd_vel,
-                                       const SpeedFrameLog& log, std::size_t commands) {
+LatencyResult timeCmdVelWhileStreaming(TelemetryProbe& probe, RobotEnd& robot, uint32_t first_seq,
+                                       ros::Publisher& cmd_vel, const SpeedFrameLog& log,
+                                       std::size_t commands) {
   std::atomic<bool> done{false};
   std::thread stream([&] {
     const Clock::time_point start = Clock::now();
     for (uint32_t seq = first_seq; !done && seq < probe.capacity(); ++seq) {
       std::this_thread::sleep_until(start + fromSeconds((seq - first_seq) / 100.0));
-      probe.write(pty, seq);
+      probe.write(robot, seq);
     }
   });
   const LatencyResult result = timeCmdVelSpaced(cmd_vel, log, commands);
@@ -1407,33 +1443,41 @@ LatencyResult timeCmdVelWhileStreaming(TelemetryProbe& probe, sim::PseudoTermina
   return result;
 }
 
+/// Frames streamed and cmd_vel commands timed in one session of section 8.
+struct UserWindow {
+  std::size_t frames = 0;
+  std::size_t commands = 0;
+};
+
 /// One session: `variant`'s program in the configuration users run, this process playing the
-/// robot on one pty (base and body; the servo bus has nothing to poll by default), the user's
-/// subscribers attached; the load (if any) starts once the node runs.
+/// robot on one line of `transport` (base and body; the servo bus has nothing to poll by
+/// default), the user's subscribers attached; the load (if any) starts once the node runs.
 UserFigures runUserSession(Context& context, const Variant& variant, const UserCondition& condition,
-                           std::size_t round) {
+                           std::size_t round, Transport transport, const UserWindow& window) {
   constexpr uint32_t kWarmUpFrames = 2000;
-  const std::size_t frames = context.options.telemetry_frames;
-  const std::size_t commands = context.options.commands;
-  const std::string ns =
-      "user_" + variant.tag + "_" + condition.tag() + "_r" + std::to_string(round);
-  sim::PseudoTerminal pty(context.paths.link(ns));
+  const std::size_t frames = window.frames;
+  const std::size_t commands = window.commands;
+  // The pty's names as before (scripts/trace_realtime.sh finds a session by its prefix).
+  const std::string ns = "user_" + variant.tag + "_" + condition.tag() + "_r" +
+                         std::to_string(round) + (transport == Transport::kTcp ? "_tcp" : "");
+  const auto robot = openRobotEnd(transport, context.paths.link(ns));
   // Commands 10-40 ms apart: at most 4 frames streamed per command.
   TelemetryProbe probe(context.nh, "/" + ns + "/joint_states",
                        kWarmUpFrames + frames + 4 * commands + 200);
-  const PlayedBase base(pty, probe);
-  DriverProcess driver(context.paths, ns, userParams(pty.linkPath(), condition, context, variant),
+  const PlayedBase base(*robot, probe);
+  DriverProcess driver(context.paths, ns, userParams(robot->port(), condition, context, variant),
                        variant.program);
   const UserSubscribers subscribers(context.nh, ns);
   ros::Publisher cmd_vel = context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
-  warmUpTelemetry(probe, pty, kWarmUpFrames, context.paths.log(ns));
+  warmUpTelemetry(probe, *robot, kWarmUpFrames, context.paths.log(ns));
   require(waitUntil([&] { return base.log().count() > 0 && cmd_vel.getNumSubscribers() > 0; }, 30s),
           "no speed frame or no cmd_vel subscriber; see " + context.paths.log(ns));
   const BackgroundLoad load(context.paths, condition.loaded);
   require(sleepUntil(Clock::now() + 1s), "stopped");
   uint32_t seq = kWarmUpFrames;
-  UserFigures figures = measureStreamingWindow(probe, pty, base.log(), driver.pid(), frames, &seq);
-  figures.cmd_vel = timeCmdVelWhileStreaming(probe, pty, seq, cmd_vel, base.log(), commands);
+  UserFigures figures =
+      measureStreamingWindow(probe, *robot, base.log(), driver.pid(), frames, &seq);
+  figures.cmd_vel = timeCmdVelWhileStreaming(probe, *robot, seq, cmd_vel, base.log(), commands);
   if (variant.program == kEventDriven.program) {
     context.node_diagnostic_statuses = subscribers.diagnosticStatuses();
     context.node_diagnostic_values = subscribers.diagnosticValues();
@@ -1509,12 +1553,20 @@ const std::vector<std::string> kUserColumns{"driver_node", "same-job floor", "no
 enum UserFigureIndex { kCpuFigure = 0, kCmdVelP99 = 2, kTelemetryP99 = 5, kLoopJitter = 6 };
 enum UserConditionIndex { kQuietIndex = 0, kLoadedIndex = 2, kLoadedRtIndex = 3 };
 
-/// Issue 43's table: its rows, in its order, from section 8's sessions.
-void addUserSummary(ResultTable& table, const UserRuns& runs) {
+/// What a transport's tables say about the line their figures include.
+std::string transportLabel(Transport transport) {
+  return transport == Transport::kTcp
+             ? "over loopback TCP (no pty worker: the programs' own latency)"
+             : "over a pty (includes the kernel's pty worker)";
+}
+
+/// Issue 43's table: its rows, in its order, from section 8's sessions over `transport`.
+void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transport) {
   std::vector<std::string> columns{"figure"};
   columns.insert(columns.end(), kUserColumns.begin(), kUserColumns.end());
   columns.push_back("goal (node / same job)");
-  table.section("8. The configuration users run against the floor: summary (issue 43's rows)",
+  table.section("8. The configuration users run against the floor, " + transportLabel(transport) +
+                    ": summary (issue 43's rows)",
                 columns);
   struct Row {
     const char* what;
@@ -1542,11 +1594,13 @@ void addUserSummary(ResultTable& table, const UserRuns& runs) {
   }
 }
 
-/// Every figure in every condition.
-void addUserRows(ResultTable& table, const UserRuns& runs) {
+/// Every figure in every condition, over `transport`.
+void addUserRows(ResultTable& table, const UserRuns& runs, Transport transport) {
   std::vector<std::string> columns{"figure", "load", "RT"};
   columns.insert(columns.end(), kUserColumns.begin(), kUserColumns.end());
-  table.section("8. The configuration users run against the floor: every figure", columns);
+  table.section("8. The configuration users run against the floor, " + transportLabel(transport) +
+                    ": every figure",
+                columns);
   for (const UserFigure& figure : kUserFigures) {
     for (std::size_t condition = 0; condition < kUserConditions.size(); ++condition) {
       std::vector<std::string> row{figure.name, kUserConditions[condition].load(),
@@ -1558,7 +1612,16 @@ void addUserRows(ResultTable& table, const UserRuns& runs) {
   }
 }
 
-void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
+/// Each transport's session window: --telemetry-frames and half of --commands, shared over the
+/// rounds; over TCP scaled by tcpWindow() to keep the default run under 9 minutes.
+UserWindow userWindow(const Options& options, Transport transport) {
+  const double share = transport == Transport::kTcp ? options.tcpWindow() : 1.0;
+  const std::size_t rounds = options.floor_rounds;
+  return {std::max<std::size_t>(200, std::lround(share * options.telemetry_frames / rounds)),
+          std::max<std::size_t>(100, std::lround(share * options.commands / (2 * rounds)))};
+}
+
+void addUserNote(Context& context) {
   const Options& o = context.options;
   ResultTable& table = context.results;
   table.note(
@@ -1576,12 +1639,25 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
       "Subscribed throughout: joint_states (robot_state_publisher), wheel_states "
       "(joint_state_publisher), imu/data, odom, /tf (rviz, navigation), /diagnostics "
       "(diagnostic_aggregator).");
+  table.note(
+      "Transports: over a pty this process holds the master and the program opens the slave; the "
+      "kernel moves the bytes each way on its pty worker (flush_to_ldisc, a normal-priority "
+      "kworker), which no thread priority reaches. Over loopback TCP this process listens on "
+      "127.0.0.1 (an ephemeral port per session) and the program connects to "
+      "tcp://127.0.0.1:<port> (TCP_NODELAY at both ends): a write() wakes the reader directly, so "
+      "those figures are the programs' own latency.");
+  for (Transport transport : o.transports) {
+    const UserWindow window = userWindow(o, transport);
+    table.note(format(
+        "Per session over %s: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock "
+        "over that window, telemetry latency, loop periods from speed frame arrivals), then %zu "
+        "cmd_vel commands 10-40 ms apart while telemetry streams.",
+        transportName(transport).c_str(), window.frames, window.commands));
+  }
   table.note(format(
-      "Per session: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock over that "
-      "window, telemetry latency, loop periods from speed frame arrivals), then %zu cmd_vel "
-      "commands 10-40 ms apart while telemetry streams. %zu round(s); node and both floors back to "
-      "back per condition, which goes first rotating.",
-      frames, commands, o.floor_rounds));
+      "%zu round(s); per condition and transport node and both floors back to back, which goes "
+      "first rotating; the transports alternate within each condition.",
+      o.floor_rounds));
   table.note(format(
       "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
       "~realtime_priority %s for all (the floors take SCHED_FIFO at it on their main thread before "
@@ -1593,37 +1669,51 @@ void addUserNote(Context& context, std::size_t frames, std::size_t commands) {
                                  : "normal priority"));
 }
 
-/// Section 8: driver_node and floor_node (same job, minimal) in every condition (quiet / loaded, RT
-/// off / on), the three back to back per condition and round, which one goes first rotating
-/// (driver_node first of all: the same-job floor takes its count of diagnostic statuses).
-void runUserConfiguration(Context& context) {
-  const Options saved = context.options;
-  const std::size_t rounds = saved.floor_rounds;
-  context.options.telemetry_frames = std::max<std::size_t>(200, saved.telemetry_frames / rounds);
-  context.options.commands = std::max<std::size_t>(100, saved.commands / (2 * rounds));
-  UserRuns runs;
-  for (std::size_t round = 0; round < rounds && !stopRequested(); ++round) {
-    for (std::size_t c = 0; c < kUserConditions.size(); ++c) {
-      const UserCondition& condition = kUserConditions[c];
-      if (!saved.conditions.empty() && saved.conditions.count(condition.tag()) == 0) continue;
+/// Section 8's sessions, per transport.
+using UserRunsByTransport = std::map<Transport, UserRuns>;
+
+/// One round of section 8: in each condition run, over each transport, driver_node and both
+/// floors back to back, which goes first rotating (driver_node first of all: the same-job floor
+/// takes its count of diagnostic statuses).
+void runUserRound(Context& context, std::size_t round, UserRunsByTransport* runs) {
+  const Options& o = context.options;
+  for (std::size_t c = 0; c < kUserConditions.size(); ++c) {
+    const UserCondition& condition = kUserConditions[c];
+    if (!o.conditions.empty() && o.conditions.count(condition.tag()) == 0) continue;
+    for (Transport transport : o.transports) {
+      const UserWindow window = userWindow(o, transport);
       const Variant* const programs[] = {&kEventDriven, &kSameJobFloor, &kFloor};
       for (std::size_t k = 0; k < 3; ++k) {
         const Variant& variant = *programs[(k + c + round) % 3];
-        auto& into = runs.of(variant)[c];
-        attempt(context,
-                format("8. %s, %s, RT %s, round %zu",
-                       variant.same_job ? "floor_node ~same_job" : variant.program.c_str(),
-                       condition.load().c_str(), condition.rt().c_str(), round + 1),
-                [&] { into.push_back(runUserSession(context, variant, condition, round)); });
+        auto& into = (*runs)[transport].of(variant)[c];
+        attempt(
+            context,
+            format("8. %s, %s, RT %s, %s, round %zu",
+                   variant.same_job ? "floor_node ~same_job" : variant.program.c_str(),
+                   condition.load().c_str(), condition.rt().c_str(),
+                   transportName(transport).c_str(), round + 1),
+            [&] {
+              into.push_back(runUserSession(context, variant, condition, round, transport, window));
+            });
       }
     }
   }
-  const std::size_t frames = context.options.telemetry_frames;
-  const std::size_t commands = context.options.commands;
-  context.options = saved;
-  addUserSummary(context.results, runs);
-  addUserRows(context.results, runs);
-  addUserNote(context, frames, commands);
+}
+
+/// Section 8: driver_node and floor_node (same job, minimal) in every condition (quiet / loaded, RT
+/// off / on), over each transport (--transport); the summary and every figure per transport.
+void runUserConfiguration(Context& context) {
+  UserRunsByTransport runs;
+  for (std::size_t round = 0; round < context.options.floor_rounds && !stopRequested(); ++round) {
+    runUserRound(context, round, &runs);
+  }
+  for (Transport transport : context.options.transports) {
+    addUserSummary(context.results, runs[transport], transport);
+  }
+  for (Transport transport : context.options.transports) {
+    addUserRows(context.results, runs[transport], transport);
+  }
+  addUserNote(context);
 }
 
 /// What the sessions of sections 1-5 measured, compared again in 7 and 9.

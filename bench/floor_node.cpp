@@ -1,9 +1,10 @@
 // floor_node: the least any roscpp driver of this robot must do, as the yardstick of driver_bench.
 // Benchmark only, never installed. It reads the same parameters as driver_node for what it does:
-// ~port, ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids, ~body/joint_names,
-// ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution, ~realtime_priority (1..99, or
-// true for 50: SCHED_FIFO on the main thread before roscpp starts its threads, so every thread
-// inherits it, as driver_node does; memory locked).
+// ~port (a tty, or tcp://HOST:PORT: a TCP connection with TCP_NODELAY, raw bytes, as to ser2net;
+// a lost connection ends the floor), ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids,
+// ~body/joint_names, ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution,
+// ~realtime_priority (1..99, or true for 50: SCHED_FIFO on the main thread before roscpp starts its
+// threads, so every thread inherits it, as driver_node does; memory locked).
 // ~same_job (default false: the minimal floor) makes it do the job a user's driver_node does, as
 // minimally as possible: besides joint_states, imu/data per telemetry frame, odom + /tf +
 // wheel_states per loop tick (the commanded motion integrated), and /diagnostics at 1 Hz with
@@ -23,18 +24,24 @@
 #include <fcntl.h>
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <pthread.h>
 #include <ros/ros.h>
 #include <sched.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
+#include <signal.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
 #include <termios.h>
 #include <tf2_msgs/TFMessage.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <algorithm>
@@ -138,8 +145,39 @@ BodyJoints readBodyJoints(ros::NodeHandle& pnh) {
   return joints;
 }
 
-/// Opens the port raw, blocking reads of at least one byte; false when it cannot be opened.
+/// Connects to tcp://HOST:PORT with TCP_NODELAY (each speed frame sent as written); false when
+/// the URL is malformed or nobody accepts.
+bool connectTcp(const std::string& url) {
+  const std::string address = url.substr(6);  // after "tcp://"
+  const std::size_t colon = address.rfind(':');
+  if (colon == std::string::npos) return false;
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(address.substr(0, colon).c_str(), address.substr(colon + 1).c_str(), &hints,
+                    &found) != 0) {
+    return false;
+  }
+  for (const addrinfo* candidate = found; candidate && g_fd < 0; candidate = candidate->ai_next) {
+    g_fd = ::socket(candidate->ai_family, candidate->ai_socktype, candidate->ai_protocol);
+    if (g_fd >= 0 && ::connect(g_fd, candidate->ai_addr, candidate->ai_addrlen) != 0) {
+      ::close(g_fd);
+      g_fd = -1;
+    }
+  }
+  ::freeaddrinfo(found);
+  if (g_fd < 0) return false;
+  const int on = 1;
+  ::setsockopt(g_fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));
+  ::signal(SIGPIPE, SIG_IGN);  // a write to a closed connection fails instead
+  return true;
+}
+
+/// Opens the port raw, blocking reads of at least one byte (or connects, for tcp://); false when
+/// it cannot be opened.
 bool openRawPort(const std::string& port) {
+  if (port.rfind("tcp://", 0) == 0) return connectTcp(port);
   g_fd = ::open(port.c_str(), O_RDWR | O_NOCTTY);
   if (g_fd < 0) return false;
   termios tio{};
@@ -188,7 +226,7 @@ void publishImu(const srd::devices::body::Telemetry& telemetry, const ros::Time&
 }
 
 /// The reader thread: one JointState (and with ~same_job one Imu) per telemetry frame, until
-/// g_running ends.
+/// g_running ends or the connection is lost (then the floor ends).
 void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states, SameJob& job) {
   const std::size_t count = joints.ids.size();
   // With the battery poll its replies are framed too (and dropped: nobody listens to battery).
@@ -214,7 +252,13 @@ void publishTelemetry(const BodyJoints& joints, ros::Publisher& joint_states, Sa
   uint8_t buffer[1024];
   while (g_running) {
     const ssize_t got = ::read(g_fd, buffer, sizeof(buffer));
-    if (got > 0) framer.feed(buffer, static_cast<std::size_t>(got));
+    if (got > 0) {
+      framer.feed(buffer, static_cast<std::size_t>(got));
+    } else if (got == 0 || errno != EINTR) {
+      ROS_ERROR("floor: the port is lost (%s); the floor ends", got == 0 ? "closed" : "read error");
+      ros::requestShutdown();
+      return;
+    }
   }
 }
 

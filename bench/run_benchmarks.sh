@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Runs the driver_node benchmarks (bench/driver_bench.cpp, a private roscore, the nodes over
-# pseudo-terminals). By default section 8 alone, about 4 minutes: driver_node in the configuration
-# users run (every default device, 20 body servos at 100 Hz, the topics a user subscribes) side by
-# side with the floor (bench/floor_node.cpp), quiet and under a CPU hog per core, with
-# ~realtime_priority off and on, each figure as node / floor / ratio. --all runs every section
-# (about 8 minutes), then the framer's (bench/bench_framer.cpp, Google Benchmark, a few seconds).
+# pseudo-terminals). By default section 8 alone, about 8-9 minutes: driver_node in the
+# configuration users run (every default device, 20 body servos at 100 Hz, the topics a user
+# subscribes) side by side with the floor (bench/floor_node.cpp), quiet and under a CPU hog per
+# core, with ~realtime_priority off and on, each figure as node / floor / ratio, the robot played
+# over a pty and over loopback TCP (--transport pty|tcp|both; pty alone about 5 minutes; TCP has no
+# kernel pty worker in the path: the programs' own latency). --all runs every section (about 12
+# minutes; 8 with --transport pty), then the framer's (bench/bench_framer.cpp, Google Benchmark, a
+# few seconds).
 # Prints the tables and writes them to bench/results/user_config.md (section 8 alone) or
 # bench/results/latest.md (--all or --sections), or $SRD_BENCH_OUTPUT.
 #
@@ -15,6 +18,7 @@
 #                       are off by default): in SRD_BENCH_WS, or else in the clone's own .ws/ with
 #                       scripts/build.sh, so `bench/run_benchmarks.sh --build` works on a fresh clone
 #   --long              longer runs (about 15 minutes); also SRD_BENCH_LONG=1
+#   --transport T       section 8's line: pty, tcp or both (default both; passed to driver_bench)
 #   --dds               instead: dds_bench alone (bench/dds_bench.cpp, built with Cyclone DDS only),
 #                       about 2-3 minutes: telemetry -> joint_states over DDS (p50/p99) and the CPU of
 #                       driver_node with ~ros2/enabled on and off and of dds_driver, alternating

@@ -23,6 +23,7 @@ target_link_libraries(servo_floor srd_core ${catkin_LIBRARIES})
 add_executable(driver_bench
   bench/bench_support.cpp
   bench/driver_bench.cpp
+  bench/robot_end.cpp
   bench/ros_bench_support.cpp
   test/support/pty_frame_reader.cpp)  # the tests' pty reader; srd_test_support exists only with tests
 target_include_directories(driver_bench PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})

@@ -31,7 +31,7 @@ while (($#)); do
 done
 [[ -n "${out}" ]] || out=$(mktemp -d /tmp/srd_rt_trace_XXXXXX)
 mkdir -p "${out}"
-# driver_bench names each session's namespace user_<variant>_load_rt_r<round>.
+# driver_bench names each session's namespace user_<variant>_load_rt_r<round> (with _tcp over TCP).
 case "${program}" in
   driver_node) namespace="__ns:=/user_event_load_rt" ;;
   floor_node) namespace="__ns:=/user_floorjob_load_rt" ;;
@@ -49,7 +49,8 @@ echo 40000 >"${instance}/buffer_size_kb"
 for event in "${events[@]}"; do echo 1 >"${instance}/events/${event}/enable"; done
 echo 0 >"${instance}/tracing_on"
 
-SRD_BENCH_OUTPUT="${out}/bench.md" bash "${package_dir}/bench/run_benchmarks.sh" --conditions load_rt "${bench_args[@]}" \
+# Over the pty (the kernel's pty worker is what this traces) unless --transport tcp is given.
+SRD_BENCH_OUTPUT="${out}/bench.md" bash "${package_dir}/bench/run_benchmarks.sh" --conditions load_rt --transport pty "${bench_args[@]}" \
   >"${out}/bench.log" 2>&1 &
 bench_pid=$!
 # Whether process $1 descends from process $2 (other sessions may run the same benchmark).

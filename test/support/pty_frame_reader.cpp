@@ -13,7 +13,13 @@ namespace sim = serial_robot_driver::sim;
 
 PtyFrameReader::PtyFrameReader(sim::PseudoTerminal& pty, const protocol::FramerConfig& config,
                                FrameCallback on_frame, ChunkCallback on_chunk)
-    : pty_(pty),
+    : PtyFrameReader([&pty](uint8_t* buffer, std::size_t capacity,
+                            int timeout_ms) { return pty.read(buffer, capacity, timeout_ms); },
+                     config, std::move(on_frame), std::move(on_chunk)) {}
+
+PtyFrameReader::PtyFrameReader(ReadFunction read, const protocol::FramerConfig& config,
+                               FrameCallback on_frame, ChunkCallback on_chunk)
+    : read_(std::move(read)),
       framer_(config, [this](protocol::FrameFamily family, const uint8_t* data,
                              std::size_t size) { on_frame_(family, data, size, chunk_arrival_); }),
       on_frame_(std::move(on_frame)),
@@ -35,7 +41,7 @@ void PtyFrameReader::run() {
   while (!stopping_) {
     std::size_t count = 0;
     try {
-      count = pty_.read(chunk.data(), chunk.size(), 20);
+      count = read_(chunk.data(), chunk.size(), 20);
     } catch (const transport::TransportError&) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
