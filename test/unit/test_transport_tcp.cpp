@@ -172,11 +172,18 @@ std::string refusedUrl() {
 
 // --- TcpStream -------------------------------------------------------------------------------
 
-TEST(TcpStream, CarriesEveryByteValueBothWays) {
+/// A TcpStream connected to a loopback server that has accepted it.
+class ConnectedTcpStream : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    stream.open();
+    ASSERT_TRUE(server.accept());
+  }
   LoopbackServer server;
-  TcpStream stream(server.url());
-  stream.open();
-  ASSERT_TRUE(server.accept());
+  TcpStream stream{server.url()};
+};
+
+TEST_F(ConnectedTcpStream, CarriesEveryByteValueBothWays) {
   EXPECT_TRUE(stream.isOpen());
   EXPECT_EQ(stream.name(), server.url());
 
@@ -187,11 +194,7 @@ TEST(TcpStream, CarriesEveryByteValueBothWays) {
   EXPECT_EQ(readExactly(stream, bytes.size()), bytes);
 }
 
-TEST(TcpStream, AFrameSplitAcrossWritesArrivesWhole) {
-  LoopbackServer server;
-  TcpStream stream(server.url());
-  stream.open();
-  ASSERT_TRUE(server.accept());
+TEST_F(ConnectedTcpStream, AFrameSplitAcrossWritesArrivesWhole) {
   const Bytes& frame = golden::base::kBattery87ReplySeq0;
   const Bytes head(frame.begin(), frame.begin() + 3);
   const Bytes tail(frame.begin() + 3, frame.end());
@@ -201,22 +204,14 @@ TEST(TcpStream, AFrameSplitAcrossWritesArrivesWhole) {
   EXPECT_EQ(readExactly(stream, tail.size()), tail);
 }
 
-TEST(TcpStream, ThePeerClosingIsADisconnectOnRead) {
-  LoopbackServer server;
-  TcpStream stream(server.url());
-  stream.open();
-  ASSERT_TRUE(server.accept());
+TEST_F(ConnectedTcpStream, ThePeerClosingIsADisconnectOnRead) {
   server.closeClient();
   uint8_t buffer[8];
   EXPECT_EQ(errorKindOf([&] { stream.read(buffer, sizeof(buffer), kPatientTimeoutMs); }),
             TransportErrorKind::kDisconnected);
 }
 
-TEST(TcpStream, ThePeerClosingIsADisconnectOnWriteNotASignal) {
-  LoopbackServer server;
-  TcpStream stream(server.url());
-  stream.open();
-  ASSERT_TRUE(server.accept());
+TEST_F(ConnectedTcpStream, ThePeerClosingIsADisconnectOnWriteNotASignal) {
   server.closeClient();
   // The first writes may still be taken by the kernel; the peer's reset fails a later one, and
   // without MSG_NOSIGNAL the SIGPIPE would end this process.
@@ -256,11 +251,7 @@ TEST(TcpStream, AMalformedOrUnknownAddressIsAnOpenFailure) {
   EXPECT_FALSE(unknown.isOpen());
 }
 
-TEST(TcpStream, WakeReadEndsABlockedRead) {
-  LoopbackServer server;
-  TcpStream stream(server.url());
-  stream.open();
-  ASSERT_TRUE(server.accept());
+TEST_F(ConnectedTcpStream, WakeReadEndsABlockedRead) {
   ASSERT_TRUE(stream.wakeable());
   std::atomic<bool> returned{false};
   std::size_t got = 1;
