@@ -293,16 +293,18 @@ struct LatencyResult {
   Summary ms;
   std::size_t attempted = 0;
   std::size_t lost = 0;  ///< no answer/frame within the timeout (or a failed call)
+  std::vector<double> samples_ms;  ///< what `ms` summarizes (section 8 pools them over rounds)
 };
 
 LatencyResult latencyResult(const std::vector<double>& samples_ms, std::size_t attempted) {
-  return {summarize(samples_ms), attempted, attempted - samples_ms.size()};
+  return {summarize(samples_ms), attempted, attempted - samples_ms.size(), samples_ms};
 }
 
 struct LoopResult {
   Summary period_ms;
   std::size_t missed_ticks = 0;
   double cpu_percent = 0;
+  std::vector<double> periods_ms;  ///< what `period_ms` summarizes
 };
 
 /// Periods between consecutive event times (s); a period of k nominal periods missed k-1 ticks.
@@ -316,6 +318,7 @@ LoopResult analyzePeriods(const std::vector<double>& times_s) {
     if (ticks > 1) result.missed_ticks += static_cast<std::size_t>(ticks - 1);
   }
   result.period_ms = summarize(periods_ms);
+  result.periods_ms = std::move(periods_ms);
   return result;
 }
 
@@ -1485,28 +1488,46 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   return figures;
 }
 
-/// One figure of section 8, taken from a session's UserFigures.
+/// One figure of section 8, taken from a session's UserFigures. A latency or jitter figure is a
+/// statistic of samples: over several rounds it is that statistic of every round's samples
+/// pooled (a p99 of all the commands, not a mean of each round's p99); the others are the mean
+/// of the rounds' values.
 struct UserFigure {
   const char* name;
   const char* unit;
   int decimals;
   double (*of)(const UserFigures&);
+  const std::vector<double>& (*samples)(const UserFigures&) = nullptr;
+  double (*statistic)(const Summary&) = nullptr;
 };
+const std::vector<double>& cmdVelSamples(const UserFigures& f) { return f.cmd_vel.samples_ms; }
+const std::vector<double>& telemetrySamples(const UserFigures& f) {
+  return f.telemetry.samples_ms;
+}
+const std::vector<double>& loopPeriods(const UserFigures& f) { return f.loop.periods_ms; }
+double p50Of(const Summary& s) { return s.p50; }
+double p99Of(const Summary& s) { return s.p99; }
+double stddevOf(const Summary& s) { return s.stddev; }
+double maxOf(const Summary& s) { return s.max; }
+
 const std::vector<UserFigure> kUserFigures{
     {"CPU at 100 Hz telemetry, 20 servos", "s/s", 4, [](const UserFigures& f) { return f.cpu; }},
-    {"cmd_vel -> speed frame p50", "ms", 3, [](const UserFigures& f) { return f.cmd_vel.ms.p50; }},
-    {"cmd_vel -> speed frame p99", "ms", 3, [](const UserFigures& f) { return f.cmd_vel.ms.p99; }},
+    {"cmd_vel -> speed frame p50", "ms", 3, [](const UserFigures& f) { return f.cmd_vel.ms.p50; },
+     cmdVelSamples, p50Of},
+    {"cmd_vel -> speed frame p99", "ms", 3, [](const UserFigures& f) { return f.cmd_vel.ms.p99; },
+     cmdVelSamples, p99Of},
     {"cmd_vel never on the wire", "%", 1,
      [](const UserFigures& f) {
        return 100.0 * f.cmd_vel.lost / std::max<std::size_t>(1, f.cmd_vel.attempted);
      }},
     {"telemetry -> joint_states p50", "ms", 3,
-     [](const UserFigures& f) { return f.telemetry.ms.p50; }},
+     [](const UserFigures& f) { return f.telemetry.ms.p50; }, telemetrySamples, p50Of},
     {"telemetry -> joint_states p99", "ms", 3,
-     [](const UserFigures& f) { return f.telemetry.ms.p99; }},
+     [](const UserFigures& f) { return f.telemetry.ms.p99; }, telemetrySamples, p99Of},
     {"50 Hz loop jitter (std) while telemetry streams", "ms", 3,
-     [](const UserFigures& f) { return f.loop.period_ms.stddev; }},
-    {"50 Hz loop worst period", "ms", 3, [](const UserFigures& f) { return f.loop.period_ms.max; }},
+     [](const UserFigures& f) { return f.loop.period_ms.stddev; }, loopPeriods, stddevOf},
+    {"50 Hz loop worst period", "ms", 3, [](const UserFigures& f) { return f.loop.period_ms.max; },
+     loopPeriods, maxOf},
 };
 
 /// Every session of section 8, per condition (kUserConditions' order), one entry per round: the
@@ -1521,8 +1542,19 @@ struct UserRuns {
   }
 };
 
-/// The mean of `figure` over the rounds of one condition; nullopt when none completed.
-std::optional<double> meanFigure(const std::vector<UserFigures>& rounds, const UserFigure& figure) {
+/// `figure` over the rounds of one condition (pooled or averaged, see UserFigure); nullopt when
+/// none completed.
+std::optional<double> roundsFigure(const std::vector<UserFigures>& rounds,
+                                   const UserFigure& figure) {
+  if (rounds.empty()) return std::nullopt;
+  if (figure.samples) {
+    std::vector<double> pooled;
+    for (const UserFigures& round : rounds) {
+      const std::vector<double>& samples = figure.samples(round);
+      pooled.insert(pooled.end(), samples.begin(), samples.end());
+    }
+    if (!pooled.empty()) return figure.statistic(summarize(pooled));
+  }
   std::vector<double> values;
   for (const UserFigures& round : rounds) values.push_back(figure.of(round));
   return meanOf(values);
@@ -1532,9 +1564,9 @@ std::optional<double> meanFigure(const std::vector<UserFigures>& rounds, const U
 /// one condition (kUserConditions' index).
 std::vector<std::string> userCells(const UserRuns& runs, std::size_t condition,
                                    const UserFigure& figure) {
-  const auto node = meanFigure(runs.node[condition], figure);
-  const auto same_job = meanFigure(runs.same_job[condition], figure);
-  const auto floor = meanFigure(runs.floor[condition], figure);
+  const auto node = roundsFigure(runs.node[condition], figure);
+  const auto same_job = roundsFigure(runs.same_job[condition], figure);
+  const auto floor = roundsFigure(runs.floor[condition], figure);
   auto cell = [&](std::optional<double> value) {
     return value ? format("%.*f %s", figure.decimals, *value, figure.unit) : std::string("-");
   };
@@ -1543,6 +1575,21 @@ std::vector<std::string> userCells(const UserRuns& runs, std::size_t condition,
                                                : std::string("-");
   };
   return {cell(node), cell(same_job), ratio(same_job), cell(floor), ratio(floor)};
+}
+
+/// Node / same-job floor in each round on its own ("0.94x, 1.31x"): how far the figure moves from
+/// one round to the next, to judge a goal missed or met by a few percent. Rounds pair in the
+/// order they completed.
+std::string perRoundRatios(const UserRuns& runs, std::size_t condition, const UserFigure& figure) {
+  const std::vector<UserFigures>& node = runs.node[condition];
+  const std::vector<UserFigures>& same_job = runs.same_job[condition];
+  std::string text;
+  for (std::size_t round = 0; round < std::min(node.size(), same_job.size()); ++round) {
+    const double yardstick = figure.of(same_job[round]);
+    if (!text.empty()) text += ", ";
+    text += yardstick > 0 ? format("%.2fx", figure.of(node[round]) / yardstick) : "-";
+  }
+  return text.empty() ? "-" : text;
 }
 
 /// The columns userCells() fills.
@@ -1564,6 +1611,7 @@ std::string transportLabel(Transport transport) {
 void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transport) {
   std::vector<std::string> columns{"figure"};
   columns.insert(columns.end(), kUserColumns.begin(), kUserColumns.end());
+  columns.push_back("node / same job, each round");
   columns.push_back("goal (node / same job)");
   table.section("8. The configuration users run against the floor, " + transportLabel(transport) +
                     ": summary (issue 43's rows)",
@@ -1589,6 +1637,7 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
     std::vector<std::string> cells{row.what};
     const auto figures = userCells(runs, row.condition, kUserFigures[row.figure]);
     cells.insert(cells.end(), figures.begin(), figures.end());
+    cells.push_back(perRoundRatios(runs, row.condition, kUserFigures[row.figure]));
     cells.push_back(row.goal);
     table.row(cells);
   }
@@ -1656,7 +1705,10 @@ void addUserNote(Context& context) {
   }
   table.note(format(
       "%zu round(s); per condition and transport node and both floors back to back, which goes "
-      "first rotating; the transports alternate within each condition.",
+      "first rotating; the transports alternate within each condition. Percentiles and the "
+      "loop's std and worst period are of every round's samples pooled, CPU and the lost share "
+      "the mean of the rounds'; the summary also gives node / same job in each round alone, "
+      "which shows how far a ratio moves between rounds on this machine.",
       o.floor_rounds));
   table.note(format(
       "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
