@@ -284,6 +284,30 @@ TEST(ConversionsOdometry, PoseTwistFramesAndCovariances) {
   EXPECT_EQ(odom.twist.covariance[35], 0.01);
 }
 
+TEST(ConversionsOdometry, OdometryFilledAgainIsTheOneBuiltAfresh) {
+  devices::base::OdometrySample sample;
+  sample.pose = {1.0, -2.0, 0.3};
+  sample.linear = 0.3;
+  sample.angular = -0.4;
+  sample.position_variance = 0.5;
+  sample.yaw_variance = 0.6;
+  // The last tick's message, with fields this one must overwrite (a longer frame name included).
+  nav_msgs::Odometry msg;
+  msg.header.frame_id = "a_much_longer_odom_frame_of_the_last_tick";
+  msg.child_frame_id = "b";
+  msg.pose.pose.position.z = 9;
+  msg.pose.pose.orientation.x = 0.5;
+  msg.twist.twist.linear.y = 2;
+  msg.twist.twist.angular.x = 3;
+  msg.pose.covariance[1] = 4;
+  const devices::base::ros::OdomFrames frames{"odom", "base_link"};
+  devices::base::ros::fillOdometry(sample, frames, ros::Time(5, 0), &msg);
+  EXPECT_EQ(msg, devices::base::ros::toOdometry(sample, frames, ros::Time(5, 0)));
+  EXPECT_EQ(msg.header.frame_id, "odom");
+  EXPECT_EQ(msg.pose.pose.position.z, 0.0);
+  EXPECT_EQ(msg.pose.covariance[1], 0.0);
+}
+
 TEST(ConversionsOdometry, WheelStatesFilledAgainAreTheOnesBuiltAfresh) {
   devices::base::OdometrySample sample;
   sample.wheel_angles = {1.5, -0.5};

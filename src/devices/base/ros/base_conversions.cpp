@@ -22,22 +22,35 @@ sensor_msgs::BatteryState toBatteryState(const BatteryReading& battery, const ::
 
 nav_msgs::Odometry toOdometry(const OdometrySample& sample, const OdomFrames& frames,
                               const ::ros::Time& stamp) {
-  const YawRotation rotation = yawRotation(sample.pose.yaw);
   nav_msgs::Odometry odom;
-  odom.header.stamp = stamp;
-  odom.header.frame_id = frames.odom;
-  odom.child_frame_id = frames.base;
-  odom.pose.pose.position.x = sample.pose.x;
-  odom.pose.pose.position.y = sample.pose.y;
-  odom.pose.pose.orientation.z = rotation.z;
-  odom.pose.pose.orientation.w = rotation.w;
-  odom.twist.twist.linear.x = sample.linear;
-  odom.twist.twist.angular.z = sample.angular;
+  fillOdometry(sample, frames, stamp, &odom);
+  return odom;
+}
+
+void fillOdometry(const OdometrySample& sample, const OdomFrames& frames, const ::ros::Time& stamp,
+                  nav_msgs::Odometry* msg) {
+  const YawRotation rotation = yawRotation(sample.pose.yaw);
+  msg->header.stamp = stamp;
+  msg->header.frame_id = frames.odom;
+  msg->child_frame_id = frames.base;
+  // Planar: z, roll and pitch are zero; every field is set, whatever the last tick left.
+  msg->pose.pose.position.x = sample.pose.x;
+  msg->pose.pose.position.y = sample.pose.y;
+  msg->pose.pose.position.z = 0.0;
+  msg->pose.pose.orientation.x = 0.0;
+  msg->pose.pose.orientation.y = 0.0;
+  msg->pose.pose.orientation.z = rotation.z;
+  msg->pose.pose.orientation.w = rotation.w;
+  msg->twist.twist.linear.x = sample.linear;
+  msg->twist.twist.linear.y = 0.0;
+  msg->twist.twist.linear.z = 0.0;
+  msg->twist.twist.angular.x = 0.0;
+  msg->twist.twist.angular.y = 0.0;
+  msg->twist.twist.angular.z = sample.angular;
   const OdometryCovariances covariances =
       odometryCovariances(sample.position_variance, sample.yaw_variance);
-  std::copy(covariances.pose.begin(), covariances.pose.end(), odom.pose.covariance.begin());
-  std::copy(covariances.twist.begin(), covariances.twist.end(), odom.twist.covariance.begin());
-  return odom;
+  std::copy(covariances.pose.begin(), covariances.pose.end(), msg->pose.covariance.begin());
+  std::copy(covariances.twist.begin(), covariances.twist.end(), msg->twist.covariance.begin());
 }
 
 sensor_msgs::JointState toWheelStates(const OdometrySample& sample, const std::string& frame,

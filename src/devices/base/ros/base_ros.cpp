@@ -6,7 +6,6 @@
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include <optional>
 
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
@@ -82,14 +81,13 @@ void BaseRos::publishOdometry(const OdometrySample& sample) {
   const bool wheels_wanted = ros_layer::wanted(wheel_states_pub_);
   // Every message is built before the first goes out: roscpp's sending thread, woken by the first,
   // then finds the others queued too instead of being woken once more for each.
-  std::optional<nav_msgs::Odometry> odom;
   if (odom_wanted || tf_wanted) {
     const BaseParams& started = device_.params();
-    odom = toOdometry(sample, {started.odom_frame, started.base_frame}, stamp);
+    fillOdometry(sample, {started.odom_frame, started.base_frame}, stamp, &odom_);
   }
   if (wheels_wanted) buildWheelStates(sample, stamp);
-  if (tf_wanted) buildTf(*odom, sample);
-  if (odom_wanted) odom_pub_.publish(*odom);
+  if (tf_wanted) buildTf(odom_, sample);
+  if (odom_wanted) odom_pub_.publish(odom_);
   if (wheels_wanted) wheel_states_pub_.publish(wheel_states_);
   if (tf_wanted) tf_pub_.publish(tf_);
 }

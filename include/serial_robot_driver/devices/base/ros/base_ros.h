@@ -46,6 +46,7 @@ class BaseRos : public ros_layer::DeviceFrontEnd {
   ros_layer::CountedPublisher battery_pub_;
   // The loop thread's messages of the last tick, filled again (published by value: roscpp
   // serializes them before publish() returns).
+  nav_msgs::Odometry odom_;
   sensor_msgs::JointState wheel_states_;
   tf2_msgs::TFMessage tf_;
   ::ros::Subscriber cmd_vel_sub_;
