@@ -4,8 +4,9 @@
 # robot_sim, with the subscribers a user has (joint_states, wheel_states, imu/data, odom, /tf,
 # /diagnostics, as robot_state_publisher, joint_state_publisher, rviz, the navigation stack and
 # diagnostic_aggregator would subscribe; here `rostopic hz`). Prints, per thread of the node: its
-# role, its CPU (s/s, from /proc), its CPU per event (telemetry frame, loop tick, ...) and its top
-# items. docs/performance.md explains the output; paste it there as is.
+# role, its CPU (s/s, from /proc), its CPU per event (telemetry frame, loop tick, ...), its top
+# items and (perf) its wake-ups and system calls per second. docs/performance.md explains the
+# output; paste it there as is.
 #
 # usage: scripts/profile_node.sh [--seconds S] [--tool perf|callgrind] [--floor] [--cmd-vel]
 #                                [--no-interface] [--out DIR] [--top N]
@@ -170,16 +171,37 @@ thread_cpu_ns() {
     awk -v tid="${tid}" '{ print tid, $1 }' "${stat}" 2>/dev/null || true
   done
 }
+# Voluntary and involuntary context switches of each thread: "tid voluntary involuntary" lines.
+thread_switches() {
+  local status tid
+  for status in /proc/"${node_pid}"/task/*/status; do
+    tid=${status%/status}
+    tid=${tid##*/}
+    awk -v tid="${tid}" '/^voluntary_ctxt_switches/ { v = $2 }
+      /^nonvoluntary_ctxt_switches/ { n = $2 } END { print tid, v, n }' "${status}" 2>/dev/null ||
+      true
+  done
+}
 # The CPU per thread from a window of its own: perf's sampling (stacks copied in the kernel) is
 # charged to the threads it samples. Callgrind's whole run is slow anyway: one window.
 if [[ "${tool}" == callgrind ]]; then callgrind_control -i on "${node_pid}" >/dev/null; fi
 thread_cpu_ns >"${out}/cpu_ns_start"
+thread_switches >"${out}/switches_start"
 sleep "${seconds}"
 thread_cpu_ns >"${out}/cpu_ns_end"
+thread_switches >"${out}/switches_end"
 if [[ "${tool}" == perf ]]; then
   echo "profile_node.sh: CPU window done; perf records ${seconds} s more" >&2
+  # The system calls each thread makes, counted alongside (perf record's sampling slows the
+  # threads, not the number of calls they make).
+  syscalls=$(printf 'syscalls:sys_enter_%s,' read write poll ppoll sendto recvfrom futex \
+    epoll_wait epoll_ctl clock_nanosleep)
+  perf stat --per-thread -x, -e "${syscalls%,}" -p "${node_pid}" -o "${out}/syscalls.csv" \
+    -- sleep "${seconds}" >/dev/null 2>&1 &
+  syscall_counter=$!
   perf record -e cpu-clock -F 4999 --call-graph dwarf,8192 -p "${node_pid}" -o "${out}/perf.data" \
     -- sleep "${seconds}" >"${out}/perf_record.log" 2>&1
+  wait "${syscall_counter}" || true
 fi
 if [[ "${tool}" == callgrind ]]; then
   # The window's counts in their own files (callgrind.out.<pid>.1-<thread>); exit adds none.

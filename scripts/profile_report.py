@@ -4,7 +4,8 @@
 usage: scripts/profile_report.py perf|callgrind OUT_DIR SECONDS [TOP] [PROGRAM]
 
 OUT_DIR holds what profile_node.sh left there: cpu_ns_start / cpu_ns_end (per-thread CPU time),
-perf.data or callgrind.out.*, and the rostopic hz logs (hz_*.log). Prints Markdown.
+switches_start / switches_end (per-thread context switches), perf.data and syscalls.csv (perf
+stat --per-thread) or callgrind.out.*, and the rostopic hz logs (hz_*.log). Prints Markdown.
 """
 import glob
 import re
@@ -64,6 +65,61 @@ def thread_cpu(out, seconds):
     """CPU s/s per tid over the window, from /proc/<pid>/task/<tid>/schedstat."""
     start, end = read_cpu_ns(f"{out}/cpu_ns_start"), read_cpu_ns(f"{out}/cpu_ns_end")
     return {tid: (end[tid] - start.get(tid, 0)) / 1e9 / seconds for tid in end}
+
+
+def read_switches(path):
+    """Per tid: (voluntary, involuntary) context switches so far."""
+    switches = {}
+    with open(path) as stream:
+        for line in stream:
+            fields = line.split()
+            if len(fields) == 3:
+                switches[int(fields[0])] = (int(fields[1]), int(fields[2]))
+    return switches
+
+
+def syscall_counts(path):
+    """Per tid, per system call, what `perf stat --per-thread -x,` counted (comm-tid,count,,event)."""
+    counts = {}
+    try:
+        with open(path) as stream:
+            lines = stream.readlines()
+    except OSError:
+        return counts
+    prefix = "syscalls:sys_enter_"
+    for line in lines:
+        fields = line.strip().split(",")
+        if len(fields) < 4 or not fields[3].startswith(prefix) or "-" not in fields[0]:
+            continue
+        tid = int(fields[0].rsplit("-", 1)[1])
+        count = int(fields[1]) if fields[1].isdigit() else 0
+        counts.setdefault(tid, {})[fields[3][len(prefix):]] = count
+    return counts
+
+
+def print_wakes_and_calls(out, seconds, roles):
+    """Per thread and second: how often it blocked (so woke up again), was preempted, and each
+    system call it made; the wake-ups and calls are what the kernel charges a thread beyond its
+    instructions."""
+    start, end = read_switches(f"{out}/switches_start"), read_switches(f"{out}/switches_end")
+    calls = syscall_counts(f"{out}/syscalls.csv")
+    names = sorted({name for per_thread in calls.values() for name, count in per_thread.items()
+                    if count > 0})
+    print("\n#### Wake-ups and system calls per thread (per second: the switches over the CPU "
+          "window, the calls over perf's)\n")
+    print("| thread | blocked (woke) | preempted | " + " | ".join(f"`{n}`" for n in names) + " |")
+    print("|---|---|---|" + "---|" * len(names))
+    totals = [0.0] * (2 + len(names))
+    for tid in sorted(end, key=lambda tid: -(end[tid][0] - start.get(tid, (0, 0))[0])):
+        woke = (end[tid][0] - start.get(tid, (0, 0))[0]) / seconds
+        preempted = (end[tid][1] - start.get(tid, (0, 0))[1]) / seconds
+        row = [woke, preempted] + [calls.get(tid, {}).get(n, 0) / seconds for n in names]
+        if sum(row) < 1:
+            continue
+        totals = [a + b for a, b in zip(totals, row)]
+        cells = " | ".join(f"{value:.0f}" for value in row)
+        print(f"| {roles.get(tid, 'tid')} ({tid}) | {cells} |")
+    print("| **all threads** | " + " | ".join(f"**{value:.0f}**" for value in totals) + " |")
 
 
 def messages_per_second(out):
@@ -146,9 +202,9 @@ def print_thread(tid, cpu, role, event, per_event_scale, self_rows, own_rows, to
             print(f"| {share:.1f} | {cpu * scale * share / 100:.2f} | `{short(symbol)}` |")
 
 
-def perf_report(out, cpu, messages, top):
+def perf_report(out, cpu, messages, top, seconds):
     self_rows, child_rows = perf_rows(out, False), perf_rows(out, True)
-    threads, diagnostics_us = {}, 0.0
+    threads, diagnostics_us, roles = {}, 0.0, {}
     for tid in sorted(cpu, key=lambda tid: -cpu[tid]):
         mine = [(share, symbol) for t, share, symbol in self_rows if t == tid]
         total = sum(share for share, _ in mine)
@@ -164,6 +220,7 @@ def perf_report(out, cpu, messages, top):
         diagnostics_us += sum(cpu[tid] * 1e6 * share / 100 for share, symbol in own
                               if symbol.startswith(DIAGNOSTICS_SYMBOL))
         threads[f"{role} (tid {tid})"] = (cpu[tid], cpu[tid] * scale, event if rate else None)
+        roles[tid] = role
         print_thread(tid, cpu[tid], role, event if rate else None, scale, relative, own, top)
     node = sum(cpu.values()) or 1.0
     print("\n#### Per thread\n\n| thread | CPU s/s | share of the node |\n|---|---|---|")
@@ -171,6 +228,7 @@ def perf_report(out, cpu, messages, top):
         print(f"| {name} | {thread_cpu_share:.4f} | {100 * thread_cpu_share / node:.0f} % |")
     print("\n#### Per event (perf's shares of each thread, times its CPU from /proc)")
     print_per_event(threads, diagnostics_us / DIAGNOSTICS_HZ)
+    print_wakes_and_calls(out, seconds, roles)
 
 
 def callgrind_rows(path, inclusive):
@@ -265,7 +323,7 @@ def main():
           f"{', under valgrind' if tool == 'callgrind' else ''}); {len(cpu)} threads; messages "
           f"sent to the subscribers {messages:.0f}/s")
     if tool == "perf":
-        perf_report(out, cpu, messages, top)
+        perf_report(out, cpu, messages, top, seconds)
     else:
         callgrind_report(out, cpu, messages, top, seconds)
 
