@@ -115,7 +115,8 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           4 with ~capture, and runs 2-4 without it if they did not run;
                           11 is the earlier per-device comparison with floor_node)
   --floor-rounds N        8, 11: node/floor rounds, each with its share of the frames and
-                          commands (default 1)
+                          commands (default 1); 8 pools the rounds' samples for its
+                          percentiles and lists each round's node / same-job ratio too
   --conditions A,B,...    8: only these conditions (quiet, quiet_rt, load, load_rt; default
                           all); the others' cells stay empty
   --realtime-priority V   8: the ~realtime_priority given for "RT on" (default 50; "true"
