@@ -6,7 +6,6 @@
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
 
-
 #include "serial_robot_driver/WheelCommand.h"
 #include "serial_robot_driver/devices/base/ros/base_conversions.h"
 #include "serial_robot_driver/ros/guarded_callbacks.h"
