@@ -9,12 +9,12 @@
 
 #include <atomic>
 #include <cerrno>
-#include <cstring>
 #include <stdexcept>
 
 #include "bench_support.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 #include "serial_robot_driver/transport/serial_port.h"
+#include "support/loopback_listener.h"
 
 namespace serial_robot_driver::bench {
 
@@ -44,22 +44,9 @@ class PtyRobotEnd : public RobotEnd {
 class TcpRobotEnd : public RobotEnd {
  public:
   TcpRobotEnd() {
-    listener_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof(address);
-    const bool ok =
-        listener_ >= 0 &&
-        ::bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0 &&
-        ::listen(listener_, 1) == 0 &&
-        ::getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length) == 0;
-    if (!ok) {
-      const std::string error = std::strerror(errno);
-      if (listener_ >= 0) ::close(listener_);
-      throw std::runtime_error("cannot listen on 127.0.0.1: " + error);
-    }
-    port_ = ntohs(address.sin_port);
+    const test_support::LoopbackListener listener = test_support::listenOnLoopback(1);
+    listener_ = listener.fd;
+    url_ = listener.url();
   }
 
   ~TcpRobotEnd() override {
@@ -68,7 +55,7 @@ class TcpRobotEnd : public RobotEnd {
     ::close(listener_);
   }
 
-  std::string port() const override { return "tcp://127.0.0.1:" + std::to_string(port_); }
+  std::string port() const override { return url_; }
 
   std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms) override {
     const int connection = connection_;
@@ -113,7 +100,7 @@ class TcpRobotEnd : public RobotEnd {
   }
 
   int listener_ = -1;
-  int port_ = 0;
+  std::string url_;
   std::atomic<int> connection_{-1};
   std::vector<int> retired_;  ///< reader thread only
 };

@@ -1,9 +1,7 @@
 // Serial ports reached over TCP (tcp://HOST:PORT, a network serial server): the URL parser's
 // extremes, TcpStream against a loopback listener made here, and SerialLink reconnecting over TCP
 // after the server dropped it.
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -16,6 +14,7 @@
 #include "serial_robot_driver/transport/tcp_stream.h"
 #include "support/framer_configs.h"
 #include "support/golden_frames.h"
+#include "support/loopback_listener.h"
 #include "support/test_helpers.h"
 #include "support/transport_fixture.h"
 
@@ -108,15 +107,9 @@ TEST(TcpUrl, OnlyTheTcpSchemeIsAUrl) {
 class LoopbackServer {
  public:
   LoopbackServer() {
-    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    EXPECT_EQ(::bind(listen_fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
-    EXPECT_EQ(::listen(listen_fd_, 4), 0);
-    socklen_t size = sizeof(address);
-    ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &size);
-    url_ = "tcp://127.0.0.1:" + std::to_string(ntohs(address.sin_port));
+    const test_support::LoopbackListener listener = test_support::listenOnLoopback(4);
+    listen_fd_ = listener.fd;
+    url_ = listener.url();
   }
   ~LoopbackServer() {
     closeClient();
