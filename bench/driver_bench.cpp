@@ -14,7 +14,8 @@
 //     user subscribes) against floor_node (bench/floor_node.cpp, the least a roscpp driver must
 //     do), side by side, quiet and under a CPU hog per core, ~realtime_priority off and on: CPU,
 //     cmd_vel latency, telemetry latency, loop jitter, and the ratios node / floor; the robot
-//     played over a pty and over loopback TCP (no pty worker in the path), per --transport
+//     played over a pty and over loopback TCP (no pty worker in the path), per --transport; with
+//     RT off, CPU also with the node and the same-job floor streaming in one window
 //  9. ~capture on vs off: base loop period and CPU (2, 3), telemetry -> joint_states and CPU (4),
 //     with a subscriber on serial_raw as rosbag record would be
 // 10. the servo bus at the wire's pace: READ_ANGLE transactions per second and CPU per
@@ -1453,40 +1454,110 @@ struct UserWindow {
   std::size_t commands = 0;
 };
 
-/// One session: `variant`'s program in the configuration users run, this process playing the
-/// robot on one line of `transport` (base and body; the servo bus has nothing to poll by
-/// default), the user's subscribers attached; the load (if any) starts once the node runs.
+/// `variant`'s program in the configuration users run in namespace `ns`, this process playing
+/// the robot on one line of `transport` (base and body; the servo bus has nothing to poll by
+/// default) and its users (the subscribers attached), warmed up: telemetry flows to joint_states
+/// and speed frames to the base. The probe holds `frames` frames after the warm-up.
+struct UserSetup {
+  static constexpr uint32_t kWarmUpFrames = 2000;
+
+  UserSetup(Context& context, const Variant& variant, const UserCondition& condition,
+            const std::string& ns, Transport transport, std::size_t frames)
+      : robot(openRobotEnd(transport, context.paths.link(ns))),
+        probe(context.nh, "/" + ns + "/joint_states", kWarmUpFrames + frames),
+        base(*robot, probe),
+        driver(context.paths, ns, userParams(robot->port(), condition, context, variant),
+               variant.program),
+        subscribers(context.nh, ns),
+        cmd_vel(context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10)) {
+    warmUpTelemetry(probe, *robot, kWarmUpFrames, context.paths.log(ns));
+    require(waitUntil([&] { return base.log().count() > 0 && cmd_vel.getNumSubscribers() > 0; },
+                      30s),
+            "no speed frame or no cmd_vel subscriber; see " + context.paths.log(ns));
+  }
+
+  // In the order they start; the program stops (and writes its zero-speed frame) while the
+  // played base still reads.
+  const std::unique_ptr<RobotEnd> robot;
+  TelemetryProbe probe;
+  const PlayedBase base;
+  DriverProcess driver;
+  const UserSubscribers subscribers;
+  ros::Publisher cmd_vel;
+};
+
+/// The pty's (or socket's) name of a session of section 8 (scripts/trace_realtime.sh finds a
+/// session by its prefix).
+std::string userNamespace(const std::string& tag, const UserCondition& condition,
+                          std::size_t round, Transport transport) {
+  return "user_" + tag + "_" + condition.tag() + "_r" + std::to_string(round) +
+         (transport == Transport::kTcp ? "_tcp" : "");
+}
+
+/// One session: `variant`'s program set up as users run it (UserSetup); the load (if any) starts
+/// once it runs.
 UserFigures runUserSession(Context& context, const Variant& variant, const UserCondition& condition,
                            std::size_t round, Transport transport, const UserWindow& window) {
-  constexpr uint32_t kWarmUpFrames = 2000;
-  const std::size_t frames = window.frames;
-  const std::size_t commands = window.commands;
-  // The pty's names as before (scripts/trace_realtime.sh finds a session by its prefix).
-  const std::string ns = "user_" + variant.tag + "_" + condition.tag() + "_r" +
-                         std::to_string(round) + (transport == Transport::kTcp ? "_tcp" : "");
-  const auto robot = openRobotEnd(transport, context.paths.link(ns));
   // Commands 10-40 ms apart: at most 4 frames streamed per command.
-  TelemetryProbe probe(context.nh, "/" + ns + "/joint_states",
-                       kWarmUpFrames + frames + 4 * commands + 200);
-  const PlayedBase base(*robot, probe);
-  DriverProcess driver(context.paths, ns, userParams(robot->port(), condition, context, variant),
-                       variant.program);
-  const UserSubscribers subscribers(context.nh, ns);
-  ros::Publisher cmd_vel = context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10);
-  warmUpTelemetry(probe, *robot, kWarmUpFrames, context.paths.log(ns));
-  require(waitUntil([&] { return base.log().count() > 0 && cmd_vel.getNumSubscribers() > 0; }, 30s),
-          "no speed frame or no cmd_vel subscriber; see " + context.paths.log(ns));
+  UserSetup setup(context, variant, condition,
+                  userNamespace(variant.tag, condition, round, transport), transport,
+                  window.frames + 4 * window.commands + 200);
   const BackgroundLoad load(context.paths, condition.loaded);
   require(sleepUntil(Clock::now() + 1s), "stopped");
-  uint32_t seq = kWarmUpFrames;
-  UserFigures figures =
-      measureStreamingWindow(probe, *robot, base.log(), driver.pid(), frames, &seq);
-  figures.cmd_vel = timeCmdVelWhileStreaming(probe, *robot, seq, cmd_vel, base.log(), commands);
+  uint32_t seq = UserSetup::kWarmUpFrames;
+  UserFigures figures = measureStreamingWindow(setup.probe, *setup.robot, setup.base.log(),
+                                               setup.driver.pid(), window.frames, &seq);
+  figures.cmd_vel = timeCmdVelWhileStreaming(setup.probe, *setup.robot, seq, setup.cmd_vel,
+                                             setup.base.log(), window.commands);
   if (variant.program == kEventDriven.program) {
-    context.node_diagnostic_statuses = subscribers.diagnosticStatuses();
-    context.node_diagnostic_values = subscribers.diagnosticValues();
+    context.node_diagnostic_statuses = setup.subscribers.diagnosticStatuses();
+    context.node_diagnostic_values = setup.subscribers.diagnosticValues();
   }
   return figures;
+}
+
+/// CPU of driver_node and of the same-job floor measured over one window in which both run.
+struct CpuAtOnce {
+  double node = 0;      ///< s/s
+  double same_job = 0;  ///< s/s
+};
+
+/// driver_node and the same-job floor set up side by side (UserSetup each), then telemetry at
+/// 100 Hz to both at once, the two frames of a period written back to back in alternating order:
+/// each program's CPU over the same `frames`-frame window. Whatever else the machine does in that
+/// window weighs on both, where back-to-back sessions each meet their own moment of it.
+CpuAtOnce measureCpuAtOnce(Context& context, const UserCondition& condition, std::size_t round,
+                           Transport transport, std::size_t frames) {
+  constexpr std::size_t kSettleFrames = 200;  // both streamed before the window (2 s)
+  UserSetup node(context, kEventDriven, condition,
+                 userNamespace("atonce_" + kEventDriven.tag, condition, round, transport),
+                 transport, kSettleFrames + frames + 10);
+  UserSetup same_job(context, kSameJobFloor, condition,
+                     userNamespace("atonce_" + kSameJobFloor.tag, condition, round, transport),
+                     transport, kSettleFrames + frames + 10);
+  UserSetup* const both[] = {&node, &same_job};
+  uint32_t seq = UserSetup::kWarmUpFrames;
+  auto stream = [&](std::size_t count) {
+    const Clock::time_point start = Clock::now();
+    for (std::size_t k = 0; k < count && !stopRequested(); ++k, ++seq) {
+      std::this_thread::sleep_until(start + fromSeconds(k / 100.0));
+      for (std::size_t i = 0; i < 2; ++i) {
+        UserSetup& setup = *both[(i + k) % 2];
+        setup.probe.write(*setup.robot, seq);
+      }
+    }
+  };
+  const BackgroundLoad load(context.paths, condition.loaded);
+  stream(kSettleFrames);
+  const double node_start = processCpuSeconds(node.driver.pid());
+  const double same_job_start = processCpuSeconds(same_job.driver.pid());
+  const Clock::time_point start = Clock::now();
+  stream(frames);
+  const double node_cpu = processCpuSeconds(node.driver.pid()) - node_start;
+  const double same_job_cpu = processCpuSeconds(same_job.driver.pid()) - same_job_start;
+  const double seconds = toSeconds(Clock::now() - start);
+  require(node.driver.running() && same_job.driver.running(), "a program stopped mid-window");
+  return {node_cpu / seconds, same_job_cpu / seconds};
 }
 
 /// One figure of section 8, taken from a session's UserFigures. A latency or jitter figure is a
@@ -1537,6 +1608,8 @@ struct UserRuns {
   std::vector<std::vector<UserFigures>> node{kUserConditions.size()};
   std::vector<std::vector<UserFigures>> same_job{kUserConditions.size()};
   std::vector<std::vector<UserFigures>> floor{kUserConditions.size()};
+  /// measureCpuAtOnce's, per condition with RT off, one entry per round.
+  std::vector<std::vector<CpuAtOnce>> cpu_at_once{kUserConditions.size()};
   std::vector<std::vector<UserFigures>>& of(const Variant& variant) {
     if (variant.same_job) return same_job;
     return variant.program == kFloor.program ? floor : node;
@@ -1593,6 +1666,25 @@ std::string perRoundRatios(const UserRuns& runs, std::size_t condition, const Us
   return text.empty() ? "-" : text;
 }
 
+/// The summary's cells for the CPU measured with both programs at once in one condition: as
+/// userCells() and perRoundRatios() fill them (the minimal floor did not take part).
+std::vector<std::string> cpuAtOnceCells(const UserRuns& runs, std::size_t condition) {
+  const std::vector<CpuAtOnce>& rounds = runs.cpu_at_once[condition];
+  if (rounds.empty()) return {"-", "-", "-", "-", "-", "-"};
+  std::vector<double> node, same_job;
+  std::string each_round;
+  for (const CpuAtOnce& round : rounds) {
+    node.push_back(round.node);
+    same_job.push_back(round.same_job);
+    if (!each_round.empty()) each_round += ", ";
+    each_round += round.same_job > 0 ? format("%.2fx", round.node / round.same_job) : "-";
+  }
+  const double node_mean = *meanOf(node), same_job_mean = *meanOf(same_job);  // both non-empty
+  return {format("%.4f s/s", node_mean), format("%.4f s/s", same_job_mean),
+          same_job_mean > 0 ? format("%.2fx", node_mean / same_job_mean) : "-", "-", "-",
+          each_round};
+}
+
 /// The columns userCells() fills.
 const std::vector<std::string> kUserColumns{"driver_node", "same-job floor", "node / same job",
                                             "minimal floor", "node / minimal"};
@@ -1622,9 +1714,11 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
     UserFigureIndex figure;
     UserConditionIndex condition;
     const char* goal;
+    bool at_once = false;  ///< the CPU with both programs at once (cpuAtOnceCells)
   };
   const Row rows[] = {
       {"CPU at 100 Hz telemetry, 20 servos", kCpuFigure, kQuietIndex, "<= 1.1x"},
+      {"the same, node and same-job floor at once", kCpuFigure, kQuietIndex, "<= 1.1x", true},
       {"cmd_vel -> speed frame on the wire, p99", kCmdVelP99, kQuietIndex, "<= 1 ms and <= 1.2x"},
       {"telemetry last byte -> joint_states, p99 (quiet)", kTelemetryP99, kQuietIndex, "keep"},
       {"the same with a CPU hog at nice 0 on each core", kTelemetryP99, kLoadedIndex, "<= 1.2x"},
@@ -1633,12 +1727,18 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
        kLoadedIndex, "<= 1.2x"},
       {"the same, ~realtime_priority on", kLoopJitter, kLoadedRtIndex, "<= 1.0x"},
       {"CPU under that load", kCpuFigure, kLoadedIndex, "<= 1.1x"},
+      {"the same, node and same-job floor at once", kCpuFigure, kLoadedIndex, "<= 1.1x", true},
   };
   for (const Row& row : rows) {
     std::vector<std::string> cells{row.what};
-    const auto figures = userCells(runs, row.condition, kUserFigures[row.figure]);
-    cells.insert(cells.end(), figures.begin(), figures.end());
-    cells.push_back(perRoundRatios(runs, row.condition, kUserFigures[row.figure]));
+    if (row.at_once) {
+      const auto figures = cpuAtOnceCells(runs, row.condition);
+      cells.insert(cells.end(), figures.begin(), figures.end());
+    } else {
+      const auto figures = userCells(runs, row.condition, kUserFigures[row.figure]);
+      cells.insert(cells.end(), figures.begin(), figures.end());
+      cells.push_back(perRoundRatios(runs, row.condition, kUserFigures[row.figure]));
+    }
     cells.push_back(row.goal);
     table.row(cells);
   }
@@ -1711,6 +1811,13 @@ void addUserNote(Context& context) {
       "the mean of the rounds'; the summary also gives node / same job in each round alone, "
       "which shows how far a ratio moves between rounds on this machine.",
       o.floor_rounds));
+  table.note(
+      "\"At once\" (RT off, per round after the three sessions): driver_node and the same-job "
+      "floor set up side by side, each on its own line with its own subscribers, then telemetry "
+      "at 100 Hz to both, a period's two frames back to back in alternating order, for as many "
+      "frames as a session's window: each process's CPU over that one window. What else the "
+      "machine does then weighs on both, where sessions back to back each meet their own "
+      "moment of it; the two share the cores, so the absolute figures are not a lone program's.");
   table.note(format(
       "Load: one `sh` busy loop per core at nice 0, from 1 s before the window. RT on: "
       "~realtime_priority %s for all (the floors take SCHED_FIFO at it on their main thread before "
@@ -1749,6 +1856,14 @@ void runUserRound(Context& context, std::size_t round, UserRunsByTransport* runs
               into.push_back(runUserSession(context, variant, condition, round, transport, window));
             });
       }
+      if (condition.realtime) continue;
+      attempt(context,
+              format("8. driver_node and floor_node ~same_job at once, %s, %s, round %zu",
+                     condition.load().c_str(), transportName(transport).c_str(), round + 1),
+              [&] {
+                (*runs)[transport].cpu_at_once[c].push_back(
+                    measureCpuAtOnce(context, condition, round, transport, window.frames));
+              });
     }
   }
 }
