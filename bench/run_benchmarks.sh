@@ -7,12 +7,13 @@
 # over a pty and over loopback TCP (--transport pty|tcp|both; pty alone about 5 minutes; TCP has no
 # kernel pty worker in the path: the programs' own latency). --all runs every section (about 12
 # minutes; 8 with --transport pty), then the framer's (bench/bench_framer.cpp, Google Benchmark, a
-# few seconds).
+# few seconds) and the cost of waiting per wake-up, the node's way and the floor's
+# (bench/bench_wait.cpp, 80 s).
 # Prints the tables and writes them to bench/results/user_config.md (section 8 alone) or
 # bench/results/latest.md (--all or --sections), or $SRD_BENCH_OUTPUT.
 #
 # usage: bench/run_benchmarks.sh [--build] [--all] [--long] [driver_bench options, see --help]
-#   --all               every section (1-10) and bench_framer, instead of section 8 alone
+#   --all               every section (1-10), bench_framer and bench_wait, instead of section 8 alone
 #   --build             build driver_bench (and driver_node, robot_sim, floor_node, servo_floor,
 #                       polling_driver_node) first, -j2, with -DSRD_BUILD_BENCHMARKS=ON (benchmarks
 #                       are off by default): in SRD_BENCH_WS, or else in the clone's own .ws/ with
@@ -66,6 +67,7 @@ if [[ -n "${SRD_BENCH_WS:-}" ]]; then
       (cd "${SRD_BENCH_WS}" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DSRD_BUILD_BENCHMARKS=ON "${launcher[@]}" --make-args -j2 driver_bench)
     fi
     if (( dds )); then (cd "${SRD_BENCH_WS}/build" && make -j2 dds_bench); fi
+    (cd "${SRD_BENCH_WS}/build" && make -j2 bench_wait)
     # bench_framer exists only where Google Benchmark is installed (libbenchmark-dev).
     (cd "${SRD_BENCH_WS}/build" && make -j2 bench_framer) ||
       echo "run_benchmarks.sh: bench_framer not built (no Google Benchmark); its section is skipped" >&2
@@ -134,5 +136,17 @@ if [[ "${status}" -eq 0 && "${all}" -eq 1 && -x "${framer}" ]]; then
     echo '```'
   } >> "${output}"
   rm -f "${framer_out}"
+fi
+# What the node's reader and loop spend to wait their (wakeable) way, against the floor's.
+waiter="$(dirname "${bench}")/bench_wait"
+if [[ "${status}" -eq 0 && "${all}" -eq 1 && -x "${waiter}" ]]; then
+  wait_out=$(mktemp)
+  "${waiter}" --rounds 4 | tee "${wait_out}"
+  {
+    echo
+    echo "### Waiting for the next event, per wake-up (bench_wait)"
+    cat "${wait_out}"
+  } >> "${output}"
+  rm -f "${wait_out}"
 fi
 exit "${status}"

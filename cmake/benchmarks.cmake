@@ -8,6 +8,11 @@ if(benchmark_FOUND)
   target_link_libraries(bench_framer srd_core srd_sim benchmark::benchmark)
 endif()
 
+# What driver_node's port reader and base loop spend per wake-up to wait their way (wakeable by
+# stop and commands) against the floor's blocking read and clock_nanosleep.
+add_executable(bench_wait bench/bench_wait.cpp)
+target_link_libraries(bench_wait srd_core srd_sim)
+
 # The floor: the least a roscpp driver of this robot must do, driver_bench's yardstick.
 add_executable(floor_node bench/floor_node.cpp bench/floor_interface.cpp)
 target_include_directories(floor_node PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})

@@ -14,6 +14,7 @@ set(SRD_CORE_SOURCES
   src/transport/recorded_stream.cpp
   src/core/serial_link.cpp
   src/core/loop_clock.cpp
+  src/core/loop_wake.cpp
   src/core/realtime.cpp
   src/core/device_module.cpp
   src/params/device_sections.cpp

@@ -10,6 +10,10 @@ class SteadyLoopClock : public LoopClock {
                  Clock::time_point deadline) override {
     wake.wait_until(lock, deadline);
   }
+  void waitUntil(std::unique_lock<std::mutex>& lock, LoopWake& wake,
+                 Clock::time_point deadline) override {
+    wake.waitUntil(lock, deadline);
+  }
 };
 }  // namespace
 

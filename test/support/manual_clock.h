@@ -4,6 +4,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 
 #include "serial_robot_driver/core/loop_clock.h"
@@ -23,17 +24,16 @@ class ManualClock : public LoopClock {
 
   void waitUntil(std::unique_lock<std::mutex>& loop_lock, std::condition_variable& wake,
                  Clock::time_point /*deadline*/) override {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      loop_mutex_ = loop_lock.mutex();
-      wake_ = &wake;
-      ++waits_;
-      waiting_ = true;
-    }
-    idle_.notify_all();
+    enterWait(loop_lock, [&wake] { wake.notify_all(); });
     wake.wait(loop_lock);  // until advance() or the controller itself notifies
-    std::lock_guard<std::mutex> lock(mutex_);
-    waiting_ = false;
+    leaveWait();
+  }
+
+  void waitUntil(std::unique_lock<std::mutex>& loop_lock, LoopWake& wake,
+                 Clock::time_point /*deadline*/) override {
+    enterWait(loop_lock, [&wake] { wake.notify(); });
+    wake.wait(loop_lock);  // until advance() or the controller itself notifies
+    leaveWait();
   }
 
   /// Returns once the loop thread waits for the first time (call after start()).
@@ -60,7 +60,7 @@ class ManualClock : public LoopClock {
   void advance(Clock::duration d) {
     step([&] {
       std::mutex* loop_mutex = nullptr;
-      std::condition_variable* wake = nullptr;
+      std::function<void()> wake;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         now_ += d;
@@ -69,7 +69,7 @@ class ManualClock : public LoopClock {
       }
       // Taking the loop's mutex first: the loop is either before its time check or waiting.
       std::lock_guard<std::mutex> lock(*loop_mutex);
-      wake->notify_all();
+      wake();
     });
   }
 
@@ -79,6 +79,21 @@ class ManualClock : public LoopClock {
   }
 
  private:
+  void enterWait(std::unique_lock<std::mutex>& loop_lock, std::function<void()> wake) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      loop_mutex_ = loop_lock.mutex();
+      wake_ = std::move(wake);
+      ++waits_;
+      waiting_ = true;
+    }
+    idle_.notify_all();
+  }
+  void leaveWait() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    waiting_ = false;
+  }
+
   uint64_t waits() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return waits_;
@@ -92,7 +107,7 @@ class ManualClock : public LoopClock {
   std::condition_variable idle_;
   Clock::time_point now_;
   std::mutex* loop_mutex_ = nullptr;
-  std::condition_variable* wake_ = nullptr;
+  std::function<void()> wake_;  ///< ends the loop's wait (its condition variable or LoopWake)
   uint64_t waits_ = 0;
   bool waiting_ = false;
 };

@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 
+#include "serial_robot_driver/core/loop_wake.h"
 #include "serial_robot_driver/core/serial_link.h"
 
 namespace serial_robot_driver::core {
@@ -19,6 +20,10 @@ class LoopClock {
   /// this clock or a notification, whichever comes first. May return early; the worker checks
   /// again.
   virtual void waitUntil(std::unique_lock<std::mutex>& lock, std::condition_variable& wake,
+                         Clock::time_point deadline) = 0;
+  /// The same for a worker woken through a LoopWake (see there: notifications pending while
+  /// `lock` is held are dropped).
+  virtual void waitUntil(std::unique_lock<std::mutex>& lock, LoopWake& wake,
                          Clock::time_point deadline) = 0;
 };
 

@@ -54,7 +54,7 @@ BaseController::~BaseController() {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
   }
-  wake_.notify_all();
+  wake_.notify();
   if (loop_.joinable()) loop_.join();
 }
 
@@ -91,7 +91,7 @@ CommandOutcome BaseController::submitCommand(double linear_x, double angular_z,
     }
   }
   if (!written_here) {
-    wake_.notify_all();
+    wake_.notify();
     return valid ? CommandOutcome::kStored : CommandOutcome::kNotFinite;
   }
   reportSpeedFrame(report);
@@ -128,7 +128,7 @@ void BaseController::setEStop(bool engaged) {
     last_command_.reset();
     linear_x_ = angular_z_ = 0.0;
   }
-  wake_.notify_all();
+  wake_.notify();
 }
 
 bool BaseController::commandMovesLocked(core::Clock::time_point now) const {
@@ -216,7 +216,7 @@ void BaseController::stop() {
     stopped_ = true;
     running_ = false;  // no cmd_vel written after the last words below
   }
-  wake_.notify_all();
+  wake_.notify();
   if (loop_.joinable()) loop_.join();
   // Last words: a zero-speed frame, so the wheels stop now rather than at the base's 1 s timeout.
   WheelFrameSent sent;
@@ -288,7 +288,7 @@ void BaseController::onLinkUp() {
     unanswered_since_.reset();  // a new connection gets its own poll periods to answer
     silent_reported_ = false;
   }
-  wake_.notify_all();
+  wake_.notify();
 }
 
 void BaseController::onLinkDown() {
@@ -333,7 +333,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
         needs_reset_ = true;
         command_pending_ = true;  // Reset on the wire now, not at the next tick
       }
-      wake_.notify_all();
+      wake_.notify();
       if (events_.on_timeout_error) events_.on_timeout_error();
       break;
     }

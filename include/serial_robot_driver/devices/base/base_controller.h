@@ -31,7 +31,6 @@
 //    waits for a base write); the loop reads the newest sample when it advances the odometry.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -43,6 +42,7 @@
 #include <vector>
 
 #include "serial_robot_driver/core/loop_clock.h"
+#include "serial_robot_driver/core/loop_wake.h"
 #include "serial_robot_driver/core/serial_link.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/base/base_odometry.h"
@@ -294,7 +294,9 @@ class BaseController : public core::LinkListener {
   std::mutex report_mutex_;
   /// Under mutex_: frames written, not yet reported.
   std::deque<WheelFrameSent> unreported_frames_;
-  std::condition_variable wake_;
+  /// Ends the loop's wait for a command, an e-stop, an FF error, a link up or stop(); the state
+  /// it is for is set under mutex_ first.
+  core::LoopWake wake_;
   bool stopping_ = false;
   bool stopped_ = false;
   bool running_ = false;          ///< between start() and stop(): cmd_vel written by its caller

@@ -199,7 +199,9 @@ TEST_F(BaseControllerTest, CmdVelFloodIsLimitedToTheLineShareAndTicksKeepTheirSc
       ++scheduled;
       continue;
     }
-    if (last_immediate) EXPECT_GE(sent.time - *last_immediate, kExpectedImmediateInterval);
+    if (last_immediate) {
+      EXPECT_GE(sent.time - *last_immediate, kExpectedImmediateInterval);
+    }
     last_immediate = sent.time;
   }
   EXPECT_EQ(scheduled, 10) << "one tick per 20 ms in 200 ms";
