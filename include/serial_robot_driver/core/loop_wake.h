@@ -1,7 +1,7 @@
 // What ends a worker thread's timed wait early: a command, an e-stop, a link event, stop(). A
 // POSIX semaphore, so that a periodic loop waits in one system call per period as a
 // clock_nanosleep would: a condition variable's timed wait takes two (its timeout ends with a
-// futex wake-up too), which `bench_wait` measures at about 8 us more per tick on a 2-core VM.
+// futex wake-up too), about 4 us more per tick on a 2-core VM (bench/bench_wait.cpp).
 #pragma once
 
 #include <semaphore.h>
