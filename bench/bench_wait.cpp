@@ -203,7 +203,7 @@ void printTable(const std::vector<Comparison>& comparisons, int rounds, double s
     std::printf("| %s | %.1f us | %.1f us | %+.1f us | %.2fx | %s |\n", c.what, floor_us, node_us,
                 node_us - floor_us, node_us / floor_us, each_round.c_str());
   }
-  std::printf("\n%d rounds of %.0f s per way; CPU from each waiting thread's own clock.\n", rounds,
+  std::printf("\n%d round(s) of %.0f s per way; CPU from each waiting thread's own clock.\n", rounds,
               seconds);
 }
 
