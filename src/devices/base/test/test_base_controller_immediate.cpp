@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "support/base_controller_fixture.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::devices::base {
 namespace {
@@ -153,6 +154,43 @@ TEST(BaseControllerImmediate, CommandsRacingTheLoopAndTheEStopKeepOneSequenceAnd
   EXPECT_GT(by_caller, 0u) << "commands were written by their caller";
   EXPECT_LT(by_caller, written.size()) << "and the loop wrote too";
   EXPECT_GT(motion, 0u) << "between the e-stops the robot was driven";
+}
+
+// The real clock and a loop too slow to cover for a lost wake-up (one tick in 10 s): each e-stop
+// wakes the loop (core::LoopWake), which writes the zero frame at once, cycle after cycle, each
+// after a motion frame its caller wrote. A wake-up lost would leave the wheels turning until the
+// tick.
+TEST(BaseControllerImmediate, EachEStopWakesTheLoopToWriteTheZeroFrameWithoutWaitingForATick) {
+  BaseConfig config = quietConfig();
+  config.loop_rate = 0.1;
+  config.baud = 4000000;
+  config.cmd_vel_timeout = 60.0;
+  WireLog log;
+  auto controller = controllerWritingTo(log, config);
+  controller->start();
+  const std::thread::id caller = std::this_thread::get_id();
+  auto zeroFramesByTheLoop = [&] {
+    std::size_t count = 0;
+    for (const WireLog::Written& written : log.written()) {
+      const bool speed_frame = written.frame.size() >= 13 && written.frame[4] == 0x01;
+      count += speed_frame && !isMotionFrame(written.frame) && written.thread != caller;
+    }
+    return count;
+  };
+  for (std::size_t cycle = 1; cycle <= 20; ++cycle) {
+    ASSERT_TRUE(test_support::waitFor(
+        [&] {
+          return controller->submitCommand(0.3, 0.0, controller->generation()) ==
+                 CommandOutcome::kSent;
+        },
+        4.0))
+        << "cycle " << cycle << ": the command was not written by its caller";
+    controller->setEStop(true);
+    ASSERT_TRUE(test_support::waitFor([&] { return zeroFramesByTheLoop() >= cycle; }, 4.0))
+        << "cycle " << cycle << ": no zero frame from the loop before its tick";
+    controller->setEStop(false);
+  }
+  controller->stop();
 }
 
 // The loop and a cmd_vel's caller both write frames; every front end (wheel_command, the DDS
