@@ -25,12 +25,10 @@ void LoopWake::dropPending() {
 
 bool LoopWake::waitUntil(std::unique_lock<std::mutex>& lock, Clock::time_point deadline) {
   // steady_clock is CLOCK_MONOTONIC: its time since epoch is that clock's reading.
-  const auto since_epoch = deadline.time_since_epoch();
-  const auto whole = std::chrono::duration_cast<std::chrono::seconds>(since_epoch);
-  timespec until{};
-  until.tv_sec = static_cast<time_t>(whole.count());
-  until.tv_nsec = static_cast<long>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(since_epoch - whole).count());
+  const auto ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(deadline.time_since_epoch()).count();
+  const timespec until{static_cast<time_t>(ns / 1000000000),
+                       static_cast<long>(ns % 1000000000)};  // NOLINT: timespec's type
   dropPending();
   lock.unlock();
   int result = 0;
@@ -39,14 +37,6 @@ bool LoopWake::waitUntil(std::unique_lock<std::mutex>& lock, Clock::time_point d
   } while (result != 0 && errno == EINTR);
   lock.lock();
   return result == 0;
-}
-
-void LoopWake::wait(std::unique_lock<std::mutex>& lock) {
-  dropPending();
-  lock.unlock();
-  while (::sem_wait(&semaphore_) != 0 && errno == EINTR) {
-  }
-  lock.lock();
 }
 
 }  // namespace serial_robot_driver::core

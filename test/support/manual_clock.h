@@ -32,7 +32,8 @@ class ManualClock : public LoopClock {
   void waitUntil(std::unique_lock<std::mutex>& loop_lock, LoopWake& wake,
                  Clock::time_point /*deadline*/) override {
     enterWait(loop_lock, [&wake] { wake.notify(); });
-    wake.wait(loop_lock);  // until advance() or the controller itself notifies
+    // Until advance() or the controller itself notifies.
+    wake.waitUntil(loop_lock, Clock::time_point::max());
     leaveWait();
   }
 

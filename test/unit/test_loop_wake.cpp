@@ -81,7 +81,7 @@ TEST(LoopWake, WaitWithoutADeadlineEndsOnANotification) {
     advanced = true;
     wake.notify();
   });
-  while (!advanced) wake.wait(lock);
+  while (!advanced) wake.waitUntil(lock, Clock::time_point::max());
   EXPECT_TRUE(lock.owns_lock());
   lock.unlock();
   notifier.join();

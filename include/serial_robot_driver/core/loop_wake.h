@@ -28,12 +28,10 @@ class LoopWake {
   void notify();
 
   /// With `lock` (the worker's mutex) held: drops the notifications seen, releases the mutex,
-  /// waits until `deadline` (steady clock) or a notify(), and takes the mutex again. True when a
-  /// notify() ended it.
+  /// waits until `deadline` (steady clock; Clock::time_point::max() for a notify() alone, as a
+  /// test's manual clock waits) or a notify(), and takes the mutex again. True when a notify()
+  /// ended it.
   bool waitUntil(std::unique_lock<std::mutex>& lock, Clock::time_point deadline);
-
-  /// As waitUntil() without a deadline (a test's manual clock moves time by notifying).
-  void wait(std::unique_lock<std::mutex>& lock);
 
  private:
   void dropPending();

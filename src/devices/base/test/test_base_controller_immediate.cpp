@@ -42,8 +42,10 @@ class WireLog {
 };
 
 // Speed frame (docs/protocols.md): 55 AA 09 SEQ 01, then left and right ticks, 8 bytes.
+bool isSpeedFrame(const Bytes& frame) { return frame.size() >= 13 && frame[4] == 0x01; }
+
 bool isMotionFrame(const Bytes& frame) {
-  if (frame.size() < 13 || frame[4] != 0x01) return false;
+  if (!isSpeedFrame(frame)) return false;
   for (std::size_t i = 5; i < 13; ++i) {
     if (frame[i] != 0) return true;
   }
@@ -60,6 +62,15 @@ std::unique_ptr<BaseController> controllerWritingTo(WireLog& log, const BaseConf
 BaseConfig quietConfig() {
   BaseConfig config;
   config.battery_poll_rate = 0;
+  return config;
+}
+
+/// quietConfig() on a 4 Mbaud line, where an immediate frame may follow the last after ~70 us.
+BaseConfig fastLineConfig(double loop_rate, double cmd_vel_timeout) {
+  BaseConfig config = quietConfig();
+  config.loop_rate = loop_rate;
+  config.baud = 4000000;
+  config.cmd_vel_timeout = cmd_vel_timeout;
   return config;
 }
 
@@ -113,10 +124,7 @@ TEST(BaseControllerImmediate, AnEStopEngagedBeforeTheWriteMeansNoMotionFrame) {
 // The real clock, a 1 kHz loop and a fast line, so the loop's ticks, the commands written by their
 // caller and the e-stop's zero frames race each other for the port.
 TEST(BaseControllerImmediate, CommandsRacingTheLoopAndTheEStopKeepOneSequenceAndStopWhenTold) {
-  BaseConfig config = quietConfig();
-  config.loop_rate = 1000.0;
-  config.baud = 4000000;  // an immediate frame may follow the last after ~70 us
-  config.cmd_vel_timeout = 5.0;
+  const BaseConfig config = fastLineConfig(1000.0, 5.0);
   WireLog log;
   auto controller = controllerWritingTo(log, config);
   controller->start();
@@ -161,10 +169,7 @@ TEST(BaseControllerImmediate, CommandsRacingTheLoopAndTheEStopKeepOneSequenceAnd
 // after a motion frame its caller wrote. A wake-up lost would leave the wheels turning until the
 // tick.
 TEST(BaseControllerImmediate, EachEStopWakesTheLoopToWriteTheZeroFrameWithoutWaitingForATick) {
-  BaseConfig config = quietConfig();
-  config.loop_rate = 0.1;
-  config.baud = 4000000;
-  config.cmd_vel_timeout = 60.0;
+  const BaseConfig config = fastLineConfig(0.1, 60.0);
   WireLog log;
   auto controller = controllerWritingTo(log, config);
   controller->start();
@@ -172,8 +177,8 @@ TEST(BaseControllerImmediate, EachEStopWakesTheLoopToWriteTheZeroFrameWithoutWai
   auto zeroFramesByTheLoop = [&] {
     std::size_t count = 0;
     for (const WireLog::Written& written : log.written()) {
-      const bool speed_frame = written.frame.size() >= 13 && written.frame[4] == 0x01;
-      count += speed_frame && !isMotionFrame(written.frame) && written.thread != caller;
+      count += isSpeedFrame(written.frame) && !isMotionFrame(written.frame) &&
+               written.thread != caller;
     }
     return count;
   };
@@ -196,10 +201,7 @@ TEST(BaseControllerImmediate, EachEStopWakesTheLoopToWriteTheZeroFrameWithoutWai
 // The loop and a cmd_vel's caller both write frames; every front end (wheel_command, the DDS
 // graph) still hears of them once each, in the order they went out.
 TEST(BaseControllerImmediate, WrittenFramesAreReportedOnceEachInWriteOrderWhileTheLoopRaces) {
-  BaseConfig config = quietConfig();
-  config.loop_rate = 1000.0;
-  config.baud = 4000000;
-  config.cmd_vel_timeout = 5.0;
+  const BaseConfig config = fastLineConfig(1000.0, 5.0);
   WireLog log;
   std::mutex reported_mutex;
   std::vector<uint8_t> reported;
