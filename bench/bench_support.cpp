@@ -1,5 +1,6 @@
 #include "bench_support.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <sched.h>
@@ -224,6 +225,28 @@ double processCpuSeconds(pid_t pid) {
     if (number == 15) stime = std::stoull(field);
   }
   return static_cast<double>(utime + stime) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
+
+std::map<pid_t, ThreadCpu> threadCpuSeconds(pid_t pid) {
+  std::map<pid_t, ThreadCpu> threads;
+  const std::string tasks = "/proc/" + std::to_string(pid) + "/task/";
+  DIR* dir = ::opendir(tasks.c_str());
+  if (dir == nullptr) return threads;
+  while (const dirent* entry = ::readdir(dir)) {
+    char* end = nullptr;
+    const long tid = std::strtol(entry->d_name, &end, 10);
+    if (end == entry->d_name || *end != '\0') continue;  // "." and ".."
+    std::ifstream comm(tasks + entry->d_name + "/comm");
+    std::ifstream schedstat(tasks + entry->d_name + "/schedstat");
+    ThreadCpu thread;
+    unsigned long long on_cpu_ns = 0;
+    if (!std::getline(comm, thread.name) || !(schedstat >> on_cpu_ns)) continue;  // just exited
+    thread.main = tid == pid;
+    thread.seconds = 1e-9 * static_cast<double>(on_cpu_ns);
+    threads[static_cast<pid_t>(tid)] = thread;
+  }
+  ::closedir(dir);
+  return threads;
 }
 
 CpuWindow::CpuWindow(pid_t pid)

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -75,6 +76,16 @@ class ChildProcess {
 /// User + system CPU time of a process in seconds (its kernel CPU clock, ns resolution; falls
 /// back to /proc/<pid>/stat, clock-tick resolution).
 double processCpuSeconds(pid_t pid);
+
+/// One thread's on-CPU time so far (the scheduler's count, /proc/<pid>/task/<tid>/schedstat, ns).
+struct ThreadCpu {
+  std::string name;  ///< its comm: what pthread_setname_np set, else the process's name
+  bool main = false;  ///< the process's first thread (tid == pid)
+  double seconds = 0;
+};
+
+/// Every thread of a process now, by tid; empty when the process is gone.
+std::map<pid_t, ThreadCpu> threadCpuSeconds(pid_t pid);
 
 /// Measures a process's CPU share over a window: construct at the start, call percent() at the end.
 class CpuWindow {

@@ -1516,26 +1516,73 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   return figures;
 }
 
-/// CPU of driver_node and of the same-job floor measured over one window in which both run.
-struct CpuAtOnce {
-  double node = 0;      ///< s/s
-  double same_job = 0;  ///< s/s
+/// One program's CPU over a window by thread, s/s: its port reader, its base loop, and the rest
+/// (roscpp's threads, the callbacks, threads that ended in the window).
+struct CpuByThread {
+  double reader = 0;
+  double loop = 0;
+  double rest = 0;
 };
 
-/// driver_node and the same-job floor set up side by side (UserSetup each), then telemetry at
-/// 100 Hz to both at once, the two frames of a period written back to back in alternating order:
-/// each program's CPU over the same `frames`-frame window. Whatever else the machine does in that
-/// window weighs on both, where back-to-back sessions each meet their own moment of it.
+/// How a program's reader and loop are told apart: driver_node names them; floor_node names its
+/// reader and runs its loop on the main thread (loop nullptr).
+struct ThreadRoles {
+  const char* reader;
+  const char* loop;
+};
+constexpr ThreadRoles kNodeThreads{"srd_reader", "srd_base_loop"};
+constexpr ThreadRoles kFloorThreads{"floor_reader", nullptr};
+
+/// A program's CPU at the start of a window: the whole process and each thread.
+struct CpuMark {
+  double process = 0;
+  std::map<pid_t, ThreadCpu> threads;
+};
+CpuMark markCpu(pid_t pid) { return {processCpuSeconds(pid), threadCpuSeconds(pid)}; }
+
+/// The window from `start` to now, per second of `seconds`, split by `roles`.
+CpuByThread cpuSince(pid_t pid, const CpuMark& start, double seconds, const ThreadRoles& roles) {
+  const CpuMark end = markCpu(pid);
+  CpuByThread split;
+  for (const auto& [tid, thread] : end.threads) {
+    const auto before = start.threads.find(tid);  // a thread started in the window: all of it
+    const double earlier = before != start.threads.end() ? before->second.seconds : 0;
+    const double used = thread.seconds - earlier;
+    const bool loop = roles.loop != nullptr ? thread.name == roles.loop : thread.main;
+    if (thread.name == roles.reader) split.reader += used / seconds;
+    if (loop) split.loop += used / seconds;
+  }
+  split.rest = (end.process - start.process) / seconds - split.reader - split.loop;
+  return split;
+}
+
+double total(const CpuByThread& cpu) { return cpu.reader + cpu.loop + cpu.rest; }
+
+/// CPU of driver_node and of another program (the same-job floor, or driver_node again) measured
+/// over one window in which both run.
+struct CpuAtOnce {
+  CpuByThread node;
+  CpuByThread other;
+};
+
+/// driver_node and `other` set up side by side (UserSetup each), then telemetry at 100 Hz to both
+/// at once, the two frames of a period written back to back in alternating order: each program's
+/// CPU over the same `frames`-frame window. Whatever else the machine does in that window weighs
+/// on both, where back-to-back sessions each meet their own moment of it. With `other` driver_node
+/// too, the control: how far two identical programs' CPU differ in one window.
 CpuAtOnce measureCpuAtOnce(Context& context, const UserCondition& condition, std::size_t round,
-                           Transport transport, std::size_t frames) {
+                           Transport transport, std::size_t frames, const Variant& other_variant) {
   constexpr std::size_t kSettleFrames = 200;  // both streamed before the window (2 s)
+  const bool control = !other_variant.same_job;
   UserSetup node(context, kEventDriven, condition,
                  userNamespace("atonce_" + kEventDriven.tag, condition, round, transport),
                  transport, kSettleFrames + frames + 10);
-  UserSetup same_job(context, kSameJobFloor, condition,
-                     userNamespace("atonce_" + kSameJobFloor.tag, condition, round, transport),
-                     transport, kSettleFrames + frames + 10);
-  UserSetup* const both[] = {&node, &same_job};
+  UserSetup other(context, other_variant, condition,
+                  userNamespace(std::string(control ? "atonce_again_" : "atonce_") +
+                                    other_variant.tag,
+                                condition, round, transport),
+                  transport, kSettleFrames + frames + 10);
+  UserSetup* const both[] = {&node, &other};
   uint32_t seq = UserSetup::kWarmUpFrames;
   auto stream = [&](std::size_t count) {
     const Clock::time_point start = Clock::now();
@@ -1549,15 +1596,16 @@ CpuAtOnce measureCpuAtOnce(Context& context, const UserCondition& condition, std
   };
   const BackgroundLoad load(context.paths, condition.loaded);
   stream(kSettleFrames);
-  const double node_start = processCpuSeconds(node.driver.pid());
-  const double same_job_start = processCpuSeconds(same_job.driver.pid());
+  const CpuMark node_start = markCpu(node.driver.pid());
+  const CpuMark other_start = markCpu(other.driver.pid());
   const Clock::time_point start = Clock::now();
   stream(frames);
-  const double node_cpu = processCpuSeconds(node.driver.pid()) - node_start;
-  const double same_job_cpu = processCpuSeconds(same_job.driver.pid()) - same_job_start;
   const double seconds = toSeconds(Clock::now() - start);
-  require(node.driver.running() && same_job.driver.running(), "a program stopped mid-window");
-  return {node_cpu / seconds, same_job_cpu / seconds};
+  CpuAtOnce cpu{cpuSince(node.driver.pid(), node_start, seconds, kNodeThreads),
+                cpuSince(other.driver.pid(), other_start, seconds,
+                         control ? kNodeThreads : kFloorThreads)};
+  require(node.driver.running() && other.driver.running(), "a program stopped mid-window");
+  return cpu;
 }
 
 /// One figure of section 8, taken from a session's UserFigures. A latency or jitter figure is a
@@ -1608,8 +1656,10 @@ struct UserRuns {
   std::vector<std::vector<UserFigures>> node{kUserConditions.size()};
   std::vector<std::vector<UserFigures>> same_job{kUserConditions.size()};
   std::vector<std::vector<UserFigures>> floor{kUserConditions.size()};
-  /// measureCpuAtOnce's, per condition with RT off, one entry per round.
+  /// measureCpuAtOnce's, per condition with RT off, one entry per round: against the same-job
+  /// floor, and the control against driver_node itself.
   std::vector<std::vector<CpuAtOnce>> cpu_at_once{kUserConditions.size()};
+  std::vector<std::vector<CpuAtOnce>> cpu_against_itself{kUserConditions.size()};
   std::vector<std::vector<UserFigures>>& of(const Variant& variant) {
     if (variant.same_job) return same_job;
     return variant.program == kFloor.program ? floor : node;
@@ -1666,23 +1716,21 @@ std::string perRoundRatios(const UserRuns& runs, std::size_t condition, const Us
   return text.empty() ? "-" : text;
 }
 
-/// The summary's cells for the CPU measured with both programs at once in one condition: as
-/// userCells() and perRoundRatios() fill them (the minimal floor did not take part).
-std::vector<std::string> cpuAtOnceCells(const UserRuns& runs, std::size_t condition) {
-  const std::vector<CpuAtOnce>& rounds = runs.cpu_at_once[condition];
+/// The summary's cells for the CPU measured with two programs at once in one condition's rounds:
+/// as userCells() and perRoundRatios() fill them (the minimal floor did not take part).
+std::vector<std::string> cpuAtOnceCells(const std::vector<CpuAtOnce>& rounds) {
   if (rounds.empty()) return {"-", "-", "-", "-", "-", "-"};
-  std::vector<double> node, same_job;
+  std::vector<double> node, other;
   std::string each_round;
   for (const CpuAtOnce& round : rounds) {
-    node.push_back(round.node);
-    same_job.push_back(round.same_job);
+    node.push_back(total(round.node));
+    other.push_back(total(round.other));
     if (!each_round.empty()) each_round += ", ";
-    each_round += round.same_job > 0 ? format("%.2fx", round.node / round.same_job) : "-";
+    each_round += other.back() > 0 ? format("%.2fx", node.back() / other.back()) : "-";
   }
-  const double node_mean = *meanOf(node), same_job_mean = *meanOf(same_job);  // both non-empty
-  return {format("%.4f s/s", node_mean), format("%.4f s/s", same_job_mean),
-          same_job_mean > 0 ? format("%.2fx", node_mean / same_job_mean) : "-", "-", "-",
-          each_round};
+  const double node_mean = *meanOf(node), other_mean = *meanOf(other);  // both non-empty
+  return {format("%.4f s/s", node_mean), format("%.4f s/s", other_mean),
+          other_mean > 0 ? format("%.2fx", node_mean / other_mean) : "-", "-", "-", each_round};
 }
 
 /// The columns userCells() fills.
@@ -1714,11 +1762,16 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
     UserFigureIndex figure;
     UserConditionIndex condition;
     const char* goal;
-    bool at_once = false;  ///< the CPU with both programs at once (cpuAtOnceCells)
+    /// The CPU with two programs at once (cpuAtOnceCells): the same-job floor, or the control.
+    std::vector<std::vector<CpuAtOnce>> UserRuns::*at_once = nullptr;
   };
+  constexpr auto kAtOnce = &UserRuns::cpu_at_once;
+  constexpr auto kControl = &UserRuns::cpu_against_itself;
   const Row rows[] = {
       {"CPU at 100 Hz telemetry, 20 servos", kCpuFigure, kQuietIndex, "<= 1.1x"},
-      {"the same, node and same-job floor at once", kCpuFigure, kQuietIndex, "<= 1.1x", true},
+      {"the same, node and same-job floor at once", kCpuFigure, kQuietIndex, "<= 1.1x", kAtOnce},
+      {"control: driver_node and a second driver_node at once", kCpuFigure, kQuietIndex,
+       "(the measurement's spread)", kControl},
       {"cmd_vel -> speed frame on the wire, p99", kCmdVelP99, kQuietIndex, "<= 1 ms and <= 1.2x"},
       {"telemetry last byte -> joint_states, p99 (quiet)", kTelemetryP99, kQuietIndex, "keep"},
       {"the same with a CPU hog at nice 0 on each core", kTelemetryP99, kLoadedIndex, "<= 1.2x"},
@@ -1727,12 +1780,14 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
        kLoadedIndex, "<= 1.2x"},
       {"the same, ~realtime_priority on", kLoopJitter, kLoadedRtIndex, "<= 1.0x"},
       {"CPU under that load", kCpuFigure, kLoadedIndex, "<= 1.1x"},
-      {"the same, node and same-job floor at once", kCpuFigure, kLoadedIndex, "<= 1.1x", true},
+      {"the same, node and same-job floor at once", kCpuFigure, kLoadedIndex, "<= 1.1x", kAtOnce},
+      {"control: driver_node and a second driver_node at once", kCpuFigure, kLoadedIndex,
+       "(the measurement's spread)", kControl},
   };
   for (const Row& row : rows) {
     std::vector<std::string> cells{row.what};
-    if (row.at_once) {
-      const auto figures = cpuAtOnceCells(runs, row.condition);
+    if (row.at_once != nullptr) {
+      const auto figures = cpuAtOnceCells((runs.*row.at_once)[row.condition]);
       cells.insert(cells.end(), figures.begin(), figures.end());
     } else {
       const auto figures = userCells(runs, row.condition, kUserFigures[row.figure]);
@@ -1742,6 +1797,57 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
     cells.push_back(row.goal);
     table.row(cells);
   }
+  table.note(
+      "The control rows put a second driver_node where the same-job floor stands at once: two "
+      "identical programs, so each round's ratio is how far this machine moves one program's CPU "
+      "against another's in one window (the phases of their threads' wake-ups against each "
+      "other's and the load's). A node / same-job ratio within that spread of 1.0 is not told "
+      "apart from it by these rounds.");
+}
+
+/// Where the CPU measured at once goes, by thread (the mean of the rounds): which of the node's
+/// threads holds what it spends beyond the same-job floor, per event of that thread.
+void addCpuAtOnceByThread(ResultTable& table, const UserRuns& runs, Transport transport) {
+  table.section("8. The configuration users run against the floor, " + transportLabel(transport) +
+                    ": CPU at once, by thread (RT off, the mean of the rounds)",
+                {"load", "thread", "driver_node", "same-job floor", "node - same job",
+                 "the same per event"});
+  struct Role {
+    const char* name;
+    double (*of)(const CpuByThread&);
+    double events_per_second;  ///< 0: per second
+    const char* event;
+  };
+  const Role roles[] = {
+      {"port reader", [](const CpuByThread& c) { return c.reader; }, 100.0, "telemetry frame"},
+      {"base loop", [](const CpuByThread& c) { return c.loop; }, 50.0, "loop tick"},
+      {"the rest (roscpp, callbacks)", [](const CpuByThread& c) { return c.rest; }, 0, "s"},
+      {"all", total, 0, "s"},
+  };
+  for (UserConditionIndex condition : {kQuietIndex, kLoadedIndex}) {
+    const std::vector<CpuAtOnce>& rounds = runs.cpu_at_once[condition];
+    if (rounds.empty()) continue;
+    for (const Role& role : roles) {
+      std::vector<double> node, same_job;
+      for (const CpuAtOnce& round : rounds) {
+        node.push_back(role.of(round.node));
+        same_job.push_back(role.of(round.other));
+      }
+      const double node_ms = 1e3 * *meanOf(node), same_job_ms = 1e3 * *meanOf(same_job);
+      const double gap_ms = node_ms - same_job_ms;
+      const std::string per_event =
+          role.events_per_second > 0
+              ? format("%+.1f us a %s", 1e3 * gap_ms / role.events_per_second, role.event)
+              : format("%+.3f ms/s", gap_ms);
+      table.row({kUserConditions[condition].load(), role.name, format("%.3f ms/s", node_ms),
+                 format("%.3f ms/s", same_job_ms), format("%+.3f ms/s", gap_ms), per_event});
+    }
+  }
+  table.note(
+      "Each program's CPU by thread over the at-once window, from the scheduler's count of each "
+      "thread (/proc/<pid>/task/<tid>/schedstat): driver_node's srd_reader and srd_base_loop, "
+      "floor_node's floor_reader and its main thread (its loop); the rest is the process's CPU "
+      "less those two.");
 }
 
 /// Every figure in every condition, over `transport`.
@@ -1861,8 +1967,15 @@ void runUserRound(Context& context, std::size_t round, UserRunsByTransport* runs
               format("8. driver_node and floor_node ~same_job at once, %s, %s, round %zu",
                      condition.load().c_str(), transportName(transport).c_str(), round + 1),
               [&] {
-                (*runs)[transport].cpu_at_once[c].push_back(
-                    measureCpuAtOnce(context, condition, round, transport, window.frames));
+                (*runs)[transport].cpu_at_once[c].push_back(measureCpuAtOnce(
+                    context, condition, round, transport, window.frames, kSameJobFloor));
+              });
+      attempt(context,
+              format("8. driver_node against itself at once (control), %s, %s, round %zu",
+                     condition.load().c_str(), transportName(transport).c_str(), round + 1),
+              [&] {
+                (*runs)[transport].cpu_against_itself[c].push_back(measureCpuAtOnce(
+                    context, condition, round, transport, window.frames, kEventDriven));
               });
     }
   }
@@ -1877,6 +1990,7 @@ void runUserConfiguration(Context& context) {
   }
   for (Transport transport : context.options.transports) {
     addUserSummary(context.results, runs[transport], transport);
+    addCpuAtOnceByThread(context.results, runs[transport], transport);
   }
   for (Transport transport : context.options.transports) {
     addUserRows(context.results, runs[transport], transport);

@@ -15,11 +15,12 @@
 // written on the loop, the reply framed): the least a node offering driver_node's interface
 // spends on it whoever listens.
 //
-// Threading: one reader thread blocks on the port, frames telemetry and publishes one JointState
-// (and one Imu) per frame; the cmd_vel callback (the AsyncSpinner's thread) writes its speed frame
-// at once; the main thread writes the speed frame (and publishes odom, /tf, wheel_states) every
-// loop period on absolute clock_nanosleep deadlines; the diagnostics timer runs on the spinner's
-// thread. Writes from the two writers are serialised by one mutex. No validation or services.
+// Threading: one reader thread ("floor_reader") blocks on the port, frames telemetry and
+// publishes one JointState (and one Imu) per frame; the cmd_vel callback (the AsyncSpinner's
+// thread) writes its speed frame at once; the main thread writes the speed frame (and publishes
+// odom, /tf, wheel_states) every loop period on absolute clock_nanosleep deadlines; the diagnostics
+// timer runs on the spinner's thread. Writes from the two writers are serialised by one mutex. No
+// validation or services.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <fcntl.h>
 #include <geometry_msgs/Twist.h>
@@ -400,7 +401,13 @@ int main(int argc, char** argv) {
   ros::Subscriber cmd_vel;
   if (base) cmd_vel = subscribeCmdVel(nh, geometry);
   std::thread reader;
-  if (body) reader = std::thread([&] { publishTelemetry(joints, joint_states, job); });
+  if (body) {
+    reader = std::thread([&] {
+      // For driver_bench's CPU by thread; the loop is the main thread (named as the process).
+      ::pthread_setname_np(::pthread_self(), "floor_reader");
+      publishTelemetry(joints, joint_states, job);
+    });
+  }
 
   ros::AsyncSpinner spinner(1);
   spinner.start();
