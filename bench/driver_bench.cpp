@@ -1963,20 +1963,22 @@ void runUserRound(Context& context, std::size_t round, UserRunsByTransport* runs
             });
       }
       if (condition.realtime) continue;
-      attempt(context,
-              format("8. driver_node and floor_node ~same_job at once, %s, %s, round %zu",
-                     condition.load().c_str(), transportName(transport).c_str(), round + 1),
-              [&] {
-                (*runs)[transport].cpu_at_once[c].push_back(measureCpuAtOnce(
-                    context, condition, round, transport, window.frames, kSameJobFloor));
-              });
-      attempt(context,
-              format("8. driver_node against itself at once (control), %s, %s, round %zu",
-                     condition.load().c_str(), transportName(transport).c_str(), round + 1),
-              [&] {
-                (*runs)[transport].cpu_against_itself[c].push_back(measureCpuAtOnce(
-                    context, condition, round, transport, window.frames, kEventDriven));
-              });
+      // At once against the same-job floor, then the control against a second driver_node.
+      const std::pair<const Variant*, std::vector<std::vector<CpuAtOnce>> UserRuns::*> at_once[] =
+          {{&kSameJobFloor, &UserRuns::cpu_at_once},
+           {&kEventDriven, &UserRuns::cpu_against_itself}};
+      for (const auto& entry : at_once) {
+        const Variant* const other = entry.first;
+        const auto into = entry.second;
+        attempt(context,
+                format("8. driver_node and %s at once, %s, %s, round %zu",
+                       other->same_job ? "floor_node ~same_job" : "a second driver_node",
+                       condition.load().c_str(), transportName(transport).c_str(), round + 1),
+                [&] {
+                  ((*runs)[transport].*into)[c].push_back(measureCpuAtOnce(
+                      context, condition, round, transport, window.frames, *other));
+                });
+      }
     }
   }
 }
