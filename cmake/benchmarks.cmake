@@ -17,7 +17,9 @@ target_link_libraries(bench_wait srd_core srd_sim)
 add_executable(floor_node bench/floor_node.cpp bench/floor_interface.cpp)
 target_include_directories(floor_node PRIVATE ${PROJECT_SOURCE_DIR}/test ${catkin_INCLUDE_DIRS})
 target_link_libraries(floor_node srd_core ${catkin_LIBRARIES})
-add_dependencies(floor_node ${catkin_EXPORTED_TARGETS})
+# Its ~same_interface includes this package's messages, action and dynamic_reconfigure headers.
+add_dependencies(floor_node ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg
+  ${catkin_EXPORTED_TARGETS})
 
 # The servo bus's floor: one blocking READ_ANGLE client (driver_bench section 10); with --publish
 # it also publishes each answer on servo_states through roscpp.
