@@ -241,7 +241,6 @@ std::map<pid_t, ThreadCpu> threadCpuSeconds(pid_t pid) {
     ThreadCpu thread;
     unsigned long long on_cpu_ns = 0;
     if (!std::getline(comm, thread.name) || !(schedstat >> on_cpu_ns)) continue;  // just exited
-    thread.main = tid == pid;
     thread.seconds = 1e-9 * static_cast<double>(on_cpu_ns);
     threads[static_cast<pid_t>(tid)] = thread;
   }

@@ -80,7 +80,6 @@ double processCpuSeconds(pid_t pid);
 /// One thread's on-CPU time so far (the scheduler's count, /proc/<pid>/task/<tid>/schedstat, ns).
 struct ThreadCpu {
   std::string name;  ///< its comm: what pthread_setname_np set, else the process's name
-  bool main = false;  ///< the process's first thread (tid == pid)
   double seconds = 0;
 };
 

@@ -1548,7 +1548,7 @@ CpuByThread cpuSince(pid_t pid, const CpuMark& start, double seconds, const Thre
     const auto before = start.threads.find(tid);  // a thread started in the window: all of it
     const double earlier = before != start.threads.end() ? before->second.seconds : 0;
     const double used = thread.seconds - earlier;
-    const bool loop = roles.loop != nullptr ? thread.name == roles.loop : thread.main;
+    const bool loop = roles.loop != nullptr ? thread.name == roles.loop : tid == pid;
     if (thread.name == roles.reader) split.reader += used / seconds;
     if (loop) split.loop += used / seconds;
   }
