@@ -182,7 +182,9 @@ class RosInterfaceFuzz : public ::testing::Test {
     std::printf("ros_interface_fuzz: %llu inputs; inputs refused %s, callback errors %s\n",
                 static_cast<unsigned long long>(count_), status->value("inputs refused").c_str(),
                 status->value("callback errors").c_str());
-    if (count_ >= 30) EXPECT_GT(status->number("inputs refused"), 0u) << "nothing refused?";
+    if (count_ >= 30) {
+      EXPECT_GT(status->number("inputs refused"), 0u) << "nothing refused?";
+    }
   }
 
   ros::NodeHandle nh_;

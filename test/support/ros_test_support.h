@@ -53,6 +53,12 @@ class TopicCounter {
       if (keep_ > 0 && messages_.size() > keep_) messages_.erase(messages_.begin());
     });
   }
+  // The callback runs on the spinner thread and the members below die before sub_ would:
+  // shutdown() waits for a running callback (a test's counters going out of scope while a message
+  // arrived crashed the test process).
+  ~TopicCounter() { sub_.shutdown(); }
+  TopicCounter(const TopicCounter&) = delete;
+  TopicCounter& operator=(const TopicCounter&) = delete;
   uint64_t count() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return count_;
