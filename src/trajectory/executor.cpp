@@ -25,6 +25,7 @@ TrajectoryExecutor::TrajectoryExecutor(std::vector<TrajectoryJoints> groups,
       tracks_.push_back(track);
     }
   }
+  writing_.assign(tracks_.size(), false);
   actual_.resize(ranges_.size());
 }
 
@@ -143,8 +144,8 @@ CommandCheck TrajectoryExecutor::check(const TrajectoryCommand& command, double 
     // The bridge starts from the desired state where a trajectory runs, else from the measurement.
     std::vector<double> current;
     for (std::size_t j : result.joint_indices) {
-      current.push_back(tracks_[j].writing ? tracks_[j].spline.sample(now).position
-                                           : actual[j].sample.position);
+      current.push_back(writing_[j] ? tracks_[j].spline.sample(now).position
+                                    : actual[j].sample.position);
     }
     result = validate(command, ranges_, defaults_.max_velocity, start - now, current);
   }
@@ -167,7 +168,7 @@ bool TrajectoryExecutor::voided(std::size_t j) const {
 
 void TrajectoryExecutor::dropVoided(const std::vector<std::size_t>& joints, double now) {
   if (joints.empty()) return;
-  for (std::size_t j : joints) tracks_[j].writing = false;
+  for (std::size_t j : joints) writing_[j] = false;
   const std::string message = "trajectory of joint '" + ranges_[joints.front()].name +
                               "' dropped: e-stop engaged after this command was accepted";
   warnThrottled(kTrajectoryError, message, now);
@@ -179,12 +180,13 @@ void TrajectoryExecutor::apply(const TrajectoryCommand& command,
                                const Generations& accepted) {
   const std::vector<Measured> actual = measured();
   for (std::size_t column = 0; column < joints.size(); ++column) {
-    Track& track = tracks_[joints[column]];
+    const std::size_t j = joints[column];
+    Track& track = tracks_[j];
     track.accepted = accepted[track.group];
     // A joint nobody drives starts from where it is; a driven one from where it is meant to be.
-    if (!track.writing) track.spline = JointSpline(actual[joints[column]].sample.position);
+    if (!writing_[j]) track.spline = JointSpline(actual[j].sample.position);
     track.spline.splice(std::max(start, now), waypointsFor(command, column, start, now));
-    track.writing = true;
+    writing_[j] = true;
     track.sent_segment = -std::numeric_limits<double>::infinity();  // no move went out yet
   }
   setTickingLocked(true);
@@ -203,12 +205,12 @@ std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, dou
     if (group.move) {
       // Per-segment: a stop where the servo is, never a move to an angle that may be stale. The
       // desired state is the spline now (feedback, and where a later goal bridges from).
-      if (!track.writing && !track.moved) {
+      if (!writing_[j] && !track.moved) {
         left_alone.push_back(ranges_[j].name);
         continue;
       }
       track.spline = JointSpline(track.spline.sample(now).position);
-      track.writing = true;  // until the next tick: it has nothing more to send
+      writing_[j] = true;  // until the next tick: it has nothing more to send
       const std::string error = group.stop ? group.stop(track.local) : std::string();
       if (!error.empty()) warnThrottled(kTrajectoryError, "trajectory: " + error, now);
       continue;
@@ -220,12 +222,12 @@ std::string TrajectoryExecutor::hold(const std::vector<std::size_t>& joints, dou
         staleJoint(actual, {j}, now) < 0 ? std::optional<double>(actual[j].sample.position)
                                          : std::nullopt);
     if (!position) {
-      track.writing = false;
+      writing_[j] = false;
       left_alone.push_back(ranges_[j].name);
       continue;
     }
     track.spline = JointSpline(*position);
-    track.writing = true;  // written once, then the servo keeps it
+    writing_[j] = true;  // written once, then the servo keeps it
   }
   if (busyLocked()) setTickingLocked(true);
   return leftAloneText(left_alone);
@@ -328,8 +330,8 @@ void TrajectoryExecutor::takeOver(const std::vector<std::string>& names, const s
     if (joint == index_.end()) continue;
     // What this executor wrote is no longer the joint's last command.
     tracks_[joint->second].last_written.reset();
-    if (!tracks_[joint->second].writing) continue;
-    tracks_[joint->second].writing = false;
+    if (!writing_[joint->second]) continue;
+    writing_[joint->second] = false;
     taken.push_back(joint->second);
   }
   if (taken.empty()) return;
@@ -343,7 +345,7 @@ void TrajectoryExecutor::stopAll(const std::string& reason) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::size_t> all;
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
-    if (tracks_[j].writing) all.push_back(j);
+    if (writing_[j]) all.push_back(j);
   }
   for (const ActiveGoal& goal : goals_)
     all.insert(all.end(), goal.joints.begin(), goal.joints.end());
@@ -378,7 +380,7 @@ void TrajectoryExecutor::tick() {
 
 bool TrajectoryExecutor::busyLocked() const {
   return !goals_.empty() ||
-         std::any_of(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.writing; });
+         std::any_of(writing_.begin(), writing_.end(), [](uint8_t writing) { return writing; });
 }
 
 void TrajectoryExecutor::setTickingLocked(bool on) {
@@ -397,7 +399,7 @@ void TrajectoryExecutor::writeTracks(double now) {
   std::vector<std::size_t> voided_joints;
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
     Track& track = tracks_[j];
-    if (!track.writing) continue;
+    if (!writing_[j]) continue;
     const TrajectoryJoints& group = groups_[track.group];
     if (voided(j)) {
       voided_joints.push_back(j);
@@ -421,7 +423,7 @@ void TrajectoryExecutor::writeTracks(double now) {
     const bool owned = std::any_of(goals_.begin(), goals_.end(), [&](const ActiveGoal& goal) {
       return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
     });
-    if (!owned && now > track.spline.endTime()) track.writing = false;
+    if (!owned && now > track.spline.endTime()) writing_[j] = false;
     track.spline.prune(now);
   }
   for (std::size_t g = 0; g < groups_.size(); ++g) {
@@ -444,18 +446,16 @@ void TrajectoryExecutor::writeTracks(double now) {
 }
 
 bool TrajectoryExecutor::jointInMotionLocked(std::size_t j) const {
-  return tracks_[j].writing ||
-         std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
+  return writing_[j] || std::any_of(goals_.begin(), goals_.end(), [j](const ActiveGoal& goal) {
            return std::find(goal.joints.begin(), goal.joints.end(), j) != goal.joints.end();
          });
 }
 
 bool TrajectoryExecutor::inMotion() {
   std::lock_guard<std::mutex> lock(mutex_);
-  for (std::size_t j = 0; j < tracks_.size(); ++j) {
-    if (jointInMotionLocked(j)) return true;
-  }
-  return false;
+  // A goal always holds a joint (one without points is done at once), so "busy" is "a joint in
+  // motion"; asked once per telemetry frame, it reads one byte per track.
+  return busyLocked();
 }
 
 std::string TrajectoryExecutor::motionInForce() {

@@ -83,16 +83,35 @@ TEST(ConversionsJointState, FillingAgainLeavesNothingOfTheLastMessage) {
   EXPECT_TRUE(msg.effort.empty());
 }
 
+// The reader thread's reused message keeps its names: the values are filled again without them,
+// and everything else is what fillJointState() gives.
+TEST(ConversionsJointState, FillingTheValuesLeavesTheNamesAlone) {
+  const devices::body::JointReadings readings =
+      devices::body::jointReadings(goldenBodyTelemetry(), hipAndKnee());
+  sensor_msgs::JointState msg;
+  msg.header.frame_id = "stale";
+  msg.name = {"kept"};
+  msg.position = {1, 2, 3};
+  msg.effort = {7};
+  devices::body::ros::fillJointStateValues(readings, ros::Time(3, 4), &msg);
+  EXPECT_EQ(msg.name, std::vector<std::string>{"kept"});
+  msg.name = readings.names;
+  EXPECT_EQ(msg, devices::body::ros::toJointState(readings, ros::Time(3, 4)));
+}
+
 // The message published as a shared pointer is reused only while nobody else holds it (an
 // in-process subscriber may keep the one it got).
 TEST(ReusedMessage, ReusedOnlyWhenNobodyElseHoldsIt) {
   ReusedMessage<sensor_msgs::JointState> reused;
   sensor_msgs::JointState* first = &reused.next();
+  EXPECT_TRUE(reused.renewed());
   EXPECT_EQ(&reused.next(), first);  // only ours: filled again
+  EXPECT_FALSE(reused.renewed());
   sensor_msgs::JointState::ConstPtr kept = reused.get();
   first->name = {"kept"};
   sensor_msgs::JointState& second = reused.next();
   EXPECT_NE(&second, first);  // the subscriber's stays as it was
+  EXPECT_TRUE(reused.renewed()) << "a new message: every field is to be filled";
   second.name = {"new"};
   EXPECT_EQ(kept->name, std::vector<std::string>{"kept"});
   EXPECT_EQ(reused.get()->name, std::vector<std::string>{"new"});

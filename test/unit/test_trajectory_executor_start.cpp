@@ -156,6 +156,52 @@ TEST_F(ExecutorRig, TrajectoriesAcceptedBeforeAnEStopNeverMoveAfterItsRelease) {
   EXPECT_EQ(executor.motionInForce(), "");
 }
 
+// The motion question a sensor calibration asks once per frame (inMotion) agrees with the text it
+// asks for (motionInForce) through a goal's life, a bare trajectory, a joint taken over and a stop.
+TEST_F(ExecutorRig, InMotionAgreesWithMotionInForceAtEveryStep) {
+  const auto expectMoving = [this](bool moving, const char* when) {
+    EXPECT_EQ(executor.inMotion(), moving) << when;
+    EXPECT_EQ(!executor.motionInForce().empty(), moving)
+        << when << ": " << executor.motionInForce();
+  };
+  measure({"arm_1", "arm_2"}, {0.0, 0.0});
+  expectMoving(false, "idle");
+  GoalLog log;
+  executor.submitGoal(goalTo({"arm_2"}, {0.5}, 1.0), log.callbacks());
+  expectMoving(true, "a goal accepted");
+  for (double t = 100.1; t < 100.95; t += 0.1) {
+    tickAt(t);
+    ASSERT_FALSE(frames.empty());
+    measure({"arm_2"}, {frames.back().second.at(0)});  // it follows
+    expectMoving(true, "a goal running");
+  }
+  measure({"arm_2"}, {0.5});
+  for (double t = 101.0; t < 101.45; t += 0.1) tickAt(t);
+  ASSERT_TRUE(log.over()) << "the goal ended";
+  EXPECT_EQ(log.outcome().status, GoalStatus::kSucceeded);
+  expectMoving(false, "the goal over and its last position written");
+
+  using Submission = TrajectoryExecutor::Submission;
+  measure({"arm_1", "arm_2"}, {0.0, 0.5});
+  ASSERT_EQ(executor.submitTrajectory(goalTo({"arm_1"}, {0.2}, 1.0).command, std::nullopt),
+            Submission::kAccepted);
+  expectMoving(true, "a trajectory without a goal");
+  executor.takeOver({"arm_1"}, "joint_commands", [] { return true; });
+  expectMoving(false, "taken over by joint_commands");
+
+  GoalLog stopped;
+  ASSERT_EQ(executor.submitGoal(goalTo({"arm_1", "arm_2"}, {0.3, 0.3}, 1.0), stopped.callbacks()),
+            Submission::kAccepted);
+  tickAt(101.6);
+  executor.stopAll("test stop");
+  ASSERT_TRUE(stopped.over());
+  EXPECT_EQ(stopped.outcome().status, GoalStatus::kAborted);
+  expectMoving(true, "held: written once more");
+  tickAt(101.7);
+  tickAt(101.8);
+  expectMoving(false, "the hold written");
+}
+
 // The e-stop's hook missed (an e-stop engaged while the executor was writing): the device's gate
 // voids the frame, and the executor drops the trajectory and aborts its goal instead of retrying.
 TEST_F(ExecutorRig, AFrameTheGateVoidedDropsItsTrajectory) {

@@ -16,14 +16,19 @@ class ReusedMessage {
   /// a new one. Its fields hold what they held last (capacity included): fill each of them.
   Message& next() {
     // use_count() reads with acquire ordering: the other holders' last reads happened before.
-    if (!message_ || message_.use_count() != 1) message_ = boost::make_shared<Message>();
+    renewed_ = !message_ || message_.use_count() != 1;
+    if (renewed_) message_ = boost::make_shared<Message>();
     return *message_;
   }
+  /// Whether the last next() gave a new message rather than the one filled before it: a field that
+  /// is the same every time need only be filled in a new one.
+  bool renewed() const { return renewed_; }
   /// What next() returned, to publish.
   const boost::shared_ptr<Message>& get() const { return message_; }
 
  private:
   boost::shared_ptr<Message> message_;
+  bool renewed_ = true;
 };
 
 }  // namespace serial_robot_driver::ros_layer

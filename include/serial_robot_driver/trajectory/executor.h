@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -123,7 +124,6 @@ class TrajectoryExecutor {
     std::size_t local = 0;  ///< index into that group's joints
     double state_timeout = 0.5;
     JointSpline spline;
-    bool writing = false;       ///< tick() writes this joint (until its spline's end is written)
     double sent_segment = 0.0;  ///< per-segment joints: start of the segment whose move went out
     /// Streamed joints: the position last written (a write that succeeded); cleared when another
     /// command takes the joint over.
@@ -195,6 +195,10 @@ class TrajectoryExecutor {
   std::mutex mutex_;  // guards everything below
   GoalDefaults defaults_;
   std::vector<Track> tracks_;
+  /// Per track: tick() writes this joint (until its spline's end is written). Kept apart from the
+  /// tracks so that the motion question asked once per telemetry frame reads one cache line, not
+  /// one Track each.
+  std::vector<uint8_t> writing_;
   std::vector<ActiveGoal> goals_;
   bool running_ = false;
   bool ticking_ = false;  ///< the ticker is on

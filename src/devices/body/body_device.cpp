@@ -30,6 +30,7 @@ BodyDevice::BodyDevice(const params::DriverParams& params, core::SerialLink& lin
                   {[this](const Telemetry& telemetry, core::Clock::time_point arrival) {
                     onTelemetry(telemetry, arrival);
                   }}) {
+  joint_conversion_ = makeJointConversion(controller_.joints());
   link.addListener(&controller_);
   if (params.section(kImuSection).calibrate_on_start) {
     gyro_calibrator_.calibrateOnStart([](const GyroCalibrationOutcome& outcome) {
@@ -54,7 +55,7 @@ void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point
   telemetry_rate_.tick();
   // Converted once per frame for every consumer, into vectors that keep their capacity. The
   // trajectories need every frame: their goals are checked against it.
-  updateJointReadings(telemetry, controller_.joints(), &joint_readings_);
+  updateJointReadings(telemetry, joint_conversion_, &joint_readings_);
   const JointReadings& joints = joint_readings_;
   if (trajectory_) {
     trajectory_->updateActual(trajectory_tracks_, joints.positions, joints.velocities);

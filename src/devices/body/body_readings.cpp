@@ -28,18 +28,32 @@ JointReadings jointReadings(const Telemetry& telemetry, const std::vector<BodyJo
 
 void updateJointReadings(const Telemetry& telemetry, const std::vector<BodyJoint>& joints,
                          JointReadings* readings) {
-  const std::size_t count = std::min(joints.size(), telemetry.servo_count);
+  updateJointReadings(telemetry, makeJointConversion(joints), readings);
+}
+
+JointConversion makeJointConversion(const std::vector<BodyJoint>& joints) {
+  JointConversion conversion;
+  for (const BodyJoint& joint : joints) {
+    conversion.names.push_back(joint.name);
+    conversion.calibrations.push_back(joint.calibration);
+  }
+  return conversion;
+}
+
+void updateJointReadings(const Telemetry& telemetry, const JointConversion& joints,
+                         JointReadings* readings) {
+  const std::size_t count = std::min(joints.calibrations.size(), telemetry.servo_count);
   if (readings->names.size() != count) {
-    readings->names.clear();
-    for (std::size_t i = 0; i < count; ++i) readings->names.push_back(joints[i].name);
+    readings->names.assign(joints.names.begin(), joints.names.begin() + count);
+    ++readings->names_generation;
   }
   // The speed's unit is not documented: without a known scale the velocity stays empty rather
   // than guessed.
-  const bool velocity_known = count > 0 && joints.front().calibration.velocity_scale > 0;
+  const bool velocity_known = count > 0 && joints.calibrations.front().velocity_scale > 0;
   readings->positions.resize(count);
   readings->velocities.resize(velocity_known ? count : 0);
   for (std::size_t i = 0; i < count; ++i) {
-    const JointCalibration& calibration = joints[i].calibration;
+    const JointCalibration& calibration = joints.calibrations[i];
     readings->positions[i] = calibration.toRadians(telemetry.servos[i].position);
     if (velocity_known) {
       readings->velocities[i] = calibration.toRadiansPerSecond(telemetry.servos[i].speed);

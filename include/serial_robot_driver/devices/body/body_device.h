@@ -134,6 +134,7 @@ class BodyDevice : public core::Device {
   core::LogThrottle command_log_{1.0};
   GyroBiasCalibrator gyro_calibrator_;  // before controller_: telemetry feeds it
   core::EventRate telemetry_rate_;      // ticked on the reader thread (locks)
+  JointConversion joint_conversion_;    // of controller_'s joints, made before the link starts
   JointReadings joint_readings_;        // reader thread only: each frame's, reused
   BodyStatus status_;                   // diagnostics thread only
   BodyController controller_;           // last: its frames use the members above

@@ -37,9 +37,14 @@ sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros:
 
 void fillJointState(const JointReadings& readings, const ::ros::Time& stamp,
                     sensor_msgs::JointState* msg) {
+  msg->name = readings.names;
+  fillJointStateValues(readings, stamp, msg);
+}
+
+void fillJointStateValues(const JointReadings& readings, const ::ros::Time& stamp,
+                          sensor_msgs::JointState* msg) {
   msg->header.stamp = stamp;
   msg->header.frame_id.clear();
-  msg->name = readings.names;
   msg->position = readings.positions;
   msg->velocity = readings.velocities;
   msg->effort.clear();

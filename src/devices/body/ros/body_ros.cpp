@@ -65,7 +65,7 @@ void BodyRos::publishFrame(const BodyFrame& frame) {
   // finds the second queued too instead of being woken once more.
   const bool joint_states_wanted = ros_layer::wanted(joint_states_pub_);
   const bool imu_wanted = ros_layer::wanted(imu_pub_);
-  if (joint_states_wanted) fillJointState(frame.joints, stamp, &joint_states_.next());
+  if (joint_states_wanted) fillJointStateMessage(frame.joints, stamp);
   if (imu_wanted) {
     const ImuReading reading =
         imuReading(frame.telemetry, frame.imu, frame.imu_axes, frame.gyro_bias);
@@ -79,6 +79,17 @@ void BodyRos::publishFrame(const BodyFrame& frame) {
   if (ros_layer::wanted(telemetry_pub_)) {
     telemetry_pub_.publish(toTelemetryMsg(frame.telemetry, device_.controller().joints(), stamp));
   }
+}
+
+void BodyRos::fillJointStateMessage(const JointReadings& readings, const ::ros::Time& stamp) {
+  sensor_msgs::JointState& msg = joint_states_.next();
+  // The names are copied only into a new message or when they changed: twenty strings a frame
+  // were a tenth of the reader's work.
+  if (joint_states_.renewed() || joint_state_names_ != readings.names_generation) {
+    msg.name = readings.names;
+    joint_state_names_ = readings.names_generation;
+  }
+  fillJointStateValues(readings, stamp, &msg);
 }
 
 }  // namespace serial_robot_driver::devices::body::ros

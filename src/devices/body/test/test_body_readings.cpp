@@ -70,11 +70,13 @@ TEST(BodyReadingsJoints, UpdatedInPlaceFrameAfterFrameWithoutNewStorage) {
   JointReadings readings;
   updateJointReadings(goldenBodyTelemetry(), hipAndKnee(-1, 0.02), &readings);
   const std::string* names = readings.names.data();
+  const uint64_t generation = readings.names_generation;
   const double* positions = readings.positions.data();
   Telemetry next = goldenBodyTelemetry();
   next.servos[1].position = static_cast<uint16_t>(next.servos[1].position + 512);  // knee moved
   updateJointReadings(next, hipAndKnee(-1, 0.02), &readings);
   EXPECT_EQ(readings.names.data(), names) << "the names are kept";
+  EXPECT_EQ(readings.names_generation, generation) << "and a message holding them keeps them";
   EXPECT_EQ(readings.positions.data(), positions) << "the storage is reused";
   EXPECT_EQ(readings.names, (std::vector<std::string>{"hip", "knee"}));
   const JointReadings fresh = jointReadings(next, hipAndKnee(-1, 0.02));
@@ -86,6 +88,7 @@ TEST(BodyReadingsJoints, UpdatedInPlaceFrameAfterFrameWithoutNewStorage) {
   next.servo_count = 1;  // fewer joints in the frame: the names follow
   updateJointReadings(next, hipAndKnee(-1, 0.02), &readings);
   EXPECT_EQ(readings.names, (std::vector<std::string>{"hip"}));
+  EXPECT_NE(readings.names_generation, generation) << "a message holding the old names copies anew";
   EXPECT_EQ(readings.positions.size(), 1u);
   EXPECT_EQ(readings.velocities.size(), 1u);
 }

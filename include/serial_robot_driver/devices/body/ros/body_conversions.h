@@ -31,6 +31,9 @@ sensor_msgs::JointState toJointState(const JointReadings& readings, const ::ros:
 /// The same into `msg` (every field that toJointState() sets), reusing its vectors' capacity.
 void fillJointState(const JointReadings& readings, const ::ros::Time& stamp,
                     sensor_msgs::JointState* msg);
+/// fillJointState() but for the names: for a message that still holds `readings.names`.
+void fillJointStateValues(const JointReadings& readings, const ::ros::Time& stamp,
+                          sensor_msgs::JointState* msg);
 
 /// REP-145 IMU message: imuReading() (the bias subtracted), with diagonal covariances
 /// from `params`. A negative orientation_variance marks the orientation as unknown

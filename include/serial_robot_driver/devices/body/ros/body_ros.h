@@ -36,6 +36,8 @@ class BodyRos : public ros_layer::DeviceFrontEnd {
 
  private:
   void publishFrame(const BodyFrame& frame);
+  /// joint_states_.next() filled from `readings`.
+  void fillJointStateMessage(const JointReadings& readings, const ::ros::Time& stamp);
 
   BodyDevice& device_;
   const ros_layer::ArrivalStamps arrival_stamps_;
@@ -46,6 +48,7 @@ class BodyRos : public ros_layer::DeviceFrontEnd {
   // Reader thread only: the messages of the last frame, filled again when nobody else holds them.
   ros_layer::ReusedMessage<sensor_msgs::JointState> joint_states_;
   ros_layer::ReusedMessage<sensor_msgs::Imu> imu_;
+  uint64_t joint_state_names_ = 0;  ///< the names_generation joint_states_ holds
   ::ros::Subscriber joint_commands_sub_;
   // imu/calibrate: its own queue and one thread, as a call blocks for ~imu/calibration_time.
   ::ros::CallbackQueue calibration_queue_;
