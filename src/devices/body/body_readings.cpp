@@ -33,6 +33,8 @@ void updateJointReadings(const Telemetry& telemetry, const std::vector<BodyJoint
 
 JointConversion makeJointConversion(const std::vector<BodyJoint>& joints) {
   JointConversion conversion;
+  conversion.names.reserve(joints.size());
+  conversion.calibrations.reserve(joints.size());
   for (const BodyJoint& joint : joints) {
     conversion.names.push_back(joint.name);
     conversion.calibrations.push_back(joint.calibration);

@@ -83,8 +83,8 @@ void BodyRos::publishFrame(const BodyFrame& frame) {
 
 void BodyRos::fillJointStateMessage(const JointReadings& readings, const ::ros::Time& stamp) {
   sensor_msgs::JointState& msg = joint_states_.next();
-  // The names are copied only into a new message or when they changed: twenty strings a frame
-  // were a tenth of the reader's work.
+  // The names are copied only into a new message or when they changed: twenty string copies a
+  // frame were about a tenth of the reader's instructions.
   if (joint_states_.renewed() || joint_state_names_ != readings.names_generation) {
     msg.name = readings.names;
     joint_state_names_ = readings.names_generation;
