@@ -94,6 +94,9 @@ struct Options {
   std::set<std::string> conditions;  ///< 8: the conditions run (UserCondition::tag()); empty: all
   double bus_seconds = 5;           ///< 10: window of each servo bus run
   std::string realtime_priority = "50";  ///< 8: ~realtime_priority when RT is on
+  int node_slice_us = -1;  ///< 8: driver_node's ~scheduler_slice_us; -1: its default
+  int floor_slice_us = 0;  ///< 8: the floors' ~scheduler_slice_us; 0: the kernel's slice
+  int control_slice_us = -1;  ///< 8: the control's second driver_node's; -1: as driver_node's
   int bench_priority = 90;               ///< SCHED_FIFO of this process's threads; 0: normal
   /// 8: the lines the robot is played on, in this order within each condition.
   std::vector<Transport> transports{Transport::kPty, Transport::kTcp};
@@ -122,6 +125,12 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           all); the others' cells stay empty
   --realtime-priority V   8: the ~realtime_priority given for "RT on" (default 50; "true"
                           passes a bool)
+  --node-slice US         8: driver_node's ~scheduler_slice_us (default: its own, 100; 0: the
+                          kernel's slice, as before the parameter existed)
+  --floor-slice US        8: the floors' ~scheduler_slice_us (default 0: the kernel's slice, as
+                          a minimal driver has it; 100: the same request as driver_node's)
+  --control-slice US      8: the control's second driver_node's ~scheduler_slice_us (default:
+                          as driver_node's), so the control measures what the slice costs
   --transport T           8: the line the robot is played on: pty (the program opens a
                           pseudo-terminal; the kernel's pty worker carries the bytes), tcp
                           (the program connects to tcp://127.0.0.1:<port>, where this
@@ -226,6 +235,12 @@ Options parseOptions(int argc, char** argv) {
       options.tcp_window = std::stod(value);
     } else if (flag == "--realtime-priority") {
       options.realtime_priority = value;
+    } else if (flag == "--node-slice") {
+      options.node_slice_us = std::stoi(value);
+    } else if (flag == "--floor-slice") {
+      options.floor_slice_us = std::stoi(value);
+    } else if (flag == "--control-slice") {
+      options.control_slice_us = std::stoi(value);
     } else if (flag == "--bench-priority") {
       options.bench_priority = std::stoi(value);
     } else if (flag == "--bus-seconds") {
@@ -256,12 +271,15 @@ struct Variant {
   /// floor_node's ~same_job and ~same_interface: the user's topics and driver_node's interface,
   /// done minimally.
   bool same_job = false;
+  /// The control's second driver_node (section 8, at once): --control-slice applies to it.
+  bool control_copy = false;
 };
 const Variant kEventDriven{"event-driven", "event", "driver_node", 0.0};
 const Variant kPolling{"polling 20 ms", "poll", "polling_driver_node", 0.02};
 const Variant kFloor{"floor", "floor", "floor_node", 0.0, true};
 const Variant kSameJobFloor{"same-job floor", "floorjob", "floor_node", 0.0, true, false, true};
 const Variant kCapturing{"capture on", "capture", "driver_node", 0.0, false, true};
+const Variant kControlCopy{"event-driven", "event", "driver_node", 0.0, false, false, false, true};
 
 struct Context {
   Options options;
@@ -1403,6 +1421,13 @@ ParamList userParams(const std::string& port, const UserCondition& condition,
   if (condition.realtime) {
     params.emplace_back("realtime_priority", realtimeValue(options.realtime_priority));
   }
+  const bool floor = variant.program == kFloor.program;
+  const bool control = variant.control_copy && options.control_slice_us >= 0;
+  const int slice_us =
+      floor ? options.floor_slice_us : control ? options.control_slice_us : options.node_slice_us;
+  if (slice_us > 0 || (slice_us == 0 && !floor)) {
+    params.emplace_back("scheduler_slice_us", slice_us);
+  }
   return params;
 }
 
@@ -1929,10 +1954,14 @@ void addUserNote(Context& context) {
       "~realtime_priority %s for all (the floors take SCHED_FIFO at it on their main thread before "
       "roscpp starts, so every thread inherits it; driver_node takes one below there and the "
       "priority itself on its port readers and base loop; memory locked). This benchmark's own "
-      "threads: %s.",
+      "threads: %s. ~scheduler_slice_us: driver_node %s, the floors %s, the control's second "
+      "driver_node %s.",
       o.realtime_priority.c_str(),
       context.bench_priority > 0 ? format("SCHED_FIFO %d", context.bench_priority).c_str()
-                                 : "normal priority"));
+                                 : "normal priority",
+      o.node_slice_us < 0 ? "its default (100 us)" : format("%d us", o.node_slice_us).c_str(),
+      o.floor_slice_us > 0 ? format("%d us", o.floor_slice_us).c_str() : "the kernel's slice",
+      o.control_slice_us < 0 ? "as driver_node" : format("%d us", o.control_slice_us).c_str()));
 }
 
 /// Section 8's sessions, per transport.
@@ -1966,7 +1995,7 @@ void runUserRound(Context& context, std::size_t round, UserRunsByTransport* runs
       // At once against the same-job floor, then the control against a second driver_node.
       const std::pair<const Variant*, std::vector<std::vector<CpuAtOnce>> UserRuns::*> at_once[] =
           {{&kSameJobFloor, &UserRuns::cpu_at_once},
-           {&kEventDriven, &UserRuns::cpu_against_itself}};
+           {&kControlCopy, &UserRuns::cpu_against_itself}};
       for (const auto& entry : at_once) {
         const Variant* const other = entry.first;
         const auto into = entry.second;

@@ -4,7 +4,9 @@
 // a lost connection ends the floor), ~loop_rate, ~base/enabled, ~body/enabled, ~body/servo_ids,
 // ~body/joint_names, ~body/zero_ticks, ~body/directions, ~body/ticks_per_revolution,
 // ~realtime_priority (1..99, or true for 50: SCHED_FIFO on the main thread before roscpp starts its
-// threads, so every thread inherits it, as driver_node does; memory locked).
+// threads, so every thread inherits it, as driver_node does; memory locked), ~scheduler_slice_us
+// (default 0: the kernel's slice, as a minimal driver has it; else asked for on the main thread
+// before roscpp starts its threads, as driver_node does: core/scheduler_slice.h).
 // ~same_job (default false: the minimal floor) makes it do the job a user's driver_node does, as
 // minimally as possible: besides joint_states, imu/data per telemetry frame, odom + /tf +
 // wheel_states per loop tick (the commanded motion integrated), and /diagnostics at 1 Hz with
@@ -54,6 +56,7 @@
 #include <vector>
 
 #include "floor_interface.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/devices/base/base_codec.h"
 #include "serial_robot_driver/devices/body/body_codec.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
@@ -375,6 +378,7 @@ void runBaseLoop(double loop_rate, SameJobOdometry* odometry) {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "floor");
+  srd::core::requestSchedulerSlice(ros::param::param("~scheduler_slice_us", 0));  // before threads
   runRealtime(realtimePriority());
   ros::NodeHandle nh, pnh("~");
   const std::string port = pnh.param<std::string>("port", "/dev/ttyUSB0");

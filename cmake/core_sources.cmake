@@ -16,6 +16,7 @@ set(SRD_CORE_SOURCES
   src/core/loop_clock.cpp
   src/core/loop_wake.cpp
   src/core/realtime.cpp
+  src/core/scheduler_slice.cpp
   src/core/device_module.cpp
   src/params/device_sections.cpp
   src/params/param_table.cpp

@@ -22,6 +22,7 @@ catkin_add_gtest(core_tests
   test/unit/test_stop_signals.cpp
   test/unit/test_serial_link.cpp
   test/unit/test_realtime.cpp
+  test/unit/test_scheduler_slice.cpp
   test/unit/test_sim_device_models.cpp
   test/unit/test_sim_pty_devices.cpp
   test/unit/test_sim_whole_robot.cpp

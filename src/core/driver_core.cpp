@@ -6,6 +6,7 @@
 #include "serial_robot_driver/core/e_stop_status.h"
 #include "serial_robot_driver/core/link_status.h"
 #include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/transport/tcp_stream.h"
 
 namespace serial_robot_driver::core {
@@ -85,6 +86,7 @@ SerialLinkOptions DriverCore::linkOptions(const std::string& path,
   options.baud = static_cast<unsigned>(params_.baudOf(*users.front()));
   options.reconnect_interval = params_.reconnect_interval;
   options.realtime_priority = params_.realtime_priority;
+  options.scheduler_slice_us = params_.scheduler_slice_us;
   options.framer = framerFor(users, params_);
   for (const DeviceModule* device : users) {
     if (!device->stale_frame_timeout) continue;
@@ -169,6 +171,10 @@ void DriverCore::start() {
   // Once, whichever front ends run: what applies, or what refused it and how to allow it.
   if (!realtime_.message.empty()) {
     log(realtime_.refused ? LogLevel::kWarn : LogLevel::kInfo, "%s", realtime_.message.c_str());
+  }
+  if (realtime_.priority == 0) {  // under SCHED_FIFO the frame threads have no slice
+    const std::string slice = probeSchedulerSlice(params_.scheduler_slice_us);
+    if (!slice.empty()) log(LogLevel::kInfo, "%s", slice.c_str());
   }
   for (auto& [path, link] : ports_) link->start();
   for (auto& device : devices_) device->start();

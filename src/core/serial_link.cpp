@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "serial_robot_driver/core/realtime.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/transport/serial_port.h"
 #include "serial_robot_driver/transport/tcp_stream.h"
 
@@ -198,7 +199,10 @@ void SerialLink::waitForRetry(Clock::time_point until) {
 
 void SerialLink::readerLoop() {
   ::pthread_setname_np(::pthread_self(), "srd_reader");  // as ps -L, top -H and perf show it
-  enterRealtime(options_.realtime_priority);  // refused: it reads at the normal policy
+  // The slice first: a thread already at SCHED_FIFO takes none. Either refused, it reads all the
+  // same at the normal policy.
+  requestSchedulerSlice(options_.scheduler_slice_us);
+  enterRealtime(options_.realtime_priority);
   while (!stopping_) {
     const Clock::time_point work_due =
         worker_ != nullptr ? worker_->nextWork() : Clock::time_point::max();

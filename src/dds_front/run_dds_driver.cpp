@@ -7,6 +7,7 @@
 
 #include "serial_robot_driver/core/driver_core.h"
 #include "serial_robot_driver/core/log.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/core/stop_signals.h"
 #include "serial_robot_driver/dds/ros_conventions.h"
 #include "serial_robot_driver/dds_front/dds_node.h"
@@ -63,6 +64,8 @@ params::DriverParams loadCheckedParams(const std::string& path) {
 /// the node's order: no more input, the devices' last words, the ports closed.
 void runUntilStopped(const params::DriverParams& params, const DdsDriverOptions& options,
                      const core::StopSignals& stop_signals) {
+  // Before any thread starts, Cyclone DDS's included: they inherit it (core/scheduler_slice.h).
+  core::requestSchedulerSlice(params.scheduler_slice_us);
   core::DriverCore core(
       params, core::SerialLink::StreamFactory{}, nullptr,
       [](const std::string& warning) { core::log(core::LogLevel::kWarn, "%s", warning.c_str()); });

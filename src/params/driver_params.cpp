@@ -5,6 +5,7 @@
 
 #include "serial_robot_driver/core/device_module.h"
 #include "serial_robot_driver/core/realtime.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 
 namespace serial_robot_driver::params {
 
@@ -30,6 +31,12 @@ void addNodeParameters(std::vector<ParamSpec>& table) {
     require(v >= 0 && v <= core::kMaxRealtimePriority, key,
             "must be 0 (off) or a SCHED_FIFO priority 1.." +
                 std::to_string(core::kMaxRealtimePriority));
+  });
+  node("scheduler_slice_us", &P::scheduler_slice_us, [](const int& v, const std::string& key) {
+    require(v == 0 || (v >= core::kMinSchedulerSliceUs && v <= core::kMaxSchedulerSliceUs), key,
+            "must be 0 (the kernel's slice) or " + std::to_string(core::kMinSchedulerSliceUs) +
+                ".." + std::to_string(core::kMaxSchedulerSliceUs) + " us (got " +
+                std::to_string(v) + ")");
   });
   node("replay_bag", &P::replay_bag, Rule<std::string>{});
   node("replay_rate", &P::replay_rate, nonNegativeNumber);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "serial_robot_driver/core/realtime.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/core/stop_signals.h"
 #include "serial_robot_driver/dds_front/ros2_graph.h"
 #include "serial_robot_driver/ros/bag_replay.h"
@@ -76,14 +77,21 @@ void runUntilStopped(DriverNode& node, BagReplay* replay, const core::StopSignal
   spinner.stop();
 }
 
-/// ~realtime_priority's lower level (core::supportPriority) on the main thread before roscpp starts
-/// its threads (with the first NodeHandle; ros::param needs none): every thread of the process
-/// inherits SCHED_FIFO one below the frame threads, roscpp's too (the poll thread that carries
-/// messages to and from the sockets, its timers), so the whole path of a frame or a command runs
-/// ahead of normal processes, and the port readers and the base loop (which take the priority
-/// itself) preempt all of them. Checked and logged once by DriverCore::start(); a value
-/// validate() refuses is not applied here either.
-void enterRealtimeBeforeRoscpp() {
+/// How the main thread is scheduled, before roscpp starts its threads (with the first NodeHandle;
+/// ros::param needs none), so that every thread of the process inherits it, roscpp's too (the poll
+/// thread that carries messages to and from the sockets, its timers) and the path of a frame or a
+/// command is scheduled as a whole:
+///  - ~scheduler_slice_us: the fair scheduler's short slice (core/scheduler_slice.h);
+///  - ~realtime_priority: its lower level (core::supportPriority), so the whole path runs ahead of
+///    normal processes, and the port readers and the base loop (which take the priority itself)
+///    preempt all of it.
+/// Checked and logged once by DriverCore::start(); a value validate() refuses is not applied here.
+void scheduleThreadsBeforeRoscpp() {
+  int slice_us = DriverParams{}.scheduler_slice_us;
+  ros::param::get("~scheduler_slice_us", slice_us);
+  if (slice_us >= core::kMinSchedulerSliceUs && slice_us <= core::kMaxSchedulerSliceUs) {
+    core::requestSchedulerSlice(slice_us);  // first: a SCHED_FIFO thread takes none
+  }
   int priority = 0;
   if (!ros::param::get("~realtime_priority", priority)) return;
   if (priority > 0 && priority <= core::kMaxRealtimePriority) {
@@ -98,7 +106,7 @@ int runDriverNode(int argc, char** argv, const StreamFactoryMaker& make_stream_f
   // is out. Blocking the signals before any thread starts makes every thread inherit the mask.
   const core::StopSignals stop_signals;
   ros::init(argc, argv, "driver_node", ros::init_options::NoSigintHandler);
-  enterRealtimeBeforeRoscpp();
+  scheduleThreadsBeforeRoscpp();
 
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");

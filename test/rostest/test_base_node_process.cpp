@@ -159,12 +159,25 @@ TEST(BaseNodeProcess, StartEngagedHoldsTheBaseUntilReleased) {
   EXPECT_TRUE(node.waitExit(10.0).has_value()) << "driver_node did not exit on SIGTERM";
 }
 
-/// A thread's name and its scheduling policy and priority, as the kernel holds them.
+/// A thread's name and its scheduling policy, priority and slice, as the kernel holds them.
 struct NodeThread {
   std::string name;
   int policy = -1;
   int priority = -1;
+  uint64_t slice_ns = 0;  ///< `se.slice` of /proc/<pid>/task/<tid>/sched
 };
+
+/// The `se.slice` line of a thread's /proc sched file (ns); 0 when there is none.
+uint64_t sliceFromSchedFile(const std::string& path) {
+  std::ifstream sched(path);
+  std::string line;
+  while (std::getline(sched, line)) {
+    if (line.rfind("se.slice", 0) != 0) continue;
+    const auto colon = line.find(':');
+    if (colon != std::string::npos) return std::stoull(line.substr(colon + 1));
+  }
+  return 0;
+}
 
 std::vector<NodeThread> nodeThreads(pid_t pid) {
   std::vector<NodeThread> threads;
@@ -175,6 +188,7 @@ std::vector<NodeThread> nodeThreads(pid_t pid) {
     thread.policy = sched_getscheduler(std::stoi(tid));
     sched_param param{};
     if (sched_getparam(std::stoi(tid), &param) == 0) thread.priority = param.sched_priority;
+    thread.slice_ns = sliceFromSchedFile(tasks + tid + "/sched");
     threads.push_back(thread);
   }
   return threads;
@@ -204,6 +218,34 @@ TEST(BaseNodeProcess, RealtimeFrameThreadsRunAboveTheRestOfTheNode) {
   EXPECT_EQ(frame_threads, 2u) << "one port reader and the base loop";
   node.signal(SIGTERM);
   EXPECT_TRUE(node.waitExit(10.0).has_value()) << "driver_node did not exit on SIGTERM";
+}
+
+// 17. ~scheduler_slice_us: by default every thread of the node, roscpp's included (the main thread
+// asks before roscpp starts them), runs in 100 us turns, so a woken thread preempts a CPU hog at
+// once; with 0 every thread keeps the kernel's slice.
+TEST(BaseNodeProcess, EveryThreadTakesTheSchedulerSliceByDefault) {
+  ASSERT_FALSE(g_driver_path.empty());
+  if (!test_support::ownSlicesKept()) GTEST_SKIP() << test_support::kNoOwnSlices;
+  const uint64_t kernel_slice = test_support::currentThreadSliceNs();
+  ASSERT_NE(kernel_slice, 100000u) << "this test thread must have the kernel's slice";
+  // The default case passes an unrelated parameter at its default: OwnDriver takes one.
+  for (const char* slice_param : {"_capture:=false", "_scheduler_slice_us:=0"}) {
+    SCOPED_TRACE(slice_param);
+    OwnDriver driver("slice", slice_param);
+    ChildProcess& node = driver.node;
+    ASSERT_TRUE(driver.ready()) << node.output();
+    ASSERT_TRUE(driver.base.waitForCount(2, 10.0)) << node.output();  // the reader and the loop run
+    const std::vector<NodeThread> threads = nodeThreads(node.pid());
+    EXPECT_GE(threads.size(), 5u) << "main, roscpp's, the reader, the loop, the spinner";
+    for (const NodeThread& thread : threads) {
+      SCOPED_TRACE(thread.name);
+      EXPECT_EQ(thread.policy, SCHED_OTHER);
+      const bool by_default = std::string(slice_param) == "_capture:=false";
+      EXPECT_EQ(thread.slice_ns, by_default ? 100000u : kernel_slice);
+    }
+    node.signal(SIGTERM);
+    EXPECT_TRUE(node.waitExit(10.0).has_value()) << "driver_node did not exit on SIGTERM";
+  }
 }
 
 }  // namespace

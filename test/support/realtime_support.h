@@ -1,6 +1,7 @@
-// What the tests of ~realtime_priority need: the calling thread's scheduling policy, whether this
-// process may use SCHED_FIFO at all (root in a container may; a CI user usually may not), and a
-// thread that has given up the capabilities that would allow it.
+// What the tests of ~realtime_priority and ~scheduler_slice_us need: the calling thread's
+// scheduling policy and slice, whether this process may use SCHED_FIFO at all (root in a container
+// may; a CI user usually may not) and whether the kernel keeps a thread's own slice, and a thread
+// that has given up the capabilities that would allow SCHED_FIFO.
 #pragma once
 
 #include <linux/capability.h>
@@ -9,26 +10,58 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <functional>
 #include <thread>
 
 #include "serial_robot_driver/core/realtime.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 
 namespace test_support {
 
 struct ThreadPolicy {
   int policy = -1;
   int priority = -1;
+  uint64_t slice_ns = 0;  ///< the fair scheduler's slice (0 where the kernel reports none)
 };
 
-/// The calling thread's policy and priority, as the kernel holds them.
+/// The calling thread's fair-scheduler slice in ns, as sched_getattr reports it: its own slice or
+/// the default from Linux 6.12 on, 0 before.
+inline uint64_t currentThreadSliceNs() {
+  struct {  // the kernel's struct sched_attr, SCHED_ATTR_SIZE_VER1
+    uint32_t size, policy;
+    uint64_t flags;
+    int32_t nice;
+    uint32_t priority;
+    uint64_t runtime, deadline, period;
+    uint32_t util_min, util_max;
+  } attr{};
+  if (syscall(SYS_sched_getattr, 0, &attr, sizeof(attr), 0) != 0) return 0;
+  return attr.runtime;
+}
+
+/// The calling thread's policy, priority and slice, as the kernel holds them.
 inline ThreadPolicy currentThreadPolicy() {
   ThreadPolicy current;
   sched_param param{};
   if (pthread_getschedparam(pthread_self(), &current.policy, &param) == 0) {
     current.priority = param.sched_priority;
   }
+  current.slice_ns = currentThreadSliceNs();
   return current;
+}
+
+/// Why a test of ~scheduler_slice_us is skipped where ownSlicesKept() is false.
+inline constexpr const char* kNoOwnSlices =
+    "this kernel keeps no slice of a thread's own (Linux before 6.12)";
+
+/// Whether this kernel keeps a thread's own slice (Linux 6.12 and later): asked on a thread that
+/// ends at once.
+inline bool ownSlicesKept() {
+  uint64_t kept = 0;
+  std::thread probe([&] { kept = serial_robot_driver::core::requestSchedulerSlice(250).kept_ns; });
+  probe.join();
+  return kept == 250000;
 }
 
 /// Whether a thread of this process may take SCHED_FIFO at `priority` (tried on a thread that

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -53,6 +54,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"reconnect_interval", [](DriverParams& p) { p.reconnect_interval = -1; }},
         BadCase{"realtime_priority", [](DriverParams& p) { p.realtime_priority = -1; }},
         BadCase{"realtime_priority", [](DriverParams& p) { p.realtime_priority = 100; }},
+        BadCase{"scheduler_slice_us", [](DriverParams& p) { p.scheduler_slice_us = -1; }},
+        BadCase{"scheduler_slice_us", [](DriverParams& p) { p.scheduler_slice_us = 99; }},
+        BadCase{"scheduler_slice_us", [](DriverParams& p) { p.scheduler_slice_us = 100001; }},
+        BadCase{"scheduler_slice_us",
+                [](DriverParams& p) { p.scheduler_slice_us = std::numeric_limits<int>::min(); }},
         BadCase{"replay_rate", [](DriverParams& p) { p.replay_rate = -1; }},
         BadCase{"capture",
                 [](DriverParams& p) {
@@ -270,6 +276,15 @@ TEST(DriverParams, SlowLoopRateIsRefusedWithTheReason) {
   params.section(devices::base::kBaseSection).enabled = true;
   params.loop_rate = kMinBaseLoopRate;
   EXPECT_NO_THROW(params.validate());
+}
+
+TEST(DriverParams, SchedulerSliceTakesOffAndTheKernelsWholeRange) {
+  DriverParams params;
+  EXPECT_EQ(params.scheduler_slice_us, 100) << "on by default, at the kernel's least";
+  for (int slice_us : {0, 100, 1000, 100000}) {
+    params.scheduler_slice_us = slice_us;
+    EXPECT_NO_THROW(params.validate()) << slice_us;
+  }
 }
 
 TEST(DriverParams, RealtimePriorityTakesOffAndEverySchedFifoPriority) {

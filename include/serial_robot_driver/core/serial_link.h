@@ -107,6 +107,8 @@ struct SerialLinkOptions {
   std::chrono::milliseconds stale_frame_timeout{0};
   /// The reader thread's SCHED_FIFO priority (core/realtime.h: ~realtime_priority); 0: normal.
   int realtime_priority = 0;
+  /// The reader thread's fair-scheduler slice (core/scheduler_slice.h); 0: the kernel's.
+  int scheduler_slice_us = 0;
 };
 
 struct LinkStats {

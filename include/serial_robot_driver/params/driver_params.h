@@ -58,6 +58,9 @@ struct DriverParams {
   bool capture = false;      ///< publish every chunk in and out on serial_raw
   /// SCHED_FIFO priority of the threads that carry frames (core/realtime.h), memory locked; 0: off
   int realtime_priority = 0;
+  /// µs: the fair scheduler's slice the node's threads ask for (core/scheduler_slice.h); 0: the
+  /// kernel's default
+  int scheduler_slice_us = 100;
   std::string replay_bag;    ///< non-empty: read the ports from this bag's serial_raw, not the wire
   double replay_rate = 1.0;  ///< replay speed; 0: as fast as possible
   /// Not a parameter: the running replay's timeline (set by the node once the bag is read), which

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "serial_robot_driver/core/realtime.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 
 namespace serial_robot_driver::devices::base {
 
@@ -200,10 +201,15 @@ void BaseController::start() {
     std::lock_guard<std::mutex> lock(mutex_);
     running_ = !stopping_;  // from now on a cmd_vel is written by its caller, at once
   }
-  const int priority = config_.realtime_priority;  // not tunable: read before the thread runs
-  loop_ = std::thread([this, priority] {
+  // Not tunable: read before the thread runs.
+  const int priority = config_.realtime_priority;
+  const int slice_us = config_.scheduler_slice_us;
+  loop_ = std::thread([this, priority, slice_us] {
     ::pthread_setname_np(::pthread_self(), "srd_base_loop");  // as ps -L, top -H and perf show it
-    core::enterRealtime(priority);  // refused: the loop runs at the normal policy
+    // The slice first: a thread already at SCHED_FIFO takes none. Either refused, the loop runs
+    // all the same at the normal policy.
+    core::requestSchedulerSlice(slice_us);
+    core::enterRealtime(priority);
     run();
   });
 }

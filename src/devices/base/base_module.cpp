@@ -16,6 +16,7 @@ BaseConfig makeBaseConfig(const params::DriverParams& params) {
   BaseConfig config = params.section(kBaseSection).controller;
   config.loop_rate = params.loop_rate;
   config.realtime_priority = params.realtime_priority;
+  config.scheduler_slice_us = params.scheduler_slice_us;
   config.baud = params.baudOf(*core::findDevice("base"));
   return config;
 }

@@ -87,6 +87,8 @@ struct BaseConfig : BaseTuning {
   core::Clock::duration imu_stale_after = kinematics::kImuHeadingStaleAfter;
   /// The loop thread's SCHED_FIFO priority (core/realtime.h: ~realtime_priority); 0: normal.
   int realtime_priority = 0;
+  /// The loop thread's fair-scheduler slice (core/scheduler_slice.h); 0: the kernel's.
+  int scheduler_slice_us = 0;
 };
 
 /// Where the odometry stood after a scheduled tick.

@@ -19,9 +19,7 @@ using test_support::currentThreadPolicy;
 using test_support::ThreadPolicy;
 
 /// The policy of the thread that reported the first odometry sample: the loop's.
-ThreadPolicy loopPolicyAt(int priority) {
-  BaseConfig config;
-  config.realtime_priority = priority;
+ThreadPolicy loopPolicyWith(const BaseConfig& config) {
   std::mutex mutex;
   std::optional<ThreadPolicy> seen;
   BaseEvents events;
@@ -41,6 +39,12 @@ ThreadPolicy loopPolicyAt(int priority) {
   controller.stop();
   EXPECT_TRUE(ticked) << "the loop ticks whatever its policy";
   return seen.value_or(ThreadPolicy{});
+}
+
+ThreadPolicy loopPolicyAt(int priority) {
+  BaseConfig config;
+  config.realtime_priority = priority;
+  return loopPolicyWith(config);
 }
 
 TEST(BaseControllerRealtime, TheLoopRunsAtTheConfiguredPriority) {
@@ -67,6 +71,15 @@ TEST(BaseControllerRealtime, TheLoopRunsAboveTheProcessThreadThatStartsIt) {
 
 TEST(BaseControllerRealtime, WithoutAPriorityTheLoopKeepsTheNormalPolicy) {
   EXPECT_EQ(loopPolicyAt(0).policy, SCHED_OTHER);
+}
+
+TEST(BaseControllerRealtime, TheLoopTakesTheConfiguredSchedulerSlice) {
+  if (!test_support::ownSlicesKept()) GTEST_SKIP() << test_support::kNoOwnSlices;
+  BaseConfig config;
+  config.scheduler_slice_us = 450;
+  const ThreadPolicy policy = loopPolicyWith(config);
+  EXPECT_EQ(policy.policy, SCHED_OTHER);
+  EXPECT_EQ(policy.slice_ns, 450000U);
 }
 
 }  // namespace
