@@ -15,7 +15,6 @@
 #include <thread>
 
 #include "serial_robot_driver/core/realtime.h"
-#include "serial_robot_driver/core/scheduler_slice.h"
 
 namespace test_support {
 
@@ -25,17 +24,21 @@ struct ThreadPolicy {
   uint64_t slice_ns = 0;  ///< the fair scheduler's slice (0 where the kernel reports none)
 };
 
+/// The kernel's struct sched_attr (SCHED_ATTR_SIZE_VER1), for the tests' own system calls.
+struct KernelSchedAttr {
+  uint32_t size = sizeof(KernelSchedAttr);
+  uint32_t policy = 0;
+  uint64_t flags = 0;
+  int32_t nice = 0;
+  uint32_t priority = 0;
+  uint64_t runtime = 0, deadline = 0, period = 0;
+  uint32_t util_min = 0, util_max = 0;
+};
+
 /// The calling thread's fair-scheduler slice in ns, as sched_getattr reports it: its own slice or
 /// the default from Linux 6.12 on, 0 before.
 inline uint64_t currentThreadSliceNs() {
-  struct {  // the kernel's struct sched_attr, SCHED_ATTR_SIZE_VER1
-    uint32_t size, policy;
-    uint64_t flags;
-    int32_t nice;
-    uint32_t priority;
-    uint64_t runtime, deadline, period;
-    uint32_t util_min, util_max;
-  } attr{};
+  KernelSchedAttr attr;
   if (syscall(SYS_sched_getattr, 0, &attr, sizeof(attr), 0) != 0) return 0;
   return attr.runtime;
 }
@@ -56,10 +59,17 @@ inline constexpr const char* kNoOwnSlices =
     "this kernel keeps no slice of a thread's own (Linux before 6.12)";
 
 /// Whether this kernel keeps a thread's own slice (Linux 6.12 and later): asked on a thread that
-/// ends at once.
+/// ends at once, by system calls of its own, not by the code under test.
 inline bool ownSlicesKept() {
   uint64_t kept = 0;
-  std::thread probe([&] { kept = serial_robot_driver::core::requestSchedulerSlice(250).kept_ns; });
+  std::thread probe([&] {
+    KernelSchedAttr attr;
+    if (syscall(SYS_sched_getattr, 0, &attr, sizeof(attr), 0) != 0) return;
+    attr.size = sizeof(attr);  // the same policy and nice value, another slice
+    attr.flags = 0;
+    attr.runtime = 250000;
+    if (syscall(SYS_sched_setattr, 0, &attr, 0) == 0) kept = currentThreadSliceNs();
+  });
   probe.join();
   return kept == 250000;
 }

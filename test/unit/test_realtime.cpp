@@ -5,15 +5,12 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
-#include <atomic>
 #include <string>
 
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/serial_link.h"
-#include "serial_robot_driver/sim/pseudo_terminal.h"
-#include "support/framer_configs.h"
+#include "support/reader_policy.h"
 #include "support/realtime_support.h"
-#include "support/test_helpers.h"
 
 namespace serial_robot_driver::core {
 namespace {
@@ -143,34 +140,12 @@ TEST(Realtime, EnterRealtimeGivesTheThreadFifoWhereAllowed) {
   EXPECT_EQ(policy.priority, 10);
 }
 
-/// Notes the policy of the thread that calls onLinkUp: the link's reader thread.
-class PolicyListener : public LinkListener {
- public:
-  void onLinkUp() override {
-    policy = currentThreadPolicy();
-    up = true;
-  }
-  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t, Clock::time_point) override {}
-  ThreadPolicy policy;
-  std::atomic<bool> up{false};
-};
-
 TEST(Realtime, TheReaderThreadRunsAtTheLinksPriority) {
   if (!fifoAllowed(12)) GTEST_SKIP() << "this process may not use SCHED_FIFO";
-  const std::string path = "/tmp/srd_realtime_test_" + std::to_string(::getpid());
-  sim::PseudoTerminal pty(path);
-  SerialLinkOptions options;
-  options.path = path;
-  options.framer = test_support::driverFramer({"base"}, 2);
-  options.realtime_priority = 12;
-  SerialLink link(options);
-  PolicyListener listener;
-  link.addListener(&listener);
-  link.start();
-  ASSERT_TRUE(test_support::waitFor([&] { return listener.up.load(); }, 3.0));
-  link.stop();
-  EXPECT_EQ(listener.policy.policy, SCHED_FIFO);
-  EXPECT_EQ(listener.policy.priority, 12);
+  const ThreadPolicy policy =
+      test_support::readerThreadPolicy([](SerialLinkOptions& o) { o.realtime_priority = 12; });
+  EXPECT_EQ(policy.policy, SCHED_FIFO);
+  EXPECT_EQ(policy.priority, 12);
 }
 
 }  // namespace

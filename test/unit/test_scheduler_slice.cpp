@@ -7,7 +7,6 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -15,10 +14,8 @@
 
 #include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/core/serial_link.h"
-#include "serial_robot_driver/sim/pseudo_terminal.h"
-#include "support/framer_configs.h"
+#include "support/reader_policy.h"
 #include "support/realtime_support.h"
-#include "support/test_helpers.h"
 
 namespace serial_robot_driver::core {
 namespace {
@@ -125,34 +122,12 @@ TEST(SchedulerSlice, AThreadAtSchedFifoIsLeftAlone) {
   EXPECT_TRUE(mentions(describeSchedulerSlice(100, outcome), "SCHED_FIFO"));
 }
 
-/// Notes the slice of the thread that calls onLinkUp: the link's reader thread.
-class SliceListener : public LinkListener {
- public:
-  void onLinkUp() override {
-    policy = currentThreadPolicy();
-    up = true;
-  }
-  void onFrame(protocol::FrameFamily, const uint8_t*, std::size_t, Clock::time_point) override {}
-  ThreadPolicy policy;
-  std::atomic<bool> up{false};
-};
-
 TEST(SchedulerSlice, TheReaderThreadTakesTheLinksSlice) {
   if (!ownSlicesKept()) GTEST_SKIP() << test_support::kNoOwnSlices;
-  const std::string path = "/tmp/srd_slice_test_" + std::to_string(::getpid());
-  sim::PseudoTerminal pty(path);
-  SerialLinkOptions options;
-  options.path = path;
-  options.framer = test_support::driverFramer({"base"}, 2);
-  options.scheduler_slice_us = 350;
-  SerialLink link(options);
-  SliceListener listener;
-  link.addListener(&listener);
-  link.start();
-  ASSERT_TRUE(test_support::waitFor([&] { return listener.up.load(); }, 3.0));
-  link.stop();
-  EXPECT_EQ(listener.policy.slice_ns, 350000U);
-  EXPECT_EQ(listener.policy.policy, SCHED_OTHER);
+  const ThreadPolicy policy =
+      test_support::readerThreadPolicy([](SerialLinkOptions& o) { o.scheduler_slice_us = 350; });
+  EXPECT_EQ(policy.slice_ns, 350000U);
+  EXPECT_EQ(policy.policy, SCHED_OTHER);
 }
 
 TEST(SchedulerSlice, TheProbeLeavesTheCallerAlone) {
