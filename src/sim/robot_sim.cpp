@@ -1,6 +1,7 @@
 #include "serial_robot_driver/sim/robot_sim.h"
 
 #include <poll.h>
+#include <pthread.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
@@ -16,6 +17,7 @@
 #include "robot_sim_plug.h"
 #include "robot_sim_port.h"
 #include "serial_robot_driver/core/device_module.h"
+#include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/sim/pseudo_terminal.h"
 
 namespace serial_robot_driver::sim {
@@ -151,6 +153,12 @@ void RobotSim::run() {
   // Wake up on time: the kernel's default 50 us of timer slack would add to every paced byte and
   // every answer latency.
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  // Answer as the boards' microcontrollers do, at once: with the shortest fair-scheduler turn a
+  // busy machine (a CI run, the benchmark's hogs) delays this thread by a fraction of a ms, not
+  // by a CPU hog's whole turn (core/scheduler_slice.h). Tests that compare the node's odometry,
+  // timed at its writes, with the simulated wheels, timed at this thread's reads, rely on it.
+  core::requestSchedulerSlice(core::kMinSchedulerSliceUs);
+  ::pthread_setname_np(::pthread_self(), "robot_sim");  // as ps -L, top -H and perf show it
   PollSet poll;
   // The wait to the next event in ns (ppoll): a poll timeout in whole ms would round every paced
   // byte, answer latency and timer up to the next ms.

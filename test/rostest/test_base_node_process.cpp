@@ -167,18 +167,6 @@ struct NodeThread {
   uint64_t slice_ns = 0;  ///< `se.slice` of /proc/<pid>/task/<tid>/sched
 };
 
-/// The `se.slice` line of a thread's /proc sched file (ns); 0 when there is none.
-uint64_t sliceFromSchedFile(const std::string& path) {
-  std::ifstream sched(path);
-  std::string line;
-  while (std::getline(sched, line)) {
-    if (line.rfind("se.slice", 0) != 0) continue;
-    const auto colon = line.find(':');
-    if (colon != std::string::npos) return std::stoull(line.substr(colon + 1));
-  }
-  return 0;
-}
-
 std::vector<NodeThread> nodeThreads(pid_t pid) {
   std::vector<NodeThread> threads;
   const std::string tasks = "/proc/" + std::to_string(pid) + "/task/";
@@ -188,7 +176,7 @@ std::vector<NodeThread> nodeThreads(pid_t pid) {
     thread.policy = sched_getscheduler(std::stoi(tid));
     sched_param param{};
     if (sched_getparam(std::stoi(tid), &param) == 0) thread.priority = param.sched_priority;
-    thread.slice_ns = sliceFromSchedFile(tasks + tid + "/sched");
+    thread.slice_ns = test_support::sliceFromSchedFile(tasks + tid + "/sched");
     threads.push_back(thread);
   }
   return threads;

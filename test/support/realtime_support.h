@@ -11,7 +11,9 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <fstream>
 #include <functional>
+#include <string>
 #include <thread>
 
 #include "serial_robot_driver/core/realtime.h"
@@ -41,6 +43,18 @@ inline uint64_t currentThreadSliceNs() {
   KernelSchedAttr attr;
   if (syscall(SYS_sched_getattr, 0, &attr, sizeof(attr), 0) != 0) return 0;
   return attr.runtime;
+}
+
+/// The `se.slice` line (ns) of a thread's /proc/<pid>/task/<tid>/sched file; 0 when there is none.
+inline uint64_t sliceFromSchedFile(const std::string& path) {
+  std::ifstream sched(path);
+  std::string line;
+  while (std::getline(sched, line)) {
+    if (line.rfind("se.slice", 0) != 0) continue;
+    const auto colon = line.find(':');
+    if (colon != std::string::npos) return std::stoull(line.substr(colon + 1));
+  }
+  return 0;
 }
 
 /// The calling thread's policy, priority and slice, as the kernel holds them.

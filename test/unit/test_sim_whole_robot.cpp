@@ -1,9 +1,15 @@
-// The whole simulated robot: shared and separate links, faults, baud-rate pacing, unplug/replug
-// and the stats file.
+// The whole simulated robot: shared and separate links, faults, baud-rate pacing, unplug/replug,
+// the stats file and its thread's scheduling.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <string>
+
 #include "support/framer_configs.h"
+#include "support/realtime_support.h"
 #include "support/sim_host.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::sim {
 namespace {
@@ -11,6 +17,32 @@ namespace {
 using namespace sim_test;  // NOLINT: the shared fixture
 
 // --- the whole robot -------------------------------------------------------------------------
+
+/// The slice (ns) of this process's thread named `name`, from /proc; 0 when there is none.
+uint64_t sliceOfThreadNamed(const std::string& name) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::string comm;
+    std::ifstream(task.path() / "comm") >> comm;
+    if (comm == name) return test_support::sliceFromSchedFile(task.path() / "sched");
+  }
+  return 0;
+}
+
+// The boards answer as their microcontrollers would, on time: the simulator's one thread takes
+// the fair scheduler's shortest slice, so a busy machine delays the simulated wheels little
+// against the node's clock (test_imu_heading, test_odom compare the two).
+TEST(RobotSim, ItsThreadRunsInTheShortestSchedulerSlice) {
+  if (!test_support::ownSlicesKept()) GTEST_SKIP() << test_support::kNoOwnSlices;
+  ASSERT_NE(test_support::currentThreadSliceNs(), 100000u) << "the test's thread has its own";
+  TempDir dir;
+  SimOptions options;
+  options.link = dir.file("robot");
+  RobotSim sim(options);
+  sim.start();
+  EXPECT_TRUE(test_support::waitFor([] { return sliceOfThreadNamed("robot_sim") == 100000u; }, 3.0))
+      << "the thread named robot_sim: slice " << sliceOfThreadNamed("robot_sim") << " ns";
+  sim.stop();
+}
 
 TEST(RobotSim, SharedPortCarriesAllThreeDevicesBehindTheLink) {
   TempDir dir;
