@@ -93,8 +93,8 @@ inline std::string armedService(const std::string& name) { return "armed/servo/"
 
 /// Calls `service` and returns its answer. The node's servo services always answer (a refusal is in
 /// the response), so a false from ros::service::call is roscpp losing the call on its way: on a
-/// loaded machine its client now and then drops a non-persistent connection whose answer and
-/// hang-up come in one poll (estop_bus failed so in CI, about 1 run in 25 under two hogs). Up to
+/// loaded machine its client now and then reports a non-persistent call failed (estop_bus did so
+/// in CI, about 1 run in 25 under two hogs; the cause inside roscpp is not pinned down). Up to
 /// two more tries, each one logged; a node that never answers still fails the test. A retried
 /// call the node had done is done twice: tests that count frames then fail, never pass wrongly.
 template <typename Srv>
