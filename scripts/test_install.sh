@@ -69,10 +69,17 @@ run 'rospack plugins --attrib=plugin nodelet' | grep -q "^serial_robot_driver $s
 run 'rosmsg show serial_robot_driver/Telemetry' | grep -q servo_ids || fail "rosmsg show Telemetry"
 run 'rossrv show serial_robot_driver/ServoPing' | grep -q id || fail "rossrv show ServoPing"
 # Unset required args (replay.launch's bag) are the user's to give, as in the build's launch check.
-for launch in "$share"/launch/*.launch; do
-  error="$(run "python3 -c 'import sys, roslaunch.rlutil as r; e = r.check_roslaunch(sys.argv[1], ignore_unset_args=True); print(e or \"\")' '$launch'")"
-  [ -z "$error" ] || fail "roslaunch check of $(basename "$launch"): $error"
-done
+# One Python process checks every launch file (an interpreter start is about a second).
+cat > "$prefix/check_launch.py" <<'PY'
+import sys
+import roslaunch.rlutil as rlutil
+errors = [(f, rlutil.check_roslaunch(f, ignore_unset_args=True)) for f in sys.argv[1:]]
+for launch, error in errors:
+    if error:
+        print("roslaunch check of %s: %s" % (launch, error))
+sys.exit(1 if any(error for _, error in errors) else 0)
+PY
+out="$(run "python3 $prefix/check_launch.py $share/launch/*.launch" 2>&1)" || fail "$out"
 
 run "exec roscore -p $master_port" > "$prefix/roscore.log" 2>&1 &
 started_pids="$! $started_pids"
@@ -107,6 +114,11 @@ node_info="$(run 'rosnode info /driver_node 2>/dev/null')"
 publications="$(echo "$node_info" | sed -n '/^Publications:/,/^$/p' | sed -nE 's/^ \* ([^ ]+) .*/\1/p' | grep -v '^/rosout$')"
 services="$(echo "$node_info" | sed -n '/^Services:/,/^$/p' | sed -nE 's/^ \* ([^ ]+).*/\1/p' | grep -vE '/(get_loggers|set_logger_level)$')"
 [ "$(echo "$publications" | wc -w)" -ge 10 ] || fail "rosnode info lists too few publications: $publications"
+# The echoes run side by side, each into a file of its own (each waits up to a second for its
+# topic's next message); the services' request types load in one Python process, with
+# rosservice's own functions behind `rosservice args` and `rosservice type`.
+echo_pids=()
+echo_topics=()
 for topic in $publications; do
   case "$topic" in
     # An action's feedback and result flow only while a goal runs (trajectory.test covers them):
@@ -118,15 +130,27 @@ for topic in $publications; do
       echo "loaded $type"
       continue ;;
   esac
-  out="$(run "timeout 20 rostopic echo -n 1 --noarr $topic 2>&1")" ||
-    fail "rostopic echo $topic: $(echo "$out" | tail -n 3)"
-  echo "$out" | grep -q "^---$" || fail "rostopic echo $topic printed no message: $(echo "$out" | tail -n 3)"
+  run "timeout 20 rostopic echo -n 1 --noarr $topic" > "$prefix/echo.${#echo_pids[@]}" 2>&1 &
+  echo_pids+=($!)
+  echo_topics+=("$topic")
+done
+for i in "${!echo_pids[@]}"; do
+  topic="${echo_topics[$i]}"
+  out="$prefix/echo.$i"
+  wait "${echo_pids[$i]}" || fail "rostopic echo $topic: $(tail -n 3 "$out")"
+  grep -q "^---$" "$out" || fail "rostopic echo $topic printed no message: $(tail -n 3 "$out")"
   echo "echoed $topic"
 done
-for service in $services; do
-  out="$(run "rosservice args $service 2>&1")" || fail "rosservice args $service: $out"
-  echo "service $service: $(run "rosservice type $service")"
-done
+cat > "$prefix/check_services.py" <<'PY'
+import sys
+import rosservice
+for name in sys.argv[1:]:
+    rosservice.get_service_args(name)  # loads the request class, as `rosservice args` does
+    print("service %s: %s" % (name, rosservice.get_service_type(name)))
+PY
+out="$(run "python3 $prefix/check_services.py $(echo $services)" 2>&1)" ||
+  fail "a service's request type does not load: $(echo "$out" | tail -n 3)"
+echo "$out"
 stop_group "$cmd_vel_pub"
 stop_group "$sim_launch"
 
