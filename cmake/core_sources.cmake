@@ -51,10 +51,10 @@ set(SRD_CORE_SOURCES
 
 srd_device_sources(core srd_device_core_sources)
 list(APPEND SRD_CORE_SOURCES ${srd_device_core_sources})
-srd_write_registry("${CMAKE_BINARY_DIR}/srd_generated/registered_devices.cpp"
+srd_write_registry("${PROJECT_BINARY_DIR}/srd_generated/registered_devices.cpp"
   "serial_robot_driver/core/device_module.h" "serial_robot_driver::core::DeviceModule" kModule
   "serial_robot_driver::core::registeredDevices" "")
-set(SRD_CORE_GENERATED_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_devices.cpp")
+set(SRD_CORE_GENERATED_SOURCES "${PROJECT_BINARY_DIR}/srd_generated/registered_devices.cpp")
 
 # The simulated robot (ROS-free as well) and the pseudo-terminals it plays the robot on: robot_sim,
 # the tests and the benchmarks use them; the driver never does.
@@ -73,7 +73,7 @@ set(SRD_SIM_SOURCES
 srd_device_sources(sim srd_device_sim_sources)
 list(APPEND SRD_SIM_SOURCES ${srd_device_sim_sources})
 # The simulator parts robot_sim can host (sim/sim_device_module.h): every device with a sim/ folder.
-srd_write_registry("${CMAKE_BINARY_DIR}/srd_generated/registered_sim_devices.cpp"
+srd_write_registry("${PROJECT_BINARY_DIR}/srd_generated/registered_sim_devices.cpp"
   "serial_robot_driver/sim/sim_device_module.h" "serial_robot_driver::sim::SimDeviceModule"
   kSimModule "serial_robot_driver::sim::registeredSimDevices" sim)
-list(APPEND SRD_SIM_SOURCES "${CMAKE_BINARY_DIR}/srd_generated/registered_sim_devices.cpp")
+list(APPEND SRD_SIM_SOURCES "${PROJECT_BINARY_DIR}/srd_generated/registered_sim_devices.cpp")

@@ -39,7 +39,7 @@ set(SRD_DDS_TYPES
 # (final extensibility and no XTypes type information, as rmw_cyclonedds' own types: peers match
 # on the type name alone).
 set(SRD_DDS_IDL_DIR ${PROJECT_SOURCE_DIR}/dds/idl)
-set(SRD_DDS_GENERATED_DIR ${CMAKE_BINARY_DIR}/srd_dds_generated)
+set(SRD_DDS_GENERATED_DIR ${PROJECT_BINARY_DIR}/srd_dds_generated)
 file(GLOB_RECURSE SRD_DDS_IDL_FILES CONFIGURE_DEPENDS ${SRD_DDS_IDL_DIR}/*.idl)
 set(SRD_DDS_GENERATED_SOURCES "")
 foreach(type ${SRD_DDS_TYPES})

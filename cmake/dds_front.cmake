@@ -2,14 +2,14 @@
 # topics, dds_driver's runner; each device's src/devices/<name>/dds/, registered like its ros/) on
 # srd_dds, and the dds_driver executable. Included only when cmake/dds.cmake found Cyclone DDS.
 srd_device_sources(dds srd_device_dds_sources)
-srd_write_registry("${CMAKE_BINARY_DIR}/srd_generated/registered_dds_front_ends.cpp"
+srd_write_registry("${PROJECT_BINARY_DIR}/srd_generated/registered_dds_front_ends.cpp"
   "serial_robot_driver/dds_front/dds_device_module.h"
   "serial_robot_driver::dds_front::DdsDeviceModule" kDdsModule
   "serial_robot_driver::dds_front::registeredDdsFrontEnds" dds)
 # ROS-1-free: no catkin include path, no catkin library.
 add_library(srd_dds_front STATIC
   ${srd_device_dds_sources}
-  "${CMAKE_BINARY_DIR}/srd_generated/registered_dds_front_ends.cpp"
+  "${PROJECT_BINARY_DIR}/srd_generated/registered_dds_front_ends.cpp"
   src/dds_front/dds_conversions.cpp
   src/dds_front/dds_node.cpp
   src/dds_front/run_dds_driver.cpp

@@ -18,7 +18,7 @@ PACKAGES=(
   python3-diagnostic-msgs python3-tf2-msgs python3-std-srvs python3-trajectory-msgs
   python3-actionlib-msgs python3-rostopic python3-rosservice libdiagnostic-aggregator-tools
   libeigen3-dev libboost-dev googletest libgtest-dev libbenchmark-dev
-  clang libclang-rt-14-dev catkin-lint catkin-tools
+  clang libclang-rt-14-dev catkin-lint catkin-tools ccache
   libactionlib-dev libactionlib-msgs-dev libtrajectory-msgs-dev
   python3-actionlib python3-actionlib-msgs python3-trajectory-msgs
 )

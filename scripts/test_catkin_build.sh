@@ -23,14 +23,22 @@ cleanup() { for pid in $started_pids; do stop_group "$pid"; done; }
 trap cleanup EXIT
 fail() { echo "catkin build test FAILED: $*"; exit 1; }
 
-mkdir -p "$ws/src"
-ln -sfn "$repo" "$ws/src/serial_robot_driver"
+# SRD_CATKIN_TOOLS_SPACES_IN=<folder>: the source and build spaces go there instead (.ci/run gives
+# .ws/, so that ccache serves this build from build.sh's: scripts/shared_ccache.sh).
+spaces="${SRD_CATKIN_TOOLS_SPACES_IN:-$ws}"
+source_space="$spaces/src" build_space="$spaces/build"
+if [ -n "${SRD_CATKIN_TOOLS_SPACES_IN:-}" ]; then
+  source_space="$spaces/catkin_tools_src" build_space="$spaces/catkin_tools_build"
+fi
+mkdir -p "$source_space" "$ws"
+ln -sfn "$repo" "$source_space/serial_robot_driver"
 cd "$ws"
 cmake_args=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=OFF)
 if command -v ccache >/dev/null; then cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake_args+=("$@")
 [ -d .catkin_tools ] || catkin init > /dev/null
-catkin config --install --cmake-args "${cmake_args[@]}" > /dev/null
+catkin config --install --source-space "$source_space" --build-space "$build_space" \
+  --cmake-args "${cmake_args[@]}" > /dev/null
 catkin build --no-status --no-notify -j2 serial_robot_driver > "$ws/build.log" 2>&1 ||
   { tail -n 40 "$ws/build.log"; fail "catkin build"; }
 
