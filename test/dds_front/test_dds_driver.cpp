@@ -478,7 +478,9 @@ TEST_F(DdsDriver, MalformedCdrOnEveryInputIsDroppedAndTheDriverGoesOn) {
       return occurrences(driver_->output(), dropped) == dropped_before + malformed;
     })) << occurrences(driver_->output(), dropped) - dropped_before
         << " of " << malformed;
-    if (*input.counted != 0) EXPECT_TRUE(status.waitForCount(key, before + 1)) << status.count(key);
+    if (*input.counted != 0) {
+      EXPECT_TRUE(status.waitForCount(key, before + 1)) << status.count(key);
+    }
     ASSERT_TRUE(driver_->running());
     EXPECT_TRUE(atRest() == rest);
   }

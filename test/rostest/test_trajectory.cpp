@@ -10,6 +10,7 @@
 #include <std_msgs/Bool.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -129,20 +130,22 @@ class TrajectoryTest : public ::testing::Test {
 };
 
 TEST_F(TrajectoryTest, GoalSucceedsAndTheServosGetThere) {
-  int feedbacks = 0;
+  // The callback owns its counter: a feedback the spinner thread delivers after the result (or
+  // after a failed assertion left this function) must not write into a finished stack frame.
+  auto feedbacks = std::make_shared<std::atomic<int>>(0);
   FollowJointTrajectoryGoal goal = goalTo({0.6, -0.4}, 1.0);
   goal.trajectory.points.insert(goal.trajectory.points.begin(), point({0.3, -0.2}, 0.5));
   client_.sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                   [&](const serial_robot_driver::FollowJointTrajectoryFeedbackConstPtr& f) {
+                   [feedbacks](const serial_robot_driver::FollowJointTrajectoryFeedbackConstPtr& f) {
                      if (f->joint_names.size() == 2 && f->desired.positions.size() == 2 &&
                          f->actual.positions.size() == 2) {
-                       ++feedbacks;
+                       ++*feedbacks;
                      }
                    });
   ASSERT_TRUE(client_.waitForResult(ros::Duration(60)));
   EXPECT_EQ(client_.getState(), State::SUCCEEDED) << client_.getState().getText();
   EXPECT_EQ(client_.getResult()->error_code, FollowJointTrajectoryResult::SUCCESSFUL);
-  EXPECT_GT(feedbacks, 0);
+  EXPECT_GT(feedbacks->load(), 0);
   EXPECT_NEAR(simJoint(0), 0.6, 0.05);
   EXPECT_NEAR(simJoint(1), -0.4, 0.05);
 }

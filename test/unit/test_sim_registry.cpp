@@ -147,7 +147,7 @@ TEST(SimRegistry, TheSimulatorHostNamesNoDevice) {
     for (std::string word; std::getline(name, word, '_');) device_words.insert(word);
   }
   std::size_t files = 0;
-  for (const fs::path folder : {root / "src/sim", root / "include/serial_robot_driver/sim"}) {
+  for (const fs::path& folder : {root / "src/sim", root / "include/serial_robot_driver/sim"}) {
     for (const auto& entry : fs::directory_iterator(folder)) {
       std::ifstream in(entry.path());
       const std::string text((std::istreambuf_iterator<char>(in)),
