@@ -43,12 +43,7 @@ srd_test_code_options(srd_ros_test_pch)  # cmake/test_compile_options.cmake
 target_precompile_headers(srd_ros_test_pch PRIVATE ${srd_ros_test_pch_headers})
 
 # The gtests that link roscpp (directly or through srd_ros / srd_test_support).
-get_property(srd_targets DIRECTORY PROPERTY BUILDSYSTEM_TARGETS)
-foreach(target IN LISTS srd_targets)
-  get_target_property(type ${target} TYPE)
-  get_target_property(libraries ${target} LINK_LIBRARIES)
-  if(type STREQUAL "EXECUTABLE" AND "${libraries}" MATCHES "gtest"
-     AND "${libraries}" MATCHES "roscpp|srd_ros|srd_test_support")
-    target_precompile_headers(${target} REUSE_FROM srd_ros_test_pch)
-  endif()
+srd_gtest_executables(srd_roscpp_gtests "roscpp|srd_ros|srd_test_support")
+foreach(target IN LISTS srd_roscpp_gtests)
+  target_precompile_headers(${target} REUSE_FROM srd_ros_test_pch)
 endforeach()

@@ -11,13 +11,25 @@ function(srd_test_code_options target)
   endif()
 endfunction()
 
+# srd_gtest_executables(<out> [<regex>]): the executables that link GoogleTest and, given a regex,
+# whose link libraries match it too (precompiled_headers.cmake picks the roscpp ones).
+function(srd_gtest_executables out)
+  set(found "")
+  get_property(targets DIRECTORY PROPERTY BUILDSYSTEM_TARGETS)
+  foreach(target IN LISTS targets)
+    get_target_property(type ${target} TYPE)
+    get_target_property(libraries ${target} LINK_LIBRARIES)
+    if(type STREQUAL "EXECUTABLE" AND "${libraries}" MATCHES "gtest"
+       AND (NOT ARGV1 OR "${libraries}" MATCHES "${ARGV1}"))
+      list(APPEND found ${target})
+    endif()
+  endforeach()
+  set(${out} ${found} PARENT_SCOPE)
+endfunction()
+
 # Every executable that links GoogleTest, and the helpers they share.
-get_property(srd_targets DIRECTORY PROPERTY BUILDSYSTEM_TARGETS)
-foreach(target IN LISTS srd_targets)
-  get_target_property(type ${target} TYPE)
-  get_target_property(libraries ${target} LINK_LIBRARIES)
-  if(type STREQUAL "EXECUTABLE" AND "${libraries}" MATCHES "gtest")
-    srd_test_code_options(${target})
-  endif()
+srd_gtest_executables(srd_gtests)
+foreach(target IN LISTS srd_gtests)
+  srd_test_code_options(${target})
 endforeach()
 srd_test_code_options(srd_test_support)
