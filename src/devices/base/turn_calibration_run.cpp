@@ -139,7 +139,7 @@ CalibrationStep TurnCalibrationRun::step(const CalibrationTick& tick) {
   out.lines.swap(pending_lines_);
   out.finished = phase_ == Phase::kDone;
   out.exit_status = exit_status_;
-  if (phase_ == Phase::kMoving) out.next_step_in = kMotionStep;
+  out.next_step_in = phase_ == Phase::kMoving ? kMotionStep : kIdleStep;
   return out;
 }
 
