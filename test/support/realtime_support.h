@@ -4,6 +4,7 @@
 // that has given up the capabilities that would allow SCHED_FIFO.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <linux/capability.h>
 #include <pthread.h>
 #include <sched.h>
@@ -19,6 +20,12 @@
 #include "serial_robot_driver/core/realtime.h"
 
 namespace test_support {
+
+/// Passes when `message` (a log line, a refusal) contains `part`, and shows the message when not.
+inline ::testing::AssertionResult mentions(const std::string& message, const std::string& part) {
+  if (message.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << part << "' is not in: " << message;
+}
 
 struct ThreadPolicy {
   int policy = -1;

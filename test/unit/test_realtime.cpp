@@ -17,12 +17,8 @@ namespace {
 
 using test_support::currentThreadPolicy;
 using test_support::fifoAllowed;
+using test_support::mentions;
 using test_support::ThreadPolicy;
-
-::testing::AssertionResult mentions(const std::string& message, const std::string& part) {
-  if (message.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' is not in: " << message;
-}
 
 RealtimeFacts allowed(int priority) {
   RealtimeFacts facts;

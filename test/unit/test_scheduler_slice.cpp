@@ -21,13 +21,9 @@ namespace serial_robot_driver::core {
 namespace {
 
 using test_support::currentThreadPolicy;
+using test_support::mentions;
 using test_support::ownSlicesKept;
 using test_support::ThreadPolicy;
-
-::testing::AssertionResult mentions(const std::string& message, const std::string& part) {
-  if (message.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' is not in: " << message;
-}
 
 TEST(SchedulerSlice, OffSaysNothingAndAsksNothing) {
   EXPECT_EQ(describeSchedulerSlice(0, SliceOutcome{}), "");

@@ -109,16 +109,17 @@ TEST(BodyControllerCalibration, VelocityUsesScaleWhenSet) {
 
 // Section 2b golden vector: N = 2, positions 2048, 1024, speeds 10, -5, IMU 1, -1, 16384, 0,
 // 0, 100, 0, 0, -16384.
-const Bytes& kGoldenTelemetry = golden::body::kTelemetryTwoServos;
+const Bytes& kTwoServosTelemetry = golden::body::kTelemetryTwoServos;
 
 // N = 1 with the foot block (LEN = 40 + 4 = 0x2C): position 256, speed 0, IMU all zero, foot
 // sensors little-endian: j0 = 01 02 -> 0x0201, j1 = 03 04 -> 0x0403, j7 = FF 00 -> 0x00FF.
 // SUM = (0x2C + 01 + 01 + 02 + 03 + 04 + FF) mod 256 = 0x36.
-const Bytes kFootTelemetry = {0x12, 0x34, 0x2C, 0x01, 0x00, 0x00, 0x00,              //
-                              0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,  //
-                              0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,  //
-                              0x01, 0x02, 0x03, 0x04, 0x00, 0x00, 0x00, 0x00,        //
-                              0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xFF, 0x00, 0x36, 0x1F, 0x2F};
+const Bytes kFootTelemetryStill = {0x12, 0x34, 0x2C, 0x01, 0x00, 0x00, 0x00,              //
+                                   0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,  //
+                                   0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,  //
+                                   0x01, 0x02, 0x03, 0x04, 0x00, 0x00, 0x00, 0x00,        //
+                                   0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xFF, 0x00, 0x36,
+                                   0x1F, 0x2F};
 
 std::vector<BodyJoint> twoJoints() {
   return {BodyJoint{"hip", 2, calibration(2048, 1)}, BodyJoint{"knee", 3, calibration(2048, 1)}};
@@ -140,7 +141,8 @@ TEST(BodyControllerTelemetry, GoldenFrameReachesTheCallbackWithItsArrivalTime) {
   Received received;
   BodyController controller(twoJoints(), nullptr, recorder(&received));
   const core::Clock::time_point arrival = core::Clock::time_point(std::chrono::milliseconds(1234));
-  controller.onFrame(kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(), arrival);
+  controller.onFrame(kTelemetryFrames, kTwoServosTelemetry.data(), kTwoServosTelemetry.size(),
+                     arrival);
 
   ASSERT_EQ(received.frames.size(), 1u);
   EXPECT_EQ(received.arrivals[0], arrival);
@@ -161,7 +163,7 @@ TEST(BodyControllerTelemetry, FootBlockIsLittleEndian) {
   Received received;
   BodyController controller({BodyJoint{"ankle", 7, calibration(2048, 1)}}, nullptr,
                             recorder(&received));
-  controller.onFrame(kTelemetryFrames, kFootTelemetry.data(), kFootTelemetry.size(),
+  controller.onFrame(kTelemetryFrames, kFootTelemetryStill.data(), kFootTelemetryStill.size(),
                      core::Clock::now());
   ASSERT_EQ(received.frames.size(), 1u);
   const Telemetry& t = received.frames[0];
@@ -177,7 +179,7 @@ TEST(BodyControllerTelemetry, FrameOfAnotherServoCountIsADecodeError) {
   std::vector<BodyJoint> joints = twoJoints();
   joints.push_back(BodyJoint{"ankle", 4, calibration(2048, 1)});
   BodyController controller(joints, nullptr, recorder(&received));
-  controller.onFrame(kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+  controller.onFrame(kTelemetryFrames, kTwoServosTelemetry.data(), kTwoServosTelemetry.size(),
                      core::Clock::now());
   EXPECT_TRUE(received.frames.empty());
   const BodyStats stats = controller.stats();
@@ -193,8 +195,8 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
   const Bytes& base_reset = golden::base::kResetSeq2;
   controller.onFrame(base::kFrames, base_reset.data(), base_reset.size(), core::Clock::now());
   // Even telemetry bytes under another family tag are not ours to decode.
-  controller.onFrame(servo_bus::kResponseFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
-                     core::Clock::now());
+  controller.onFrame(servo_bus::kResponseFrames, kTwoServosTelemetry.data(),
+                     kTwoServosTelemetry.size(), core::Clock::now());
   EXPECT_TRUE(received.frames.empty());
   EXPECT_EQ(controller.stats().frames_decoded, 0u);
   EXPECT_EQ(controller.stats().decode_errors, 0u);
@@ -202,7 +204,7 @@ TEST(BodyControllerTelemetry, OtherFamiliesOnASharedPortAreIgnored) {
 
 TEST(BodyControllerTelemetry, WorksWithoutACallback) {
   BodyController controller(twoJoints(), nullptr);
-  controller.onFrame(kTelemetryFrames, kGoldenTelemetry.data(), kGoldenTelemetry.size(),
+  controller.onFrame(kTelemetryFrames, kTwoServosTelemetry.data(), kTwoServosTelemetry.size(),
                      core::Clock::now());
   EXPECT_EQ(controller.stats().frames_decoded, 1u);
 }

@@ -24,7 +24,6 @@ namespace serial_robot_driver::devices::servo_bus {
 namespace {
 
 using std::chrono::milliseconds;
-using test_support::waitFor;
 
 constexpr double kWaitSeconds = 5.0;  // generous: the machine may be busy
 
@@ -83,7 +82,7 @@ ServoBusConfig polling(std::vector<uint8_t> ids, double rate_hz) {
 TEST(ServoBusOnLink, PollsOnTheReaderThreadWhileCallersAreAnswered) {
   // Polled as fast as the pty goes: the bus is never idle, so every call competes with the poll.
   BusOnLink rig("busy", polling({1, 2, 3}, 1000.0));
-  ASSERT_TRUE(waitFor([&] { return rig.angles >= 50; }, kWaitSeconds));
+  ASSERT_TRUE(test_support::waitFor([&] { return rig.angles >= 50; }, kWaitSeconds));
 
   // Two callers on two threads, as two service calls: each transaction of theirs is read by the
   // reader thread, between (or while it waits to do) its own polls.
@@ -102,7 +101,7 @@ TEST(ServoBusOnLink, PollsOnTheReaderThreadWhileCallersAreAnswered) {
   EXPECT_EQ(failures, 0);
 
   const int before = rig.angles;
-  ASSERT_TRUE(waitFor([&] { return rig.angles >= before + 50; }, kWaitSeconds))
+  ASSERT_TRUE(test_support::waitFor([&] { return rig.angles >= before + 50; }, kWaitSeconds))
       << "the poll goes on after the calls";
   EXPECT_EQ(rig.angles_off_reader, 0) << "every poll ran on the link's reader thread";
   const ServoBusStats stats = rig.bus->client().stats();
@@ -119,9 +118,10 @@ TEST(ServoBusOnLink, AMoveFromAnotherThreadWakesTheIdleReader) {
   move.id = 2;
   move.angle_deg = 30.0;
   rig.bus->queueMoves({move});
-  ASSERT_TRUE(waitFor([&] { return rig.bus->stats().moves_sent == 1; }, kWaitSeconds));
   ASSERT_TRUE(
-      waitFor([&] { return sim::servoBusStats(rig.sim->stats()).requests >= 1; }, kWaitSeconds));
+      test_support::waitFor([&] { return rig.bus->stats().moves_sent == 1; }, kWaitSeconds));
+  ASSERT_TRUE(test_support::waitFor(
+      [&] { return sim::servoBusStats(rig.sim->stats()).requests >= 1; }, kWaitSeconds));
   EXPECT_EQ(rig.bus->stats().moves_failed, 0u);
 }
 
@@ -129,7 +129,7 @@ TEST(ServoBusOnLink, ShutdownSaysItsLastWordsThroughTheRunningReader) {
   ServoBusConfig config = polling({1, 2}, 200.0);
   config.on_shutdown = ShutdownAction::kStop;
   BusOnLink rig("shutdown", config);
-  ASSERT_TRUE(waitFor([&] { return rig.angles >= 10; }, kWaitSeconds));
+  ASSERT_TRUE(test_support::waitFor([&] { return rig.angles >= 10; }, kWaitSeconds));
   SpinRequest spin;
   spin.id = 1;
   spin.mode = 1;  // continuous
@@ -139,9 +139,9 @@ TEST(ServoBusOnLink, ShutdownSaysItsLastWordsThroughTheRunningReader) {
   const uint64_t requests_before = sim::servoBusStats(rig.sim->stats()).requests;
   rig.bus->shutdown();
   EXPECT_TRUE(rig.bus->movingIds().empty()) << "the SPIN stop went out";
-  ASSERT_TRUE(
-      waitFor([&] { return sim::servoBusStats(rig.sim->stats()).requests > requests_before; },
-              kWaitSeconds));
+  ASSERT_TRUE(test_support::waitFor(
+      [&] { return sim::servoBusStats(rig.sim->stats()).requests > requests_before; },
+      kWaitSeconds));
   EXPECT_EQ(rig.bus->client().ping(1).error, ServoError::kShutdown);
 }
 
@@ -150,10 +150,10 @@ TEST(ServoBusOnLink, ASilentServoIsBackedOffWithoutHoldingUpTheOthers) {
   ServoBusConfig config = polling({1, 9}, 100.0);
   config.client.timeout = milliseconds(100);
   BusOnLink rig("silent", config);
-  ASSERT_TRUE(waitFor([&] { return rig.bus->stats().offline_ids == std::vector<uint8_t>{9}; },
-                      kWaitSeconds));
+  ASSERT_TRUE(test_support::waitFor(
+      [&] { return rig.bus->stats().offline_ids == std::vector<uint8_t>{9}; }, kWaitSeconds));
   const int before = rig.angles;
-  ASSERT_TRUE(waitFor([&] { return rig.angles >= before + 20; }, kWaitSeconds));
+  ASSERT_TRUE(test_support::waitFor([&] { return rig.angles >= before + 20; }, kWaitSeconds));
   EXPECT_EQ(rig.angles_off_reader, 0);
   EXPECT_TRUE(rig.bus->client().ping(1).ok());
   EXPECT_EQ(rig.bus->client().ping(9).error, ServoError::kTimeout);
