@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the fuzz targets with clang and runs each for a share of the given time.
 #   fuzz/run_fuzz.sh [total_seconds]     (default 30: a CI smoke run, 4 s per target)
-#   fuzz/run_fuzz.sh --build-only        (builds; .ci/run builds ahead with it while tests run)
+#   fuzz/run_fuzz.sh --build-only        (builds the targets, runs none)
 # Environment: FUZZ_BUILD (build directory, default /tmp/fuzzbuild).
 # Exits non-zero when a target crashes, leaks, times out or reports undefined behaviour; the input
 # that did it is saved as $FUZZ_BUILD/artifacts/<target>-crash-*.

@@ -5,8 +5,8 @@
 # install space alone and checks that joint_states flow and the servo/ping service is up.
 # Tests are not built here (scripts/build.sh's workspace runs them); ccache is used when present.
 # Usage: scripts/test_catkin_build.sh [--build-only] [extra cmake arguments]. Prints "catkin build
-# test passed" or what failed. --build-only stops after the build (.ci/run builds ahead with it while
-# the tests run; the check itself runs afterwards with the same cmake arguments).
+# test passed" or what failed. --build-only stops after the build (.ci/run builds with it at the
+# lowest priority while the tests run, then runs the check with the same cmake arguments).
 set -euo pipefail
 build_only=false
 if [ "${1:-}" = --build-only ]; then build_only=true; shift; fi
