@@ -27,6 +27,12 @@ add_executable(servo_floor bench/servo_floor.cpp)
 target_include_directories(servo_floor PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(servo_floor srd_core ${catkin_LIBRARIES})
 
+# How often roscpp loses a service call on a busy machine, by way of connecting
+# (bench/service_call_loss.sh): why the tests call services through test_support::callService.
+add_executable(service_call_loss bench/service_call_loss.cpp)
+target_include_directories(service_call_loss PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(service_call_loss ${catkin_LIBRARIES})
+
 add_executable(driver_bench
   bench/bench_support.cpp
   bench/driver_bench.cpp

@@ -134,7 +134,7 @@ TEST_F(BaseNodeTest, ServicesWriteResetAndClearEncoders) {
     ASSERT_TRUE(ros::service::waitForService(c.service, 10000));
     const std::size_t from = base_->count();
     std_srvs::Trigger trigger;
-    ASSERT_TRUE(ros::service::call(c.service, trigger));
+    ASSERT_TRUE(test_support::callService(c.service, trigger));
     EXPECT_TRUE(trigger.response.success) << trigger.response.message;
     std::size_t index = 0;
     ASSERT_TRUE(base_->waitUntil(

@@ -72,7 +72,7 @@ TEST_F(EStopBus, AMotionWaitingBehindASlowTransactionIsRefusedWhenTheEStopComes)
     spin.request.id = 1;
     spin.request.mode = 1;
     spin.request.speed_dps = 90;
-    ros::service::call("servo/spin", spin);
+    test_support::callService("servo/spin", spin);
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the spin is waiting for the bus
   EXPECT_EQ(count(g_bus->frames(), kSpin1Continuous90), spins_before);
@@ -99,7 +99,7 @@ TEST_F(EStopBus, AStopDuringALongScanWaitsForOneTransactionAndTheBaseKeepsItsPac
   srd::ServoScan scan;
   scan.request.first_id = 10;
   scan.request.last_id = 25;  // absent: 16 x 0.5 s
-  std::thread scanner([&] { ros::service::call("servo/scan", scan); });
+  std::thread scanner([&] { test_support::callService("servo/scan", scan); });
   ASSERT_TRUE(g_bus->waitForFrames(
       [](const auto& frames) {
         return !frames.empty() && frames.back().bytes[2] == kPingCmd &&

@@ -192,7 +192,9 @@ TEST(Fleet, ServoCallsReachTheirOwnRobotsBus) {
   const auto readAngle = [](const std::string& robot, double* angle) {
     serial_robot_driver::ServoReadAngle read;
     read.request.id = 1;
-    if (!ros::service::call("/" + robot + "/servo/read_angle", read) || !read.response.success) return false;
+    if (!test_support::callService("/" + robot + "/servo/read_angle", read) ||
+        !read.response.success)
+      return false;
     *angle = read.response.angle_deg;
     return true;
   };
@@ -204,7 +206,7 @@ TEST(Fleet, ServoCallsReachTheirOwnRobotsBus) {
   rotate.request.id = 1;
   rotate.request.angle_deg = robot2_before > 0 ? robot2_before - 60.0 : robot2_before + 60.0;
   rotate.request.interval_ms = 0;
-  ASSERT_TRUE(ros::service::call("/robot1/servo/rotate", rotate));
+  ASSERT_TRUE(test_support::callService("/robot1/servo/rotate", rotate));
   ASSERT_TRUE(rotate.response.success) << rotate.response.message;
   double robot1_angle = 0;
   EXPECT_TRUE(waitFor(

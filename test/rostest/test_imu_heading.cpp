@@ -74,7 +74,7 @@ struct Robot {
   }
   bool resetOdometry() {
     std_srvs::Trigger trigger;
-    return ros::service::call("/" + ns_ + "/base/reset_odometry", trigger) &&
+    return test_support::callService("/" + ns_ + "/base/reset_odometry", trigger) &&
            trigger.response.success;
   }
   /// Waits until the simulated wheels stand still and the node's odom has caught up.

@@ -87,7 +87,6 @@ class NodeTraffic {
       : nh_(layout.ns), wheels(nh_, "wheel_command"), joints(nh_, "joint_states", 100) {
     cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     joint_commands_ = nh_.advertise<sensor_msgs::JointState>("joint_commands", 10);
-    ping_ = nh_.serviceClient<ServoPing>("servo/ping");
   }
 
   /// Subscribed both ways before any port exists, so the very first wheel frame is seen.
@@ -95,7 +94,7 @@ class NodeTraffic {
     return wheels.waitConnected(20) && joints.waitConnected(20) &&
            waitFor([&] { return cmd_vel_.getNumSubscribers() > 0; }, 20) &&
            waitFor([&] { return joint_commands_.getNumSubscribers() > 0; }, 20) &&
-           ping_.waitForExistence(ros::Duration(20));
+           ros::service::waitForService(nh_.resolveName("servo/ping"), ros::Duration(20));
   }
 
   void driveForward(double speed) {
@@ -112,7 +111,8 @@ class NodeTraffic {
   ServoPing::Response ping(uint8_t id) {
     ServoPing srv;
     srv.request.id = id;
-    EXPECT_TRUE(ping_.call(srv)) << "servo/ping must answer, never fail the call";
+    EXPECT_TRUE(test_support::callService(nh_.resolveName("servo/ping"), srv))
+        << "servo/ping must answer, never fail the call";
     return srv.response;
   }
 
@@ -126,7 +126,6 @@ class NodeTraffic {
  private:
   ros::Publisher cmd_vel_;
   ros::Publisher joint_commands_;
-  ros::ServiceClient ping_;
 };
 
 /// The simulators of one layout and which one plays which device.

@@ -132,7 +132,7 @@ TEST(DriverNodelet, DrivesAndStopsTheWheelsOnUnload) {
   limit.value = 0.3;
   tune.request.config.doubles.push_back(limit);
   ASSERT_TRUE(ros::service::waitForService("/driver_node/base/set_parameters", 10000));
-  ASSERT_TRUE(ros::service::call("/driver_node/base/set_parameters", tune));
+  ASSERT_TRUE(test_support::callService("/driver_node/base/set_parameters", tune));
   bool answered = false;
   for (const auto& value : tune.response.config.doubles) {
     if (value.name == "max_wheel_speed") answered = value.value == 0.3;
@@ -145,7 +145,7 @@ TEST(DriverNodelet, DrivesAndStopsTheWheelsOnUnload) {
   nodelet::NodeletUnload unload;
   unload.request.name = "/driver_node";
   ASSERT_TRUE(ros::service::waitForService("/driver_nodelet_manager/unload_nodelet", 10000));
-  ASSERT_TRUE(ros::service::call("/driver_nodelet_manager/unload_nodelet", unload));
+  ASSERT_TRUE(test_support::callService("/driver_nodelet_manager/unload_nodelet", unload));
   EXPECT_TRUE(unload.response.success);
   expectLastFrameIsZero(*base);
 }
@@ -169,7 +169,7 @@ TEST(DriverNodelet, ManagerSigintStopsTheWheels) {
   nodelet::NodeletLoad load;
   load.request.name = "/sig/driver_node";
   load.request.type = "serial_robot_driver/DriverNodelet";
-  ASSERT_TRUE(ros::service::call("/sig_manager/load_nodelet", load)) << manager.output();
+  ASSERT_TRUE(test_support::callService("/sig_manager/load_nodelet", load)) << manager.output();
   ASSERT_TRUE(load.response.success) << manager.output();
 
   Driving driving("/sig/cmd_vel");
@@ -219,7 +219,8 @@ class NodeletReplay : public testing::Test {
     nodelet::NodeletLoad request;
     request.request.name = name;
     request.request.type = "serial_robot_driver/DriverNodelet";
-    ASSERT_TRUE(ros::service::call("/replay_manager/load_nodelet", request)) << manager_->output();
+    ASSERT_TRUE(test_support::callService("/replay_manager/load_nodelet", request))
+        << manager_->output();
     ASSERT_TRUE(request.response.success) << manager_->output();
   }
 

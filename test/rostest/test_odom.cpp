@@ -79,7 +79,7 @@ class OdomTest : public ::testing::Test {
 
   bool resetOdometry() {
     std_srvs::Trigger trigger;
-    return ros::service::call("base/reset_odometry", trigger) && trigger.response.success;
+    return test_support::callService("base/reset_odometry", trigger) && trigger.response.success;
   }
 
   ros::NodeHandle nh_;

@@ -121,9 +121,9 @@ class RosInterfaceFuzz : public ::testing::Test {
     spin.request.id = 1;
     spin.request.mode = mode;
     spin.request.speed_dps = 90;
-    ASSERT_TRUE(
-        waitFor([&] { return ros::service::call("servo/spin", spin) && spin.response.success; },
-                kWaitSeconds));
+    ASSERT_TRUE(waitFor(
+        [&] { return test_support::callService("servo/spin", spin) && spin.response.success; },
+        kWaitSeconds));
   }
 
   /// Sends the run's inputs, a third before, a third under and a third after the e-stop; sets
@@ -155,9 +155,9 @@ class RosInterfaceFuzz : public ::testing::Test {
     EXPECT_EQ(test_support::nodePid("/driver_node"), pid_) << "driver_node was restarted";
     srd::ServoPing ping;
     ping.request.id = 1;
-    EXPECT_TRUE(
-        waitFor([&] { return ros::service::call("servo/ping", ping) && ping.response.online; },
-                kWaitSeconds));
+    EXPECT_TRUE(waitFor(
+        [&] { return test_support::callService("servo/ping", ping) && ping.response.online; },
+        kWaitSeconds));
     const uint64_t states = joint_states_.count();
     EXPECT_TRUE(joint_states_.waitForCount(states + 50, kWaitSeconds)) << "joint_states stopped";
   }

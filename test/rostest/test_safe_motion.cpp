@@ -84,7 +84,7 @@ srd::ServoSpin spin(const std::string& ns, uint8_t id, uint8_t mode = 1) {
   call.request.mode = mode;
   call.request.speed_dps = 90;
   EXPECT_TRUE(ros::service::waitForService(ns + "/servo/spin", 30000));
-  EXPECT_TRUE(ros::service::call(ns + "/servo/spin", call));
+  EXPECT_TRUE(test_support::callService(ns + "/servo/spin", call));
   return call;
 }
 
@@ -135,10 +135,10 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
   srd::ServoRotate rotate;
   rotate.request.id = 1;
   rotate.request.angle_deg = 90.0;
-  ASSERT_TRUE(ros::service::call("servo/rotate", rotate));
+  ASSERT_TRUE(test_support::callService("servo/rotate", rotate));
   EXPECT_FALSE(rotate.response.success);
   srd::ServoHold hold;
-  ASSERT_TRUE(ros::service::call("servo/hold", hold));
+  ASSERT_TRUE(test_support::callService("servo/hold", hold));
   EXPECT_FALSE(hold.response.success);
   sensor_msgs::JointState command;
   command.name = {"servo_1"};
@@ -148,11 +148,11 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
   // Reads and pings still work.
   srd::ServoReadAngle read;
   read.request.id = 1;
-  ASSERT_TRUE(ros::service::call("servo/read_angle", read));
+  ASSERT_TRUE(test_support::callService("servo/read_angle", read));
   EXPECT_TRUE(read.response.success) << read.response.message;
   srd::ServoPing ping;
   ping.request.id = 2;
-  ASSERT_TRUE(ros::service::call("servo/ping", ping));
+  ASSERT_TRUE(test_support::callService("servo/ping", ping));
   EXPECT_TRUE(ping.response.online) << ping.response.message;
 
   // The refusals are counted, servo_commands among them, and nothing moved.
@@ -170,7 +170,7 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
 
   // Released: motion is obeyed again.
   setEStop(false);
-  ASSERT_TRUE(ros::service::call("servo/rotate", rotate));
+  ASSERT_TRUE(test_support::callService("servo/rotate", rotate));
   EXPECT_TRUE(rotate.response.success) << rotate.response.message;
   EXPECT_TRUE(waitFor([&] { return std::fabs(simServo(*g_robot, 1)->angle_deg - 90.0) < 1e-6; },
                       kWaitSeconds));
@@ -178,7 +178,7 @@ TEST_F(SafeMotion, EStopStopsASpinningServoAndRefusesMotionUntilReleased) {
 
 TEST_F(SafeMotion, RelaxDampsEveryConfiguredServoAndHoldKeepsTheAngle) {
   srd::ServoRelax relax;  // no ids: every configured servo (1 and 2)
-  ASSERT_TRUE(ros::service::call("servo/relax", relax));
+  ASSERT_TRUE(test_support::callService("servo/relax", relax));
   EXPECT_TRUE(relax.response.success) << relax.response.message;
   EXPECT_TRUE(
       waitFor([&] { return simServo(*g_robot, 1)->relaxed && simServo(*g_robot, 2)->relaxed; },
@@ -190,7 +190,7 @@ TEST_F(SafeMotion, RelaxDampsEveryConfiguredServoAndHoldKeepsTheAngle) {
   ASSERT_TRUE(waitMoving(*g_robot, 2, true));
   srd::ServoHold hold;
   hold.request.ids = {2};
-  ASSERT_TRUE(ros::service::call("servo/hold", hold));
+  ASSERT_TRUE(test_support::callService("servo/hold", hold));
   EXPECT_TRUE(hold.response.success) << hold.response.message;
   ASSERT_TRUE(waitMoving(*g_robot, 2, false));
   EXPECT_FALSE(simServo(*g_robot, 2)->relaxed);
@@ -233,7 +233,7 @@ TEST(SafeMotionProcess, NodeletUnloadRelaxesASpinningServo) {
   nodelet::NodeletLoad load;
   load.request.name = "/unl/driver_node";
   load.request.type = "serial_robot_driver/DriverNodelet";
-  ASSERT_TRUE(ros::service::call("/unl_manager/load_nodelet", load)) << manager.output();
+  ASSERT_TRUE(test_support::callService("/unl_manager/load_nodelet", load)) << manager.output();
   ASSERT_TRUE(load.response.success) << manager.output();
 
   ASSERT_TRUE(spinOnceConnected("/unl", 0)) << manager.output();
@@ -241,7 +241,7 @@ TEST(SafeMotionProcess, NodeletUnloadRelaxesASpinningServo) {
 
   nodelet::NodeletUnload unload;
   unload.request.name = "/unl/driver_node";
-  ASSERT_TRUE(ros::service::call("/unl_manager/unload_nodelet", unload));
+  ASSERT_TRUE(test_support::callService("/unl_manager/unload_nodelet", unload));
   EXPECT_TRUE(unload.response.success);
   EXPECT_TRUE(waitMoving(*robot, 0, false)) << manager.output();
   EXPECT_TRUE(simServo(*robot, 0)->relaxed) << manager.output();
@@ -304,12 +304,12 @@ TEST(SafeMotionProcess, AHotServoIsReportedRelaxedAndRefused) {
   srd::ServoRotate rotate;
   rotate.request.id = 1;
   rotate.request.angle_deg = 45.0;
-  ASSERT_TRUE(ros::service::call("/hot/servo/rotate", rotate));
+  ASSERT_TRUE(test_support::callService("/hot/servo/rotate", rotate));
   EXPECT_FALSE(rotate.response.success);
   EXPECT_NE(rotate.response.message.find("over_temperature"), std::string::npos)
       << rotate.response.message;
   rotate.request.id = 2;
-  ASSERT_TRUE(ros::service::call("/hot/servo/rotate", rotate));
+  ASSERT_TRUE(test_support::callService("/hot/servo/rotate", rotate));
   EXPECT_TRUE(rotate.response.success) << rotate.response.message;
   EXPECT_TRUE(waitFor([&] { return std::fabs(simServo(*robot, 2)->angle_deg - 45.0) < 1e-6; },
                       kWaitSeconds));

@@ -88,7 +88,7 @@ bool waitUntilOnline(const std::string& ping_service) {
       [&] {
         srd::ServoPing srv;
         srv.request.id = 3;
-        return ros::service::call(ping_service, srv) && srv.response.online;
+        return test_support::callService(ping_service, srv) && srv.response.online;
       },
       30.0);
 }

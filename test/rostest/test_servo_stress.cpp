@@ -56,8 +56,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
       std::make_shared<Caller>("servo_stress", Caller::Role::kOnlineLow),
       std::make_shared<Caller>("servo_stress", Caller::Role::kOnlineHigh),
       std::make_shared<Caller>("servo_stress", Caller::Role::kOffline)};
-  ros::ServiceClient warm_up = nh.serviceClient<srd::ServoPing>("servo/ping");
-  ASSERT_TRUE(warm_up.waitForExistence(ros::Duration(20)));
+  ASSERT_TRUE(ros::service::waitForService(nh.resolveName("servo/ping"), ros::Duration(20)));
   ASSERT_TRUE(waitFor([&] { return diagnostics.latest(port_status).received > 0; }, 20))
       << "no diagnostics for the port";
 
@@ -79,7 +78,7 @@ TEST(ServoStress, ServiceCallsNeverStallTheHeartbeatOrTelemetry) {
   ASSERT_TRUE(joints.waitForCount(20, 20)) << "no joint_states";
   srd::ServoPing first_ping;
   first_ping.request.id = kOnlineIds[1];
-  ASSERT_TRUE(warm_up.call(first_ping));
+  ASSERT_TRUE(test_support::callService(nh.resolveName("servo/ping"), first_ping));
   ASSERT_TRUE(first_ping.response.online) << first_ping.response.message;
   motion.start();
   test_support::sleepSeconds(0.5);

@@ -345,7 +345,7 @@ TEST_F(TrajectoryTest, BusServoJointFollowsOneMovePerSegment) {
   rotate.request.id = 2;
   rotate.request.angle_deg = 0.0;
   rotate.request.interval_ms = 200;
-  ASSERT_TRUE(ros::service::call("servo/rotate", rotate));
+  ASSERT_TRUE(test_support::callService("servo/rotate", rotate));
   ASSERT_TRUE(client_.waitForResult(ros::Duration(30)));
   EXPECT_EQ(client_.getState(), State::ABORTED);
   EXPECT_NE(errorString().find("servo/rotate"), std::string::npos) << errorString();

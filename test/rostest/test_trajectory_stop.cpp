@@ -269,7 +269,7 @@ TEST_F(TrajectoryStop, RetunedPollRateKeepsBusGoalsFresh) {
   set.request.config.doubles.push_back(rate);
   const std::string service = std::string(kNode) + "/servo_bus/set_parameters";
   ASSERT_TRUE(ros::service::waitForService(service, 30000));
-  ASSERT_TRUE(ros::service::call(service, set));
+  ASSERT_TRUE(test_support::callService(service, set));
   test_support::sleepSeconds(1.5);  // the poll is at 1 Hz from its next round
 
   // At 1 Hz a measurement is up to 1 s old: the limit is now 3 s, not 0.5 s.
@@ -281,7 +281,7 @@ TEST_F(TrajectoryStop, RetunedPollRateKeepsBusGoalsFresh) {
 
   rate.value = 20.0;
   set.request.config.doubles = {rate};
-  EXPECT_TRUE(ros::service::call(service, set));
+  EXPECT_TRUE(test_support::callService(service, set));
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "serial_robot_driver/ServoScan.h"
 #include "serial_robot_driver/ServoSpin.h"
 #include "serial_robot_driver/ServoWrite.h"
+#include "support/ros_test_support.h"
 #include "support/test_helpers.h"
 
 namespace ros_fuzz {
@@ -103,14 +104,9 @@ sensor_msgs::JointState fuzzJointState(Extremes& x, const std::vector<std::strin
 
 template <typename Service>
 void call(const std::string& name, Service& service) {
-  // The answer's content is the node's business; that it answers at all is what counts here.
-  if (ros::service::call(name, service)) return;
-  // A non-persistent call is a lookup at the master and a new connection each time; on a busy
-  // machine (tests run side by side) one of those can fail before the node sees the request. The
-  // same request again: the node must answer it (a node that is gone or stuck still fails here).
-  std::printf("ros_interface_fuzz: %s: no answer to the first call (service %s), calling again\n",
-              name.c_str(), ros::service::exists(name, false) ? "still advertised" : "not found");
-  EXPECT_TRUE(test_support::waitFor([&] { return ros::service::call(name, service); },
+  // The answer's content is the node's business; that it answers at all is what counts here (a
+  // call roscpp lost on the way is tried again, see callService).
+  EXPECT_TRUE(test_support::waitFor([&] { return test_support::callService(name, service); },
                                     kAnswerSeconds))
       << name << " gave no answer";
 }

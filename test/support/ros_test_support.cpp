@@ -3,10 +3,13 @@
 
 #include <gtest/gtest.h>
 #include <ros/network.h>
+#include <ros/service.h>
 #include <std_msgs/Bool.h>
 #include <unistd.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 #include <xmlrpcpp/XmlRpcValue.h>
+
+#include <cstdio>
 
 namespace test_support {
 
@@ -20,6 +23,13 @@ RosTestNode::RosTestNode(int& argc, char** argv, const std::string& name, int sp
 RosTestNode::~RosTestNode() {
   spinner_->stop();
   ros::shutdown();
+}
+
+bool retryLostServiceCall(const std::string& service, int attempt, int tries) {
+  if (attempt >= tries || !ros::service::exists(service, false)) return false;
+  std::fprintf(stderr, "%s: roscpp lost the call (try %d of %d), calling again\n", service.c_str(),
+               attempt, tries);
+  return true;
 }
 
 std::string findDriverNode() {

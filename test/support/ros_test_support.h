@@ -91,6 +91,32 @@ class TopicCounter {
   std::vector<Msg> messages_;
 };
 
+/// Whether a service call that roscpp reported failed is worth another try: `service` is still
+/// advertised (a service not there yet, or gone with its node, answers nothing however often it is
+/// called). Logs the lost try on stderr.
+bool retryLostServiceCall(const std::string& service, int attempt, int tries);
+
+/// ros::service::call, and again (up to three tries) when roscpp lost the call while the service
+/// is advertised. Every roscpp server, driver_node's too, now and then closes a freshly accepted
+/// connection on a busy machine: its poll loop hands a stale "peer closed" event (POLLRDHUP) of a
+/// socket just closed to the new socket that reuses its descriptor (roscpp guards against that for
+/// POLLERR, POLLHUP and POLLNVAL only), and the client gets no answer.
+/// bench/service_call_loss.sh measures it: about 1 call in 1,600 to 7,000 under two CPU hogs. A
+/// persistent connection loses fewer, but one made per call has also hung a call for good in that
+/// benchmark (no answer, no error), so the tests keep roscpp's default connection and call again.
+/// The servo services always answer (a refusal is in the response), so a false here means the
+/// call never reached them or its answer was lost on the way; a call the node had done before the
+/// loss is done twice: tests that count frames then fail, never pass wrongly.
+template <typename Service>
+bool callService(const std::string& service, Service& srv) {
+  constexpr int kTries = 3;
+  for (int attempt = 1; attempt <= kTries; ++attempt) {
+    if (ros::service::call(service, srv)) return true;
+    if (!retryLostServiceCall(service, attempt, kTries)) return false;
+  }
+  return false;
+}
+
 /// Reads the private parameter `key` of node `node` (e.g. "/soak/driver_node", "port").
 std::string nodeParam(const std::string& node, const std::string& key);
 

@@ -91,21 +91,11 @@ inline ServoBusPlayer* g_armed = nullptr;  // /armed/driver_node: dangerous writ
 inline std::string safeService(const std::string& name) { return "servo/" + name; }
 inline std::string armedService(const std::string& name) { return "armed/servo/" + name; }
 
-/// Calls `service` and returns its answer. The node's servo services always answer (a refusal is in
-/// the response), so a false from ros::service::call is roscpp losing the call on its way: on a
-/// loaded machine its client now and then reports a non-persistent call failed (estop_bus did so
-/// in CI, about 1 run in 25 under two hogs; the cause inside roscpp is not pinned down). Up to
-/// two more tries, each one logged; a node that never answers still fails the test. A retried
-/// call the node had done is done twice: tests that count frames then fail, never pass wrongly.
+/// Calls `service` and returns its answer; a call roscpp lost is tried again (callService), and
+/// a node that never answers fails the test.
 template <typename Srv>
 Srv call(const std::string& service, Srv srv) {
-  constexpr int kTries = 3;
-  for (int attempt = 1; attempt <= kTries; ++attempt) {
-    if (ros::service::call(service, srv)) return srv;
-    std::fprintf(stderr, "%s: the call failed in roscpp (try %d of %d)\n", service.c_str(), attempt,
-                 kTries);
-  }
-  ADD_FAILURE() << service << ": no answer in " << kTries << " calls";
+  if (!test_support::callService(service, srv)) ADD_FAILURE() << service << ": no answer";
   return srv;
 }
 
@@ -296,7 +286,7 @@ class SimBusTest : public ::testing::Test {
       srd::ServoRead read;
       read.request.id = 7;  // nobody answers
       read.request.param = "voltage";
-      ros::service::call("servo/read", read);
+      test_support::callService("servo/read", read);
     });
     return g_bus->waitForFrames(
         [](const auto& frames) {

@@ -131,18 +131,11 @@ class Motion {
 /// Calls the servo and base services in turn until stopped, counting the outcomes.
 class ServiceCaller {
  public:
-  explicit ServiceCaller(ros::NodeHandle& nh)
-      : ping_(nh.serviceClient<srd::ServoPing>("servo/ping")),
-        read_(nh.serviceClient<srd::ServoRead>("servo/read")),
-        read_angle_(nh.serviceClient<srd::ServoReadAngle>("servo/read_angle")),
-        read_all_(nh.serviceClient<srd::ServoReadAll>("servo/read_all")),
-        rotate_(nh.serviceClient<srd::ServoRotate>("servo/rotate")),
-        base_reset_(nh.serviceClient<std_srvs::Trigger>("base/reset")),
-        clear_encoders_(nh.serviceClient<std_srvs::Trigger>("base/clear_encoders")) {}
+  explicit ServiceCaller(ros::NodeHandle& nh) : nh_(nh) {}
 
   bool waitConnected() {
-    return ping_.waitForExistence(ros::Duration(20)) &&
-           clear_encoders_.waitForExistence(ros::Duration(20));
+    return ros::service::waitForService(nh_.resolveName("servo/ping"), ros::Duration(20)) &&
+           ros::service::waitForService(nh_.resolveName("base/clear_encoders"), ros::Duration(20));
   }
   void start() {
     thread_ = std::thread([this] {
@@ -163,11 +156,11 @@ class ServiceCaller {
 
  private:
   template <typename Srv>
-  void account(ros::ServiceClient& client, Srv& srv, bool needs_answer,
+  void account(const std::string& service, Srv& srv, bool needs_answer,
                bool (*success)(const typename Srv::Response&),
                const std::string& (*message)(const typename Srv::Response&)) {
     const auto start = test_support::Clock::now();
-    const bool ok = client.call(srv);
+    const bool ok = test_support::callService(nh_.resolveName(service), srv);
     slowest_s = std::max(slowest_s, test_support::secondsSince(start));
     ++calls;
     if (!ok) {
@@ -189,7 +182,7 @@ class ServiceCaller {
         srd::ServoPing srv;
         srv.request.id = 1;
         account<srd::ServoPing>(
-            ping_, srv, true, [](const auto& r) { return bool(r.online); },
+            "servo/ping", srv, true, [](const auto& r) { return bool(r.online); },
             [](const auto& r) -> const std::string& { return r.message; });
         break;
       }
@@ -198,7 +191,7 @@ class ServiceCaller {
         srv.request.id = 0;
         srv.request.param = "voltage";
         account<srd::ServoRead>(
-            read_, srv, true, [](const auto& r) { return bool(r.success); },
+            "servo/read", srv, true, [](const auto& r) { return bool(r.success); },
             [](const auto& r) -> const std::string& { return r.message; });
         break;
       }
@@ -206,7 +199,7 @@ class ServiceCaller {
         srd::ServoReadAngle srv;
         srv.request.id = 2;
         account<srd::ServoReadAngle>(
-            read_angle_, srv, true, [](const auto& r) { return bool(r.success); },
+            "servo/read_angle", srv, true, [](const auto& r) { return bool(r.success); },
             [](const auto& r) -> const std::string& { return r.message; });
         break;
       }
@@ -214,7 +207,7 @@ class ServiceCaller {
         srd::ServoReadAll srv;
         srv.request.id = 1;
         account<srd::ServoReadAll>(
-            read_all_, srv, true, [](const auto& r) { return bool(r.success); },
+            "servo/read_all", srv, true, [](const auto& r) { return bool(r.success); },
             [](const auto& r) -> const std::string& { return r.message; });
         break;
       }
@@ -224,22 +217,22 @@ class ServiceCaller {
         srv.request.angle_deg = static_cast<double>(i % 90);
         srv.request.interval_ms = 50;
         account<srd::ServoRotate>(
-            rotate_, srv, false, [](const auto& r) { return bool(r.success); },  // no wait
+            "servo/rotate", srv, false, [](const auto& r) { return bool(r.success); },  // no wait
             [](const auto& r) -> const std::string& { return r.message; });
         break;
       }
       default: {
         std_srvs::Trigger srv;
-        ros::ServiceClient& client = (i / 6) % 2 == 0 ? base_reset_ : clear_encoders_;
+        const char* service = (i / 6) % 2 == 0 ? "base/reset" : "base/clear_encoders";
         account<std_srvs::Trigger>(
-            client, srv, false, [](const auto& r) { return bool(r.success); },
+            service, srv, false, [](const auto& r) { return bool(r.success); },
             [](const auto& r) -> const std::string& { return r.message; });
         break;
       }
     }
   }
 
-  ros::ServiceClient ping_, read_, read_angle_, read_all_, rotate_, base_reset_, clear_encoders_;
+  ros::NodeHandle nh_;  // the services' namespace
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

@@ -59,11 +59,8 @@ struct Robot {
   std_srvs::Trigger::Response calibrate() {
     std_srvs::Trigger trigger;
     EXPECT_TRUE(ros::service::waitForService("/" + ns_ + "/imu/calibrate", ros::Duration(20)));
-    // In a parallel suite a call now and then gets no answer (roscpp's call returns false, as
-    // ros_interface_fuzz saw): asked again for up to 10 s. A node that never answers still fails.
-    EXPECT_TRUE(waitFor([&] { return ros::service::call("/" + ns_ + "/imu/calibrate", trigger); },
-                        10))
-        << "imu/calibrate gave no answer for 10 s";
+    EXPECT_TRUE(test_support::callService("/" + ns_ + "/imu/calibrate", trigger))
+        << "imu/calibrate gave no answer";
     return trigger.response;
   }
   /// imu/data's mean angular velocity over the next `seconds`.
@@ -108,7 +105,7 @@ struct Robot {
     call.request.mode = mode;
     call.request.speed_dps = 60;
     EXPECT_TRUE(ros::service::waitForService("/" + ns_ + "/servo/spin", ros::Duration(20)));
-    return ros::service::call("/" + ns_ + "/servo/spin", call) && call.response.success;
+    return test_support::callService("/" + ns_ + "/servo/spin", call) && call.response.success;
   }
   /// Calls imu/calibrate until its answer contains `part` (each refusal answers at once).
   std_srvs::Trigger::Response calibrateUntil(const std::string& part, double seconds) {

@@ -20,12 +20,12 @@ TEST(EchoNode, PingAnswersWithTheRoundTripAndDiagnosticsCountIt) {
   std_srvs::Trigger call;
   // The node retries its port until robot_sim's link exists: the first pings may find it down.
   ASSERT_TRUE(test_support::waitFor(
-      [&] { return ros::service::call("echo/ping", call) && call.response.success; }, 20.0))
+      [&] { return test_support::callService("echo/ping", call) && call.response.success; }, 20.0))
       << call.response.message;
   EXPECT_EQ(call.response.message.rfind("round trip ", 0), 0u) << call.response.message;
   EXPECT_NE(call.response.message.find(" ms"), std::string::npos) << call.response.message;
   for (int i = 0; i < 4; ++i) {
-    ASSERT_TRUE(ros::service::call("echo/ping", call));
+    ASSERT_TRUE(test_support::callService("echo/ping", call));
     EXPECT_TRUE(call.response.success) << call.response.message;
   }
 

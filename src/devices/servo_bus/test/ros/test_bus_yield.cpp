@@ -73,7 +73,7 @@ class Background {
  public:
   Background(std::string name, Service call) : call_(std::move(call)) {
     thread_ = std::thread([this, name = std::move(name)] {
-      ros::service::call(name, call_);
+      test_support::callService(name, call_);
       done_ = true;
     });
   }
@@ -151,7 +151,7 @@ TEST_F(BusYield, StopServicesAnswerWhileTwoLongCallsHoldTheOtherThreads) {
       {"servo/relax", [] {
          srd::ServoRelax relax;
          relax.request.ids = {1};
-         return ros::service::call("servo/relax", relax) && relax.response.success;
+         return test_support::callService("servo/relax", relax) && relax.response.success;
        }}};
   const std::vector<std::function<bool(const PtyTap::Frame&)>> stop_frames = {
       [](const PtyTap::Frame& f) { return f.bytes == kSpin1StopSpeed0; },

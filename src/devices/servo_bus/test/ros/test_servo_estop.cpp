@@ -36,7 +36,7 @@ srd::ServoWrite writeCall(uint8_t id, const std::string& param, int64_t value) {
   call.request.id = id;
   call.request.param = param;
   call.request.value = value;
-  EXPECT_TRUE(ros::service::call("servo/write", call));
+  EXPECT_TRUE(test_support::callService("servo/write", call));
   return call;
 }
 
@@ -62,9 +62,9 @@ TEST_F(ServoEStop, ASlowRotateWhoseFirstStopIsLostIsStillStoppedUnderTheEStop) {
   const double from_deg = simServo(1)->angle_deg;
   rotate.request.angle_deg = from_deg > 0.0 ? from_deg - 60.0 : from_deg + 60.0;
   rotate.request.interval_ms = 40000;  // 1.5 deg/s
-  ASSERT_TRUE(
-      waitFor([&] { return ros::service::call("servo/rotate", rotate) && rotate.response.success; },
-              kWaitSeconds));
+  ASSERT_TRUE(waitFor(
+      [&] { return test_support::callService("servo/rotate", rotate) && rotate.response.success; },
+      kWaitSeconds));
   ASSERT_TRUE(waitMoving(1, true));
   setEStop(true);
   ASSERT_TRUE(waitMoving(1, false)) << "the slow servo still turns under the e-stop";
@@ -159,7 +159,7 @@ TEST_F(ServoEStop, RelaxIsAllowedUnderTheEStopAndTheStopsDoNotUndoIt) {
   ASSERT_TRUE(waitMoving(1, false));
   srd::ServoRelax relax;
   relax.request.ids = {1};
-  ASSERT_TRUE(ros::service::call("servo/relax", relax));
+  ASSERT_TRUE(test_support::callService("servo/relax", relax));
   EXPECT_TRUE(relax.response.success) << relax.response.message;
   ASSERT_TRUE(waitFor([&] { return simServo(1)->relaxed; }, kWaitSeconds));
   const std::size_t relaxed_at = g_bus->frameCount();

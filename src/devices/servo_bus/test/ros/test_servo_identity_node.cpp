@@ -47,7 +47,7 @@ DiagnosticsWatch::Status identifiedStatus(const DiagnosticsWatch& diagnostics, i
 ServoInfo info(uint8_t id) {
   ServoInfo srv;
   srv.request.id = id;
-  EXPECT_TRUE(ros::service::call("servo/info", srv));
+  EXPECT_TRUE(test_support::callService("servo/info", srv));
   return srv;
 }
 
