@@ -17,13 +17,7 @@ ws=${SRD_BENCH_WS:-${package_dir}/.ws}
 program="${ws}/devel/lib/serial_robot_driver/service_call_loss"
 [[ -x "${program}" ]] || { echo "no ${program}: build with -DSRD_BUILD_BENCHMARKS=ON" >&2; exit 1; }
 
-free_port() {  # a port nothing listens on
-  local port
-  while true; do
-    port=$((20000 + RANDOM % 20000))
-    (exec 3<>"/dev/tcp/127.0.0.1/${port}") 2>/dev/null || { echo "${port}"; return; }
-  done
-}
+source "${package_dir}/scripts/free_port.sh"
 port=$(free_port)
 export ROS_MASTER_URI="http://127.0.0.1:${port}" ROS_HOME
 ROS_HOME=$(mktemp -d)

@@ -2,14 +2,7 @@
 # (test_install.sh, test_catkin_build.sh). Source it with `set -m` in force; before calling run,
 # set install_prefix (the install space) and install_home (a HOME of its own).
 # Debian's catkin installs no setup.bash into a prefix; run sets the variables it would set.
-# A port nothing listens on: the rostests and the other check start masters of their own meanwhile.
-free_port() {
-  local port
-  while true; do
-    port=$((20000 + RANDOM % 20000))
-    (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null || { echo "$port"; return; }
-  done
-}
+source "$(dirname "${BASH_SOURCE[0]}")/free_port.sh"
 master_port=$(free_port)
 
 stop_group() {  # SIGINT to a job's process group, SIGKILL after 10 s
