@@ -84,14 +84,18 @@ std::unique_ptr<sim::RobotSim> startSim(const std::string& base_link, const std:
 class NodeTraffic {
  public:
   explicit NodeTraffic(const Layout& layout)
-      : nh_(layout.ns), wheels(nh_, "wheel_command"), joints(nh_, "joint_states", 100) {
+      : node_(layout.node()),
+        nh_(layout.ns),
+        wheels(nh_, "wheel_command"),
+        joints(nh_, "joint_states", 100) {
     cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     joint_commands_ = nh_.advertise<sensor_msgs::JointState>("joint_commands", 10);
   }
 
-  /// Subscribed both ways before any port exists, so the very first wheel frame is seen.
+  /// Subscribed both ways before any port exists, so the very first wheel frame is seen (the node
+  /// builds wheel_command only for subscribers it counts, a little after waitConnected()).
   bool connect() {
-    return wheels.waitConnected(20) && joints.waitConnected(20) &&
+    return wheels.waitCountedBy(node_, 20) && joints.waitCountedBy(node_, 20) &&
            waitFor([&] { return cmd_vel_.getNumSubscribers() > 0; }, 20) &&
            waitFor([&] { return joint_commands_.getNumSubscribers() > 0; }, 20) &&
            ros::service::waitForService(nh_.resolveName("servo/ping"), ros::Duration(20));
@@ -117,6 +121,7 @@ class NodeTraffic {
   }
 
  private:
+  std::string node_;
   ros::NodeHandle nh_;
 
  public:

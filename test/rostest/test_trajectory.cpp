@@ -90,6 +90,14 @@ class TrajectoryTest : public ::testing::Test {
     ASSERT_TRUE(joint_states_.waitForCount(5, 30)) << "no joint_states from driver_node";
     ASSERT_TRUE(client_.waitForServer(ros::Duration(30)));
     ASSERT_TRUE(other_client_.waitForServer(ros::Duration(30)));
+    // waitForServer() sees the node before the node counts this process's result subscription;
+    // a result published in between would never arrive.
+    ASSERT_TRUE(waitFor(
+        [&] {
+          return test_support::nodeCountsSubscriber(
+              "/driver_node", nh_.resolveName("follow_joint_trajectory/result"));
+        },
+        30));
     ASSERT_TRUE(waitFor([&] { return topic_.getNumSubscribers() > 0; }, 20));
     ASSERT_TRUE(waitFor([&] { return joint_commands_.getNumSubscribers() > 0; }, 20));
   }

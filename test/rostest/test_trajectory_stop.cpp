@@ -116,6 +116,14 @@ class TrajectoryStop : public ::testing::Test {
   }
   void SetUp() override {
     ASSERT_TRUE(client_.waitForServer(ros::Duration(kWait)));
+    // waitForServer() sees the node before the node counts this process's result subscription;
+    // a result published in between would never arrive.
+    ASSERT_TRUE(waitFor(
+        [&] {
+          return test_support::nodeCountsSubscriber(
+              "/driver_node", nh_.resolveName("follow_joint_trajectory/result"));
+        },
+        kWait));
     ASSERT_TRUE(waitFor([&] { return joint_commands_.getNumSubscribers() > 0; }, kWait));
     // The body's port is open: a write now would reach the fake board.
     ASSERT_TRUE(diagnostics_.waitFor(

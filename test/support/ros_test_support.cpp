@@ -10,6 +10,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <cstdio>
+#include <optional>
 
 namespace test_support {
 
@@ -50,24 +51,52 @@ std::string nodeParam(const std::string& node, const std::string& key) {
   return value;
 }
 
-int nodePid(const std::string& node) {
+namespace {
+
+/// Calls `method` of `node`'s XML-RPC API with this node as the caller; the reply's value
+/// (its third field) when the call succeeded.
+std::optional<XmlRpc::XmlRpcValue> callNodeApi(const std::string& node, const std::string& method) {
   XmlRpc::XmlRpcValue request, response, payload;
   request[0] = ros::this_node::getName();
   request[1] = node;
-  if (!ros::master::execute("lookupNode", request, response, payload, false)) return -1;
+  if (!ros::master::execute("lookupNode", request, response, payload, false)) return std::nullopt;
   const std::string uri = static_cast<std::string>(payload);
   std::string host;
   uint32_t port = 0;
-  if (!ros::network::splitURI(uri, host, port)) return -1;
+  if (!ros::network::splitURI(uri, host, port)) return std::nullopt;
   XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
-  XmlRpc::XmlRpcValue pid_request, pid_response;
-  pid_request[0] = ros::this_node::getName();
-  if (!client.execute("getPid", pid_request, pid_response)) return -1;
-  if (pid_response.getType() != XmlRpc::XmlRpcValue::TypeArray || pid_response.size() < 3 ||
-      static_cast<int>(pid_response[0]) != 1) {
-    return -1;
+  XmlRpc::XmlRpcValue api_request, api_response;
+  api_request[0] = ros::this_node::getName();
+  if (!client.execute(method.c_str(), api_request, api_response)) return std::nullopt;
+  if (api_response.getType() != XmlRpc::XmlRpcValue::TypeArray || api_response.size() < 3 ||
+      static_cast<int>(api_response[0]) != 1) {
+    return std::nullopt;
   }
-  return static_cast<int>(pid_response[2]);
+  return api_response[2];
+}
+
+}  // namespace
+
+int nodePid(const std::string& node) {
+  const std::optional<XmlRpc::XmlRpcValue> pid = callNodeApi(node, "getPid");
+  return pid ? static_cast<int>(*pid) : -1;
+}
+
+bool nodeCountsSubscriber(const std::string& node, const std::string& topic) {
+  // getBusInfo lists each connection as [id, peer, direction, transport, topic, ...]; the node
+  // adds an outbound one once the subscriber's header arrived, when it starts counting it.
+  std::optional<XmlRpc::XmlRpcValue> connections = callNodeApi(node, "getBusInfo");
+  if (!connections || connections->getType() != XmlRpc::XmlRpcValue::TypeArray) return false;
+  for (int i = 0; i < connections->size(); ++i) {
+    XmlRpc::XmlRpcValue& connection = (*connections)[i];
+    if (connection.getType() != XmlRpc::XmlRpcValue::TypeArray || connection.size() < 5) continue;
+    if (static_cast<std::string>(connection[1]) == ros::this_node::getName() &&
+        static_cast<std::string>(connection[2]) == "o" &&
+        static_cast<std::string>(connection[4]) == topic) {
+      return true;
+    }
+  }
+  return false;
 }
 
 std::string DiagnosticsWatch::Status::value(const std::string& key) const {

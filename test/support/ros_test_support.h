@@ -40,6 +40,10 @@ class RosTestNode {
 /// (devel/lib/serial_robot_driver/). Empty when not found.
 std::string findDriverNode();
 
+/// Whether `node` (e.g. "/ns/driver_node") has this process's subscriber of `topic` among its
+/// publication's subscribers, asked through the node's own XML-RPC API (getBusInfo).
+bool nodeCountsSubscriber(const std::string& node, const std::string& topic);
+
 /// Counts the messages of one topic and keeps the most recent ones (all of them when keep == 0).
 template <typename Msg>
 class TopicCounter {
@@ -81,6 +85,12 @@ class TopicCounter {
   }
   bool waitConnected(double timeout_s) const {
     return waitFor([&] { return sub_.getNumPublishers() > 0; }, timeout_s);
+  }
+  /// Stronger than waitConnected(): until `node` (e.g. "/ns/driver_node") counts this subscriber
+  /// on its side, which it does a little later. A node that publishes only to subscribers it
+  /// counts (driver_node) publishes the message of one frame from then on.
+  bool waitCountedBy(const std::string& node, double timeout_s) const {
+    return waitFor([&] { return nodeCountsSubscriber(node, sub_.getTopic()); }, timeout_s);
   }
 
  private:
