@@ -111,7 +111,7 @@ bool retryLostServiceCall(const std::string& service, int attempt, int tries);
 /// connection on a busy machine: its poll loop hands a stale "peer closed" event (POLLRDHUP) of a
 /// socket just closed to the new socket that reuses its descriptor (roscpp guards against that for
 /// POLLERR, POLLHUP and POLLNVAL only), and the client gets no answer.
-/// bench/service_call_loss.sh measures it: about 1 call in 1,600 to 7,000 under two CPU hogs. A
+/// bench/service_call_loss.sh measures it: about 1 call in 1,600 to 12,000 under CPU hogs. A
 /// persistent connection loses fewer, but one made per call has also hung a call for good in that
 /// benchmark (no answer, no error), so the tests keep roscpp's default connection and call again.
 /// The servo services always answer (a refusal is in the response), so a false here means the
