@@ -183,14 +183,14 @@ struct Board {
 
   /// Flushes every topic: after this, no message of an earlier frame is still on its way (each
   /// topic is in order, and the sync frames come after everything written before).
-  bool sync(double timeout_s = 15.0) {
+  bool sync() {
     clear();
     write(kSyncFoot);
     write(kSync);
-    const bool ok = foot.waitFor([](const FootPressure& m) { return isSync(m); }, timeout_s) &&
-                    joints.waitFor([](const JointState& m) { return isSync(m); }, timeout_s) &&
-                    imu.waitFor([](const Imu& m) { return isSync(m); }, timeout_s) &&
-                    telemetry.waitFor([](const Telemetry& m) { return isSync(m); }, timeout_s);
+    const bool ok = foot.waitFor([](const FootPressure& m) { return isSync(m); }) &&
+                    joints.waitFor([](const JointState& m) { return isSync(m); }) &&
+                    imu.waitFor([](const Imu& m) { return isSync(m); }) &&
+                    telemetry.waitFor([](const Telemetry& m) { return isSync(m); });
     clear();
     return ok;
   }
@@ -233,11 +233,15 @@ class BodyNode : public testing::Test {
       }
       ASSERT_TRUE(board.connected) << "no joint_states for telemetry written to the pty";
       // Each topic's subscription connects on its own, and the node builds no message for a topic
-      // nobody subscribes to yet: offer sync frames until all four topics carry them. The full
-      // sync below then flushes whatever an earlier offer left on its way.
-      bool every_topic = false;
-      for (int attempt = 0; attempt < 60 && !every_topic; ++attempt) every_topic = board.sync(0.5);
-      ASSERT_TRUE(every_topic) << "sync frames never came back on every topic";
+      // with no subscriber it counts yet: the sync below needs all four counted.
+      for (const ros::Subscriber& subscriber : board.subscribers) {
+        ASSERT_TRUE(waitFor(
+            [&] {
+              return test_support::nodeCountsSubscriber("/driver_node", subscriber.getTopic());
+            },
+            20.0))
+            << "/driver_node never counted the subscriber of " << subscriber.getTopic();
+      }
       board.connect_failed = false;
     }
     ASSERT_TRUE(board.sync()) << "sentinel frames did not come back on every topic";
