@@ -41,12 +41,11 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/core/clock.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/transport/byte_stream.h"
 
 namespace serial_robot_driver::core {
-
-using Clock = std::chrono::steady_clock;
 
 /// How every device puts a frame on its port: writes one whole frame and returns false when the
 /// port is down or the write failed (SerialLink::write). Tests pass a fake.

@@ -11,19 +11,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "serial_robot_driver/core/clock.h"
+
 namespace serial_robot_driver::sim {
 
-using Clock = std::chrono::steady_clock;
+using core::Clock;
+using core::fromSeconds;
+using core::toSeconds;
 using TimePoint = Clock::time_point;
-
-/// Seconds as a double, for rates and kinematics.
-inline double toSeconds(Clock::duration duration) {
-  return std::chrono::duration<double>(duration).count();
-}
-/// A duration from (possibly fractional) seconds.
-inline Clock::duration fromSeconds(double seconds) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-}
 
 /// A kind of frame a device sends, as RobotSim's fault injection and send counters see it. Each
 /// device defines its own (one object per kind: it is known by its address).

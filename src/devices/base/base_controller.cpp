@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "serial_robot_driver/core/clock.h"
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/scheduler_slice.h"
 
@@ -15,18 +16,13 @@ namespace serial_robot_driver::devices::base {
 using kinematics::WheelSpeeds;
 
 namespace {
-double seconds(core::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-core::Clock::duration fromSeconds(double s) {
-  return std::chrono::duration_cast<core::Clock::duration>(std::chrono::duration<double>(s));
-}
 
 /// A speed frame's airtime at `baud` (start + 8 data + stop bits per byte), stretched so that
 /// frames sent this closely take at most `line_share` of the line.
 core::Clock::duration immediateInterval(int baud, double line_share) {
   const double frame_bits = 10.0 * static_cast<double>(encodeWheelSpeed(0, 0, 0).size());
   const double airtime = frame_bits / std::max(baud, 1);
-  return fromSeconds(airtime / std::clamp(line_share, 0.01, 1.0));
+  return core::fromSeconds(airtime / std::clamp(line_share, 0.01, 1.0));
 }
 
 int16_t withDirection(int16_t ticks, int direction) {
@@ -44,7 +40,7 @@ BaseController::BaseController(BaseConfig config, core::FrameWriter writer, Base
       writer_(std::move(writer)),
       events_(std::move(events)),
       clock_(clock ? std::move(clock) : core::steadyLoopClock()),
-      period_(fromSeconds(1.0 / config.loop_rate)),
+      period_(core::fromSeconds(1.0 / config.loop_rate)),
       min_immediate_interval_(immediateInterval(config.baud, config.immediate_line_share)),
       limiter_(config.max_wheel_accel),
       quantizer_(config.geometry, config.speed_dithering),
@@ -134,7 +130,7 @@ void BaseController::setEStop(bool engaged) {
 
 bool BaseController::commandMovesLocked(core::Clock::time_point now) const {
   const bool command_live =
-      !e_stop_ && last_command_ && seconds(now - *last_command_) <= config_.cmd_vel_timeout;
+      !e_stop_ && last_command_ && core::toSeconds(now - *last_command_) <= config_.cmd_vel_timeout;
   return command_live && (linear_x_ != 0.0 || angular_z_ != 0.0);
 }
 
@@ -256,7 +252,7 @@ void BaseController::rescheduleBatteryPollLocked(double next_rate, core::Clock::
   if (next_rate == config_.battery_poll_rate) return;
   if (next_rate > 0) {
     // A faster rate starts now, not after the slower period still pending.
-    next_battery_poll_ = std::min(next_battery_poll_, now + fromSeconds(1.0 / next_rate));
+    next_battery_poll_ = std::min(next_battery_poll_, now + core::fromSeconds(1.0 / next_rate));
   } else {
     unanswered_since_.reset();  // no requests, nothing unanswered
     silent_reported_ = false;
@@ -273,12 +269,13 @@ BaseStats BaseController::stats() const {
   const core::Clock::time_point now = clock_->now();
   BaseStats snapshot = stats_;
   odometry_.addHeadingStats(snapshot, now);
-  snapshot.min_immediate_interval_ms = seconds(min_immediate_interval_) * 1e3;
+  snapshot.min_immediate_interval_ms = core::toSeconds(min_immediate_interval_) * 1e3;
   if (last_running_timeout_error_) {
-    snapshot.seconds_since_running_timeout_error = seconds(now - *last_running_timeout_error_);
+    snapshot.seconds_since_running_timeout_error =
+        core::toSeconds(now - *last_running_timeout_error_);
   }
   if (config_.battery_poll_rate > 0 && unanswered_since_) {
-    snapshot.seconds_without_reply = seconds(now - *unanswered_since_);
+    snapshot.seconds_without_reply = core::toSeconds(now - *unanswered_since_);
     snapshot.base_silent =
         *snapshot.seconds_without_reply > config_.silent_after_polls / config_.battery_poll_rate;
   }
@@ -329,7 +326,7 @@ void BaseController::onFrame(protocol::FrameFamily family, const uint8_t* data, 
         ++stats_.timeout_errors_received;
         // One FF may still be in flight from before our Reset (e.g. at power-on): not "running".
         const bool running = !needs_reset_ && last_reset_sent_ &&
-                             seconds(now - *last_reset_sent_) >= config_.heartbeat_gap;
+                             core::toSeconds(now - *last_reset_sent_) >= config_.heartbeat_gap;
         if (running) {
           ++stats_.timeout_errors_while_running;
           last_running_timeout_error_ = now;
@@ -376,7 +373,8 @@ bool BaseController::writeLocked(const std::vector<uint8_t>& frame, core::Clock:
 
 WheelSpeeds BaseController::targetSpeedsLocked(core::Clock::time_point now, bool* timed_out_now) {
   if (e_stop_) return WheelSpeeds::Zero();
-  const bool timed_out = !last_command_ || seconds(now - *last_command_) > config_.cmd_vel_timeout;
+  const bool timed_out =
+      !last_command_ || core::toSeconds(now - *last_command_) > config_.cmd_vel_timeout;
   if (timed_out && !command_timed_out_ && last_command_) {
     ++stats_.cmd_vel_timeouts;
     *timed_out_now = true;
@@ -410,7 +408,8 @@ void BaseController::sendSpeedLocked(core::Clock::time_point now, bool immediate
   // A tick that read the clock before a cmd_vel's frame took the lock goes on from that frame:
   // frame times (and so the ramp's steps and the odometry's intervals) never run backwards.
   if (last_write_ && now < *last_write_) now = *last_write_;
-  const double dt = last_speed_frame_ ? seconds(now - *last_speed_frame_) : seconds(period_);
+  const double dt =
+      last_speed_frame_ ? core::toSeconds(now - *last_speed_frame_) : core::toSeconds(period_);
   const WheelSpeeds target = targetSpeedsLocked(now, &report->timed_out_now);
   if (e_stop_) {
     limiter_.reset();  // an e-stop does not ramp down
@@ -420,7 +419,8 @@ void BaseController::sendSpeedLocked(core::Clock::time_point now, bool immediate
 
   // The base drops into its timeout error after 1 s without a frame; if our own gap reached that,
   // assume it did, even if its FF frame was lost.
-  if (last_write_ && seconds(now - *last_write_) >= config_.heartbeat_gap) needs_reset_ = true;
+  if (last_write_ && core::toSeconds(now - *last_write_) >= config_.heartbeat_gap)
+    needs_reset_ = true;
   WheelFrameSent sent;
   if (needs_reset_) {
     if (!writeLocked(encodeReset(seq_.peek()), now)) return;
@@ -469,7 +469,7 @@ void BaseController::tick(core::Clock::time_point now) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (last_tick_) {
-      const double period_ms = seconds(now - *last_tick_) * 1e3;
+      const double period_ms = core::toSeconds(now - *last_tick_) * 1e3;
       stats_.last_period_ms = period_ms;
       if (period_ms > stats_.worst_period_ms) stats_.worst_period_ms = period_ms;
     }
@@ -493,7 +493,7 @@ void BaseController::tick(core::Clock::time_point now) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (config_.battery_poll_rate > 0 && unanswered_since_ && !silent_reported_) {
-      const double silent_for = seconds(now - *unanswered_since_);
+      const double silent_for = core::toSeconds(now - *unanswered_since_);
       if (silent_for > config_.silent_after_polls / config_.battery_poll_rate) {
         silent_reported_ = true;
         went_silent = silent_for;

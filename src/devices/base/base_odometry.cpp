@@ -3,19 +3,12 @@
 #include <algorithm>
 #include <chrono>
 
+#include "serial_robot_driver/core/clock.h"
 #include "serial_robot_driver/devices/base/base_controller.h"
 
 namespace serial_robot_driver::devices::base {
 
 using kinematics::WheelSpeeds;
-
-namespace {
-double seconds(core::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-core::Clock::duration fromSeconds(double s) {
-  return std::chrono::duration_cast<core::Clock::duration>(std::chrono::duration<double>(s));
-}
-}  // namespace
 
 BaseOdometry::BaseOdometry(const BaseConfig& config)
     : geometry_(config.geometry),
@@ -29,9 +22,10 @@ void BaseOdometry::advance(core::Clock::time_point now) {
   double dt = 0;
   if (accepted_at_) {
     // The base runs the last accepted speeds until its heartbeat timeout stops it.
-    const core::Clock::time_point end = std::min(now, *accepted_at_ + fromSeconds(heartbeat_gap_));
+    const core::Clock::time_point end =
+        std::min(now, *accepted_at_ + core::fromSeconds(heartbeat_gap_));
     if (end > integrated_until_) {
-      dt = seconds(end - integrated_until_);
+      dt = core::toSeconds(end - integrated_until_);
       wheel_travel_ += held_speeds_ * dt;
       integrated_until_ = end;
     }
@@ -91,7 +85,7 @@ OdometrySample BaseOdometry::sample(core::Clock::time_point now) const {
   OdometrySample sample;
   sample.time = now;
   sample.pose = odometry_.pose();
-  const bool running = accepted_at_ && seconds(now - *accepted_at_) < heartbeat_gap_;
+  const bool running = accepted_at_ && core::toSeconds(now - *accepted_at_) < heartbeat_gap_;
   if (running) {
     sample.linear = (held_speeds_.x() + held_speeds_.y()) / 2.0;
     sample.angular = (held_speeds_.y() - held_speeds_.x()) / geometry_.wheel_separation;

@@ -5,6 +5,8 @@
 #include <ctime>
 #include <utility>
 
+#include "serial_robot_driver/core/clock.h"
+
 namespace serial_robot_driver::devices::body {
 
 namespace {
@@ -31,10 +33,6 @@ std::string utc(std::chrono::system_clock::time_point when) {
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &parts);
   return text;
-}
-
-core::Clock::duration fromSeconds(double seconds) {
-  return std::chrono::duration_cast<core::Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
 }  // namespace
@@ -146,8 +144,13 @@ GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, core::Clock::time
     std::lock_guard<std::mutex> lock(mutex_);
     noteMotionLocked(motion, arrival, after_gap);
     if (!session_ && start_report_ && !cancelled_ && !motion && settledLocked(arrival)) {
-      session_ = Session{
-          "calibrate_on_start", arrival, arrival + fromSeconds(seconds), seconds, {}, {}, true};
+      session_ = Session{"calibrate_on_start",
+                         arrival,
+                         arrival + core::fromSeconds(seconds),
+                         seconds,
+                         {},
+                         {},
+                         true};
     }
     if (session_ && arrival >= session_->begin) {
       if (motion && session_->not_still.empty()) {
@@ -202,7 +205,7 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
     return refuseLocked(how, "no IMU telemetry (" + since + ")", units, false);
   }
   if (!settledLocked(now)) return refuseLocked(how, unsettledLocked(now), units, true);
-  session_ = Session{how, now, now + fromSeconds(seconds), seconds, {}, {}, false};
+  session_ = Session{how, now, now + core::fromSeconds(seconds), seconds, {}, {}, false};
   // Between frames too the robot may start moving (or telemetry stop while it moves): look every
   // 50 ms, not only when a frame arrives.
   while (!cancelled_ && session_->not_still.empty() && core::Clock::now() < session_->end) {

@@ -15,9 +15,6 @@ namespace serial_robot_driver::devices::servo_bus {
 
 namespace {
 
-constexpr uint8_t kServoIdParam = dataId(ServoDataId::kServoId);
-constexpr uint8_t kIdAfterReset = 0;  // RESET_USER_DATA sets the servo's id to 0
-
 std::string servoLabel(uint8_t id) { return "servo " + std::to_string(id); }
 
 /// The parameters that change where or how a servo moves, or where its stop goes.
@@ -238,7 +235,8 @@ ServoStatus MotionSafety::writeParam(uint8_t id, std::string_view param, int64_t
     if (!refused.ok()) return refused;
   }
   const ServoStatus status = client_.writeParam(id, param, value);
-  if (status.ok() && info != nullptr && info->data_id == kServoIdParam && value != id) {
+  if (status.ok() && info != nullptr && info->data_id == dataId(ServoDataId::kServoId) &&
+      value != id) {
     followAddress(id, static_cast<uint8_t>(value));
   }
   return status;
@@ -249,7 +247,7 @@ ServoStatus MotionSafety::resetUserData(uint8_t id) {
   const ServoStatus refused = settingRefusal(id, "RESET_USER_DATA");
   if (!refused.ok()) return refused;
   const ServoStatus status = client_.resetUserData(id);
-  if (status.ok()) followAddress(id, kIdAfterReset);
+  if (status.ok()) followAddress(id, kServoIdAfterReset);
   return status;
 }
 

@@ -19,10 +19,8 @@ namespace {
 constexpr uint8_t kMaxSpinMode = 3;
 constexpr double kDegreesPerTurn = 360.0;
 
-constexpr uint8_t kServoIdParam = dataId(ServoDataId::kServoId);
 constexpr uint8_t kBaudrateParam = dataId(ServoDataId::kBaudrate);
 constexpr std::size_t kReadDataHeader = 2;  // id, data_id, then the value
-constexpr uint8_t kDefaultServoId = 0;      // what RESET_USER_DATA sets the id to
 
 ServoStatus fromWriteCheck(WriteCheck check, const ParamInfo& param, int64_t value) {
   ServoError error = ServoError::kInvalidArgument;
@@ -229,7 +227,7 @@ ServoStatus ServoBusClient::writeParam(uint8_t id, std::string_view param_name, 
   // One lock for the probe, the write and the read-back: no other call comes between them, but
   // each transaction hands the bus to a stop first (transact), so a stop waits for one attempt.
   std::lock_guard<BusMutex> bus(transactions_.busMutex());
-  const bool id_change = param->data_id == kServoIdParam && value != id;
+  const bool id_change = param->data_id == dataId(ServoDataId::kServoId) && value != id;
   const uint8_t new_id = static_cast<uint8_t>(value);
   if (id_change) {
     const ServoStatus free = checkIdFreeLocked(id, new_id);
@@ -301,7 +299,7 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
                 "unreachable; refused because dangerous writes are not allowed");
   }
   Expectation expect(Command::kResetUserData, id);
-  expect.alt_id = kDefaultServoId;  // the reset moves the servo to id 0 and it may answer there
+  expect.alt_id = kServoIdAfterReset;  // the reset moves the servo to id 0 and it may answer there
   // One lock for every attempt and PING: a stop still goes first after the one in flight.
   std::lock_guard<BusMutex> bus(transactions_.busMutex());
   ServoStatus last;
@@ -322,7 +320,7 @@ ServoStatus ServoBusClient::resetUserData(uint8_t id) {
     if (last.error != ServoError::kTimeout) return last;
     // No answer: the servo may have reset and moved to id 0 without answering. (For a servo at
     // id 0 already a PING proves nothing: the reset is re-sent instead.)
-    if (id != kDefaultServoId && pingOnceLocked(kDefaultServoId).ok()) {
+    if (id != kServoIdAfterReset && pingOnceLocked(kServoIdAfterReset).ok()) {
       return ok(servoName(id) +
                 " reset its user data to the factory defaults; it gave no answer "
                 "but now answers PING at id 0");

@@ -51,6 +51,8 @@ enum class ServoDataId : uint8_t {
   kAngleMidOffset = 53,
 };
 constexpr uint8_t dataId(ServoDataId id) { return static_cast<uint8_t>(id); }
+/// The id RESET_USER_DATA gives a servo.
+constexpr uint8_t kServoIdAfterReset = 0;
 
 enum class ParamType { kU8, kU16, kU32, kI16 };
 constexpr std::array<ParamType, 4> kParamTypes = {ParamType::kU8, ParamType::kU16, ParamType::kU32,
