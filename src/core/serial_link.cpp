@@ -237,6 +237,15 @@ bool SerialLink::pump(Clock::time_point until) {
   return connected_ && !lost_ && !stopping_;
 }
 
+void SerialLink::dropStaleCandidates() {
+  // No byte for a whole timeout: what is buffered will not complete. Frames found behind the stale
+  // candidate keep the arrival time of their bytes.
+  while (framer_.dropStaleCandidate()) {
+  }
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  stats_.framer = framer_.stats();
+}
+
 Clock::duration SerialLink::reconnectInterval() const {
   return std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(options_.reconnect_interval));
@@ -257,12 +266,7 @@ void SerialLink::readOnce(Clock::time_point until) {
     // The stream's clock: a replay measures the recorded silence on its own timeline.
     const auto quiet = stream_->now() - chunk_arrival_;
     if (quiet >= options_.stale_frame_timeout) {
-      // No byte for a whole timeout: what is buffered will not complete. Frames found behind
-      // the stale candidate keep the arrival time of their bytes.
-      while (framer_.dropStaleCandidate()) {
-      }
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      stats_.framer = framer_.stats();
+      dropStaleCandidates();
       return;
     }
     const auto left =
@@ -279,7 +283,15 @@ void SerialLink::readOnce(Clock::time_point until) {
   }
   if (n == 0) return;
   // A replayed recording knows when its bytes arrived; a live port's bytes arrived now.
-  chunk_arrival_ = stream_->arrivalTime().value_or(Clock::now());
+  const Clock::time_point arrival = stream_->arrivalTime().value_or(Clock::now());
+  // Bytes read a whole timeout after the last ones find the buffered candidate stale even when a
+  // busy machine, not the line, kept them: judged by the arrival times the capture records, a
+  // replay drops exactly what the live run dropped.
+  if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0 &&
+      arrival - chunk_arrival_ >= options_.stale_frame_timeout) {
+    dropStaleCandidates();
+  }
+  chunk_arrival_ = arrival;
   if (observer_) observer_->onChunk({options_.path, false, chunk_.data(), n, chunk_arrival_});
   framer_.feed(chunk_.data(), n);
   std::lock_guard<std::mutex> lock(state_mutex_);

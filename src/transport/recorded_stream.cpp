@@ -42,15 +42,16 @@ void RecordedStream::open() {
 
 SteadyTime RecordedStream::now() const {
   const RecordedPort& port = *port_;
-  if (port.pacing_->paced()) return port.pacing_->now();
-  if (port.next_ < port.chunks_.size()) {
-    const RecordedChunk& next = port.chunks_[port.next_];
-    // Before a recorded reopen the port was lost right after its last bytes (read() throws at
-    // once, as the live read did), not after a silence that a stale-frame timer could count.
-    if (next.data.empty() && arrival_) return *arrival_;
-    return port.pacing_->onTimeline(next.recorded);
-  }
-  return port.pacing_->end();
+  const ReplayPacing& pacing = *port.pacing_;
+  if (port.next_ >= port.chunks_.size()) return pacing.paced() ? pacing.now() : pacing.end();
+  const RecordedChunk& next = port.chunks_[port.next_];
+  // Before a recorded reopen the port was lost right after its last bytes (read() throws at
+  // once, as the live read did), not after a silence that a stale-frame timer could count.
+  if (next.data.empty() && arrival_) return *arrival_;
+  // The timeline never runs past bytes not yet read (live, the reader had them by then), so a
+  // stale-frame timer decides as it did live however late a paced replay's thread runs.
+  const SteadyTime next_arrival = pacing.onTimeline(next.recorded);
+  return pacing.paced() ? std::min(pacing.now(), next_arrival) : next_arrival;
 }
 
 std::size_t RecordedStream::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {

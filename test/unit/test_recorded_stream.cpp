@@ -4,6 +4,7 @@
 
 #include <array>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "serial_robot_driver/transport/recorded_stream.h"
@@ -154,6 +155,22 @@ TEST(RecordedStream, APacedReplayRunsOnThroughTheSilenceAtTheEnd) {
   EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x01}));
   EXPECT_TRUE(readOnce(stream).empty());
   EXPECT_FALSE(port->finished());
+}
+
+// Paced: however late the reader looks, the timeline stands at the next chunk it has not read
+// (the live reader had those bytes by then), so a stale-frame timer counts the recorded silence
+// before them and never more.
+TEST(RecordedStream, APacedClockNeverRunsPastTheNextUnreadChunk) {
+  std::vector<RecordedChunk> chunks = {{at(0), {0x01}}, {at(5), {0x02}}};
+  auto pacing = std::make_shared<ReplayPacing>(1.0, at(0), at(900));
+  auto port = std::make_shared<RecordedPort>("/dev/ttyTEST", chunks, pacing);
+  RecordedStream stream(port);
+  stream.open();
+  EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x01}));
+  std::this_thread::sleep_for(milliseconds(20));  // a late reader: the timeline is past at(5)
+  EXPECT_EQ(stream.now(), pacing->onTimeline(at(5)));
+  EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x02}));
+  EXPECT_GT(stream.now(), pacing->onTimeline(at(5)));  // past the last chunk it runs on
 }
 
 }  // namespace

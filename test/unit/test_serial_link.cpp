@@ -4,8 +4,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <memory>
 #include <mutex>
+#include <optional>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "serial_robot_driver/core/serial_link.h"
@@ -91,6 +96,60 @@ TEST(SerialLink, GivesUpOnAStalePartialFrameAndDeliversTheFrameBehindIt) {
   Bytes stream = {0x05, 0x1C, 0x01, 0x21};
   stream.insert(stream.end(), kPingReply.begin(), kPingReply.end());
   pty.write(stream.data(), stream.size());
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
+  EXPECT_EQ(listener.frames[0].second, kPingReply);
+  EXPECT_EQ(link.stats().framer.stale_candidates, 1u);
+  link.stop();
+}
+
+// A port whose reader finds each chunk already waiting, stamped with the given arrival, its clock
+// never ahead of the last one: a reader that a busy machine kept from bytes until after their
+// stale-frame timeout, with no timer run out in between.
+class LateReaderStream : public transport::ByteStream {
+ public:
+  using Chunks = std::vector<std::pair<Clock::time_point, Bytes>>;
+  explicit LateReaderStream(std::shared_ptr<Chunks> chunks) : chunks_(std::move(chunks)) {}
+  void open() override { open_ = true; }
+  void close() override { open_ = false; }
+  bool isOpen() const override { return open_; }
+  std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms) override {
+    if (next_ >= chunks_->size()) {
+      std::this_thread::sleep_for(milliseconds(std::min(timeout_ms, 5)));
+      return 0;
+    }
+    const auto& [arrival, bytes] = (*chunks_)[next_++];
+    arrival_ = arrival;
+    const std::size_t n = std::min(capacity, bytes.size());
+    std::copy_n(bytes.begin(), n, buffer);
+    return n;
+  }
+  void write(const uint8_t*, std::size_t) override {}
+  std::string name() const override { return "late reader"; }
+  std::optional<Clock::time_point> arrivalTime() const override { return arrival_; }
+  Clock::time_point now() const override { return arrival_.value_or(Clock::now()); }
+
+ private:
+  std::shared_ptr<Chunks> chunks_;
+  std::size_t next_ = 0;
+  bool open_ = false;
+  std::optional<Clock::time_point> arrival_;
+};
+
+// The stale-frame decision follows the bytes' arrival times, the ones a capture records, not
+// whether the reader's timer ran out first: so a replay of the capture decides the same.
+TEST(SerialLink, BytesArrivingATimeoutAfterAPartialFrameFindItStaleHoweverLateTheyAreRead) {
+  SerialLinkOptions options = optionsFor("late reader");
+  options.stale_frame_timeout = milliseconds(50);
+  const Clock::time_point start = Clock::now();
+  auto chunks = std::make_shared<LateReaderStream::Chunks>(LateReaderStream::Chunks{
+      {start, {0x05, 0x1C, 0x01, 0x21}},  // a stray PING-answer header claiming N = 33
+      {start + milliseconds(50), kPingReply}});
+  SerialLink link(options, [chunks](const SerialLinkOptions&) {
+    return std::make_unique<LateReaderStream>(chunks);
+  });
+  RecordingListener listener;
+  link.addListener(&listener);
+  link.start();
   ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
   EXPECT_EQ(listener.frames[0].second, kPingReply);
   EXPECT_EQ(link.stats().framer.stale_candidates, 1u);

@@ -171,6 +171,8 @@ class SerialLink {
   void readerLoop();
   /// One read (up to `until`, the stale-frame and the stream's own limits) and its frames.
   void readOnce(Clock::time_point until);
+  /// Drops the framer's candidates that a stale-frame timeout of silence left incomplete.
+  void dropStaleCandidates();
   bool tryOpen();
   void closeStream(const std::string& reason);
   /// Waits while the port is down: until `until`, stop() or wake().

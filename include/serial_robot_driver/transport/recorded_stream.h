@@ -110,8 +110,9 @@ class RecordedStream : public ByteStream {
   std::string name() const override { return port_->name(); }
   /// The chunk's recorded stamp on the replay's timeline.
   std::optional<SteadyTime> arrivalTime() const override { return arrival_; }
-  /// The timeline's present; at rate 0, the next chunk's time (or the end), as if the recorded
-  /// silence before it had passed (before a recorded reopen: the last chunk's time).
+  /// The timeline's present, never past the next chunk not yet read; at rate 0, the next chunk's
+  /// time (or the end), as if the recorded silence before it had passed (before a recorded
+  /// reopen: the last chunk's time).
   SteadyTime now() const override;
 
  private:
