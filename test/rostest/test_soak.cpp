@@ -59,6 +59,9 @@ TEST(Soak, FaultsForAMinuteAndEveryCounterReconciles) {
   ServiceCaller services(nh);
   ASSERT_TRUE(joints.waitConnected(20) && imu.waitConnected(20) && telemetry.waitConnected(20) &&
               wheels.waitConnected(20));
+  // The node counts a subscriber a little after it is connected, and the counts below are exact.
+  ASSERT_TRUE(joints.waitCountedBy(node_name, 20) && imu.waitCountedBy(node_name, 20) &&
+              telemetry.waitCountedBy(node_name, 20) && wheels.waitCountedBy(node_name, 20));
   ASSERT_TRUE(motion.waitConnected());
   ASSERT_TRUE(services.waitConnected());
   ASSERT_TRUE(waitFor([&] { return diagnostics.latest(port_status).received > 0; }, 20))

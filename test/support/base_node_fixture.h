@@ -200,7 +200,8 @@ struct TimedWheelCommand {
 class RosSide {
  public:
   /// `node_name`: the driver's, whose "<node>: base" diagnostic status is watched.
-  explicit RosSide(const std::string& node_name) : diagnostics_(nh_, node_name) {
+  explicit RosSide(const std::string& node_name)
+      : node_name_(ros::names::resolve(node_name)), diagnostics_(nh_, node_name) {
     cmd_vel_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     wheel_sub_ = nh_.subscribe("wheel_command", 1000, &RosSide::onWheelCommand, this);
     battery_sub_ = nh_.subscribe("battery", 10, &RosSide::onBattery, this);
@@ -234,6 +235,16 @@ class RosSide {
     return waitFor([&] { return wheelCommand(seq, since).has_value(); }, timeout_s);
   }
 
+  /// Waits until the node counts both subscriptions: it builds no message for one it does not.
+  bool waitCountedByNode(double timeout_s) const {
+    return waitFor(
+        [&] {
+          return test_support::nodeCountsSubscriber(node_name_, wheel_sub_.getTopic()) &&
+                 test_support::nodeCountsSubscriber(node_name_, battery_sub_.getTopic());
+        },
+        timeout_s);
+  }
+
   std::vector<sensor_msgs::BatteryState> battery() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return battery_;
@@ -254,6 +265,7 @@ class RosSide {
     battery_.push_back(*msg);
   }
 
+  std::string node_name_;
   ros::NodeHandle nh_;
   test_support::DiagnosticsWatch diagnostics_;
   ros::Publisher cmd_vel_;
@@ -340,19 +352,12 @@ class BaseNodeTest : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_NE(g_ros, nullptr);
+    // Before the port exists, so that every frame the node writes is reported on wheel_command
+    // (the first test also waits here for the node to start).
+    ASSERT_TRUE(g_ros->waitCountedByNode(20.0)) << "driver_node does not count the subscriptions";
     base_ = std::make_unique<FakeBase>(g_port);
-    // The first test also waits for the node to start; later ones only for its reconnect.
+    // Later tests wait here for the node's reconnect.
     ASSERT_TRUE(base_->waitForCount(2, 20.0)) << "driver_node never wrote to " << g_port;
-    if (g_ros->wheelCommands().empty()) {
-      // First test: the wheel_command subscription may have connected after the node's first
-      // frames. Once messages flow, start over on a fresh pty so no frame goes unreported.
-      ASSERT_TRUE(waitFor([] { return !g_ros->wheelCommands().empty(); }, 10.0))
-          << "no wheel_command messages";
-      base_->unplug();
-      std::this_thread::sleep_for(std::chrono::milliseconds(300));
-      base_->plug();
-      ASSERT_TRUE(base_->waitForCount(2, 10.0)) << "driver_node did not reconnect";
-    }
   }
 
   void TearDown() override {
