@@ -247,8 +247,7 @@ void SerialLink::dropStaleCandidates() {
 }
 
 Clock::duration SerialLink::reconnectInterval() const {
-  return std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(options_.reconnect_interval));
+  return fromSeconds(options_.reconnect_interval);
 }
 
 void SerialLink::readOnce(Clock::time_point until) {
