@@ -237,6 +237,10 @@ bool SerialLink::pump(Clock::time_point until) {
   return connected_ && !lost_ && !stopping_;
 }
 
+bool SerialLink::timesPartialFrame() const {
+  return options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0;
+}
+
 void SerialLink::dropStaleCandidates() {
   // No byte for a whole timeout: what is buffered will not complete. Frames found behind the stale
   // candidate keep the arrival time of their bytes.
@@ -261,7 +265,7 @@ void SerialLink::readOnce(Clock::time_point until) {
         read_timeout, std::max(std::chrono::milliseconds(0),
                                std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now())));
   }
-  if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0) {
+  if (timesPartialFrame()) {
     // The stream's clock: a replay measures the recorded silence on its own timeline.
     const auto quiet = stream_->now() - chunk_arrival_;
     if (quiet >= options_.stale_frame_timeout) {
@@ -286,8 +290,7 @@ void SerialLink::readOnce(Clock::time_point until) {
   // Bytes read a whole timeout after the last ones find the buffered candidate stale even when a
   // busy machine, not the line, kept them: judged by the arrival times the capture records, a
   // replay drops exactly what the live run dropped.
-  if (options_.stale_frame_timeout.count() > 0 && framer_.buffered() > 0 &&
-      arrival - chunk_arrival_ >= options_.stale_frame_timeout) {
+  if (timesPartialFrame() && arrival - chunk_arrival_ >= options_.stale_frame_timeout) {
     dropStaleCandidates();
   }
   chunk_arrival_ = arrival;

@@ -171,6 +171,8 @@ class SerialLink {
   void readerLoop();
   /// One read (up to `until`, the stale-frame and the stream's own limits) and its frames.
   void readOnce(Clock::time_point until);
+  /// A partial frame is buffered and the port gives such frames up after a stale-frame timeout.
+  bool timesPartialFrame() const;
   /// Drops the framer's candidates that a stale-frame timeout of silence left incomplete.
   void dropStaleCandidates();
   bool tryOpen();
