@@ -28,6 +28,20 @@ std::shared_ptr<RecordedPort> portOf(std::vector<RecordedChunk> chunks, double r
   return std::make_shared<RecordedPort>("/dev/ttyTEST", std::move(chunks), pacing);
 }
 
+/// One recorded port replayed from at(0) to `end` (silence after its last chunk included) at
+/// `rate`, its stream open.
+struct ReplayUntil {
+  ReplayUntil(std::vector<RecordedChunk> chunks, double rate, RecordedStamp end)
+      : pacing(std::make_shared<ReplayPacing>(rate, at(0), end)),
+        port(std::make_shared<RecordedPort>("/dev/ttyTEST", std::move(chunks), pacing)),
+        stream(port) {
+    stream.open();
+  }
+  std::shared_ptr<ReplayPacing> pacing;
+  std::shared_ptr<RecordedPort> port;
+  RecordedStream stream;
+};
+
 std::vector<uint8_t> readOnce(RecordedStream& stream, std::size_t capacity = 64) {
   std::vector<uint8_t> buffer(capacity);
   buffer.resize(stream.read(buffer.data(), buffer.size(), 10));
@@ -131,41 +145,33 @@ TEST(ReplayPacing, ScalesTheWaitsNotTheTimeline) {
 // Rate 0: each port's clock stands at its next chunk, so the silence before it has passed by the
 // time the link looks; after the last chunk it stands at the recording's end.
 TEST(RecordedStream, AtFullSpeedTheClockJumpsToTheNextChunkThenToTheEnd) {
-  std::vector<RecordedChunk> chunks = {{at(0), {0x01}}, {at(400), {0x02}}};
-  auto pacing = std::make_shared<ReplayPacing>(0.0, at(0), at(900));
-  auto port = std::make_shared<RecordedPort>("/dev/ttyTEST", chunks, pacing);
-  RecordedStream stream(port);
-  stream.open();
+  ReplayUntil replay({{at(0), {0x01}}, {at(400), {0x02}}}, 0.0, at(900));
+  RecordedStream& stream = replay.stream;
+  const auto& pacing = replay.pacing;
   EXPECT_EQ(stream.now(), pacing->onTimeline(at(0)));
   readOnce(stream);
   EXPECT_EQ(stream.now(), pacing->onTimeline(at(400)));
   readOnce(stream);
   EXPECT_EQ(stream.now(), pacing->onTimeline(at(900)));
   EXPECT_TRUE(readOnce(stream).empty());
-  EXPECT_TRUE(port->finished());
+  EXPECT_TRUE(replay.port->finished());
 }
 
 // Paced: the port is finished only once the recording's end has been reached, silence included.
 TEST(RecordedStream, APacedReplayRunsOnThroughTheSilenceAtTheEnd) {
-  std::vector<RecordedChunk> chunks = {{at(0), {0x01}}};
-  auto pacing = std::make_shared<ReplayPacing>(1.0, at(0), at(3600000));
-  auto port = std::make_shared<RecordedPort>("/dev/ttyTEST", chunks, pacing);
-  RecordedStream stream(port);
-  stream.open();
-  EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x01}));
-  EXPECT_TRUE(readOnce(stream).empty());
-  EXPECT_FALSE(port->finished());
+  ReplayUntil replay({{at(0), {0x01}}}, 1.0, at(3600000));
+  EXPECT_EQ(readOnce(replay.stream), (std::vector<uint8_t>{0x01}));
+  EXPECT_TRUE(readOnce(replay.stream).empty());
+  EXPECT_FALSE(replay.port->finished());
 }
 
 // Paced: however late the reader looks, the timeline stands at the next chunk it has not read
 // (the live reader had those bytes by then), so a stale-frame timer counts the recorded silence
 // before them and never more.
 TEST(RecordedStream, APacedClockNeverRunsPastTheNextUnreadChunk) {
-  std::vector<RecordedChunk> chunks = {{at(0), {0x01}}, {at(5), {0x02}}};
-  auto pacing = std::make_shared<ReplayPacing>(1.0, at(0), at(900));
-  auto port = std::make_shared<RecordedPort>("/dev/ttyTEST", chunks, pacing);
-  RecordedStream stream(port);
-  stream.open();
+  ReplayUntil replay({{at(0), {0x01}}, {at(5), {0x02}}}, 1.0, at(900));
+  RecordedStream& stream = replay.stream;
+  const auto& pacing = replay.pacing;
   EXPECT_EQ(readOnce(stream), (std::vector<uint8_t>{0x01}));
   std::this_thread::sleep_for(milliseconds(20));  // a late reader: the timeline is past at(5)
   EXPECT_EQ(stream.now(), pacing->onTimeline(at(5)));
