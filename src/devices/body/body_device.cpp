@@ -51,28 +51,32 @@ bool BodyDevice::moving() const {
 }
 
 void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point arrival) {
-  // On the link's reader thread.
+  // On the link's reader thread. What subscribers receive goes out first; what only this node
+  // uses follows (the trajectories' measured positions, the odometry's heading, the gyro
+  // calibration's stillness check, which asks every device), so none of it delays joint_states.
   telemetry_rate_.tick();
-  // Converted once per frame for every consumer, into vectors that keep their capacity. The
-  // trajectories need every frame: their goals are checked against it.
+  // Converted once per frame for every consumer, into vectors that keep their capacity.
   updateJointReadings(telemetry, joint_conversion_, &joint_readings_);
   const JointReadings& joints = joint_readings_;
-  if (trajectory_) {
-    trajectory_->updateActual(trajectory_tracks_, joints.positions, joints.velocities);
-  }
   const std::shared_ptr<const ImuInForce> imu = std::atomic_load(&imu_);
-  if (imu_heading_.wanted()) {
-    imu_heading_.publish(imuYaw(telemetry, imu->params, imu->axes), arrival);
-  }
-  // Every frame feeds the calibration (calibrate_on_start, imu/calibrate).
-  const GyroVector gyro_bias = gyro_calibrator_.onSample(
-      {static_cast<double>(telemetry.imu[kGyroX]), static_cast<double>(telemetry.imu[kGyroY]),
-       static_cast<double>(telemetry.imu[kGyroZ])},
-      arrival, imu->gyro_units, imu->params.calibration_time);
-  const BodyFrame frame{telemetry, arrival, joints, imu->params, gyro_bias, imu->axes};
+  const BodyFrame frame{telemetry, arrival, joints, imu->params, gyro_calibrator_.bias(),
+                        imu->axes};
   for (const BodyOutputs& outputs : outputs_) {
     if (outputs.frame) outputs.frame(frame);
   }
+  // The trajectories need every frame: their goals are checked against it.
+  if (trajectory_) {
+    trajectory_->updateActual(trajectory_tracks_, joints.positions, joints.velocities);
+  }
+  if (imu_heading_.wanted()) {
+    imu_heading_.publish(imuYaw(telemetry, imu->params, imu->axes), arrival);
+  }
+  // Every frame feeds the calibration (calibrate_on_start, imu/calibrate). A bias it finds applies
+  // from the next frame on.
+  gyro_calibrator_.onSample(
+      {static_cast<double>(telemetry.imu[kGyroX]), static_cast<double>(telemetry.imu[kGyroY]),
+       static_cast<double>(telemetry.imu[kGyroZ])},
+      arrival, imu->gyro_units, imu->params.calibration_time);
 }
 
 std::string BodyDevice::commandJoints(const JointCommand& command) {

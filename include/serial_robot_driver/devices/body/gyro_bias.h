@@ -109,8 +109,9 @@ class GyroBiasCalibrator {
                               MotionCheck moving = {});
 
   /// Reader thread: one frame's raw gyro (LSB, sensor axes) arrived at `arrival`. `units` and
-  /// `seconds` (~imu/calibration_time) are the ones in force for this frame. Returns the bias to
-  /// subtract from it.
+  /// `seconds` (~imu/calibration_time) are the ones in force for this frame. Returns the bias in
+  /// force after it (bias()): one that this frame completed is new. The body asks bias() before
+  /// it publishes a frame and hands the frame here after, so a new bias applies from the next one.
   GyroVector onSample(const GyroVector& raw, core::Clock::time_point arrival,
                       const GyroUnits& units, double seconds);
   /// Blocks the caller for `seconds` while the samples arrive, then keeps the bias found or
