@@ -34,12 +34,19 @@ StatusReport linkStatus(const LinkStats& s, const SerialLinkOptions& options) {
   status.add("unknown servo commands", s.framer.unknown_commands);
   status.add("stale partial frames dropped", s.framer.stale_candidates);
   status.add("bytes skipped (resync)", s.framer.bytes_skipped);
+  status.add("internal errors (reader thread)", s.handler_errors);
+  status.add("last internal error", s.last_handler_error);
   status.add("low latency", s.low_latency);
   status.add("latency_timer (ms)",
              s.latency_timer_ms ? std::to_string(*s.latency_timer_ms) : std::string("n/a"));
   // Above 1 ms the adapter holds short frames back that long: replies and commands come late.
   if (s.connected && s.latency_timer_ms && *s.latency_timer_ms > 1) {
     status.mergeSummary(StatusLevel::kWarn, "latency_timer above 1 ms");
+  }
+  // A bug met on the reader thread: the port goes on, but what it dropped is gone.
+  if (s.handler_errors > 0) {
+    status.mergeSummary(StatusLevel::kWarn,
+                        std::to_string(s.handler_errors) + " internal errors on the reader thread");
   }
   return status;
 }

@@ -3,6 +3,7 @@
 #include <pthread.h>
 
 #include <algorithm>
+#include <exception>
 
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/scheduler_slice.h"
@@ -30,17 +31,49 @@ std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& o
   return std::make_unique<transport::SerialPort>(
       transport::SerialPortOptions{options.path, options.baud});
 }
+
+/// Runs `call`; what it throws goes to `note(what)` instead of up the reader thread.
+template <typename Call, typename Note>
+void catchAll(const Call& call, const Note& note) {
+  try {
+    call();
+  } catch (const std::exception& e) {
+    note(e.what());
+  } catch (...) {
+    note("an exception that is not a std::exception");
+  }
+}
 }  // namespace
+
+template <typename Event>
+void SerialLink::toListeners(const char* what, const Event& event) {
+  for (LinkListener* listener : listeners_) {
+    catchAll([&] { event(*listener); },
+             [&](const std::string& error) { noteHandlerError(what, error); });
+  }
+}
 
 SerialLink::SerialLink(SerialLinkOptions options, StreamFactory factory)
     : options_(std::move(options)),
       factory_(factory ? std::move(factory) : StreamFactory(openSerialPort)),
       framer_(options_.framer,
               [this](protocol::FrameFamily family, const uint8_t* data, std::size_t size) {
-                for (LinkListener* listener : listeners_) {
-                  listener->onFrame(family, data, size, chunk_arrival_);
-                }
+                toListeners("a frame's listener", [&](LinkListener& listener) {
+                  listener.onFrame(family, data, size, chunk_arrival_);
+                });
               }) {}
+
+void SerialLink::noteHandlerError(const char* where, const std::string& what) {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    ++stats_.handler_errors;
+    stats_.last_handler_error = std::string(where) + ": " + what;
+  }
+  if (handler_error_log_.pass()) {
+    log(LogLevel::kError, "%s: internal error on the reader thread, dropped: %s (%s)",
+        options_.path.c_str(), what.c_str(), where);
+  }
+}
 
 SerialLink::~SerialLink() { stop(); }
 
@@ -129,7 +162,8 @@ bool SerialLink::tryOpen() {
       std::lock_guard<std::mutex> lock(state_mutex_);
       stats_.last_error = error;
     }
-    for (LinkListener* listener : listeners_) listener->onOpenFailed(error);
+    toListeners("a listener of a failed open",
+                [&](LinkListener& listener) { listener.onOpenFailed(error); });
     return false;
   }
   framer_.reset();  // a partial frame from before the loss means nothing now
@@ -142,7 +176,8 @@ bool SerialLink::tryOpen() {
   }
   if (observer_) observer_->onChunk({options_.path, false, nullptr, 0, Clock::now()});
   // Listeners hear "up" before any write can succeed: the base must have queued its Reset first.
-  for (LinkListener* listener : listeners_) listener->onLinkUp();
+  toListeners("a listener of the link coming up",
+              [](LinkListener& listener) { listener.onLinkUp(); });
   {
     std::lock_guard<std::mutex> lock(write_mutex_);
     stream_ = std::move(stream);
@@ -170,7 +205,8 @@ void SerialLink::closeStream(const std::string& reason) {
     ++stats_.disconnects;
     stats_.last_error = reason;
   }
-  for (LinkListener* listener : listeners_) listener->onLinkDown();
+  toListeners("a listener of the link going down",
+              [](LinkListener& listener) { listener.onLinkDown(); });
 }
 
 void SerialLink::wakeReader() {
@@ -207,7 +243,8 @@ void SerialLink::readerLoop() {
     const Clock::time_point work_due =
         worker_ != nullptr ? worker_->nextWork() : Clock::time_point::max();
     if (work_due <= Clock::now()) {
-      worker_->work();
+      catchAll([this] { worker_->work(); },
+               [this](const std::string& error) { noteHandlerError("the port's worker", error); });
       continue;
     }
     if (!connected_) {

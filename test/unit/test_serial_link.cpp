@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -271,6 +272,91 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   EXPECT_TRUE(stats.connected);
   EXPECT_EQ(stats.frames_out, 1u);
   EXPECT_EQ(stats.framer.bytes_skipped, 2u);
+  link.stop();
+}
+
+/// A listener with a bug: it throws on its first frame and on the link coming up (when asked to).
+class ThrowingListener : public RecordingListener {
+ public:
+  explicit ThrowingListener(bool throw_on_link_up) : throw_on_link_up_(throw_on_link_up) {}
+  void onLinkUp() override {
+    RecordingListener::onLinkUp();
+    if (throw_on_link_up_) throw std::runtime_error("link up went wrong");
+  }
+  void onFrame(protocol::FrameFamily family, const uint8_t* data, std::size_t size,
+               Clock::time_point arrival) override {
+    RecordingListener::onFrame(family, data, size, arrival);
+    if (frameCount() == 1) throw std::out_of_range("vector::_M_range_check");
+  }
+
+ private:
+  const bool throw_on_link_up_;
+};
+
+TEST(SerialLink, AListenerThatThrowsLosesItsFrameNotTheReaderNorTheOtherListeners) {
+  const std::string path = uniqueLinkPath("throwing");
+  sim::PseudoTerminal pty(path);
+  SerialLink link(optionsFor(path));
+  ThrowingListener buggy(true);
+  RecordingListener after;  // after the buggy one: it must still get every frame
+  link.addListener(&buggy);
+  link.addListener(&after);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+  ASSERT_TRUE(waitFor([&] { return after.ups == 1; }, kWaitSeconds));
+
+  pty.write(kBatteryReply.data(), kBatteryReply.size());
+  ASSERT_TRUE(waitFor([&] { return after.frameCount() == 1; }, kWaitSeconds));
+  pty.write(kPingReply.data(), kPingReply.size());
+  ASSERT_TRUE(waitFor([&] { return after.frameCount() == 2; }, kWaitSeconds))
+      << "the reader went on after the exception";
+  EXPECT_EQ(buggy.frameCount(), 2u);
+  EXPECT_EQ(after.frames[1].second, kPingReply);
+
+  const LinkStats stats = link.stats();
+  EXPECT_TRUE(stats.connected);
+  EXPECT_EQ(stats.handler_errors, 2u) << "the link coming up and the first frame";
+  EXPECT_EQ(stats.last_handler_error, "a frame's listener: vector::_M_range_check");
+  // The port still writes: nothing took it down.
+  ASSERT_TRUE(link.write(golden::base::kResetSeq2));
+  EXPECT_EQ(readWritten(pty, golden::base::kResetSeq2.size()), golden::base::kResetSeq2);
+  link.stop();
+}
+
+/// A worker with a bug: its first work() throws; the reader asks it again when woken.
+class ThrowingWorker : public LinkWorker {
+ public:
+  Clock::time_point nextWork() override {
+    return armed ? Clock::time_point::min() : Clock::time_point::max();
+  }
+  void work() override {
+    armed = false;
+    if (++calls == 1) throw std::runtime_error("transaction went wrong");
+  }
+  std::atomic<bool> armed{false};
+  std::atomic<int> calls{0};
+};
+
+TEST(SerialLink, AWorkerThatThrowsIsCountedAndTheReaderGoesOn) {
+  const std::string path = uniqueLinkPath("throwing_worker");
+  sim::PseudoTerminal pty(path);
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  ThrowingWorker worker;
+  link.addListener(&listener);
+  link.setWorker(&worker);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+  for (int round = 1; round <= 2; ++round) {
+    worker.armed = true;
+    link.wake();
+    ASSERT_TRUE(waitFor([&] { return worker.calls == round; }, kWaitSeconds));
+  }
+  pty.write(kPingReply.data(), kPingReply.size());
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
+  const LinkStats stats = link.stats();
+  EXPECT_EQ(stats.handler_errors, 1u);
+  EXPECT_EQ(stats.last_handler_error, "the port's worker: transaction went wrong");
   link.stop();
 }
 

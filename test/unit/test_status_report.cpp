@@ -133,7 +133,8 @@ TEST(LinkStatus, ConnectedIsOkAndListsTheCountersInOrder) {
                       "path", "baud", "connected", "connects", "disconnects", "last error",
                       "bytes in", "bytes out", "frames out", "write failures", frames_key,
                       "checksum errors", "bad tails", "bad lengths", "unknown servo commands",
-                      "stale partial frames dropped", "bytes skipped (resync)", "low latency",
+                      "stale partial frames dropped", "bytes skipped (resync)",
+                      "internal errors (reader thread)", "last internal error", "low latency",
                       "latency_timer (ms)"}))
       << "a frame family with no frame is left out";
   EXPECT_EQ(*status.find("baud"), "115200");
@@ -160,6 +161,18 @@ TEST(LinkStatus, ALatencyTimerAbove1MsWarnsOnlyWhileConnected) {
   EXPECT_EQ(down.message, "not connected: No such file or directory");
   stats.last_error.clear();
   EXPECT_EQ(linkStatus(stats, options).message, "not connected");
+}
+
+TEST(LinkStatus, AnInternalErrorOnTheReaderThreadWarnsAndNamesTheLastOne) {
+  LinkStats stats;
+  stats.connected = true;
+  stats.handler_errors = 2;
+  stats.last_handler_error = "a frame's listener: vector::_M_range_check";
+  const StatusReport status = linkStatus(stats, SerialLinkOptions{});
+  EXPECT_EQ(status.level, StatusLevel::kWarn);
+  EXPECT_EQ(status.message, "2 internal errors on the reader thread");
+  EXPECT_EQ(*status.find("internal errors (reader thread)"), "2");
+  EXPECT_EQ(*status.find("last internal error"), "a frame's listener: vector::_M_range_check");
 }
 
 TEST(WireCaptureStatus, ADroppedChunkWarns) {

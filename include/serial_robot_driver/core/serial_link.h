@@ -18,6 +18,9 @@
 //    check per read and per write.
 //  - With options.realtime_priority the reader thread runs SCHED_FIFO (core/realtime.h), or at the
 //    normal policy where the process may not.
+//  - The wire is an input like any topic: an exception that a listener or the worker lets out is
+//    caught on the reader thread, counted (LinkStats::handler_errors), logged (throttled) and its
+//    frame or event dropped for that listener. It never ends the thread, nor with it the process.
 //  - An idle reader sleeps in its read until data comes; stop(), wake() and a writer that saw the
 //    port fail wake it through the stream (ByteStream::wakeRead), not by a periodic time-out.
 //  - A LinkWorker (setWorker: the servo bus, a request/response device) runs ON the reader thread,
@@ -42,6 +45,7 @@
 #include <vector>
 
 #include "serial_robot_driver/core/clock.h"
+#include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/protocol/stream_framer.h"
 #include "serial_robot_driver/transport/byte_stream.h"
 
@@ -121,6 +125,10 @@ struct LinkStats {
   bool low_latency = false;
   std::optional<int> latency_timer_ms;  ///< USB adapter's latency_timer, when known
   std::string last_error;               ///< why the port was last lost or could not be opened
+  /// Exceptions a listener or the worker let out on the reader thread: each is caught there, its
+  /// frame or event dropped for that listener, and the reader goes on.
+  uint64_t handler_errors = 0;
+  std::string last_handler_error;  ///< "<where>: <what>" of the last one
 };
 
 class SerialLink {
@@ -181,6 +189,11 @@ class SerialLink {
   void waitForRetry(Clock::time_point until);
   Clock::duration reconnectInterval() const;
   void wakeReader();  // a read in progress returns at once (stop, loss seen by a writer)
+  /// `event(listener)` for every listener, each guarded (the reader thread's last line).
+  template <typename Event>
+  void toListeners(const char* what, const Event& event);
+  /// Counts and logs (throttled) an exception caught on the reader thread.
+  void noteHandlerError(const char* where, const std::string& what);
 
   SerialLinkOptions options_;
   StreamFactory factory_;
@@ -201,6 +214,7 @@ class SerialLink {
   mutable std::condition_variable state_cv_;
   bool wake_pending_ = false;  // guarded by state_mutex_: wake() came
   LinkStats stats_;
+  LogThrottle handler_error_log_{5.0};
   std::thread reader_;
 };
 
