@@ -32,7 +32,8 @@ std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& o
       transport::SerialPortOptions{options.path, options.baud});
 }
 
-/// Runs `call`; what it throws goes to `note(what)` instead of up the reader thread.
+/// Runs `call`; what it throws goes to `note(what)` instead of up the reader thread. The rule of
+/// core::runGuarded (the front ends' callbacks), without a std::function built for every frame.
 template <typename Call, typename Note>
 void catchAll(const Call& call, const Note& note) {
   try {
