@@ -3,8 +3,8 @@
 #include <pthread.h>
 
 #include <algorithm>
-#include <exception>
 
+#include "serial_robot_driver/core/guarded_call.h"
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/scheduler_slice.h"
 #include "serial_robot_driver/transport/serial_port.h"
@@ -32,18 +32,6 @@ std::unique_ptr<transport::ByteStream> openSerialPort(const SerialLinkOptions& o
       transport::SerialPortOptions{options.path, options.baud});
 }
 
-/// Runs `call`; what it throws goes to `note(what)` instead of up the reader thread. The rule of
-/// core::runGuarded (the front ends' callbacks), without a std::function built for every frame.
-template <typename Call, typename Note>
-void catchAll(const Call& call, const Note& note) {
-  try {
-    call();
-  } catch (const std::exception& e) {
-    note(e.what());
-  } catch (...) {
-    note("an exception that is not a std::exception");
-  }
-}
 }  // namespace
 
 template <typename Event>

@@ -7,6 +7,7 @@
 // missed.
 #pragma once
 
+#include <exception>
 #include <functional>
 #include <string>
 #include <type_traits>
@@ -28,6 +29,20 @@ bool runGuarded(InputRefusals& counters, const std::string& source,
 
 /// The message a request that ended in the error `what` is answered with.
 std::string internalErrorText(const std::string& what);
+
+/// runGuarded()'s rule for the threads that own a port or the base loop, per frame or tick: runs
+/// `call`; what it throws goes to `note(what)` instead of up the thread, and no std::function is
+/// built for it.
+template <typename Call, typename Note>
+void catchAll(const Call& call, const Note& note) {
+  try {
+    call();
+  } catch (const std::exception& e) {
+    note(e.what());
+  } catch (...) {
+    note("an exception that is not a std::exception");
+  }
+}
 
 namespace detail {
 template <typename T, typename = void>

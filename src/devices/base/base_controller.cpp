@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "serial_robot_driver/core/clock.h"
+#include "serial_robot_driver/core/guarded_call.h"
 #include "serial_robot_driver/core/realtime.h"
 #include "serial_robot_driver/core/scheduler_slice.h"
 
@@ -508,6 +509,23 @@ void BaseController::tick(core::Clock::time_point now) {
   if (events_.on_odometry) events_.on_odometry(sample);
 }
 
+template <typename Step>
+void BaseController::guarded(const Step& step) {
+  // The loop's last line: what a step lets out (a bug here or in an output) loses that step only,
+  // so the heartbeat and the e-stop's zero frames keep going out.
+  core::catchAll(step, [this](const std::string& what) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++stats_.internal_errors;
+      stats_.last_internal_error = what;
+    }
+    if (internal_error_log_.pass()) {
+      core::log(core::LogLevel::kError, "base loop: internal error, this tick was cut short: %s",
+                what.c_str());
+    }
+  });
+}
+
 void BaseController::run() {
   core::Clock::time_point deadline = clock_->now() + period_;
   std::unique_lock<std::mutex> lock(mutex_);
@@ -530,13 +548,13 @@ void BaseController::run() {
       }
       command_pending_ = false;
       lock.unlock();
-      sendSpeed(now, true);
+      guarded([&] { sendSpeed(now, true); });
       lock.lock();
       continue;
     }
     command_pending_ = false;
     lock.unlock();
-    tick(now);
+    guarded([&] { tick(now); });
     lock.lock();
     deadline += period_;
     if (clock_->now() >= deadline) {

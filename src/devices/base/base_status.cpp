@@ -77,6 +77,8 @@ void addLoopCounters(const BaseStats& s, core::StatusReport* status) {
   status->add("cmd_vel timeouts", s.cmd_vel_timeouts);
   status->add("rejected cmd_vel (NaN/Inf)", s.rejected_commands);
   status->add("loop overruns", s.loop_overruns);
+  status->add("loop internal errors", s.internal_errors);
+  status->add("last loop internal error", s.last_internal_error);
   status->addf("last loop period (ms)", "%.3f", s.last_period_ms);
   status->addf("worst loop period (ms)", "%.3f", s.worst_period_ms);
 }
@@ -90,6 +92,10 @@ core::StatusReport baseStatus(const BaseStats& s, const core::PortState& port,
   summarizeLink(s, port, &status);
   summarizeBattery(s, limits, &status);
   if (s.e_stop) status.mergeSummary(core::StatusLevel::kWarn, "e-stop engaged: holding zero speed");
+  if (s.internal_errors > 0) {
+    status.mergeSummary(core::StatusLevel::kWarn,
+                        std::to_string(s.internal_errors) + " internal errors in the control loop");
+  }
   addHeadingSource(s, &status);
   status.hardware_id = port.path;
   addLinkCounters(s, port, &status);

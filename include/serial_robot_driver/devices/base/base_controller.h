@@ -41,6 +41,7 @@
 #include <thread>
 #include <vector>
 
+#include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/core/loop_clock.h"
 #include "serial_robot_driver/core/loop_wake.h"
 #include "serial_robot_driver/core/serial_link.h"
@@ -147,6 +148,10 @@ struct BaseStats {
   bool e_stop = false;
   double min_immediate_interval_ms = 0;
   uint64_t loop_overruns = 0;  ///< ticks that started more than one period late
+  /// Exceptions a tick (or a rushed frame) let out of the loop: caught, that step cut short, and
+  /// the loop goes on. The last one's text.
+  uint64_t internal_errors = 0;
+  std::string last_internal_error;
   double last_period_ms = 0;
   double worst_period_ms = 0;
   std::optional<uint8_t> battery_percent;
@@ -253,6 +258,9 @@ class BaseController : public core::LinkListener {
 
  private:
   void run();
+  /// Runs one step of the loop (a tick, a rushed frame) guarded: see BaseStats::internal_errors.
+  template <typename Step>
+  void guarded(const Step& step);
   /// A scheduled tick: battery poll when due, then the wheel frame.
   void tick(core::Clock::time_point now);
   /// What a written wheel frame reports once mutex_ is released.
@@ -326,6 +334,7 @@ class BaseController : public core::LinkListener {
   bool silent_reported_ = false;
   std::optional<core::Clock::time_point> last_running_timeout_error_;
   BaseStats stats_;
+  core::LogThrottle internal_error_log_{5.0};
   std::thread loop_;
 };
 

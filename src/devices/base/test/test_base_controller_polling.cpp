@@ -2,7 +2,11 @@
 // loop on the real clock.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <stdexcept>
+
 #include "support/base_controller_fixture.h"
+#include "support/test_helpers.h"
 
 namespace serial_robot_driver::devices::base {
 namespace {
@@ -105,6 +109,30 @@ TEST(BaseControllerLoop, RunningLoopKeepsTheHeartbeatAndStopsTheWheels) {
   EXPECT_TRUE(moved);
   EXPECT_EQ(frames.back()[4], 0x01);
   EXPECT_EQ(frames.back()[6], 0) << "the last frame stops the wheels";
+}
+
+TEST(BaseControllerLoop, ATickThatThrowsIsCountedAndTheHeartbeatGoesOn) {
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  RecordingWriter writer;
+  std::atomic<int> odometry_reports{0};
+  BaseEvents events;
+  events.on_odometry = [&](const OdometrySample&) {
+    if (++odometry_reports == 1) throw std::runtime_error("odom went wrong");
+  };
+  BaseController controller(config, std::ref(writer), events);
+  controller.start();
+  controller.setCommand(0.2, 0.0);
+  ASSERT_TRUE(test_support::waitFor([&] { return odometry_reports >= 4; }, 3.0))
+      << "the loop went on after the exception";
+  const BaseStats stats = controller.stats();
+  EXPECT_EQ(stats.internal_errors, 1u);
+  EXPECT_EQ(stats.last_internal_error, "odom went wrong");
+  EXPECT_GE(stats.speed_frames, 4u) << "a wheel frame every tick, the one that threw included";
+  controller.stop();
+  const std::vector<Bytes> frames = writer.frames();
+  EXPECT_GT(frames[frames.size() - 2][6], 0) << "moving until the stop";
+  EXPECT_EQ(frames.back()[6], 0) << "the stop's frame still goes out";
 }
 
 TEST(BaseControllerLoop, NewCommandGoesOutBeforeTheNextTick) {

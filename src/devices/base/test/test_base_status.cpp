@@ -51,6 +51,8 @@ TEST(BaseStatus, ARunningBaseIsDrivingWithEveryCounter) {
                                                       "cmd_vel timeouts",
                                                       "rejected cmd_vel (NaN/Inf)",
                                                       "loop overruns",
+                                                      "loop internal errors",
+                                                      "last loop internal error",
                                                       "last loop period (ms)",
                                                       "worst loop period (ms)"}))
       << "no battery, heading or silence keys before there is something to say";
@@ -125,6 +127,17 @@ TEST(BaseStatus, EveryProblemIsNamedWorstLevelFirst) {
             "no reply from the base for 30 s; battery 15 % (below 20 %); e-stop engaged: holding "
             "zero speed");
   EXPECT_EQ(*status.find("e-stop engaged"), "True");
+}
+
+TEST(BaseStatus, AnInternalErrorInTheLoopWarnsAndNamesTheLastOne) {
+  BaseStats stats;
+  stats.internal_errors = 3;
+  stats.last_internal_error = "odom went wrong";
+  const StatusReport status = baseStatus(stats, kUp, kLimits);
+  EXPECT_EQ(status.level, StatusLevel::kWarn);
+  EXPECT_EQ(status.message, "3 internal errors in the control loop");
+  EXPECT_EQ(*status.find("loop internal errors"), "3");
+  EXPECT_EQ(*status.find("last loop internal error"), "odom went wrong");
 }
 
 TEST(BaseStatus, OdomWithoutTheImuHeadingWarns) {
