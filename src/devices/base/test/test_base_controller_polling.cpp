@@ -135,6 +135,43 @@ TEST(BaseControllerLoop, ATickThatThrowsIsCountedAndTheHeartbeatGoesOn) {
   EXPECT_EQ(frames.back()[6], 0) << "the stop's frame still goes out";
 }
 
+TEST(BaseControllerLoop, WithEveryTickThrowingTheEStopStillStopsTheWheelsAndVoidsTheCommand) {
+  BaseConfig config;
+  config.battery_poll_rate = 0;
+  RecordingWriter writer;
+  std::atomic<int> odometry_reports{0};
+  BaseEvents events;
+  events.on_odometry = [&](const OdometrySample&) {
+    ++odometry_reports;
+    throw std::runtime_error("odom always goes wrong");
+  };
+  BaseController controller(config, std::ref(writer), events);
+  controller.start();
+  controller.setCommand(0.2, 0.0);
+  const auto moving = [&] {
+    const std::vector<Bytes> frames = writer.frames();
+    return !frames.empty() && frames.back()[4] == 0x01 && frames.back()[6] > 0;
+  };
+  ASSERT_TRUE(test_support::waitFor(moving, 3.0));
+  controller.setEStop(true);
+  const std::size_t at_e_stop = writer.frames().size();
+  const int reports_at_e_stop = odometry_reports;
+  ASSERT_TRUE(
+      test_support::waitFor([&] { return odometry_reports >= reports_at_e_stop + 3; }, 3.0));
+  controller.setEStop(false);  // released: the command accepted before it stays void
+  const int reports_at_release = odometry_reports;
+  ASSERT_TRUE(
+      test_support::waitFor([&] { return odometry_reports >= reports_at_release + 3; }, 3.0));
+  controller.stop();
+  const std::vector<Bytes> frames = writer.frames();
+  ASSERT_GT(frames.size(), at_e_stop + 1);
+  // The e-stop's own frame may be the one written while setEStop() ran; every one after is zero.
+  for (std::size_t i = at_e_stop + 1; i < frames.size(); ++i) {
+    if (frames[i][4] == 0x01) EXPECT_EQ(frames[i][6], 0) << "frame " << i << " after the e-stop";
+  }
+  EXPECT_GE(controller.stats().internal_errors, 6u);
+}
+
 TEST(BaseControllerLoop, NewCommandGoesOutBeforeTheNextTick) {
   BaseConfig config;
   config.battery_poll_rate = 0;
