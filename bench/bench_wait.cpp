@@ -2,9 +2,11 @@
 // floor's (bench/floor_node.cpp), per wake-up, in the thread's own CPU clock (user + kernel).
 //
 //  reader  a 130-byte frame written to a pty at 100 Hz (telemetry's size and rate). driver_node's
-//          port reader: transport::SerialPort::read, a poll() on the port and on its ReadWaker's
-//          eventfd (so that stop() or a failed write can end the wait) with a time-out, then a
-//          non-blocking read(). The floor: one blocking read() on the pty.
+//          port reader: transport::SerialPort::read, an epoll_wait() on the set its ReadWaiter keeps
+//          of the port and an eventfd (so that stop() or a failed write can end the wait), without
+//          a time-out when nothing else is due, then a non-blocking read(). The floor: one blocking
+//          read() on the pty. A second row waits as the reader did before ReadWaiter: a poll() on
+//          both fds with the 5 s time-out it then always had.
 //  loop    a 50 Hz deadline. driver_node's base loop: its core::LoopWake (a semaphore) waited on
 //          until the deadline through core::steadyLoopClock, so that an e-stop, a command or stop()
 //          can wake it. The floor: clock_nanosleep(TIMER_ABSTIME). A third row waits on a
@@ -14,6 +16,8 @@
 // drift weighs on both; each round's ratio is printed beside the means. Numbers only: nothing is
 // asserted. Built with -DSRD_BUILD_BENCHMARKS=ON; run it with no arguments, or --help.
 #include <fcntl.h>
+#include <poll.h>
+#include <sys/eventfd.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -94,26 +98,59 @@ Window readerWindow(sim::PseudoTerminal& pty, double seconds,
   return window;
 }
 
-/// driver_node's way: SerialPort::read as its port reader calls it (a 5 s time-out, wakeable).
+/// driver_node's way: SerialPort::read as its port reader calls it, with a time-out in ms (-1:
+/// none, when nothing else is due; the port is wakeable).
+template <int kTimeoutMs>
 Window nodeReader(double seconds) {
   sim::PseudoTerminal pty;
   transport::SerialPort port({pty.slavePath(), 115200});
   port.open();
   std::vector<uint8_t> buffer(4096);
   return readerWindow(
-      pty, seconds, [&] { return port.read(buffer.data(), buffer.size(), 5000) > 0; },
+      pty, seconds, [&] { return port.read(buffer.data(), buffer.size(), kTimeoutMs) > 0; },
       [&] { port.wakeRead(); });
 }
 
-/// The floor's way: a blocking read() on the raw pty.
-Window floorReader(double seconds) {
-  sim::PseudoTerminal pty;
-  const int fd = ::open(pty.slavePath().c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC);
+/// The pty's client end, raw, opened with `flags` beside O_RDWR.
+int openRaw(const sim::PseudoTerminal& pty, int flags) {
+  const int fd = ::open(pty.slavePath().c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC | flags);
   if (fd < 0) throw std::runtime_error("cannot open " + pty.slavePath());
   termios raw{};
   ::tcgetattr(fd, &raw);
   ::cfmakeraw(&raw);
   ::tcsetattr(fd, TCSANOW, &raw);
+  return fd;
+}
+
+/// driver_node's reader before ReadWaiter: a poll() on the non-blocking port and an eventfd, then a
+/// read().
+Window pollingReader(double seconds) {
+  sim::PseudoTerminal pty;
+  const int fd = openRaw(pty, O_NONBLOCK);
+  const int wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd < 0) throw std::runtime_error("cannot make an eventfd");
+  std::vector<uint8_t> buffer(4096);
+  const Window window = readerWindow(
+      pty, seconds,
+      [&] {
+        pollfd waiters[2] = {{fd, POLLIN, 0}, {wake_fd, POLLIN, 0}};
+        if (::poll(waiters, 2, 5000) <= 0 || !(waiters[0].revents & POLLIN)) return false;
+        return ::read(fd, buffer.data(), buffer.size()) > 0;
+      },
+      [&] {
+        const uint64_t one = 1;
+        if (::write(wake_fd, &one, sizeof(one)) < 0) {
+        }
+      });
+  ::close(wake_fd);
+  ::close(fd);
+  return window;
+}
+
+/// The floor's way: a blocking read() on the raw pty.
+Window floorReader(double seconds) {
+  sim::PseudoTerminal pty;
+  const int fd = openRaw(pty, 0);
   std::vector<uint8_t> buffer(4096);
   const uint8_t last_byte = 0;
   const Window window = readerWindow(
@@ -227,8 +264,12 @@ int main(int argc, char** argv) {
     }
   }
   std::vector<Comparison> comparisons{
-      {"port reader, 130 B at 100 Hz on a pty (poll + read vs blocking read)", floorReader,
-       nodeReader, {}, {}},
+      {"port reader, 130 B at 100 Hz on a pty (epoll_wait + read vs blocking read)", floorReader,
+       nodeReader<-1>, {}, {}},
+      {"port reader, the same with a 5 s time-out (something due: a servo poll, a partial frame)",
+       floorReader, nodeReader<5000>, {}, {}},
+      {"port reader, poll on the port and an eventfd + read (driver_node's before ReadWaiter)",
+       floorReader, pollingReader, {}, {}},
       {"50 Hz loop (LoopWake until the deadline vs clock_nanosleep)", floorLoop,
        loopWaitingOn<core::LoopWake>, {}, {}},
       {"50 Hz loop, a condition variable (driver_node's loop before LoopWake)", floorLoop,

@@ -8,6 +8,7 @@ set(SRD_CORE_SOURCES
   src/kinematics/diff_drive.cpp
   src/kinematics/odometry.cpp
   src/kinematics/heading_fusion.cpp
+  src/transport/read_waiter.cpp
   src/transport/serial_port.cpp
   src/transport/tcp_stream.cpp
   src/transport/termios2_baud.cpp

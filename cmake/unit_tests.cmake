@@ -15,6 +15,7 @@ catkin_add_gtest(core_tests
   test/unit/test_transport_errors_and_links.cpp
   test/unit/test_transport_baud_and_lock.cpp
   test/unit/test_transport_tcp.cpp
+  test/unit/test_read_waiter.cpp
   test/unit/test_recorded_stream.cpp
   test/unit/test_recording_replay.cpp
   test/unit/test_capture_queue.cpp

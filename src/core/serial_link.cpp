@@ -3,6 +3,7 @@
 #include <pthread.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "serial_robot_driver/core/guarded_call.h"
 #include "serial_robot_driver/core/realtime.h"
@@ -16,9 +17,14 @@ namespace {
 /// How long one read waits before the reader thread checks for stop/lost flags. Data wakes it at
 /// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on, for
 /// streams that cannot be woken. A wakeable stream is woken for those, so its reader sleeps until
-/// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here).
+/// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here), and
+/// with nothing due it waits without a timer at all (kNoTimeout), whose arming on a VM costs each
+/// wait about 3 us, a third of what the wait costs beyond one blocking read (bench_wait).
 constexpr int kReadTimeoutMs = 100;
+/// The longest a wakeable stream's read waits for something due (a worker's transaction, a stale
+/// partial frame): keeps far deadlines within an int of milliseconds.
 constexpr int kWakeableReadTimeoutMs = 5000;
+constexpr int kNoTimeout = -1;
 /// The longest a reader with nothing to do waits for its port to be reopened in one go.
 constexpr int kLongestIdleWaitS = 3600;
 
@@ -281,15 +287,16 @@ Clock::duration SerialLink::reconnectInterval() const {
 }
 
 void SerialLink::readOnce(Clock::time_point until) {
-  // A wakeable stream sleeps until data, stop(), wake() or a failed write wakes it; the others
-  // poll.
-  const int longest_read_ms = stream_->wakeable() ? kWakeableReadTimeoutMs : kReadTimeoutMs;
-  auto read_timeout = std::chrono::milliseconds(longest_read_ms);
+  // A wakeable stream sleeps until data, stop(), wake() or a failed write wakes it, or something
+  // falls due; the others poll.
+  std::optional<std::chrono::milliseconds> read_timeout;
+  if (!stream_->wakeable()) read_timeout = std::chrono::milliseconds(kReadTimeoutMs);
   if (until != Clock::time_point::max()) {
-    // Whole milliseconds, rounded up: poll() cannot wait less, and rounding down would spin.
-    read_timeout = std::min(
-        read_timeout, std::max(std::chrono::milliseconds(0),
-                               std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now())));
+    // Whole milliseconds, rounded up: the wait cannot be shorter, and rounding down would spin.
+    const auto due = std::clamp(std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now()),
+                                std::chrono::milliseconds(0),
+                                std::chrono::milliseconds(kWakeableReadTimeoutMs));
+    read_timeout = std::min(read_timeout.value_or(due), due);
   }
   if (timesPartialFrame()) {
     // The stream's clock: a replay measures the recorded silence on its own timeline.
@@ -298,14 +305,16 @@ void SerialLink::readOnce(Clock::time_point until) {
       dropStaleCandidates();
       return;
     }
+    // Limited as a duration first: the int conversion never sees more than kWakeableReadTimeoutMs.
     const auto left =
-        std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet);
-    // Limited as a duration first: the int conversion never sees more than longest_read_ms.
-    read_timeout = std::min(read_timeout, std::max(left, std::chrono::milliseconds(1)));
+        std::clamp(std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet),
+                   std::chrono::milliseconds(1), std::chrono::milliseconds(kWakeableReadTimeoutMs));
+    read_timeout = std::min(read_timeout.value_or(left), left);
   }
+  const int timeout_ms = read_timeout ? static_cast<int>(read_timeout->count()) : kNoTimeout;
   std::size_t n = 0;
   try {
-    n = stream_->read(chunk_.data(), chunk_.size(), static_cast<int>(read_timeout.count()));
+    n = stream_->read(chunk_.data(), chunk_.size(), timeout_ms);
   } catch (const transport::TransportError& e) {
     closeStream(e.what());
     return;

@@ -5,7 +5,6 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/file.h>
-#include <sys/eventfd.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -80,8 +79,11 @@ void configureRaw8N1(int fd, speed_t speed, const std::string& path) {
   settings.c_cflag &= ~(CSIZE | PARENB | CSTOPB | CRTSCTS);
   settings.c_cflag |= CS8 | CLOCAL | CREAD;
   settings.c_iflag &= ~(IXON | IXOFF | IXANY);
-  // Non-blocking reads; timeouts come from poll(), which termios VTIME cannot express below 100 ms.
-  settings.c_cc[VMIN] = 0;
+  // Reads never block (the fd is O_NONBLOCK); timeouts come from the reader's wait, which termios
+  // VTIME cannot express below 100 ms. VMIN 1 makes a read with nothing there EAGAIN, as on a
+  // socket, where VMIN 0 would return 0, which the reader could not tell from the end of a hung-up
+  // tty: a read may come with no new byte announced (ReadWaiter, bytes a full buffer left).
+  settings.c_cc[VMIN] = 1;
   settings.c_cc[VTIME] = 0;
   if (::cfsetispeed(&settings, speed) != 0 || ::cfsetospeed(&settings, speed) != 0) {
     throwErrno(TransportErrorKind::kConfigureFailed, "cannot set the baud rate of " + path, errno);
@@ -163,40 +165,66 @@ std::optional<int> readLatencyTimerMs(const std::string& device_path) {
   return latency_ms;
 }
 
-std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
-                       const std::string& what, int wake_fd) {
-  if (fd < 0) throw TransportError(TransportErrorKind::kDisconnected, what + " is not open");
-  if (capacity == 0) return 0;
+namespace {
 
-  pollfd waiters[2] = {{fd, POLLIN, 0}, {wake_fd, POLLIN, 0}};
-  const int ready = ::poll(waiters, wake_fd >= 0 ? 2 : 1, timeout_ms);
+/// A wait on `fd` alone, for the streams nobody wakes (the simulator's end of a pty, the benchmarks'
+/// robot): a poll() that sets nothing up beforehand.
+Readiness pollOne(int fd, int timeout_ms, const std::string& what) {
+  pollfd waiter{fd, POLLIN, 0};
+  const int ready = ::poll(&waiter, 1, timeout_ms);
   if (ready < 0) {
-    if (errno == EINTR) return 0;
+    if (errno == EINTR) return Readiness::kTimeout;
     throwIoErrno("poll on", what, errno);
   }
-  if (ready == 0) return 0;
-  if (waiters[1].revents & POLLIN) {
-    uint64_t count = 0;
-    if (::read(wake_fd, &count, sizeof(count)) < 0) { /* already consumed: nothing to do */
-    }
-    return 0;  // the caller checks why it was woken; pending data is read on its next call
-  }
-  const pollfd& waiter = waiters[0];
+  if (ready == 0) return Readiness::kTimeout;
   if (waiter.revents & POLLNVAL) {
     throw TransportError(TransportErrorKind::kDisconnected, what + " is not open (POLLNVAL)");
   }
-  // Read even when POLLHUP is set too: bytes that arrived before the hang-up are still delivered.
-  if (!(waiter.revents & POLLIN)) {
-    throw TransportError(TransportErrorKind::kDisconnected, what + " hung up");
-  }
+  return (waiter.revents & POLLIN) ? Readiness::kInput : Readiness::kHangUp;
+}
 
-  const ssize_t received = ::read(fd, buffer, capacity);
-  if (received > 0) return static_cast<std::size_t>(received);
-  if (received == 0) {
-    throw TransportError(TransportErrorKind::kDisconnected, what + " reached end of file");
+}  // namespace
+
+std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
+                       const std::string& what, ReadWaiter* waiter) {
+  if (fd < 0) throw TransportError(TransportErrorKind::kDisconnected, what + " is not open");
+  if (capacity == 0) return 0;
+  if (waiter != nullptr && !waiter->valid()) waiter = nullptr;
+
+  for (;;) {
+    Readiness readiness = Readiness::kTimeout;
+    if (waiter != nullptr) {
+      const WaitResult waited = waiter->wait(timeout_ms);
+      if (waited.readiness == Readiness::kFailed) throwIoErrno("wait on", what, waited.error);
+      readiness = waited.readiness;
+    } else {
+      readiness = pollOne(fd, timeout_ms, what);
+    }
+    // Woken: the caller checks why; pending data is read on its next call.
+    if (readiness == Readiness::kTimeout || readiness == Readiness::kWoken) return 0;
+    if (readiness == Readiness::kHangUp) {
+      throw TransportError(TransportErrorKind::kDisconnected, what + " hung up");
+    }
+
+    const ssize_t received = ::read(fd, buffer, capacity);
+    // A full buffer or an interrupted read may leave bytes that no new arrival announces.
+    if (waiter != nullptr && (received == static_cast<ssize_t>(capacity) ||
+                              (received < 0 && errno == EINTR))) {
+      waiter->moreMayBeWaiting();
+    }
+    if (received > 0) return static_cast<std::size_t>(received);
+    if (received == 0) {
+      throw TransportError(TransportErrorKind::kDisconnected, what + " reached end of file");
+    }
+    if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+      throwIoErrno("read from", what, errno);
+    }
+    if (waiter != nullptr && waiter->hungUp()) {
+      throw TransportError(TransportErrorKind::kDisconnected, what + " hung up");
+    }
+    // Nothing was left after all: wait for the next arrival (that look took no time).
+    if (readiness != Readiness::kMaybeInput || errno == EINTR) return 0;
   }
-  if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) return 0;
-  throwIoErrno("read from", what, errno);
 }
 
 void writeAllToFd(int fd, const uint8_t* data, std::size_t size, const std::string& what,
@@ -330,19 +358,6 @@ void takeExclusively(int fd, const std::string& path) {
 
 }  // namespace
 
-ReadWaker::ReadWaker() : fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
-
-ReadWaker::~ReadWaker() {
-  if (fd_ >= 0) ::close(fd_);
-}
-
-void ReadWaker::wake() {
-  if (fd_ < 0) return;
-  const uint64_t one = 1;
-  if (::write(fd_, &one, sizeof(one)) < 0) { /* the count is already non-zero: still woken */
-  }
-}
-
 SerialPort::SerialPort(SerialPortOptions options) : options_(std::move(options)) {}
 
 SerialPort::~SerialPort() { close(); }
@@ -380,12 +395,17 @@ void SerialPort::open() {
   ::tcflush(fd, TCIOFLUSH);
   low_latency_ = requestLowLatency(fd);
   latency_timer_ms_ = readLatencyTimerMs(options_.path);
+  if (const int error = waiter_.watch(fd)) {
+    ::close(fd);
+    throwErrno(TransportErrorKind::kOpenFailed, "cannot wait for input on " + options_.path, error);
+  }
   fd_ = fd;
 }
 
 void SerialPort::close() {
   const int fd = fd_.exchange(-1);
   if (fd >= 0) {
+    waiter_.unwatch(fd);
     // The exclusive flag outlives this fd while another one (a simulator's pty end) stays open.
     (void)::ioctl(fd, TIOCNXCL);
     ::close(fd);  // releases the flock
@@ -395,7 +415,7 @@ void SerialPort::close() {
 }
 
 std::size_t SerialPort::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {
-  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path, waker_.fd());
+  return readFromFd(fd_, buffer, capacity, timeout_ms, options_.path, &waiter_);
 }
 
 void SerialPort::write(const uint8_t* data, std::size_t size) {

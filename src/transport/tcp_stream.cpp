@@ -204,6 +204,10 @@ void TcpStream::open() {
     const int fd = connectTo(*candidate, deadline, &error);
     if (fd >= 0) {
       configureSocket(fd);
+      if (const int watch_error = waiter_.watch(fd)) {
+        ::close(fd);
+        throwOpenFailed(url_, "cannot wait for input: " + std::string(std::strerror(watch_error)));
+      }
       fd_ = fd;
       return;
     }
@@ -215,11 +219,13 @@ void TcpStream::open() {
 
 void TcpStream::close() {
   const int fd = fd_.exchange(-1);
-  if (fd >= 0) ::close(fd);
+  if (fd < 0) return;
+  waiter_.unwatch(fd);
+  ::close(fd);
 }
 
 std::size_t TcpStream::read(uint8_t* buffer, std::size_t capacity, int timeout_ms) {
-  return readFromFd(fd_, buffer, capacity, timeout_ms, url_, waker_.fd());
+  return readFromFd(fd_, buffer, capacity, timeout_ms, url_, &waiter_);
 }
 
 void TcpStream::write(const uint8_t* data, std::size_t size) {

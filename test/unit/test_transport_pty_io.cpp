@@ -92,7 +92,9 @@ TEST_F(TransportTest, SerialPortConfiguresACookedTerminalAsRaw8N1) {
   EXPECT_EQ(settings.c_oflag & OPOST, 0u);
   EXPECT_EQ(settings.c_cflag & (PARENB | CSTOPB | CRTSCTS), 0u);
   EXPECT_EQ(settings.c_cflag & CSIZE, static_cast<tcflag_t>(CS8));
-  EXPECT_EQ(settings.c_cc[VMIN], 0);
+  // Reads never block (O_NONBLOCK); with VMIN 1 one that finds nothing is EAGAIN, not a 0 that
+  // would read as the end of a hung-up tty.
+  EXPECT_EQ(settings.c_cc[VMIN], 1);
   EXPECT_EQ(settings.c_cc[VTIME], 0);
   EXPECT_EQ(::cfgetospeed(&settings), static_cast<speed_t>(B57600));
   EXPECT_EQ(::cfgetispeed(&settings), static_cast<speed_t>(B57600));
@@ -129,6 +131,42 @@ TEST_F(TransportTest, WakeReadEndsTheNextReadWithZeroAndKeepsPendingBytes) {
   uint8_t buffer[8];
   EXPECT_EQ(port.read(buffer, sizeof(buffer), kPatientTimeoutMs), 0u);
   EXPECT_EQ(readExactly(port, from_robot.size()), from_robot);
+}
+
+// The reader is told of each arrival once: bytes a read had no room for are read next, though no
+// new byte comes to announce them.
+TEST_F(TransportTest, BytesASmallReadLeftAreReadNextWithoutNewArrivals) {
+  PseudoTerminal pty;
+  SerialPort port({pty.slavePath(), 115200});
+  port.open();
+  const Bytes from_robot = {0x55, 0xAA, 0x01, 0x02, 0x03, 0x04};
+  writeBytes(pty, from_robot);
+  Bytes received = readExactly(port, 2);  // whatever had come, two at a time
+  while (received.size() < from_robot.size()) {
+    const Bytes more = readExactly(port, 2);
+    ASSERT_EQ(more.size(), 2u);
+    received.insert(received.end(), more.begin(), more.end());
+  }
+  EXPECT_EQ(received, from_robot);
+  // The last read filled its buffer too: the one after it looks, finds nothing, and says so.
+  uint8_t buffer[2];
+  EXPECT_EQ(port.read(buffer, sizeof(buffer), 0), 0u);
+}
+
+// A hang-up after a read that left bytes behind (which a pty's hang-up discards) is the loss it is,
+// not a wait for more.
+TEST_F(TransportTest, AHangUpAfterAReadThatLeftBytesIsALoss) {
+  PseudoTerminal pty;
+  SerialPort port({pty.slavePath(), 115200});
+  port.open();
+  writeBytes(pty, Bytes{0x01, 0x02, 0x03, 0x04});
+  EXPECT_EQ(readExactly(port, 1), Bytes{0x01});
+  pty.close();
+  uint8_t buffer[8];
+  EXPECT_EQ(errorKindOf([&] {
+              for (int attempt = 0; attempt < 4; ++attempt) port.read(buffer, sizeof(buffer), kPatientTimeoutMs);
+            }),
+            TransportErrorKind::kDisconnected);
 }
 
 }  // namespace

@@ -38,7 +38,8 @@ class ByteStream {
   virtual void open() = 0;
   virtual void close() = 0;
   virtual bool isOpen() const = 0;
-  /// Waits up to `timeout_ms` for data and returns what arrived (0 on timeout: not an error).
+  /// Waits up to `timeout_ms` for data and returns what arrived (0 on timeout: not an error). A
+  /// wakeable() stream also takes -1: until data comes or wakeRead() is called.
   /// Throws TransportError when the device is gone.
   virtual std::size_t read(uint8_t* buffer, std::size_t capacity, int timeout_ms) = 0;
   /// Writes all bytes or throws TransportError.

@@ -11,27 +11,9 @@
 #include <vector>
 
 #include "serial_robot_driver/transport/byte_stream.h"
+#include "serial_robot_driver/transport/read_waiter.h"
 
 namespace serial_robot_driver::transport {
-
-/// The eventfd a stream polls beside its fd so that another thread can end a read at once
-/// (ByteStream::wakeRead): shared by SerialPort and TcpStream. Lives as long as its stream.
-class ReadWaker {
- public:
-  ReadWaker();
-  ~ReadWaker();
-  ReadWaker(const ReadWaker&) = delete;
-  ReadWaker& operator=(const ReadWaker&) = delete;
-
-  /// -1 if the kernel refused an eventfd: the stream is then not wakeable.
-  int fd() const { return fd_; }
-  bool valid() const { return fd_ >= 0; }
-  /// Thread-safe; a read in progress (or the next one) returns 0 at once.
-  void wake();
-
- private:
-  int fd_;
-};
 
 struct SerialPortOptions {
   std::string path;
@@ -71,17 +53,17 @@ class SerialPort : public ByteStream {
   /// such an adapter.
   StreamInfo info() const override { return {low_latency_, latency_timer_ms_}; }
 
-  /// An eventfd polled beside the port wakes a read (stop, or a writer that saw the port fail),
-  /// so an idle reader needs no periodic time-out.
-  bool wakeable() const override { return waker_.valid(); }
-  void wakeRead() override { waker_.wake(); }
+  /// A read waits on the port and on a ReadWaiter's eventfd, which ends it at once (stop, or a
+  /// writer that saw the port fail), so an idle reader needs no periodic time-out.
+  bool wakeable() const override { return waiter_.valid(); }
+  void wakeRead() override { waiter_.wake(); }
 
  private:
   SerialPortOptions options_;
   std::atomic<int> fd_{-1};
   bool low_latency_ = false;
   std::optional<int> latency_timer_ms_;
-  ReadWaker waker_;
+  ReadWaiter waiter_;
 };
 
 /// Who holds a port: a pid and where it was found (a lock file's path, or "/proc/locks").
@@ -114,10 +96,10 @@ std::optional<int> readLatencyTimerMs(const std::string& device_path);
 /// Shared by SerialPort, TcpStream and sim::PseudoTerminal: waits up to `timeout_ms` for input on
 /// the non-blocking `fd` and reads what is there (0 on timeout or EAGAIN/EINTR). Hang-up, EOF, EIO
 /// and a socket's reset or time-out (ECONNRESET, ETIMEDOUT, ...) throw TransportError
-/// kDisconnected; `what` names the device in error messages. When `wake_fd` (an eventfd) is
-/// readable the wait ends at once: its count is consumed and 0 returned.
+/// kDisconnected; `what` names the device in error messages. A stream with a `waiter` (watching
+/// `fd`) waits there, and its wake-up ends the wait at once with 0; without one, `fd` is polled.
 std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeout_ms,
-                       const std::string& what, int wake_fd = -1);
+                       const std::string& what, ReadWaiter* waiter = nullptr);
 
 /// What writeAllToFd() writes to: a socket is written with send(MSG_NOSIGNAL), so a closed peer is
 /// an EPIPE error and not a SIGPIPE that would end the process.

@@ -57,13 +57,13 @@ class TcpStream : public ByteStream {
   void write(const uint8_t* data, std::size_t size) override;
   std::string name() const override { return url_; }
 
-  bool wakeable() const override { return waker_.valid(); }
-  void wakeRead() override { waker_.wake(); }
+  bool wakeable() const override { return waiter_.valid(); }
+  void wakeRead() override { waiter_.wake(); }
 
  private:
   std::string url_;
   std::atomic<int> fd_{-1};
-  ReadWaker waker_;
+  ReadWaiter waiter_;
 };
 
 }  // namespace serial_robot_driver::transport
