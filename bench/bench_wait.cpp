@@ -2,11 +2,11 @@
 // floor's (bench/floor_node.cpp), per wake-up, in the thread's own CPU clock (user + kernel).
 //
 //  reader  a 130-byte frame written to a pty at 100 Hz (telemetry's size and rate). driver_node's
-//          port reader: transport::SerialPort::read, an epoll_wait() on the set its ReadWaiter keeps
-//          of the port and an eventfd (so that stop() or a failed write can end the wait), without
-//          a time-out when nothing else is due, then a non-blocking read(). The floor: one blocking
-//          read() on the pty. A second row waits as the reader did before ReadWaiter: a poll() on
-//          both fds with the 5 s time-out it then always had.
+//          port reader: transport::SerialPort::read, an epoll_wait() on the set its ReadWaiter
+//          keeps of the port and an eventfd (so that stop() or a failed write can end the wait),
+//          without a time-out when nothing else is due (a second row: with one), then a
+//          non-blocking read(). The floor: one blocking read() on the pty. A third row waits as the
+//          reader did before ReadWaiter: a poll() on both fds with the 5 s time-out it then had.
 //  loop    a 50 Hz deadline. driver_node's base loop: its core::LoopWake (a semaphore) waited on
 //          until the deadline through core::steadyLoopClock, so that an e-stop, a command or stop()
 //          can wake it. The floor: clock_nanosleep(TIMER_ABSTIME). A third row waits on a

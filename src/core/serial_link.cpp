@@ -18,8 +18,8 @@ namespace {
 /// once, so this only bounds how fast stop() returns and a writer-detected loss is acted on, for
 /// streams that cannot be woken. A wakeable stream is woken for those, so its reader sleeps until
 /// data comes: an idle port costs no periodic wake-ups (each costs tens of microseconds here), and
-/// with nothing due it waits without a timer at all (kNoTimeout), whose arming on a VM costs each
-/// wait about 3 us, a third of what the wait costs beyond one blocking read (bench_wait).
+/// with nothing due it waits without a timer at all (kNoTimeout), which would otherwise be armed
+/// and cancelled around every frame for nothing.
 constexpr int kReadTimeoutMs = 100;
 /// The longest a wakeable stream's read waits for something due (a worker's transaction, a stale
 /// partial frame): keeps far deadlines within an int of milliseconds.
@@ -293,9 +293,9 @@ void SerialLink::readOnce(Clock::time_point until) {
   if (!stream_->wakeable()) read_timeout = std::chrono::milliseconds(kReadTimeoutMs);
   if (until != Clock::time_point::max()) {
     // Whole milliseconds, rounded up: the wait cannot be shorter, and rounding down would spin.
-    const auto due = std::clamp(std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now()),
-                                std::chrono::milliseconds(0),
-                                std::chrono::milliseconds(kWakeableReadTimeoutMs));
+    const auto due =
+        std::clamp(std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now()),
+                   std::chrono::milliseconds(0), std::chrono::milliseconds(kWakeableReadTimeoutMs));
     read_timeout = std::min(read_timeout.value_or(due), due);
   }
   if (timesPartialFrame()) {
@@ -306,9 +306,9 @@ void SerialLink::readOnce(Clock::time_point until) {
       return;
     }
     // Limited as a duration first: the int conversion never sees more than kWakeableReadTimeoutMs.
-    const auto left =
-        std::clamp(std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet),
-                   std::chrono::milliseconds(1), std::chrono::milliseconds(kWakeableReadTimeoutMs));
+    const auto left = std::clamp(
+        std::chrono::ceil<std::chrono::milliseconds>(options_.stale_frame_timeout - quiet),
+        std::chrono::milliseconds(1), std::chrono::milliseconds(kWakeableReadTimeoutMs));
     read_timeout = std::min(read_timeout.value_or(left), left);
   }
   const int timeout_ms = read_timeout ? static_cast<int>(read_timeout->count()) : kNoTimeout;

@@ -1,5 +1,4 @@
 #include "serial_robot_driver/transport/serial_port.h"
-#include "serial_robot_driver/transport/termios2_baud.h"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -11,6 +10,8 @@
 #include <sys/sysmacros.h>
 #include <termios.h>
 #include <unistd.h>
+
+#include "serial_robot_driver/transport/termios2_baud.h"
 
 #ifdef __linux__
 #include <linux/serial.h>
@@ -167,8 +168,8 @@ std::optional<int> readLatencyTimerMs(const std::string& device_path) {
 
 namespace {
 
-/// A wait on `fd` alone, for the streams nobody wakes (the simulator's end of a pty, the benchmarks'
-/// robot): a poll() that sets nothing up beforehand.
+/// A wait on `fd` alone, for the streams nobody wakes (the simulator's end of a pty, the
+/// benchmarks' robot): a poll() that sets nothing up beforehand.
 Readiness pollOne(int fd, int timeout_ms, const std::string& what) {
   pollfd waiter{fd, POLLIN, 0};
   const int ready = ::poll(&waiter, 1, timeout_ms);
@@ -208,8 +209,8 @@ std::size_t readFromFd(int fd, uint8_t* buffer, std::size_t capacity, int timeou
 
     const ssize_t received = ::read(fd, buffer, capacity);
     // A full buffer or an interrupted read may leave bytes that no new arrival announces.
-    if (waiter != nullptr && (received == static_cast<ssize_t>(capacity) ||
-                              (received < 0 && errno == EINTR))) {
+    if (waiter != nullptr &&
+        (received == static_cast<ssize_t>(capacity) || (received < 0 && errno == EINTR))) {
       waiter->moreMayBeWaiting();
     }
     if (received > 0) return static_cast<std::size_t>(received);

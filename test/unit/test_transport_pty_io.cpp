@@ -164,7 +164,8 @@ TEST_F(TransportTest, AHangUpAfterAReadThatLeftBytesIsALoss) {
   pty.close();
   uint8_t buffer[8];
   EXPECT_EQ(errorKindOf([&] {
-              for (int attempt = 0; attempt < 4; ++attempt) port.read(buffer, sizeof(buffer), kPatientTimeoutMs);
+              for (int attempt = 0; attempt < 4; ++attempt)
+                port.read(buffer, sizeof(buffer), kPatientTimeoutMs);
             }),
             TransportErrorKind::kDisconnected);
 }

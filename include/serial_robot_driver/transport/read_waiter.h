@@ -12,13 +12,13 @@ namespace serial_robot_driver::transport {
 
 /// What ended a wait.
 enum class Readiness {
-  kTimeout,  ///< nothing happened within the time-out (or a signal interrupted the wait)
-  kWoken,    ///< wake() was called; input that is waiting too stays for the next wait
-  kInput,    ///< bytes arrived on the fd
+  kTimeout,     ///< nothing happened within the time-out (or a signal interrupted the wait)
+  kWoken,       ///< wake() was called; input that is waiting too stays for the next wait
+  kInput,       ///< bytes arrived on the fd
   kMaybeInput,  ///< bytes may be left (announced beside a wake-up, a filled buffer, a hang-up):
                 ///< read to learn, and wait again when there are none
-  kHangUp,   ///< the fd hung up or failed with nothing left to read
-  kFailed,   ///< the wait itself failed: WaitResult::error holds the errno
+  kHangUp,      ///< the fd hung up or failed with nothing left to read
+  kFailed,      ///< the wait itself failed: WaitResult::error holds the errno
 };
 
 struct WaitResult {
@@ -60,7 +60,7 @@ class ReadWaiter {
   int wake_fd_;
   int watched_fd_ = -1;
   bool input_pending_ = false;  ///< announced, not yet handed to the reader, or maybe left unread
-  bool hung_up_ = false;        ///< the watched fd hung up or failed: its reader must read to the end
+  bool hung_up_ = false;  ///< the watched fd hung up or failed: its reader must read to the end
 };
 
 }  // namespace serial_robot_driver::transport
