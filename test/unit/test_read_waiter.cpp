@@ -39,20 +39,24 @@ struct Pipe {
   }
 };
 
-TEST(ReadWaiter, NothingDueWaitsOutTheTimeOut) {
+/// A waiter watching one pipe's read end, as a stream watches its fd once open.
+class ReadWaiterOnAPipe : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(waiter.valid());
+    ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+  }
   ReadWaiter waiter;
-  ASSERT_TRUE(waiter.valid());
   Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+};
+
+TEST_F(ReadWaiterOnAPipe, NothingDueWaitsOutTheTimeOut) {
   EXPECT_EQ(waiter.wait(0).readiness, Readiness::kTimeout);
   EXPECT_EQ(waiter.wait(5).readiness, Readiness::kTimeout);
 }
 
 // Edge-triggered: each arrival is announced once, whether or not the bytes before it were read.
-TEST(ReadWaiter, EachArrivalIsAnnouncedOnce) {
-  ReadWaiter waiter;
-  Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+TEST_F(ReadWaiterOnAPipe, EachArrivalIsAnnouncedOnce) {
   pipe.put('a');
   EXPECT_EQ(waiter.wait(kNoLimit).readiness, Readiness::kInput);
   EXPECT_EQ(waiter.wait(0).readiness, Readiness::kTimeout);
@@ -65,10 +69,7 @@ TEST(ReadWaiter, EachArrivalIsAnnouncedOnce) {
 
 // A reader whose buffer was too small for what had come says so, and is not left asleep beside
 // bytes that no new arrival would announce.
-TEST(ReadWaiter, BytesAReaderLeftBehindEndTheNextWaitAtOnce) {
-  ReadWaiter waiter;
-  Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+TEST_F(ReadWaiterOnAPipe, BytesAReaderLeftBehindEndTheNextWaitAtOnce) {
   pipe.put('a');
   pipe.put('b');
   EXPECT_EQ(waiter.wait(kNoLimit).readiness, Readiness::kInput);
@@ -90,10 +91,7 @@ TEST(ReadWaiter, BytesWaitingBeforeTheWatchAreAnnounced) {
 }
 
 // The reader learns first why it was woken (stop, a failed write); the input stays for later.
-TEST(ReadWaiter, AWakeUpComesBeforeInputAndIsConsumedOnce) {
-  ReadWaiter waiter;
-  Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+TEST_F(ReadWaiterOnAPipe, AWakeUpComesBeforeInputAndIsConsumedOnce) {
   pipe.put('b');
   waiter.wake();
   waiter.wake();  // two wake-ups before a wait end one wait
@@ -104,10 +102,7 @@ TEST(ReadWaiter, AWakeUpComesBeforeInputAndIsConsumedOnce) {
 
 // A wait without a time-out, as an idle port's reader sleeps, ends when another thread wakes it
 // (a test that hangs here fails on ctest's time-out).
-TEST(ReadWaiter, AWakeUpFromAnotherThreadEndsAWaitWithoutLimit) {
-  ReadWaiter waiter;
-  Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+TEST_F(ReadWaiterOnAPipe, AWakeUpFromAnotherThreadEndsAWaitWithoutLimit) {
   std::thread waker([&] { waiter.wake(); });
   EXPECT_EQ(waiter.wait(kNoLimit).readiness, Readiness::kWoken);
   waker.join();
@@ -123,10 +118,7 @@ TEST(ReadWaiter, AWakeUpBeforeAnyFdIsWatchedIsKept) {
 
 // After a hang-up every wait ends at once, so that the reader's read meets the end (EOF here, EIO
 // on a pty) behind the last bytes, however many reads those take.
-TEST(ReadWaiter, AHangUpEndsEveryWaitUntilTheReaderMeetsTheEnd) {
-  ReadWaiter waiter;
-  Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+TEST_F(ReadWaiterOnAPipe, AHangUpEndsEveryWaitUntilTheReaderMeetsTheEnd) {
   pipe.put('c');
   pipe.put('d');
   pipe.closeWriteEnd();
@@ -140,10 +132,7 @@ TEST(ReadWaiter, AHangUpEndsEveryWaitUntilTheReaderMeetsTheEnd) {
   EXPECT_EQ(::read(pipe.read_end, &byte, 1), 0);  // the end
 }
 
-TEST(ReadWaiter, AHangUpWithNothingLeftIsAHangUp) {
-  ReadWaiter waiter;
-  Pipe pipe;
-  ASSERT_EQ(waiter.watch(pipe.read_end), 0);
+TEST_F(ReadWaiterOnAPipe, AHangUpWithNothingLeftIsAHangUp) {
   pipe.closeWriteEnd();
   EXPECT_EQ(waiter.wait(kNoLimit).readiness, Readiness::kHangUp);
   EXPECT_TRUE(waiter.hungUp());

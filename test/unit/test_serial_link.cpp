@@ -275,6 +275,25 @@ TEST(SerialLink, DeliversFramesAndWritesBytes) {
   link.stop();
 }
 
+// With nothing due, the reader of a wakeable port waits without a timer, so stop() must end that
+// wait itself (a reader that missed it would hang here, and ctest's time-out fails the test). The
+// port is up and has just delivered a frame: the reader is back in its wait, not reopening.
+TEST(SerialLink, StopEndsAReaderWaitingWithoutATimer) {
+  const std::string path = uniqueLinkPath("untimed");
+  sim::PseudoTerminal pty(path);
+  SerialLink link(optionsFor(path));
+  RecordingListener listener;
+  link.addListener(&listener);
+  link.start();
+  ASSERT_TRUE(link.waitConnected(milliseconds(3000)));
+  pty.write(kPingReply.data(), kPingReply.size());
+  ASSERT_TRUE(waitFor([&] { return listener.frameCount() == 1; }, kWaitSeconds));
+
+  link.stop();
+  EXPECT_EQ(listener.downs, 1);
+  EXPECT_FALSE(link.stats().connected);
+}
+
 /// A listener with a bug: it throws on its first frame and on the link coming up (when asked to).
 class ThrowingListener : public RecordingListener {
  public:
