@@ -43,6 +43,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -97,6 +98,8 @@ struct Options {
   int node_slice_us = -1;  ///< 8: driver_node's ~scheduler_slice_us; -1: its default
   int floor_slice_us = 0;  ///< 8: the floors' ~scheduler_slice_us; 0: the kernel's slice
   int control_slice_us = -1;  ///< 8: the control's second driver_node's; -1: as driver_node's
+  /// 8: the control's second driver_node, another build of it; "" = bin_dir's
+  std::string control_bin;
   int bench_priority = 90;               ///< SCHED_FIFO of this process's threads; 0: normal
   /// 8: the lines the robot is played on, in this order within each condition.
   std::vector<Transport> transports{Transport::kPty, Transport::kTcp};
@@ -131,6 +134,10 @@ const char* const kUsage = R"(usage: driver_bench [options]
                           a minimal driver has it; 100: the same request as driver_node's)
   --control-slice US      8: the control's second driver_node's ~scheduler_slice_us (default:
                           as driver_node's), so the control measures what the slice costs
+  --control-bin PATH      8: the control's second driver_node is this executable (another
+                          build, e.g. of the code before a change), so the control row is
+                          that change measured side by side in one window (default: the
+                          same driver_node)
   --transport T           8: the line the robot is played on: pty (the program opens a
                           pseudo-terminal; the kernel's pty worker carries the bytes), tcp
                           (the program connects to tcp://127.0.0.1:<port>, where this
@@ -241,6 +248,12 @@ Options parseOptions(int argc, char** argv) {
       options.floor_slice_us = std::stoi(value);
     } else if (flag == "--control-slice") {
       options.control_slice_us = std::stoi(value);
+    } else if (flag == "--control-bin") {
+      if (::access(value.c_str(), X_OK) != 0) {
+        throw std::invalid_argument("--control-bin: no executable at " + value);
+      }
+      // Absolute, so that the process that starts it reads it as a path, not a name in bin_dir.
+      options.control_bin = std::filesystem::absolute(value).string();
     } else if (flag == "--bench-priority") {
       options.bench_priority = std::stoi(value);
     } else if (flag == "--bus-seconds") {
@@ -1479,6 +1492,14 @@ struct UserWindow {
   std::size_t commands = 0;
 };
 
+/// The executable `variant` runs: its program in bin_dir, or the control's --control-bin.
+std::string programOf(const Context& context, const Variant& variant) {
+  if (variant.control_copy && !context.options.control_bin.empty()) {
+    return context.options.control_bin;
+  }
+  return variant.program;
+}
+
 /// `variant`'s program in the configuration users run in namespace `ns`, this process playing
 /// the robot on one line of `transport` (base and body; the servo bus has nothing to poll by
 /// default) and its users (the subscribers attached), warmed up: telemetry flows to joint_states
@@ -1492,7 +1513,7 @@ struct UserSetup {
         probe(context.nh, "/" + ns + "/joint_states", kWarmUpFrames + frames),
         base(*robot, probe),
         driver(context.paths, ns, userParams(robot->port(), condition, context, variant),
-               variant.program),
+               programOf(context, variant)),
         subscribers(context.nh, ns),
         cmd_vel(context.nh.advertise<geometry_msgs::Twist>(driver.topic("cmd_vel"), 10)) {
     warmUpTelemetry(probe, *robot, kWarmUpFrames, context.paths.log(ns));
@@ -1955,13 +1976,14 @@ void addUserNote(Context& context) {
       "roscpp starts, so every thread inherits it; driver_node takes one below there and the "
       "priority itself on its port readers and base loop; memory locked). This benchmark's own "
       "threads: %s. ~scheduler_slice_us: driver_node %s, the floors %s, the control's second "
-      "driver_node %s.",
+      "driver_node %s. The control's second driver_node: %s.",
       o.realtime_priority.c_str(),
       context.bench_priority > 0 ? format("SCHED_FIFO %d", context.bench_priority).c_str()
                                  : "normal priority",
       o.node_slice_us < 0 ? "its default (100 us)" : format("%d us", o.node_slice_us).c_str(),
       o.floor_slice_us > 0 ? format("%d us", o.floor_slice_us).c_str() : "the kernel's slice",
-      o.control_slice_us < 0 ? "as driver_node" : format("%d us", o.control_slice_us).c_str()));
+      o.control_slice_us < 0 ? "as driver_node" : format("%d us", o.control_slice_us).c_str(),
+      o.control_bin.empty() ? "the same executable" : o.control_bin.c_str()));
 }
 
 /// Section 8's sessions, per transport.

@@ -45,9 +45,11 @@ DriverProcess::DriverProcess(const RunPaths& paths, const std::string& ns, const
   for (const auto& [key, value] : params) {
     ros::param::set("/" + ns_ + "/driver/" + key, value);
   }
+  // A program named by its path (another build) runs as is; a name, from the run's bin_dir.
+  const std::string path =
+      program.find('/') != std::string::npos ? program : paths.bin_dir + "/" + program;
   process_ = std::make_unique<ChildProcess>(
-      program + " " + ns_,
-      std::vector<std::string>{paths.bin_dir + "/" + program, "__name:=driver", "__ns:=/" + ns_},
+      program + " " + ns_, std::vector<std::string>{path, "__name:=driver", "__ns:=/" + ns_},
       paths.log(ns_));
 }
 

@@ -38,7 +38,8 @@ catkin_add_gtest(core_tests
   test/unit/test_status_report.cpp
   test/unit/test_capabilities.cpp
   test/unit/test_event_rate.cpp
-  test/unit/test_loop_wake.cpp)
+  test/unit/test_loop_wake.cpp
+  test/unit/test_swapped_value.cpp)
 target_include_directories(core_tests PRIVATE ${PROJECT_SOURCE_DIR}/test)  # support/test_helpers.h
 target_link_libraries(core_tests srd_core srd_sim gtest_main)
 # test_device_registry.cpp reads config/analyzers.yaml from the sources.

@@ -18,6 +18,7 @@ void logOutcome(const GyroCalibrationOutcome& outcome, const char* prefix) {
 BodyDevice::BodyDevice(const params::DriverParams& params, core::SerialLink& link)
     : link_(link),
       imu_(std::make_shared<const ImuInForce>(params.section(kImuSection))),
+      frame_imu_(imu_),
       imu_heading_(params.section(kImuSection).orientation_variance),
       gyro_calibrator_([this] { return notStill(); }, {}, [this] { return moving(); }),
       // Expected telemetry rates, as diagnostic_updater's FrequencyStatus.
@@ -58,9 +59,8 @@ void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point
   // Converted once per frame for every consumer, into vectors that keep their capacity.
   updateJointReadings(telemetry, joint_conversion_, &joint_readings_);
   const JointReadings& joints = joint_readings_;
-  const std::shared_ptr<const ImuInForce> imu = std::atomic_load(&imu_);
-  const BodyFrame frame{telemetry, arrival, joints, imu->params, gyro_calibrator_.bias(),
-                        imu->axes};
+  const ImuInForce& imu = frame_imu_.current();
+  const BodyFrame frame{telemetry, arrival, joints, imu.params, gyro_calibrator_.bias(), imu.axes};
   for (const BodyOutputs& outputs : outputs_) {
     if (outputs.frame) outputs.frame(frame);
   }
@@ -69,14 +69,14 @@ void BodyDevice::onTelemetry(const Telemetry& telemetry, core::Clock::time_point
     trajectory_->updateActual(trajectory_tracks_, joints.positions, joints.velocities);
   }
   if (imu_heading_.wanted()) {
-    imu_heading_.publish(imuYaw(telemetry, imu->params, imu->axes), arrival);
+    imu_heading_.publish(imuYaw(telemetry, imu.params, imu.axes), arrival);
   }
   // Every frame feeds the calibration (calibrate_on_start, imu/calibrate). A bias it finds applies
   // from the next frame on.
   gyro_calibrator_.onSample(
       {static_cast<double>(telemetry.imu[kGyroX]), static_cast<double>(telemetry.imu[kGyroY]),
        static_cast<double>(telemetry.imu[kGyroZ])},
-      arrival, imu->gyro_units, imu->params.calibration_time);
+      arrival, imu.gyro_units, imu.params.calibration_time);
 }
 
 std::string BodyDevice::commandJoints(const JointCommand& command) {
@@ -105,7 +105,7 @@ std::string BodyDevice::commandJoints(const JointCommand& command) {
 }
 
 core::Outcome BodyDevice::calibrateGyro() {
-  const std::shared_ptr<const ImuInForce> imu = std::atomic_load(&imu_);
+  const std::shared_ptr<const ImuInForce> imu = imu_.get();
   const GyroCalibrationOutcome outcome =
       gyro_calibrator_.calibrate(imu->params.calibration_time, imu->gyro_units, "imu/calibrate");
   logOutcome(outcome, "");
@@ -113,7 +113,7 @@ core::Outcome BodyDevice::calibrateGyro() {
 }
 
 void BodyDevice::retune(const ImuParams& tuned) {
-  std::atomic_store(&imu_, std::make_shared<const ImuInForce>(tuned));
+  imu_.set(std::make_shared<const ImuInForce>(tuned));
 }
 
 void BodyDevice::retune(const params::DriverParams& in_force) {
@@ -149,7 +149,7 @@ core::StatusReport BodyDevice::status() {
   telemetry_rate_.addTo(report);  // OK / WARN from the telemetry rate, plus its own keys
   BodyStatus::Update update = status_.update(controller_.stats(), link_.stats().framer,
                                              {link_.options().path, link_.connected()});
-  gyro_calibrator_.report(update.report, std::atomic_load(&imu_)->gyro_units);
+  gyro_calibrator_.report(update.report, imu_.get()->gyro_units);
   logFlow(update.flow);
   report.mergeSummary(update.report.level, update.report.message);
   if (!update.report.hardware_id.empty()) report.hardware_id = update.report.hardware_id;

@@ -112,6 +112,13 @@ std::optional<std::string> GyroBiasCalibrator::motionNow(bool name_it) const {
   return why;
 }
 
+bool GyroBiasCalibrator::looksForMotionLocked(core::Clock::time_point arrival,
+                                              bool after_gap) const {
+  // Averaging, or waiting to start (calibrate_on_start): every frame counts, so every frame looks.
+  if (session_ || start_report_ || after_gap || !last_look_) return true;
+  return arrival < *last_look_ || arrival - *last_look_ >= limits_.idle_motion_look;
+}
+
 void GyroBiasCalibrator::noteMotionLocked(const std::optional<std::string>& motion,
                                           core::Clock::time_point arrival, bool after_gap) {
   if (motion) {
@@ -127,21 +134,35 @@ GyroVector GyroBiasCalibrator::onSample(const GyroVector& raw, core::Clock::time
                                         const GyroUnits& units, double seconds) {
   bool after_gap = false;
   bool name_motion = false;
+  bool look = false;
+  bool kept_moving = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     after_gap = !last_arrival_ || arrival - *last_arrival_ > limits_.max_telemetry_age;
     last_arrival_ = arrival;
     // What moves is named only where it is kept: a motion starting, or a calibration under way.
     name_motion = still_since_ || session_ || last_motion_.empty();
+    look = looksForMotionLocked(arrival, after_gap);
+    kept_moving = last_look_moved_;
   }
-  // Asked on every frame, calibrating or not: the settle time counts from the end of a motion.
-  // Without mutex_ held: the check takes the other devices' locks.
-  const std::optional<std::string> motion = motionNow(name_motion);
+  // Asked calibrating or not (the settle time counts from the end of a motion), without mutex_
+  // held: the check takes the other devices' locks. A frame that does not look keeps the last
+  // answer, which changes nothing noteMotionLocked() keeps.
+  std::optional<std::string> motion;
+  if (look) {
+    motion = motionNow(name_motion);
+  } else if (kept_moving) {
+    motion = std::string();
+  }
   std::optional<GyroCalibrationOutcome> start_outcome;
   StartReport report;
   GyroVector bias{};
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (look) {
+      last_look_ = arrival;
+      last_look_moved_ = motion.has_value();
+    }
     noteMotionLocked(motion, arrival, after_gap);
     if (!session_ && start_report_ && !cancelled_ && !motion && settledLocked(arrival)) {
       session_ = Session{"calibrate_on_start",
@@ -192,6 +213,7 @@ GyroCalibrationOutcome GyroBiasCalibrator::calibrate(double seconds, const GyroU
     // Seen moving now, between frames maybe: the settle time counts from after this too.
     still_since_.reset();
     last_motion_ = not_still;
+    last_look_.reset();  // the next frame looks again, rather than keep an answer of "still"
     return refuseLocked(how, "the robot is not held still (" + not_still + ")", units, true);
   }
   const core::Clock::time_point now = core::Clock::now();

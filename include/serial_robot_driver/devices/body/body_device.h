@@ -18,6 +18,7 @@
 #include "serial_robot_driver/core/log.h"
 #include "serial_robot_driver/core/outcome.h"
 #include "serial_robot_driver/core/serial_link.h"
+#include "serial_robot_driver/core/swapped_value.h"
 #include "serial_robot_driver/devices/body/body_controller.h"
 #include "serial_robot_driver/devices/body/body_params.h"
 #include "serial_robot_driver/devices/body/body_readings.h"
@@ -118,9 +119,10 @@ class BodyDevice : public core::Device {
   void logFlow(BodyStatus::FlowChange flow) const;
 
   core::SerialLink& link_;
-  /// Swapped whole by retune() and loaded once per frame by the reader thread, so a frame is
-  /// converted with one set of scales (std::atomic_load / atomic_store).
-  std::shared_ptr<const ImuInForce> imu_;
+  /// Swapped whole by retune(), so a frame is converted with one set of scales; frame_imu_ is
+  /// the reader thread's (onTelemetry's), read once per frame.
+  core::SwappedValue<ImuInForce> imu_;
+  core::SwappedValue<ImuInForce>::Reader frame_imu_;
   std::vector<BodyOutputs> outputs_;  // added before start(), then only read
   // Set before the links start, read on the reader and calibration threads.
   const core::MotionQuery* motion_query_ = nullptr;

@@ -51,8 +51,15 @@ struct GyroCalibrationLimits {
   std::size_t min_samples = 10;
   /// The newest IMU frame must be younger than this for telemetry to count as flowing.
   std::chrono::milliseconds max_telemetry_age{500};
-  /// Still for this long (every frame asks the stillness check) before the averaging starts.
+  /// Still for this long before the averaging starts.
   std::chrono::milliseconds settle = kGyroSettleTime;
+  /// While no calibration averages or waits to start, a frame asks whether anything moves only
+  /// when the last frame that asked is this much older; the frames between keep its answer. The
+  /// question takes every device's lock, and every motion lasts far longer than this (a joint
+  /// command counts for 0.5 s, a cmd_vel until it times out, a servo until it is stopped), so
+  /// the settle time only counts from a look up to this much after the motion ended. 0: every
+  /// frame asks.
+  std::chrono::milliseconds idle_motion_look{50};
 };
 
 /// Mean and spread per axis of raw gyro samples (Welford's running update: no catastrophic
@@ -160,6 +167,8 @@ class GyroBiasCalibrator {
                                       const GyroUnits& units, bool not_still);
   /// Without mutex_: nullopt while nothing moves; else what moves, "" when `name_it` is false.
   std::optional<std::string> motionNow(bool name_it) const;
+  /// Requires mutex_: whether the frame at `arrival` asks motionNow() or keeps the last answer.
+  bool looksForMotionLocked(core::Clock::time_point arrival, bool after_gap) const;
   /// Requires mutex_: a frame at `arrival` found `motion` (motionNow()).
   void noteMotionLocked(const std::optional<std::string>& motion, core::Clock::time_point arrival,
                         bool after_gap);
@@ -175,6 +184,9 @@ class GyroBiasCalibrator {
   /// Since when every frame found the robot still (the end of the last motion, or the first frame
   /// after a telemetry gap: what happened in the gap is unknown); unset while it moves.
   std::optional<core::Clock::time_point> still_since_;
+  /// The arrival of the last frame that asked whether anything moves, and what it found.
+  std::optional<core::Clock::time_point> last_look_;
+  bool last_look_moved_ = false;
   std::string last_motion_;   ///< what the last motion began with (still_since_ its end)
   std::string last_refusal_;  ///< since the last good calibration
   StartReport start_report_;  ///< set while calibrate_on_start waits for its result

@@ -253,6 +253,8 @@ class GyroSettleTest : public GyroCalibratorTest {
   static GyroCalibrationLimits settling() {
     GyroCalibrationLimits limits;
     limits.settle = milliseconds(300);
+    // Every frame looks, so "still" is seen on the next frame (the look's own interval is below).
+    limits.idle_motion_look = milliseconds(0);
     return limits;
   }
   GyroSettleTest() : GyroCalibratorTest(settling()) {}
@@ -425,6 +427,69 @@ TEST(GyroBiasCalibratorMotionCheck, FramesAskTheBoolAndNameAMotionOnceWhenItStar
   EXPECT_TRUE(outcome.not_still);
   EXPECT_TRUE(contains(outcome.message, "the robot was moving until")) << outcome.message;
   EXPECT_TRUE(contains(outcome.message, "base: cmd_vel of 0.2 m/s")) << outcome.message;
+}
+
+// While nothing averages or waits to start, frames ask whether anything moves once per
+// idle_motion_look (50 ms) and keep that answer between; a motion starting between two looks is
+// seen (and named) at the next one; a telemetry gap, an armed calibrate_on_start and a refusal
+// for motion make the next frame look at once.
+TEST(GyroBiasCalibratorMotionCheck, IdleFramesLookEveryFiftyMillisecondsAndKeepTheAnswerBetween) {
+  int looks = 0;
+  int texts = 0;
+  bool moving = false;
+  GyroBiasCalibrator calibrator(
+      [&] {
+        ++texts;
+        return moving ? std::string("body: joint command written 0.01 s ago") : std::string();
+      },
+      GyroCalibrationLimits{},
+      [&] {
+        ++looks;
+        return moving;
+      });
+  const core::Clock::time_point t0 = core::Clock::now() - milliseconds(5000);
+  int frame = 0;
+  const auto feed = [&](int frames) {  // 100 Hz
+    for (int end = frame + frames; frame < end; ++frame) {
+      calibrator.onSample({0, 0, 0}, t0 + frame * milliseconds(10), kUnits, 0.3);
+    }
+  };
+  feed(100);
+  EXPECT_EQ(looks, 20) << "frame 0, then every fifth frame";
+  moving = true;
+  feed(4);  // frames 100-103: 100 looks and names it
+  EXPECT_EQ(looks, 21);
+  EXPECT_EQ(texts, 1);
+  moving = false;
+  feed(1);  // frame 104 keeps "moving"
+  moving = true;
+  feed(5);  // 105 looks: moving again, not a new start, so not named again
+  EXPECT_EQ(looks, 22);
+  EXPECT_EQ(texts, 1);
+  moving = false;
+  feed(5);  // 110 looks: still
+  EXPECT_EQ(looks, 23);
+
+  // A gap in the telemetry: the first frame after it looks.
+  frame += 100;
+  feed(1);
+  EXPECT_EQ(looks, 24);
+
+  // A refusal for motion between frames: the next frame looks rather than keep "still".
+  moving = true;
+  const GyroCalibrationOutcome refused = calibrator.calibrate(0.3, kUnits, "imu/calibrate");
+  EXPECT_FALSE(refused.success);
+  EXPECT_TRUE(refused.not_still);
+  const int before = looks;
+  feed(1);
+  EXPECT_EQ(looks, before + 1);
+  moving = false;
+
+  // Armed calibrate_on_start: every frame counts, so every frame looks.
+  calibrator.calibrateOnStart([](const GyroCalibrationOutcome&) {});
+  const int armed = looks;
+  feed(10);
+  EXPECT_EQ(looks, armed + 10);
 }
 
 }  // namespace
