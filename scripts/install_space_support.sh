@@ -19,6 +19,19 @@ run() {  # run <command>: in an environment holding only the system's ROS and th
     bash -c "$1"
 }
 
+start_roscore() {  # start_roscore <log>: a master on a free port; a port taken meanwhile is retried
+  local attempt
+  for attempt in 1 2 3; do
+    master_port=$(free_port)
+    run "exec roscore -p $master_port" >> "$1" 2>&1 &
+    started_pids="$! ${started_pids:-}"
+    wait_for 30 'rostopic list' && return 0
+    stop_group "$!"
+    echo "roscore did not start on port $master_port (attempt $attempt)" >> "$1"
+  done
+  return 1
+}
+
 wait_for() {  # wait_for <seconds> <command run in the install environment>
   local deadline=$((SECONDS + $1))
   until run "$2" > /dev/null 2>&1; do

@@ -35,7 +35,8 @@ start() { "$@" > "$work/$(basename "$1").$RANDOM.log" 2>&1 & started="$! $starte
 display=":$((50 + RANDOM % 400))"
 start Xvfb "$display" -screen 0 1100x720x24 -nolisten tcp
 export DISPLAY="$display" LIBGL_ALWAYS_SOFTWARE=1
-export ROS_MASTER_URI="http://localhost:$((20000 + RANDOM % 20000))" ROS_HOME="$work/ros"
+source "$repo/scripts/free_port.sh"
+export ROS_MASTER_URI="http://localhost:$(free_port)" ROS_HOME="$work/ros"
 start roscore -p "${ROS_MASTER_URI##*:}"
 for _ in $(seq 60); do rostopic list > /dev/null 2>&1 && break; sleep 0.5; done
 

@@ -54,9 +54,8 @@ mkdir -p "$install_home"
 [ "$(run 'rospack find serial_robot_driver')" = "$install/share/serial_robot_driver" ] ||
   fail "rospack does not find the package in $install"
 
-run "exec roscore -p $master_port" > "$ws/roscore.log" 2>&1 &
-started_pids="$! $started_pids"
-wait_for 30 'rostopic list' || fail "roscore did not start"
+: > "$ws/roscore.log"
+start_roscore "$ws/roscore.log" || { tail -n 5 "$ws/roscore.log"; fail "roscore did not start"; }
 link="$ws/sim_pty"
 run "exec roslaunch serial_robot_driver sim.launch link:=$link" > "$ws/sim.log" 2>&1 &
 started_pids="$! $started_pids"

@@ -81,9 +81,8 @@ sys.exit(1 if any(error for _, error in errors) else 0)
 PY
 out="$(run "python3 $prefix/check_launch.py $share/launch/*.launch" 2>&1)" || fail "$out"
 
-run "exec roscore -p $master_port" > "$prefix/roscore.log" 2>&1 &
-started_pids="$! $started_pids"
-wait_for 30 'rostopic list' || fail "roscore did not start"
+: > "$prefix/roscore.log"
+start_roscore "$prefix/roscore.log" || { tail -n 5 "$prefix/roscore.log"; fail "roscore did not start"; }
 
 link="$prefix/sim_pty"
 # capture, foot and polled servo angles: serial_raw, foot_pressure and servo_states flow too, so
