@@ -3,7 +3,7 @@
 # set install_prefix (the install space) and install_home (a HOME of its own).
 # Debian's catkin installs no setup.bash into a prefix; run sets the variables it would set.
 source "$(dirname "${BASH_SOURCE[0]}")/free_port.sh"
-master_port=$(free_port)
+master_port=""  # start_roscore picks it, just before the master starts
 
 stop_group() {  # SIGINT to a job's process group, SIGKILL after 10 s
   kill -INT -- "-$1" 2>/dev/null || return 0
@@ -21,6 +21,7 @@ run() {  # run <command>: in an environment holding only the system's ROS and th
 
 start_roscore() {  # start_roscore <log>: a master on a free port; a port taken meanwhile is retried
   local attempt
+  : > "$1"
   for attempt in 1 2 3; do
     master_port=$(free_port)
     run "exec roscore -p $master_port" >> "$1" 2>&1 &
@@ -29,6 +30,7 @@ start_roscore() {  # start_roscore <log>: a master on a free port; a port taken 
     stop_group "$!"
     echo "roscore did not start on port $master_port (attempt $attempt)" >> "$1"
   done
+  tail -n 5 "$1"
   return 1
 }
 

@@ -54,8 +54,7 @@ mkdir -p "$install_home"
 [ "$(run 'rospack find serial_robot_driver')" = "$install/share/serial_robot_driver" ] ||
   fail "rospack does not find the package in $install"
 
-: > "$ws/roscore.log"
-start_roscore "$ws/roscore.log" || { tail -n 5 "$ws/roscore.log"; fail "roscore did not start"; }
+start_roscore "$ws/roscore.log" || fail "roscore did not start"
 link="$ws/sim_pty"
 run "exec roslaunch serial_robot_driver sim.launch link:=$link" > "$ws/sim.log" 2>&1 &
 started_pids="$! $started_pids"

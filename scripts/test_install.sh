@@ -81,8 +81,7 @@ sys.exit(1 if any(error for _, error in errors) else 0)
 PY
 out="$(run "python3 $prefix/check_launch.py $share/launch/*.launch" 2>&1)" || fail "$out"
 
-: > "$prefix/roscore.log"
-start_roscore "$prefix/roscore.log" || { tail -n 5 "$prefix/roscore.log"; fail "roscore did not start"; }
+start_roscore "$prefix/roscore.log" || fail "roscore did not start"
 
 link="$prefix/sim_pty"
 # capture, foot and polled servo angles: serial_raw, foot_pressure and servo_states flow too, so
