@@ -1345,12 +1345,18 @@ class BackgroundLoad {
 
 /// The subscribers a user's robot has besides joint_states (the probe's): joint_state_publisher
 /// (wheel_states, as launch/description.launch merges it), rviz (imu/data, odom, /tf), the
-/// navigation stack (odom, /tf) and diagnostic_aggregator (/diagnostics). Each counts messages.
+/// navigation stack (odom, /tf) and diagnostic_aggregator (/diagnostics). Each counts messages;
+/// odom's keep their stamps, which both programs take from their own clock at each loop tick.
 class UserSubscribers {
  public:
   UserSubscribers(ros::NodeHandle& nh, const std::string& ns) {
     add<sensor_msgs::Imu>(nh, "/" + ns + "/imu/data");
-    add<nav_msgs::Odometry>(nh, "/" + ns + "/odom");
+    subscribers_.push_back(nh.subscribe<nav_msgs::Odometry>(
+        "/" + ns + "/odom", 100, [this](const nav_msgs::Odometry::ConstPtr& odom) {
+          ++messages_;
+          std::lock_guard<std::mutex> lock(stamps_mutex_);
+          odom_stamps_s_.push_back(odom->header.stamp.toSec());
+        }));
     add<sensor_msgs::JointState>(nh, "/" + ns + "/wheel_states");
     add<tf2_msgs::TFMessage>(nh, "/tf");
     subscribers_.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
@@ -1366,6 +1372,19 @@ class UserSubscribers {
   std::size_t diagnosticStatuses() const { return statuses_; }
   /// Key/values of all statuses in the last /diagnostics message.
   std::size_t diagnosticValues() const { return values_; }
+  /// odom messages received so far.
+  std::size_t odomCount() const {
+    std::lock_guard<std::mutex> lock(stamps_mutex_);
+    return odom_stamps_s_.size();
+  }
+  /// The stamps (s) of odom messages [from, to).
+  std::vector<double> odomStamps(std::size_t from, std::size_t to) const {
+    std::lock_guard<std::mutex> lock(stamps_mutex_);
+    to = std::min(to, odom_stamps_s_.size());
+    from = std::min(from, to);
+    return {odom_stamps_s_.begin() + static_cast<std::ptrdiff_t>(from),
+            odom_stamps_s_.begin() + static_cast<std::ptrdiff_t>(to)};
+  }
 
  private:
   template <typename Message>
@@ -1376,6 +1395,8 @@ class UserSubscribers {
   std::atomic<std::size_t> messages_{0};
   std::atomic<std::size_t> statuses_{0};
   std::atomic<std::size_t> values_{0};
+  mutable std::mutex stamps_mutex_;
+  std::vector<double> odom_stamps_s_;
   std::vector<ros::Subscriber> subscribers_;
 };
 
@@ -1449,20 +1470,28 @@ struct UserFigures {
   double cpu = 0;  ///< s/s over the streaming window (telemetry at 100 Hz, no cmd_vel)
   LatencyResult telemetry, cmd_vel;
   LoopResult loop;  ///< speed frame periods over the streaming window
+  /// The same window's periods by the program's own clock (its odom stamps): the loop's own
+  /// timing, without the line's (the pty worker, the loopback's softirq) between it and the wire.
+  LoopResult loop_stamped;
 };
 
 /// Telemetry at 100 Hz, `frames` frames numbered from *seq, no cmd_vel: the process's CPU,
-/// telemetry -> joint_states and the loop's periods over that window.
+/// telemetry -> joint_states and the loop's periods over that window, on the wire and by the
+/// program's odom stamps.
 UserFigures measureStreamingWindow(TelemetryProbe& probe, RobotEnd& robot, const SpeedFrameLog& log,
-                                   pid_t pid, std::size_t frames, uint32_t* seq) {
+                                   const UserSubscribers& subscribers, pid_t pid,
+                                   std::size_t frames, uint32_t* seq) {
   const uint32_t first = *seq;
   const std::size_t first_speed_frame = log.count();
+  const std::size_t first_odom = subscribers.odomCount();
   const double cpu_start = processCpuSeconds(pid);
   const Clock::time_point start = Clock::now();
   const RateStep run = streamTelemetry(probe, robot, 100.0, frames, seq);
   UserFigures figures;
   figures.cpu = (processCpuSeconds(pid) - cpu_start) / toSeconds(Clock::now() - start);
   figures.loop = analyzePeriods(log.arrivalSeconds(first_speed_frame, log.count()));
+  figures.loop_stamped =
+      analyzePeriods(subscribers.odomStamps(first_odom, subscribers.odomCount()));
   figures.telemetry = latencyResult(probe.latenciesMs(first, *seq), run.attempted);
   return figures;
 }
@@ -1551,8 +1580,9 @@ UserFigures runUserSession(Context& context, const Variant& variant, const UserC
   const BackgroundLoad load(context.paths, condition.loaded);
   require(sleepUntil(Clock::now() + 1s), "stopped");
   uint32_t seq = UserSetup::kWarmUpFrames;
-  UserFigures figures = measureStreamingWindow(setup.probe, *setup.robot, setup.base.log(),
-                                               setup.driver.pid(), window.frames, &seq);
+  UserFigures figures =
+      measureStreamingWindow(setup.probe, *setup.robot, setup.base.log(), setup.subscribers,
+                             setup.driver.pid(), window.frames, &seq);
   figures.cmd_vel = timeCmdVelWhileStreaming(setup.probe, *setup.robot, seq, setup.cmd_vel,
                                              setup.base.log(), window.commands);
   if (variant.program == kEventDriven.program) {
@@ -1671,6 +1701,9 @@ const std::vector<double>& telemetrySamples(const UserFigures& f) {
   return f.telemetry.samples_ms;
 }
 const std::vector<double>& loopPeriods(const UserFigures& f) { return f.loop.periods_ms; }
+const std::vector<double>& stampedLoopPeriods(const UserFigures& f) {
+  return f.loop_stamped.periods_ms;
+}
 double p50Of(const Summary& s) { return s.p50; }
 double p99Of(const Summary& s) { return s.p99; }
 double stddevOf(const Summary& s) { return s.stddev; }
@@ -1694,6 +1727,11 @@ const std::vector<UserFigure> kUserFigures{
      [](const UserFigures& f) { return f.loop.period_ms.stddev; }, loopPeriods, stddevOf},
     {"50 Hz loop worst period", "ms", 3, [](const UserFigures& f) { return f.loop.period_ms.max; },
      loopPeriods, maxOf},
+    {"50 Hz loop jitter (std), the program's odom stamps", "ms", 3,
+     [](const UserFigures& f) { return f.loop_stamped.period_ms.stddev; }, stampedLoopPeriods,
+     stddevOf},
+    {"50 Hz loop worst period, the program's odom stamps", "ms", 3,
+     [](const UserFigures& f) { return f.loop_stamped.period_ms.max; }, stampedLoopPeriods, maxOf},
 };
 
 /// Every session of section 8, per condition (kUserConditions' order), one entry per round: the
@@ -1713,7 +1751,7 @@ struct UserRuns {
 };
 
 /// `figure` over the rounds of one condition (pooled or averaged, see UserFigure); nullopt when
-/// none completed.
+/// none completed, or when a figure of samples has none (the minimal floor publishes no odom).
 std::optional<double> roundsFigure(const std::vector<UserFigures>& rounds,
                                    const UserFigure& figure) {
   if (rounds.empty()) return std::nullopt;
@@ -1723,7 +1761,8 @@ std::optional<double> roundsFigure(const std::vector<UserFigures>& rounds,
       const std::vector<double>& samples = figure.samples(round);
       pooled.insert(pooled.end(), samples.begin(), samples.end());
     }
-    if (!pooled.empty()) return figure.statistic(summarize(pooled));
+    if (pooled.empty()) return std::nullopt;
+    return figure.statistic(summarize(pooled));
   }
   std::vector<double> values;
   for (const UserFigures& round : rounds) values.push_back(figure.of(round));
@@ -1784,7 +1823,13 @@ const std::vector<std::string> kUserColumns{"driver_node", "same-job floor", "no
                                             "minimal floor", "node / minimal"};
 
 /// Indices into kUserFigures and kUserConditions for the summary.
-enum UserFigureIndex { kCpuFigure = 0, kCmdVelP99 = 2, kTelemetryP99 = 5, kLoopJitter = 6 };
+enum UserFigureIndex {
+  kCpuFigure = 0,
+  kCmdVelP99 = 2,
+  kTelemetryP99 = 5,
+  kLoopJitter = 6,
+  kStampedLoopJitter = 8
+};
 enum UserConditionIndex { kQuietIndex = 0, kLoadedIndex = 2, kLoadedRtIndex = 3 };
 
 /// What a transport's tables say about the line their figures include.
@@ -1825,6 +1870,8 @@ void addUserSummary(ResultTable& table, const UserRuns& runs, Transport transpor
       {"50 Hz loop jitter (std) while telemetry streams, under that load", kLoopJitter,
        kLoadedIndex, "<= 1.2x"},
       {"the same, ~realtime_priority on", kLoopJitter, kLoadedRtIndex, "<= 1.0x"},
+      {"the same by the program's own clock (its odom stamps: the loop without the line)",
+       kStampedLoopJitter, kLoadedRtIndex, "(where the line's share is)"},
       {"CPU under that load", kCpuFigure, kLoadedIndex, "<= 1.1x"},
       {"the same, node and same-job floor at once", kCpuFigure, kLoadedIndex, "<= 1.1x", kAtOnce},
       {"control: driver_node and a second driver_node at once", kCpuFigure, kLoadedIndex,
@@ -1952,7 +1999,9 @@ void addUserNote(Context& context) {
     const UserWindow window = userWindow(o, transport);
     table.note(format(
         "Per session over %s: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock "
-        "over that window, telemetry latency, loop periods from speed frame arrivals), then %zu "
+        "over that window, telemetry latency, loop periods from speed frame arrivals and from the "
+        "program's own odom stamps, which both programs take from their clock at each tick), "
+        "then %zu "
         "cmd_vel commands 10-40 ms apart while telemetry streams.",
         transportName(transport).c_str(), window.frames, window.commands));
   }
