@@ -2001,8 +2001,7 @@ void addUserNote(Context& context) {
         "Per session over %s: %zu frames at 100 Hz without cmd_vel (CPU from the process's clock "
         "over that window, telemetry latency, loop periods from speed frame arrivals and from the "
         "program's own odom stamps, which both programs take from their clock at each tick), "
-        "then %zu "
-        "cmd_vel commands 10-40 ms apart while telemetry streams.",
+        "then %zu cmd_vel commands 10-40 ms apart while telemetry streams.",
         transportName(transport).c_str(), window.frames, window.commands));
   }
   table.note(format(
